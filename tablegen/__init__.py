@@ -1,0 +1,1 @@
+"""tablegen: the direct rebound model and the offline table build."""
