@@ -116,6 +116,16 @@ def smallest_positive_root(c0, c1, c2, c3):
 
 
 @numba.njit(**JIT)
+def _form(A, p, q):
+    """pᵀ A q for a 3×3 array A and 3-tuples p, q."""
+    acc = 0.0
+    for i in range(3):
+        for j in range(3):
+            acc += p[i] * A[i, j] * q[j]
+    return acc
+
+
+@numba.njit(**JIT)
 def collide(V, W, r, Kinv, wall, dV, dW):
     """Apply one collision at contact point ``r`` (relative to the centre of mass).
 
@@ -152,33 +162,29 @@ def collide(V, W, r, Kinv, wall, dV, dW):
         cos_g = (rx * V[0] + ry * V[1] + rz * V[2]) / (rnorm * speed_p)
     mu = friction_factor(wall, cos_g) / speed_c
 
-    # G = I − [r]× K⁻¹ [r]× ; M = K⁻¹ [r]× column by column ([r]× e_j = r × e_j)
-    G = np.empty((3, 3))
-    rc = np.empty((3, 3))          # [r]×
-    rc[0, 0], rc[0, 1], rc[0, 2] = 0.0, -rz, ry
-    rc[1, 0], rc[1, 1], rc[1, 2] = rz, 0.0, -rx
-    rc[2, 0], rc[2, 1], rc[2, 2] = -ry, rx, 0.0
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                m_kj = Kinv[k, 0] * rc[0, j] + Kinv[k, 1] * rc[1, j] + Kinv[k, 2] * rc[2, j]
-                acc += rc[i, k] * m_kj
-            G[i, j] = (1.0 if i == j else 0.0) - acc
+    # G = I − [r]× K⁻¹ [r]×, G_ij = δ_ij + (r × e_i)·K⁻¹(r × e_j)
+    e0 = (0.0, rz, -ry)
+    e1 = (-rz, 0.0, rx)
+    e2 = (ry, -rx, 0.0)
+    g00 = 1.0 + _form(Kinv, e0, e0)
+    g11 = 1.0 + _form(Kinv, e1, e1)
+    g22 = 1.0 + _form(Kinv, e2, e2)
+    g01 = _form(Kinv, e0, e1)
+    g02 = _form(Kinv, e0, e2)
+    g12 = _form(Kinv, e1, e2)
 
     # tangential system (1 + hλG_xx) x + hλG_xz z = rx(λ), hλG_zx x + (1 + hλG_zz) z = rz(λ)
     h = 0.5 * mu
-    p, q, s = h * G[0, 0], h * G[2, 2], h * 0.5 * (G[0, 2] + G[2, 0])
+    p, q, s = h * g00, h * g22, h * g02
     d1, d2 = p + q, p * q - s * s                      # det = 1 + d1 λ + d2 λ²
-    rx1, rx2 = -mu * uc, -0.5 * mu * G[0, 1]
-    rz1, rz2 = -mu * wc, -0.5 * mu * G[2, 1]
+    rx1, rx2 = -mu * uc, -0.5 * mu * g01
+    rz1, rz2 = -mu * wc, -0.5 * mu * g12
     x2, x3 = rx2 + q * rx1 - s * rz1, q * rx2 - s * rz2   # det·x = rx1 λ + x2 λ² + x3 λ³
     z2, z3 = rz2 + p * rz1 - s * rx1, p * rz2 - s * rx2   # det·z = rz1 λ + z2 λ² + z3 λ³
-    gyx, gyy, gyz = G[1, 0], G[1, 1], G[1, 2]
     c0 = -dvc
-    c1 = gyx * rx1 + gyz * rz1 + gyy - dvc * d1
-    c2 = gyx * x2 + gyz * z2 + gyy * d1 - dvc * d2
-    c3 = gyx * x3 + gyz * z3 + gyy * d2
+    c1 = g01 * rx1 + g12 * rz1 + g11 - dvc * d1
+    c2 = g01 * x2 + g12 * z2 + g11 * d1 - dvc * d2
+    c3 = g01 * x3 + g12 * z3 + g11 * d2
     if not c3 > 0.0:
         # frictionless limit (μ → 0): the cubic degenerates to a line
         if not c1 > 0.0:

@@ -13,10 +13,17 @@ can reach the wall before the smallest positive root τ of
     h + h' τ − ½ M τ² = 0,
 
 taken over the vertices (polyhedron) or the support point (ellipsoid). The
-step τ is never too long (no contact is missed, however fast the spin), and
-near an approaching contact it converges quadratically (gap_{k+1} ≈ M gap_k²/h'²).
-The search stops when the lowest point is within ``contact_tol`` (units of a)
-of the wall, and a collision follows if the contact point is approaching.
+step τ is never too long: no contact is missed, however fast the spin.
+
+Near an approaching contact the search takes Newton steps τ_N = h/|h'| of the
+binding point b instead, where they are provably safe: τ_N shorter than every
+other point's safe step, and h_b' + Mτ_N < 0 so that b approaches the wall
+monotonically during the step. Landing above the wall then proves that b did
+not cross it; landing below brackets the contact, which safeguarded Newton
+(bisection fallback) refines. Either way convergence is quadratic with the
+true curvature of h_b rather than the bound M. The search stops when the
+lowest point is within ``contact_tol`` (units of a) of the wall, and a
+collision follows if the contact point is approaching.
 
 Bounds used (K = J/m principal values, ℓ = L/m, T = energy/m):
 |Ω| ≤ ω_max = min(|ℓ|/K_min, √(2T/K_min));
@@ -147,31 +154,58 @@ def find_contact(shape, verts, nv, semi, Rb, M, params, y0, v, contact_tol, set_
     set_tol : points this close to the lowest one share the contact (units of a).
     max_steps : step budget of this search.
     t : start time of the search (a/(m/s)), ≥ 0.
-    R, W, h, r_all, rc : work arrays; on return R and W hold the orientation
-        and lab angular velocity at the returned time and, for a contact, rc
-        the contact point relative to the centroid (lab frame).
+    R, W : on entry the orientation and lab angular velocity at time ``t``; on
+        return, at the returned time.
+    h, r_all, rc : work arrays; for a contact, rc receives the contact point
+        relative to the centroid (lab frame).
 
     Returns
     -------
     (code, t, n_steps) with code one of the ``SEARCH_*`` values.
     """
+    b = -1                # the binding point of the last step
+    t_lo = t              # latest time known to precede any contact
+    t_hi = np.inf         # a time past the contact of point b, once a Newton step overshoots
     for step in range(max_steps):
-        rotation_at(params, t, R, W)
+        if step > 0:
+            rotation_at(params, t, R, W)
         y = y0 + v * t
         n = lowest_points(shape, verts, nv, semi, R, y, h, r_all)
         hmin = np.inf
         for i in range(n):
             hmin = min(hmin, h[i])
-        if hmin <= contact_tol and choose_contact(n, h, r_all, v, W, set_tol, rc):
+        if -contact_tol <= hmin <= contact_tol and choose_contact(n, h, r_all, v, W, set_tol, rc):
             return SEARCH_CONTACT, t, step + 1
+        if hmin < -contact_tol or t_hi < np.inf:
+            # Bracket [t_lo, t_hi] in which only point b reaches the wall, monotonically:
+            # safeguarded Newton on its height.
+            if h[b] < 0.0:
+                t_hi = t
+            else:
+                t_lo = t
+            t_new = t - h[b] / point_height_rate(v, W, r_all[b])
+            t = t_new if t_lo < t_new < t_hi else 0.5 * (t_lo + t_hi)
+            continue
         if v > 0.0 and y > Rb:
             return SEARCH_ESCAPED, t, step + 1
-        tau = np.inf
+        tau, tau_other = np.inf, np.inf
         for i in range(n):
-            tau = min(tau, safe_step(h[i], point_height_rate(v, W, r_all[i]), M))
+            tau_i = safe_step(h[i], point_height_rate(v, W, r_all[i]), M)
+            if tau_i < tau:
+                tau, tau_other, b = tau_i, tau, i
+            else:
+                tau_other = min(tau_other, tau_i)
         if v > 0.0 and tau >= (Rb - y) / v:
             return SEARCH_ESCAPED, t, step + 1
         if not (0.0 < tau < np.inf):
             return SEARCH_STALLED, t, step + 1
+        # Newton step of the binding point where it is safe (module doc): no other
+        # point can reach the wall first, and b approaches monotonically.
+        rate_b = point_height_rate(v, W, r_all[b])
+        if rate_b < 0.0:
+            t_newton = h[b] / -rate_b
+            if t_newton < tau_other and t_newton * M < -rate_b:
+                tau = max(tau, t_newton)
+        t_lo = t
         t += tau
     return SEARCH_STALLED, t, max_steps

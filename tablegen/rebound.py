@@ -36,6 +36,18 @@ from tablegen.shapes import MAX_VERTICES, body_vertices, bounding_radius
 
 HISTORY_COLUMNS = 17
 
+# layout of the scratch array of :func:`rebound`
+_VERTS = 0
+_HEIGHTS = _VERTS + 3 * MAX_VERTICES
+_OFFSETS = _HEIGHTS + MAX_VERTICES
+_PARAMS = _OFFSETS + 3 * MAX_VERTICES
+_R = _PARAMS + ROT_PARAMS_SIZE
+_K_LAB = _R + 9
+_KINV_LAB = _K_LAB + 9
+_K = _KINV_LAB + 9                 # then seven 3-vectors: K, 1/K, ℓ, r_c, ΔV, ΔΩ, Ω(t)
+WORK_SIZE = _K + 21
+_BLOCKS = 1024                     # parallel work units of rebound_batch (scratch allocated per block)
+
 
 @numba.njit(**JIT)
 def quaternion_to_matrix(q, R):
@@ -57,7 +69,7 @@ def lab_tensor(R, diag, out):
 
 @numba.njit(**JIT)
 def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol, set_tol,
-            max_steps, V, W, history):
+            max_steps, V, W, history, work):
     """Simulate one particle's rebound.
 
     Parameters
@@ -75,6 +87,7 @@ def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol
     history : (H, HISTORY_COLUMNS) output; row k receives the state at the start
         of flight k (k < H): time (a/(m/s)), centre height y (a), V (3), Ω (3),
         R (9, row-major). Pass an array with H = 0 to record nothing.
+    work : (WORK_SIZE,) float64 scratch space (no allocation per particle).
 
     Returns
     -------
@@ -82,25 +95,29 @@ def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol
     with e_rot = ½ Ω·KΩ, the rotational energy per unit mass after the rebound, and
     failure_reason one of the FAILURE_* codes of :mod:`data_schema.samples`.
     """
-    verts = np.empty((MAX_VERTICES, 3))
+    verts = work[_VERTS:_VERTS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
+    h = work[_HEIGHTS:_HEIGHTS + MAX_VERTICES]
+    r_all = work[_OFFSETS:_OFFSETS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
+    params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
+    R = work[_R:_R + 9].reshape((3, 3))
+    K_lab = work[_K_LAB:_K_LAB + 9].reshape((3, 3))
+    Kinv_lab = work[_KINV_LAB:_KINV_LAB + 9].reshape((3, 3))
+    K = work[_K:_K + 3]
+    Kinv = work[_K + 3:_K + 6]
+    ell = work[_K + 6:_K + 9]
+    rc = work[_K + 9:_K + 12]
+    dV = work[_K + 12:_K + 15]
+    dW = work[_K + 15:_K + 18]
+    Wt = work[_K + 18:_K + 21]          # angular velocity during the search
+
     nv = body_vertices(shape, semi[0], semi[1], semi[2], kappa, hand, verts)
     Rb = bounding_radius(shape, semi[0], semi[1], semi[2], verts, nv)
     a2, b2, c2 = semi[0] ** 2, semi[1] ** 2, semi[2] ** 2
-    K = np.array([kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)])
-    Kinv = 1.0 / K
-    R = R0.copy()
+    K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
+    Kinv[:] = 1.0 / K
+    R[:] = R0
     V[:] = V0
     W[:] = W0
-    Wt = W0.copy()                      # angular velocity during the search
-    h = np.empty(MAX_VERTICES)
-    r_all = np.empty((MAX_VERTICES, 3))
-    rc = np.empty(3)
-    params = np.empty(ROT_PARAMS_SIZE)
-    ell = np.empty(3)
-    K_lab = np.empty((3, 3))
-    Kinv_lab = np.empty((3, 3))
-    dV = np.empty(3)
-    dW = np.empty(3)
 
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
         n = lowest_points(shape, verts, nv, semi, R, 0.0, h, r_all)
@@ -129,6 +146,7 @@ def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol
         e_rot = 0.5 * (W[0] * ell[0] + W[1] * ell[1] + W[2] * ell[2])
         rotation_init(K, R, ell, params)
         M = curvature_bound(shape, semi, Rb, K, ell, W)
+        Wt[:] = W
         code, t, steps = find_contact(shape, verts, nv, semi, Rb, M, params, y, V[1],
                                       contact_tol, set_tol, max_steps, 0.0, R, Wt, h, r_all, rc)
         n_steps += steps
@@ -160,24 +178,30 @@ def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol
 def rebound_batch(shapes, ratios, hands, quats, V0, W0, kfacs, kappa, wall, n_max,
                   contact_tol, set_tol, max_steps,
                   out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi):
-    """Run :func:`rebound` for every particle i (parallel over particles).
+    """Run :func:`rebound` for every particle i (parallel over blocks of particles).
 
     Inputs per particle: ``shapes[i]`` code, ``ratios[i] = (b/a, c/b)``,
     ``hands[i]`` = ±1, ``quats[i]`` orientation quaternion (any norm > 0).
     Common: V0, W0 (lab; m/s and (m/s)/a), ``kfacs[code]`` second-moment
-    factors, kappa, wall and the tolerances. Outputs are filled per particle.
+    factors, kappa, wall and the tolerances. Outputs are filled per particle;
+    each particle's result depends on its inputs only, not on the blocking.
     """
-    no_history = np.empty((0, HISTORY_COLUMNS))
-    for i in numba.prange(shapes.shape[0]):
-        semi = np.array([1.0, ratios[i, 0], ratios[i, 0] * ratios[i, 1]])
+    n = shapes.shape[0]
+    n_blocks = min(n, _BLOCKS)
+    for block in numba.prange(n_blocks):
+        no_history = np.empty((0, HISTORY_COLUMNS))
+        work = np.empty(WORK_SIZE)
+        semi = np.empty(3)
         R0 = np.empty((3, 3))
-        quaternion_to_matrix(quats[i], R0)
-        status, failure, ncoll, steps, multi, erot = rebound(
-            shapes[i], semi, kappa, float(hands[i]), kfacs[shapes[i]], R0, V0, W0, wall,
-            n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history)
-        out_status[i] = status
-        out_failure[i] = failure
-        out_ncoll[i] = ncoll
-        out_steps[i] = steps
-        out_multi[i] = multi
-        out_erot[i] = erot
+        for i in range(block * n // n_blocks, (block + 1) * n // n_blocks):
+            semi[0], semi[1], semi[2] = 1.0, ratios[i, 0], ratios[i, 0] * ratios[i, 1]
+            quaternion_to_matrix(quats[i], R0)
+            status, failure, ncoll, steps, multi, erot = rebound(
+                shapes[i], semi, kappa, float(hands[i]), kfacs[shapes[i]], R0, V0, W0, wall,
+                n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
+            out_status[i] = status
+            out_failure[i] = failure
+            out_ncoll[i] = ncoll
+            out_steps[i] = steps
+            out_multi[i] = multi
+            out_erot[i] = erot

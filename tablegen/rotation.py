@@ -15,6 +15,8 @@ Notation
 lab angular momentum per unit mass, ``m = R^T ell`` the body-frame angular momentum,
 ``L = |ell|``, ``2E = sum m_i^2 / K_i`` twice the kinetic energy per unit mass.
 Euler's equations in the body frame read ``dm/dt = m x omega_b`` with ``omega_b = m / K``.
+No rescaling is done: ``|ell|`` and ``K`` should lie within ~1e+-100 of 1 (squares and
+the exact products of the double-double step must neither overflow nor underflow).
 
 Method
 ------
@@ -32,14 +34,14 @@ Method
    absolute differences ``d_ij = |J_i - J_j|`` so that both cases read the same)::
 
        m(t) = (a_0 cn u, a_1 sn u, a_2 dn u),   u = nu t + u_0,
-       a_0^2 = P J_0 / d_20,   a_1^2 = P J_1 / d_21,   a_2^2 = Q J_2 / d_20,
+       a_0^2 = P J_0 / d_20,   a_1^2 = P J_1 / d_21,   a_2^2 = S J_2 / d_20,
        P = |2E J_2 - L^2| = m_0^2 d_20/J_0 + m_1^2 d_21/J_1,
-       Q = |L^2 - 2E J_0| = m_1^2 d_10/J_1 + m_2^2 d_20/J_2,
-       nu = sign(J_2 - J_1) sqrt(d_21 Q / (J_0 J_1 J_2)),
-       k^2 = d_10 P / (d_21 Q),
-       k'^2 = 1 - k^2 = d_20 (d_21 m_2^2/J_2 - d_10 m_0^2/J_0) / (d_21 Q).
+       S = |L^2 - 2E J_0| = m_1^2 d_10/J_1 + m_2^2 d_20/J_2,
+       nu = sign(J_2 - J_1) sqrt(d_21 S / (J_0 J_1 J_2)),
+       k^2 = d_10 P / (d_21 S),
+       k'^2 = 1 - k^2 = d_20 (d_21 m_2^2/J_2 - d_10 m_0^2/J_0) / (d_21 S).
 
-   ``P`` and ``Q`` are sums of terms of one sign (no cancellation).  The only
+   ``P`` and ``S`` are sums of terms of one sign (no cancellation).  The only
    cancellation is the distance to the separatrix in ``k'^2``; it is evaluated in
    double-double arithmetic (Dekker's exact products), so ``k'`` keeps full relative
    accuracy for states arbitrarily close to the separatrix (``k -> 1``), taking the
@@ -73,14 +75,26 @@ Method
    to::
 
        psi(t) = L/J_2 t + kappa/nu (G(u) - G(u_0)),
-       G(u) = L Pi(am u; -beta | k) - a_2 atan(sqrt(1 + beta) tan am u) / sqrt(1 + beta),
+       G(u) = int_0^u (L - a_2 dn) / (1 + beta sn^2) du
+            = L Pi(am u; -beta | k) - a_2 atan(sqrt(1 + beta) tan am u) / sqrt(1 + beta),
 
-   with the incomplete elliptic integral of the third kind written through Carlson's
-   ``R_J`` (DLMF 19.25.14; the ``F`` part equals the reduced ``u`` itself) and both
-   terms continued through the half periods (``Pi`` grows by ``2 Pi(-beta|k)`` per
-   ``2K``).  Carlson's integrals use the duplication algorithms of B. C. Carlson,
-   "Numerical computation of real or complex elliptic integrals", Numer. Algorithms 10
-   (1995) 13-26 (series of DLMF 19.36.1 and 19.36.2).
+   with ``u = nu t + u_0``.  ``G`` grows by the same amount every period ``2K``; its mean
+   slope ``f_bar = G(K)/K`` goes into the secular rate and only the periodic remainder
+   ``G_p(u) = G(u) - f_bar u`` is evaluated, on the reduced ``u_r`` in ``[-K, K]`` where
+   ``F(am u_r | k) = u_r``::
+
+       psi(t) = (L/J_2 + kappa f_bar) t + kappa/nu (G_p(u) - G_p(u_0)).
+
+   The incomplete integral of the third kind is written through Carlson's ``R_J`` in one
+   of two cancellation-free forms: ``Pi - F = -beta/3 sn^3 R_J(cn^2, dn^2, 1, 1 + beta
+   sn^2)`` (DLMF 19.25.14) for ``beta <= 1``, and for ``beta > 1`` the reflection
+   ``n -> k^2/n`` (DLMF 19.7.9), which leaves ``R_J`` with ``p = 1 + (k^2/beta) sn^2``
+   plus an arctangent.  This keeps the error of psi at ~eps times its physical size
+   also for nearly axisymmetric bodies, where ``nu`` is tiny and ``kappa/nu`` huge.
+   Carlson's integrals use the duplication algorithms of B. C. Carlson, "Numerical
+   computation of real or complex elliptic integrals", Numer. Algorithms 10 (1995)
+   13-26 (series of DLMF 19.36.1 and 19.36.2).  On the exact separatrix (``k = 1``, no
+   period) ``G`` is elementary and used as it is.
 
 5. *Steady rotations* -- ``m`` an eigenvector of the inertia tensor: a sphere, spin about
    any principal axis (including the unstable middle one, which therefore stays put
@@ -97,7 +111,6 @@ The lab angular momentum ``R K R^T omega = L C e_z = R0 Q n(0) L`` and the energ
 import math
 
 import numba
-import numpy as np
 
 from tablegen._jit import JIT
 
@@ -109,7 +122,7 @@ _MODE_STEADY = 1.0  # constant omega about a principal direction
 _MODE_GENERAL = 2.0  # elliptic solution, 0 < k' <= 1
 _MODE_SEPARATRIX = 3.0  # elliptic solution on the separatrix, k' == 0
 
-_NLEV_MAX = 24  # Landen levels; k' = 5e-324 needs 15
+_NLEV_MAX = 24  # Landen levels; k' = 1e-9 needs 7, k' = 5e-324 needs 12
 _LANDEN_KTOL = 1e-9  # stop once k_n < this: sn(w|k_n) = sin w + O(k_n^2)
 
 _I_MODE = 0
@@ -121,21 +134,23 @@ _I_NU = 19  # du/dt
 _I_U0 = 20  # u at t = 0
 _I_TWOK = 21  # 2 K(k), period of the reduction of u
 _I_L = 22  # |L|
-_I_LIN = 23  # L / J_2, secular rate of psi
+_I_LIN = 23  # secular rate of psi
 _I_KAPNU = 24  # kappa / nu
 _I_BETA = 25  # beta = -alpha^2 of the third-kind integral
 _I_G = 26  # sqrt(1 + beta)
-_I_JUMP = 27  # increase of G(u) over one 2K
-_I_G0 = 28  # G(u_0)
-_I_PERM = 29  # 3 entries: body axis of working axis i
-_I_SIGN = 32  # 3 entries: sign of working axis i
-_I_NLEV = 35  # number of Landen levels
-_I_WSCALE = 36  # 1 / prod(1 + k_n)
-_I_KN = 37  # _NLEV_MAX entries: k_n, n = 1..N
+_I_GAMMA = 27  # gamma = k^2 / beta
+_I_SQD = 28  # sqrt((1 + beta) (1 + gamma))
+_I_FOFF = 29  # mean integrand f_bar (form 2) or f_bar - L (form 1)
+_I_G0 = 30  # G_p(u_0)
+_I_PERM = 31  # 3 entries: body axis of working axis i
+_I_SIGN = 34  # 3 entries: sign of working axis i
+_I_NLEV = 37  # number of Landen levels
+_I_WSCALE = 38  # 1 / prod(1 + k_n)
+_I_KN = 39  # _NLEV_MAX entries: k_n, n = 1..N
 _I_OMKN = _I_KN + _NLEV_MAX  # _NLEV_MAX entries: 1 - k_n
 
 ROT_PARAMS_SIZE = _I_OMKN + _NLEV_MAX
-"""Length of the float64 parameter array filled by :func:`rotation_init` (85)."""
+"""Length of the float64 parameter array filled by :func:`rotation_init` (87)."""
 
 _SNAP = 16.0 * 2.220446049250313e-16  # relative size of rounding noise in R0^T ell
 
@@ -151,7 +166,8 @@ def _carlson_rc1(e):
     ``sum_n (-e)^n / (2n + 1)`` (truncation < 1e-19).
     """
     if abs(e) < 1e-3:
-        return 1.0 - e * (1.0 / 3.0 - e * (1.0 / 5.0 - e * (1.0 / 7.0 - e * (1.0 / 9.0 - e / 11.0))))
+        return 1.0 - e * (1.0 / 3.0 - e * (1.0 / 5.0 - e * (1.0 / 7.0
+                                                         - e * (1.0 / 9.0 - e / 11.0))))
     if e > 0.0:
         s = math.sqrt(e)
         return math.atan(s) / s
@@ -305,15 +321,52 @@ def _landen_sncndn(w, params):
 
 
 @numba.njit(**JIT)
-def _phase_state(params, u):
-    """sn(u), cn(u), dn(u) and the phase integral ``G(u)`` (module docstring, item 4).
+def _pi_minus_f(s, c, d, beta):
+    """Pi(phi; -beta | k) - F(phi | k) = -beta/3 sn^3 R_J(cn^2, dn^2, 1, 1 + beta sn^2).
 
-    ``G(u) = int_0^u (L - a_2 dn) / (1 + beta sn^2) du
-           = L Pi(am u; -beta | k) - a_2 atan(g tan am u) / g``,  ``g = sqrt(1 + beta)``.
-    ``u = u_r + 2jK`` with ``u_r`` in ``[-K, K]`` (``am u_r`` in ``[-pi/2, pi/2]``); ``G``
-    grows by ``JUMP = 2 L Pi(-beta|k) - a_2 pi / g`` per period ``2K``.  On the reduced
-    range ``Pi(am u_r) = u_r - beta/3 sn^3 R_J(cn^2, dn^2, 1, 1 + beta sn^2)``
-    (DLMF 19.25.14).  On the separatrix (``k = 1``) ``sn = tanh u, cn = dn = sech u`` and
+    DLMF 19.25.14 with ``sin phi = s``, ``cos phi = c >= 0``, ``Delta = d``; free of
+    cancellation for ``beta <= 1`` (form 1).
+    """
+    if beta == 0.0 or s == 0.0:
+        return 0.0
+    return -beta / 3.0 * s * s * s * carlson_rj(c * c, d * d, 1.0, 1.0 + beta * s * s)
+
+
+@numba.njit(**JIT)
+def _pi_large_beta(s, c, d, gamma, sqd):
+    """Pi(phi; -beta | k) for beta > 1 (form 2), a sum of two terms of one sign.
+
+    The relation between ``Pi(phi; n)`` and ``Pi(phi; k^2/n)`` (DLMF 19.7.9, the R_C
+    reduced to an arctangent) and DLMF 19.25.14 for ``n' = k^2/n = -gamma`` give::
+
+        Pi(phi; -beta | k) = gamma/3 sn^3 R_J(cn^2, dn^2, 1, 1 + gamma sn^2)
+                             + atan(sqrt(D) sn / (cn dn)) / sqrt(D),
+        D = (1 + beta)(1 + gamma).
+    """
+    pi3 = math.atan2(sqd * s, c * d) / sqd
+    if s != 0.0:
+        pi3 += gamma / 3.0 * s * s * s * carlson_rj(c * c, d * d, 1.0, 1.0 + gamma * s * s)
+    return pi3
+
+
+@numba.njit(**JIT)
+def _phase_state(params, u):
+    """sn(u), cn(u), dn(u) and the periodic part ``G_p(u)`` of the phase integral.
+
+    ``G(u) = int_0^u f du'``, ``f = (L - a_2 dn) / (1 + beta sn^2)``, is
+    ``L Pi(am u; -beta | k) - a_2 T(am u)`` with ``T(phi) = atan(g tan phi) / g``,
+    ``g = sqrt(1 + beta)`` (module docstring, item 4).  With ``u = u_r + 2jK``,
+    ``u_r`` in ``[-K, K]`` (``am u_r`` in ``[-pi/2, pi/2]``, ``F(am u_r) = u_r``), and
+    ``f_bar`` the mean of ``f``, ``G(u) = f_bar u + G_p(u_r)``: the secular part goes
+    into the rate of psi and only the periodic part is evaluated::
+
+        form 1 (beta <= 1):  G_p = L (Pi - F) - a_2 T - (f_bar - L) u_r,
+        form 2 (beta > 1):   G_p = L Pi - a_2 T - f_bar u_r,
+
+    each with the cancellation-free expression of ``Pi`` for its range of ``beta``.
+    (The rounding of ``u`` then perturbs psi by ``eps |u| kappa (f - f_bar) / nu``, the
+    size of the physical oscillation of psi times eps.)  On the separatrix (``k = 1``,
+    not periodic) ``sn = tanh u, cn = dn = sech u`` and the whole ``G`` is returned, with
     ``Pi(am u; -beta | 1) = (u + sqrt(beta) atan(sqrt(beta) tanh u)) / (1 + beta)``.
     """
     ell = params[_I_L]
@@ -331,14 +384,16 @@ def _phase_state(params, u):
     odd = int(j) & 1
     ur = u - j * twok
     s, c, d = _landen_sncndn(ur * params[_I_WSCALE], params)
-    pi3 = ur
-    if beta > 0.0 and s != 0.0:
-        pi3 -= beta / 3.0 * s * s * s * carlson_rj(c * c, d * d, 1.0, 1.0 + beta * s * s)
-    gval = j * params[_I_JUMP] + ell * pi3 - a2 * math.atan2(g * s, abs(c)) / g
+    ca = abs(c)
+    if beta <= 1.0:
+        pi3 = _pi_minus_f(s, ca, d, beta)
+    else:
+        pi3 = _pi_large_beta(s, ca, d, params[_I_GAMMA], params[_I_SQD])
+    gp = ell * pi3 - a2 * math.atan2(g * s, ca) / g - params[_I_FOFF] * ur
     if odd:  # sn(u_r + 2jK) = (-1)^j sn(u_r), likewise cn; dn has period 2K
         s = -s
         c = -c
-    return s, c, d, gval
+    return s, c, d, gp
 
 
 @numba.njit(**JIT)
@@ -483,22 +538,26 @@ def rotation_init(K, R0, ell, params):
     d20 = abs(j2 - j0)
     d21 = abs(j2 - j1)
     pp = x * x * d20 / j0 + y * y * d21 / j1
-    qq = y * y * d10 / j1 + z * z * d20 / j2
-    kp2 = min(d20 * abs(hsep) / (j0 * j2 * d21 * qq), 1.0)
-    k2 = min(d10 * pp / (d21 * qq), 1.0)
-    a2 = math.sqrt(qq * j2 / d20)
+    ss = y * y * d10 / j1 + z * z * d20 / j2
+    kp2 = min(d20 * abs(hsep) / (j0 * j2 * d21 * ss), 1.0)
+    k2 = min(d10 * pp / (d21 * ss), 1.0)
+    a2 = math.sqrt(ss * j2 / d20)
     params[_I_A + 0] = math.sqrt(pp * j0 / d20)
     params[_I_A + 1] = math.sqrt(pp * j1 / d21)
     params[_I_A + 2] = a2
-    nu = math.copysign(math.sqrt(d21 * qq / (j0 * j1 * j2)), j2 - j1)
+    nu = math.copysign(math.sqrt(d21 * ss / (j0 * j1 * j2)), j2 - j1)
     params[_I_NU] = nu
     beta = j2 * d10 / (j0 * d21)
+    gamma = pp * j0 / (ss * j2)  # = k^2 / beta
     gfac = math.sqrt(1.0 + beta)
+    sqd = math.sqrt((1.0 + beta) * (1.0 + gamma))
+    kappa = (j2 - j0) / (j0 * j2)
     params[_I_BETA] = beta
     params[_I_G] = gfac
+    params[_I_GAMMA] = gamma
+    params[_I_SQD] = sqd
     params[_I_L] = lmag
-    params[_I_LIN] = lmag / j2
-    params[_I_KAPNU] = (j2 - j0) / (j0 * j2) / nu
+    params[_I_KAPNU] = kappa / nu
 
     # ---- initial amplitude phi_0 (cos phi_0 >= 0) and phase u_0 = F(phi_0 | k)
     cf = x * math.sqrt(j1 * d20)
@@ -508,16 +567,24 @@ def rotation_init(K, R0, ell, params):
     sf /= h
     if kp2 == 0.0:
         params[_I_MODE] = _MODE_SEPARATRIX
+        params[_I_LIN] = lmag / j2
         u0 = math.asinh(sf / cf)
     else:
         params[_I_MODE] = _MODE_GENERAL
         kcomp = _landen_chain(math.sqrt(k2), math.sqrt(kp2), params)
-        u0 = sf * carlson_rf(cf * cf, cf * cf + kp2 * sf * sf, 1.0)
-        pic = kcomp
-        if beta > 0.0:
-            pic -= beta / 3.0 * carlson_rj(0.0, kp2, 1.0, 1.0 + beta)
         params[_I_TWOK] = 2.0 * kcomp
-        params[_I_JUMP] = 2.0 * lmag * pic - a2 * math.pi / gfac
+        u0 = sf * carlson_rf(cf * cf, cf * cf + kp2 * sf * sf, 1.0)
+        # mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar
+        g_quarter = -a2 * 0.5 * math.pi / gfac  # -a_2 T(pi/2)
+        if beta <= 1.0:
+            g_quarter += lmag * _pi_minus_f(1.0, 0.0, math.sqrt(kp2), beta)
+            foff = g_quarter / kcomp  # f_bar - L
+            params[_I_LIN] = lmag / j0 + kappa * foff
+        else:
+            g_quarter += lmag * _pi_large_beta(1.0, 0.0, math.sqrt(kp2), gamma, sqd)
+            foff = g_quarter / kcomp  # f_bar
+            params[_I_LIN] = lmag / j2 + kappa * foff
+        params[_I_FOFF] = foff
     params[_I_U0] = u0
     s, c, d, gval = _phase_state(params, u0)
     params[_I_G0] = gval

@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from tablegen.rebound import HISTORY_COLUMNS, rebound
+from tablegen.rebound import HISTORY_COLUMNS, WORK_SIZE, rebound
 from tablegen.shapes import second_moment_factor, shape_code
 from tablegen.simulate import incident_velocity
 from tablegen.wall import CORUNDUM_ON_STEEL
@@ -20,7 +20,7 @@ def run_one(shape, semi, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0),
         shape_code(shape), np.asarray(semi, dtype=float), kappa, float(hand),
         second_moment_factor(shape, kappa), np.ascontiguousarray(R0), incident_velocity(alpha1, speed),
         np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(), n_max,
-        contact_tol, set_tol, max_steps, V, W, history)
+        contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE))
     return V, W, status, ncoll, erot, history
 
 
