@@ -72,8 +72,24 @@ def atomic_output(path, overwrite: bool = False):
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())      # as an ordinary new file, not mkstemp's 0600
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.remove(tmp)
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def package_version() -> str:
+    """Version of the installed package (recorded in every file written), or "unknown"."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("rebound-scatter")
+    except PackageNotFoundError:
+        return "unknown"

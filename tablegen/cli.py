@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from data_schema.samples import write_samples
+from tablegen.config import PRESETS
 from tablegen.shapes import MIX, SHAPES
 
 
@@ -33,6 +34,25 @@ def _build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--out", metavar="FILE.h5", help="write the per-particle samples (HDF5, docs/format.md)")
     sim.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
     sim.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
+
+    build = sub.add_parser("build", help="build a rebound table over a grid of incident states",
+                           description="Run the direct model over the (shape, alpha1, speed) grid of a "
+                                       "configuration and write the table (HDF5, docs/format.md). "
+                                       "Resumable: rerun the same command after an interruption.")
+    source = build.add_mutually_exclusive_group()
+    source.add_argument("--config", metavar="FILE", help="TOML build configuration (docs/format.md)")
+    source.add_argument("--preset", default="default", choices=PRESETS,
+                        help="embedded configuration (default: %(default)s)")
+    build.add_argument("-o", "--out", required=True, metavar="TABLE.h5", help="output table file")
+    build.add_argument("--workers", type=int, default=None, help="local worker processes (default: CPU count)")
+    build.add_argument("--scheduler", metavar="ADDRESS", help="Dask distributed scheduler to run the cells on")
+    build.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    build.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
+    build.add_argument("--print-config", action="store_true",
+                       help="print the resolved configuration and exit without building")
+
+    info = sub.add_parser("info", help="describe a rebound table")
+    info.add_argument("table", metavar="TABLE.h5")
     return parser
 
 
@@ -58,10 +78,50 @@ def _simulate(args, parser) -> int:
     return 0
 
 
+def _build(args, parser) -> int:
+    from tablegen.build import BuildError, build_table
+    from tablegen.config import ConfigError, load_config
+
+    try:
+        config = load_config(args.config, args.preset)
+    except ConfigError as exc:
+        parser.error(str(exc))
+    if args.print_config:
+        print(config.to_toml(), end="")
+        return 0
+    if args.workers is not None and args.workers < 1:
+        parser.error(f"--workers must be >= 1; got {args.workers}")
+    if Path(args.out).exists() and not args.overwrite:
+        parser.error(f"{args.out} exists; pass --overwrite to replace it")
+    print(f"building {config.n_cells} cells x {config.particles_per_cell} particles into {args.out}",
+          file=sys.stderr)
+    try:
+        path = build_table(config, args.out, workers=args.workers, scheduler=args.scheduler,
+                           overwrite=args.overwrite, progress=not args.no_progress)
+    except (BuildError, FileNotFoundError) as exc:
+        print(f"tablegen build: error: {exc}", file=sys.stderr)
+        return 1
+    print(f"table written to {path}")
+    return 0
+
+
+def _info(args, parser) -> int:
+    from data_schema.common import DataFormatError
+    from data_schema.table import read_table
+    from tablegen.info import describe_table
+
+    try:
+        table = read_table(args.table)
+    except (FileNotFoundError, DataFormatError) as exc:
+        parser.error(str(exc))
+    print(describe_table(table, Path(args.table)))
+    return 0
+
+
 def main(argv=None) -> int:
     parser = _build_parser()
     args = parser.parse_args(argv)
-    commands = {"simulate": _simulate}
+    commands = {"simulate": _simulate, "build": _build, "info": _info}
     return commands[args.command](args, parser)
 
 

@@ -15,6 +15,7 @@ import warnings
 
 import numpy as np
 
+from data_schema.common import package_version
 from data_schema.samples import SampleSet
 from tablegen.rebound import rebound_batch
 from tablegen.shapes import (
@@ -185,7 +186,7 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
                     "aspect_mean": aspect.mean, "aspect_sd": aspect.sd,
                     "aspect_low": aspect.low, "aspect_high": aspect.high,
                     "wall_law": wall.name, "wall_k": wall.k, "wall_p": wall.p, "wall_q": wall.q,
-                    "chunk_size": CHUNK_SIZE, "package_version": _package_version()})
+                    "chunk_size": CHUNK_SIZE, "package_version": package_version()})
 
 
 def _progress_bar(total: int, enabled: bool):
@@ -193,11 +194,3 @@ def _progress_bar(total: int, enabled: bool):
         return None
     from tqdm.auto import tqdm
     return tqdm(total=total, unit="particle", unit_scale=True, desc="rebounds")
-
-
-def _package_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("rebound-scatter")
-    except PackageNotFoundError:
-        return "unknown"

@@ -1,0 +1,227 @@
+"""Rebound tables: the conditional law of the reflected state on a grid of incident states.
+
+Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
+
+    /                      attrs: file_type = "rebound_table", format_version = (1, 0),
+                           created (ISO 8601 UTC), package_version, config (TOML text),
+                           config_sha256, master_seed
+    /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
+                           attrs: kappa, n_max, particles_per_cell
+    /resolution            attrs: alpha2_levels, alpha2_bins, beta2_levels, beta2_bins, spin_atoms
+    /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
+
+Representation of one cell (docs/model.md §6, docs/format.md): reflected state
+X = (α2, β2, s = |V⁺|/|V⁻|, Ω⁺a/|V⁻|) of the rebounded particles, folded by the
+mirror symmetry Z → −Z to β2 ≥ 0 (Ω_x, Ω_y multiplied by sign β2), stored as a
+discretised inverse Rosenblatt transform:
+
+1. ``alpha2_q`` (L1+1): quantile function of α2 at probabilities k/L1;
+2. ``beta2_q`` (B1, L2+1): quantile function of |β2| in each of B1 equal-count α2
+   bins (bin b holds the α2 probability range [b/B1, (b+1)/B1));
+3. ``speed_q`` (B1, B2, A+1): quantile function of s in each (α2, |β2|) leaf,
+   the |β2| bins equal-count within their α2 bin;
+4. ``spin`` (B1, B2, A, 3): per leaf, A spin atoms (Ω_x, Ω_y, Ω_z) folded; atom j
+   is the sample of s-rank (j + ½)/A in the leaf, so the atom drawn with the s
+   interval j keeps the joint law of (s, Ω) at the leaf's resolution.
+
+Drawing needs one multiply, one floor and one linear interpolation per level.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from data_schema.common import DataFormatError, atomic_output, check_file, write_header
+
+TABLE_FILE_TYPE = "rebound_table"
+TABLE_VERSION = (1, 0)
+
+N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
+STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
+STATE_UNITS = ("rad", "rad", "1", "1", "1", "1")
+# indicatrix grids: α2 ∈ [0, π], β2 ∈ [−π/2, π/2], 2.5° bins
+INDICATRIX_ALPHA2_EDGES = np.linspace(0.0, np.pi, 73)
+INDICATRIX_BETA2_EDGES = np.linspace(-np.pi / 2, np.pi / 2, 73)
+
+
+@dataclasses.dataclass(frozen=True)
+class TableResolution:
+    """Sizes of a cell's representation (see module doc)."""
+
+    alpha2_levels: int = 64   # L1
+    alpha2_bins: int = 16     # B1
+    beta2_levels: int = 32    # L2
+    beta2_bins: int = 8       # B2
+    spin_atoms: int = 32      # A
+
+    def __post_init__(self):
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"The table resolution '{f.name}' must be an integer >= 1; got {value!r}.")
+
+    def cell_shapes(self) -> dict:
+        """Shape of each per-cell dataset (without the three leading grid dimensions)."""
+        b1, b2, a = self.alpha2_bins, self.beta2_bins, self.spin_atoms
+        return {
+            "alpha2_q": (self.alpha2_levels + 1,),
+            "beta2_q": (b1, self.beta2_levels + 1),
+            "speed_q": (b1, b2, a + 1),
+            "spin": (b1, b2, a, 3),
+            "status_counts": (3,),
+            "collision_counts": (N_COLLISION_CLASSES,),
+            "mean": (len(STATE_NAMES),),
+            "std": (len(STATE_NAMES),),
+            "indicatrix_2d": (len(INDICATRIX_ALPHA2_EDGES) - 1,),
+            "indicatrix_3d": (len(INDICATRIX_ALPHA2_EDGES) - 1, len(INDICATRIX_BETA2_EDGES) - 1),
+        }
+
+
+# name: (dtype, units, meaning) of the per-cell datasets
+CELL_DATASETS = {
+    "alpha2_q": ("float64", "rad", "quantile function of α2 at probabilities k/L1"),
+    "beta2_q": ("float64", "rad", "quantile function of |β2| per equal-count α2 bin"),
+    "speed_q": ("float64", "1", "quantile function of s = |V⁺|/|V⁻| per (α2, |β2|) leaf"),
+    "spin": ("float32", "1", "spin atoms Ω⁺a/|V⁻| (x, y, z), folded to β2 ≥ 0, per leaf and s interval"),
+    "status_counts": ("int64", "1", "particles rebounded, trapped, failed"),
+    "collision_counts": ("int64", "1", "rebounds with 1, 2, ..., 10 and more than 10 collisions"),
+    "mean": ("float64", "rad, rad, 1, 1, 1, 1", "means of α2, β2, s, Ω_x, Ω_y, Ω_z over rebounds"),
+    "std": ("float64", "rad, rad, 1, 1, 1, 1", "standard deviations of the same"),
+    "indicatrix_2d": ("float32", "1/rad", "I(α2): density of α2 on INDICATRIX_ALPHA2_EDGES"),
+    "indicatrix_3d": ("float32", "1/rad²", "I(α2, β2): density on the α2 × β2 edges, ∫∫ I dα2 dβ2 = 1"),
+}
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class CellTable:
+    """The representation of one (shape, α1, |V⁻|) cell; arrays as in :data:`CELL_DATASETS`."""
+
+    alpha2_q: np.ndarray
+    beta2_q: np.ndarray
+    speed_q: np.ndarray
+    spin: np.ndarray
+    status_counts: np.ndarray
+    collision_counts: np.ndarray
+    mean: np.ndarray
+    std: np.ndarray
+    indicatrix_2d: np.ndarray
+    indicatrix_3d: np.ndarray
+
+    def arrays(self) -> dict:
+        return {name: getattr(self, name) for name in CELL_DATASETS}
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class ReboundTable:
+    """A whole table: grids, resolution, provenance and the stacked cell arrays.
+
+    ``cells[name]`` has shape (n_shape, n_alpha, n_speed) + the cell shape of
+    ``name`` (:meth:`TableResolution.cell_shapes`).
+    """
+
+    alpha1_deg: np.ndarray
+    speed_m_s: np.ndarray
+    shapes: tuple
+    resolution: TableResolution
+    cells: dict
+    kappa: float
+    n_max: int
+    particles_per_cell: int
+    config_text: str
+    config_sha256: str
+    master_seed: int
+    created: str
+    package_version: str
+
+    def __post_init__(self):
+        lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
+        expected = self.resolution.cell_shapes()
+        missing = set(CELL_DATASETS) - set(self.cells)
+        if missing:
+            raise ValueError(f"ReboundTable is missing cell datasets {sorted(missing)}")
+        for name, shape in expected.items():
+            if self.cells[name].shape != lead + shape:
+                raise ValueError(f"cell dataset {name!r} has shape {self.cells[name].shape}, "
+                                 f"expected {lead + shape}")
+
+    def cell(self, shape: str, i_alpha: int, i_speed: int) -> CellTable:
+        """The cell of ``shape`` at grid indices (i_alpha, i_speed)."""
+        s = self.shapes.index(shape)
+        return CellTable(**{name: arr[s, i_alpha, i_speed] for name, arr in self.cells.items()})
+
+    # -- HDF5 ---------------------------------------------------------------
+    def to_hdf5(self, f: h5py.File) -> None:
+        """Write the table into an open file (header attributes excluded)."""
+        f.attrs["created"] = self.created
+        f.attrs["package_version"] = self.package_version
+        f.attrs["config"] = self.config_text
+        f.attrs["config_sha256"] = self.config_sha256
+        f.attrs["master_seed"] = np.uint64(self.master_seed)
+        grid = f.create_group("grid")
+        grid.create_dataset("alpha1_deg", data=np.asarray(self.alpha1_deg, dtype=np.float64)).attrs["units"] = "deg"
+        grid.create_dataset("speed_m_s", data=np.asarray(self.speed_m_s, dtype=np.float64)).attrs["units"] = "m/s"
+        grid.create_dataset("shapes", data=np.array(self.shapes, dtype=h5py.string_dtype()))
+        grid.attrs["kappa"] = self.kappa
+        grid.attrs["n_max"] = self.n_max
+        grid.attrs["particles_per_cell"] = self.particles_per_cell
+        res = f.create_group("resolution")
+        for field in dataclasses.fields(self.resolution):
+            res.attrs[field.name] = getattr(self.resolution, field.name)
+        cells = f.create_group("cells")
+        for name, (dtype, units, meaning) in CELL_DATASETS.items():
+            ds = cells.create_dataset(name, data=np.asarray(self.cells[name], dtype=dtype))
+            ds.attrs["units"] = units
+            ds.attrs["meaning"] = meaning
+
+    @classmethod
+    def from_hdf5(cls, f: h5py.File) -> "ReboundTable":
+        """Read a table written by :meth:`to_hdf5`; DataFormatError naming what is missing."""
+        where = f.filename
+        for group in ("grid", "resolution", "cells"):
+            if group not in f:
+                raise DataFormatError(f"{where}: missing group '{group}'")
+        for name in ("alpha1_deg", "speed_m_s", "shapes"):
+            if name not in f["grid"]:
+                raise DataFormatError(f"{where}: missing dataset 'grid/{name}'")
+        missing = [n for n in CELL_DATASETS if n not in f["cells"]]
+        if missing:
+            raise DataFormatError(f"{where}: missing dataset(s) {', '.join('cells/' + n for n in missing)}")
+        try:
+            resolution = TableResolution(**{k: int(v) for k, v in f["resolution"].attrs.items()})
+            cells = {name: f["cells"][name][()] for name in CELL_DATASETS}
+            grid = f["grid"]
+            return cls(
+                alpha1_deg=grid["alpha1_deg"][()], speed_m_s=grid["speed_m_s"][()],
+                shapes=tuple(s.decode() if isinstance(s, bytes) else str(s) for s in grid["shapes"][()]),
+                resolution=resolution, cells=cells, kappa=float(grid.attrs["kappa"]),
+                n_max=int(grid.attrs["n_max"]), particles_per_cell=int(grid.attrs["particles_per_cell"]),
+                config_text=str(f.attrs["config"]), config_sha256=str(f.attrs["config_sha256"]),
+                master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
+                package_version=str(f.attrs["package_version"]))
+        except (OSError, KeyError, TypeError) as exc:
+            raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
+        except ValueError as exc:
+            raise DataFormatError(f"{where}: inconsistent table: {exc}") from exc
+
+
+def write_table(path, table: ReboundTable, overwrite: bool = False) -> Path:
+    """Write ``table`` to a new HDF5 file at ``path`` atomically; return the path."""
+    with atomic_output(path, overwrite) as tmp:
+        with h5py.File(tmp, "w") as f:
+            write_header(f, TABLE_FILE_TYPE, TABLE_VERSION)
+            table.to_hdf5(f)
+    return Path(path)
+
+
+def read_table(path) -> ReboundTable:
+    """Read a rebound table, after :func:`data_schema.check_file`."""
+    check_file(path, TABLE_FILE_TYPE, TABLE_VERSION[0])
+    try:
+        with h5py.File(path, "r") as f:
+            return ReboundTable.from_hdf5(f)
+    except OSError as exc:
+        raise DataFormatError(f"{path}: cannot read the table (truncated or corrupt?): {exc}") from exc

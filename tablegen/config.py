@@ -1,0 +1,242 @@
+"""Table-build configuration: TOML files and the embedded presets.
+
+A configuration has three sections (every key optional; defaults are those of
+the ``default`` preset)::
+
+    [grid]
+    alpha1_deg = [2, 5, 10, ...] or {start = 5, stop = 90, step = 5}   # degrees, in (0, 90]
+    speed_m_s  = [50, 100, ...]  or {start = 50, stop = 300, step = 50}  # m/s, > 0
+    shapes     = ["ellipsoid", "prism", "cut_prism", "tetrahedron"]
+
+    [simulation]
+    particles_per_cell = 25000        # direct-model particles per (shape, α1, |V⁻|) cell
+    seed = 20261121                   # master seed; each cell's seed derives from it
+    kappa = 0.3                       # cut-prism corner truncation
+    n_max = 1000                      # collisions before a particle counts as trapped
+    aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}   # b/a and c/b
+
+    [table]
+    resolution = "auto"               # or {alpha2_levels = .., alpha2_bins = .., ...}
+
+Unknown keys and invalid values raise :class:`ConfigError` naming the key.
+Presets: ``default`` (the README's main job, a few minutes on 2 cores),
+``production`` (the table users should run with) and ``paper`` (the study of
+Panfilov & Tsirkunov 2022 at 10⁸ particles per cell; for a cluster).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+import tomllib
+from importlib import resources
+
+import numpy as np
+
+from data_schema.table import TableResolution
+from tablegen.shapes import SHAPES, AspectRatioLaw, check_kappa
+from tablegen.tabulate import resolution_for
+
+PRESETS = ("default", "production", "paper")
+
+
+class ConfigError(ValueError):
+    """An invalid build configuration; the message names the offending key."""
+
+
+@dataclasses.dataclass(frozen=True)
+class BuildConfig:
+    """A fully resolved build configuration (every value explicit)."""
+
+    alpha1_deg: tuple
+    speed_m_s: tuple
+    shapes: tuple
+    particles_per_cell: int
+    seed: int
+    kappa: float
+    n_max: int
+    aspect: AspectRatioLaw
+    resolution: TableResolution
+
+    @property
+    def n_cells(self) -> int:
+        return len(self.shapes) * len(self.alpha1_deg) * len(self.speed_m_s)
+
+    def to_toml(self) -> str:
+        """The resolved configuration as TOML text (reads back to an equal config)."""
+        def fmt(values):
+            return "[" + ", ".join(repr(float(v)) for v in values) + "]"
+        res = ", ".join(f"{f.name} = {getattr(self.resolution, f.name)}"
+                        for f in dataclasses.fields(self.resolution))
+        a = self.aspect
+        return "\n".join([
+            "[grid]",
+            f"alpha1_deg = {fmt(self.alpha1_deg)}",
+            f"speed_m_s = {fmt(self.speed_m_s)}",
+            "shapes = [" + ", ".join(f'"{s}"' for s in self.shapes) + "]",
+            "",
+            "[simulation]",
+            f"particles_per_cell = {self.particles_per_cell}",
+            f"seed = {self.seed}",
+            f"kappa = {self.kappa!r}",
+            f"n_max = {self.n_max}",
+            f"aspect_ratio = {{mean = {a.mean!r}, sd = {a.sd!r}, low = {a.low!r}, high = {a.high!r}}}",
+            "",
+            "[table]",
+            f"resolution = {{{res}}}",
+            "",
+        ])
+
+    def sha256(self) -> str:
+        """Hash of :meth:`to_toml`: identifies the configuration in files and checkpoints."""
+        return hashlib.sha256(self.to_toml().encode()).hexdigest()
+
+
+_SCHEMA = {
+    "grid": {"alpha1_deg", "speed_m_s", "shapes"},
+    "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
+    "table": {"resolution"},
+}
+
+
+def preset_text(name: str) -> str:
+    """The TOML text of an embedded preset."""
+    if name not in PRESETS:
+        raise ConfigError(f"unknown preset {name!r}; presets: {', '.join(PRESETS)}")
+    return resources.files("tablegen.presets").joinpath(f"{name}.toml").read_text()
+
+
+def load_config(path=None, preset: str = "default") -> BuildConfig:
+    """Read a configuration file (or the named preset when ``path`` is None)."""
+    if path is None:
+        return parse_config(preset_text(preset), f"preset '{preset}'")
+    try:
+        with open(path, "rb") as f:
+            text = f.read().decode()
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read the configuration: {exc}") from exc
+    return parse_config(text, str(path))
+
+
+def parse_config(text: str, source: str = "<config>") -> BuildConfig:
+    """Parse and validate TOML text; defaults come from the ``default`` preset."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: not valid TOML: {exc}") from exc
+    _check_keys(data, source)
+    base = {} if source == "preset 'default'" else tomllib.loads(preset_text("default"))
+    merged = {section: {**base.get(section, {}), **data.get(section, {})} for section in _SCHEMA}
+    grid, sim, table = merged["grid"], merged["simulation"], merged["table"]
+
+    alpha1 = _grid_values(grid.get("alpha1_deg"), "grid.alpha1_deg", source)
+    bad = [a for a in alpha1 if not 0.0 < a <= 90.0]
+    if bad:
+        raise ConfigError(f"{source}: 'grid.alpha1_deg' values must be in (0, 90] degrees; got {bad[0]!r}")
+    speeds = _grid_values(grid.get("speed_m_s"), "grid.speed_m_s", source)
+    bad = [v for v in speeds if not (math.isfinite(v) and v > 0.0)]
+    if bad:
+        raise ConfigError(f"{source}: 'grid.speed_m_s' values must be finite and > 0 m/s; got {bad[0]!r}")
+    shapes = grid.get("shapes")
+    if not isinstance(shapes, list) or not shapes:
+        raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(SHAPES)}; got {shapes!r}")
+    for s in shapes:
+        if s not in SHAPES:
+            raise ConfigError(f"{source}: 'grid.shapes' entries must be one of {', '.join(SHAPES)}; got {s!r}")
+    if len(set(shapes)) != len(shapes):
+        raise ConfigError(f"{source}: 'grid.shapes' has duplicates: {shapes!r}")
+
+    n = _integer(sim.get("particles_per_cell"), "simulation.particles_per_cell", 256, source)
+    seed = _integer(sim.get("seed"), "simulation.seed", 0, source)
+    if seed >= 2 ** 63:
+        raise ConfigError(f"{source}: 'simulation.seed' must be < 2**63; got {seed!r}")
+    n_max = _integer(sim.get("n_max"), "simulation.n_max", 1, source)
+    try:
+        kappa = check_kappa(sim.get("kappa"))
+    except (TypeError, ValueError):
+        raise ConfigError(f"{source}: 'simulation.kappa' must be in [0, 1); got {sim.get('kappa')!r}") from None
+    aspect_raw = sim.get("aspect_ratio")
+    if not isinstance(aspect_raw, dict) or set(aspect_raw) - {"mean", "sd", "low", "high"}:
+        raise ConfigError(f"{source}: 'simulation.aspect_ratio' must be a table with keys mean, sd, low, "
+                          f"high; got {aspect_raw!r}")
+    try:
+        aspect = AspectRatioLaw(**{k: float(v) for k, v in aspect_raw.items()})
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{source}: 'simulation.aspect_ratio': {exc}") from None
+
+    res_raw = table.get("resolution")
+    if res_raw == "auto":
+        resolution = resolution_for(n)
+    elif isinstance(res_raw, dict):
+        allowed = {f.name for f in dataclasses.fields(TableResolution)}
+        unknown = set(res_raw) - allowed
+        if unknown:
+            raise ConfigError(f"{source}: unknown key 'table.resolution.{sorted(unknown)[0]}'; "
+                              f"allowed: {', '.join(sorted(allowed))}")
+        try:
+            resolution = TableResolution(**res_raw)
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(f"{source}: 'table.resolution': {exc}") from None
+    else:
+        raise ConfigError(f"{source}: 'table.resolution' must be \"auto\" or a table of sizes; got {res_raw!r}")
+
+    return BuildConfig(alpha1_deg=tuple(alpha1), speed_m_s=tuple(speeds), shapes=tuple(shapes),
+                       particles_per_cell=n, seed=seed, kappa=kappa, n_max=n_max, aspect=aspect,
+                       resolution=resolution)
+
+
+def _check_keys(data: dict, source: str) -> None:
+    for section, value in data.items():
+        if section not in _SCHEMA:
+            raise ConfigError(f"{source}: unknown section '[{section}]'; sections: {', '.join(_SCHEMA)}")
+        if not isinstance(value, dict):
+            raise ConfigError(f"{source}: '{section}' must be a table ([{section}])")
+        for key in value:
+            if key not in _SCHEMA[section]:
+                raise ConfigError(f"{source}: unknown key '{section}.{key}'; allowed in [{section}]: "
+                                  f"{', '.join(sorted(_SCHEMA[section]))}")
+
+
+def _integer(value, key, minimum, source) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ConfigError(f"{source}: '{key}' must be an integer >= {minimum}; got {value!r}")
+    return value
+
+
+def _grid_values(spec, key, source) -> list:
+    """A grid from a list of numbers or {start, stop, step} (stop included)."""
+    if isinstance(spec, dict):
+        if set(spec) != {"start", "stop", "step"}:
+            raise ConfigError(f"{source}: '{key}' as a table needs exactly start, stop, step; got {spec!r}")
+        try:
+            start, stop, step = (float(spec[k]) for k in ("start", "stop", "step"))
+        except (TypeError, ValueError):
+            raise ConfigError(f"{source}: '{key}' start, stop, step must be numbers; got {spec!r}") from None
+        if not (step > 0 and stop >= start):
+            raise ConfigError(f"{source}: '{key}' needs step > 0 and stop >= start; got {spec!r}")
+        count = int(math.floor((stop - start) / step + 1e-9)) + 1
+        values = [start + k * step for k in range(count)]
+    elif isinstance(spec, list):
+        values = spec
+    else:
+        raise ConfigError(f"{source}: '{key}' must be a list of numbers or {{start, stop, step}}; got {spec!r}")
+    if not values:
+        raise ConfigError(f"{source}: '{key}' is empty; give at least one value")
+    if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
+        raise ConfigError(f"{source}: '{key}' values must be numbers; got {values!r}")
+    values = [float(v) for v in values]
+    if any(b <= a for a, b in zip(values, values[1:])):
+        raise ConfigError(f"{source}: '{key}' values must be strictly increasing; got {values!r}")
+    return values
+
+
+def derive_seed(seed: int, *key: int) -> int:
+    """A 63-bit seed derived from ``seed`` and a spawn key (independent streams per key)."""
+    hi, lo = np.random.SeedSequence(seed, spawn_key=key).generate_state(2, np.uint32)
+    return (int(hi) << 31) ^ int(lo)
+
+
+def cell_seed(master_seed: int, shape: str, i_alpha: int, i_speed: int) -> int:
+    """The seed of one cell, derived from the master seed, the shape and the grid indices."""
+    return derive_seed(master_seed, SHAPES.index(shape), i_alpha, i_speed)

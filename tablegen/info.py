@@ -1,0 +1,47 @@
+"""Human-readable description of a rebound table (``tablegen info``)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from data_schema.samples import STATUS_NAMES
+from data_schema.table import TABLE_VERSION, ReboundTable
+
+
+def _grid(values) -> str:
+    v = np.asarray(values)
+    steps = np.unique(np.round(np.diff(v), 9)) if len(v) > 1 else []
+    step = f", step {steps[0]:g}" if len(steps) == 1 else ""
+    return f"{len(v)} values, {v[0]:g} to {v[-1]:g}{step}"
+
+
+def describe_table(table: ReboundTable, path: Path | None = None) -> str:
+    """Format version, grids, shapes, counts per cell (summarised), size, config hash."""
+    counts = table.cells["status_counts"]            # (shape, alpha, speed, status)
+    total = counts.sum(axis=-1)
+    lines = []
+    if path is not None:
+        lines.append(f"{path}: rebound table, {path.stat().st_size / 1e6:.1f} MB")
+    lines += [
+        f"format version {TABLE_VERSION[0]}.{TABLE_VERSION[1]}, made {table.created} by package "
+        f"version {table.package_version}",
+        f"config sha256 {table.config_sha256}, master seed {table.master_seed}",
+        f"alpha1 (deg): {_grid(table.alpha1_deg)}",
+        f"speed (m/s):  {_grid(table.speed_m_s)}",
+        f"shapes: {', '.join(table.shapes)} (cut_prism kappa = {table.kappa:g}); n_max = {table.n_max}",
+        f"cells: {total.size}, {table.particles_per_cell} particles each",
+        "resolution: " + ", ".join(f"{f.name} {getattr(table.resolution, f.name)}"
+                                   for f in dataclasses.fields(table.resolution)),
+        f"{'shape':<12}" + "".join(f"{name + ' %':>22}" for name in STATUS_NAMES.values()),
+    ]
+    for s, shape in enumerate(table.shapes):
+        frac = 100.0 * counts[s] / total[s][..., None]
+        cols = []
+        for k in range(len(STATUS_NAMES)):
+            f = frac[..., k]
+            cols.append(f"{f.min():6.2f}..{f.max():6.2f} (mean {f.mean():5.2f})")
+        lines.append(f"{shape:<12}" + "".join(f"{c:>22}" for c in cols))
+    return "\n".join(lines)

@@ -1,0 +1,1 @@
+"""Embedded build-configuration presets (TOML): default, production, paper."""

@@ -1,0 +1,150 @@
+"""Table build: determinism across workers and schedulers, resume after SIGKILL, atomicity."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from data_schema.common import DataFormatError
+from data_schema.table import CELL_DATASETS, read_table
+from tablegen.build import BuildError, build_table
+from tablegen.config import parse_config
+
+TINY = """
+[grid]
+alpha1_deg = [30.0, 80.0]
+speed_m_s = [100.0, 250.0]
+shapes = ["prism", "tetrahedron"]
+[simulation]
+particles_per_cell = 3000
+seed = 7
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny_table(tmp_path_factory):
+    path = tmp_path_factory.mktemp("tiny") / "table.h5"
+    build_table(parse_config(TINY), path, workers=1)
+    return path
+
+
+def _cell_bytes(path):
+    with h5py.File(path, "r") as f:
+        return {name: f["cells"][name][()].tobytes() for name in CELL_DATASETS}
+
+
+def test_table_contents_are_consistent(tiny_table):
+    table = read_table(tiny_table)
+    assert table.shapes == ("prism", "tetrahedron")
+    counts = table.cells["status_counts"]
+    assert np.all(counts.sum(axis=-1) == 3000)
+    assert np.all(table.cells["collision_counts"].sum(axis=-1) == counts[..., 0])
+    # the stored quantile functions are finite and non-decreasing
+    for name in ("alpha2_q", "beta2_q", "speed_q"):
+        q = table.cells[name]
+        assert np.all(np.isfinite(q)), name
+        assert np.all(np.diff(q, axis=-1) >= 0), name
+    assert np.all(np.isfinite(table.cells["spin"]))
+    # physical ranges: α2 ∈ [0, π], folded β2 ∈ [0, π/2], s ∈ (0, 1]
+    assert table.cells["alpha2_q"].min() >= 0 and table.cells["alpha2_q"].max() <= np.pi
+    assert table.cells["beta2_q"].min() >= 0 and table.cells["beta2_q"].max() <= np.pi / 2
+    assert table.cells["speed_q"].min() > 0 and table.cells["speed_q"].max() <= 1
+    # indicatrices are densities: ∫ I dα2 = 1 and ∫∫ I dα2 dβ2 = 1
+    d = np.pi / 72
+    np.testing.assert_allclose(table.cells["indicatrix_2d"].sum(axis=-1) * d, 1.0, rtol=1e-5)
+    np.testing.assert_allclose(table.cells["indicatrix_3d"].sum(axis=(-1, -2)) * d * d, 1.0, rtol=1e-5)
+
+
+def test_bit_identical_for_one_or_two_workers(tiny_table, tmp_path):
+    two = build_table(parse_config(TINY), tmp_path / "two.h5", workers=2)
+    assert _cell_bytes(two) == _cell_bytes(tiny_table)
+
+
+def test_bit_identical_on_a_dask_cluster(tiny_table, tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        path = build_table(parse_config(TINY), tmp_path / "dask.h5", scheduler=cluster.scheduler_address)
+    assert _cell_bytes(path) == _cell_bytes(tiny_table)
+
+
+def test_resume_after_sigkill_gives_the_same_table(tmp_path):
+    config_text = TINY.replace("particles_per_cell = 3000", "particles_per_cell = 30000")
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(config_text)
+    out = tmp_path / "killed.h5"
+    command = [sys.executable, "-m", "tablegen.cli", "build", "--config", str(cfg), "-o", str(out),
+               "--workers", "1", "--no-progress"]
+    proc = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    partial = tmp_path / "killed.h5.partial"
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(partial.glob("*.npz"))) < 2:
+        time.sleep(0.01)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    done = len(list(partial.glob("*.npz")))
+    assert 2 <= done < 8, f"kill landed outside the build ({done} cells done)"
+    assert not out.exists()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    assert not partial.exists()
+    reference = build_table(parse_config(config_text), tmp_path / "whole.h5", workers=1)
+    assert _cell_bytes(out) == _cell_bytes(reference)
+
+
+def test_checkpoint_of_another_config_is_refused(tmp_path):
+    out = tmp_path / "t.h5"
+    partial = tmp_path / "t.h5.partial"
+    partial.mkdir()
+    (partial / "config.toml").write_text("something else\n")
+    with pytest.raises(BuildError, match="another configuration"):
+        build_table(parse_config(TINY), out, workers=1)
+    assert not out.exists()
+
+
+def test_existing_output_needs_overwrite(tiny_table, tmp_path):
+    out = tmp_path / "t.h5"
+    out.write_bytes(b"keep")
+    with pytest.raises(FileExistsError, match="overwrite"):
+        build_table(parse_config(TINY), out, workers=1)
+    assert out.read_bytes() == b"keep"
+
+
+def test_worker_failure_names_the_cell(tmp_path):
+    """Too few particles for the requested resolution: the build fails loudly, naming the cell."""
+    config = parse_config(TINY + "[table]\nresolution = {alpha2_bins = 64, beta2_bins = 64, spin_atoms = 64}\n")
+    with pytest.raises(BuildError, match=r"cell \(shape=prism, alpha1=30 deg, speed=100 m/s\)|cell \(shape="):
+        build_table(config, tmp_path / "t.h5", workers=1)
+    assert not (tmp_path / "t.h5").exists()
+
+
+def test_info_describes_the_table(tiny_table, capsys):
+    from tablegen.cli import main
+    assert main(["info", str(tiny_table)]) == 0
+    out = capsys.readouterr().out
+    for text in ("format version 1.0", "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
+                 "3000 particles"):
+        assert text in out
+
+
+def test_reader_rejects_version_missing_dataset_and_truncation(tiny_table, tmp_path):
+    import shutil
+    bad = tmp_path / "v.h5"
+    shutil.copy(tiny_table, bad)
+    with h5py.File(bad, "a") as f:
+        f.attrs["format_version"] = np.array([9, 0])
+    with pytest.raises(DataFormatError, match=r"v\.h5.*version 9\.0"):
+        read_table(bad)
+    shutil.copy(tiny_table, bad)
+    with h5py.File(bad, "a") as f:
+        del f["cells/speed_q"]
+    with pytest.raises(DataFormatError, match="cells/speed_q"):
+        read_table(bad)
+    data = tiny_table.read_bytes()
+    bad.write_bytes(data[: len(data) // 3])
+    with pytest.raises(DataFormatError, match="v.h5"):
+        read_table(bad)
