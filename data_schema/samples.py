@@ -28,6 +28,9 @@ import numpy as np
 
 from data_schema.common import DataFormatError, atomic_output, check_file, write_header
 
+# particle shapes; a shape's code in files (dataset ``shape_code``) is its index here
+SHAPE_NAMES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
+
 SAMPLES_FILE_TYPE = "rebound_samples"
 SAMPLES_VERSION = (1, 0)
 

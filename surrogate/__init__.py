@@ -1,1 +1,18 @@
-"""surrogate: the runtime rebound sampler (reads tables made by tablegen; never imports it)."""
+"""surrogate: the runtime rebound sampler.
+
+Reads tables made by ``tablegen build`` through :mod:`data_schema` and never
+imports :mod:`tablegen`, so a flow solver installs the runtime alone::
+
+    import surrogate
+    table = surrogate.load("table.h5")
+    V_out, Omega_out, status = surrogate.sample_global(table, V, normals, half_size, shape="prism",
+                                                       random_state=1)
+
+From numba code, call :func:`surrogate.kernels.rebound` with ``table.kernel_data``.
+"""
+
+from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
+from surrogate.table import SurrogateTable, load
+
+__all__ = ["LocalDraws", "SurrogateTable", "check_random_state", "load", "mix_cdf", "sample_global",
+           "sample_local"]

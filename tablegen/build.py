@@ -17,6 +17,7 @@ that path never holds a half-written table; the checkpoint is then removed.
 from __future__ import annotations
 
 import datetime
+import multiprocessing
 import os
 import shutil
 import tempfile
@@ -147,7 +148,10 @@ def _run_local(config, tasks, checkpoint, workers, bar) -> None:
     if not tasks:
         return
     threads = max(1, (os.cpu_count() or 1) // workers)
-    with ProcessPoolExecutor(max_workers=workers, initializer=_worker_init, initargs=(threads,)) as pool:
+    # spawn, not fork: forking a process whose numba kernels already ran on OpenMP threads is unsafe
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_worker_init,
+                             initargs=(threads,)) as pool:
         futures = {pool.submit(compute_cell, config, *task): task for task in tasks}
         try:
             for future in as_completed(futures):

@@ -40,10 +40,11 @@ import numpy as np
 from scipy.spatial import ConvexHull
 from scipy.special import ndtr, ndtri
 
+from data_schema.samples import SHAPE_NAMES
 from tablegen._jit import JIT
 
 ELLIPSOID, PRISM, CUT_PRISM, TETRAHEDRON = 0, 1, 2, 3
-SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
+SHAPES = SHAPE_NAMES
 MIX = "mix"
 MAX_VERTICES = 24
 DEFAULT_KAPPA = 0.3

@@ -1,0 +1,190 @@
+"""NumPy API of the runtime sampler: validated, vectorised draws of reflected states.
+
+Two entry points:
+
+* :func:`sample_local` — for arrays of incidence angle α1 (deg) and speed |V⁻|
+  (m/s), the reflected state (α2, β2, s, Ω⁺a/|V⁻|) in the local frame (wall
+  y = 0, normal +Y, impact plane XY);
+* :func:`sample_global` — the solver's API: incident velocities and wall
+  normals in any global frame in, V⁺ (m/s) and Ω⁺ (rad/s) out.
+
+Both accept a shape name or a mix of shapes, ``random_state`` (int, Generator
+or None) and ``clamp``: by default an incident state outside the table's grid
+is an error; with ``clamp=True`` the dimensionless law at the nearest grid
+edge is used (and scaled by the particle's actual speed).
+Each particle gets a status: 0 rebounded, 1 trapped (rolling along or
+deposited on the wall, drawn with its tabulated probability; its V⁺ and Ω⁺
+are NaN, not a made-up rebound).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from data_schema.samples import SHAPE_NAMES
+from surrogate.kernels import U_PER_DRAW, draw_local_batch, rebound_batch
+from surrogate.table import SurrogateTable
+
+NORMAL_TOLERANCE = 1e-6
+
+
+class LocalDraws(NamedTuple):
+    """Reflected states in the local frame (arrays of length n)."""
+
+    alpha2: np.ndarray        # rad, in [0, π]
+    beta2: np.ndarray         # rad, in [−π/2, π/2]
+    speed_ratio: np.ndarray   # |V⁺|/|V⁻|
+    omega: np.ndarray         # (n, 3) Ω⁺ a/|V⁻|, local frame
+    status: np.ndarray        # int8: 0 rebounded, 1 trapped
+
+
+def check_random_state(random_state) -> np.random.Generator:
+    """A Generator from an int seed, a Generator (used as is) or None (fresh entropy)."""
+    if isinstance(random_state, np.random.Generator):
+        return random_state
+    if random_state is None or (isinstance(random_state, (int, np.integer)) and not isinstance(random_state, bool)
+                                and random_state >= 0):
+        return np.random.default_rng(random_state)
+    raise ValueError(f"The 'random_state' parameter must be a non-negative int, a numpy Generator or None; "
+                     f"got {random_state!r}.")
+
+
+def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
+    """Cumulative shape weights in the table's shape order.
+
+    ``shape`` is a shape name, a dict {shape: weight}, or a sequence of four
+    weights in the order ellipsoid, prism, cut_prism, tetrahedron. Weights must
+    be non-negative and sum to 1 (within 1e-9); a shape with positive weight
+    must be in the table.
+    """
+    if isinstance(shape, str):
+        weights = {shape: 1.0}
+    elif isinstance(shape, dict):
+        weights = dict(shape)
+    else:
+        values = list(shape)
+        if len(values) != len(SHAPE_NAMES):
+            raise ValueError(f"The 'shape' mix must have {len(SHAPE_NAMES)} weights ({', '.join(SHAPE_NAMES)}); "
+                             f"got {values!r}.")
+        weights = dict(zip(SHAPE_NAMES, values))
+    for name, w in weights.items():
+        if name not in SHAPE_NAMES:
+            raise ValueError(f"The 'shape' parameter must name one of {', '.join(SHAPE_NAMES)}; got {name!r}.")
+        if not (np.isfinite(w) and w >= 0):
+            raise ValueError(f"The mix weight of {name!r} must be finite and >= 0; got {w!r}.")
+        if w > 0 and name not in table.shapes:
+            raise ValueError(f"shape {name!r} is not in the table {table.path} (it holds {', '.join(table.shapes)}).")
+    total = sum(weights.values())
+    if abs(total - 1.0) > 1e-9:
+        raise ValueError(f"The mix weights must sum to 1; got {total!r} from {weights!r}.")
+    cdf = np.cumsum([weights.get(name, 0.0) for name in table.shapes])
+    cdf[-1] = 1.0
+    return cdf
+
+
+def _check_range(name, values, bounds, clamp, units) -> None:
+    """Non-finite values are always an error; out-of-range ones unless ``clamp``.
+
+    With ``clamp`` the kernels use the law of the nearest grid edge (the
+    dimensionless reflected state), applied to the particle's actual speed.
+    """
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise ValueError(f"The '{name}' value at index {bad[0]} is not finite: {values[bad[0]]!r}.")
+    if clamp:
+        return
+    lo, hi = bounds
+    bad = np.flatnonzero((values < lo) | (values > hi))
+    if bad.size:
+        raise ValueError(f"The '{name}' value {values[bad[0]]!r} {units} (index {bad[0]}) is outside the table's "
+                         f"range [{lo:g}, {hi:g}]; pass clamp=True to use the law at the nearest grid edge.")
+
+
+def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random_state=None,
+                 clamp: bool = False) -> LocalDraws:
+    """Draw one reflected state per entry of ``alpha1`` (deg) and ``speed`` (m/s).
+
+    ``alpha1`` and ``speed`` are broadcast together; their common shape is
+    flattened to n draws.
+    """
+    a, v = np.broadcast_arrays(np.asarray(alpha1, dtype=np.float64), np.asarray(speed, dtype=np.float64))
+    a, v = a.ravel(), v.ravel()
+    _check_range("alpha1", a, table.alpha1_range, clamp, "deg")
+    _check_range("speed", v, table.speed_range, clamp, "m/s")
+    cdf = mix_cdf(table, shape)
+    rng = check_random_state(random_state)
+    u = rng.random((len(a), U_PER_DRAW))
+    out = np.empty((len(a), 6))
+    status = np.empty(len(a), dtype=np.int8)
+    draw_local_batch(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), u, out, status)
+    return LocalDraws(alpha2=out[:, 0], beta2=out[:, 1], speed_ratio=out[:, 2], omega=out[:, 3:], status=status)
+
+
+def _vectors(name, value, n=None):
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 3 or (n is not None and arr.shape[0] not in (1, n)):
+        raise ValueError(f"The '{name}' parameter must have shape (N, 3); got {np.shape(value)}.")
+    bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1))
+    if bad.size:
+        raise ValueError(f"The '{name}' vector at index {bad[0]} is not finite: {arr[bad[0]]!r}.")
+    return arr
+
+
+def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
+                  clamp: bool = False):
+    """Reflected velocities and spins of particles hitting walls, in the global frame.
+
+    Parameters
+    ----------
+    table : a loaded table (:func:`surrogate.load`).
+    velocity : (N, 3) incident velocities V⁻, m/s; each must move into its wall (V⁻·n < 0).
+    normal : (N, 3) or (3,) wall unit normals pointing into the gas; normals whose
+        length differs from 1 by more than 1e-6 are rejected, not normalised.
+    half_size : (N,) or scalar, particle half-size a in m (half the largest extent).
+    shape : shape name or mix (see :func:`mix_cdf`).
+    random_state : int, Generator or None.
+    clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
+        edge instead of raising.
+
+    Returns
+    -------
+    (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8); NaN rows for
+    trapped particles.
+    """
+    V = _vectors("velocity", velocity)
+    n_particles = V.shape[0]
+    nrm = np.broadcast_to(_vectors("normal", normal, n_particles), (n_particles, 3))
+    length = np.linalg.norm(nrm, axis=1)
+    bad = np.flatnonzero(np.abs(length - 1.0) > NORMAL_TOLERANCE)
+    if bad.size:
+        raise ValueError(f"The 'normal' at index {bad[0]} has length {length[bad[0]]!r}; wall normals must be "
+                         f"unit vectors (|n| - 1 within {NORMAL_TOLERANCE}).")
+    speed = np.linalg.norm(V, axis=1)
+    bad = np.flatnonzero(speed == 0)
+    if bad.size:
+        raise ValueError(f"The 'velocity' at index {bad[0]} is zero; a particle must move into the wall.")
+    vn = np.einsum("ij,ij->i", V, nrm)
+    bad = np.flatnonzero(vn >= 0)
+    if bad.size:
+        raise ValueError(f"The 'velocity' at index {bad[0]} does not move into the wall: V.n = {vn[bad[0]]!r} "
+                         f"m/s must be < 0.")
+    a = np.broadcast_to(np.asarray(half_size, dtype=np.float64), (n_particles,))
+    bad = np.flatnonzero(~(np.isfinite(a) & (a > 0)))
+    if bad.size:
+        raise ValueError(f"The 'half_size' at index {bad[0]} must be finite and > 0 m; got {a[bad[0]]!r}.")
+    alpha1 = np.degrees(np.arctan2(-vn, np.sqrt(np.maximum(speed ** 2 - vn ** 2, 0.0))))
+    _check_range("alpha1", alpha1, table.alpha1_range, clamp, "deg")
+    _check_range("speed", speed, table.speed_range, clamp, "m/s")
+    cdf = mix_cdf(table, shape)
+    rng = check_random_state(random_state)
+    u = rng.random((n_particles, U_PER_DRAW))
+    V_out = np.empty((n_particles, 3))
+    W_out = np.empty((n_particles, 3))
+    status = np.empty(n_particles, dtype=np.int8)
+    rebound_batch(table.kernel_data, cdf, np.ascontiguousarray(V), np.ascontiguousarray(nrm),
+                  np.ascontiguousarray(a), u, V_out, W_out, status)
+    return V_out, W_out, status

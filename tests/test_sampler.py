@@ -1,0 +1,221 @@
+"""Runtime sampler: frames, interpolation, mix, trapped draws, numba API, errors."""
+
+import subprocess
+import sys
+
+import numba
+import numpy as np
+import pytest
+from scipy import stats
+from scipy.spatial.transform import Rotation
+
+import surrogate
+from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
+from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch
+
+
+def test_runtime_does_not_import_tablegen():
+    code = ("import sys, surrogate, surrogate.cli, surrogate.kernels, surrogate.sampling, surrogate.table; "
+            "sys.exit(any(m == 'tablegen' or m.startswith('tablegen.') for m in sys.modules))")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+def test_loaded_table_is_immutable(small_table):
+    with pytest.raises(ValueError):
+        small_table.kernel_data.speed_q[0, 0, 0, 0, 0, 0] = 1.0
+    assert all(a.flags.c_contiguous for a in small_table.kernel_data)
+
+
+def _local_velocity(d, speed):
+    cb = np.cos(d.beta2)
+    return speed * d.speed_ratio[:, None] * np.column_stack(
+        [cb * np.cos(d.alpha2), cb * np.sin(d.alpha2), np.sin(d.beta2)])
+
+
+def test_global_equals_local_in_the_model_frame(small_table):
+    """Wall y = 0, normal +Y, V⁻ in the XY plane moving +X: the global API is the local law."""
+    n, speed, alpha1 = 500, 150.0, 60.0
+    a1 = np.radians(alpha1)
+    V = np.tile([speed * np.cos(a1), -speed * np.sin(a1), 0.0], (n, 1))
+    V_out, W_out, status = surrogate.sample_global(small_table, V, [0.0, 1.0, 0.0], 2e-4, "prism", random_state=4)
+    d = surrogate.sample_local(small_table, np.full(n, alpha1), speed, "prism", random_state=4)
+    np.testing.assert_array_equal(status, d.status)
+    np.testing.assert_allclose(V_out, _local_velocity(d, speed), rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(W_out, d.omega * speed / 2e-4, rtol=1e-12, atol=1e-6)
+
+
+def test_global_frame_is_rotation_equivariant(small_table):
+    """Rotating the incident velocity and the wall rotates the outcome (same random numbers)."""
+    rng = np.random.default_rng(0)
+    n = 400
+    normal = np.tile([0.0, 1.0, 0.0], (n, 1))
+    a1 = np.radians(rng.uniform(30, 90, n))
+    phi = rng.uniform(0, 2 * np.pi, n)
+    speed = rng.uniform(50, 250, n)
+    V = np.column_stack([speed * np.cos(a1) * np.cos(phi), -speed * np.sin(a1), speed * np.cos(a1) * np.sin(phi)])
+    Q = Rotation.random(random_state=1).as_matrix()
+    out1 = surrogate.sample_global(small_table, V, normal, 1e-3, [0.25] * 4, random_state=7)
+    out2 = surrogate.sample_global(small_table, V @ Q.T, normal @ Q.T, 1e-3, [0.25] * 4, random_state=7)
+    np.testing.assert_array_equal(out1[2], out2[2])
+    np.testing.assert_allclose(out2[0], out1[0] @ Q.T, atol=1e-9 * 250)
+    np.testing.assert_allclose(out2[1], out1[1] @ Q.T, atol=1e-9 * 250 / 1e-3)
+
+
+def test_normal_impact_picks_a_uniform_in_wall_axis(small_table):
+    """V⁻ ∥ −n: the impact plane is undefined, the tangential rebound direction is uniform.
+
+    Kolmogorov–Smirnov against the uniform law on (−π, π]: with 4000 draws and
+    the seed fixed, a p-value below 1e-3 would mean a preferred direction.
+    """
+    n = 4000
+    normal = np.array([0.0, 0.0, 1.0])
+    V_out, _, status = surrogate.sample_global(small_table, np.tile([0.0, 0.0, -200.0], (n, 1)), normal, 1e-3,
+                                               "cut_prism", random_state=3)
+    ok = status == STATUS_REBOUNDED
+    assert np.all(V_out[ok, 2] > 0)
+    azimuth = np.arctan2(V_out[ok, 1], V_out[ok, 0])
+    assert stats.kstest(azimuth, stats.uniform(loc=-np.pi, scale=2 * np.pi).cdf).pvalue > 1e-3
+
+
+def test_mirror_sign_and_ranges(small_table):
+    """β2, Ω_x, Ω_y are symmetric about 0 (mean within 4 standard errors, fixed seed)."""
+    d = surrogate.sample_local(small_table, np.full(20000, 60.0), 150.0, "tetrahedron", random_state=5)
+    ok = d.status == STATUS_REBOUNDED
+    for x in (d.beta2[ok], d.omega[ok, 0], d.omega[ok, 1]):
+        assert abs(x.mean()) < 4 * x.std() / np.sqrt(ok.sum())
+    assert np.all((d.alpha2[ok] >= 0) & (d.alpha2[ok] <= np.pi))
+    assert np.all((d.speed_ratio[ok] > 0) & (d.speed_ratio[ok] <= 1))
+
+
+def test_stochastic_interpolation_mixes_the_neighbours(small_table):
+    """Between grid points the law is the weighted mixture of the neighbouring cells.
+
+    At α1 = 40° (w = 1/3 towards 60°) the mean of α2 is the weighted mean of the
+    cell means; with 40 000 draws the tolerance is 4 standard errors of each mean.
+    At a grid point the neighbour is never used.
+    """
+    n = 40000
+    m30, m40, m60 = (surrogate.sample_local(small_table, np.full(n, a), 150.0, "prism", random_state=k).alpha2
+                     for k, a in ((1, 30.0), (2, 40.0), (3, 60.0)))
+    expected = (2 * m30.mean() + m60.mean()) / 3
+    se = np.sqrt((2 / 3) ** 2 * m30.var() / n + (1 / 3) ** 2 * m60.var() / n + m40.var() / n)
+    assert abs(m40.mean() - expected) < 4 * se
+    assert abs(m30.mean() - m60.mean()) > 20 * se          # the test has power
+    at_grid = surrogate.sample_local(small_table, np.full(n, 60.0), 150.0, "prism", random_state=3).alpha2
+    np.testing.assert_array_equal(at_grid, m60)
+
+
+def test_trapped_fraction_matches_the_table(small_table):
+    """Ellipsoids at normal impact and 250 m/s get trapped; the drawn fraction matches the table (4σ binomial)."""
+    s = small_table.shapes.index("ellipsoid")
+    p = small_table.kernel_data.p_trapped[s, 2, 2]
+    assert p > 0.005
+    n = 40000
+    d = surrogate.sample_local(small_table, np.full(n, 90.0), 250.0, "ellipsoid", random_state=8)
+    trapped = d.status == STATUS_TRAPPED
+    assert abs(trapped.mean() - p) < 4 * np.sqrt(p * (1 - p) / n)
+    assert np.all(np.isnan(d.alpha2[trapped])) and not np.any(np.isnan(d.alpha2[~trapped]))
+
+
+def test_a_pure_mix_is_the_single_shape(small_table):
+    a = surrogate.sample_local(small_table, np.full(1000, 45.0), 150.0, "prism", random_state=9)
+    b = surrogate.sample_local(small_table, np.full(1000, 45.0), 150.0, {"prism": 1.0}, random_state=9)
+    np.testing.assert_array_equal(a.alpha2, b.alpha2)
+
+
+def test_reproducible_and_generator_accepted(small_table):
+    a = surrogate.sample_local(small_table, np.full(100, 45.0), 150.0, "prism", random_state=1)
+    b = surrogate.sample_local(small_table, np.full(100, 45.0), 150.0, "prism",
+                               random_state=np.random.default_rng(1))
+    np.testing.assert_array_equal(a.alpha2, b.alpha2)
+
+
+@numba.njit
+def _solver_loop(data, cdf, V, n, a, seed):
+    """What a user's numba particle loop does: its own RNG, its own scratch, our kernel."""
+    np.random.seed(seed)
+    V_out = np.empty_like(V)
+    W_out = np.empty_like(V)
+    status = np.empty(V.shape[0], dtype=np.int8)
+    u = np.empty(U_PER_DRAW)
+    work = np.empty(12)
+    U = np.empty((V.shape[0], U_PER_DRAW))
+    for i in range(V.shape[0]):
+        for k in range(U_PER_DRAW):
+            u[k] = np.random.random()
+        U[i] = u
+        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i], work)
+    return V_out, W_out, status, U
+
+
+def test_callable_from_a_numba_loop(small_table):
+    m = 300
+    rng = np.random.default_rng(2)
+    V = np.column_stack([rng.uniform(20, 100, m), -rng.uniform(60, 200, m), rng.uniform(-50, 50, m)])
+    n = np.tile([0.0, 1.0, 0.0], (m, 1))
+    a = np.full(m, 1e-4)
+    cdf = surrogate.mix_cdf(small_table, [0.25] * 4)
+    V1, W1, s1, U = _solver_loop(small_table.kernel_data, cdf, V, n, a, 42)
+    V2, W2, s2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_batch(small_table.kernel_data, cdf, V, n, a, U, V2, W2, s2)
+    np.testing.assert_array_equal(s1, s2)
+    np.testing.assert_array_equal(V1, V2)
+    np.testing.assert_array_equal(W1, W2)
+    assert np.all(s1 == STATUS_REBOUNDED)
+
+
+BAD_GLOBAL = [
+    (dict(velocity=[[10.0, 5.0, 0.0]]), "does not move into the wall"),
+    (dict(velocity=[[0.0, 0.0, 0.0]]), "is zero"),
+    (dict(velocity=[[np.nan, -100.0, 0.0]]), "not finite"),
+    (dict(velocity=[[np.inf, -100.0, 0.0]]), "not finite"),
+    (dict(normal=[0.0, 2.0, 0.0]), "unit vectors"),
+    (dict(half_size=0.0), "half_size"),
+    (dict(velocity=[[10.0, -400.0, 0.0]]), r"'speed' value .* outside the table's range \[50, 250\]"),
+    (dict(velocity=[[200.0, -10.0, 0.0]]), r"'alpha1' value .* outside the table's range \[30, 90\]"),
+    (dict(shape=[0.5, 0.6, 0.0, -0.1]), "must be finite and >= 0"),
+    (dict(shape=[0.5, 0.6, 0.0, 0.0]), "sum to 1"),
+    (dict(shape="sphere"), "must name one of"),
+    (dict(random_state=-1), "random_state"),
+]
+
+
+@pytest.mark.parametrize("kwargs, message", BAD_GLOBAL)
+def test_bad_input_is_rejected_with_the_value(small_table, kwargs, message):
+    args = dict(velocity=[[100.0, -100.0, 0.0]], normal=[0.0, 1.0, 0.0], half_size=1e-4, shape="prism",
+                random_state=0) | kwargs
+    with pytest.raises(ValueError, match=message):
+        surrogate.sample_global(small_table, **args)
+
+
+def test_clamp_uses_the_nearest_edge(small_table):
+    far = surrogate.sample_local(small_table, np.full(500, 90.0), 400.0, "prism", random_state=1, clamp=True)
+    edge = surrogate.sample_local(small_table, np.full(500, 90.0), 250.0, "prism", random_state=1)
+    np.testing.assert_array_equal(far.alpha2, edge.alpha2)
+    with pytest.raises(ValueError, match="not finite"):
+        surrogate.sample_local(small_table, np.nan, 100.0, "prism", clamp=True)
+
+
+def test_shape_missing_from_the_table(tmp_path):
+    from tablegen.build import build_table
+    from tablegen.config import parse_config
+    path = build_table(parse_config("[grid]\nalpha1_deg=[45.0]\nspeed_m_s=[100.0]\nshapes=[\"prism\"]\n"
+                                    "[simulation]\nparticles_per_cell=3000\n"), tmp_path / "p.h5", workers=1)
+    table = surrogate.load(path)
+    with pytest.raises(ValueError, match="'tetrahedron' is not in the table"):
+        surrogate.sample_local(table, 45.0, 100.0, "tetrahedron")
+
+
+def test_cli_sample_writes_the_raw_layout(small_table_path, tmp_path):
+    out = tmp_path / "s.h5"
+    subprocess.run([sys.executable, "-m", "surrogate.cli", "sample", "--table", str(small_table_path),
+                    "--alpha1", "45", "--speed", "100", "--mix", "0.1,0.2,0.3,0.4", "-n", "2000", "--seed", "5",
+                    "--out", str(out)], check=True, capture_output=True)
+    s = read_samples(out)
+    assert len(s) == 2000 and s.producer == "surrogate sample" and np.all(s.n_collisions == -1)
+    ok = s.rebounded
+    np.testing.assert_allclose(np.linalg.norm(s.velocity[ok], axis=1) / 100.0, s.speed_ratio[ok])
+    bad = subprocess.run([sys.executable, "-m", "surrogate.cli", "sample", "--table", str(small_table_path),
+                          "--alpha1", "10", "--speed", "100", "--shape", "prism", "-n", "5"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "alpha1" in bad.stderr
