@@ -28,6 +28,8 @@ import numpy as np
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 
 U_PER_DRAW = 9
+WORK_SIZE = 12          # scratch floats :func:`rebound` needs
+STATUS_INVALID = -1     # returned by :func:`rebound` for an incident state that does not hit the wall
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 
@@ -120,11 +122,13 @@ def impact_frame(V, n, u_axis, ex, ez):
     if vt > 1e-12 * speed:
         ex[0], ex[1], ex[2] = tx / vt, ty / vt, tz / vt
     else:
-        # orthonormal basis (p, q) of the wall plane, then a uniform angle
-        k = 0 if abs(n[0]) <= abs(n[1]) and abs(n[0]) <= abs(n[2]) else (1 if abs(n[1]) <= abs(n[2]) else 2)
-        e = np.zeros(3)
-        e[k] = 1.0
-        px, py, pz = n[1] * e[2] - n[2] * e[1], n[2] * e[0] - n[0] * e[2], n[0] * e[1] - n[1] * e[0]
+        # orthonormal basis (p, q) of the wall plane: p = n × e_k with e_k the axis least aligned with n
+        if abs(n[0]) <= abs(n[1]) and abs(n[0]) <= abs(n[2]):
+            px, py, pz = 0.0, n[2], -n[1]
+        elif abs(n[1]) <= abs(n[2]):
+            px, py, pz = -n[2], 0.0, n[0]
+        else:
+            px, py, pz = n[1], -n[0], 0.0
         pn = math.sqrt(px * px + py * py + pz * pz)
         px, py, pz = px / pn, py / pn, pz / pn
         qx, qy, qz = n[1] * pz - n[2] * py, n[2] * px - n[0] * pz, n[0] * py - n[1] * px
@@ -149,17 +153,25 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, work):
     n : (3,) unit wall normal pointing into the gas.
     a : particle half-size (half its largest extent), m.
     u : (U_PER_DRAW,) uniforms in [0, 1).
-    V_out, W_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN if trapped).
-    work : (12,) scratch array.
+    V_out, W_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
+    work : (WORK_SIZE,) scratch array.
 
-    The impact frame is ex (tangential direction of V), n, ez = ex × n; the
-    local draw is rotated back into the global frame. The mirror symmetry of
-    the model is applied with a random sign inside :func:`draw_local`. Inputs
-    are not validated here (the Python API does it).
+    Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
+    move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
+    (tangential direction of V), n, ez = ex × n; the local draw is rotated back
+    into the global frame. The mirror symmetry of the model is applied with a
+    random sign inside :func:`draw_local`. An α1 or |V⁻| outside the table's
+    grid uses the law at the nearest grid edge (check ``table.alpha1_range``
+    and ``table.speed_range`` beforehand if that matters); n is assumed unit.
     """
     ex = work[0:3]
     ez = work[3:6]
     state = work[6:12]
+    vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
+    if not vn < 0.0 or not math.isfinite(V[0] + V[1] + V[2]):
+        V_out[:] = np.nan
+        W_out[:] = np.nan
+        return STATUS_INVALID
     alpha1, speed = impact_frame(V, n, u[8], ex, ez)
     status = draw_local(data, mix_cdf, alpha1, speed, u, state)
     if status != STATUS_REBOUNDED:
@@ -180,7 +192,7 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, work):
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status):
     """:func:`rebound` for every row (parallel); u has shape (N, U_PER_DRAW)."""
     for i in numba.prange(V.shape[0]):
-        work = np.empty(12)
+        work = np.empty(WORK_SIZE)
         status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], work)
 
 

@@ -54,12 +54,15 @@ def check_random_state(random_state) -> np.random.Generator:
 def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
     """Cumulative shape weights in the table's shape order.
 
-    ``shape`` is a shape name, a dict {shape: weight}, or a sequence of four
-    weights in the order ellipsoid, prism, cut_prism, tetrahedron. Weights must
+    ``shape`` is a shape name, ``"mix"`` (equal weights over the table's
+    shapes), a dict {shape: weight}, or a sequence of four weights in the order
+    ellipsoid, prism, cut_prism, tetrahedron. Weights must
     be non-negative and sum to 1 (within 1e-9); a shape with positive weight
     must be in the table.
     """
-    if isinstance(shape, str):
+    if isinstance(shape, str) and shape == "mix":
+        weights = {name: 1.0 / len(table.shapes) for name in table.shapes}
+    elif isinstance(shape, str):
         weights = {shape: 1.0}
     elif isinstance(shape, dict):
         weights = dict(shape)

@@ -93,7 +93,7 @@ class BuildConfig:
         return hashlib.sha256(self.to_toml().encode()).hexdigest()
 
 
-_SCHEMA = {
+CONFIG_KEYS = {
     "grid": {"alpha1_deg", "speed_m_s", "shapes"},
     "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
     "table": {"resolution"},
@@ -127,7 +127,7 @@ def parse_config(text: str, source: str = "<config>") -> BuildConfig:
         raise ConfigError(f"{source}: not valid TOML: {exc}") from exc
     _check_keys(data, source)
     base = {} if source == "preset 'default'" else tomllib.loads(preset_text("default"))
-    merged = {section: {**base.get(section, {}), **data.get(section, {})} for section in _SCHEMA}
+    merged = {section: {**base.get(section, {}), **data.get(section, {})} for section in CONFIG_KEYS}
     grid, sim, table = merged["grid"], merged["simulation"], merged["table"]
 
     alpha1 = _grid_values(grid.get("alpha1_deg"), "grid.alpha1_deg", source)
@@ -188,14 +188,14 @@ def parse_config(text: str, source: str = "<config>") -> BuildConfig:
 
 def _check_keys(data: dict, source: str) -> None:
     for section, value in data.items():
-        if section not in _SCHEMA:
-            raise ConfigError(f"{source}: unknown section '[{section}]'; sections: {', '.join(_SCHEMA)}")
+        if section not in CONFIG_KEYS:
+            raise ConfigError(f"{source}: unknown section '[{section}]'; sections: {', '.join(CONFIG_KEYS)}")
         if not isinstance(value, dict):
             raise ConfigError(f"{source}: '{section}' must be a table ([{section}])")
         for key in value:
-            if key not in _SCHEMA[section]:
+            if key not in CONFIG_KEYS[section]:
                 raise ConfigError(f"{source}: unknown key '{section}.{key}'; allowed in [{section}]: "
-                                  f"{', '.join(sorted(_SCHEMA[section]))}")
+                                  f"{', '.join(sorted(CONFIG_KEYS[section]))}")
 
 
 def _integer(value, key, minimum, source) -> int:

@@ -1,14 +1,20 @@
 """The prose format description stays in step with data_schema."""
 
+import dataclasses
 from pathlib import Path
 
 import pytest
 
-from data_schema import samples
+from data_schema import samples, table
+from tablegen.config import CONFIG_KEYS
 
 FORMAT_DOC = (Path(__file__).resolve().parents[1] / "docs" / "format.md").read_text()
 NAMES = ([samples.SAMPLES_FILE_TYPE, "file_type", "format_version", "samples"]
-         + list(samples.REQUIRED_DATASETS) + list(samples.OPTIONAL_DATASETS) + list(samples.REQUIRED_ATTRS))
+         + list(samples.REQUIRED_DATASETS) + list(samples.OPTIONAL_DATASETS) + list(samples.REQUIRED_ATTRS)
+         + [table.TABLE_FILE_TYPE, "created", "package_version", "config", "config_sha256", "master_seed",
+            "grid/alpha1_deg", "grid/speed_m_s", "grid/shapes", "kappa", "n_max", "particles_per_cell"]
+         + [f.name for f in dataclasses.fields(table.TableResolution)]
+         + list(table.CELL_DATASETS))
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -16,6 +22,12 @@ def test_every_schema_name_is_documented(name):
     assert f"`{name}`" in FORMAT_DOC, f"docs/format.md does not describe `{name}`"
 
 
-def test_documented_version_matches_code():
-    major, minor = samples.SAMPLES_VERSION
-    assert f"({major}, {minor})" in FORMAT_DOC
+@pytest.mark.parametrize("version", [samples.SAMPLES_VERSION, table.TABLE_VERSION])
+def test_documented_version_matches_code(version):
+    assert f"({version[0]}, {version[1]})" in FORMAT_DOC
+
+
+def test_config_keys_are_documented():
+    for section, keys in CONFIG_KEYS.items():
+        for key in keys:
+            assert f"`{section}.{key}`" in FORMAT_DOC, f"{section}.{key}"

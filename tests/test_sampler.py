@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch
+from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, WORK_SIZE, rebound, rebound_batch
 
 
 def test_runtime_does_not_import_tablegen():
@@ -138,7 +138,7 @@ def _solver_loop(data, cdf, V, n, a, seed):
     W_out = np.empty_like(V)
     status = np.empty(V.shape[0], dtype=np.int8)
     u = np.empty(U_PER_DRAW)
-    work = np.empty(12)
+    work = np.empty(WORK_SIZE)
     U = np.empty((V.shape[0], U_PER_DRAW))
     for i in range(V.shape[0]):
         for k in range(U_PER_DRAW):
@@ -219,3 +219,12 @@ def test_cli_sample_writes_the_raw_layout(small_table_path, tmp_path):
                           "--alpha1", "10", "--speed", "100", "--shape", "prism", "-n", "5"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "alpha1" in bad.stderr
+
+
+def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
+    V_out, W_out = np.empty(3), np.empty(3)
+    cdf = surrogate.mix_cdf(small_table, "mix")
+    status = rebound(small_table.kernel_data, cdf, np.array([10.0, 5.0, 0.0]), np.array([0.0, 1.0, 0.0]), 1e-4,
+                     np.full(U_PER_DRAW, 0.5), V_out, W_out, np.empty(WORK_SIZE))
+    assert status == STATUS_INVALID and np.all(np.isnan(V_out)) and np.all(np.isnan(W_out))
+    np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])
