@@ -43,7 +43,7 @@ try:
 except ImportError:            # running from a source checkout without `pip install -e .`
     sys.path.insert(0, str(REPO))
     import surrogate
-from surrogate import STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, WORK_SIZE
+from surrogate import STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW
 from surrogate.kernels import rebound
 
 # A small table for this beam: alpha1 down to 2 deg (grazing hits on the
@@ -99,7 +99,6 @@ def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size
     v_out = np.full((n, 3), np.nan)
     outcome = np.full(n, MISSED, dtype=np.int8)
     u = np.empty(U_PER_DRAW)                   # uniforms for one kernel call
-    work = np.empty(WORK_SIZE)                 # kernel scratch
     normal = np.empty(3)
     vo = np.empty(3)
     wo = np.empty(3)                           # Omega+ in rad/s (not used here)
@@ -122,7 +121,7 @@ def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size
             if model == TABLE:
                 for k in range(U_PER_DRAW):
                     u[k] = np.random.random()
-                status = rebound(data, mix_cdf, v, normal, half_size, u, vo, wo, work)
+                status = rebound(data, mix_cdf, v, normal, half_size, u, vo, wo)
             else:
                 vn = v[0] * normal[0] + v[1] * normal[1] + v[2] * normal[2]
                 for k in range(3):

@@ -8,14 +8,14 @@ imports :mod:`tablegen`, so a flow solver installs the runtime alone::
     V_out, Omega_out, status = surrogate.sample_global(table, V, normals, half_size, shape="prism",
                                                        random_state=1)
 
-From numba code, call :func:`surrogate.kernels.rebound` with ``table.kernel_data``,
-``U_PER_DRAW`` uniforms and a scratch array of ``WORK_SIZE`` floats per call.
+From numba code, call :func:`surrogate.kernels.rebound` with ``table.kernel_data``
+and ``U_PER_DRAW`` uniforms per call.
 """
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, WORK_SIZE
+from surrogate.kernels import STATUS_INVALID, U_PER_DRAW
 from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 
 __all__ = ["LocalDraws", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW",
-           "WORK_SIZE", "check_random_state", "load", "mix_cdf", "sample_global", "sample_local"]
+           "check_random_state", "load", "mix_cdf", "sample_global", "sample_local"]

@@ -28,16 +28,15 @@ import numpy as np
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 
 U_PER_DRAW = 9
-WORK_SIZE = 12          # scratch floats :func:`rebound` needs
 STATUS_INVALID = -1     # returned by :func:`rebound` for an incident state that does not hit the wall
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def locate(grid, lookup, scale, x):
     """(j, w): grid interval [g_j, g_{j+1}] holding x and the weight of g_{j+1} (O(1)).
 
-    x must lie within the grid; a one-point grid gives (0, 0).
+    Outside the grid, the nearest edge with weight 0 or 1; a one-point grid gives (0, 0).
     """
     n = grid.shape[0]
     if n == 1:
@@ -51,44 +50,44 @@ def locate(grid, lookup, scale, x):
     return j, min(max(w, 0.0), 1.0)
 
 
-@numba.njit(**JIT)
-def _lerp_row(q, u):
-    """Quantile function q (levels k/L, k = 0..L) at probability u ∈ [0, 1): (value, interval)."""
-    levels = q.shape[0] - 1
+@numba.njit(inline="always", **JIT)
+def _interval(u, levels):
+    """Fractional index u·levels split into (k, f) with 0 ≤ k < levels."""
     p = u * levels
     k = min(int(p), levels - 1)
-    return q[k] + (p - k) * (q[k + 1] - q[k]), k
+    return k, p - k
 
 
-@numba.njit(**JIT)
-def draw_folded(data, s, ia, iv, u_alpha2, u_beta2, u_speed, out):
-    """Draw the folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of one cell into out[0:6].
+@numba.njit(inline="always", **JIT)
+def draw_folded(data, s, ia, iv, u_alpha2, u_beta2, u_speed):
+    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell (s, ia, iv).
 
     Chain (data_schema.table): α2 from its quantile function; its equal-count
     bin b = ⌊u·B1⌋ selects the |β2| quantile function; the |β2| bin c = ⌊u·B2⌋
     selects the leaf whose s quantile function gives s and, from the same
-    interval index, the spin atom.
+    interval index, the spin atom. Arrays are read by scalar indices only (no
+    views, so no reference counting on the hot path).
     """
-    a_q = data.alpha2_q[s, ia, iv]
-    b_q = data.beta2_q[s, ia, iv]
-    s_q = data.speed_q[s, ia, iv]
-    out[0], _ = _lerp_row(a_q, u_alpha2)
-    b = min(int(u_alpha2 * b_q.shape[0]), b_q.shape[0] - 1)
-    out[1], _ = _lerp_row(b_q[b], u_beta2)
-    c = min(int(u_beta2 * s_q.shape[1]), s_q.shape[1] - 1)
-    out[2], j = _lerp_row(s_q[b, c], u_speed)
-    spin = data.spin[s, ia, iv, b, c, j]
-    out[3], out[4], out[5] = spin[0], spin[1], spin[2]
+    aq, bq, sq, spin = data.alpha2_q, data.beta2_q, data.speed_q, data.spin
+    k, f = _interval(u_alpha2, aq.shape[3] - 1)
+    alpha2 = aq[s, ia, iv, k] + f * (aq[s, ia, iv, k + 1] - aq[s, ia, iv, k])
+    b = min(int(u_alpha2 * bq.shape[3]), bq.shape[3] - 1)
+    k, f = _interval(u_beta2, bq.shape[4] - 1)
+    beta2 = bq[s, ia, iv, b, k] + f * (bq[s, ia, iv, b, k + 1] - bq[s, ia, iv, b, k])
+    c = min(int(u_beta2 * sq.shape[4]), sq.shape[4] - 1)
+    j, f = _interval(u_speed, sq.shape[5] - 1)
+    speed = sq[s, ia, iv, b, c, j] + f * (sq[s, ia, iv, b, c, j + 1] - sq[s, ia, iv, b, c, j])
+    return alpha2, beta2, speed, spin[s, ia, iv, b, c, j, 0], spin[s, ia, iv, b, c, j, 1], spin[s, ia, iv, b, c, j, 2]
 
 
-@numba.njit(**JIT)
-def draw_local(data, mix_cdf, alpha1, speed, u, out):
-    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame; returns the status.
+@numba.njit(inline="always", **JIT)
+def draw_local(data, mix_cdf, alpha1, speed, u):
+    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame.
 
     ``mix_cdf`` is the cumulative shape weights in the table's shape order
-    (last entry 1). On return out[0:6] = (α2, β2, s, Ω_x a/|V⁻|, Ω_y a/|V⁻|,
-    Ω_z a/|V⁻|) for a rebound, NaN for a trapped particle. α1 and |V⁻| must lie
-    within the table's grid (the Python API checks or clamps them).
+    (last entry 1). Returns (status, α2, β2, s, Ω_x a/|V⁻|, Ω_y a/|V⁻|,
+    Ω_z a/|V⁻|); the state is NaN for a trapped particle. Outside the table's
+    grid the law at the nearest grid edge is used.
     """
     shape = 0
     while shape < mix_cdf.shape[0] - 1 and u[0] >= mix_cdf[shape]:
@@ -98,29 +97,28 @@ def draw_local(data, mix_cdf, alpha1, speed, u, out):
     ia = ja + 1 if u[1] < wa else ja
     iv = jv + 1 if u[2] < wv else jv
     if u[3] < data.p_trapped[shape, ia, iv]:
-        out[:6] = np.nan
-        return STATUS_TRAPPED
-    draw_folded(data, shape, ia, iv, u[4], u[5], u[6], out)
+        return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+    alpha2, beta2, s, wx, wy, wz = draw_folded(data, shape, ia, iv, u[4], u[5], u[6])
     if u[7] < 0.5:
-        out[1] = -out[1]
-        out[3] = -out[3]
-        out[4] = -out[4]
-    return STATUS_REBOUNDED
+        return STATUS_REBOUNDED, alpha2, -beta2, s, -wx, -wy, wz
+    return STATUS_REBOUNDED, alpha2, beta2, s, wx, wy, wz
 
 
-@numba.njit(**JIT)
-def impact_frame(V, n, u_axis, ex, ez):
-    """In-wall axes of the impact frame: ex along the tangential part of V, ez = ex × n.
+@numba.njit(inline="always", **JIT)
+def impact_frame(V, n, u_axis):
+    """Impact frame of V on a wall of unit normal n.
 
-    At normal impact (tangential part below 1e-12 |V|) ex is uniform in the wall
-    plane, from ``u_axis``. Returns (α1 in degrees, |V|).
+    ex is the direction of the tangential part of V (uniform in the wall plane,
+    from ``u_axis``, at normal impact: tangential part below 1e-12 |V|); the
+    frame is (ex, n, ez = ex × n). Returns (α1 in degrees, |V|, ex, ez) with
+    ex and ez as 3-tuples.
     """
     vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
     tx, ty, tz = V[0] - vn * n[0], V[1] - vn * n[1], V[2] - vn * n[2]
     vt = math.sqrt(tx * tx + ty * ty + tz * tz)
     speed = math.sqrt(vn * vn + vt * vt)
     if vt > 1e-12 * speed:
-        ex[0], ex[1], ex[2] = tx / vt, ty / vt, tz / vt
+        ex0, ex1, ex2 = tx / vt, ty / vt, tz / vt
     else:
         # orthonormal basis (p, q) of the wall plane: p = n × e_k with e_k the axis least aligned with n
         if abs(n[0]) <= abs(n[1]) and abs(n[0]) <= abs(n[2]):
@@ -134,15 +132,13 @@ def impact_frame(V, n, u_axis, ex, ez):
         qx, qy, qz = n[1] * pz - n[2] * py, n[2] * px - n[0] * pz, n[0] * py - n[1] * px
         phi = 2.0 * math.pi * u_axis
         c, s = math.cos(phi), math.sin(phi)
-        ex[0], ex[1], ex[2] = c * px + s * qx, c * py + s * qy, c * pz + s * qz
-    ez[0] = ex[1] * n[2] - ex[2] * n[1]
-    ez[1] = ex[2] * n[0] - ex[0] * n[2]
-    ez[2] = ex[0] * n[1] - ex[1] * n[0]
-    return math.degrees(math.atan2(-vn, vt)), speed
+        ex0, ex1, ex2 = c * px + s * qx, c * py + s * qy, c * pz + s * qz
+    ez = (ex1 * n[2] - ex2 * n[1], ex2 * n[0] - ex0 * n[2], ex0 * n[1] - ex1 * n[0])
+    return math.degrees(math.atan2(-vn, vt)), speed, (ex0, ex1, ex2), ez
 
 
 @numba.njit(**JIT)
-def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, work):
+def rebound(data, mix_cdf, V, n, a, u, V_out, W_out):
     """Reflected state of one particle in the global frame; returns the status.
 
     Parameters
@@ -150,11 +146,10 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, work):
     data : ``table.kernel_data``.
     mix_cdf : cumulative shape weights (table shape order).
     V : (3,) incident velocity, m/s; must move into the wall (V·n < 0).
-    n : (3,) unit wall normal pointing into the gas.
+    n : (3,) unit wall normal pointing into the gas (not checked here).
     a : particle half-size (half its largest extent), m.
     u : (U_PER_DRAW,) uniforms in [0, 1).
     V_out, W_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
-    work : (WORK_SIZE,) scratch array.
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
     move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
@@ -162,29 +157,28 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, work):
     into the global frame. The mirror symmetry of the model is applied with a
     random sign inside :func:`draw_local`. An α1 or |V⁻| outside the table's
     grid uses the law at the nearest grid edge (check ``table.alpha1_range``
-    and ``table.speed_range`` beforehand if that matters); n is assumed unit.
+    and ``table.speed_range`` beforehand if that matters).
     """
-    ex = work[0:3]
-    ez = work[3:6]
-    state = work[6:12]
     vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
     if not vn < 0.0 or not math.isfinite(V[0] + V[1] + V[2]):
-        V_out[:] = np.nan
-        W_out[:] = np.nan
+        for k in range(3):
+            V_out[k] = np.nan
+            W_out[k] = np.nan
         return STATUS_INVALID
-    alpha1, speed = impact_frame(V, n, u[8], ex, ez)
-    status = draw_local(data, mix_cdf, alpha1, speed, u, state)
+    alpha1, speed, ex, ez = impact_frame(V, n, u[8])
+    status, alpha2, beta2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1, speed, u)
     if status != STATUS_REBOUNDED:
-        V_out[:] = np.nan
-        W_out[:] = np.nan
+        for k in range(3):
+            V_out[k] = np.nan
+            W_out[k] = np.nan
         return status
-    alpha2, beta2 = state[0], state[1]
-    vs = state[2] * speed
-    lx, ly, lz = vs * math.cos(beta2) * math.cos(alpha2), vs * math.cos(beta2) * math.sin(alpha2), vs * math.sin(beta2)
+    vs = s * speed
+    cb = math.cos(beta2)
+    lx, ly, lz = vs * cb * math.cos(alpha2), vs * cb * math.sin(alpha2), vs * math.sin(beta2)
     w = speed / a
     for k in range(3):
         V_out[k] = lx * ex[k] + ly * n[k] + lz * ez[k]
-        W_out[k] = w * (state[3] * ex[k] + state[4] * n[k] + state[5] * ez[k])
+        W_out[k] = w * (wx * ex[k] + wy * n[k] + wz * ez[k])
     return status
 
 
@@ -192,12 +186,13 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, work):
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status):
     """:func:`rebound` for every row (parallel); u has shape (N, U_PER_DRAW)."""
     for i in numba.prange(V.shape[0]):
-        work = np.empty(WORK_SIZE)
-        status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], work)
+        status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i])
 
 
 @numba.njit(parallel=True, **JIT)
 def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status):
-    """:func:`draw_local` for every row (parallel)."""
+    """:func:`draw_local` for every row (parallel); out has shape (N, 6)."""
     for i in numba.prange(alpha1.shape[0]):
-        status[i] = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i], out[i])
+        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i])
+        status[i] = st
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = a2, b2, s, wx, wy, wz

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, WORK_SIZE, rebound, rebound_batch
+from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch
 
 
 def test_runtime_does_not_import_tablegen():
@@ -138,13 +138,12 @@ def _solver_loop(data, cdf, V, n, a, seed):
     W_out = np.empty_like(V)
     status = np.empty(V.shape[0], dtype=np.int8)
     u = np.empty(U_PER_DRAW)
-    work = np.empty(WORK_SIZE)
     U = np.empty((V.shape[0], U_PER_DRAW))
     for i in range(V.shape[0]):
         for k in range(U_PER_DRAW):
             u[k] = np.random.random()
         U[i] = u
-        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i], work)
+        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i])
     return V_out, W_out, status, U
 
 
@@ -225,6 +224,6 @@ def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
     V_out, W_out = np.empty(3), np.empty(3)
     cdf = surrogate.mix_cdf(small_table, "mix")
     status = rebound(small_table.kernel_data, cdf, np.array([10.0, 5.0, 0.0]), np.array([0.0, 1.0, 0.0]), 1e-4,
-                     np.full(U_PER_DRAW, 0.5), V_out, W_out, np.empty(WORK_SIZE))
+                     np.full(U_PER_DRAW, 0.5), V_out, W_out)
     assert status == STATUS_INVALID and np.all(np.isnan(V_out)) and np.all(np.isnan(W_out))
     np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])

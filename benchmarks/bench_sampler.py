@@ -1,0 +1,464 @@
+"""Cost per reflected state of the runtime sampler, against the direct model and a restitution bounce.
+
+What is measured
+----------------
+One run times the same N random incident states (default N = 10⁶) five ways
+and prints the cost in ns per reflected state:
+
+(a) ``surrogate.sample_global(table, V, normals, a, shape, random_state)``, the
+    vectorised NumPy API in the global frame, with numba's default thread
+    count and with one numba thread. The time covers the whole call: input
+    checks, the NumPy draw of the U_PER_DRAW uniforms per state, the parallel
+    kernel and the outputs. Two breakdown rows time
+    ``surrogate.kernels.rebound_batch`` alone on pre-drawn uniforms;
+(b) ``surrogate.kernels.rebound`` called from a user's ``@njit`` loop on one
+    thread, as a flow solver would call it: the loop draws the U_PER_DRAW
+    uniforms of each state with ``np.random.random()`` (numba's generator) and
+    that cost is included. Variant (b'): the same loop reading pre-drawn
+    uniforms; breakdown row: the ``np.random.random()`` draws alone;
+(c) the direct model, ``tablegen.simulate.simulate`` with the shape mix, one
+    thread, per particle simulated (whatever its status; NumPy input draws,
+    kernel and result assembly included). The states' α1 distribution
+    (uniform 10–90°) is represented by the midpoints of four equal α1 bins
+    (20, 40, 60, 80°) and their |V⁻| distribution by the midpoints of two
+    equal speed bins, each configuration weighted equally: the figure is the
+    mean of the eight costs per particle;
+(d) a deterministic bounce of a sphere with the Grant & Tabakoff (1975)
+    restitution polynomials (:func:`grant_tabakoff_bounce`), from a user's
+    ``@njit`` loop on one thread, built like our kernel's impact frame: what a
+    solver pays today for a rebound without scatter.
+
+Then it prints the ratios (c)/(b) (target ≥ 10⁴: the sampler must be that
+much cheaper than the direct model), (b)/(d) (target ≤ 3: at most three
+times a deterministic restitution law) and (b) itself (target ≤ 100 ns per
+state per core), each with 'met' or 'NOT met'. The exit code does not depend
+on the targets.
+
+Incident states: speed uniform over the table's speed range, α1 uniform over
+10–90° (within the table's α1 range), random unit wall normals, the
+tangential direction uniform in the wall plane, half-size a = 0.1 mm, the
+four shapes with equal weights. Trapped draws count as reflected states (the
+sampler returns their status, as the direct model does).
+
+The table is built by the script into a temporary folder (α1 ∈ {10, 30, 50,
+70, 90}°, |V⁻| ∈ {100, 200, 300} m/s, the four shapes, 20000 particles per
+cell: about a minute on two cores; --quick: 4096 particles per cell), or
+given with ``--table PATH``. Note that such a small table (a few MB) stays in
+the CPU caches; a production table (tens of MB) adds memory latency to the
+per-state cost.
+
+How
+---
+Everything timed is compiled and run once first (warm-up; numba compilation
+is excluded). Each figure is the best of ``--repeats`` runs timed with
+``time.perf_counter``; process CPU time over wall time of that run is shown
+as cpu/wall: about the thread count used on an idle machine, lower when other
+processes took the CPU (then the wall figures are pessimistic; the load
+average is printed, and the column cpu ns/st, process CPU time per state of
+that run, is the steadier figure). Ratios and targets use wall times. For (c),
+pilot runs size n so that each timed run takes about ``--min-time`` seconds.
+The output starts with the machine details.
+
+Run from the repository root::
+
+    PYTHONPATH=. python benchmarks/bench_sampler.py                  # full run (a few minutes)
+    PYTHONPATH=. python benchmarks/bench_sampler.py --quick          # smoke run
+    PYTHONPATH=. python benchmarks/bench_sampler.py --table table.h5 --json sampler.json
+
+If the numbers look odd after kernel edits, delete numba's cache files
+(``*.nbi``, ``*.nbc``) and rerun.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+import surrogate
+from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch
+
+SEED = 20240601
+HALF_SIZE = 1e-4                    # m, particle half-size a
+ALPHA1_RANGE = (10.0, 90.0)         # deg, incident states
+SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
+TABLE_TOML = """
+[grid]
+alpha1_deg = [10.0, 30.0, 50.0, 70.0, 90.0]
+speed_m_s = [100.0, 200.0, 300.0]
+shapes = ["ellipsoid", "prism", "cut_prism", "tetrahedron"]
+[simulation]
+particles_per_cell = {particles}
+"""
+DIRECT_ALPHA1 = (20.0, 40.0, 60.0, 80.0)   # midpoints of four equal bins of 10–90°
+TARGET_DIRECT_OVER_KERNEL = 1e4            # (c)/(b) at least
+TARGET_KERNEL_OVER_BOUNCE = 3.0            # (b)/(d) at most
+TARGET_KERNEL_NS = 100.0                   # (b) at most, ns per state per core
+
+# the bench's own kernels: the options of surrogate.kernels.JIT, without the on-disk cache
+JIT = dict(nogil=True, fastmath=False, error_model="numpy")
+
+# Grant & Tabakoff (1975), sand on 2024 aluminium: coefficients of 1, β1, β1², β1³ (β1 in rad)
+GT_NORMAL = (1.0, -0.4159, 0.4994, -0.292)
+GT_TANGENTIAL = (1.0, -2.12, 3.0775, -1.1)
+
+
+def machine_info() -> dict:
+    """Platform, CPU and library versions of this run (as in bench_direct.py)."""
+    cpu = platform.processor() or "unknown"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return {"platform": platform.platform(), "cpu": cpu, "cpu_count": os.cpu_count(),
+            "usable_cpus": usable, "python": platform.python_version(),
+            "numpy": np.__version__, "numba": numba.__version__,
+            "numba_default_threads": numba.get_num_threads(),
+            "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
+
+
+# ----------------------------------------------------------------------------- kernels of the bench
+
+@numba.njit(**JIT)
+def grant_tabakoff_bounce(V, n, V_out):
+    """Deterministic rebound of a sphere with the Grant & Tabakoff restitution ratios.
+
+    Restitution ratios as polynomials in the impact angle β1 (rad, from the
+    wall), sand on 2024 aluminium, from G. Grant and W. Tabakoff, "Erosion
+    prediction in turbomachinery resulting from environmental solid
+    particles", J. Aircraft 12(5), 471–478 (1975)::
+
+        e_N = V⁺_n / V⁻_n = 1 − 0.4159 β1 + 0.4994 β1² − 0.292 β1³
+        e_T = V⁺_t / V⁻_t = 1 − 2.12 β1 + 3.0775 β1² − 1.1 β1³
+
+    (coefficients as specified for this benchmark; some secondary sources
+    print e_N with −0.4994 β1² + 0.292 β1³. The signs do not change the cost
+    measured.) The wall frame is built as in
+    :func:`surrogate.kernels.impact_frame`: normal and tangential parts of V,
+    ex along the tangential part, ez = ex × n, β1 = atan2(−V·n, |V_t|); then
+    V⁺ = e_T |V_t| ex − e_N (V·n) n + 0·ez is rotated back into the global
+    frame as :func:`surrogate.kernels.rebound` does. No spin, no scatter.
+    V must move into the wall (V·n < 0). Scalars only, like the sampler kernel.
+    """
+    vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
+    tx, ty, tz = V[0] - vn * n[0], V[1] - vn * n[1], V[2] - vn * n[2]
+    vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+    speed = math.sqrt(vn * vn + vt * vt)
+    if vt > 1e-12 * speed:
+        ex = (tx / vt, ty / vt, tz / vt)
+    else:                       # normal impact: no tangential part to scale
+        ex = (0.0, 0.0, 0.0)
+    ez = (ex[1] * n[2] - ex[2] * n[1], ex[2] * n[0] - ex[0] * n[2], ex[0] * n[1] - ex[1] * n[0])
+    beta1 = math.atan2(-vn, vt)
+    e_n = GT_NORMAL[0] + beta1 * (GT_NORMAL[1] + beta1 * (GT_NORMAL[2] + beta1 * GT_NORMAL[3]))
+    e_t = GT_TANGENTIAL[0] + beta1 * (GT_TANGENTIAL[1] + beta1 * (GT_TANGENTIAL[2] + beta1 * GT_TANGENTIAL[3]))
+    lx, ly, lz = e_t * vt, -e_n * vn, 0.0
+    for k in range(3):
+        V_out[k] = lx * ex[k] + ly * n[k] + lz * ez[k]
+
+
+@numba.njit(**JIT)
+def seed_numba_rng(seed):
+    """Seed numba's own generator (the one np.random.random() uses in nopython code)."""
+    np.random.seed(seed)
+
+
+@numba.njit(**JIT)
+def loop_kernel_rng(data, cdf, V, n, a, V_out, W_out, status):
+    """(b) A solver's loop: its own uniforms from np.random.random(), our kernel."""
+    u = np.empty(U_PER_DRAW)
+    for i in range(V.shape[0]):
+        for k in range(U_PER_DRAW):
+            u[k] = np.random.random()
+        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i])
+
+
+@numba.njit(**JIT)
+def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, W_out, status):
+    """(b') The same loop on pre-drawn uniforms U (N, U_PER_DRAW)."""
+    for i in range(V.shape[0]):
+        status[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V_out[i], W_out[i])
+
+
+@numba.njit(**JIT)
+def loop_rng_only(count, out):
+    """Breakdown of (b): the U_PER_DRAW np.random.random() draws per state alone (summed into out)."""
+    s = 0.0
+    for i in range(count):
+        for k in range(U_PER_DRAW):
+            s += np.random.random()
+    out[0] = s
+
+
+@numba.njit(**JIT)
+def loop_bounce(V, n, V_out):
+    """(d) A solver's loop over the deterministic Grant–Tabakoff bounce."""
+    for i in range(V.shape[0]):
+        grant_tabakoff_bounce(V[i], n[i], V_out[i])
+
+
+# ----------------------------------------------------------------------------- inputs
+
+def build_bench_table(folder: Path, particles: int) -> tuple:
+    """Build the bench's table into ``folder``; returns (path, seconds)."""
+    from tablegen.build import build_table
+    from tablegen.config import parse_config
+    path = folder / "bench_sampler_table.h5"
+    start = time.perf_counter()
+    build_table(parse_config(TABLE_TOML.format(particles=particles), "bench_sampler table"), path)
+    return path, time.perf_counter() - start
+
+
+def incident_states(table, count: int, seed: int) -> dict:
+    """Random incident states within the table's grid (see the module doc).
+
+    α1 and |V⁻| are drawn from ranges shrunk by a relative 1e-9 so that the
+    values recomputed from V (rounding) stay inside the grid.
+    """
+    rng = np.random.default_rng(seed)
+    a_lo, a_hi = max(ALPHA1_RANGE[0], table.alpha1_range[0]), min(ALPHA1_RANGE[1], table.alpha1_range[1])
+    v_lo, v_hi = table.speed_range
+    if a_lo > a_hi:
+        raise SystemExit(f"the table's alpha1 range {table.alpha1_range} does not meet {ALPHA1_RANGE} deg")
+    alpha1 = rng.uniform(a_lo * (1 + 1e-9), a_hi * (1 - 1e-9), count) if a_hi > a_lo else np.full(count, a_lo)
+    speed = rng.uniform(v_lo * (1 + 1e-9), v_hi * (1 - 1e-9), count) if v_hi > v_lo else np.full(count, v_lo)
+    normal = rng.standard_normal((count, 3))
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    tangent = rng.standard_normal((count, 3))
+    tangent -= np.einsum("ij,ij->i", tangent, normal)[:, None] * normal
+    tangent /= np.linalg.norm(tangent, axis=1)[:, None]
+    a_rad = np.radians(alpha1)
+    V = speed[:, None] * (np.cos(a_rad)[:, None] * tangent - np.sin(a_rad)[:, None] * normal)
+    return {"V": np.ascontiguousarray(V), "normal": np.ascontiguousarray(normal),
+            "half_size": np.full(count, HALF_SIZE), "alpha1": alpha1, "speed": speed,
+            "U": rng.random((count, U_PER_DRAW)),
+            "speed_bins": (v_lo + 0.25 * (v_hi - v_lo), v_lo + 0.75 * (v_hi - v_lo))}
+
+
+# ----------------------------------------------------------------------------- timing
+
+def best_time(fn, repeats: int, threads: int, setup=None) -> tuple:
+    """Best wall time of ``repeats`` calls of fn() on ``threads`` numba threads: (wall s, cpu s of that run).
+
+    ``setup()`` runs before each call, outside the timing.
+    """
+    saved = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        best = (math.inf, math.inf)
+        for _ in range(repeats):
+            if setup is not None:
+                setup()
+            w0, c0 = time.perf_counter(), time.process_time()
+            fn()
+            best = min(best, (time.perf_counter() - w0, time.process_time() - c0))
+    finally:
+        numba.set_num_threads(saved)
+    return best
+
+
+def row(key, label, count, threads, wall, cpu, note="") -> dict:
+    return {"key": key, "label": label, "n": count, "threads": threads, "time_s": wall,
+            "cpu_over_wall": cpu / wall, "ns_per_state": wall / count * 1e9,
+            "cpu_ns_per_state": cpu / count * 1e9, "states_per_s": count / wall, "note": note}
+
+
+def direct_cost(speed_bins, min_time: float, repeats: int) -> tuple:
+    """(c): mean ns per particle of simulate('mix', ...) over the α1 × speed configurations, one thread."""
+    from tablegen.simulate import simulate
+
+    def run(alpha1, speed, n):
+        return lambda: simulate("mix", alpha1, speed, n, seed=SEED)
+
+    simulate("mix", DIRECT_ALPHA1[0], speed_bins[0], 64, seed=SEED)     # warm-up: compile or load
+    rows = []
+    for alpha1 in DIRECT_ALPHA1:
+        for speed in speed_bins:
+            n = 500                             # grow the pilot until it takes >= min_time / 5
+            while (pilot := best_time(run(alpha1, speed, n), 1, 1)[0]) < 0.2 * min_time:
+                n = math.ceil(n * min(10.0, max(2.0, 0.3 * min_time / pilot)))
+            n = max(1, math.ceil(min_time * n / pilot))
+            wall, cpu = best_time(run(alpha1, speed, n), repeats, 1)
+            rows.append({"alpha1_deg": alpha1, "speed_m_s": speed, "n": n, "time_s": wall,
+                         "cpu_over_wall": cpu / wall, "ns_per_particle": wall / n * 1e9,
+                         "cpu_ns_per_particle": cpu / n * 1e9})
+    return float(np.mean([r["ns_per_particle"] for r in rows])), rows
+
+
+# ----------------------------------------------------------------------------- main
+
+COLUMNS = (("case", 46, "s", "label"), ("thr", 3, "d", "threads"), ("n", 9, "d", "n"),
+           ("best s", 8, ".4f", "time_s"), ("cpu/wall", 8, ".2f", "cpu_over_wall"),
+           ("ns/state", 10, ".1f", "ns_per_state"), ("cpu ns/st", 10, ".1f", "cpu_ns_per_state"),
+           ("states/s", 10, ".3g", "states_per_s"))
+
+
+def print_row(r: dict) -> None:
+    print(" ".join(f"{r[k]:{'<' if i == 0 else '>'}{w}{spec}}" for i, (_, w, spec, k) in enumerate(COLUMNS)),
+          flush=True)
+
+
+def verdict(ok: bool) -> str:
+    return "met" if ok else "NOT met"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="smoke run: N = 1e5, 1 repeat, 0.1 s per direct timing, 4096 particles per cell")
+    parser.add_argument("--table", metavar="PATH", help="use this table instead of building one")
+    parser.add_argument("-n", "--states", type=int, default=None,
+                        help="incident states N (default 1e6; --quick 1e5)")
+    parser.add_argument("--repeats", type=int, default=None, help="timed runs per figure, the best kept "
+                        "(default 3; --quick 1)")
+    parser.add_argument("--min-time", type=float, default=None,
+                        help="seconds per direct-model timing, about (default 1; --quick 0.1)")
+    parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON to FILE")
+    args = parser.parse_args(argv)
+    count = args.states or (100_000 if args.quick else 1_000_000)
+    repeats = args.repeats or (1 if args.quick else 3)
+    min_time = args.min_time or (0.1 if args.quick else 1.0)
+    particles = 4096 if args.quick else 20000
+
+    info = machine_info()
+    threads = info["numba_default_threads"]
+    print("Runtime sampler cost per reflected state (surrogate) vs direct model and a restitution bounce")
+    for key, value in info.items():
+        print(f"  {key:22s} {value}")
+
+    with tempfile.TemporaryDirectory(prefix="bench_sampler_") as tmp:
+        if args.table:
+            path, build_s = Path(args.table), None
+        else:
+            print(f"  building the table ({particles} particles per cell) ...", flush=True)
+            path, build_s = build_bench_table(Path(tmp), particles)
+        table = surrogate.load(path)
+    print(f"  table                  {'built in %.1f s' % build_s if build_s is not None else path}: "
+          f"shapes {', '.join(table.shapes)}; alpha1 [{', '.join(f'{x:g}' for x in table.alpha1_deg)}] deg; "
+          f"speed [{', '.join(f'{x:g}' for x in table.speed_m_s)}] m/s; {table.particles_per_cell} particles per cell; "
+          f"{sum(x.nbytes for x in table.kernel_data) / 1e6:.1f} MB of kernel arrays")
+    missing = [s for s in SHAPES if s not in table.shapes]
+    if missing:
+        raise SystemExit(f"the table lacks shapes {missing}; the bench draws the equal mix of all four")
+
+    st = incident_states(table, count, SEED)
+    V, nrm, a, U = st["V"], st["normal"], st["half_size"], st["U"]
+    mix = {s: 0.25 for s in SHAPES}
+    cdf = surrogate.mix_cdf(table, mix)
+    data = table.kernel_data
+    V_out, W_out = np.empty((count, 3)), np.empty((count, 3))
+    status = np.empty(count, dtype=np.int8)
+    print(f"  states                 N = {count}: speed U{table.speed_range} m/s, alpha1 "
+          f"U({st['alpha1'].min():.2f}, {st['alpha1'].max():.2f}) deg, random unit normals, a = {HALF_SIZE:g} m, "
+          f"shape mix {', '.join(f'{s} {w:g}' for s, w in mix.items())}")
+    print(f"  best of {repeats}; seed {SEED}; U_PER_DRAW = {U_PER_DRAW}")
+
+    # warm-up: compile everything timed below (a small slice; numba caches per type signature)
+    m = min(count, 1000)
+    surrogate.sample_global(table, V[:m], nrm[:m], a[:m], shape=mix, random_state=SEED)
+    rebound_batch(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
+    seed_numba_rng(SEED)
+    loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
+    loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
+    loop_rng_only(m, np.empty(1))
+    loop_bounce(V[:m], nrm[:m], V_out[:m])
+    print(f"  threading layer        {numba.threading_layer()}\n")
+
+    header = " ".join(f"{h:{'<' if i == 0 else '>'}{w}}" for i, (h, w, _, _) in enumerate(COLUMNS))
+    print(header)
+    print("-" * len(header))
+    rows = {}
+
+    def record(key, label, thr, fn, setup=None, note=""):
+        wall, cpu = best_time(fn, repeats, thr, setup)
+        rows[key] = row(key, label, count, thr, wall, cpu, note)
+        print_row(rows[key])
+
+    def api():
+        return surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED)
+
+    record("a_all", "(a) sample_global, all cores", threads, api)
+    record("a_1", "(a) sample_global, 1 numba thread", 1, api)
+    record("a_kernel_all", "    breakdown: rebound_batch alone, all cores", threads,
+           lambda: rebound_batch(data, cdf, V, nrm, a, U, V_out, W_out, status), note="pre-drawn uniforms")
+    record("a_kernel_1", "    breakdown: rebound_batch alone, 1 thread", 1,
+           lambda: rebound_batch(data, cdf, V, nrm, a, U, V_out, W_out, status), note="pre-drawn uniforms")
+    trapped_api = float(np.mean(api()[2] != 0))
+    record("b", "(b) rebound in @njit loop, np.random.random()", 1,
+           lambda: loop_kernel_rng(data, cdf, V, nrm, a, V_out, W_out, status),
+           setup=lambda: seed_numba_rng(SEED))
+    trapped_b = float(np.mean(status != 0))
+    record("b_predrawn", "(b') rebound in @njit loop, pre-drawn uniforms", 1,
+           lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status))
+    record("b_rng", f"    breakdown: {U_PER_DRAW} np.random.random() alone", 1,
+           lambda: loop_rng_only(count, np.empty(1)), setup=lambda: seed_numba_rng(SEED))
+    record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))
+
+    direct_ns, direct_rows = direct_cost(st["speed_bins"], min_time, repeats)
+    cpu_direct = float(np.mean([r["cpu_over_wall"] for r in direct_rows]))
+    rows["c"] = {"key": "c", "label": "(c) direct model simulate('mix'), mean", "n": sum(r["n"] for r in direct_rows),
+                 "threads": 1, "time_s": sum(r["time_s"] for r in direct_rows), "cpu_over_wall": cpu_direct,
+                 "ns_per_state": direct_ns, "states_per_s": 1e9 / direct_ns,
+                 "cpu_ns_per_state": float(np.mean([r["cpu_ns_per_particle"] for r in direct_rows])),
+                 "configurations": direct_rows}
+    print_row(rows["c"])
+    for r in direct_rows:
+        print(f"    alpha1 {r['alpha1_deg']:4g} deg, |V-| {r['speed_m_s']:5g} m/s: n {r['n']:7d}, "
+              f"{r['ns_per_particle']:10.1f} ns/particle, cpu/wall {r['cpu_over_wall']:.2f}, "
+              f"{r['cpu_ns_per_particle']:10.1f} cpu ns/particle")
+
+    b, d, c = rows["b"]["ns_per_state"], rows["d"]["ns_per_state"], rows["c"]["ns_per_state"]
+    ratios = {"direct_over_kernel": c / b, "kernel_over_bounce": b / d, "kernel_ns": b,
+              "kernel_predrawn_over_bounce": rows["b_predrawn"]["ns_per_state"] / d,
+              "api_1thread_over_kernel": rows["a_1"]["ns_per_state"] / b,
+              "rng_share_of_kernel": rows["b_rng"]["ns_per_state"] / b}
+    targets = {"direct_over_kernel": bool(c / b >= TARGET_DIRECT_OVER_KERNEL),
+               "kernel_over_bounce": bool(b / d <= TARGET_KERNEL_OVER_BOUNCE),
+               "kernel_ns": bool(b <= TARGET_KERNEL_NS)}
+    print(f"\ntrapped fraction drawn: (a) {trapped_api:.4f}, (b) {trapped_b:.4f}")
+    print("\nratios (ns per state over ns per state)")
+    print(f"  (c)/(b)  direct model / sampler kernel        {c / b:12.4g}   target >= {TARGET_DIRECT_OVER_KERNEL:.0e}: "
+          f"{verdict(targets['direct_over_kernel'])}")
+    print(f"  (b)/(d)  sampler kernel / Grant-Tabakoff      {b / d:12.4g}   target <= {TARGET_KERNEL_OVER_BOUNCE:g}: "
+          f"{verdict(targets['kernel_over_bounce'])}")
+    print(f"  (b)      sampler kernel, ns per state per core {b:11.4g}   target <= {TARGET_KERNEL_NS:g} ns: "
+          f"{verdict(targets['kernel_ns'])}")
+    print(f"  (b')/(d) kernel on pre-drawn uniforms / G-T   {ratios['kernel_predrawn_over_bounce']:12.4g}")
+    print(f"  (a, 1 thread)/(b) NumPy API / @njit loop      {ratios['api_1thread_over_kernel']:12.4g}")
+    print(f"  RNG share of (b)                              {ratios['rng_share_of_kernel']:12.4g}")
+    print("\nTargets are figures only: the exit code does not depend on them. Ratios and targets use the wall\n"
+          "times (ns/state). cpu/wall = process CPU time / wall time of the best run: about the thread count\n"
+          "on an idle machine; lower, other work took the CPU and the wall figures are pessimistic (cpu ns/st,\n"
+          "the process CPU time per state, is then the steadier figure; on several threads it sums them).\n"
+          "(c) counts every particle simulated, whatever its status; (c) cpu ns/st is the mean over its rows.")
+
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"machine": info, "threading_layer": numba.threading_layer(),
+                       "settings": {"states": count, "repeats": repeats, "min_time_s": min_time,
+                                    "quick": args.quick, "seed": SEED, "half_size_m": HALF_SIZE,
+                                    "table": str(path) if args.table else "built",
+                                    "table_build_s": build_s, "particles_per_cell": table.particles_per_cell,
+                                    "u_per_draw": U_PER_DRAW},
+                       "targets": {"direct_over_kernel_min": TARGET_DIRECT_OVER_KERNEL,
+                                   "kernel_over_bounce_max": TARGET_KERNEL_OVER_BOUNCE,
+                                   "kernel_ns_max": TARGET_KERNEL_NS, "met": targets},
+                       "trapped_fraction": {"a": trapped_api, "b": trapped_b},
+                       "results": rows, "ratios": ratios}, f, indent=2)
+        print(f"figures written to {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
