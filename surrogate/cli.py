@@ -57,6 +57,12 @@ def _sample(args, parser) -> int:
                                     "clamp": bool(args.clamp)})
     counts = ", ".join(f"{name} {int(np.sum(draws.status == code))}" for code, name in STATUS_NAMES.items())
     print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s, {label}: {counts}")
+    ok = samples.rebounded
+    for name, values in (("alpha2 (deg)", np.degrees(draws.alpha2[ok])), ("beta2 (deg)", np.degrees(draws.beta2[ok])),
+                         ("|V+|/|V-|", draws.speed_ratio[ok]), ("Omega_z a/|V-|", draws.omega[ok, 2])):
+        if values.size:
+            q05, q50, q95 = np.percentile(values, [5, 50, 95])
+            print(f"  {name:<15} mean {values.mean():8.3f}   5% {q05:8.3f}   median {q50:8.3f}   95% {q95:8.3f}")
     if args.out:
         print(f"samples written to {write_samples(args.out, samples, overwrite=args.overwrite)}")
     return 0

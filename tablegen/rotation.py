@@ -54,10 +54,13 @@ Method
    ``k_{n+1} = k_n^2 / (1 + k'_n)^2`` the modulus falls quadratically to zero, where
    ``sn = sin, cn = cos, dn = 1``; the chain of moduli is precomputed (it depends on the
    body and state only) and ``rotation_at`` climbs it back with a few rational
-   operations.  ``K(k) = pi/2 prod(1 + k_n)`` (DLMF 19.8.12); ``u`` is reduced to
-   ``[-K, K]`` first.  ``dn`` is formed as ``(cn^2 + (1 - k_n) sn^2) / (1 + k_n sn^2)``
-   which keeps full relative accuracy when ``dn ~ k'`` is small.  The exact separatrix
-   (``k' = 0``) uses ``sn = tanh, cn = dn = sech``.
+   operations (in homogeneous coordinates, one division in all, up to 7 levels).
+   ``K(k) = pi/2 prod(1 + k_n)`` (DLMF 19.8.12); ``u`` is reduced to ``[-K, K]`` first.
+   The moduli near 1 are formed as ``k_{n+1} = (1 - k'_n) / (1 + k'_n)`` from the
+   accurate ``k'_n``, so that neither ``K`` nor the chain loses the accuracy of ``k'``.
+   ``dn`` is formed as ``(cn^2 + (1 - k_n) sn^2) / (1 + k_n sn^2)`` which keeps full
+   relative accuracy when ``dn ~ k'`` is small.  The exact separatrix (``k' = 0``) uses
+   ``sn = tanh, cn = dn = sech``.
 
 4. *Orientation* (the construction of Celledoni, Fasso, Safstrom & Zanna, "The exact
    computation of the free rigid body motion and its use in splitting methods",
@@ -93,8 +96,13 @@ Method
    also for nearly axisymmetric bodies, where ``nu`` is tiny and ``kappa/nu`` huge.
    Carlson's integrals use the duplication algorithms of B. C. Carlson, "Numerical
    computation of real or complex elliptic integrals", Numer. Algorithms 10 (1995)
-   13-26 (series of DLMF 19.36.1 and 19.36.2).  On the exact separatrix (``k = 1``, no
-   period) ``G`` is elementary and used as it is.
+   13-26, with the series DLMF 19.36.1 and 19.36.2 continued to degrees 9 and 11 (fewer
+   duplication steps for the same truncation error); the ``R_J`` of ``G_p`` takes
+   ``cn, dn`` as the square roots of its first arguments and
+   ``(p - cn^2)(p - dn^2)(p - 1) = eta (1 + eta)(eta + k^2) sn^6`` in closed form.  The
+   complete integrals in ``f_bar`` come from the AGM that accompanies the Landen chain
+   (DLMF 19.8.6).  On the exact separatrix (``k = 1``, no period) ``G`` is elementary
+   and used as it is.
 
 5. *Steady rotations* -- ``m`` an eigenvector of the inertia tensor: a sphere, spin about
    any principal axis (including the unstable middle one, which therefore stays put
@@ -128,31 +136,44 @@ _LANDEN_KTOL = 1e-9  # stop once k_n < this: sn(w|k_n) = sin w + O(k_n^2)
 _I_MODE = 0
 _I_C = 1  # 9 entries, row-major: C (elliptic modes) or R0 (static / steady)
 _I_OMEGA = 10  # 3 entries: constant lab omega (steady mode)
-_I_J = 13  # 3 entries: working moments J_0, J_1, J_2
+_I_LJ = 13  # 3 entries: L / J_i, J_i the working moments
 _I_A = 16  # 3 entries: amplitudes a_0, a_1, a_2
 _I_NU = 19  # du/dt
 _I_U0 = 20  # u at t = 0
 _I_TWOK = 21  # 2 K(k), period of the reduction of u
-_I_L = 22  # |L|
-_I_LIN = 23  # secular rate of psi
-_I_KAPNU = 24  # kappa / nu
-_I_BETA = 25  # beta = -alpha^2 of the third-kind integral
-_I_G = 26  # sqrt(1 + beta)
-_I_GAMMA = 27  # gamma = k^2 / beta
-_I_SQD = 28  # sqrt((1 + beta) (1 + gamma))
-_I_FOFF = 29  # mean integrand f_bar (form 2) or f_bar - L (form 1)
-_I_G0 = 30  # G_p(u_0)
-_I_PERM = 31  # 3 entries: body axis of working axis i
-_I_SIGN = 34  # 3 entries: sign of working axis i
-_I_NLEV = 37  # number of Landen levels
-_I_WSCALE = 38  # 1 / prod(1 + k_n)
-_I_KN = 39  # _NLEV_MAX entries: k_n, n = 1..N
+_I_INV2K = 22  # 1 / (2 K)
+_I_L = 23  # |L|
+_I_LIN = 24  # secular rate of psi
+_I_KAPNU = 25  # kappa / nu
+_I_BETA = 26  # beta = -alpha^2 of the third-kind integral
+_I_G = 27  # g = sqrt(1 + beta)
+_I_A2G = 28  # a_2 / g
+_I_FORM2 = 29  # 1.0 if beta > 1 (reflected form 2), else 0.0
+_I_ETA = 30  # characteristic of the R_J term: beta (form 1) or gamma = k^2/beta (form 2)
+_I_DCOEF = 31  # eta (1 + eta) (eta + k^2): (p - x)(p - y)(p - z) = DCOEF sn^6 in R_J
+_I_CPI = 32  # coefficient of sn^3 R_J in G_p: -L beta/3 (form 1), L gamma/3 (form 2)
+_I_SQD = 33  # sqrt((1 + beta) (1 + gamma)) (form 2)
+_I_LSQD = 34  # L / SQD (form 2)
+_I_FOFF = 35  # mean integrand f_bar (form 2) or f_bar - L (form 1)
+_I_G0 = 36  # G_p(u_0)
+_I_PERM = 37  # 3 entries: body axis of working axis i
+_I_SIGN = 40  # 3 entries: sign of working axis i
+_I_NLEV = 43  # number of Landen levels
+_I_WSCALE = 44  # 1 / prod(1 + k_n)
+_I_KN = 45  # _NLEV_MAX entries: k_n, n = 1..N
 _I_OMKN = _I_KN + _NLEV_MAX  # _NLEV_MAX entries: 1 - k_n
 
 ROT_PARAMS_SIZE = _I_OMKN + _NLEV_MAX
-"""Length of the float64 parameter array filled by :func:`rotation_init` (87)."""
+"""Length of the float64 parameter array filled by :func:`rotation_init` (93)."""
 
 _SNAP = 16.0 * 2.220446049250313e-16  # relative size of rounding noise in R0^T ell
+
+# Duplication stops once the arguments agree to these relative spreads; the series
+# below (R_J to degree 11, R_F to degree 9) then truncate at < 6e-18 (R_J) and < 2e-18
+# (R_F) relative -- as small as the degree-5 series after the relative spreads 1.5e-3
+# and 2e-3 of Carlson's usual criterion, with one to two fewer duplication steps.
+_RJ_TOL_INV = 1.0 / 0.04
+_RF_TOL_INV = 1.0 / 0.025
 
 
 # --------------------------------------------------------------------------------------
@@ -176,15 +197,52 @@ def _carlson_rc1(e):
 
 
 @numba.njit(**JIT)
-def carlson_rf(x, y, z):
-    """Carlson's R_F(x, y, z) = 1/2 int_0^inf dt / sqrt((t+x)(t+y)(t+z)).
+def _rf_series(e2, e3):
+    """Series of R_F (DLMF 19.36.1 continued to degree 9, A^(-1/2) factored out).
 
-    x, y, z >= 0 with at most one of them zero.  Duplication theorem (Carlson 1995,
-    section 2) until the arguments agree to a relative 2e-3, then the fifth-order
-    series DLMF 19.36.1 (truncation ~ (2e-3)^6).
+    Degree-N terms: the t^N coefficient of ``(1 + E_2 t^2 - E_3 t^3)^(-1/2)`` times
+    ``(1/2)_N / (3/2)_N`` (the expansion of Carlson's R-function, DLMF 19.19.7), ``E_j``
+    the elementary symmetric functions of ``(X, Y, Z)``, ``X + Y + Z = 0``.
     """
-    a = (x + y + z) / 3.0
-    while max(abs(a - x), abs(a - y), abs(a - z)) > 2e-3 * a:
+    return 1.0 + (e2 * (-1.0 / 10.0 + e2 * (1.0 / 24.0 + e2 * (-5.0 / 208.0
+                                                            + e2 * (35.0 / 2176.0))))
+            + e3 * (1.0 / 14.0 + e2 * (-3.0 / 44.0 + e2 * (1.0 / 16.0
+                                                         - e2 * (35.0 / 608.0))))
+            + e3 * e3 * (3.0 / 104.0 - e2 * (15.0 / 272.0) + e3 * (5.0 / 304.0)))
+
+
+@numba.njit(**JIT)
+def _rj_series(e2, e3, e4, e5):
+    """Series of R_J (DLMF 19.36.2 continued to degree 11, A^(-3/2) factored out).
+
+    Degree-N terms: the t^N coefficient of ``(1 + E_2 t^2 - E_3 t^3 + E_4 t^4 -
+    E_5 t^5)^(-1/2)`` times ``(3/2)_N / (5/2)_N``, ``E_j`` the elementary symmetric
+    functions of ``(X, Y, Z, P, P)`` (their sum is 0).
+    """
+    return 1.0 + (e2 * (-3.0 / 14.0 + e2 * (9.0 / 88.0 + e2 * (-1.0 / 16.0 + e2 * (
+                    105.0 / 2432.0 - e2 * (189.0 / 5888.0)))))
+                  + e3 * (1.0 / 6.0 + e2 * (-9.0 / 52.0 + e2 * (45.0 / 272.0 + e2 * (
+                          -5.0 / 32.0 + e2 * (189.0 / 1280.0))))
+                          + e3 * (3.0 / 40.0 + e2 * (-45.0 / 304.0 + e2 * (315.0 / 1472.0))
+                                  + e3 * (5.0 / 112.0 - e2 * (21.0 / 160.0))))
+                  + e4 * (-3.0 / 22.0 + e2 * (3.0 / 20.0 + e2 * (-45.0 / 304.0
+                                                              + e2 * (105.0 / 736.0)))
+                          + e3 * (-9.0 / 68.0 + e2 * (15.0 / 56.0 - e2 * (63.0 / 160.0))
+                                  - e3 * (45.0 / 368.0))
+                          + e4 * (9.0 / 152.0 - e2 * (45.0 / 368.0) + e3 * (9.0 / 80.0)))
+                  + e5 * (3.0 / 26.0 + e2 * (-9.0 / 68.0 + e2 * (15.0 / 112.0
+                                                              - e2 * (21.0 / 160.0)))
+                          + e3 * (9.0 / 76.0 - e2 * (45.0 / 184.0) + e3 * (9.0 / 80.0))
+                          + e4 * (-3.0 / 28.0 + e2 * (9.0 / 40.0)) + e5 * (9.0 / 184.0)))
+
+
+@numba.njit(**JIT)
+def _rf_tail(x, y, z, a, fac, qx, qy, qmax):
+    """Duplication steps of R_F(x, y, z) until the spread ``fac qmax`` (``qmax`` already
+    divided by the tolerance) falls below ``a``, then the series; ``qx = A_0 - x_0``,
+    ``qy = A_0 - y_0`` and ``fac = 4^-m`` give Carlson's ``X = qx fac / A_m`` etc. free of
+    the cancellation in ``A_m - x_m``."""
+    while fac * qmax > a:
         sx = math.sqrt(x)
         sy = math.sqrt(y)
         sz = math.sqrt(z)
@@ -193,12 +251,73 @@ def carlson_rf(x, y, z):
         y = 0.25 * (y + lam)
         z = 0.25 * (z + lam)
         a = 0.25 * (a + lam)
-    dx = (a - x) / a
-    dy = (a - y) / a
+        fac *= 0.25
+    f = fac / a
+    dx = qx * f
+    dy = qy * f
     dz = -(dx + dy)
-    e2 = dx * dy - dz * dz
-    e3 = dx * dy * dz
-    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
+    return _rf_series(dx * dy - dz * dz, dx * dy * dz) / math.sqrt(a)
+
+
+@numba.njit(**JIT)
+def carlson_rf(x, y, z):
+    """Carlson's R_F(x, y, z) = 1/2 int_0^inf dt / sqrt((t+x)(t+y)(t+z)).
+
+    x, y, z >= 0 with at most one of them zero.  Duplication theorem (Carlson 1995,
+    section 2) until the arguments agree to a relative 2.5e-2, then the series DLMF
+    19.36.1 continued to degree 9 (truncation < 2e-18).
+    """
+    a = (x + y + z) / 3.0
+    qx = a - x
+    qy = a - y
+    qmax = max(abs(qx), abs(qy), abs(a - z)) * _RF_TOL_INV
+    return _rf_tail(x, y, z, a, 1.0, qx, qy, qmax)
+
+
+@numba.njit(**JIT)
+def _rf_amp(x, sx, y, sy):
+    """R_F(x, y, 1) with ``sx = sqrt(x)``, ``sy = sqrt(y)`` known: the first duplication
+    step takes no square root."""
+    a = (x + y + 1.0) / 3.0
+    qx = a - x
+    qy = a - y
+    qmax = max(abs(qx), abs(qy), abs(a - 1.0)) * _RF_TOL_INV
+    lam = sx * (sy + 1.0) + sy
+    return _rf_tail(0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (1.0 + lam),
+                    0.25 * (a + lam), 0.25, qx, qy, qmax)
+
+
+@numba.njit(**JIT)
+def _rj_tail(x, y, z, p, delta, a, fac, acc, qx, qy, qz, qmax):
+    """Duplication steps of R_J (Carlson 1995, Algorithm 3, with the R_C corrections
+    ``6 sum 4^-m R_C(1, 1 + e_m) / d_m``, ``e_m = 4^{-3m} delta / d_m^2``) until the spread
+    ``fac qmax`` falls below ``a``, then the series; as in :func:`_rf_tail`."""
+    while fac * qmax > a:
+        sx = math.sqrt(x)
+        sy = math.sqrt(y)
+        sz = math.sqrt(z)
+        sp = math.sqrt(p)
+        lam = sx * (sy + sz) + sy * sz
+        inv = 1.0 / ((sp + sx) * (sp + sy) * (sp + sz))
+        acc += fac * _carlson_rc1(fac * fac * fac * delta * inv * inv) * inv
+        x = 0.25 * (x + lam)
+        y = 0.25 * (y + lam)
+        z = 0.25 * (z + lam)
+        p = 0.25 * (p + lam)
+        a = 0.25 * (a + lam)
+        fac *= 0.25
+    f = fac / a
+    dx = qx * f
+    dy = qy * f
+    dz = qz * f
+    dp = -0.5 * (dx + dy + dz)
+    xyz = dx * dy * dz
+    dp2 = dp * dp
+    e2 = dx * dy + dx * dz + dy * dz - 3.0 * dp2
+    e3 = xyz + 2.0 * e2 * dp + 4.0 * dp2 * dp
+    e4 = (2.0 * xyz + e2 * dp + 3.0 * dp2 * dp) * dp
+    e5 = xyz * dp2
+    return fac * _rj_series(e2, e3, e4, e5) / (a * math.sqrt(a)) + 6.0 * acc
 
 
 @numba.njit(**JIT)
@@ -207,38 +326,34 @@ def carlson_rj(x, y, z, p):
 
     x, y, z >= 0 with at most one of them zero, p > 0.  Duplication with the R_C
     corrections of Carlson (1995), Algorithm 3 (``e_m = 4^{-3m} delta / d_m^2``), until
-    the arguments agree to a relative 1.5e-3, then the series DLMF 19.36.2.
+    the arguments agree to a relative 4e-2, then the series DLMF 19.36.2 continued to
+    degree 11 (truncation < 6e-18).
     """
     delta = (p - x) * (p - y) * (p - z)
     a = (x + y + z + 2.0 * p) / 5.0
-    fac = 1.0  # 4^-m
-    acc = 0.0
-    while max(abs(a - x), abs(a - y), abs(a - z), abs(a - p)) > 1.5e-3 * a:
-        sx = math.sqrt(x)
-        sy = math.sqrt(y)
-        sz = math.sqrt(z)
-        sp = math.sqrt(p)
-        lam = sx * (sy + sz) + sy * sz
-        d = (sp + sx) * (sp + sy) * (sp + sz)
-        acc += fac * _carlson_rc1(fac * fac * fac * delta / (d * d)) / d
-        x = 0.25 * (x + lam)
-        y = 0.25 * (y + lam)
-        z = 0.25 * (z + lam)
-        p = 0.25 * (p + lam)
-        a = 0.25 * (a + lam)
-        fac *= 0.25
-    dx = (a - x) / a
-    dy = (a - y) / a
-    dz = (a - z) / a
-    dp = -0.5 * (dx + dy + dz)
-    xyz = dx * dy * dz
-    e2 = dx * dy + dx * dz + dy * dz - 3.0 * dp * dp
-    e3 = xyz + 2.0 * e2 * dp + 4.0 * dp * dp * dp
-    e4 = (2.0 * xyz + e2 * dp + 3.0 * dp * dp * dp) * dp
-    e5 = xyz * dp * dp
-    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
-              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)
-    return fac * series / (a * math.sqrt(a)) + 6.0 * acc
+    qx = a - x
+    qy = a - y
+    qz = a - z
+    qmax = max(abs(qx), abs(qy), abs(qz), abs(a - p)) * _RJ_TOL_INV
+    return _rj_tail(x, y, z, p, delta, a, 1.0, 0.0, qx, qy, qz, qmax)
+
+
+@numba.njit(**JIT)
+def _rj_amp(x, sx, y, sy, p, delta):
+    """R_J(x, y, 1, p) with ``sx = sqrt(x)``, ``sy = sqrt(y)`` and
+    ``delta = (p - x)(p - y)(p - 1) >= 0`` given (in closed form by the caller, free of
+    cancellation): the first duplication step takes one square root."""
+    a = (x + y + 1.0 + 2.0 * p) / 5.0
+    qx = a - x
+    qy = a - y
+    qz = a - 1.0
+    qmax = max(abs(qx), abs(qy), abs(qz), abs(a - p)) * _RJ_TOL_INV
+    sp = math.sqrt(p)
+    lam = sx * (sy + 1.0) + sy
+    inv = 1.0 / ((sp + sx) * (sp + sy) * (sp + 1.0))
+    acc = _carlson_rc1(delta * inv * inv) * inv
+    return _rj_tail(0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (1.0 + lam),
+                    0.25 * (p + lam), delta, 0.25 * (a + lam), 0.25, acc, qx, qy, qz, qmax)
 
 
 # --------------------------------------------------------------------------------------
@@ -305,19 +420,42 @@ def _landen_sncndn(w, params):
 
         sn_{n-1} = (1 + k_n) s / (1 + k_n s^2),   cn_{n-1} = cn_n dn_n / (1 + k_n s^2),
         dn_{n-1} = (cn_n^2 + (1 - k_n) s^2) / (1 + k_n s^2)   [= (1 - k_n s^2)/(...)].
+
+    Up to 7 levels (k' > ~1e-9) the climb runs in homogeneous coordinates
+    ``sn = S/W, cn = C/W, dn = D/V`` (``W, V >= 1`` grow at most like ``2^706``), which
+    replaces the division of each level by a few products: one division at the end.
     """
     s = math.sin(w)
     c = math.cos(w)
     d = 1.0
-    for i in range(int(params[_I_NLEV]) - 1, -1, -1):
+    nlev = int(params[_I_NLEV])
+    if nlev > 7:
+        for i in range(nlev - 1, -1, -1):
+            kn = params[_I_KN + i]
+            s2 = s * s
+            r = 1.0 / (1.0 + kn * s2)
+            d_new = (c * c + params[_I_OMKN + i] * s2) * r
+            s = (1.0 + kn) * s * r
+            c = c * d * r
+            d = d_new
+        return s, c, d
+    # homogeneous coordinates: S' = (1 + k) S W V, C' = C D W, W' = V P, D' = C^2 +
+    # (1 - k) S^2, V' = P with P = W^2 + k S^2 (the common denominator of the level)
+    w = 1.0
+    v = 1.0
+    for i in range(nlev - 1, -1, -1):
         kn = params[_I_KN + i]
         s2 = s * s
-        r = 1.0 / (1.0 + kn * s2)
-        d_new = (c * c + params[_I_OMKN + i] * s2) * r
-        s = (1.0 + kn) * s * r
-        c = c * d * r
-        d = d_new
-    return s, c, d
+        w2 = w * w
+        pw = w2 + kn * s2
+        dn = c * c + params[_I_OMKN + i] * s2
+        s = (1.0 + kn) * s * (w * v)
+        c = c * d * w
+        w = v * pw
+        v = pw
+        d = dn
+    rw = 1.0 / w
+    return s * rw, c * rw, d / v
 
 
 @numba.njit(**JIT)
@@ -325,7 +463,8 @@ def _pi_minus_f(s, c, d, beta):
     """Pi(phi; -beta | k) - F(phi | k) = -beta/3 sn^3 R_J(cn^2, dn^2, 1, 1 + beta sn^2).
 
     DLMF 19.25.14 with ``sin phi = s``, ``cos phi = c >= 0``, ``Delta = d``; free of
-    cancellation for ``beta <= 1`` (form 1).
+    cancellation for ``beta <= 1`` (form 1).  (The kernels use the same formula through
+    :func:`_gp_amp`.)
     """
     if beta == 0.0 or s == 0.0:
         return 0.0
@@ -350,6 +489,34 @@ def _pi_large_beta(s, c, d, gamma, sqd):
 
 
 @numba.njit(**JIT)
+def _gp_amp(params, s, c, d, ur):
+    """Periodic part ``G_p`` of the phase integral at ``sin phi = s``, ``cos phi = c >= 0``,
+    ``Delta = d``, ``phi = am u_r``, ``u_r`` in ``[-K, K]`` (see :func:`_phase_state`)::
+
+        form 1 (beta <= 1):  G_p = L (Pi - F) - a_2 T - (f_bar - L) u_r,
+        form 2 (beta > 1):   G_p = L Pi - a_2 T - f_bar u_r,
+
+    ``Pi - F`` (form 1) as in :func:`_pi_minus_f`, ``Pi`` (form 2) as in
+    :func:`_pi_large_beta`, ``T = atan(g tan phi) / g``.  The ``R_J`` term
+    ``CPI sn^3 R_J(cn^2, dn^2, 1, 1 + eta sn^2)`` gets its square roots ``cn, dn`` and
+    ``(p - x)(p - y)(p - 1) = eta (1 + eta)(eta + k^2) sn^6`` in closed form.
+    ``eta = 0`` only for an axisymmetric body with ``J_0 = J_1`` (``k = beta = 0``,
+    ``am u = u``, ``f = L - a_2 = f_bar``): there ``G_p = 0`` identically.
+    """
+    eta = params[_I_ETA]
+    if eta == 0.0:
+        return 0.0
+    gp = -params[_I_A2G] * math.atan2(params[_I_G] * s, c) - params[_I_FOFF] * ur
+    if params[_I_FORM2] != 0.0:
+        gp += params[_I_LSQD] * math.atan2(params[_I_SQD] * s, c * d)
+    if s != 0.0:
+        s2 = s * s
+        rj = _rj_amp(c * c, c, d * d, d, 1.0 + eta * s2, params[_I_DCOEF] * (s2 * s2 * s2))
+        gp += params[_I_CPI] * (s * s2) * rj
+    return gp
+
+
+@numba.njit(**JIT)
 def _phase_state(params, u):
     """sn(u), cn(u), dn(u) and the periodic part ``G_p(u)`` of the phase integral.
 
@@ -358,39 +525,27 @@ def _phase_state(params, u):
     ``g = sqrt(1 + beta)`` (module docstring, item 4).  With ``u = u_r + 2jK``,
     ``u_r`` in ``[-K, K]`` (``am u_r`` in ``[-pi/2, pi/2]``, ``F(am u_r) = u_r``), and
     ``f_bar`` the mean of ``f``, ``G(u) = f_bar u + G_p(u_r)``: the secular part goes
-    into the rate of psi and only the periodic part is evaluated::
-
-        form 1 (beta <= 1):  G_p = L (Pi - F) - a_2 T - (f_bar - L) u_r,
-        form 2 (beta > 1):   G_p = L Pi - a_2 T - f_bar u_r,
-
-    each with the cancellation-free expression of ``Pi`` for its range of ``beta``.
+    into the rate of psi and only the periodic part is evaluated (:func:`_gp_amp`), each
+    form with the cancellation-free expression of ``Pi`` for its range of ``beta``.
     (The rounding of ``u`` then perturbs psi by ``eps |u| kappa (f - f_bar) / nu``, the
     size of the physical oscillation of psi times eps.)  On the separatrix (``k = 1``,
     not periodic) ``sn = tanh u, cn = dn = sech u`` and the whole ``G`` is returned, with
     ``Pi(am u; -beta | 1) = (u + sqrt(beta) atan(sqrt(beta) tanh u)) / (1 + beta)``.
     """
-    ell = params[_I_L]
-    a2 = params[_I_A + 2]
-    beta = params[_I_BETA]
-    g = params[_I_G]
     if params[_I_MODE] == _MODE_SEPARATRIX:
+        beta = params[_I_BETA]
+        g = params[_I_G]
         s = math.tanh(u)
         c = 1.0 / math.cosh(u)
         sb = math.sqrt(beta)
         pi3 = (u + sb * math.atan(sb * s)) / (1.0 + beta)
-        return s, c, c, ell * pi3 - a2 * math.atan2(g * s, c) / g
+        return s, c, c, params[_I_L] * pi3 - params[_I_A + 2] * math.atan2(g * s, c) / g
     twok = params[_I_TWOK]
-    j = math.floor(u / twok + 0.5)
-    odd = int(j) & 1
+    j = math.floor(u * params[_I_INV2K] + 0.5)
     ur = u - j * twok
     s, c, d = _landen_sncndn(ur * params[_I_WSCALE], params)
-    ca = abs(c)
-    if beta <= 1.0:
-        pi3 = _pi_minus_f(s, ca, d, beta)
-    else:
-        pi3 = _pi_large_beta(s, ca, d, params[_I_GAMMA], params[_I_SQD])
-    gp = ell * pi3 - a2 * math.atan2(g * s, ca) / g - params[_I_FOFF] * ur
-    if odd:  # sn(u_r + 2jK) = (-1)^j sn(u_r), likewise cn; dn has period 2K
+    gp = _gp_amp(params, s, abs(c), d, ur)
+    if int(j) & 1:  # sn(u_r + 2jK) = (-1)^j sn(u_r), likewise cn; dn has period 2K
         s = -s
         c = -c
     return s, c, d, gp
@@ -436,26 +591,74 @@ def _is_steady(m0, m1, m2, k0, k1, k2):
 
 
 @numba.njit(**JIT)
-def _landen_chain(k, kp, params):
-    """Store the descending Landen moduli and return K(k) = pi/2 prod(1 + k_n).
+def _landen_agm(k, kp, eta, params):
+    """Store the descending Landen moduli; return K(k) = pi/2 prod(1 + k_n) and
+    ``(Pi(-eta | k) - K(k)) / K(k)`` (complete integrals, ``0 <= eta``).
 
     ``k_{n+1} = k_n^2 / (1 + k'_n)^2``, ``1 - k_{n+1} = 2 k'_n / (1 + k'_n)``,
     ``k'_{n+1} = 2 sqrt(k'_n) / (1 + k'_n)`` -- all free of cancellation for k -> 0 and
-    k -> 1 (needs k' > 0).
+    k -> 1 (needs k' > 0).  The same sequence is the AGM ``a_n, g_n = a_n k'_n`` of
+    ``(1, k')``, ``a_{n+1} = a_n (1 + k'_n) / 2``, which carries the complete integral of
+    the third kind (DLMF 19.8.6 with ``alpha^2 = -eta``)::
+
+        p_0^2 = 1 + eta,  Q_0 = 1,  eps_n = (p_n^2 - a_n g_n) / (p_n^2 + a_n g_n),
+        p_{n+1} = (p_n^2 + a_n g_n) / (2 p_n),  Q_{n+1} = Q_n eps_n / 2,
+        Pi(-eta | k) - K(k) = -K(k)/2 eta/(1 + eta) sum_n Q_n,
+
+    a sum of terms of one sign up to the quadratically small ones, with
+    ``p_0^2 - a_0 g_0 = eta + k^2 / (1 + k')`` written without cancellation.  It runs
+    until ``Q_n`` is negligible (at least as long as the Landen chain).  The ratio
+    ``(Pi - K) / K`` does not depend on the rounding of ``K``.
+
+    ``k_{n+1}`` is taken as ``(1 - k'_n) / (1 + k'_n)`` while ``k'_n <= 1/2``: the moduli
+    near 1 then keep full accuracy (the squared form doubles their relative error at each
+    level, which near the separatrix cost ~1e-14 in ``prod(1 + k_n)`` and in the
+    effective ``k'`` of the chain).
     """
-    prod = 1.0
     n = 0
-    while k >= _LANDEN_KTOL and n < _NLEV_MAX:
+    prod = 1.0
+    a = 1.0
+    pp2 = 1.0 + eta
+    num = eta + k * k / (1.0 + kp)
+    q = 1.0
+    qsum = 1.0
+    while True:
+        den = pp2 + a * a * kp
+        q *= 0.5 * num / den
+        qsum += q
+        landen = k >= _LANDEN_KTOL and n < _NLEV_MAX
+        if not landen and abs(q) <= 1e-17 * qsum:
+            break
         opk = 1.0 + kp
-        k = (k / opk) ** 2
-        params[_I_KN + n] = k
-        params[_I_OMKN + n] = 2.0 * kp / opk
-        kp = 2.0 * math.sqrt(kp) / opk
-        prod *= 1.0 + k
-        n += 1
+        r = 1.0 / opk
+        if landen:
+            k = (1.0 - kp) * r if kp <= 0.5 else (k * r) ** 2
+            params[_I_KN + n] = k
+            params[_I_OMKN + n] = 2.0 * kp * r
+            prod *= 1.0 + k
+            n += 1
+        a = 0.5 * a * opk
+        kp = 2.0 * math.sqrt(kp) * r
+        pp2 = den * den / (4.0 * pp2)
+        num = pp2 - a * a * kp
     params[_I_NLEV] = n
     params[_I_WSCALE] = 1.0 / prod
-    return 0.5 * math.pi * prod
+    return 0.5 * math.pi * prod, -0.5 * eta / (1.0 + eta) * qsum
+
+
+@numba.njit(**JIT)
+def _landen_chain(k, kp, params):
+    """Store the descending Landen moduli and return K(k) = pi/2 prod(1 + k_n)
+    (:func:`_landen_agm`)."""
+    return _landen_agm(k, kp, 0.0, params)[0]
+
+
+@numba.njit(**JIT)
+def _store_r0(R0, params):
+    """C = R0 (static and steady modes)."""
+    for r in range(3):
+        for c in range(3):
+            params[_I_C + 3 * r + c] = R0[r, c]
 
 
 @numba.njit(**JIT)
@@ -472,17 +675,15 @@ def rotation_init(K, R0, ell, params):
     See the module docstring for the formulas (Landau & Lifshitz section 37; Celledoni
     et al. 2008; Carlson 1995).
     """
-    for i in range(ROT_PARAMS_SIZE):
+    for i in range(_I_KN):  # the Landen levels beyond _I_NLEV are never read
         params[i] = 0.0
-    for r in range(3):
-        for c in range(3):
-            params[_I_C + 3 * r + c] = R0[r, c]
     mb0 = R0[0, 0] * ell[0] + R0[1, 0] * ell[1] + R0[2, 0] * ell[2]
     mb1 = R0[0, 1] * ell[0] + R0[1, 1] * ell[1] + R0[2, 1] * ell[2]
     mb2 = R0[0, 2] * ell[0] + R0[1, 2] * ell[1] + R0[2, 2] * ell[2]
     lmag = math.sqrt(mb0 * mb0 + mb1 * mb1 + mb2 * mb2)
     if lmag == 0.0:
         params[_I_MODE] = _MODE_STATIC
+        _store_r0(R0, params)
         return
 
     # ---- steady rotation about an eigenvector of the inertia tensor
@@ -492,6 +693,7 @@ def rotation_init(K, R0, ell, params):
     s2 = mb2 if abs(mb2) > thr else 0.0
     if _is_steady(s0, s1, s2, K[0], K[1], K[2]):
         params[_I_MODE] = _MODE_STEADY
+        _store_r0(R0, params)
         w0 = s0 / K[0]
         w1 = s1 / K[1]
         w2 = s2 / K[2]
@@ -529,9 +731,9 @@ def rotation_init(K, R0, ell, params):
     params[_I_SIGN + 0] = sg0
     params[_I_SIGN + 1] = sg1
     params[_I_SIGN + 2] = sg2
-    params[_I_J + 0] = j0
-    params[_I_J + 1] = j1
-    params[_I_J + 2] = j2
+    params[_I_LJ + 0] = lmag / j0
+    params[_I_LJ + 1] = lmag / j1
+    params[_I_LJ + 2] = lmag / j2
 
     # ---- Landau-Lifshitz amplitudes, rate and modulus
     d10 = abs(j1 - j0)
@@ -554,8 +756,7 @@ def rotation_init(K, R0, ell, params):
     kappa = (j2 - j0) / (j0 * j2)
     params[_I_BETA] = beta
     params[_I_G] = gfac
-    params[_I_GAMMA] = gamma
-    params[_I_SQD] = sqd
+    params[_I_A2G] = a2 / gfac
     params[_I_L] = lmag
     params[_I_KAPNU] = kappa / nu
 
@@ -569,24 +770,43 @@ def rotation_init(K, R0, ell, params):
         params[_I_MODE] = _MODE_SEPARATRIX
         params[_I_LIN] = lmag / j2
         u0 = math.asinh(sf / cf)
+        params[_I_U0] = u0
+        s, c, d, gval = _phase_state(params, u0)
     else:
         params[_I_MODE] = _MODE_GENERAL
-        kcomp = _landen_chain(math.sqrt(k2), math.sqrt(kp2), params)
+        # the R_J term: Pi - F with eta = beta (form 1) or Pi(-gamma) - F (form 2)
+        form2 = beta > 1.0
+        eta = gamma if form2 else beta
+        params[_I_FORM2] = 1.0 if form2 else 0.0
+        params[_I_ETA] = eta
+        params[_I_DCOEF] = eta * (1.0 + eta) * (eta + k2)
+        params[_I_CPI] = lmag * gamma / 3.0 if form2 else -lmag * beta / 3.0
+        params[_I_SQD] = sqd
+        params[_I_LSQD] = lmag / sqd
+        kcomp, pik = _landen_agm(math.sqrt(k2), math.sqrt(kp2), eta, params)
         params[_I_TWOK] = 2.0 * kcomp
-        u0 = sf * carlson_rf(cf * cf, cf * cf + kp2 * sf * sf, 1.0)
-        # mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar
-        g_quarter = -a2 * 0.5 * math.pi / gfac  # -a_2 T(pi/2)
-        if beta <= 1.0:
-            g_quarter += lmag * _pi_minus_f(1.0, 0.0, math.sqrt(kp2), beta)
-            foff = g_quarter / kcomp  # f_bar - L
-            params[_I_LIN] = lmag / j0 + kappa * foff
+        params[_I_INV2K] = 0.5 / kcomp
+        if k2 == 0.0:  # axisymmetric (J_0 = J_1): F(phi | 0) = phi
+            u0 = math.atan2(sf, cf)
         else:
-            g_quarter += lmag * _pi_large_beta(1.0, 0.0, math.sqrt(kp2), gamma, sqd)
+            d = math.sqrt(cf * cf + kp2 * sf * sf)  # dn(u_0)
+            u0 = sf * _rf_amp(cf * cf, cf, d * d, d)
+        # mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar
+        # G(K) = L Pi(-beta) - a_2 T(pi/2) with Pi(-beta) - K = pik K (form 1) or
+        # Pi(-beta) = K - Pi(-gamma) + pi / (2 sqd) (form 2)
+        g_quarter = -a2 * 0.5 * math.pi / gfac  # -a_2 T(pi/2)
+        if form2:
+            g_quarter += lmag * (0.5 * math.pi / sqd - pik * kcomp)
             foff = g_quarter / kcomp  # f_bar
             params[_I_LIN] = lmag / j2 + kappa * foff
+        else:
+            foff = lmag * pik - a2 * 0.5 * math.pi / (gfac * kcomp)  # f_bar - L
+            params[_I_LIN] = lmag / j0 + kappa * foff
         params[_I_FOFF] = foff
-    params[_I_U0] = u0
-    s, c, d, gval = _phase_state(params, u0)
+        params[_I_U0] = u0
+        # G_p and n at u_0 as rotation_at evaluates them (not from sf, cf, d): then
+        # psi(0) = 0 and R(0) = R0 exactly up to rounding
+        s, c, d, gval = _phase_state(params, u0)
     params[_I_G0] = gval
 
     # ---- C = R0 Q B(n(0)): makes R(0) = R0 exactly up to rounding
@@ -665,10 +885,9 @@ def rotation_at(params, t, R_out, omega_out):
     m11 = sp * b10 + cp * b11
     m12 = sp * b20 + cp * b21
     # working-frame angular velocity L n / J
-    lmag = params[_I_L]
-    w0 = lmag * n0 / params[_I_J + 0]
-    w1 = lmag * n1 / params[_I_J + 1]
-    w2 = lmag * n2 / params[_I_J + 2]
+    w0 = params[_I_LJ + 0] * n0
+    w1 = params[_I_LJ + 1] * n1
+    w2 = params[_I_LJ + 2] * n2
     o0 = int(params[_I_PERM + 0])
     o1 = int(params[_I_PERM + 1])
     o2 = int(params[_I_PERM + 2])

@@ -251,6 +251,45 @@ def test_third_kind_integral_forms_against_mpmath(beta):
                 assert val == pytest.approx(ref, rel=4e-15, abs=1e-300)
 
 
+@pytest.mark.parametrize("kp2", [1.0, 0.5, 1e-3, 1e-10, 1e-20, 1e-100, 1e-300])
+def test_complete_integrals_from_the_landen_agm_against_mpmath(kp2):
+    """K(k) from the Landen chain and (Pi(-eta|k) - K) / K from its AGM (DLMF 19.8.6),
+    also for k -> 1 (k' down to 1e-150) and tiny eta; reference -eta/3 R_J / R_F."""
+    mpmath = pytest.importorskip("mpmath")
+    with mpmath.workdps(40):
+        kp_mp = mpmath.sqrt(mpmath.mpf(kp2))
+        k = float(mpmath.sqrt(1 - mpmath.mpf(kp2)))
+        kref = mpmath.elliprf(0, kp2, 1)
+        for eta in (0.0, 1e-12, 1e-4, 0.3, 1.0):
+            params = np.zeros(ROT_PARAMS_SIZE)
+            kk, pik = rot._landen_agm(k, float(kp_mp), eta, params)
+            ref = -mpmath.mpf(eta) / 3 * mpmath.elliprj(0, kp2, 1, 1 + mpmath.mpf(eta)) / kref
+            assert kk == pytest.approx(float(kref), rel=1.5e-15)
+            assert pik == pytest.approx(float(ref), rel=2e-15, abs=1e-300)
+
+
+def test_rj_with_known_square_roots_against_mpmath():
+    """The R_J of the phase integral, R_J(cn^2, dn^2, 1, 1 + eta sn^2) with cn, dn as the
+    square roots and (p - x)(p - y)(p - 1) in closed form, near phi = pi/2 and k = 1 too."""
+    mpmath = pytest.importorskip("mpmath")
+    rng = np.random.default_rng(17)
+    with mpmath.workdps(40):
+        for i in range(400):
+            kp2 = 10.0 ** rng.uniform(-30, 0) if i % 2 else rng.uniform(0.0, 1.0)
+            k2 = float(1 - mpmath.mpf(kp2))
+            phi = 0.5 * math.pi - 10.0 ** rng.uniform(-16, 0)  # near pi/2 ...
+            if i % 3:
+                phi = rng.uniform(0.0, 0.5 * math.pi)  # ... or anywhere
+            s, c = math.sin(phi), math.cos(phi)
+            d = math.sqrt(c * c + kp2 * s * s)
+            eta = 10.0 ** rng.uniform(-14, 0)
+            delta = eta * (1.0 + eta) * (eta + k2) * (s * s) ** 3
+            val = rot._rj_amp(c * c, c, d * d, d, 1.0 + eta * s * s, delta)
+            ref = mpmath.elliprj(mpmath.mpf(c) ** 2, mpmath.mpf(d) ** 2, 1,
+                                 1 + eta * mpmath.mpf(s) ** 2)
+            assert val == pytest.approx(float(ref), rel=2e-15)
+
+
 # --------------------------------------------------------------------------------------
 # comparison with the numerical integration of Euler's equations
 # --------------------------------------------------------------------------------------
