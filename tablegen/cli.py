@@ -97,7 +97,7 @@ def _build(args, parser) -> int:
           file=sys.stderr)
     try:
         path = build_table(config, args.out, workers=args.workers, scheduler=args.scheduler,
-                           overwrite=args.overwrite, progress=not args.no_progress)
+                           overwrite=args.overwrite, progress=not args.no_progress and sys.stderr.isatty())
     except (BuildError, FileNotFoundError) as exc:
         print(f"tablegen build: error: {exc}", file=sys.stderr)
         return 1
