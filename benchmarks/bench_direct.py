@@ -49,8 +49,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import sys
 import time
 
@@ -58,6 +56,7 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_FAILED, STATUS_TRAPPED
+from machine import machine_info  # benchmarks/machine.py, next to this script
 from tablegen.simulate import simulate
 
 SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
@@ -72,22 +71,6 @@ COLUMNS = (  # (header, width, format spec, key of the result row)
     ("steps/reb", 9, ".1f", "search_steps_per_rebound"), ("trapped", 7, "d", "trapped"),
     ("failed", 6, "d", "failed"), ("target", 6, "s", "meets_target"),
 )
-
-
-def machine_info() -> dict:
-    """Platform, CPU and library versions of this run."""
-    cpu = platform.processor() or "unknown"
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return {"platform": platform.platform(), "cpu": cpu, "cpu_count": os.cpu_count(),
-            "usable_cpus": usable, "python": platform.python_version(),
-            "numpy": np.__version__, "numba": numba.__version__,
-            "numba_default_threads": numba.get_num_threads(),
-            "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
 
 
 def best_time(shape, alpha1, speed, n, threads, repeats):

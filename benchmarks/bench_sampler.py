@@ -74,8 +74,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import sys
 import tempfile
 import time
@@ -85,6 +83,7 @@ import numba
 import numpy as np
 
 import surrogate
+from machine import machine_info  # benchmarks/machine.py, next to this script
 from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch
 
 SEED = 20240601
@@ -110,22 +109,6 @@ JIT = dict(nogil=True, fastmath=False, error_model="numpy")
 # Grant & Tabakoff (1975), sand on 2024 aluminium: coefficients of 1, β1, β1², β1³ (β1 in rad)
 GT_NORMAL = (1.0, -0.4159, 0.4994, -0.292)
 GT_TANGENTIAL = (1.0, -2.12, 3.0775, -1.1)
-
-
-def machine_info() -> dict:
-    """Platform, CPU and library versions of this run (as in bench_direct.py)."""
-    cpu = platform.processor() or "unknown"
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return {"platform": platform.platform(), "cpu": cpu, "cpu_count": os.cpu_count(),
-            "usable_cpus": usable, "python": platform.python_version(),
-            "numpy": np.__version__, "numba": numba.__version__,
-            "numba_default_threads": numba.get_num_threads(),
-            "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
 
 
 # ----------------------------------------------------------------------------- kernels of the bench

@@ -481,7 +481,6 @@ def test_exact_separatrix():
     in exact arithmetic.  Compared with long double Taylor while the orbit is still far
     from the saddle, and it must creep towards the middle axis without NaN for t -> inf.
     """
-    rng = np.random.default_rng(3)
     for perm, y, scale in [((0, 1, 2), 0.75, 1.0), ((2, 0, 1), -1.5, 0.25), ((1, 2, 0), 0.0, 3.0)]:
         perm = np.array(perm)
         K = np.empty(3)
