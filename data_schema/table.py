@@ -2,29 +2,32 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (1, 0),
+    /                      attrs: file_type = "rebound_table", format_version = (2, 0),
                            created (ISO 8601 UTC), package_version, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
                            attrs: kappa, n_max, particles_per_cell
-    /resolution            attrs: alpha2_levels, alpha2_bins, beta2_levels, beta2_bins, spin_atoms
+    /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
-Representation of one cell (docs/model.md §6, docs/format.md): reflected state
-X = (α2, β2, s = |V⁺|/|V⁻|, Ω⁺a/|V⁻|) of the rebounded particles, folded by the
-mirror symmetry Z → −Z to β2 ≥ 0 (Ω_x, Ω_y multiplied by sign β2), stored as a
-discretised inverse Rosenblatt transform:
+Representation of one cell (docs/format.md): the reflected state of the
+rebounded particles, folded by the mirror symmetry Z → −Z to β2 ≥ 0 (Ω_x, Ω_y
+multiplied by sign β2) and written in chain order
 
-1. ``alpha2_q`` (L1+1): quantile function of α2 at probabilities k/L1;
-2. ``beta2_q`` (B1, L2+1): quantile function of |β2| in each of B1 equal-count α2
-   bins (bin b holds the α2 probability range [b/B1, (b+1)/B1));
-3. ``speed_q`` (B1, B2, A+1): quantile function of s in each (α2, |β2|) leaf,
-   the |β2| bins equal-count within their α2 bin;
-4. ``spin`` (B1, B2, A, 3): per leaf, A spin atoms (Ω_x, Ω_y, Ω_z) folded; atom j
-   is the sample of s-rank (j + ½)/A in the leaf, so the atom drawn with the s
-   interval j keeps the joint law of (s, Ω) at the leaf's resolution.
+    x = (α2, |β2|, s = |V⁺|/|V⁻|, Ω_z, Ω_x', Ω_y')     (Ω in units of |V⁻|/a),
 
-Drawing needs one multiply, one floor and one linear interpolation per level.
+is a mixture of C components ("clusters"). Inside cluster c the law is a
+triangular chain of conditional inverse CDFs (a discretised inverse Rosenblatt
+transform), each a shift, linear in the variables already drawn, of a residual
+quantile function::
+
+    x_k = loc[c, k] + scale[c, k] · S_k,m(u_k) + Σ_{j<k} slope[c, k, j] · x_j,   m = shape_id[c, k]
+
+where S_k,m is one of M standardised quantile functions of variable k (the
+shape dictionary), stored at probabilities i/L, i = 0..L, and linearly
+interpolated. Cluster c is drawn with probability ``cluster_weight[c]``.
+Drawing needs one multiply, one floor and one linear interpolation per
+variable and no search.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ import numpy as np
 from data_schema.common import DataFormatError, atomic_output, check_file, write_header
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (1, 0)
+TABLE_VERSION = (2, 0)
 
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
 STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
@@ -48,30 +51,45 @@ INDICATRIX_ALPHA2_EDGES = np.linspace(0.0, np.pi, 73)
 INDICATRIX_BETA2_EDGES = np.linspace(-np.pi / 2, np.pi / 2, 73)
 
 
+# chain order of the folded state inside a cluster (module doc)
+CHAIN_NAMES = ("alpha2", "abs_beta2", "speed_ratio", "omega_z", "omega_x_folded", "omega_y_folded")
+CHAIN_TO_STATE = (0, 1, 2, 5, 3, 4)   # chain variable k is folded state column CHAIN_TO_STATE[k]
+N_CHAIN = len(CHAIN_NAMES)
+N_SLOPES = N_CHAIN * (N_CHAIN - 1) // 2
+
+
+def slope_index(k: int, j: int) -> int:
+    """Position of slope[c, k, j] (j < k) in the packed ``cluster_slope`` rows: k(k−1)/2 + j."""
+    return k * (k - 1) // 2 + j
+
+
 @dataclasses.dataclass(frozen=True)
 class TableResolution:
     """Sizes of a cell's representation (see module doc)."""
 
-    alpha2_levels: int = 64   # L1
-    alpha2_bins: int = 16     # B1
-    beta2_levels: int = 32    # L2
-    beta2_bins: int = 8       # B2
-    spin_atoms: int = 32      # A
+    clusters: int = 500          # C: mixture components per cell (fewer used when a cell has few rebounds)
+    dictionary_size: int = 16    # M: standardised residual quantile functions per chain variable
+    levels: int = 24             # L: quantile functions are stored at probabilities i/L, i = 0..L
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise ValueError(f"The table resolution '{f.name}' must be an integer >= 1; got {value!r}.")
+        if self.dictionary_size > 256:
+            raise ValueError(f"The table resolution 'dictionary_size' must be <= 256 (stored as uint8); "
+                             f"got {self.dictionary_size!r}.")
 
     def cell_shapes(self) -> dict:
         """Shape of each per-cell dataset (without the three leading grid dimensions)."""
-        b1, b2, a = self.alpha2_bins, self.beta2_bins, self.spin_atoms
+        c = self.clusters
         return {
-            "alpha2_q": (self.alpha2_levels + 1,),
-            "beta2_q": (b1, self.beta2_levels + 1),
-            "speed_q": (b1, b2, a + 1),
-            "spin": (b1, b2, a, 3),
+            "cluster_weight": (c,),
+            "cluster_loc": (c, N_CHAIN),
+            "cluster_scale": (c, N_CHAIN),
+            "cluster_shape": (c, N_CHAIN),
+            "cluster_slope": (c, N_SLOPES),
+            "shape_dictionary": (N_CHAIN, self.dictionary_size, self.levels + 1),
             "status_counts": (3,),
             "collision_counts": (N_COLLISION_CLASSES,),
             "mean": (len(STATE_NAMES),),
@@ -83,10 +101,13 @@ class TableResolution:
 
 # name: (dtype, units, meaning) of the per-cell datasets
 CELL_DATASETS = {
-    "alpha2_q": ("float64", "rad", "quantile function of α2 at probabilities k/L1"),
-    "beta2_q": ("float64", "rad", "quantile function of |β2| per equal-count α2 bin"),
-    "speed_q": ("float64", "1", "quantile function of s = |V⁺|/|V⁻| per (α2, |β2|) leaf"),
-    "spin": ("float32", "1", "spin atoms Ω⁺a/|V⁻| (x, y, z), folded to β2 ≥ 0, per leaf and s interval"),
+    "cluster_weight": ("float64", "1", "probability of each mixture component; 0 for unused clusters; sums to 1"),
+    "cluster_loc": ("float32", "rad, rad, 1, 1, 1, 1", "location of each chain variable's residual, per cluster"),
+    "cluster_scale": ("float32", "rad, rad, 1, 1, 1, 1", "scale of each chain variable's residual, per cluster"),
+    "cluster_shape": ("uint8", "1", "index into shape_dictionary of each chain variable's residual, per cluster"),
+    "cluster_slope": ("float32", "1", "slopes of x_k on x_j (j < k), packed at k(k-1)/2 + j, per cluster"),
+    "shape_dictionary": ("float32", "1", "standardised residual quantile functions at probabilities i/L, "
+                                         "per chain variable"),
     "status_counts": ("int64", "1", "particles rebounded, trapped, failed"),
     "collision_counts": ("int64", "1", "rebounds with 1, 2, ..., 10 and more than 10 collisions"),
     "mean": ("float64", "rad, rad, 1, 1, 1, 1", "means of α2, β2, s, Ω_x, Ω_y, Ω_z over rebounds"),
@@ -100,10 +121,12 @@ CELL_DATASETS = {
 class CellTable:
     """The representation of one (shape, α1, |V⁻|) cell; arrays as in :data:`CELL_DATASETS`."""
 
-    alpha2_q: np.ndarray
-    beta2_q: np.ndarray
-    speed_q: np.ndarray
-    spin: np.ndarray
+    cluster_weight: np.ndarray
+    cluster_loc: np.ndarray
+    cluster_scale: np.ndarray
+    cluster_shape: np.ndarray
+    cluster_slope: np.ndarray
+    shape_dictionary: np.ndarray
     status_counts: np.ndarray
     collision_counts: np.ndarray
     mean: np.ndarray

@@ -6,8 +6,8 @@ from its own ``@njit`` loop. Every draw consumes exactly :data:`U_PER_DRAW`
 uniforms from [0, 1)::
 
     u[0] shape from the mix        u[1] α1 neighbour       u[2] speed neighbour
-    u[3] trapped or not            u[4] α2                 u[5] |β2|
-    u[6] s and spin                u[7] mirror sign        u[8] in-wall axis at normal impact
+    u[3] trapped or not            u[4] mixture component  u[5:11] the six chain variables
+    u[11] mirror sign              u[12] in-wall axis at normal impact
 
 Between grid points the sampler uses stochastic interpolation: the cell of the
 neighbour at x_{j+1} is used with probability w = (x − x_j)/(x_{j+1} − x_j), as
@@ -26,8 +26,9 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
+from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 
-U_PER_DRAW = 9
+U_PER_DRAW = 13
 STATUS_INVALID = -1     # returned by :func:`rebound` for an incident state that does not hit the wall
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
@@ -51,33 +52,50 @@ def locate(grid, lookup, scale, x):
 
 
 @numba.njit(inline="always", **JIT)
-def _interval(u, levels):
-    """Fractional index u·levels split into (k, f) with 0 ≤ k < levels."""
-    p = u * levels
-    k = min(int(p), levels - 1)
-    return k, p - k
+def _residual(data, s, ia, iv, c, k, u):
+    """loc + scale · S(u) of chain variable k in component c: multiply, floor, linear interpolation."""
+    rows, dic = data.clusters, data.dictionary
+    levels = dic.shape[4] - 1
+    t = u * levels
+    i = min(int(t), levels - 1)
+    m = int(rows[s, ia, iv, c, ROW_SHAPE + k])
+    lo = dic[s, ia, iv, m, i]
+    return rows[s, ia, iv, c, ROW_LOC + k] + rows[s, ia, iv, c, ROW_SCALE + k] * (
+        lo + (t - i) * (dic[s, ia, iv, m, i + 1] - lo))
 
 
 @numba.njit(inline="always", **JIT)
-def draw_folded(data, s, ia, iv, u_alpha2, u_beta2, u_speed):
-    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell (s, ia, iv).
+def draw_folded(data, s, ia, iv, u):
+    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell (s, ia, iv) from u[4:11].
 
-    Chain (data_schema.table): α2 from its quantile function; its equal-count
-    bin b = ⌊u·B1⌋ selects the |β2| quantile function; the |β2| bin c = ⌊u·B2⌋
-    selects the leaf whose s quantile function gives s and, from the same
-    interval index, the spin atom. Arrays are read by scalar indices only (no
-    views, so no reference counting on the hot path).
+    Representation (data_schema.table): u[4] picks the mixture component c with
+    the Walker alias table (one multiply, one floor, one compare); then chain
+    variable k (α2, |β2|, s, Ω_z, Ω_x, Ω_y) is the component's residual quantile
+    function at u[5 + k], shifted by the component's slopes on the variables
+    already drawn. α2 is reflected into [0, π] and |β2| capped at π/2 (the
+    linear shifts can step outside by a hair, ~1e-4 of draws). Arrays are read
+    by scalar indices only (no views, so no reference counting on the hot path).
     """
-    aq, bq, sq, spin = data.alpha2_q, data.beta2_q, data.speed_q, data.spin
-    k, f = _interval(u_alpha2, aq.shape[3] - 1)
-    alpha2 = aq[s, ia, iv, k] + f * (aq[s, ia, iv, k + 1] - aq[s, ia, iv, k])
-    b = min(int(u_alpha2 * bq.shape[3]), bq.shape[3] - 1)
-    k, f = _interval(u_beta2, bq.shape[4] - 1)
-    beta2 = bq[s, ia, iv, b, k] + f * (bq[s, ia, iv, b, k + 1] - bq[s, ia, iv, b, k])
-    c = min(int(u_beta2 * sq.shape[4]), sq.shape[4] - 1)
-    j, f = _interval(u_speed, sq.shape[5] - 1)
-    speed = sq[s, ia, iv, b, c, j] + f * (sq[s, ia, iv, b, c, j + 1] - sq[s, ia, iv, b, c, j])
-    return alpha2, beta2, speed, spin[s, ia, iv, b, c, j, 0], spin[s, ia, iv, b, c, j, 1], spin[s, ia, iv, b, c, j, 2]
+    r = data.clusters
+    n_clusters = r.shape[3]
+    t = u[4] * n_clusters
+    c = min(int(t), n_clusters - 1)
+    if t - c >= r[s, ia, iv, c, ROW_ALIAS_PROB]:
+        c = int(r[s, ia, iv, c, ROW_ALIAS])
+    b = ROW_SLOPE      # slopes of x_k on x_j at b + k(k−1)/2 + j
+    x0 = _residual(data, s, ia, iv, c, 0, u[5])
+    x1 = _residual(data, s, ia, iv, c, 1, u[6]) + r[s, ia, iv, c, b] * x0
+    x2 = _residual(data, s, ia, iv, c, 2, u[7]) + r[s, ia, iv, c, b + 1] * x0 + r[s, ia, iv, c, b + 2] * x1
+    x3 = (_residual(data, s, ia, iv, c, 3, u[8]) + r[s, ia, iv, c, b + 3] * x0 + r[s, ia, iv, c, b + 4] * x1
+          + r[s, ia, iv, c, b + 5] * x2)
+    x4 = (_residual(data, s, ia, iv, c, 4, u[9]) + r[s, ia, iv, c, b + 6] * x0 + r[s, ia, iv, c, b + 7] * x1
+          + r[s, ia, iv, c, b + 8] * x2 + r[s, ia, iv, c, b + 9] * x3)
+    x5 = (_residual(data, s, ia, iv, c, 5, u[10]) + r[s, ia, iv, c, b + 10] * x0 + r[s, ia, iv, c, b + 11] * x1
+          + r[s, ia, iv, c, b + 12] * x2 + r[s, ia, iv, c, b + 13] * x3 + r[s, ia, iv, c, b + 14] * x4)
+    alpha2 = abs(x0)
+    if alpha2 > math.pi:
+        alpha2 = 2.0 * math.pi - alpha2
+    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3
 
 
 @numba.njit(inline="always", **JIT)
@@ -98,8 +116,8 @@ def draw_local(data, mix_cdf, alpha1, speed, u):
     iv = jv + 1 if u[2] < wv else jv
     if u[3] < data.p_trapped[shape, ia, iv]:
         return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-    alpha2, beta2, s, wx, wy, wz = draw_folded(data, shape, ia, iv, u[4], u[5], u[6])
-    if u[7] < 0.5:
+    alpha2, beta2, s, wx, wy, wz = draw_folded(data, shape, ia, iv, u)
+    if u[11] < 0.5:
         return STATUS_REBOUNDED, alpha2, -beta2, s, -wx, -wy, wz
     return STATUS_REBOUNDED, alpha2, beta2, s, wx, wy, wz
 
@@ -165,7 +183,7 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out):
             V_out[k] = np.nan
             W_out[k] = np.nan
         return STATUS_INVALID
-    alpha1, speed, ex, ez = impact_frame(V, n, u[8])
+    alpha1, speed, ex, ez = impact_frame(V, n, u[12])
     status, alpha2, beta2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1, speed, u)
     if status != STATUS_REBOUNDED:
         for k in range(3):

@@ -15,7 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from data_schema.table import ReboundTable, read_table
+from data_schema.table import N_CHAIN, N_SLOPES, ReboundTable, read_table
 
 
 class KernelData(NamedTuple):
@@ -28,10 +28,19 @@ class KernelData(NamedTuple):
     speed_lookup: np.ndarray
     speed_scale: np.ndarray
     p_trapped: np.ndarray      # (n_shape, n_alpha, n_speed)
-    alpha2_q: np.ndarray
-    beta2_q: np.ndarray
-    speed_q: np.ndarray
-    spin: np.ndarray
+    clusters: np.ndarray       # (n_shape, n_alpha, n_speed, C, ROW_SIZE) float32, one row per component
+    dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6·M, L + 1) float32 residual shapes
+
+
+# Layout of a component's row in KernelData.clusters: everything one draw needs
+# from a component, contiguous (140 bytes), so a draw touches few cache lines.
+ROW_ALIAS_PROB = 0    # Walker alias table: keep the component if the fractional part < this
+ROW_ALIAS = 1         # ... else use this component
+ROW_LOC = 2           # 6 locations (chain order)
+ROW_SCALE = 8         # 6 scales
+ROW_SHAPE = 14        # 6 rows of KernelData.dictionary (k·M + shape index)
+ROW_SLOPE = 20        # 15 slopes, x_k on x_j at k(k−1)/2 + j
+ROW_SIZE = 35
 
 
 def interval_lookup(grid: np.ndarray):
@@ -50,6 +59,46 @@ def interval_lookup(grid: np.ndarray):
     points = grid[0] + step * np.arange(m)
     lookup = np.clip(np.searchsorted(grid, points, side="right") - 1, 0, len(grid) - 2)
     return lookup.astype(np.int64), np.array([grid[0], 1.0 / step])
+
+
+def alias_table(weights: np.ndarray):
+    """Walker's alias table of probabilities ``weights`` (summing to 1): (keep, alias).
+
+    Drawing: t = u·C, c = ⌊t⌋; keep c if t − c < keep[c], else take alias[c].
+    Component c is then drawn with probability weights[c] (exactly, up to
+    rounding). Zero-weight components have keep = 0 and are never drawn.
+    """
+    n = len(weights)
+    keep = np.asarray(weights, dtype=np.float64) * (n / np.sum(weights))
+    alias = np.arange(n)
+    small = [i for i in range(n) if keep[i] < 1.0]
+    large = [i for i in range(n) if keep[i] >= 1.0]
+    while small and large:
+        lo, hi = small.pop(), large[-1]
+        alias[lo] = hi
+        keep[hi] -= 1.0 - keep[lo]
+        if keep[hi] < 1.0:
+            small.append(large.pop())
+    for i in small + large:     # left over only by rounding: their keep is 1 within ~1e-15
+        keep[i] = 1.0
+    return keep, alias
+
+
+def kernel_rows(cells: dict) -> tuple:
+    """The cell arrays of a table rearranged for the kernels: (clusters, dictionary), see :class:`KernelData`."""
+    weight = cells["cluster_weight"]
+    lead = weight.shape[:3]
+    n_clusters = weight.shape[3]
+    dic = cells["shape_dictionary"]
+    size = dic.shape[4]
+    rows = np.empty(lead + (n_clusters, ROW_SIZE), dtype=np.float32)
+    for cell in np.ndindex(*lead):
+        rows[cell + (slice(None), ROW_ALIAS_PROB)], rows[cell + (slice(None), ROW_ALIAS)] = alias_table(weight[cell])
+    rows[..., ROW_LOC:ROW_LOC + N_CHAIN] = cells["cluster_loc"]
+    rows[..., ROW_SCALE:ROW_SCALE + N_CHAIN] = cells["cluster_scale"]
+    rows[..., ROW_SHAPE:ROW_SHAPE + N_CHAIN] = np.arange(N_CHAIN) * size + cells["cluster_shape"]
+    rows[..., ROW_SLOPE:ROW_SLOPE + N_SLOPES] = cells["cluster_slope"]
+    return rows, dic.reshape(lead + (N_CHAIN * size, dic.shape[5]))
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -85,13 +134,13 @@ class SurrogateTable:
         landed = counts[..., STATUS_REBOUNDED] + counts[..., STATUS_TRAPPED]
         a_lookup, a_scale = interval_lookup(table.alpha1_deg)
         v_lookup, v_scale = interval_lookup(table.speed_m_s)
+        rows, dictionary = kernel_rows(table.cells)
         data = KernelData(
             alpha1_deg=_frozen(np.asarray(table.alpha1_deg, dtype=np.float64)), alpha1_lookup=_frozen(a_lookup),
             alpha1_scale=_frozen(a_scale), speed=_frozen(np.asarray(table.speed_m_s, dtype=np.float64)),
             speed_lookup=_frozen(v_lookup), speed_scale=_frozen(v_scale),
             p_trapped=_frozen(counts[..., STATUS_TRAPPED] / landed),
-            alpha2_q=_frozen(table.cells["alpha2_q"]), beta2_q=_frozen(table.cells["beta2_q"]),
-            speed_q=_frozen(table.cells["speed_q"]), spin=_frozen(table.cells["spin"]))
+            clusters=_frozen(rows), dictionary=_frozen(dictionary))
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=data.alpha1_deg, speed_m_s=data.speed,
                    particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, kernel_data=data)

@@ -39,6 +39,9 @@ class BuildError(RuntimeError):
     """A cell failed or the checkpoint does not match; the message says which."""
 
 
+REPRESENTATION_KEY = 2 ** 31    # spawn key of the k-means seed (chunks use keys 0, 1, ...)
+
+
 def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> str:
     return (f"cell (shape={shape}, alpha1={config.alpha1_deg[i_alpha]:g} deg, "
             f"speed={config.speed_m_s[i_speed]:g} m/s)")
@@ -53,7 +56,8 @@ def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) ->
         acc.add(simulate(shape, config.alpha1_deg[i_alpha], config.speed_m_s[i_speed], n,
                          seed=derive_seed(seed, chunk), kappa=config.kappa,
                          aspect=config.aspect, n_max=config.n_max))
-    return acc.finish(config.resolution, cell_label(config, shape, i_alpha, i_speed))
+    return acc.finish(config.resolution, derive_seed(seed, REPRESENTATION_KEY),
+                      cell_label(config, shape, i_alpha, i_speed))
 
 
 def _worker_init(threads: int) -> None:

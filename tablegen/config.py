@@ -16,7 +16,7 @@ the ``default`` preset)::
     aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}   # b/a and c/b
 
     [table]
-    resolution = "auto"               # or {alpha2_levels = .., alpha2_bins = .., ...}
+    resolution = "auto"               # or {clusters = .., dictionary_size = .., levels = ..}
 
 Unknown keys and invalid values raise :class:`ConfigError` naming the key.
 Presets: ``default`` (the README's main job, a few minutes on 2 cores),

@@ -1,10 +1,18 @@
 """From a cell's direct-model samples to its stored representation (docs/format.md).
 
-The representation is a discretised inverse Rosenblatt transform of the
-folded reflected state (:mod:`data_schema.table`): α2 → |β2| given an α2 bin →
-(s, Ω) given an (α2, |β2|) leaf, where Ω rides on s as comonotone atoms.
-Conditioning bins are cut at ranks, so each holds the same number of samples
-(±1). Mirror folding: the model is exactly symmetric under Z → −Z, which maps
+The representation (:mod:`data_schema.table`) is a mixture of small triangular
+chains. The folded states, each variable divided by its standard deviation,
+are partitioned by mini-batch k-means into C clusters of about
+:data:`SAMPLES_PER_CLUSTER` samples. Inside a cluster each chain variable is
+regressed (least squares) on the variables before it, and the residual's
+quantile function is stored at L + 1 probability levels, standardised to
+(location, scale, shape); the C shapes of each variable are compressed into a
+dictionary of M shapes by k-means. Every stored quantity is estimated from all
+the cell's samples (each sample is in one cluster), which is what lets the
+table reproduce the joint law: a law built from a subsample carries that
+subsample's noise, which a classifier detects (docs/design/table_representation.md).
+
+Mirror folding: the model is exactly symmetric under Z → −Z, which maps
 (β2, Ω_x, Ω_y) to their negatives; every sample is mapped to its image with
 β2 ≥ 0, so all n samples inform one half-space and the runtime restores the
 sign with probability ½ — the variance of the stored law is that of 2n samples
@@ -14,42 +22,33 @@ of a symmetric law.
 from __future__ import annotations
 
 import numpy as np
+from sklearn.cluster import KMeans, MiniBatchKMeans
+from threadpoolctl import threadpool_limits
 
 from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet
 from data_schema.table import (
-    INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_COLLISION_CLASSES, CellTable, TableResolution,
+    CHAIN_TO_STATE, INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_CHAIN, N_COLLISION_CLASSES, N_SLOPES,
+    CellTable, TableResolution, slope_index,
 )
 
+SAMPLES_PER_CLUSTER = 25      # target cluster size; smaller clusters fit better down to ~25 (design note)
+MAX_CLUSTERS = 500            # memory budget: 35·C + 6·M·(L + 1) numbers per cell
+KMEANS_FIT_SAMPLES = 50_000   # cluster centres are fitted on at most this many samples, then all are assigned
+RIDGE = 2.0                   # slope shrinkage: regressor sums of squares × (1 + RIDGE / cluster size)
 
-def resolution_for(particles_per_cell: int, spin_atoms_max: int = 64, samples_per_atom: int = 4) -> TableResolution:
-    """The finest default resolution whose every leaf holds ``samples_per_atom`` samples per atom.
 
-    Leaves are 16 α2 bins × 8 |β2| bins; the number of spin atoms per leaf A
-    (a power of two, 8 to ``spin_atoms_max``) is the largest with
-    16·8·A·samples_per_atom ≤ particles_per_cell; below 4096 particles the bins
-    shrink to 8 × 4. Fewer than 256 particles per cell cannot fill a table.
+def resolution_for(particles_per_cell: int) -> TableResolution:
+    """The default resolution: C = clip(particles_per_cell // 25, 16, 500) clusters, M = 16, L = 24.
+
+    Smaller clusters fit the joint law better as long as each holds about 25
+    samples; 500 clusters cap a cell at 19 900 stored numbers. Cells with fewer
+    rebounds than particles use fewer clusters (see :func:`represent`).
     """
     if particles_per_cell < 256:
         raise ValueError(f"The 'particles_per_cell' parameter must be >= 256 to build a table; "
                          f"got {particles_per_cell!r}.")
-    b1, b2 = (16, 8) if particles_per_cell >= 16 * 8 * 8 * samples_per_atom else (8, 4)
-    atoms = 8
-    while atoms * 2 <= spin_atoms_max and b1 * b2 * atoms * 2 * samples_per_atom <= particles_per_cell:
-        atoms *= 2
-    return TableResolution(alpha2_levels=64, alpha2_bins=b1, beta2_levels=32, beta2_bins=b2, spin_atoms=atoms)
-
-
-def _rank_bins(x: np.ndarray, n_bins: int) -> list:
-    """Indices of x split into n_bins equal-count groups by rank (ascending)."""
-    order = np.argsort(x, kind="stable")
-    edges = (np.arange(n_bins + 1) * len(x)) // n_bins
-    return [order[edges[b]:edges[b + 1]] for b in range(n_bins)]
-
-
-def _quantiles(x: np.ndarray, n_levels: int) -> np.ndarray:
-    """Empirical quantile function at probabilities k/n_levels, k = 0..n_levels."""
-    return np.quantile(x, np.linspace(0.0, 1.0, n_levels + 1))
-
+    clusters = int(np.clip(particles_per_cell // SAMPLES_PER_CLUSTER, 16, MAX_CLUSTERS))
+    return TableResolution(clusters=clusters, dictionary_size=16, levels=24)
 
 def folded_state(samples: SampleSet) -> np.ndarray:
     """(α2, |β2|, s, Ω_x, Ω_y, Ω_z) of the rebounded particles, Ω_x and Ω_y times sign β2."""
@@ -96,39 +95,133 @@ class CellAccumulator:
             self.states.append(folded_state(samples)[:keep])
             self.n_states += keep
 
-    def finish(self, resolution: TableResolution, label: str = "cell") -> CellTable:
-        """The cell's representation and statistics; ``label`` names the cell in errors."""
+    def finish(self, resolution: TableResolution, seed: int, label: str = "cell") -> CellTable:
+        """The cell's representation and statistics.
+
+        ``seed`` seeds the k-means partition (so the table is reproducible);
+        ``label`` names the cell in errors.
+        """
         n = int(self.status_counts[STATUS_REBOUNDED])
-        r = resolution
-        if self.n_states < r.alpha2_bins * r.beta2_bins * (r.spin_atoms + 1):
-            raise ValueError(f"{label}: only {self.n_states} rebounds, too few for a resolution of "
-                             f"{r.alpha2_bins}x{r.beta2_bins} leaves of {r.spin_atoms + 1} samples")
+        if self.n_states < SAMPLES_PER_CLUSTER:
+            raise ValueError(f"{label}: only {self.n_states} rebounds; a table cell needs at least "
+                             f"{SAMPLES_PER_CLUSTER}")
         mean = self.sums / n
         std = np.sqrt(np.maximum(self.squares / n - mean ** 2, 0.0))
         d_a2 = np.diff(INDICATRIX_ALPHA2_EDGES)
         d_b2 = np.diff(INDICATRIX_BETA2_EDGES)
         return CellTable(
-            **represent(np.concatenate(self.states), r),
+            **represent(np.concatenate(self.states), resolution, seed),
             status_counts=self.status_counts.copy(), collision_counts=self.collision_counts.copy(),
             mean=mean, std=std,
             indicatrix_2d=(self.hist2 / (n * d_a2)).astype(np.float32),
             indicatrix_3d=(self.hist3 / (n * np.outer(d_a2, d_b2))).astype(np.float32))
 
 
-def represent(folded: np.ndarray, resolution: TableResolution) -> dict:
-    """The stored law (α2, β2, s, spin quantile/atom arrays) of folded states (n, 6)."""
-    alpha2, beta2, speed, omega = folded[:, 0], folded[:, 1], folded[:, 2], folded[:, 3:]
+def _partition(z: np.ndarray, n_clusters: int, seed: int) -> np.ndarray:
+    """Cluster label of each row of z (already scaled): mini-batch k-means.
+
+    Centres are fitted on the first :data:`KMEANS_FIT_SAMPLES` rows (the
+    samples are in random order), then every row goes to its nearest centre.
+    Random initial centres and a few epochs suffice: the chains fitted inside
+    the clusters, not the centres, carry the law (measured: k-means++ and full
+    k-means give the same accuracy at 2–3× the cost).
+    """
+    if n_clusters == 1:
+        return np.zeros(len(z), dtype=np.int64)
+    km = MiniBatchKMeans(n_clusters, init="random", n_init=1, batch_size=4096, max_iter=5,
+                         max_no_improvement=2, random_state=seed).fit(z[:KMEANS_FIT_SAMPLES])
+    return km.predict(z).astype(np.int64)
+
+
+def _group_quantiles(x: np.ndarray, group: np.ndarray, counts: np.ndarray, levels: int) -> np.ndarray:
+    """(G, levels + 1) quantile functions of x per group at p = i/levels (linear in the order statistics)."""
+    order = np.lexsort((x, group))
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    pos = np.linspace(0.0, 1.0, levels + 1)[None, :] * (counts[:, None] - 1)
+    lo = np.floor(pos).astype(np.int64)
+    hi = np.minimum(lo + 1, counts[:, None] - 1)
+    f = pos - lo
+    xs = x[order]
+    return xs[starts[:, None] + lo] * (1.0 - f) + xs[starts[:, None] + hi] * f
+
+
+def _group_slopes(A: np.ndarray, x: np.ndarray, group: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """(G, p) least-squares slopes of x on the p columns of A within each group (both centred per group).
+
+    Ridge: each regressor's within-group sum of squares is multiplied by
+    1 + RIDGE/count, negligible for clusters of hundreds, a shrinkage towards 0
+    for clusters of a few samples.
+    """
+    G, p = len(counts), A.shape[1]
+    mean_A = np.stack([np.bincount(group, A[:, i], G) for i in range(p)], axis=1) / counts[:, None]
+    Ac = A - mean_A[group]
+    xc = x - (np.bincount(group, x, G) / counts)[group]
+    S = np.empty((G, p, p))
+    r = np.empty((G, p))
+    for i in range(p):
+        r[:, i] = np.bincount(group, Ac[:, i] * xc, G)
+        for j in range(i, p):
+            S[:, i, j] = S[:, j, i] = np.bincount(group, Ac[:, i] * Ac[:, j], G)
+    diag = np.maximum(np.einsum("gii->gi", S), 1e-300)
+    S += (RIDGE * diag / counts[:, None])[:, :, None] * np.eye(p)
+    return np.linalg.solve(S, r[..., None])[..., 0]
+
+
+def _dictionary(shapes: np.ndarray, size: int, seed: int):
+    """Compress standardised quantile functions (G, L+1) into ``size`` shapes: (dictionary, index per row).
+
+    Dictionary shapes are k-means centres, re-standardised and made
+    non-decreasing (a quantile function); unused rows repeat the first.
+    """
+    m = min(size, len(shapes))
+    km = KMeans(m, n_init=1, random_state=seed).fit(shapes)
+    centres = km.cluster_centers_
+    centres = (centres - centres.mean(axis=1, keepdims=True)) / np.maximum(centres.std(axis=1, keepdims=True),
+                                                                            1e-300)
+    centres = np.maximum.accumulate(centres, axis=1)
+    dictionary = np.repeat(centres[:1], size, axis=0)
+    dictionary[:m] = centres
+    return dictionary, km.labels_
+
+
+def represent(folded: np.ndarray, resolution: TableResolution, seed: int) -> dict:
+    """The stored law (``cluster_*`` and ``shape_dictionary`` arrays) of folded states (n, 6).
+
+    Uses min(C, n // 25) clusters (at least one); the remaining rows of the
+    C-row arrays have weight 0 and are never drawn. Single-threaded BLAS and
+    OpenMP (threadpool_limits), so the arrays do not depend on the thread count.
+    """
     r = resolution
-    beta2_q = np.empty((r.alpha2_bins, r.beta2_levels + 1))
-    speed_q = np.empty((r.alpha2_bins, r.beta2_bins, r.spin_atoms + 1))
-    spin = np.empty((r.alpha2_bins, r.beta2_bins, r.spin_atoms, 3), dtype=np.float32)
-    atom_rank = (np.arange(r.spin_atoms) + 0.5) / r.spin_atoms
-    for b, in_a in enumerate(_rank_bins(alpha2, r.alpha2_bins)):
-        beta2_q[b] = _quantiles(beta2[in_a], r.beta2_levels)
-        for c, in_leaf in enumerate(_rank_bins(beta2[in_a], r.beta2_bins)):
-            leaf = in_a[in_leaf]
-            order = leaf[np.argsort(speed[leaf], kind="stable")]
-            speed_q[b, c] = _quantiles(speed[order], r.spin_atoms)
-            spin[b, c] = omega[order[(atom_rank * len(order)).astype(np.int64)]]
-    return {"alpha2_q": _quantiles(alpha2, r.alpha2_levels), "beta2_q": beta2_q,
-            "speed_q": speed_q, "spin": spin}
+    seed = seed % 2 ** 31                              # scikit-learn takes 32-bit seeds
+    z = folded[:, list(CHAIN_TO_STATE)].astype(np.float64)
+    n = len(z)
+    with threadpool_limits(1):
+        scale = z.std(axis=0)
+        used = max(1, min(r.clusters, n // SAMPLES_PER_CLUSTER))
+        group = _partition((z - z.mean(axis=0)) / np.where(scale > 0, scale, 1.0), used, seed)
+        counts = np.bincount(group, minlength=used)
+        nonempty = counts > 0                          # k-means may leave a centre without samples
+        group = (np.cumsum(nonempty) - 1)[group]
+        counts = counts[nonempty]
+        G = len(counts)
+        weight = np.zeros(r.clusters)
+        weight[:G] = counts / n
+        loc = np.zeros((r.clusters, N_CHAIN))
+        scl = np.zeros((r.clusters, N_CHAIN))
+        shape_id = np.zeros((r.clusters, N_CHAIN), dtype=np.uint8)
+        slope = np.zeros((r.clusters, N_SLOPES))
+        dictionary = np.empty((N_CHAIN, r.dictionary_size, r.levels + 1))
+        for k in range(N_CHAIN):
+            residual = z[:, k]
+            if k:
+                b = _group_slopes(z[:, :k], residual, group, counts)
+                slope[:G, slope_index(k, 0):slope_index(k, 0) + k] = b
+                residual = residual - np.einsum("ij,ij->i", z[:, :k], b[group])
+            q = _group_quantiles(residual, group, counts, r.levels)
+            loc[:G, k] = q.mean(axis=1)
+            scl[:G, k] = q.std(axis=1)
+            standard = (q - loc[:G, k, None]) / np.maximum(scl[:G, k, None], 1e-300)
+            dictionary[k], shape_id[:G, k] = _dictionary(standard, r.dictionary_size, seed + k)
+    return {"cluster_weight": weight, "cluster_loc": loc.astype(np.float32), "cluster_scale": scl.astype(np.float32),
+            "cluster_shape": shape_id, "cluster_slope": slope.astype(np.float32),
+            "shape_dictionary": dictionary.astype(np.float32)}

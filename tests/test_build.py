@@ -44,16 +44,24 @@ def test_table_contents_are_consistent(tiny_table):
     counts = table.cells["status_counts"]
     assert np.all(counts.sum(axis=-1) == 3000)
     assert np.all(table.cells["collision_counts"].sum(axis=-1) == counts[..., 0])
-    # the stored quantile functions are finite and non-decreasing
-    for name in ("alpha2_q", "beta2_q", "speed_q"):
-        q = table.cells[name]
-        assert np.all(np.isfinite(q)), name
-        assert np.all(np.diff(q, axis=-1) >= 0), name
-    assert np.all(np.isfinite(table.cells["spin"]))
-    # physical ranges: α2 ∈ [0, π], folded β2 ∈ [0, π/2], s ∈ (0, 1]
-    assert table.cells["alpha2_q"].min() >= 0 and table.cells["alpha2_q"].max() <= np.pi
-    assert table.cells["beta2_q"].min() >= 0 and table.cells["beta2_q"].max() <= np.pi / 2
-    assert table.cells["speed_q"].min() > 0 and table.cells["speed_q"].max() <= 1
+    # mixture weights are cluster counts over the rebounds; unused components (weight 0) come last
+    w = table.cells["cluster_weight"]
+    np.testing.assert_allclose(w.sum(axis=-1), 1.0, rtol=1e-12)
+    counts_in_clusters = w * counts[..., :1]
+    np.testing.assert_allclose(counts_in_clusters, np.round(counts_in_clusters), atol=1e-9)
+    assert np.all(np.diff(w > 0, axis=-1) <= 0)
+    # about 25 rebounds per cluster (k-means may leave a few centres empty)
+    used = (w > 0).sum(axis=-1)
+    assert np.all(used <= counts[..., 0] // 25) and np.all(used >= 0.8 * (counts[..., 0] // 25))
+    # the dictionary holds standardised quantile functions: finite, non-decreasing, mean 0, sd 1
+    dic = table.cells["shape_dictionary"].astype(np.float64)
+    assert np.all(np.isfinite(dic)) and np.all(np.diff(dic, axis=-1) >= 0)
+    np.testing.assert_allclose(dic.mean(axis=-1), 0.0, atol=1e-5)
+    np.testing.assert_allclose(dic.std(axis=-1), 1.0, rtol=1e-5)
+    assert table.cells["cluster_shape"].max() < table.resolution.dictionary_size
+    for name in ("cluster_loc", "cluster_scale", "cluster_slope"):
+        assert np.all(np.isfinite(table.cells[name])), name
+    assert table.cells["cluster_scale"].min() >= 0
     # indicatrices are densities: ∫ I dα2 = 1 and ∫∫ I dα2 dβ2 = 1
     d = np.pi / 72
     np.testing.assert_allclose(table.cells["indicatrix_2d"].sum(axis=-1) * d, 1.0, rtol=1e-5)
@@ -115,9 +123,14 @@ def test_existing_output_needs_overwrite(tiny_table, tmp_path):
 
 
 def test_worker_failure_names_the_cell(tmp_path):
-    """Too few particles for the requested resolution: the build fails loudly, naming the cell."""
-    config = parse_config(TINY + "[table]\nresolution = {alpha2_bins = 64, beta2_bins = 64, spin_atoms = 64}\n")
-    with pytest.raises(BuildError, match=r"cell \(shape=prism, alpha1=30 deg, speed=100 m/s\)|cell \(shape="):
+    """A cell with too few rebounds to represent fails the build loudly, naming the cell.
+
+    With n_max = 1 every tetrahedron needing a second collision at normal
+    impact is trapped: about 5 % of 256 particles rebound, below the 25 a cell needs.
+    """
+    config = parse_config("[grid]\nalpha1_deg = [90.0]\nspeed_m_s = [200.0]\nshapes = [\"tetrahedron\"]\n"
+                          "[simulation]\nparticles_per_cell = 256\nn_max = 1\nseed = 3\n")
+    with pytest.raises(BuildError, match=r"cell \(shape=tetrahedron, alpha1=90 deg, speed=200 m/s\).*rebounds"):
         build_table(config, tmp_path / "t.h5", workers=1)
     assert not (tmp_path / "t.h5").exists()
 
@@ -126,7 +139,7 @@ def test_info_describes_the_table(tiny_table, capsys):
     from tablegen.cli import main
     assert main(["info", str(tiny_table)]) == 0
     out = capsys.readouterr().out
-    for text in ("format version 1.0", "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
+    for text in ("format version 2.0", "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
                  "3000 particles"):
         assert text in out
 
@@ -141,8 +154,8 @@ def test_reader_rejects_version_missing_dataset_and_truncation(tiny_table, tmp_p
         read_table(bad)
     shutil.copy(tiny_table, bad)
     with h5py.File(bad, "a") as f:
-        del f["cells/speed_q"]
-    with pytest.raises(DataFormatError, match="cells/speed_q"):
+        del f["cells/cluster_slope"]
+    with pytest.raises(DataFormatError, match="cells/cluster_slope"):
         read_table(bad)
     data = tiny_table.read_bytes()
     bad.write_bytes(data[: len(data) // 3])

@@ -44,7 +44,7 @@ BAD = [
     ("[simulation]\nkappa = 1.5", "simulation.kappa"),
     ("[simulation]\nparticle_count = 10", "simulation.particle_count"),
     ("[grids]\nalpha1_deg = [10.0]", "[grids]"),
-    ("[table]\nresolution = {spin_atoms = 0}", "table.resolution"),
+    ("[table]\nresolution = {clusters = 0}", "table.resolution"),
     ("[table]\nresolution = {atoms = 8}", "table.resolution.atoms"),
 ]
 

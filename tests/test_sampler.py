@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
 from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch
+from surrogate.table import alias_table
 
 
 def test_runtime_does_not_import_tablegen():
@@ -22,8 +23,20 @@ def test_runtime_does_not_import_tablegen():
 
 def test_loaded_table_is_immutable(small_table):
     with pytest.raises(ValueError):
-        small_table.kernel_data.speed_q[0, 0, 0, 0, 0, 0] = 1.0
+        small_table.kernel_data.clusters[0, 0, 0, 0, 0] = 1.0
     assert all(a.flags.c_contiguous for a in small_table.kernel_data)
+
+
+@pytest.mark.parametrize("weights", [[0.25, 0.25, 0.25, 0.25], [0.7, 0.0, 0.2, 0.1, 0.0], [1.0, 0.0, 0.0],
+                                     np.random.default_rng(3).dirichlet(np.ones(500))])
+def test_alias_table_reproduces_the_weights(weights):
+    """Exact probability of each component under the alias draw: (keep[c] + Σ_{alias[d]=c} (1 − keep[d]))/C."""
+    keep, alias = alias_table(np.asarray(weights))
+    C = len(weights)
+    prob = keep.copy()
+    np.add.at(prob, alias, 1.0 - keep)
+    np.testing.assert_allclose(prob / C, weights, atol=1e-14)
+    assert np.all(keep[np.asarray(weights) == 0] == 0)
 
 
 def _local_velocity(d, speed):

@@ -14,6 +14,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from data_schema.table import read_table
+from surrogate.table import ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 from tablegen.validation import classifier_accuracy, compare, direct_states, table_states
 
 N_DRAWS = 20_000
@@ -45,23 +47,46 @@ def test_two_direct_samples_are_indistinguishable():
     assert abs(classifier_accuracy(X, Y) - 0.5) < 4 * 0.0035
 
 
-def test_a_table_that_drops_the_alpha2_speed_dependence_is_caught(small_table):
-    """A deliberately broken table: s drawn from the wrong α2 bin.
+def _without_alpha2_speed_dependence(table, weights, seed=0):
+    """A deliberately broken copy of ``table``: s no longer depends on α2 (or |β2|).
 
-    Reversing the α2-bin axis of the s quantile functions (and spin atoms)
-    keeps every marginal but decouples s from α2. The classifier on (α2, s)
-    must flag it (intact table measured at 0.526, broken at 0.80), and the
-    marginal KS test alone must not be what catches it.
+    In every cell, s's slopes on α2 and |β2| are set to 0, their mean
+    contribution folded into s's location, and each component's s law
+    (location, scale, shape) is moved to another component of nearly the same
+    weight (random permutation within blocks of 20 components sorted by
+    weight). The s marginal is kept; its link to the direction is gone.
     """
+    rows = np.array(table.kernel_data.clusters)
+    m0 = rows[..., ROW_LOC]                                  # component means of α2 and |β2|
+    m1 = rows[..., ROW_LOC + 1] + rows[..., ROW_SLOPE] * m0
+    level = rows[..., ROW_LOC + 2] + rows[..., ROW_SLOPE + 1] * m0 + rows[..., ROW_SLOPE + 2] * m1
+    rows[..., ROW_LOC + 2] = level
+    rows[..., ROW_SLOPE + 1] = rows[..., ROW_SLOPE + 2] = 0.0
+    rng = np.random.default_rng(seed)
+    for cell in np.ndindex(*weights.shape[:3]):
+        order = np.argsort(weights[cell], kind="stable")
+        perm = np.arange(len(order))
+        for start in range(0, len(order), 20):
+            block = order[start:start + 20]
+            perm[block] = rng.permutation(block)
+        for col in (ROW_LOC + 2, ROW_SCALE + 2, ROW_SHAPE + 2):
+            rows[cell + (slice(None), col)] = rows[cell + (perm, col)]
+    return dataclasses.replace(table, kernel_data=table.kernel_data._replace(clusters=rows))
+
+
+def test_a_table_that_drops_the_alpha2_speed_dependence_is_caught(small_table, small_table_path):
+    """The classifier on (α2, s) flags the broken table; the α2 and s marginals alone do not.
+
+    Measured: intact 0.508, broken 0.686 at n = 2·10⁴ (SE 0.0035); the
+    thresholds 0.55 and 0.62 sit > 10 SE from both.
+    """
+    weights = read_table(small_table_path).cells["cluster_weight"]
+    broken = _without_alpha2_speed_dependence(small_table, weights)
     D = direct_states("prism", 60.0, 150.0, N_DRAWS, seed=101)
-    data = small_table.kernel_data
-    flip = np.arange(data.speed_q.shape[3])[::-1]
-    broken = dataclasses.replace(small_table, kernel_data=data._replace(
-        speed_q=np.ascontiguousarray(data.speed_q[:, :, :, flip]),
-        spin=np.ascontiguousarray(data.spin[:, :, :, flip])))
     pair = [0, 2]
     intact_T = table_states(small_table, "prism", 60.0, 150.0, N_DRAWS, seed=7)
     broken_T = table_states(broken, "prism", 60.0, 150.0, N_DRAWS, seed=7)
     assert classifier_accuracy(intact_T[:, pair], D[:, pair]) < 0.55
-    assert classifier_accuracy(broken_T[:, pair], D[:, pair]) > 0.65
-    assert max(compare(broken_T, D, joint=False)["ks"].values()) <= KS_TARGET
+    assert classifier_accuracy(broken_T[:, pair], D[:, pair]) > 0.62
+    ks = compare(broken_T, D, joint=False)["ks"]
+    assert ks["alpha2"] <= KS_TARGET and ks["speed_ratio"] <= KS_TARGET
