@@ -1,4 +1,4 @@
-"""Command line of tablegen: ``tablegen simulate ...``.
+"""Command line of tablegen: ``tablegen simulate|build|info|report ...``.
 
 Bad arguments exit with status 2 and a message naming the argument and its
 allowed range (argparse convention).
@@ -53,7 +53,39 @@ def _build_parser() -> argparse.ArgumentParser:
 
     info = sub.add_parser("info", help="describe a rebound table")
     info.add_argument("table", metavar="TABLE.h5")
+
+    report = sub.add_parser("report", help="write the paper's study (figures and index.md) to a folder",
+                            description="Write the study of Panfilov & Tsirkunov (2022) at |V-| = 200 m/s, "
+                                        "Omega- = 0 to a new folder: PNG figures against alpha1, PDFs, "
+                                        "indicatrices, collision counts and index.md (docs/report.md). "
+                                        "Needs matplotlib: pip install \"rebound-scatter[plots]\".")
+    source = report.add_mutually_exclusive_group(required=True)
+    source.add_argument("--table", metavar="TABLE.h5",
+                        help="draw from a table, at its grid alpha1 and its grid speed nearest 200 m/s")
+    source.add_argument("--direct", action="store_true", help="run the direct model at 200 m/s")
+    report.add_argument("-o", "--out", required=True, metavar="FOLDER", help="output folder (must not exist)")
+    report.add_argument("--shapes", nargs="+", choices=SHAPES + (MIX,), default=list(SHAPES + (MIX,)),
+                        help="shapes to report, and 'mix' for the equal-weight mix (default: all)")
+    report.add_argument("-n", type=int, default=20_000, metavar="N",
+                        help="particles (--direct) or draws (--table) per shape and alpha1, >= 1 "
+                             "(default %(default)s)")
+    report.add_argument("--seed", type=int, default=None, help="random seed (default: fresh, recorded)")
+    report.add_argument("--alpha1", type=_alpha1_list, metavar="LIST",
+                        help="comma-separated incidence angles in (0, 90] deg (default: 5,10,...,90 with "
+                             "--direct; the table's grid with --table, of which LIST must be a subset)")
+    report.add_argument("--overwrite", action="store_true", help="replace an existing output folder")
+    report.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
     return parser
+
+
+def _alpha1_list(text: str) -> tuple:
+    """Comma-separated angles in (0, 90] degrees, as a tuple (argparse type)."""
+    from tablegen.simulate import check_alpha1
+
+    try:
+        return tuple(check_alpha1(v) for v in text.split(","))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"comma-separated angles in (0, 90] deg; {exc}") from None
 
 
 def _simulate(args, parser) -> int:
@@ -118,10 +150,41 @@ def _info(args, parser) -> int:
     return 0
 
 
+def _report(args, parser) -> int:
+    from data_schema.common import DataFormatError
+    from tablegen.report import DEFAULT_ALPHA1, check_output_folder, direct_data, table_data, write_report
+    from tablegen.report_plots import require_matplotlib
+    from tablegen.simulate import check_seed
+
+    if args.n < 1:
+        parser.error(f"argument -n: must be >= 1; got {args.n}")
+    try:
+        seed = check_seed(args.seed)
+        check_output_folder(args.out, args.overwrite)
+    except (ValueError, FileExistsError, FileNotFoundError) as exc:
+        parser.error(str(exc))
+    try:
+        require_matplotlib()
+    except ImportError as exc:
+        print(f"tablegen report: error: {exc}", file=sys.stderr)
+        return 1
+    try:
+        if args.direct:
+            data = direct_data(args.shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed,
+                               progress=not args.no_progress and sys.stderr.isatty())
+        else:
+            data = table_data(args.table, args.shapes, args.alpha1, args.n, seed)
+    except (ValueError, FileNotFoundError, DataFormatError) as exc:
+        parser.error(str(exc))
+    path = write_report(data, args.out, overwrite=args.overwrite)
+    print(f"report written to {path / 'index.md'}")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = _build_parser()
     args = parser.parse_args(argv)
-    commands = {"simulate": _simulate, "build": _build, "info": _info}
+    commands = {"simulate": _simulate, "build": _build, "info": _info, "report": _report}
     return commands[args.command](args, parser)
 
 
