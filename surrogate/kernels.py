@@ -12,7 +12,12 @@ uniforms from [0, 1)::
 Between grid points the sampler uses stochastic interpolation: the cell of the
 neighbour at x_{j+1} is used with probability w = (x − x_j)/(x_{j+1} − x_j), as
 Monte Carlo transport codes do between incident-energy points; a multimodal
-law stays multimodal (no averaging of quantiles).
+law stays multimodal (no averaging of quantiles). By default (``scaled``) the
+state drawn from the neighbour is then moved, variable by variable, to the
+bilinearly interpolated mean and standard deviation, so moments vary
+continuously between grid points (like the unit-base interpolation of
+transport codes, which stretches a neighbour's secondary law to the
+interpolated range).
 
 Frames and units: the local frame is the model's lab frame (wall y = 0,
 normal +Y, impact plane XY, α1 from the wall); angles in radians except α1
@@ -99,13 +104,41 @@ def draw_folded(data, s, ia, iv, u):
 
 
 @numba.njit(inline="always", **JIT)
-def draw_local(data, mix_cdf, alpha1, speed, u):
+def _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, k, x, centred):
+    """x drawn from cell (ia, iv), moved to the moments interpolated between cells ja, ja1 (α1) × jv, jv1 (speed).
+
+    x' = m + (x − m_cell) σ/σ_cell with m, σ bilinear in the four neighbouring
+    cells' means and standard deviations of state variable k; ``centred``
+    variables (β2, Ω_x, Ω_y: mean 0 by the mirror symmetry) are only scaled.
+    """
+    mo = data.moments
+    sd = ((1.0 - wa) * ((1.0 - wv) * mo[shape, ja, jv, 1, k] + wv * mo[shape, ja, jv1, 1, k])
+          + wa * ((1.0 - wv) * mo[shape, ja1, jv, 1, k] + wv * mo[shape, ja1, jv1, 1, k]))
+    sd_cell = mo[shape, ia, iv, 1, k]
+    ratio = sd / sd_cell if sd_cell > 0.0 else 1.0
+    if centred:
+        return x * ratio
+    mean = ((1.0 - wa) * ((1.0 - wv) * mo[shape, ja, jv, 0, k] + wv * mo[shape, ja, jv1, 0, k])
+            + wa * ((1.0 - wv) * mo[shape, ja1, jv, 0, k] + wv * mo[shape, ja1, jv1, 0, k]))
+    return mean + (x - mo[shape, ia, iv, 0, k]) * ratio
+
+
+@numba.njit(inline="always", **JIT)
+def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
     """One reflected state at (α1 deg, |V⁻| m/s) in the local frame.
 
     ``mix_cdf`` is the cumulative shape weights in the table's shape order
     (last entry 1). Returns (status, α2, β2, s, Ω_x a/|V⁻|, Ω_y a/|V⁻|,
     Ω_z a/|V⁻|); the state is NaN for a trapped particle. Outside the table's
     grid the law at the nearest grid edge is used.
+
+    Between grid points the cell of a neighbour is drawn with its
+    interpolation weight (stochastic interpolation). With ``scaled``, the
+    state drawn from that cell is then moved, variable by variable, to the
+    mean and standard deviation interpolated bilinearly between the four
+    neighbouring cells (x' = m + (x − m_cell) σ/σ_cell): the neighbour's shape
+    and correlations with moments that vary continuously, instead of a
+    mixture of the two neighbours' laws.
     """
     shape = 0
     while shape < mix_cdf.shape[0] - 1 and u[0] >= mix_cdf[shape]:
@@ -117,6 +150,16 @@ def draw_local(data, mix_cdf, alpha1, speed, u):
     if u[3] < data.p_trapped[shape, ia, iv]:
         return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     alpha2, beta2, s, wx, wy, wz = draw_folded(data, shape, ia, iv, u)
+    if scaled and (wa > 0.0 or wv > 0.0):
+        ja1 = min(ja + 1, data.alpha1_deg.shape[0] - 1)     # = ja on a one-point grid (weight 0)
+        jv1 = min(jv + 1, data.speed.shape[0] - 1)
+        alpha2 = abs(_rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 0, alpha2, False))
+        alpha2 = 2.0 * math.pi - alpha2 if alpha2 > math.pi else alpha2
+        beta2 = min(_rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 1, beta2, True), 0.5 * math.pi)
+        s = max(_rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 2, s, False), 0.0)
+        wx = _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 3, wx, True)
+        wy = _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 4, wy, True)
+        wz = _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 5, wz, False)
     if u[11] < 0.5:
         return STATUS_REBOUNDED, alpha2, -beta2, s, -wx, -wy, wz
     return STATUS_REBOUNDED, alpha2, beta2, s, wx, wy, wz
@@ -156,7 +199,7 @@ def impact_frame(V, n, u_axis):
 
 
 @numba.njit(**JIT)
-def rebound(data, mix_cdf, V, n, a, u, V_out, W_out):
+def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
     """Reflected state of one particle in the global frame; returns the status.
 
     Parameters
@@ -168,6 +211,8 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out):
     a : particle half-size (half its largest extent), m.
     u : (U_PER_DRAW,) uniforms in [0, 1).
     V_out, W_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
+    scaled : between grid points, move the draw to the interpolated moments
+        (default; :func:`draw_local`); False: plain stochastic interpolation.
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
     move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
@@ -184,7 +229,7 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out):
             W_out[k] = np.nan
         return STATUS_INVALID
     alpha1, speed, ex, ez = impact_frame(V, n, u[12])
-    status, alpha2, beta2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1, speed, u)
+    status, alpha2, beta2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1, speed, u, scaled)
     if status != STATUS_REBOUNDED:
         for k in range(3):
             V_out[k] = np.nan
@@ -201,16 +246,16 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out):
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status):
+def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row (parallel); u has shape (N, U_PER_DRAW)."""
     for i in numba.prange(V.shape[0]):
-        status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i])
+        status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
 
 
 @numba.njit(parallel=True, **JIT)
-def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status):
+def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
     """:func:`draw_local` for every row (parallel); out has shape (N, 6)."""
     for i in numba.prange(alpha1.shape[0]):
-        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i])
+        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i], scaled)
         status[i] = st
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = a2, b2, s, wx, wy, wz

@@ -12,6 +12,9 @@ Both accept a shape name or a mix of shapes, ``random_state`` (int, Generator
 or None) and ``clamp``: by default an incident state outside the table's grid
 is an error; with ``clamp=True`` the dimensionless law at the nearest grid
 edge is used (and scaled by the particle's actual speed).
+Between grid points the law of a neighbouring grid point is drawn with its
+interpolation weight and, by default (``interpolation="scaled"``), moved to the
+interpolated means and standard deviations.
 Each particle gets a status: 0 rebounded, 1 trapped (rolling along or
 deposited on the wall, drawn with its tabulated probability; its V⁺ and Ω⁺
 are NaN, not a made-up rebound).
@@ -87,6 +90,16 @@ def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
     return cdf
 
 
+INTERPOLATIONS = ("stochastic", "scaled")
+
+
+def _scaled(interpolation: str) -> bool:
+    if interpolation not in INTERPOLATIONS:
+        raise ValueError(f"The 'interpolation' parameter must be one of {', '.join(INTERPOLATIONS)}; "
+                         f"got {interpolation!r}.")
+    return interpolation == "scaled"
+
+
 def _check_range(name, values, bounds, clamp, units) -> None:
     """Non-finite values are always an error; out-of-range ones unless ``clamp``.
 
@@ -106,11 +119,12 @@ def _check_range(name, values, bounds, clamp, units) -> None:
 
 
 def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random_state=None,
-                 clamp: bool = False) -> LocalDraws:
+                 clamp: bool = False, interpolation: str = "scaled") -> LocalDraws:
     """Draw one reflected state per entry of ``alpha1`` (deg) and ``speed`` (m/s).
 
     ``alpha1`` and ``speed`` are broadcast together; their common shape is
-    flattened to n draws.
+    flattened to n draws. ``interpolation``: ``"scaled"`` (default) or
+    ``"stochastic"`` (see :func:`sample_global`).
     """
     a, v = np.broadcast_arrays(np.asarray(alpha1, dtype=np.float64), np.asarray(speed, dtype=np.float64))
     a, v = a.ravel(), v.ravel()
@@ -121,7 +135,8 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
     u = rng.random((len(a), U_PER_DRAW))
     out = np.empty((len(a), 6))
     status = np.empty(len(a), dtype=np.int8)
-    draw_local_batch(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), u, out, status)
+    draw_local_batch(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), u, out, status,
+                     _scaled(interpolation))
     return LocalDraws(alpha2=out[:, 0], beta2=out[:, 1], speed_ratio=out[:, 2], omega=out[:, 3:], status=status)
 
 
@@ -138,7 +153,7 @@ def _vectors(name, value, n=None):
 
 
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
-                  clamp: bool = False):
+                  clamp: bool = False, interpolation: str = "scaled"):
     """Reflected velocities and spins of particles hitting walls, in the global frame.
 
     Parameters
@@ -150,6 +165,11 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     half_size : (N,) or scalar, particle half-size a in m (half the largest extent).
     shape : shape name or mix (see :func:`mix_cdf`).
     random_state : int, Generator or None.
+    interpolation : between grid points, ``"scaled"`` (default: the law of a
+        neighbouring grid point drawn with its interpolation weight, then moved to
+        the bilinearly interpolated means and standard deviations) or
+        ``"stochastic"`` (the neighbour's law as is); see
+        :func:`surrogate.kernels.draw_local` and docs/VALIDATION.md for how they compare.
     clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
         edge instead of raising.
 
@@ -189,5 +209,5 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     W_out = np.empty((n_particles, 3))
     status = np.empty(n_particles, dtype=np.int8)
     rebound_batch(table.kernel_data, cdf, np.ascontiguousarray(V), np.ascontiguousarray(nrm),
-                  np.ascontiguousarray(a), u, V_out, W_out, status)
+                  np.ascontiguousarray(a), u, V_out, W_out, status, _scaled(interpolation))
     return V_out, W_out, status

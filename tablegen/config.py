@@ -4,12 +4,12 @@ A configuration has three sections (every key optional; defaults are those of
 the ``default`` preset)::
 
     [grid]
-    alpha1_deg = [2, 5, 10, ...] or {start = 5, stop = 90, step = 5}   # degrees, in (0, 90]
+    alpha1_deg = [1, 2, 3, ...] or {start = 5, stop = 90, step = 5}    # degrees, in (0, 90]
     speed_m_s  = [50, 100, ...]  or {start = 50, stop = 300, step = 50}  # m/s, > 0
     shapes     = ["ellipsoid", "prism", "cut_prism", "tetrahedron"]
 
     [simulation]
-    particles_per_cell = 25000        # direct-model particles per (shape, α1, |V⁻|) cell
+    particles_per_cell = 20000        # direct-model particles per (shape, α1, |V⁻|) cell
     seed = 20261121                   # master seed; each cell's seed derives from it
     kappa = 0.3                       # cut-prism corner truncation
     n_max = 1000                      # collisions before a particle counts as trapped

@@ -40,9 +40,11 @@ def classifier_accuracy(X: np.ndarray, Y: np.ndarray, seed: int = 0) -> float:
     return float(model.score(Z_test, y_test))
 
 
-def table_states(table, shape, alpha1: float, speed: float, n: int, seed: int) -> np.ndarray:
+def table_states(table, shape, alpha1: float, speed: float, n: int, seed: int,
+                 interpolation: str = "stochastic") -> np.ndarray:
     """(m, 6) rebounded states drawn from a table (m ≤ n: trapped draws are dropped)."""
-    d = surrogate.sample_local(table, np.full(n, alpha1), speed, shape, random_state=seed)
+    d = surrogate.sample_local(table, np.full(n, alpha1), speed, shape, random_state=seed,
+                               interpolation=interpolation)
     ok = d.status == STATUS_REBOUNDED
     return np.column_stack([d.alpha2[ok], d.beta2[ok], d.speed_ratio[ok], d.omega[ok]])
 

@@ -100,22 +100,59 @@ def test_mirror_sign_and_ranges(small_table):
     assert np.all((d.speed_ratio[ok] > 0) & (d.speed_ratio[ok] <= 1))
 
 
-def test_stochastic_interpolation_mixes_the_neighbours(small_table):
-    """Between grid points the law is the weighted mixture of the neighbouring cells.
+@pytest.mark.parametrize("interpolation", ["stochastic", "scaled"])
+def test_interpolation_mean_is_the_weighted_mean_of_the_neighbours(small_table, interpolation):
+    """Between grid points the mean of α2 is the weighted mean of the neighbouring cells' means.
 
-    At α1 = 40° (w = 1/3 towards 60°) the mean of α2 is the weighted mean of the
-    cell means; with 40 000 draws the tolerance is 4 standard errors of each mean.
-    At a grid point the neighbour is never used.
+    Both modes: the stochastic mixture by construction, the scaled one because
+    it moves each draw to the interpolated mean. At α1 = 40° (w = 1/3 towards
+    60°), with 40 000 draws the tolerance is 4 standard errors of the
+    difference. At a grid point the neighbour is never used.
     """
     n = 40000
-    m30, m40, m60 = (surrogate.sample_local(small_table, np.full(n, a), 150.0, "prism", random_state=k).alpha2
+    m30, m40, m60 = (surrogate.sample_local(small_table, np.full(n, a), 150.0, "prism", random_state=k,
+                                            interpolation=interpolation).alpha2
                      for k, a in ((1, 30.0), (2, 40.0), (3, 60.0)))
     expected = (2 * m30.mean() + m60.mean()) / 3
     se = np.sqrt((2 / 3) ** 2 * m30.var() / n + (1 / 3) ** 2 * m60.var() / n + m40.var() / n)
     assert abs(m40.mean() - expected) < 4 * se
     assert abs(m30.mean() - m60.mean()) > 20 * se          # the test has power
-    at_grid = surrogate.sample_local(small_table, np.full(n, 60.0), 150.0, "prism", random_state=3).alpha2
+    at_grid = surrogate.sample_local(small_table, np.full(n, 60.0), 150.0, "prism", random_state=3,
+                                     interpolation=interpolation).alpha2
     np.testing.assert_array_equal(at_grid, m60)
+
+
+def _sd_and_se(x):
+    """Sample standard deviation and its standard error √((μ4 − σ⁴)/n)/(2σ) (any law with a 4th moment)."""
+    sd = x.std()
+    return sd, np.sqrt(np.mean((x - x.mean()) ** 4) - sd ** 4) / (2 * sd * np.sqrt(len(x)))
+
+
+def test_scaled_interpolation_has_the_interpolated_spread(small_table):
+    """Off grid in α1 and speed, the scaled draws have the bilinear interpolation of the neighbours' sds.
+
+    At (40°, 100 m/s) the weights are 1/3 towards 60° and 1/2 towards 150 m/s.
+    Tolerance: 4 standard errors of the difference (each sd's SE from its own
+    sample's fourth moment, 40 000 draws each). The stochastic mixture of the
+    same neighbours has a larger spread (it adds the spread between the cell
+    means), which the test also checks so that it can tell the two apart.
+    """
+    n = 40000
+    corners = {(a, v): surrogate.sample_local(small_table, np.full(n, a), v, "prism", random_state=10 + k).speed_ratio
+               for k, (a, v) in enumerate([(30.0, 50.0), (60.0, 50.0), (30.0, 150.0), (60.0, 150.0)])}
+    weight = {(30.0, 50.0): 1 / 3, (60.0, 50.0): 1 / 6, (30.0, 150.0): 1 / 3, (60.0, 150.0): 1 / 6}
+    sds = {key: _sd_and_se(x[np.isfinite(x)]) for key, x in corners.items()}
+    expected = sum(weight[key] * sds[key][0] for key in corners)
+    se_expected = np.sqrt(sum((weight[key] * sds[key][1]) ** 2 for key in corners))
+    results = {}
+    for mode in ("scaled", "stochastic"):
+        x = surrogate.sample_local(small_table, np.full(n, 40.0), 100.0, "prism", random_state=20,
+                                   interpolation=mode).speed_ratio
+        results[mode] = _sd_and_se(x[np.isfinite(x)])
+    sd, se = results["scaled"]
+    assert abs(sd - expected) < 4 * np.hypot(se, se_expected)
+    sd_mix, se_mix = results["stochastic"]
+    assert sd_mix - expected > 4 * np.hypot(se_mix, se_expected)
 
 
 def test_trapped_fraction_matches_the_table(small_table):
