@@ -13,9 +13,10 @@ and prints the cost in ns per reflected state:
     ``surrogate.kernels.rebound_batch`` alone on pre-drawn uniforms;
 (b) ``surrogate.kernels.rebound`` called from a user's ``@njit`` loop on one
     thread, as a flow solver would call it: the loop draws the U_PER_DRAW
-    uniforms of each state with ``np.random.random()`` (numba's generator) and
-    that cost is included. Variant (b'): the same loop reading pre-drawn
-    uniforms; breakdown row: the ``np.random.random()`` draws alone;
+    uniforms of each state with ``surrogate.rng.fill_uniforms`` (xoshiro256+,
+    caller-owned state) and that cost is included. Variants: the uniforms from
+    numba's ``np.random.random()``; (b') the loop reading pre-drawn uniforms;
+    breakdown row: the xoshiro256+ draws alone;
 (c) the direct model, ``tablegen.simulate.simulate`` with the shape mix, one
     thread, per particle simulated (whatever its status; NumPy input draws,
     kernel and result assembly included). The states' α1 distribution
@@ -85,6 +86,7 @@ import numpy as np
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
 from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch
+from surrogate.rng import fill_uniforms, seed_state
 
 SEED = 20240601
 HALF_SIZE = 1e-4                    # m, particle half-size a
@@ -158,8 +160,17 @@ def seed_numba_rng(seed):
 
 
 @numba.njit(**JIT)
-def loop_kernel_rng(data, cdf, V, n, a, V_out, W_out, status):
-    """(b) A solver's loop: its own uniforms from np.random.random(), our kernel."""
+def loop_kernel_rng(data, cdf, V, n, a, state, V_out, W_out, status):
+    """(b) A solver's loop: uniforms from a xoshiro256+ state (surrogate.rng.fill_uniforms), our kernel."""
+    u = np.empty(U_PER_DRAW)
+    for i in range(V.shape[0]):
+        fill_uniforms(state, u)
+        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i])
+
+
+@numba.njit(**JIT)
+def loop_kernel_nprandom(data, cdf, V, n, a, V_out, W_out, status):
+    """(b, np.random) The same loop drawing its uniforms with numba's np.random.random()."""
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         for k in range(U_PER_DRAW):
@@ -175,12 +186,14 @@ def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, W_out, status):
 
 
 @numba.njit(**JIT)
-def loop_rng_only(count, out):
-    """Breakdown of (b): the U_PER_DRAW np.random.random() draws per state alone (summed into out)."""
+def loop_rng_only(count, state, out):
+    """Breakdown of (b): the U_PER_DRAW xoshiro256+ uniforms per state alone (summed into out)."""
     s = 0.0
+    u = np.empty(U_PER_DRAW)
     for i in range(count):
+        fill_uniforms(state, u)
         for k in range(U_PER_DRAW):
-            s += np.random.random()
+            s += u[k]
     out[0] = s
 
 
@@ -352,9 +365,10 @@ def main(argv=None) -> int:
     surrogate.sample_global(table, V[:m], nrm[:m], a[:m], shape=mix, random_state=SEED)
     rebound_batch(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
     seed_numba_rng(SEED)
-    loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
+    loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
+    loop_kernel_nprandom(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
     loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
-    loop_rng_only(m, np.empty(1))
+    loop_rng_only(m, seed_state(SEED), np.empty(1))
     loop_bounce(V[:m], nrm[:m], V_out[:m])
     print(f"  threading layer        {numba.threading_layer()}\n")
 
@@ -378,14 +392,16 @@ def main(argv=None) -> int:
     record("a_kernel_1", "    breakdown: rebound_batch alone, 1 thread", 1,
            lambda: rebound_batch(data, cdf, V, nrm, a, U, V_out, W_out, status), note="pre-drawn uniforms")
     trapped_api = float(np.mean(api()[2] != 0))
-    record("b", "(b) rebound in @njit loop, np.random.random()", 1,
-           lambda: loop_kernel_rng(data, cdf, V, nrm, a, V_out, W_out, status),
+    record("b", "(b) rebound in @njit loop, xoshiro256+ uniforms", 1,
+           lambda: loop_kernel_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, W_out, status))
+    record("b_nprandom", "    variant: uniforms from np.random.random()", 1,
+           lambda: loop_kernel_nprandom(data, cdf, V, nrm, a, V_out, W_out, status),
            setup=lambda: seed_numba_rng(SEED))
     trapped_b = float(np.mean(status != 0))
     record("b_predrawn", "(b') rebound in @njit loop, pre-drawn uniforms", 1,
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status))
-    record("b_rng", f"    breakdown: {U_PER_DRAW} np.random.random() alone", 1,
-           lambda: loop_rng_only(count, np.empty(1)), setup=lambda: seed_numba_rng(SEED))
+    record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
+           lambda: loop_rng_only(count, seed_state(SEED), np.empty(1)))
     record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))
 
     direct_ns, direct_rows = direct_cost(st["speed_bins"], min_time, repeats)

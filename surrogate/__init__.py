@@ -9,13 +9,16 @@ imports :mod:`tablegen`, so a flow solver installs the runtime alone::
                                                        random_state=1)
 
 From numba code, call :func:`surrogate.kernels.rebound` with ``table.kernel_data``
-and ``U_PER_DRAW`` uniforms per call.
+and ``U_PER_DRAW`` uniforms per call; :func:`surrogate.rng.fill_uniforms` draws
+them fast from a caller-owned xoshiro256+ state (:func:`surrogate.rng.seed_state`).
 """
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.kernels import STATUS_INVALID, U_PER_DRAW
+from surrogate.rng import fill_uniforms, seed_state
 from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 
 __all__ = ["LocalDraws", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW",
-           "check_random_state", "load", "mix_cdf", "sample_global", "sample_local"]
+           "check_random_state", "fill_uniforms", "load", "mix_cdf", "sample_global", "sample_local",
+           "seed_state"]

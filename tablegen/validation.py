@@ -41,7 +41,7 @@ def classifier_accuracy(X: np.ndarray, Y: np.ndarray, seed: int = 0) -> float:
 
 
 def table_states(table, shape, alpha1: float, speed: float, n: int, seed: int,
-                 interpolation: str = "stochastic") -> np.ndarray:
+                 interpolation: str = "scaled") -> np.ndarray:
     """(m, 6) rebounded states drawn from a table (m ≤ n: trapped draws are dropped)."""
     d = surrogate.sample_local(table, np.full(n, alpha1), speed, shape, random_state=seed,
                                interpolation=interpolation)
