@@ -43,7 +43,7 @@ try:
 except ImportError:            # running from a source checkout without `pip install -e .`
     sys.path.insert(0, str(REPO))
     import surrogate
-from surrogate import STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW
+from surrogate import STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.kernels import rebound
 
 # A small table for this beam: alpha1 down to 2 deg (grazing hits on the
@@ -87,14 +87,14 @@ def hit_time(p, v, geometry, radius):
 
 
 @njit   # not cache=True: a cached copy would not notice later edits to surrogate.kernels
-def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size, e, seed):
+def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size, e, rng_state):
     """Move every particle to time t_end (in place); rebound it at its wall hit.
 
     pos, vel : (N, 3) start positions (m) and velocities (m/s), global frame.
     model : TABLE (surrogate kernel) or SPECULAR (sphere with restitution e).
+    rng_state : (4,) uint64 xoshiro256+ state (surrogate.seed_state), advanced in place.
     Returns (V+ at the hit (N, 3) m/s, NaN if missed or trapped; outcome (N,) int8).
     """
-    np.random.seed(seed)                       # numba's own generator
     n = pos.shape[0]
     v_out = np.full((n, 3), np.nan)
     outcome = np.full(n, MISSED, dtype=np.int8)
@@ -119,8 +119,7 @@ def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size
                 r = math.sqrt(p[0] * p[0] + p[1] * p[1])
                 normal[0], normal[1], normal[2] = p[0] / r, p[1] / r, 0.0
             if model == TABLE:
-                for k in range(U_PER_DRAW):
-                    u[k] = np.random.random()
+                fill_uniforms(rng_state, u)
                 status = rebound(data, mix_cdf, v, normal, half_size, u, vo, wo)
             else:
                 vn = v[0] * normal[0] + v[1] * normal[1] + v[2] * normal[2]
@@ -161,7 +160,7 @@ def run(pos, vel, t_end, geometry, model, table, cdf, e, seed):
     pos = pos.copy()
     dt = 0.02 * RADIUS / SPEED_RANGE[1]        # 0.2 mm per step at the top speed
     v_out, outcome = track(pos, vel, t_end, dt, geometry, RADIUS, model, table.kernel_data, cdf,
-                           HALF_SIZE, e, seed)
+                           HALF_SIZE, e, seed_state(seed))
     return pos, v_out, outcome
 
 

@@ -65,3 +65,51 @@ def compare(T: np.ndarray, D: np.ndarray, joint: bool = True, seed: int = 0) -> 
     if joint:
         result["classifier_accuracy"] = classifier_accuracy(T, D, seed)
     return result
+
+
+# ----------------------------------------------------------------------------- the validation matrix
+
+SHAPES_AND_MIX = ("ellipsoid", "prism", "cut_prism", "tetrahedron", "mix")
+ALPHA1_TARGETS = (3.0, 12.0, 30.0, 60.0, 85.0)   # deg: grazing, low, middle, high, near normal
+SPEED_TARGETS = (75.0, 275.0)                    # m/s: low and high end of the usual grids
+
+
+def grid_points(grid, targets) -> list:
+    """The grid values nearest to ``targets`` (each once, in grid order)."""
+    grid = np.asarray(grid, dtype=float)
+    return sorted({float(grid[np.argmin(np.abs(grid - t))]) for t in targets})
+
+
+def midpoints(grid, targets) -> list:
+    """Midpoints of the grid intervals holding (or nearest to) ``targets`` (each once, increasing)."""
+    grid = np.asarray(grid, dtype=float)
+    if len(grid) < 2:
+        return []
+    j = np.clip(np.searchsorted(grid, targets) - 1, 0, len(grid) - 2)
+    return sorted({float((grid[i] + grid[i + 1]) / 2) for i in j})
+
+
+def matrix_points(table) -> list:
+    """(where, α1, speed) of the validation matrix: on-grid points and off-grid midpoints in both coordinates."""
+    on = [("on grid", a, v) for a in grid_points(table.alpha1_deg, ALPHA1_TARGETS)
+          for v in grid_points(table.speed_m_s, SPEED_TARGETS)]
+    off = [("off grid", a, v) for a in midpoints(table.alpha1_deg, ALPHA1_TARGETS)
+           for v in midpoints(table.speed_m_s, SPEED_TARGETS)]
+    return on + off
+
+
+def compare_point(table, shape: str, alpha1: float, speed: float, n: int, seed: int) -> dict:
+    """One row of the matrix: table draws (seed) against direct states (independent seed) at one point.
+
+    Returns the KS statistics, the classifier accuracy, the largest error of
+    a mean in units of its standard error (of the difference of two sample
+    means) and the largest difference of a correlation coefficient.
+    """
+    T = table_states(table, shape, alpha1, speed, n, seed=seed)
+    D = direct_states(shape, alpha1, speed, n, seed=seed + 1)
+    r = compare(T, D, seed=seed % 2 ** 31)
+    se = np.sqrt(r["std_table"] ** 2 / len(T) + r["std_direct"] ** 2 / len(D))
+    return {"shape": shape, "alpha1": alpha1, "speed": speed, "n_table": len(T), "n_direct": len(D),
+            "ks": r["ks"], "classifier_accuracy": r["classifier_accuracy"],
+            "mean_error_se": float(np.max(np.abs(r["mean_table"] - r["mean_direct"]) / se)),
+            "corr_error": float(np.nanmax(np.abs(r["corr_table"] - r["corr_direct"])))}
