@@ -186,6 +186,13 @@ def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, W_out, status):
 
 
 @numba.njit(**JIT)
+def loop_kernel_predrawn_unscaled(data, cdf, V, n, a, U, V_out, W_out, status):
+    """Breakdown of (b'): the same loop with plain stochastic interpolation (no moment scaling)."""
+    for i in range(V.shape[0]):
+        status[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V_out[i], W_out[i], False)
+
+
+@numba.njit(**JIT)
 def loop_rng_only(count, state, out):
     """Breakdown of (b): the U_PER_DRAW xoshiro256+ uniforms per state alone (summed into out)."""
     s = 0.0
@@ -368,6 +375,7 @@ def main(argv=None) -> int:
     loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
     loop_kernel_nprandom(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
     loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
+    loop_kernel_predrawn_unscaled(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
     loop_rng_only(m, seed_state(SEED), np.empty(1))
     loop_bounce(V[:m], nrm[:m], V_out[:m])
     print(f"  threading layer        {numba.threading_layer()}\n")
@@ -400,6 +408,8 @@ def main(argv=None) -> int:
     trapped_b = float(np.mean(status != 0))
     record("b_predrawn", "(b') rebound in @njit loop, pre-drawn uniforms", 1,
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status))
+    record("b_unscaled", "    breakdown: (b') without moment scaling", 1,
+           lambda: loop_kernel_predrawn_unscaled(data, cdf, V, nrm, a, U, V_out, W_out, status))
     record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
            lambda: loop_rng_only(count, seed_state(SEED), np.empty(1)))
     record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))
