@@ -6,7 +6,8 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
                            created (ISO 8601 UTC), package_version, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
-                           attrs: kappa, n_max, particles_per_cell
+                           attrs: kappa, n_max, particles_per_cell,
+                           restitution_k, restitution_p (since 2.1: the wall's normal-restitution law)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
@@ -41,7 +42,7 @@ import numpy as np
 from data_schema.common import DataFormatError, atomic_output, check_file, write_header
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (2, 0)
+TABLE_VERSION = (2, 1)
 
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
 STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
@@ -159,6 +160,8 @@ class ReboundTable:
     master_seed: int
     created: str
     package_version: str
+    restitution_k: float | None = None   # normal restitution exp(−k |V_c|^p) of the wall law (format ≥ 2.1)
+    restitution_p: float | None = None
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -191,6 +194,9 @@ class ReboundTable:
         grid.attrs["kappa"] = self.kappa
         grid.attrs["n_max"] = self.n_max
         grid.attrs["particles_per_cell"] = self.particles_per_cell
+        if self.restitution_k is not None:
+            grid.attrs["restitution_k"] = self.restitution_k
+            grid.attrs["restitution_p"] = self.restitution_p
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -224,7 +230,9 @@ class ReboundTable:
                 n_max=int(grid.attrs["n_max"]), particles_per_cell=int(grid.attrs["particles_per_cell"]),
                 config_text=str(f.attrs["config"]), config_sha256=str(f.attrs["config_sha256"]),
                 master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
-                package_version=str(f.attrs["package_version"]))
+                package_version=str(f.attrs["package_version"]),
+                restitution_k=float(grid.attrs["restitution_k"]) if "restitution_k" in grid.attrs else None,
+                restitution_p=float(grid.attrs["restitution_p"]) if "restitution_p" in grid.attrs else None)
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:

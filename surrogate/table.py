@@ -31,6 +31,7 @@ class KernelData(NamedTuple):
     clusters: np.ndarray       # (n_shape, n_alpha, n_speed, C, ROW_SIZE) float32, one row per component
     dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6·M, L + 1) float32 residual shapes
     moments: np.ndarray        # (n_shape, n_alpha, n_speed, 2, 6) mean and sd of (α2, β2, s, Ω_x, Ω_y, Ω_z)
+    restitution: np.ndarray    # (3,) k, p of the wall's normal restitution exp(−k V^p), 1 if known (format ≥ 2.1)
 
 
 # Layout of a component's row in KernelData.clusters: everything one draw needs
@@ -142,7 +143,9 @@ class SurrogateTable:
             speed_lookup=_frozen(v_lookup), speed_scale=_frozen(v_scale),
             p_trapped=_frozen(counts[..., STATUS_TRAPPED] / landed),
             clusters=_frozen(rows), dictionary=_frozen(dictionary),
-            moments=_frozen(np.stack([table.cells["mean"], table.cells["std"]], axis=3)))
+            moments=_frozen(np.stack([table.cells["mean"], table.cells["std"]], axis=3)),
+            restitution=_frozen(np.array([table.restitution_k or 0.0, table.restitution_p or 0.0,
+                                          float(table.restitution_k is not None)])))
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=data.alpha1_deg, speed_m_s=data.speed,
                    particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, kernel_data=data)

@@ -29,6 +29,7 @@ import numpy as np
 from data_schema.table import CELL_DATASETS, CellTable, ReboundTable, write_table
 from data_schema.common import package_version
 from tablegen.config import BuildConfig, cell_seed, derive_seed
+from tablegen.wall import CORUNDUM_ON_STEEL
 from tablegen.simulate import simulate
 from tablegen.tabulate import CellAccumulator
 
@@ -201,6 +202,7 @@ def _assemble(config: BuildConfig, checkpoint: Checkpoint) -> ReboundTable:
     return ReboundTable(
         alpha1_deg=np.array(config.alpha1_deg), speed_m_s=np.array(config.speed_m_s), shapes=config.shapes,
         resolution=config.resolution, cells=cells, kappa=config.kappa, n_max=config.n_max,
+        restitution_k=CORUNDUM_ON_STEEL.k, restitution_p=CORUNDUM_ON_STEEL.p,
         particles_per_cell=config.particles_per_cell, config_text=config.to_toml(),
         config_sha256=config.sha256(), master_seed=config.seed,
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),

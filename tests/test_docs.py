@@ -12,7 +12,8 @@ FORMAT_DOC = (Path(__file__).resolve().parents[1] / "docs" / "format.md").read_t
 NAMES = ([samples.SAMPLES_FILE_TYPE, "file_type", "format_version", "samples"]
          + list(samples.REQUIRED_DATASETS) + list(samples.OPTIONAL_DATASETS) + list(samples.REQUIRED_ATTRS)
          + [table.TABLE_FILE_TYPE, "created", "package_version", "config", "config_sha256", "master_seed",
-            "grid/alpha1_deg", "grid/speed_m_s", "grid/shapes", "kappa", "n_max", "particles_per_cell"]
+            "grid/alpha1_deg", "grid/speed_m_s", "grid/shapes", "kappa", "n_max", "particles_per_cell",
+            "restitution_k", "restitution_p"]
          + [f.name for f in dataclasses.fields(table.TableResolution)]
          + list(table.CELL_DATASETS))
 

@@ -277,3 +277,20 @@ def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
                      np.full(U_PER_DRAW, 0.5), V_out, W_out)
     assert status == STATUS_INVALID and np.all(np.isnan(V_out)) and np.all(np.isnan(W_out))
     np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])
+
+
+def test_speed_shift_scales_the_normal_rebound_velocity(small_table):
+    """_to_speed: v⁺_n scaled by a(V)/a(V_j), a = 1 − (1 − exp(−k V^p)) sin α1; v⁺_t and v⁺_z kept."""
+    from surrogate.kernels import _to_speed
+    data = small_table.kernel_data
+    k, p, known = data.restitution
+    assert known == 1.0 and (k, p) == (0.1, 0.61)       # the wall law the table was built with
+    alpha2, beta2, s = 1.1, 0.3, 0.4
+    sin_a1 = np.sin(np.radians(60.0))
+    same = _to_speed(data, data.speed[1], sin_a1, 1, alpha2, beta2, s)
+    np.testing.assert_allclose(same, (alpha2, beta2, s), rtol=1e-14)
+    a = lambda v: 1.0 - (1.0 - np.exp(-k * v ** p)) * sin_a1
+    a2, b2, s2 = _to_speed(data, 100.0, sin_a1, 1, alpha2, beta2, s)
+    before = s * np.array([np.cos(beta2) * np.cos(alpha2), np.cos(beta2) * np.sin(alpha2), np.sin(beta2)])
+    after = s2 * np.array([np.cos(b2) * np.cos(a2), np.cos(b2) * np.sin(a2), np.sin(b2)])
+    np.testing.assert_allclose(after, before * [1.0, a(100.0) / a(data.speed[1]), 1.0], rtol=1e-12)
