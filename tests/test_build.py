@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from data_schema.common import DataFormatError
-from data_schema.table import CELL_DATASETS, read_table
+from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table
 from tablegen.build import BuildError, build_table
 from tablegen.config import parse_config
 
@@ -139,7 +139,7 @@ def test_info_describes_the_table(tiny_table, capsys):
     from tablegen.cli import main
     assert main(["info", str(tiny_table)]) == 0
     out = capsys.readouterr().out
-    for text in ("format version 2.0", "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
+    for text in (f"format version {TABLE_VERSION[0]}.{TABLE_VERSION[1]}", "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
                  "3000 particles"):
         assert text in out
 
