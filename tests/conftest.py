@@ -1,26 +1,31 @@
-"""Shared fixtures: a small table built once per test session."""
+"""Shared fixtures: small tables built once per test session (2e4 particles per cell, all four shapes)."""
 
 import pytest
 
 from tablegen.build import build_table
 from tablegen.config import parse_config
 
-SMALL_TABLE_CONFIG = """
-[grid]
-alpha1_deg = [30.0, 60.0, 90.0]
-speed_m_s = [50.0, 150.0, 250.0]
-[simulation]
-particles_per_cell = 20000
-seed = 11
-"""
+
+def _table_config(alpha1_deg, speed_m_s, seed):
+    return (f"[grid]\nalpha1_deg = {list(alpha1_deg)}\nspeed_m_s = {list(speed_m_s)}\n"
+            f"[simulation]\nparticles_per_cell = 20000\nseed = {seed}\n")
+
+
+def _build(tmp_path_factory, name, config_text):
+    path = tmp_path_factory.mktemp("tables") / f"{name}.h5"
+    build_table(parse_config(config_text), path)
+    return path
+
+
+SMALL_TABLE_CONFIG = _table_config([30.0, 60.0, 90.0], [50.0, 150.0, 250.0], seed=11)
+# grid points around (3.5°, 175 m/s) and (42.5°, 175 m/s), with the default preset's α1 steps there
+OFF_GRID_TABLE_CONFIG = _table_config([3.0, 4.0, 40.0, 45.0], [150.0, 200.0], seed=12)
 
 
 @pytest.fixture(scope="session")
 def small_table_path(tmp_path_factory):
-    """A table of all four shapes on a 3 × 3 grid, 2e4 particles per cell."""
-    path = tmp_path_factory.mktemp("tables") / "small.h5"
-    build_table(parse_config(SMALL_TABLE_CONFIG), path)
-    return path
+    """A table on a 3 × 3 grid."""
+    return _build(tmp_path_factory, "small", SMALL_TABLE_CONFIG)
 
 
 @pytest.fixture(scope="session")
@@ -29,20 +34,8 @@ def small_table(small_table_path):
     return surrogate.load(small_table_path)
 
 
-OFF_GRID_TABLE_CONFIG = """
-[grid]
-alpha1_deg = [3.0, 4.0, 40.0, 45.0]
-speed_m_s = [150.0, 200.0]
-[simulation]
-particles_per_cell = 20000
-seed = 12
-"""
-
-
 @pytest.fixture(scope="session")
 def off_grid_table(tmp_path_factory):
-    """Grid points around (3.5°, 175 m/s) and (42.5°, 175 m/s), with the default preset's α1 steps there."""
+    """A table for comparisons between grid points (see OFF_GRID_TABLE_CONFIG)."""
     import surrogate
-    path = tmp_path_factory.mktemp("tables") / "off_grid.h5"
-    build_table(parse_config(OFF_GRID_TABLE_CONFIG), path)
-    return surrogate.load(path)
+    return surrogate.load(_build(tmp_path_factory, "off_grid", OFF_GRID_TABLE_CONFIG))
