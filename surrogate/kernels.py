@@ -139,7 +139,7 @@ def _to_speed(data, speed, sin_alpha1, iv, alpha2, beta2, s):
     """
     law = data.restitution
     a_target = 1.0 - (1.0 - math.exp(-law[0] * speed ** law[1])) * sin_alpha1
-    a_grid = 1.0 - (1.0 - math.exp(-law[0] * data.speed[iv] ** law[1])) * sin_alpha1
+    a_grid = 1.0 - (1.0 - data.speed_restitution[iv]) * sin_alpha1
     f = a_target / a_grid
     cb = math.cos(beta2)
     vt = s * cb * math.cos(alpha2)
@@ -166,7 +166,8 @@ def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
     mean and standard deviation interpolated bilinearly between the four
     neighbouring cells (x' = m + (x − m_cell) σ/σ_cell): the neighbour's shape
     and correlations with moments that vary continuously, instead of a
-    mixture of the two neighbours' laws.
+    mixture of the two neighbours' laws. Between grid speeds of a table that
+    records its wall law, α2 and s are moved by :func:`_to_speed` instead.
     """
     shape = 0
     while shape < mix_cdf.shape[0] - 1 and u[0] >= mix_cdf[shape]:

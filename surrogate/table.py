@@ -32,6 +32,7 @@ class KernelData(NamedTuple):
     dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6·M, L + 1) float32 residual shapes
     moments: np.ndarray        # (n_shape, n_alpha, n_speed, 2, 6) mean and sd of (α2, β2, s, Ω_x, Ω_y, Ω_z)
     restitution: np.ndarray    # (3,) k, p of the wall's normal restitution exp(−k V^p), 1 if known (format ≥ 2.1)
+    speed_restitution: np.ndarray  # (n_speed,) exp(−k V^p) at the grid speeds (0 if unknown)
 
 
 # Layout of a component's row in KernelData.clusters: everything one draw needs
@@ -145,7 +146,10 @@ class SurrogateTable:
             clusters=_frozen(rows), dictionary=_frozen(dictionary),
             moments=_frozen(np.stack([table.cells["mean"], table.cells["std"]], axis=3)),
             restitution=_frozen(np.array([table.restitution_k or 0.0, table.restitution_p or 0.0,
-                                          float(table.restitution_k is not None)])))
+                                          float(table.restitution_k is not None)])),
+            speed_restitution=_frozen(
+                np.exp(-table.restitution_k * np.asarray(table.speed_m_s, dtype=np.float64) ** table.restitution_p)
+                if table.restitution_k is not None else np.zeros(len(table.speed_m_s))))
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=data.alpha1_deg, speed_m_s=data.speed,
                    particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, kernel_data=data)

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from data_schema.common import package_version
+from data_schema.common import atomic_output, package_version
 from data_schema.table import STATE_NAMES
 
 SEED = 20261121
@@ -170,11 +170,9 @@ def main(argv=None) -> int:
     rows = run_matrix(tables, args.n, args.workers)
     command = "python -m tablegen.validation_report " + " ".join(f"--table {k}={v}" for k, v in tables.items())
     text = document(rows, tables, args.n, command)
-    out = Path(args.out)
-    tmp = out.with_name(out.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, out)
-    print(f"wrote {out} ({len(rows)} comparisons)")
+    with atomic_output(args.out, overwrite=True) as tmp:
+        Path(tmp).write_text(text, encoding="utf-8")
+    print(f"wrote {args.out} ({len(rows)} comparisons)")
     return 0
 
 
