@@ -2,12 +2,12 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (2, 0),
+    /                      attrs: file_type = "rebound_table", format_version = (3, 0),
                            created (ISO 8601 UTC), package_version, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
                            attrs: kappa, n_max, particles_per_cell,
-                           restitution_k, restitution_p (since 2.1: the wall's normal-restitution law)
+                           restitution_k, restitution_p (the wall's normal-restitution law)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
@@ -29,6 +29,11 @@ shape dictionary), stored at probabilities i/L, i = 0..L, and linearly
 interpolated. Cluster c is drawn with probability ``cluster_weight[c]``.
 Drawing needs one multiply, one floor and one linear interpolation per
 variable and no search.
+
+Each cluster holds rebounds of one collision regime (``cluster_regime``):
+0 for rebounds of at most :data:`FEW_COLLISIONS` collisions, 1 for more. The
+sampler moves a draw between grid speeds by a law that depends on the regime
+(docs/format.md, "Between grid points").
 """
 
 from __future__ import annotations
@@ -42,9 +47,10 @@ import numpy as np
 from data_schema.common import DataFormatError, atomic_output, check_file, write_header
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (2, 1)
+TABLE_VERSION = (3, 0)
 
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
+FEW_COLLISIONS = 2                  # regime 0 of a cluster: rebounds of at most this many collisions
 STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
 STATE_UNITS = ("rad", "rad", "1", "1", "1", "1")
 # indicatrix grids: α2 ∈ [0, π], β2 ∈ [−π/2, π/2], 2.5° bins
@@ -90,6 +96,7 @@ class TableResolution:
             "cluster_scale": (c, N_CHAIN),
             "cluster_shape": (c, N_CHAIN),
             "cluster_slope": (c, N_SLOPES),
+            "cluster_regime": (c,),
             "shape_dictionary": (N_CHAIN, self.dictionary_size, self.levels + 1),
             "status_counts": (3,),
             "collision_counts": (N_COLLISION_CLASSES,),
@@ -107,6 +114,8 @@ CELL_DATASETS = {
     "cluster_scale": ("float32", "rad, rad, 1, 1, 1, 1", "scale of each chain variable's residual, per cluster"),
     "cluster_shape": ("uint8", "1", "index into shape_dictionary of each chain variable's residual, per cluster"),
     "cluster_slope": ("float32", "1", "slopes of x_k on x_j (j < k), packed at k(k-1)/2 + j, per cluster"),
+    "cluster_regime": ("uint8", "1", "collision regime of each cluster's rebounds: 0 = at most FEW_COLLISIONS "
+                                     "collisions, 1 = more"),
     "shape_dictionary": ("float32", "1", "standardised residual quantile functions at probabilities i/L, "
                                          "per chain variable"),
     "status_counts": ("int64", "1", "particles rebounded, trapped, failed"),
@@ -127,6 +136,7 @@ class CellTable:
     cluster_scale: np.ndarray
     cluster_shape: np.ndarray
     cluster_slope: np.ndarray
+    cluster_regime: np.ndarray
     shape_dictionary: np.ndarray
     status_counts: np.ndarray
     collision_counts: np.ndarray
@@ -160,8 +170,8 @@ class ReboundTable:
     master_seed: int
     created: str
     package_version: str
-    restitution_k: float | None = None   # normal restitution exp(−k |V_c|^p) of the wall law (format ≥ 2.1)
-    restitution_p: float | None = None
+    restitution_k: float                 # normal restitution exp(−k |V_c|^p) of the wall law, (m/s)^(−p)
+    restitution_p: float
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -194,9 +204,8 @@ class ReboundTable:
         grid.attrs["kappa"] = self.kappa
         grid.attrs["n_max"] = self.n_max
         grid.attrs["particles_per_cell"] = self.particles_per_cell
-        if self.restitution_k is not None:
-            grid.attrs["restitution_k"] = self.restitution_k
-            grid.attrs["restitution_p"] = self.restitution_p
+        grid.attrs["restitution_k"] = self.restitution_k
+        grid.attrs["restitution_p"] = self.restitution_p
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -231,8 +240,7 @@ class ReboundTable:
                 config_text=str(f.attrs["config"]), config_sha256=str(f.attrs["config_sha256"]),
                 master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
                 package_version=str(f.attrs["package_version"]),
-                restitution_k=float(grid.attrs["restitution_k"]) if "restitution_k" in grid.attrs else None,
-                restitution_p=float(grid.attrs["restitution_p"]) if "restitution_p" in grid.attrs else None)
+                restitution_k=float(grid.attrs["restitution_k"]), restitution_p=float(grid.attrs["restitution_p"]))
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:

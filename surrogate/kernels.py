@@ -13,14 +13,16 @@ Between grid points the sampler uses stochastic interpolation: the cell of the
 neighbour at x_{j+1} is used with probability w = (x − x_j)/(x_{j+1} − x_j), as
 Monte Carlo transport codes do between incident-energy points; a multimodal
 law stays multimodal (no averaging of quantiles). By default (``scaled``) the
-state drawn from the neighbour is then moved, variable by variable, to the
-bilinearly interpolated mean and standard deviation, so moments vary
-continuously between grid points (like the unit-base interpolation of
-transport codes, which stretches a neighbour's secondary law to the
-interpolated range). Between grid speeds, when the table records its wall
-law (format ≥ 2.1), α2 and s are instead moved to the incident speed by
-scaling the normal rebound velocity with the ratio of normal restitutions
-(:func:`_to_speed`).
+state drawn from the neighbour is then moved to the incident state:
+
+* in α1, variable by variable, to the mean and standard deviation interpolated
+  linearly between the two neighbouring α1 (like the unit-base interpolation
+  of transport codes, which stretches a neighbour's secondary law to the
+  interpolated range);
+* in |V⁻|, by the wall's restitution law (:func:`_to_speed`), with a law that
+  depends on the drawn cluster's collision regime: the velocity change and
+  the spin of a rebound of one or two collisions scale with 1 + a(V), the
+  normal rebound velocity of a longer one with a(V).
 
 Frames and units: the local frame is the model's lab frame (wall y = 0,
 normal +Y, impact plane XY, α1 from the wall); angles in radians except α1
@@ -34,7 +36,7 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
+from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 
 U_PER_DRAW = 13
 STATUS_INVALID = -1     # returned by :func:`rebound` for an incident state that does not hit the wall
@@ -74,7 +76,7 @@ def _residual(data, s, ia, iv, c, k, u):
 
 @numba.njit(inline="always", **JIT)
 def draw_folded(data, s, ia, iv, u):
-    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell (s, ia, iv) from u[4:11].
+    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell (s, ia, iv) from u[4:11], and its cluster's regime.
 
     Representation (data_schema.table): u[4] picks the mixture component c with
     the Walker alias table (one multiply, one floor, one compare); then chain
@@ -103,71 +105,72 @@ def draw_folded(data, s, ia, iv, u):
     alpha2 = abs(x0)
     if alpha2 > math.pi:
         alpha2 = 2.0 * math.pi - alpha2
-    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3
+    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, r[s, ia, iv, c, ROW_REGIME]
 
 
 @numba.njit(inline="always", **JIT)
-def _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, k, x, centred):
-    """x drawn from cell (ia, iv), moved to the moments interpolated between cells ja, ja1 (α1) × jv, jv1 (speed).
+def _rescaled(data, shape, ja, ja1, wa, ia, iv, k, x, centred):
+    """x drawn from cell (ia, iv), moved to the moments interpolated in α1 between cells ja and ja1 (speed iv).
 
-    x' = m + (x − m_cell) σ/σ_cell with m, σ bilinear in the four neighbouring
+    x' = m + (x − m_cell) σ/σ_cell with m, σ linear in α1 between the two
     cells' means and standard deviations of state variable k; ``centred``
     variables (β2, Ω_x, Ω_y: mean 0 by the mirror symmetry) are only scaled.
     """
     mo = data.moments
-    sd = ((1.0 - wa) * ((1.0 - wv) * mo[shape, ja, jv, 1, k] + wv * mo[shape, ja, jv1, 1, k])
-          + wa * ((1.0 - wv) * mo[shape, ja1, jv, 1, k] + wv * mo[shape, ja1, jv1, 1, k]))
+    sd = (1.0 - wa) * mo[shape, ja, iv, 1, k] + wa * mo[shape, ja1, iv, 1, k]
     sd_cell = mo[shape, ia, iv, 1, k]
     ratio = sd / sd_cell if sd_cell > 0.0 else 1.0
     if centred:
         return x * ratio
-    mean = ((1.0 - wa) * ((1.0 - wv) * mo[shape, ja, jv, 0, k] + wv * mo[shape, ja, jv1, 0, k])
-            + wa * ((1.0 - wv) * mo[shape, ja1, jv, 0, k] + wv * mo[shape, ja1, jv1, 0, k]))
+    mean = (1.0 - wa) * mo[shape, ja, iv, 0, k] + wa * mo[shape, ja1, iv, 0, k]
     return mean + (x - mo[shape, ia, iv, 0, k]) * ratio
 
 
 @numba.njit(inline="always", **JIT)
-def _to_speed(data, speed, sin_alpha1, iv, alpha2, beta2, s):
-    """A folded rebound drawn at grid speed V_iv, moved to incident speed V (both m/s).
+def _to_speed(data, regime, speed, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, wy, wz):
+    """A rebound drawn at grid speed V_iv, moved to incident speed V (both m/s); returns (vx, vy, vz, wx, wy, wz).
 
-    The normal rebound velocity is scaled by a(V)/a(V_iv), with
-    a(V) = 1 − (1 − exp(−k V^p)) sin α1 the normal restitution of the wall law
-    the table was built with, for a contact point moving like the centre of
-    mass; the tangential and out-of-plane components are kept. Near normal
-    impact the speed ratio s has a narrow core that follows a(V) (measured:
-    the law of v⁺_n/(|V⁻| a) changes 5× less between 50 and 75 m/s than that of s).
+    Local frame, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. With
+    a(V) = 1 − (1 − exp(−k V^p)) sin α1, the normal restitution of the wall
+    law for a contact point moving like the centre of mass:
+
+    * regime 0 (at most two collisions): the velocity change V⁺ − V⁻ and the
+      spin Ω⁺ are multiplied by (1 + a(V))/(1 + a(V_iv)). For one
+      frictionless collision this is exact: the impulse is (1 + a) times the
+      incident normal velocity over the contact's effective inverse mass.
+    * regime 1 (more collisions): the normal rebound velocity is multiplied
+      by a(V)/a(V_iv), the rest kept (the last, slow contacts set it).
+
+    Measured against the direct model between grid speeds 25–50 m/s apart
+    (docs/design/table_representation.md): either law alone fails near
+    normal impact for some shape (classifier accuracy up to 0.79), the pair
+    by regime stays ≤ 0.54. A normal velocity the shift would reverse is
+    reflected (the rebound must leave the wall).
     """
     law = data.restitution
     a_target = 1.0 - (1.0 - math.exp(-law[0] * speed ** law[1])) * sin_alpha1
     a_grid = 1.0 - (1.0 - data.speed_restitution[iv]) * sin_alpha1
-    f = a_target / a_grid
-    cb = math.cos(beta2)
-    vt = s * cb * math.cos(alpha2)
-    vn = s * cb * math.sin(alpha2) * f
-    vz = s * math.sin(beta2)
-    s_new = math.sqrt(vt * vt + vn * vn + vz * vz)
-    if s_new == 0.0:
-        return alpha2, beta2, s
-    return math.atan2(vn, vt), math.asin(vz / s_new), s_new
+    if regime == 0.0:
+        f = (1.0 + a_target) / (1.0 + a_grid)
+        return (cos_alpha1 + f * (vx - cos_alpha1), abs(f * (vy + sin_alpha1) - sin_alpha1), f * vz,
+                f * wx, f * wy, f * wz)
+    return vx, vy * (a_target / a_grid), vz, wx, wy, wz
 
 
 @numba.njit(inline="always", **JIT)
-def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
-    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame.
+def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
+    """One reflected state at (α1 deg, |V⁻| m/s) as local-frame vectors.
 
     ``mix_cdf`` is the cumulative shape weights in the table's shape order
-    (last entry 1). Returns (status, α2, β2, s, Ω_x a/|V⁻|, Ω_y a/|V⁻|,
-    Ω_z a/|V⁻|); the state is NaN for a trapped particle. Outside the table's
-    grid the law at the nearest grid edge is used.
+    (last entry 1). Returns (status, V⁺_x, V⁺_y, V⁺_z, Ω_x, Ω_y, Ω_z) with
+    V⁺ in units of |V⁻| and Ω⁺ in units of |V⁻|/a; NaN for a trapped
+    particle. Outside the table's grid the law at the nearest grid edge is used.
 
     Between grid points the cell of a neighbour is drawn with its
-    interpolation weight (stochastic interpolation). With ``scaled``, the
-    state drawn from that cell is then moved, variable by variable, to the
-    mean and standard deviation interpolated bilinearly between the four
-    neighbouring cells (x' = m + (x − m_cell) σ/σ_cell): the neighbour's shape
-    and correlations with moments that vary continuously, instead of a
-    mixture of the two neighbours' laws. Between grid speeds of a table that
-    records its wall law, α2 and s are moved by :func:`_to_speed` instead.
+    interpolation weight (stochastic interpolation). With ``scaled`` the
+    draw is then moved to the incident state: in α1 to the interpolated
+    means and standard deviations (:func:`_rescaled`), in |V⁻| by the wall's
+    restitution law (:func:`_to_speed`).
     """
     shape = 0
     while shape < mix_cdf.shape[0] - 1 and u[0] >= mix_cdf[shape]:
@@ -178,27 +181,40 @@ def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
     iv = jv + 1 if u[2] < wv else jv
     if u[3] < data.p_trapped[shape, ia, iv]:
         return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-    alpha2, beta2, s, wx, wy, wz = draw_folded(data, shape, ia, iv, u)
-    if scaled and (wa > 0.0 or wv > 0.0):
-        ja1 = min(ja + 1, data.alpha1_deg.shape[0] - 1)     # = ja on a one-point grid (weight 0)
-        jv1 = min(jv + 1, data.speed.shape[0] - 1)
-        by_restitution = data.restitution[2] > 0.0 and wv > 0.0
-        # α2 and s: moments interpolated in α1 at the drawn speed row, then moved to the
-        # incident speed by the restitution law (_to_speed); the others: bilinear moments
-        kv, kv1, wv_velocity = (iv, iv, 0.0) if by_restitution else (jv, jv1, wv)
-        alpha2 = abs(_rescaled(data, shape, ja, ja1, wa, kv, kv1, wv_velocity, ia, iv, 0, alpha2, False))
+    alpha2, beta2, s, wx, wy, wz, regime = draw_folded(data, shape, ia, iv, u)
+    if scaled and wa > 0.0:
+        ja1 = ja + 1
+        alpha2 = abs(_rescaled(data, shape, ja, ja1, wa, ia, iv, 0, alpha2, False))
         alpha2 = 2.0 * math.pi - alpha2 if alpha2 > math.pi else alpha2
-        beta2 = min(_rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 1, beta2, True), 0.5 * math.pi)
-        s = max(_rescaled(data, shape, ja, ja1, wa, kv, kv1, wv_velocity, ia, iv, 2, s, False), 0.0)
-        wx = _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 3, wx, True)
-        wy = _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 4, wy, True)
-        wz = _rescaled(data, shape, ja, ja1, wa, jv, jv1, wv, ia, iv, 5, wz, False)
-        if by_restitution:
-            v_target = data.speed[jv] + wv * (data.speed[jv1] - data.speed[jv])
-            alpha2, beta2, s = _to_speed(data, v_target, math.sin(math.radians(alpha1)), iv, alpha2, beta2, s)
+        beta2 = min(_rescaled(data, shape, ja, ja1, wa, ia, iv, 1, beta2, True), 0.5 * math.pi)
+        s = max(_rescaled(data, shape, ja, ja1, wa, ia, iv, 2, s, False), 0.0)
+        wx = _rescaled(data, shape, ja, ja1, wa, ia, iv, 3, wx, True)
+        wy = _rescaled(data, shape, ja, ja1, wa, ia, iv, 4, wy, True)
+        wz = _rescaled(data, shape, ja, ja1, wa, ia, iv, 5, wz, False)
+    cb = math.cos(beta2)
+    vx, vy, vz = s * cb * math.cos(alpha2), s * cb * math.sin(alpha2), s * math.sin(beta2)
+    if scaled and wv > 0.0:
+        a1 = math.radians(alpha1)
+        v_target = data.speed[jv] + wv * (data.speed[jv + 1] - data.speed[jv])
+        vx, vy, vz, wx, wy, wz = _to_speed(data, regime, v_target, math.cos(a1), math.sin(a1), iv,
+                                           vx, vy, vz, wx, wy, wz)
     if u[11] < 0.5:
-        return STATUS_REBOUNDED, alpha2, -beta2, s, -wx, -wy, wz
-    return STATUS_REBOUNDED, alpha2, beta2, s, wx, wy, wz
+        return STATUS_REBOUNDED, vx, vy, -vz, -wx, -wy, wz
+    return STATUS_REBOUNDED, vx, vy, vz, wx, wy, wz
+
+
+@numba.njit(inline="always", **JIT)
+def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
+    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame: (status, α2, β2, s, Ω_x, Ω_y, Ω_z).
+
+    Angles in radians, s = |V⁺|/|V⁻|, Ω in units of |V⁻|/a; the state is NaN
+    for a trapped particle. See :func:`draw_velocity` (same arguments).
+    """
+    status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
+    if status != STATUS_REBOUNDED:
+        return status, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+    s = math.sqrt(vx * vx + vy * vy + vz * vz)
+    return status, math.atan2(vy, vx), math.asin(vz / s) if s > 0.0 else 0.0, s, wx, wy, wz
 
 
 @numba.njit(inline="always", **JIT)
@@ -247,14 +263,14 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
     a : particle half-size (half its largest extent), m.
     u : (U_PER_DRAW,) uniforms in [0, 1).
     V_out, W_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
-    scaled : between grid points, move the draw to the interpolated moments
-        (default; :func:`draw_local`); False: plain stochastic interpolation.
+    scaled : between grid points, move the draw to the incident state
+        (default; :func:`draw_velocity`); False: plain stochastic interpolation.
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
     move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
     (tangential direction of V), n, ez = ex × n; the local draw is rotated back
     into the global frame. The mirror symmetry of the model is applied with a
-    random sign inside :func:`draw_local`. An α1 or |V⁻| outside the table's
+    random sign inside :func:`draw_velocity`. An α1 or |V⁻| outside the table's
     grid uses the law at the nearest grid edge (check ``table.alpha1_range``
     and ``table.speed_range`` beforehand if that matters).
     """
@@ -265,18 +281,15 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
             W_out[k] = np.nan
         return STATUS_INVALID
     alpha1, speed, ex, ez = impact_frame(V, n, u[12])
-    status, alpha2, beta2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1, speed, u, scaled)
+    status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
     if status != STATUS_REBOUNDED:
         for k in range(3):
             V_out[k] = np.nan
             W_out[k] = np.nan
         return status
-    vs = s * speed
-    cb = math.cos(beta2)
-    lx, ly, lz = vs * cb * math.cos(alpha2), vs * cb * math.sin(alpha2), vs * math.sin(beta2)
     w = speed / a
     for k in range(3):
-        V_out[k] = lx * ex[k] + ly * n[k] + lz * ez[k]
+        V_out[k] = speed * (vx * ex[k] + vy * n[k] + vz * ez[k])
         W_out[k] = w * (wx * ex[k] + wy * n[k] + wz * ez[k])
     return status
 

@@ -14,7 +14,8 @@ is an error; with ``clamp=True`` the dimensionless law at the nearest grid
 edge is used (and scaled by the particle's actual speed).
 Between grid points the law of a neighbouring grid point is drawn with its
 interpolation weight and, by default (``interpolation="scaled"``), moved to the
-interpolated means and standard deviations.
+incident state: in α1 to the interpolated means and standard deviations, in
+|V⁻| by the wall's restitution law (:func:`surrogate.kernels.draw_velocity`).
 Each particle gets a status: 0 rebounded, 1 trapped (rolling along or
 deposited on the wall, drawn with its tabulated probability; its V⁺ and Ω⁺
 are NaN, not a made-up rebound).
@@ -166,10 +167,11 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     shape : shape name or mix (see :func:`mix_cdf`).
     random_state : int, Generator or None.
     interpolation : between grid points, ``"scaled"`` (default: the law of a
-        neighbouring grid point drawn with its interpolation weight, then moved to
-        the bilinearly interpolated means and standard deviations) or
-        ``"stochastic"`` (the neighbour's law as is); see
-        :func:`surrogate.kernels.draw_local` and docs/VALIDATION.md for how they compare.
+        neighbouring grid point drawn with its interpolation weight, then moved
+        to the incident α1 by the interpolated means and standard deviations and
+        to the incident speed by the wall's restitution law) or ``"stochastic"``
+        (the neighbour's law as is); see :func:`surrogate.kernels.draw_velocity`
+        and docs/VALIDATION.md for how they compare.
     clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
         edge instead of raising.
 

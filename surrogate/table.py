@@ -31,19 +31,20 @@ class KernelData(NamedTuple):
     clusters: np.ndarray       # (n_shape, n_alpha, n_speed, C, ROW_SIZE) float32, one row per component
     dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6·M, L + 1) float32 residual shapes
     moments: np.ndarray        # (n_shape, n_alpha, n_speed, 2, 6) mean and sd of (α2, β2, s, Ω_x, Ω_y, Ω_z)
-    restitution: np.ndarray    # (3,) k, p of the wall's normal restitution exp(−k V^p), 1 if known (format ≥ 2.1)
-    speed_restitution: np.ndarray  # (n_speed,) exp(−k V^p) at the grid speeds (0 if unknown)
+    restitution: np.ndarray    # (2,) k, p of the wall's normal restitution exp(−k V^p), V in m/s
+    speed_restitution: np.ndarray  # (n_speed,) exp(−k V^p) at the grid speeds
 
 
 # Layout of a component's row in KernelData.clusters: everything one draw needs
-# from a component, contiguous (140 bytes), so a draw touches few cache lines.
+# from a component, contiguous (144 bytes), so a draw touches few cache lines.
 ROW_ALIAS_PROB = 0    # Walker alias table: keep the component if the fractional part < this
 ROW_ALIAS = 1         # ... else use this component
 ROW_LOC = 2           # 6 locations (chain order)
 ROW_SCALE = 8         # 6 scales
 ROW_SHAPE = 14        # 6 rows of KernelData.dictionary (k·M + shape index)
 ROW_SLOPE = 20        # 15 slopes, x_k on x_j at k(k−1)/2 + j
-ROW_SIZE = 35
+ROW_REGIME = 35       # collision regime: 0 = at most FEW_COLLISIONS collisions, 1 = more
+ROW_SIZE = 36
 
 
 def interval_lookup(grid: np.ndarray):
@@ -101,6 +102,7 @@ def kernel_rows(cells: dict) -> tuple:
     rows[..., ROW_SCALE:ROW_SCALE + N_CHAIN] = cells["cluster_scale"]
     rows[..., ROW_SHAPE:ROW_SHAPE + N_CHAIN] = np.arange(N_CHAIN) * size + cells["cluster_shape"]
     rows[..., ROW_SLOPE:ROW_SLOPE + N_SLOPES] = cells["cluster_slope"]
+    rows[..., ROW_REGIME] = cells["cluster_regime"]
     return rows, dic.reshape(lead + (N_CHAIN * size, dic.shape[5]))
 
 
@@ -145,11 +147,9 @@ class SurrogateTable:
             p_trapped=_frozen(counts[..., STATUS_TRAPPED] / landed),
             clusters=_frozen(rows), dictionary=_frozen(dictionary),
             moments=_frozen(np.stack([table.cells["mean"], table.cells["std"]], axis=3)),
-            restitution=_frozen(np.array([table.restitution_k or 0.0, table.restitution_p or 0.0,
-                                          float(table.restitution_k is not None)])),
+            restitution=_frozen(np.array([table.restitution_k, table.restitution_p])),
             speed_restitution=_frozen(
-                np.exp(-table.restitution_k * np.asarray(table.speed_m_s, dtype=np.float64) ** table.restitution_p)
-                if table.restitution_k is not None else np.zeros(len(table.speed_m_s))))
+                np.exp(-table.restitution_k * np.asarray(table.speed_m_s, dtype=np.float64) ** table.restitution_p)))
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=data.alpha1_deg, speed_m_s=data.speed,
                    particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, kernel_data=data)

@@ -7,7 +7,10 @@ are partitioned by mini-batch k-means into C clusters of about
 regressed (least squares) on the variables before it, and the residual's
 quantile function is stored at L + 1 probability levels, standardised to
 (location, scale, shape); the C shapes of each variable are compressed into a
-dictionary of M shapes by k-means. Every stored quantity is estimated from all
+dictionary of M shapes by k-means. Rebounds of at most two collisions and
+rebounds of more are clustered apart (``cluster_regime``), with clusters
+shared in proportion to their numbers: the sampler moves the two regimes
+between grid speeds by different laws. Every stored quantity is estimated from all
 the cell's samples (each sample is in one cluster), which is what lets the
 table reproduce the joint law: a law built from a subsample carries that
 subsample's noise, which a classifier detects (docs/design/table_representation.md).
@@ -27,7 +30,8 @@ from threadpoolctl import threadpool_limits
 
 from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet
 from data_schema.table import (
-    CHAIN_TO_STATE, INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_CHAIN, N_COLLISION_CLASSES, N_SLOPES,
+    CHAIN_TO_STATE, FEW_COLLISIONS, INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_CHAIN, N_COLLISION_CLASSES,
+    N_SLOPES,
     CellTable, TableResolution, slope_index,
 )
 
@@ -50,6 +54,7 @@ def resolution_for(particles_per_cell: int) -> TableResolution:
     clusters = int(np.clip(particles_per_cell // SAMPLES_PER_CLUSTER, 16, MAX_CLUSTERS))
     return TableResolution(clusters=clusters, dictionary_size=16, levels=24)
 
+
 def folded_state(samples: SampleSet) -> np.ndarray:
     """(α2, |β2|, s, Ω_x, Ω_y, Ω_z) of the rebounded particles, Ω_x and Ω_y times sign β2."""
     ok = samples.rebounded
@@ -57,6 +62,11 @@ def folded_state(samples: SampleSet) -> np.ndarray:
     sign = np.where(beta2 < 0.0, -1.0, 1.0)
     return np.column_stack([samples.alpha2[ok], np.abs(beta2), samples.speed_ratio[ok],
                             samples.omega[ok, 0] * sign, samples.omega[ok, 1] * sign, samples.omega[ok, 2]])
+
+
+def collision_regime(samples: SampleSet) -> np.ndarray:
+    """Collision regime of the rebounded particles: 0 for at most FEW_COLLISIONS collisions, 1 for more."""
+    return (samples.n_collisions[samples.rebounded] > FEW_COLLISIONS).astype(np.uint8)
 
 
 class CellAccumulator:
@@ -71,6 +81,7 @@ class CellAccumulator:
     def __init__(self, max_states: int = 4_000_000):
         self.max_states = max_states
         self.states = []
+        self.regimes = []
         self.n_states = 0
         self.status_counts = np.zeros(len(STATUS_NAMES), dtype=np.int64)
         self.collision_counts = np.zeros(N_COLLISION_CLASSES, dtype=np.int64)
@@ -93,6 +104,7 @@ class CellAccumulator:
         keep = min(self.max_states - self.n_states, int(ok.sum()))
         if keep > 0:
             self.states.append(folded_state(samples)[:keep])
+            self.regimes.append(collision_regime(samples)[:keep])
             self.n_states += keep
 
     def finish(self, resolution: TableResolution, seed: int, label: str = "cell") -> CellTable:
@@ -110,7 +122,7 @@ class CellAccumulator:
         d_a2 = np.diff(INDICATRIX_ALPHA2_EDGES)
         d_b2 = np.diff(INDICATRIX_BETA2_EDGES)
         return CellTable(
-            **represent(np.concatenate(self.states), resolution, seed),
+            **represent(np.concatenate(self.states), np.concatenate(self.regimes), resolution, seed),
             status_counts=self.status_counts.copy(), collision_counts=self.collision_counts.copy(),
             mean=mean, std=std,
             indicatrix_2d=(self.hist2 / (n * d_a2)).astype(np.float32),
@@ -173,6 +185,9 @@ def _dictionary(shapes: np.ndarray, size: int, seed: int):
     Dictionary shapes are k-means centres, re-standardised and made
     non-decreasing (a quantile function); unused rows repeat the first.
     """
+    if len(shapes) == 0:                               # no cluster with a spread: any standard shape will do
+        ramp = np.linspace(-1.0, 1.0, shapes.shape[1])
+        return np.repeat((ramp / ramp.std())[None], size, axis=0), np.zeros(0, dtype=np.int64)
     m = min(size, len(shapes))
     km = KMeans(m, n_init=1, random_state=seed).fit(shapes)
     centres = km.cluster_centers_
@@ -184,28 +199,60 @@ def _dictionary(shapes: np.ndarray, size: int, seed: int):
     return dictionary, km.labels_
 
 
-def represent(folded: np.ndarray, resolution: TableResolution, seed: int) -> dict:
+def regime_clusters(counts, clusters: int) -> list:
+    """Clusters given to each collision regime of ``counts`` rebounds (total ≤ ``clusters``).
+
+    In proportion to the counts, at least one for a regime that has rebounds,
+    and at most one per :data:`SAMPLES_PER_CLUSTER` rebounds of the regime.
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    share = np.where(counts > 0, np.maximum(np.floor(clusters * counts / counts.sum()), 1), 0).astype(np.int64)
+    share[np.argmax(counts)] += clusters - share.sum()      # the largest regime takes the rounding remainder
+    return [int(c) if n == 0 else int(max(1, min(c, n // SAMPLES_PER_CLUSTER))) for c, n in zip(share, counts)]
+
+
+def _regime_partition(z: np.ndarray, regime: np.ndarray, clusters: int, seed: int) -> tuple:
+    """Cluster label of each row of z, clustering each collision regime apart: (labels, regime of each label).
+
+    Labels of empty k-means centres are dropped, so labels run over 0..G−1.
+    """
+    counts = np.bincount(regime, minlength=2)
+    group = np.empty(len(z), dtype=np.int64)
+    label_regime = []
+    for reg, c in enumerate(regime_clusters(counts, clusters)):
+        rows = np.flatnonzero(regime == reg)
+        if rows.size == 0:
+            continue
+        label = _partition(z[rows], c, seed + reg)
+        used = np.bincount(label, minlength=c) > 0          # k-means may leave a centre without samples
+        group[rows] = len(label_regime) + (np.cumsum(used) - 1)[label]
+        label_regime += [reg] * int(used.sum())
+    return group, np.array(label_regime, dtype=np.uint8)
+
+
+def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolution, seed: int) -> dict:
     """The stored law (``cluster_*`` and ``shape_dictionary`` arrays) of folded states (n, 6).
 
-    Uses min(C, n // 25) clusters (at least one); the remaining rows of the
-    C-row arrays have weight 0 and are never drawn. Single-threaded BLAS and
-    OpenMP (threadpool_limits), so the arrays do not depend on the thread count.
+    ``regime`` (n,) is each state's collision regime (:func:`collision_regime`).
+    Uses at most min(C, n // 25) clusters (at least one per regime present);
+    the remaining rows of the C-row arrays have weight 0 and are never drawn.
+    Single-threaded BLAS and OpenMP (threadpool_limits), so the arrays do not
+    depend on the thread count.
     """
     r = resolution
-    seed = seed % 2 ** 31                              # scikit-learn takes 32-bit seeds
+    seed = seed % 2 ** 31                              # scikit-learn takes 32-bit seeds (seed + 5 still fits)
     z = folded[:, list(CHAIN_TO_STATE)].astype(np.float64)
     n = len(z)
     with threadpool_limits(1):
         scale = z.std(axis=0)
-        used = max(1, min(r.clusters, n // SAMPLES_PER_CLUSTER))
-        group = _partition((z - z.mean(axis=0)) / np.where(scale > 0, scale, 1.0), used, seed)
-        counts = np.bincount(group, minlength=used)
-        nonempty = counts > 0                          # k-means may leave a centre without samples
-        group = (np.cumsum(nonempty) - 1)[group]
-        counts = counts[nonempty]
-        G = len(counts)
+        group, label_regime = _regime_partition((z - z.mean(axis=0)) / np.where(scale > 0, scale, 1.0),
+                                                np.asarray(regime, dtype=np.int64), r.clusters, seed)
+        G = len(label_regime)
+        counts = np.bincount(group, minlength=G)
         weight = np.zeros(r.clusters)
         weight[:G] = counts / n
+        cluster_regime = np.zeros(r.clusters, dtype=np.uint8)
+        cluster_regime[:G] = label_regime
         loc = np.zeros((r.clusters, N_CHAIN))
         scl = np.zeros((r.clusters, N_CHAIN))
         shape_id = np.zeros((r.clusters, N_CHAIN), dtype=np.uint8)
@@ -220,8 +267,11 @@ def represent(folded: np.ndarray, resolution: TableResolution, seed: int) -> dic
             q = _group_quantiles(residual, group, counts, r.levels)
             loc[:G, k] = q.mean(axis=1)
             scl[:G, k] = q.std(axis=1)
-            standard = (q - loc[:G, k, None]) / np.maximum(scl[:G, k, None], 1e-300)
-            dictionary[k], shape_id[:G, k] = _dictionary(standard, r.dictionary_size, seed + k)
+            # a cluster of one value (a few samples) has no shape: scale 0 and shape 0
+            spread = scl[:G, k] > 1e-9 * max(scale[k], 1e-300)
+            scl[:G, k][~spread] = 0.0
+            standard = (q[spread] - loc[:G, k, None][spread]) / scl[:G, k, None][spread]
+            dictionary[k], shape_id[:G, k][spread] = _dictionary(standard, r.dictionary_size, seed + k)
     return {"cluster_weight": weight, "cluster_loc": loc.astype(np.float32), "cluster_scale": scl.astype(np.float32),
-            "cluster_shape": shape_id, "cluster_slope": slope.astype(np.float32),
+            "cluster_shape": shape_id, "cluster_slope": slope.astype(np.float32), "cluster_regime": cluster_regime,
             "shape_dictionary": dictionary.astype(np.float32)}

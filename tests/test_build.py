@@ -49,7 +49,8 @@ def test_table_contents_are_consistent(tiny_table):
     np.testing.assert_allclose(w.sum(axis=-1), 1.0, rtol=1e-12)
     counts_in_clusters = w * counts[..., :1]
     np.testing.assert_allclose(counts_in_clusters, np.round(counts_in_clusters), atol=1e-9)
-    assert np.all(np.diff(w > 0, axis=-1) <= 0)
+    assert np.all(np.diff((w > 0).astype(int), axis=-1) <= 0)
+    assert set(np.unique(table.cells["cluster_regime"])) <= {0, 1}
     # about 25 rebounds per cluster (k-means may leave a few centres empty)
     used = (w > 0).sum(axis=-1)
     assert np.all(used <= counts[..., 0] // 25) and np.all(used >= 0.8 * (counts[..., 0] // 25))

@@ -279,18 +279,27 @@ def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
     np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])
 
 
-def test_speed_shift_scales_the_normal_rebound_velocity(small_table):
-    """_to_speed: v⁺_n scaled by a(V)/a(V_j), a = 1 − (1 − exp(−k V^p)) sin α1; v⁺_t and v⁺_z kept."""
+def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
+    """_to_speed from grid speed V_j to V, a(V) = 1 − (1 − exp(−k V^p)) sin α1 (local frame, units of |V⁻|).
+
+    Regime 0: V⁺ − V⁻ and Ω⁺ times (1 + a(V))/(1 + a(V_j)), V⁻ = (cos α1, −sin α1, 0);
+    regime 1: v⁺_n times a(V)/a(V_j), the rest kept; at V = V_j nothing moves.
+    """
     from surrogate.kernels import _to_speed
     data = small_table.kernel_data
-    k, p, known = data.restitution
-    assert known == 1.0 and (k, p) == (0.1, 0.61)       # the wall law the table was built with
-    alpha2, beta2, s = 1.1, 0.3, 0.4
-    sin_a1 = np.sin(np.radians(60.0))
-    same = _to_speed(data, data.speed[1], sin_a1, 1, alpha2, beta2, s)
-    np.testing.assert_allclose(same, (alpha2, beta2, s), rtol=1e-14)
-    a = lambda v: 1.0 - (1.0 - np.exp(-k * v ** p)) * sin_a1
-    a2, b2, s2 = _to_speed(data, 100.0, sin_a1, 1, alpha2, beta2, s)
-    before = s * np.array([np.cos(beta2) * np.cos(alpha2), np.cos(beta2) * np.sin(alpha2), np.sin(beta2)])
-    after = s2 * np.array([np.cos(b2) * np.cos(a2), np.cos(b2) * np.sin(a2), np.sin(b2)])
-    np.testing.assert_allclose(after, before * [1.0, a(100.0) / a(data.speed[1]), 1.0], rtol=1e-12)
+    k, p = data.restitution
+    assert (k, p) == (0.1, 0.61)       # the wall law the table was built with
+    a1 = np.radians(60.0)
+    c, s = np.cos(a1), np.sin(a1)
+    v, w = np.array([0.2, 0.3, -0.05]), np.array([0.4, -0.1, 0.7])
+    a = lambda speed: 1.0 - (1.0 - np.exp(-k * speed ** p)) * s
+    for regime in (0.0, 1.0):
+        same = _to_speed(data, regime, data.speed[1], c, s, 1, *v, *w)
+        np.testing.assert_allclose(same, np.concatenate([v, w]), rtol=1e-14)
+    f = (1 + a(100.0)) / (1 + a(data.speed[1]))
+    moved = _to_speed(data, 0.0, 100.0, c, s, 1, *v, *w)
+    incident = np.array([c, -s, 0.0])
+    np.testing.assert_allclose(moved, np.concatenate([incident + f * (v - incident), f * w]), rtol=1e-12)
+    moved = _to_speed(data, 1.0, 100.0, c, s, 1, *v, *w)
+    np.testing.assert_allclose(moved, np.concatenate([v * [1.0, a(100.0) / a(data.speed[1]), 1.0], w]),
+                               rtol=1e-12)

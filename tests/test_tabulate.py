@@ -5,7 +5,7 @@ import pytest
 from scipy import stats
 
 from data_schema.table import CHAIN_TO_STATE, N_CHAIN, TableResolution, slope_index
-from tablegen.tabulate import represent, resolution_for
+from tablegen.tabulate import _regime_partition, regime_clusters, represent, resolution_for
 
 N = 40_000
 
@@ -15,6 +15,10 @@ def _folded(chain: np.ndarray) -> np.ndarray:
     folded = np.empty_like(chain)
     folded[:, list(CHAIN_TO_STATE)] = chain
     return folded
+
+
+def _one_regime(x):
+    return np.zeros(len(x), dtype=np.uint8)
 
 
 def _linear_chain(n, seed):
@@ -38,7 +42,8 @@ def test_one_cluster_recovers_the_slopes_and_residual_shapes():
     (sample quantiles at p ∈ [1/24, 23/24] have SE ≤ 0.013 in σ units at N = 4·10⁴).
     """
     x = _linear_chain(N, seed=1)
-    cell = represent(_folded(x), TableResolution(clusters=1, dictionary_size=1, levels=24), seed=0)
+    cell = represent(_folded(x), _one_regime(x), TableResolution(clusters=1, dictionary_size=1, levels=24),
+                     seed=0)
     slope = cell["cluster_slope"][0]
     for k in range(1, N_CHAIN):
         for j in range(k):
@@ -63,7 +68,8 @@ def test_one_cluster_recovers_the_slopes_and_residual_shapes():
 def test_clusters_follow_the_number_of_samples():
     """min(C, n // 25) components are used, weighted by their sample counts; the rest have weight 0."""
     x = _linear_chain(2_000, seed=2)
-    cell = represent(_folded(x), TableResolution(clusters=500, dictionary_size=16, levels=24), seed=0)
+    cell = represent(_folded(x), _one_regime(x), TableResolution(clusters=500, dictionary_size=16, levels=24),
+                     seed=0)
     w = cell["cluster_weight"]
     used = np.count_nonzero(w)
     assert 0.8 * 80 <= used <= 80 and np.all(w[used:] == 0)
@@ -74,10 +80,42 @@ def test_clusters_follow_the_number_of_samples():
 def test_same_seed_same_arrays_and_the_seed_matters():
     x = _folded(_linear_chain(5_000, seed=3))
     r = resolution_for(5_000)
-    a, b, c = (represent(x, r, seed) for seed in (5, 5, 6))
+    regime = (x[:, 0] > 1.5).astype(np.uint8)
+    a, b, c = (represent(x, regime, r, seed) for seed in (5, 5, 6))
     for name in a:
         assert a[name].tobytes() == b[name].tobytes(), name
     assert any(a[name].tobytes() != c[name].tobytes() for name in a)
+
+
+def test_each_collision_regime_gets_its_own_clusters():
+    """Clusters never mix regimes: each regime's cluster weights add up to its share of the samples.
+
+    Regime 1 is x0 > 1.7 (30 % of a uniform x0 on [1, 2]); the 200 clusters are
+    shared 140/60 (in proportion), each regime's weights are its counts over n.
+    """
+    x = _linear_chain(10_000, seed=4)
+    regime = (x[:, 0] > 1.7).astype(np.uint8)
+    cell = represent(_folded(x), regime, TableResolution(clusters=200, dictionary_size=16, levels=24), seed=0)
+    w, reg = cell["cluster_weight"], cell["cluster_regime"]
+    for r in (0, 1):
+        assert w[(reg == r) & (w > 0)].sum() == pytest.approx(np.mean(regime == r), rel=1e-12)
+    share = [np.count_nonzero((reg == r) & (w > 0)) for r in (0, 1)]
+    n1 = int(regime.sum())
+    assert 0.8 * 140 <= share[0] <= 140 and 0.8 * 60 <= share[1] <= 60, (share, n1)
+    # the partition itself: every state's cluster is of the state's regime
+    group, label_regime = _regime_partition(x, regime.astype(np.int64), 200, seed=0)
+    assert np.array_equal(label_regime[group], regime)
+    assert np.array_equal(np.unique(group), np.arange(len(label_regime)))
+
+
+@pytest.mark.parametrize("counts, clusters, expected", [
+    ((7000, 3000), 100, [70, 30]),      # proportional
+    ((9950, 50), 100, [99, 1]),         # a small regime keeps one cluster
+    ((10000, 0), 100, [100, 0]),        # an empty regime gets none
+    ((100, 900), 500, [4, 36]),         # at most one cluster per 25 samples
+])
+def test_clusters_are_shared_between_regimes(counts, clusters, expected):
+    assert regime_clusters(counts, clusters) == expected
 
 
 @pytest.mark.parametrize("n, clusters", [(256, 16), (10_000, 400), (25_000, 500), (10 ** 8, 500)])
