@@ -36,6 +36,7 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
+from surrogate.prefetch import prefetch
 from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 
 U_PER_DRAW = 13
@@ -158,6 +159,24 @@ def _to_speed(data, regime, speed, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, w
 
 
 @numba.njit(inline="always", **JIT)
+def _cell(data, mix_cdf, alpha1, speed, u):
+    """The cell a draw reads: (shape, ja, wa, jv, wv, ia, iv).
+
+    Shape from u[0] and the mix; grid intervals (ja, jv) with the weights of
+    their upper points (wa, wv); the neighbour cell (ia, iv) drawn with those
+    weights from u[1], u[2] (stochastic interpolation).
+    """
+    shape = 0
+    while shape < mix_cdf.shape[0] - 1 and u[0] >= mix_cdf[shape]:
+        shape += 1
+    ja, wa = locate(data.alpha1_deg, data.alpha1_lookup, data.alpha1_scale, alpha1)
+    jv, wv = locate(data.speed, data.speed_lookup, data.speed_scale, speed)
+    ia = ja + 1 if u[1] < wa else ja
+    iv = jv + 1 if u[2] < wv else jv
+    return shape, ja, wa, jv, wv, ia, iv
+
+
+@numba.njit(inline="always", **JIT)
 def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
     """One reflected state at (α1 deg, |V⁻| m/s) as local-frame vectors.
 
@@ -172,13 +191,7 @@ def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
     means and standard deviations (:func:`_rescaled`), in |V⁻| by the wall's
     restitution law (:func:`_to_speed`).
     """
-    shape = 0
-    while shape < mix_cdf.shape[0] - 1 and u[0] >= mix_cdf[shape]:
-        shape += 1
-    ja, wa = locate(data.alpha1_deg, data.alpha1_lookup, data.alpha1_scale, alpha1)
-    jv, wv = locate(data.speed, data.speed_lookup, data.speed_scale, speed)
-    ia = ja + 1 if u[1] < wa else ja
-    iv = jv + 1 if u[2] < wv else jv
+    shape, ja, wa, jv, wv, ia, iv = _cell(data, mix_cdf, alpha1, speed, u)
     if u[3] < data.p_trapped[shape, ia, iv]:
         return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     alpha2, beta2, s, wx, wy, wz, regime = draw_folded(data, shape, ia, iv, u)
@@ -294,11 +307,73 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
     return status
 
 
+BLOCK = 16      # particles whose table reads rebound_many puts in flight together
+
+
+@numba.njit(**JIT)
+def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
+    """:func:`rebound` for every row, one thread, with the table reads of BLOCK particles in flight at once.
+
+    Same arguments as :func:`rebound_batch` and the same results, bit for bit,
+    as calling :func:`rebound` row by row. A draw reads the table in three
+    dependent steps (the component's alias entry, then its row, then its
+    residual shapes); one particle at a time, each step waits for memory.
+    Here each step is first issued for a block of particles as cache hints
+    (:func:`surrogate.prefetch.prefetch`), so their memory latencies overlap,
+    and the draws then run on cached data. For a flow solver that collects
+    its wall hits: call this from its ``@njit`` code on the hit arrays.
+    """
+    rows, dic, levels = data.clusters, data.dictionary, data.dictionary.shape[4] - 1
+    n_clusters = rows.shape[3]
+    cell = np.empty((BLOCK, 4), dtype=np.int64)       # shape, ia, iv, component of each particle of a block
+    for start in range(0, V.shape[0], BLOCK):
+        stop = min(start + BLOCK, V.shape[0])
+        for i in range(start, stop):                  # 1: cell statistics and the component's alias entry
+            vn = V[i, 0] * n[i, 0] + V[i, 1] * n[i, 1] + V[i, 2] * n[i, 2]
+            if not vn < 0.0 or not math.isfinite(V[i, 0] + V[i, 1] + V[i, 2]):
+                cell[i - start, 0] = -1               # rebound() reports it; nothing to read
+                continue
+            alpha1, speed, ex, ez = impact_frame(V[i], n[i], u[i, 12])
+            shape, ja, wa, jv, wv, ia, iv = _cell(data, mix_cdf, alpha1, speed, u[i])
+            c = min(int(u[i, 4] * n_clusters), n_clusters - 1)
+            cell[i - start, 0], cell[i - start, 1], cell[i - start, 2], cell[i - start, 3] = shape, ia, iv, c
+            prefetch(rows, (shape, ia, iv, c, 0))
+            prefetch(data.p_trapped, (shape, ia, iv))
+            prefetch(data.moments, (shape, ia, iv, 0, 0))
+            prefetch(data.moments, (shape, ja, iv, 0, 0))
+            prefetch(data.moments, (shape, min(ja + 1, data.moments.shape[1] - 1), iv, 0, 0))
+        for b in range(stop - start):                 # 2: the component's row (144 bytes: up to 3 lines)
+            shape, ia, iv, c = cell[b, 0], cell[b, 1], cell[b, 2], cell[b, 3]
+            if shape < 0:
+                continue
+            t = u[start + b, 4] * n_clusters
+            if t - c >= rows[shape, ia, iv, c, ROW_ALIAS_PROB]:
+                c = int(rows[shape, ia, iv, c, ROW_ALIAS])
+                cell[b, 3] = c
+            prefetch(rows, (shape, ia, iv, c, 0))
+            prefetch(rows, (shape, ia, iv, c, ROW_SHAPE))
+            prefetch(rows, (shape, ia, iv, c, ROW_REGIME))
+        for b in range(stop - start):                 # 3: its residual shapes at the drawn levels
+            shape, ia, iv, c = cell[b, 0], cell[b, 1], cell[b, 2], cell[b, 3]
+            if shape < 0:
+                continue
+            for k in range(6):
+                m = int(rows[shape, ia, iv, c, ROW_SHAPE + k])
+                level = min(int(u[start + b, 5 + k] * levels), levels - 1)
+                prefetch(dic, (shape, ia, iv, m, level))
+                prefetch(dic, (shape, ia, iv, m, level + 1))
+        for i in range(start, stop):                  # 4: the draws
+            status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
+
+
 @numba.njit(parallel=True, **JIT)
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
-    """:func:`rebound` for every row (parallel); u has shape (N, U_PER_DRAW)."""
-    for i in numba.prange(V.shape[0]):
-        status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
+    """:func:`rebound` for every row (parallel over chunks of :func:`rebound_many`); u has shape (N, U_PER_DRAW)."""
+    chunk = 64 * BLOCK
+    for j in numba.prange((V.shape[0] + chunk - 1) // chunk):
+        lo, hi = j * chunk, min((j + 1) * chunk, V.shape[0])
+        rebound_many(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u[lo:hi], V_out[lo:hi], W_out[lo:hi],
+                     status[lo:hi], scaled)
 
 
 @numba.njit(parallel=True, **JIT)

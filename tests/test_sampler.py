@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch
+from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch, rebound_many
 from surrogate.table import alias_table
 
 
@@ -211,6 +211,35 @@ def test_callable_from_a_numba_loop(small_table):
     np.testing.assert_array_equal(V1, V2)
     np.testing.assert_array_equal(W1, W2)
     assert np.all(s1 == STATUS_REBOUNDED)
+
+
+def test_block_kernel_gives_the_row_by_row_results(small_table):
+    """rebound_many (table reads of 16 particles issued together) = rebound row by row, bit for bit.
+
+    1001 rows (not a multiple of the block), normal impacts (trapped draws
+    occur there), rows that leave the wall or are NaN (reported invalid).
+    """
+    m = 1001
+    rng = np.random.default_rng(3)
+    speed = rng.uniform(50, 250, m)
+    a1 = np.radians(rng.uniform(30, 90, m))
+    a1[::7] = np.pi / 2
+    V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m)])
+    V[5], V[600] = [10.0, 5.0, 0.0], [np.nan, -100.0, 0.0]
+    n = np.tile([0.0, 1.0, 0.0], (m, 1))
+    a = np.full(m, 1e-4)
+    U = rng.random((m, U_PER_DRAW))
+    cdf = surrogate.mix_cdf(small_table, "mix")
+    data = small_table.kernel_data
+    V1, W1, s1 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    for i in range(m):
+        s1[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V1[i], W1[i])
+    V2, W2, s2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_many(data, cdf, V, n, a, U, V2, W2, s2)
+    np.testing.assert_array_equal(s1, s2)
+    np.testing.assert_array_equal(V1, V2)
+    np.testing.assert_array_equal(W1, W2)
+    assert s1[5] == s1[600] == STATUS_INVALID and np.any(s1 == STATUS_TRAPPED)
 
 
 BAD_GLOBAL = [
