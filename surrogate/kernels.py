@@ -397,8 +397,8 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
                 continue
             cell = (index[b, 1], index[b, 2], frame[b, 8], index[b, 3], frame[b, 9], index[b, 4], index[b, 5])
             st, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, frame[b, 0], u[i], scaled)
-            status[i] = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 1], a[i], (frame[b, 2], frame[b, 3], frame[b, 4]),
-                                   n[i], (frame[b, 5], frame[b, 6], frame[b, 7]), V_out[i], W_out[i])
+            ex, ez = (frame[b, 2], frame[b, 3], frame[b, 4]), (frame[b, 5], frame[b, 6], frame[b, 7])
+            status[i] = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 1], a[i], ex, n[i], ez, V_out[i], W_out[i])
 
 
 @numba.njit(parallel=True, **JIT)
