@@ -16,7 +16,9 @@ and prints the cost in ns per reflected state:
     uniforms of each state with ``surrogate.rng.fill_uniforms`` (xoshiro256+,
     caller-owned state) and that cost is included. Variants: the uniforms from
     numba's ``np.random.random()``; (b') the loop reading pre-drawn uniforms;
-    breakdown row: the xoshiro256+ draws alone;
+    (b-block) a solver that collects its wall hits and calls
+    ``surrogate.kernels.rebound_many`` on them from ``@njit`` code (uniforms
+    from xoshiro256+ included); breakdown row: the xoshiro256+ draws alone;
 (c) the direct model, ``tablegen.simulate.simulate`` with the shape mix, one
     thread, per particle simulated (whatever its status; NumPy input draws,
     kernel and result assembly included). The states' α1 distribution
@@ -85,7 +87,7 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch
+from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch, rebound_many
 from surrogate.rng import fill_uniforms, seed_state
 
 SEED = 20240601
@@ -166,6 +168,14 @@ def loop_kernel_rng(data, cdf, V, n, a, state, V_out, W_out, status):
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
         status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i])
+
+
+@numba.njit(**JIT)
+def loop_block_rng(data, cdf, V, n, a, state, U, V_out, W_out, status):
+    """(b, block) A solver that collects its wall hits: their uniforms (xoshiro256+) into U, then rebound_many."""
+    for i in range(V.shape[0]):
+        fill_uniforms(state, U[i])
+    rebound_many(data, cdf, V, n, a, U, V_out, W_out, status)
 
 
 @numba.njit(**JIT)
@@ -374,6 +384,8 @@ def main(argv=None) -> int:
     seed_numba_rng(SEED)
     loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
     loop_kernel_nprandom(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
+    U_block = np.empty_like(U)
+    loop_block_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), U_block[:m], V_out[:m], W_out[:m], status[:m])
     loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
     loop_kernel_predrawn_unscaled(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
     loop_rng_only(m, seed_state(SEED), np.empty(1))
@@ -410,6 +422,8 @@ def main(argv=None) -> int:
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status))
     record("b_unscaled", "    breakdown: (b') without moment scaling", 1,
            lambda: loop_kernel_predrawn_unscaled(data, cdf, V, nrm, a, U, V_out, W_out, status))
+    record("b_block", "(b-block) rebound_many in @njit, xoshiro256+", 1,
+           lambda: loop_block_rng(data, cdf, V, nrm, a, seed_state(SEED), U_block, V_out, W_out, status))
     record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
            lambda: loop_rng_only(count, seed_state(SEED), np.empty(1)))
     record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))
@@ -428,7 +442,9 @@ def main(argv=None) -> int:
               f"{r['cpu_ns_per_particle']:10.1f} cpu ns/particle")
 
     b, d, c = rows["b"]["ns_per_state"], rows["d"]["ns_per_state"], rows["c"]["ns_per_state"]
+    bb = rows["b_block"]["ns_per_state"]
     ratios = {"direct_over_kernel": c / b, "kernel_over_bounce": b / d, "kernel_ns": b,
+              "direct_over_block": c / bb, "block_over_bounce": bb / d, "block_ns": bb,
               "kernel_predrawn_over_bounce": rows["b_predrawn"]["ns_per_state"] / d,
               "api_1thread_over_kernel": rows["a_1"]["ns_per_state"] / b,
               "rng_share_of_kernel": rows["b_rng"]["ns_per_state"] / b}
@@ -443,6 +459,9 @@ def main(argv=None) -> int:
           f"{verdict(targets['kernel_over_bounce'])}")
     print(f"  (b)      sampler kernel, ns per state per core {b:11.4g}   target <= {TARGET_KERNEL_NS:g} ns: "
           f"{verdict(targets['kernel_ns'])}")
+    print(f"  (c)/(b-block) direct model / block kernel     {c / bb:12.4g}")
+    print(f"  (b-block)/(d) block kernel / Grant-Tabakoff   {bb / d:12.4g}")
+    print(f"  (b-block) block kernel, ns per state per core {bb:11.4g}")
     print(f"  (b')/(d) kernel on pre-drawn uniforms / G-T   {ratios['kernel_predrawn_over_bounce']:12.4g}")
     print(f"  (a, 1 thread)/(b) NumPy API / @njit loop      {ratios['api_1thread_over_kernel']:12.4g}")
     print(f"  RNG share of (b)                              {ratios['rng_share_of_kernel']:12.4g}")

@@ -24,6 +24,10 @@ state drawn from the neighbour is then moved to the incident state:
   the spin of a rebound of one or two collisions scale with 1 + a(V), the
   normal rebound velocity of a longer one with a(V).
 
+Entry points: :func:`rebound` (one particle, global frame), :func:`rebound_many`
+(many particles, one thread, their table reads overlapped), :func:`rebound_batch`
+(parallel), :func:`draw_local` and :func:`draw_velocity` (local frame).
+
 Frames and units: the local frame is the model's lab frame (wall y = 0,
 normal +Y, impact plane XY, α1 from the wall); angles in radians except α1
 (degrees), Ω in units of |V⁻|/a locally. The global kernel returns V⁺ in m/s
