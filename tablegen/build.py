@@ -6,10 +6,11 @@ bit-identical whatever the number of workers, the scheduler or the order in
 which cells finish.
 
 Checkpoints: next to the output ``table.h5`` the build keeps a folder
-``table.h5.partial/`` holding the resolved configuration and one ``.npz`` file
-per finished cell (each written to a temporary name and renamed, so a killed
-build leaves only whole files). Rerunning the same command computes only the
-missing cells; a checkpoint made with another configuration is refused. The
+``table.h5.partial/`` holding the resolved configuration (headed by the table
+format version) and one ``.npz`` file per finished cell (each written to a
+temporary name and renamed, so a killed build leaves only whole files).
+Rerunning the same command computes only the missing cells; a checkpoint made
+with another configuration or for another table format is refused. The
 table is assembled into a temporary file and renamed onto the output path, so
 that path never holds a half-written table; the checkpoint is then removed.
 """
@@ -26,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from data_schema.table import CELL_DATASETS, CellTable, ReboundTable, write_table
+from data_schema.table import CELL_DATASETS, TABLE_VERSION, CellTable, ReboundTable, write_table
 from data_schema.common import package_version
 from tablegen.config import BuildConfig, cell_seed, derive_seed
 from tablegen.wall import CORUNDUM_ON_STEEL
@@ -73,14 +74,16 @@ class Checkpoint:
         self.path = out.with_name(out.name + ".partial")
         self.config = config
         marker = self.path / "config.toml"
+        expected = f"# table format {TABLE_VERSION[0]}.{TABLE_VERSION[1]}\n" + config.to_toml()
         if marker.exists():
-            if marker.read_text() != config.to_toml():
+            if marker.read_text() != expected:
                 raise BuildError(
-                    f"{self.path} holds a checkpoint of a build with another configuration; "
-                    f"rerun with the configuration it was made with, or delete {self.path} to start over")
+                    f"{self.path} holds a checkpoint of a build with another configuration or table format; "
+                    f"rerun with the configuration and package version it was made with, or delete "
+                    f"{self.path} to start over")
         else:
             self.path.mkdir(exist_ok=True)
-            _write_atomically(marker, config.to_toml().encode())
+            _write_atomically(marker, expected.encode())
         for stale in self.path.glob(".*.tmp"):      # left by a build killed mid-write
             stale.unlink()
 

@@ -115,6 +115,17 @@ def test_checkpoint_of_another_config_is_refused(tmp_path):
     assert not out.exists()
 
 
+def test_checkpoint_of_another_table_format_is_refused(tmp_path):
+    """Cells checkpointed by a package writing another table format are not mixed into this one."""
+    out = tmp_path / "t.h5"
+    partial = tmp_path / "t.h5.partial"
+    partial.mkdir()
+    (partial / "config.toml").write_text("# table format 2.1\n" + parse_config(TINY).to_toml())
+    with pytest.raises(BuildError, match="table format"):
+        build_table(parse_config(TINY), out, workers=1)
+    assert not out.exists()
+
+
 def test_existing_output_needs_overwrite(tiny_table, tmp_path):
     out = tmp_path / "t.h5"
     out.write_bytes(b"keep")
