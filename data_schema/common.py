@@ -44,7 +44,8 @@ def check_file(path, file_type: str, major: int) -> None:
     if int(version[0]) != major:
         raise DataFormatError(
             f"{path}: format version {int(version[0])}.{int(version[1])} is not readable by this "
-            f"version of the package, which reads major version {major}")
+            f"version of the package, which reads major version {major}; make the file again with this "
+            f"version (docs/format.md, 'Identification and versions')")
 
 
 def write_header(f: h5py.File, file_type: str, version: tuple[int, int]) -> None:
