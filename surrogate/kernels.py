@@ -303,8 +303,8 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
     and ``table.speed_range`` beforehand if that matters).
     """
     if not _moves_into_wall(V, n):
-        return _to_global(STATUS_INVALID, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, a, (0.0, 0.0, 0.0), n,
-                          (0.0, 0.0, 0.0), V_out, W_out)
+        _fill_nan(V_out, W_out)
+        return STATUS_INVALID
     alpha1, speed, ex, ez = impact_frame(V, n, u[12])
     status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
     return _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez, V_out, W_out)
@@ -317,13 +317,18 @@ def _moves_into_wall(V, n):
 
 
 @numba.njit(inline="always", **JIT)
+def _fill_nan(V_out, W_out):
+    for k in range(3):
+        V_out[k] = np.nan
+        W_out[k] = np.nan
+
+
+@numba.njit(inline="always", **JIT)
 def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez, V_out, W_out):
     """Write a local draw (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the frame (ex, n, ez); NaN
     unless rebounded. Returns the status."""
     if status != STATUS_REBOUNDED:
-        for k in range(3):
-            V_out[k] = np.nan
-            W_out[k] = np.nan
+        _fill_nan(V_out, W_out)
         return status
     w = speed / a
     for k in range(3):
@@ -349,12 +354,12 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     its wall hits: call this from its ``@njit`` code on the hit arrays.
     """
     _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled,
-                    np.empty((BLOCK, 8), dtype=np.int64), np.empty((BLOCK, 10)))
+                    np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, 10)))
 
 
 @numba.njit(**KERNEL)
 def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, index, frame):
-    """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, 8) int64 holds validity, shape, ja,
+    """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, 7) int64 holds validity, shape, ja,
     jv, ia, iv and the component of each particle of a block; ``frame`` (BLOCK, 10) α1, |V⁻|, ex, ez, wa, wv."""
     rows, dic, levels = data.clusters, data.dictionary, data.dictionary.shape[4] - 1
     n_clusters = rows.shape[3]
@@ -412,7 +417,7 @@ def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     for j in numba.prange((V.shape[0] + chunk - 1) // chunk):
         lo, hi = j * chunk, min((j + 1) * chunk, V.shape[0])
         _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u[lo:hi], V_out[lo:hi], W_out[lo:hi],
-                        status[lo:hi], scaled, np.empty((BLOCK, 8), dtype=np.int64), np.empty((BLOCK, 10)))
+                        status[lo:hi], scaled, np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, 10)))
 
 
 @numba.njit(parallel=True, **JIT)
