@@ -108,6 +108,25 @@ def test_each_collision_regime_gets_its_own_clusters():
     assert np.array_equal(np.unique(group), np.arange(len(label_regime)))
 
 
+def test_clusters_of_one_value_get_scale_zero_and_leave_the_dictionary_standard():
+    """A regime of 3 identical states forms a cluster without spread: scale 0, and the dictionary stays
+    made of standardised quantile functions (mean 0, sd 1); a variable constant in the whole cell gets
+    scale 0 everywhere and a standard dictionary too."""
+    x = _linear_chain(2_000, seed=5)
+    x[:, 5] = 0.25                                          # constant in the whole cell
+    x[:3] = x[0]                                            # three identical states ...
+    regime = np.zeros(len(x), dtype=np.uint8)
+    regime[:3] = 1                                          # ... alone in regime 1
+    cell = represent(_folded(x), regime, TableResolution(clusters=80, dictionary_size=16, levels=24), seed=0)
+    one = np.flatnonzero((cell["cluster_regime"] == 1) & (cell["cluster_weight"] > 0))
+    assert len(one) == 1 and np.all(cell["cluster_scale"][one[0]] == 0.0)
+    assert np.all(cell["cluster_scale"][:, 5] == 0.0)
+    np.testing.assert_allclose(cell["cluster_loc"][cell["cluster_weight"] > 0, 5], 0.25, rtol=1e-6)
+    dic = cell["shape_dictionary"].astype(np.float64)
+    np.testing.assert_allclose(dic.mean(axis=-1), 0.0, atol=1e-5)
+    np.testing.assert_allclose(dic.std(axis=-1), 1.0, rtol=1e-5)
+
+
 @pytest.mark.parametrize("counts, clusters, expected", [
     ((7000, 3000), 100, [70, 30]),      # proportional
     ((9950, 50), 100, [99, 1]),         # a small regime keeps one cluster

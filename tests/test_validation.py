@@ -16,7 +16,7 @@ import pytest
 from scipy.stats import ks_2samp
 
 from data_schema.table import read_table
-from surrogate.table import ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
+from surrogate.table import ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 from tablegen.validation import (
     classifier_accuracy, compare, direct_states, grid_points, midpoints, table_states,
 )
@@ -75,8 +75,20 @@ def test_between_grid_speeds_near_normal_impact(near_normal_table, shape):
 
 
 def test_near_normal_speed_step_is_needed(near_normal_table):
-    T = table_states(near_normal_table, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9, interpolation="stochastic")
+    """Both the speed step and its choice by collision regime are needed (the test above can fail).
+
+    Without the step (plain neighbour laws), and with every component treated
+    as regime 1 (only the normal rebound velocity scaled: the sampler's
+    previous law, measured 0.68–0.71 for the ellipsoid there), the classifier
+    exceeds the off-grid target.
+    """
     D = direct_states("ellipsoid", 83.75, 62.5, N_DRAWS, seed=103)
+    T = table_states(near_normal_table, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9, interpolation="stochastic")
+    assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
+    rows = np.array(near_normal_table.kernel_data.clusters)
+    rows[..., ROW_REGIME] = 1.0
+    one_law = dataclasses.replace(near_normal_table, kernel_data=near_normal_table.kernel_data._replace(clusters=rows))
+    T = table_states(one_law, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9)
     assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
 
 
