@@ -41,7 +41,9 @@ import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.prefetch import prefetch
+from surrogate.restitution import restitution_at
 from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
+from surrogate.trig import atan2_first_quadrant, sincos
 
 U_PER_DRAW = 13
 STATUS_INVALID = -1     # returned by :func:`rebound` for an incident state that does not hit the wall
@@ -54,7 +56,7 @@ KERNEL = dict(JIT, _nrt=False)
 
 
 @numba.njit(inline="always", **JIT)
-def locate(grid, lookup, scale, x):
+def locate(grid, lookup, scale, inv_spacing, x):
     """(j, w): grid interval [g_j, g_{j+1}] holding x and the weight of g_{j+1} (O(1)).
 
     Outside the grid, the nearest edge with weight 0 or 1; a one-point grid gives (0, 0).
@@ -67,21 +69,20 @@ def locate(grid, lookup, scale, x):
     j = lookup[k]
     if j < n - 2 and x >= grid[j + 1]:
         j += 1
-    w = (x - grid[j]) / (grid[j + 1] - grid[j])
+    w = (x - grid[j]) * inv_spacing[j]
     return j, min(max(w, 0.0), 1.0)
 
 
 @numba.njit(inline="always", **JIT)
-def _residual(data, s, ia, iv, c, k, u):
-    """loc + scale · S(u) of chain variable k in component c: multiply, floor, linear interpolation."""
-    rows, dic = data.clusters, data.dictionary
-    levels = dic.shape[4] - 1
+def _residual(row, dic, k, u):
+    """loc + scale · S(u) of chain variable k of a component (its ``row``, its cell's dictionary ``dic``):
+    multiply, floor, linear interpolation."""
+    levels = dic.shape[1] - 1
     t = u * levels
     i = min(int(t), levels - 1)
-    m = int(rows[s, ia, iv, c, ROW_SHAPE + k])
-    lo = dic[s, ia, iv, m, i]
-    return rows[s, ia, iv, c, ROW_LOC + k] + rows[s, ia, iv, c, ROW_SCALE + k] * (
-        lo + (t - i) * (dic[s, ia, iv, m, i + 1] - lo))
+    m = int(row[ROW_SHAPE + k])
+    lo = dic[m, i]
+    return row[ROW_LOC + k] + row[ROW_SCALE + k] * (lo + (t - i) * (dic[m, i + 1] - lo))
 
 
 @numba.njit(inline="always", **JIT)
@@ -93,29 +94,30 @@ def draw_folded(data, s, ia, iv, u):
     variable k (α2, |β2|, s, Ω_z, Ω_x, Ω_y) is the component's residual quantile
     function at u[5 + k], shifted by the component's slopes on the variables
     already drawn. α2 is reflected into [0, π] and |β2| capped at π/2 (the
-    linear shifts can step outside by a hair, ~1e-4 of draws). Arrays are read
-    by scalar indices only (no views, so no reference counting on the hot path).
+    linear shifts can step outside by a hair, ~1e-4 of draws). The component's
+    row and the cell's dictionary are taken as views once, so every read
+    after that is at a constant offset (the kernels run without reference
+    counting, so views cost nothing).
     """
-    r = data.clusters
-    n_clusters = r.shape[3]
+    rows = data.clusters[s, ia, iv]
+    n_clusters = rows.shape[0]
     t = u[4] * n_clusters
     c = min(int(t), n_clusters - 1)
-    if t - c >= r[s, ia, iv, c, ROW_ALIAS_PROB]:
-        c = int(r[s, ia, iv, c, ROW_ALIAS])
+    if t - c >= rows[c, ROW_ALIAS_PROB]:
+        c = int(rows[c, ROW_ALIAS])
+    r, dic = rows[c], data.dictionary[s, ia, iv]
     b = ROW_SLOPE      # slopes of x_k on x_j at b + k(k−1)/2 + j
-    x0 = _residual(data, s, ia, iv, c, 0, u[5])
-    x1 = _residual(data, s, ia, iv, c, 1, u[6]) + r[s, ia, iv, c, b] * x0
-    x2 = _residual(data, s, ia, iv, c, 2, u[7]) + r[s, ia, iv, c, b + 1] * x0 + r[s, ia, iv, c, b + 2] * x1
-    x3 = (_residual(data, s, ia, iv, c, 3, u[8]) + r[s, ia, iv, c, b + 3] * x0 + r[s, ia, iv, c, b + 4] * x1
-          + r[s, ia, iv, c, b + 5] * x2)
-    x4 = (_residual(data, s, ia, iv, c, 4, u[9]) + r[s, ia, iv, c, b + 6] * x0 + r[s, ia, iv, c, b + 7] * x1
-          + r[s, ia, iv, c, b + 8] * x2 + r[s, ia, iv, c, b + 9] * x3)
-    x5 = (_residual(data, s, ia, iv, c, 5, u[10]) + r[s, ia, iv, c, b + 10] * x0 + r[s, ia, iv, c, b + 11] * x1
-          + r[s, ia, iv, c, b + 12] * x2 + r[s, ia, iv, c, b + 13] * x3 + r[s, ia, iv, c, b + 14] * x4)
+    x0 = _residual(r, dic, 0, u[5])
+    x1 = _residual(r, dic, 1, u[6]) + r[b] * x0
+    x2 = _residual(r, dic, 2, u[7]) + r[b + 1] * x0 + r[b + 2] * x1
+    x3 = _residual(r, dic, 3, u[8]) + r[b + 3] * x0 + r[b + 4] * x1 + r[b + 5] * x2
+    x4 = _residual(r, dic, 4, u[9]) + r[b + 6] * x0 + r[b + 7] * x1 + r[b + 8] * x2 + r[b + 9] * x3
+    x5 = (_residual(r, dic, 5, u[10]) + r[b + 10] * x0 + r[b + 11] * x1 + r[b + 12] * x2 + r[b + 13] * x3
+          + r[b + 14] * x4)
     alpha2 = abs(x0)
     if alpha2 > math.pi:
         alpha2 = 2.0 * math.pi - alpha2
-    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, r[s, ia, iv, c, ROW_REGIME]
+    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, r[ROW_REGIME]
 
 
 @numba.njit(inline="always", **JIT)
@@ -128,8 +130,8 @@ def _rescaled(data, shape, ja, ja1, wa, ia, iv, k, x, centred):
     """
     mo = data.moments
     sd = (1.0 - wa) * mo[shape, ja, iv, 1, k] + wa * mo[shape, ja1, iv, 1, k]
-    sd_cell = mo[shape, ia, iv, 1, k]
-    ratio = sd / sd_cell if sd_cell > 0.0 else 1.0
+    inv_sd_cell = mo[shape, ia, iv, 2, k]
+    ratio = sd * inv_sd_cell if inv_sd_cell > 0.0 else 1.0
     if centred:
         return x * ratio
     mean = (1.0 - wa) * mo[shape, ja, iv, 0, k] + wa * mo[shape, ja1, iv, 0, k]
@@ -137,8 +139,9 @@ def _rescaled(data, shape, ja, ja1, wa, ia, iv, k, x, centred):
 
 
 @numba.njit(inline="always", **JIT)
-def _to_speed(data, regime, speed, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, wy, wz):
-    """A rebound drawn at grid speed V_iv, moved to incident speed V (both m/s); returns (vx, vy, vz, wx, wy, wz).
+def _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, wy, wz):
+    """A rebound drawn at grid speed V_iv, moved to incident speed V = V_jv + wv (V_jv+1 − V_jv); returns
+    (vx, vy, vz, wx, wy, wz).
 
     Local frame, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. With
     a(V) = 1 − (1 − exp(−k V^p)) sin α1, the normal restitution of the wall
@@ -155,10 +158,10 @@ def _to_speed(data, regime, speed, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, w
     (docs/design/table_representation.md): either law alone fails near
     normal impact for some shape (classifier accuracy up to 0.79), the pair
     by regime stays ≤ 0.54. A normal velocity the shift would reverse is
-    reflected (the rebound must leave the wall).
+    reflected (the rebound must leave the wall). exp(−k V^p) comes from the
+    table's polynomial pieces (:mod:`surrogate.restitution`).
     """
-    law = data.restitution
-    a_target = 1.0 - (1.0 - math.exp(-law[0] * speed ** law[1])) * sin_alpha1
+    a_target = 1.0 - (1.0 - restitution_at(data.restitution_pieces, jv, wv)) * sin_alpha1
     a_grid = 1.0 - (1.0 - data.speed_restitution[iv]) * sin_alpha1
     if regime == 0.0:
         f = (1.0 + a_target) / (1.0 + a_grid)
@@ -178,8 +181,8 @@ def _cell(data, mix_cdf, alpha1, speed, u):
     shape = 0
     for k in range(mix_cdf.shape[0] - 1):     # the first k with u[0] < cdf[k], without data-dependent branches
         shape += u[0] >= mix_cdf[k]
-    ja, wa = locate(data.alpha1_deg, data.alpha1_lookup, data.alpha1_scale, alpha1)
-    jv, wv = locate(data.speed, data.speed_lookup, data.speed_scale, speed)
+    ja, wa = locate(data.alpha1_deg, data.alpha1_lookup, data.alpha1_scale, data.alpha1_inv_spacing, alpha1)
+    jv, wv = locate(data.speed, data.speed_lookup, data.speed_scale, data.speed_inv_spacing, speed)
     ia = ja + 1 if u[1] < wa else ja
     iv = jv + 1 if u[2] < wv else jv
     return shape, ja, wa, jv, wv, ia, iv
@@ -200,12 +203,13 @@ def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
     means and standard deviations (:func:`_rescaled`), in |V⁻| by the wall's
     restitution law (:func:`_to_speed`).
     """
-    return _draw_in_cell(data, _cell(data, mix_cdf, alpha1, speed, u), alpha1, u, scaled)
+    sin_a1, cos_a1 = sincos(math.radians(alpha1))
+    return _draw_in_cell(data, _cell(data, mix_cdf, alpha1, speed, u), cos_a1, sin_a1, u, scaled)
 
 
 @numba.njit(inline="always", **JIT)
-def _draw_in_cell(data, cell, alpha1, u, scaled):
-    """:func:`draw_velocity` once its cell (:func:`_cell`) is known."""
+def _draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
+    """:func:`draw_velocity` once its cell (:func:`_cell`) is known; α1 given by its cosine and sine."""
     shape, ja, wa, jv, wv, ia, iv = cell
     if u[3] < data.p_trapped[shape, ia, iv]:
         return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
@@ -219,12 +223,11 @@ def _draw_in_cell(data, cell, alpha1, u, scaled):
         wx = _rescaled(data, shape, ja, ja1, wa, ia, iv, 3, wx, True)
         wy = _rescaled(data, shape, ja, ja1, wa, ia, iv, 4, wy, True)
         wz = _rescaled(data, shape, ja, ja1, wa, ia, iv, 5, wz, False)
-    cb = math.cos(beta2)
-    vx, vy, vz = s * cb * math.cos(alpha2), s * cb * math.sin(alpha2), s * math.sin(beta2)
+    sb, cb = sincos(beta2)
+    sa, ca = sincos(alpha2)
+    vx, vy, vz = s * cb * ca, s * cb * sa, s * sb
     if scaled and wv > 0.0:
-        a1 = math.radians(alpha1)
-        v_target = data.speed[jv] + wv * (data.speed[jv + 1] - data.speed[jv])
-        vx, vy, vz, wx, wy, wz = _to_speed(data, regime, v_target, math.cos(a1), math.sin(a1), iv,
+        vx, vy, vz, wx, wy, wz = _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv,
                                            vx, vy, vz, wx, wy, wz)
     if u[11] < 0.5:
         return STATUS_REBOUNDED, vx, vy, -vz, -wx, -wy, wz
@@ -251,15 +254,16 @@ def impact_frame(V, n, u_axis):
 
     ex is the direction of the tangential part of V (uniform in the wall plane,
     from ``u_axis``, at normal impact: tangential part below 1e-12 |V|); the
-    frame is (ex, n, ez = ex × n). Returns (α1 in degrees, |V|, ex, ez) with
-    ex and ez as 3-tuples.
+    frame is (ex, n, ez = ex × n). Returns (α1 in degrees, |V|, cos α1, sin α1,
+    ex, ez) with ex and ez as 3-tuples.
     """
     vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
     tx, ty, tz = V[0] - vn * n[0], V[1] - vn * n[1], V[2] - vn * n[2]
     vt = math.sqrt(tx * tx + ty * ty + tz * tz)
     speed = math.sqrt(vn * vn + vt * vt)
     if vt > 1e-12 * speed:
-        ex0, ex1, ex2 = tx / vt, ty / vt, tz / vt
+        inv = 1.0 / vt
+        ex0, ex1, ex2 = tx * inv, ty * inv, tz * inv
     else:
         # orthonormal basis (p, q) of the wall plane: p = n × e_k with e_k the axis least aligned with n
         if abs(n[0]) <= abs(n[1]) and abs(n[0]) <= abs(n[2]):
@@ -271,11 +275,11 @@ def impact_frame(V, n, u_axis):
         pn = math.sqrt(px * px + py * py + pz * pz)
         px, py, pz = px / pn, py / pn, pz / pn
         qx, qy, qz = n[1] * pz - n[2] * py, n[2] * px - n[0] * pz, n[0] * py - n[1] * px
-        phi = 2.0 * math.pi * u_axis
-        c, s = math.cos(phi), math.sin(phi)
+        s, c = sincos(2.0 * math.pi * u_axis)
         ex0, ex1, ex2 = c * px + s * qx, c * py + s * qy, c * pz + s * qz
     ez = (ex1 * n[2] - ex2 * n[1], ex2 * n[0] - ex0 * n[2], ex0 * n[1] - ex1 * n[0])
-    return math.degrees(math.atan2(-vn, vt)), speed, (ex0, ex1, ex2), ez
+    inv_speed = 1.0 / speed
+    return (math.degrees(atan2_first_quadrant(-vn, vt)), speed, vt * inv_speed, -vn * inv_speed, (ex0, ex1, ex2), ez)
 
 
 @numba.njit(**KERNEL)
@@ -305,8 +309,9 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
     if not _moves_into_wall(V, n):
         _fill_nan(V_out, W_out)
         return STATUS_INVALID
-    alpha1, speed, ex, ez = impact_frame(V, n, u[12])
-    status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
+    alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
+    cell = _cell(data, mix_cdf, alpha1, speed, u)
+    status, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
     return _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez, V_out, W_out)
 
 
@@ -338,6 +343,7 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez, V_out, W_out
 
 
 BLOCK = 16      # particles whose table reads rebound_many puts in flight together
+FRAME = 11      # floats per particle in rebound_many's frame scratch
 
 
 @numba.njit(**JIT)
@@ -354,13 +360,13 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     its wall hits: call this from its ``@njit`` code on the hit arrays.
     """
     _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled,
-                    np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, 10)))
+                    np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, FRAME)))
 
 
 @numba.njit(**KERNEL)
 def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, index, frame):
     """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, 7) int64 holds validity, shape, ja,
-    jv, ia, iv and the component of each particle of a block; ``frame`` (BLOCK, 10) α1, |V⁻|, ex, ez, wa, wv."""
+    jv, ia, iv and the component of each particle of a block; ``frame`` (BLOCK, FRAME) |V⁻|, cos α1, sin α1, ex, ez, wa, wv."""
     rows, dic, levels = data.clusters, data.dictionary, data.dictionary.shape[4] - 1
     n_clusters = rows.shape[3]
     for start in range(0, V.shape[0], BLOCK):
@@ -370,13 +376,13 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
             index[b, 0] = _moves_into_wall(V[i], n[i])
             if not index[b, 0]:
                 continue
-            alpha1, speed, ex, ez = impact_frame(V[i], n[i], u[i, 12])
+            alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V[i], n[i], u[i, 12])
             shape, ja, wa, jv, wv, ia, iv = _cell(data, mix_cdf, alpha1, speed, u[i])
             c = min(int(u[i, 4] * n_clusters), n_clusters - 1)
             index[b, 1], index[b, 2], index[b, 3], index[b, 4], index[b, 5], index[b, 6] = shape, ja, jv, ia, iv, c
-            frame[b, 0], frame[b, 1], frame[b, 8], frame[b, 9] = alpha1, speed, wa, wv
-            frame[b, 2], frame[b, 3], frame[b, 4] = ex
-            frame[b, 5], frame[b, 6], frame[b, 7] = ez
+            frame[b, 0], frame[b, 1], frame[b, 2], frame[b, 9], frame[b, 10] = speed, cos_a1, sin_a1, wa, wv
+            frame[b, 3], frame[b, 4], frame[b, 5] = ex
+            frame[b, 6], frame[b, 7], frame[b, 8] = ez
             prefetch(rows, (shape, ia, iv, c, 0))
             prefetch(data.p_trapped, (shape, ia, iv))
             prefetch(data.moments, (shape, ja, iv, 0, 0))
@@ -404,10 +410,10 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
             if not index[b, 0]:
                 status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
                 continue
-            cell = (index[b, 1], index[b, 2], frame[b, 8], index[b, 3], frame[b, 9], index[b, 4], index[b, 5])
-            st, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, frame[b, 0], u[i], scaled)
-            ex, ez = (frame[b, 2], frame[b, 3], frame[b, 4]), (frame[b, 5], frame[b, 6], frame[b, 7])
-            status[i] = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 1], a[i], ex, n[i], ez, V_out[i], W_out[i])
+            cell = (index[b, 1], index[b, 2], frame[b, 9], index[b, 3], frame[b, 10], index[b, 4], index[b, 5])
+            st, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, frame[b, 1], frame[b, 2], u[i], scaled)
+            ex, ez = (frame[b, 3], frame[b, 4], frame[b, 5]), (frame[b, 6], frame[b, 7], frame[b, 8])
+            status[i] = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 0], a[i], ex, n[i], ez, V_out[i], W_out[i])
 
 
 @numba.njit(parallel=True, **JIT)
@@ -417,7 +423,7 @@ def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     for j in numba.prange((V.shape[0] + chunk - 1) // chunk):
         lo, hi = j * chunk, min((j + 1) * chunk, V.shape[0])
         _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u[lo:hi], V_out[lo:hi], W_out[lo:hi],
-                        status[lo:hi], scaled, np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, 10)))
+                        status[lo:hi], scaled, np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, FRAME)))
 
 
 @numba.njit(parallel=True, **JIT)

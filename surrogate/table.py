@@ -16,6 +16,7 @@ import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import N_CHAIN, N_SLOPES, ReboundTable, read_table
+from surrogate.restitution import restitution_pieces
 
 
 class KernelData(NamedTuple):
@@ -24,15 +25,17 @@ class KernelData(NamedTuple):
     alpha1_deg: np.ndarray     # (n_alpha,) grid
     alpha1_lookup: np.ndarray  # (m,) interval index on a uniform auxiliary grid
     alpha1_scale: np.ndarray   # (2,) origin and inverse step of that grid
+    alpha1_inv_spacing: np.ndarray  # (max(n_alpha − 1, 1),) 1/(g_{j+1} − g_j) of each grid interval (0: one point)
     speed: np.ndarray          # (n_speed,) grid, m/s
     speed_lookup: np.ndarray
     speed_scale: np.ndarray
+    speed_inv_spacing: np.ndarray
     p_trapped: np.ndarray      # (n_shape, n_alpha, n_speed)
     clusters: np.ndarray       # (n_shape, n_alpha, n_speed, C, ROW_SIZE) float32, one row per component
     dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6·M, L + 1) float32 residual shapes
-    moments: np.ndarray        # (n_shape, n_alpha, n_speed, 2, 6) mean and sd of (α2, β2, s, Ω_x, Ω_y, Ω_z)
-    restitution: np.ndarray    # (2,) k, p of the wall's normal restitution exp(−k V^p), V in m/s
-    speed_restitution: np.ndarray  # (n_speed,) exp(−k V^p) at the grid speeds
+    moments: np.ndarray        # (n_shape, n_alpha, n_speed, 3, 6) mean, sd, 1/sd (0 if sd = 0) of (α2, β2, s, Ω_x, Ω_y, Ω_z)
+    speed_restitution: np.ndarray  # (n_speed,) the wall's normal restitution factor exp(−k V^p) at the grid speeds
+    restitution_pieces: np.ndarray  # (max(n_speed − 1, 1), S, D + 1) exp(−k V^p) between them (surrogate.restitution)
 
 
 # Layout of a component's row in KernelData.clusters: everything one draw needs
@@ -53,16 +56,16 @@ def interval_lookup(grid: np.ndarray):
     A uniform auxiliary grid with step no larger than half the smallest grid
     spacing stores, for each of its points, the index j of the grid interval
     [g_j, g_{j+1}) holding it; a query reads that index and corrects it by at
-    most one step. Returns (lookup, (origin, 1/step)).
+    most one step. Returns (lookup, (origin, 1/step), 1/(g_{j+1} − g_j) per interval).
     """
     grid = np.asarray(grid, dtype=np.float64)
     if len(grid) == 1:
-        return np.zeros(1, dtype=np.int64), np.array([grid[0], 0.0])
+        return np.zeros(1, dtype=np.int64), np.array([grid[0], 0.0]), np.zeros(1)
     step = np.diff(grid).min() / 2.0
     m = int(np.ceil((grid[-1] - grid[0]) / step)) + 1
     points = grid[0] + step * np.arange(m)
     lookup = np.clip(np.searchsorted(grid, points, side="right") - 1, 0, len(grid) - 2)
-    return lookup.astype(np.int64), np.array([grid[0], 1.0 / step])
+    return lookup.astype(np.int64), np.array([grid[0], 1.0 / step]), 1.0 / np.diff(grid)
 
 
 def alias_table(weights: np.ndarray):
@@ -106,6 +109,13 @@ def kernel_rows(cells: dict) -> tuple:
     return rows, dic.reshape(lead + (N_CHAIN * size, dic.shape[5]))
 
 
+def moments(mean: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """Mean, sd and 1/sd (0 where sd = 0) of every cell's state variables stacked on a new axis 3, as
+    KernelData.moments holds them (the kernels multiply by 1/sd instead of dividing by sd)."""
+    inverse = np.divide(1.0, std, out=np.zeros_like(std, dtype=np.float64), where=std > 0.0)
+    return np.stack([mean, std, inverse], axis=3)
+
+
 def _frozen(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a)
     a.setflags(write=False)
@@ -123,6 +133,8 @@ class SurrogateTable:
     particles_per_cell: int
     n_max: int
     config_sha256: str
+    restitution_k: float       # the wall's normal restitution exp(−k V^p) the table was built with, (m/s)^(−p)
+    restitution_p: float
     kernel_data: KernelData
 
     @property
@@ -137,22 +149,24 @@ class SurrogateTable:
     def from_table(cls, table: ReboundTable, path: str = "<memory>") -> "SurrogateTable":
         counts = table.cells["status_counts"].astype(np.float64)
         landed = counts[..., STATUS_REBOUNDED] + counts[..., STATUS_TRAPPED]
-        a_lookup, a_scale = interval_lookup(table.alpha1_deg)
-        v_lookup, v_scale = interval_lookup(table.speed_m_s)
+        a_lookup, a_scale, a_inv = interval_lookup(table.alpha1_deg)
+        v_lookup, v_scale, v_inv = interval_lookup(table.speed_m_s)
         rows, dictionary = kernel_rows(table.cells)
         data = KernelData(
             alpha1_deg=_frozen(np.asarray(table.alpha1_deg, dtype=np.float64)), alpha1_lookup=_frozen(a_lookup),
-            alpha1_scale=_frozen(a_scale), speed=_frozen(np.asarray(table.speed_m_s, dtype=np.float64)),
-            speed_lookup=_frozen(v_lookup), speed_scale=_frozen(v_scale),
+            alpha1_scale=_frozen(a_scale), alpha1_inv_spacing=_frozen(a_inv),
+            speed=_frozen(np.asarray(table.speed_m_s, dtype=np.float64)),
+            speed_lookup=_frozen(v_lookup), speed_scale=_frozen(v_scale), speed_inv_spacing=_frozen(v_inv),
             p_trapped=_frozen(counts[..., STATUS_TRAPPED] / landed),
             clusters=_frozen(rows), dictionary=_frozen(dictionary),
-            moments=_frozen(np.stack([table.cells["mean"], table.cells["std"]], axis=3)),
-            restitution=_frozen(np.array([table.restitution_k, table.restitution_p])),
+            moments=_frozen(moments(table.cells["mean"], table.cells["std"])),
             speed_restitution=_frozen(
-                np.exp(-table.restitution_k * np.asarray(table.speed_m_s, dtype=np.float64) ** table.restitution_p)))
+                np.exp(-table.restitution_k * np.asarray(table.speed_m_s, dtype=np.float64) ** table.restitution_p)),
+            restitution_pieces=_frozen(restitution_pieces(table.speed_m_s, table.restitution_k, table.restitution_p)))
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=data.alpha1_deg, speed_m_s=data.speed,
                    particles_per_cell=table.particles_per_cell, n_max=table.n_max,
-                   config_sha256=table.config_sha256, kernel_data=data)
+                   config_sha256=table.config_sha256, restitution_k=table.restitution_k,
+                   restitution_p=table.restitution_p, kernel_data=data)
 
 
 def load(path) -> SurrogateTable:

@@ -1,0 +1,68 @@
+"""Trigonometry inlined into the sampler kernels: :func:`sincos` and :func:`atan2_first_quadrant`.
+
+A call to libm (``sin``/``cos``, which LLVM merges into ``sincos``, or
+``atan2``) costs the call itself and, because every floating-point register
+is caller-saved, the spilling of the kernel's live values around it. These
+are instead a few multiply-adds that the compiler schedules with the rest of
+the kernel, on the argument ranges the kernels use, to a few units in the
+last place (tests/test_kernel_math.py compares them with libm on dense grids).
+
+* :func:`sincos`, |x| ≤ 2π: Cody–Waite reduction by the nearest multiple q
+  of π/2 (π/2 split into two doubles, so the reduced angle r, |r| ≤ π/4, is
+  accurate to about 1e-17), the Taylor polynomials of sin r to r¹⁵ and
+  cos r to r¹⁶ (truncation below 5e-17 for |r| ≤ π/4), the quadrant's signs.
+* :func:`atan2_first_quadrant`, x, y ≥ 0: the ratio t = min/max ∈ [0, 1]
+  (π/2 − atan for y > x), then atan t = atan c + atan z with c the nearest
+  of 0, 1/4, 1/2, 3/4, 1 and z = (t − c)/(1 + c t), |z| ≤ 1/8, taken in one
+  division from x and y; atan z by its Taylor series to z¹⁷ (truncation
+  below 1e-18).
+"""
+
+import math
+
+import numba
+
+_HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double
+_HALF_PI_LO = 6.123233995736766e-17    # π/2 − _HALF_PI_HI
+_TWO_OVER_PI = 2.0 / math.pi
+# Taylor coefficients (−1)^k / n!: sin r = r + r³ S3 + ... + r¹⁵ S15, cos r = 1 + r² C2 + ... + r¹⁶ C16
+S3, S5, S7, S9, S11, S13, S15 = ((-1.0) ** k / math.factorial(2 * k + 1) for k in range(1, 8))
+C2, C4, C6, C8, C10, C12, C14, C16 = ((-1.0) ** k / math.factorial(2 * k) for k in range(1, 9))
+
+
+@numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
+def sincos(x):
+    """(sin x, cos x) for |x| ≤ 2π (x in radians), to a few ulp."""
+    q = math.floor(x * _TWO_OVER_PI + 0.5)
+    r = (x - q * _HALF_PI_HI) - q * _HALF_PI_LO
+    z = r * r
+    s = r + r * z * (S3 + z * (S5 + z * (S7 + z * (S9 + z * (S11 + z * (S13 + z * S15))))))
+    c = 1.0 + z * (C2 + z * (C4 + z * (C6 + z * (C8 + z * (C10 + z * (C12 + z * (C14 + z * C16)))))))
+    quadrant = int(q) & 3
+    if quadrant == 0:
+        return s, c
+    if quadrant == 1:
+        return c, -s
+    if quadrant == 2:
+        return -s, -c
+    return -c, s
+
+
+_ATAN_NODES = (0.0, 0.25, 0.5, 0.75, 1.0)
+_ATAN_AT_NODES = tuple(math.atan(c) for c in _ATAN_NODES)
+
+
+@numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
+def atan2_first_quadrant(y, x):
+    """atan2(y, x) in radians for x ≥ 0, y ≥ 0, not both 0, to a few ulp."""
+    swap = y > x
+    lo, hi = (x, y) if swap else (y, x)
+    # the node c nearest to t = lo/hi, chosen without dividing (midpoints 1/8, 3/8, 5/8, 7/8)
+    node = (lo > 0.125 * hi) + (lo > 0.375 * hi) + (lo > 0.625 * hi) + (lo > 0.875 * hi)
+    c = _ATAN_NODES[node]
+    z = (lo - c * hi) / (hi + c * lo)
+    w = z * z
+    atan_z = z - z * w * (1.0 / 3.0 - w * (1.0 / 5.0 - w * (1.0 / 7.0 - w * (1.0 / 9.0 - w * (
+        1.0 / 11.0 - w * (1.0 / 13.0 - w * (1.0 / 15.0 - w * (1.0 / 17.0))))))))
+    angle = _ATAN_AT_NODES[node] + atan_z
+    return 0.5 * math.pi - angle if swap else angle

@@ -1,0 +1,80 @@
+"""The sampler kernels' inlined functions against their closed forms: sincos, first-quadrant atan2, and the
+polynomial pieces of the wall's restitution factor exp(−k V^p)."""
+
+import math
+
+import numba
+import numpy as np
+import pytest
+
+from surrogate.restitution import restitution_at, restitution_pieces
+from surrogate.trig import atan2_first_quadrant, sincos
+
+ULP_ONE = np.spacing(1.0)     # 2.2e-16
+
+
+@numba.njit
+def _sincos_all(x, s, c):
+    for i in range(x.shape[0]):
+        s[i], c[i] = sincos(x[i])
+
+
+@numba.njit
+def _atan2_all(y, x, out):
+    for i in range(x.shape[0]):
+        out[i] = atan2_first_quadrant(y[i], x[i])
+
+
+@numba.njit
+def _restitution_all(pieces, j, w, out):
+    for i in range(w.shape[0]):
+        out[i] = restitution_at(pieces, j[i], w[i])
+
+
+def test_sincos_matches_libm_on_its_domain():
+    """|x| ≤ 2π, dense grid plus the quadrant edges (multiples of π/4): within 2 ulp of 1 (absolute)."""
+    x = np.concatenate([np.linspace(-2 * np.pi, 2 * np.pi, 400_001), np.arange(-8, 9) * (np.pi / 4),
+                        np.nextafter(np.arange(-8, 9) * (np.pi / 4), 0.0), [0.0, -0.0, 1e-300]])
+    s, c = np.empty_like(x), np.empty_like(x)
+    _sincos_all(x, s, c)
+    assert np.max(np.abs(s - np.sin(x))) <= 2 * ULP_ONE
+    assert np.max(np.abs(c - np.cos(x))) <= 2 * ULP_ONE
+    assert np.max(np.abs(s * s + c * c - 1.0)) <= 4 * ULP_ONE
+    assert s[-1] == 1e-300 and c[-1] == 1.0          # tiny angles: sin x = x exactly
+
+
+def test_atan2_first_quadrant_matches_libm():
+    """x, y ≥ 0 over radii 1e-3–1e3 and every direction, plus the axes, the diagonal and the node
+    boundaries t = 1/8, 3/8, 5/8, 7/8: within 2 ulp of the angle."""
+    rng = np.random.default_rng(7)
+    theta = np.concatenate([np.linspace(0.0, np.pi / 2, 200_001), rng.uniform(0.0, np.pi / 2, 100_000)])
+    radius = rng.uniform(1e-3, 1e3, theta.size)
+    y, x = radius * np.sin(theta), radius * np.cos(theta)
+    t = np.array([0.125, 0.375, 0.625, 0.875])
+    y = np.concatenate([y, [0.0, 2.0, 3.0], t, np.nextafter(t, 0), np.ones(4)])
+    x = np.concatenate([x, [1.0, 0.0, 3.0], np.ones(4), np.ones(4), t])
+    out = np.empty_like(x)
+    _atan2_all(y, x, out)
+    exact = np.arctan2(y, x)
+    assert np.all(np.abs(out - exact) <= 2 * np.spacing(np.maximum(exact, 1e-300)))
+    assert out[theta.size:theta.size + 3].tolist() == [0.0, math.pi / 2, math.pi / 4]
+
+
+@pytest.mark.parametrize("grid", [[50.0, 100.0, 150.0, 200.0, 250.0, 300.0], list(np.arange(50.0, 301.0, 25.0)),
+                                  [1.0, 50.0], [0.1, 10.0, 1000.0], [20.0, 25.0, 400.0], [120.0]])
+def test_restitution_pieces_match_the_closed_form(grid):
+    """exp(−k V^p) from the pieces at 4001 weights per interval (both ends included), for tablegen's default
+    wall (k, p) = (0.1, 0.61) and laws from gentle to steep: absolute error ≤ 1e-12 (the factor is ≤ 1
+    and enters a(V) = 1 − (1 − f) sin α1 additively)."""
+    grid = np.array(grid)
+    for k, p in ((0.1, 0.61), (0.02, 0.3), (0.5, 0.9), (1.0, 1.0), (0.1, 1.5)):
+        pieces = restitution_pieces(grid, k, p)
+        if len(grid) == 1:
+            assert pieces.shape[:2] == (1, 1)      # no interval: the kernel never reads it (weight 0)
+            continue
+        w = np.linspace(0.0, 1.0, 4001)
+        for j in range(len(grid) - 1):
+            got = np.empty_like(w)
+            _restitution_all(pieces, np.full(w.size, j), w, got)
+            exact = np.exp(-k * (grid[j] + w * (grid[j + 1] - grid[j])) ** p)
+            assert np.max(np.abs(got - exact)) <= 1e-12, (grid, k, p, j)
