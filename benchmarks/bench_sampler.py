@@ -11,12 +11,16 @@ and prints the cost in ns per reflected state:
     checks, the NumPy draw of the U_PER_DRAW uniforms per state, the parallel
     kernel and the outputs. Two breakdown rows time
     ``surrogate.kernels.rebound_batch`` alone on pre-drawn uniforms;
-(b) ``surrogate.kernels.rebound`` called from a user's ``@njit`` loop on one
-    thread, as a flow solver would call it: the loop draws the U_PER_DRAW
-    uniforms of each state with ``surrogate.rng.fill_uniforms`` (xoshiro256+,
-    caller-owned state) and that cost is included. Variants: the uniforms from
-    numba's ``np.random.random()``; (b') the loop reading pre-drawn uniforms;
-    (b-block) a solver that collects its wall hits and calls
+(b) ``surrogate.kernels.rebound_tuple`` called from a user's ``@njit`` loop
+    on one thread, as a flow solver would call it per wall hit: the particle's
+    V and n passed as 3-tuples of its components and V⁺, Ω⁺ returned as
+    tuples (no array views, so the loop does no reference counting); the loop
+    draws the U_PER_DRAW uniforms of each state with
+    ``surrogate.rng.fill_uniforms`` (xoshiro256+, caller-owned state) and that
+    cost is included. Variants: ``surrogate.kernels.rebound`` on the rows
+    ``V[i]``, ``n[i]``, ``V_out[i]``, ``W_out[i]`` (array views); the uniforms
+    from numba's ``np.random.random()``; (b') the loop reading pre-drawn
+    uniforms; (b-block) a solver that collects its wall hits and calls
     ``surrogate.kernels.rebound_many`` on them from ``@njit`` code (uniforms
     from xoshiro256+ included); breakdown row: the xoshiro256+ draws alone;
 (c) the direct model, ``tablegen.simulate.simulate`` with the shape mix, one
@@ -46,9 +50,13 @@ sampler returns their status, as the direct model does).
 The table is built by the script into a temporary folder (α1 ∈ {10, 30, 50,
 70, 90}°, |V⁻| ∈ {100, 200, 300} m/s, the four shapes, 20000 particles per
 cell: about a minute on two cores; --quick: 4096 particles per cell), or
-given with ``--table PATH``. Note that such a small table (a few MB) stays in
-the CPU caches; a production table (tens of MB) adds memory latency to the
-per-state cost.
+given with ``--table PATH``. A draw reads a component row and then residual
+shape rows that the row names, two dependent memory reads at random places
+of the table, so the per-particle figures depend on the memory latency at
+the table's size: the script prints it (a pointer chase over a buffer as
+large as the table's arrays). A table within the last-level cache (the
+bench's, a few MB) costs tens of ns per read, a production table (tens to
+hundreds of MB) the DRAM latency, about 150 ns on the reference machine.
 
 How
 ---
@@ -87,7 +95,7 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch, rebound_many
+from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch, rebound_many, rebound_tuple
 from surrogate.rng import fill_uniforms, seed_state
 
 SEED = 20240601
@@ -163,7 +171,20 @@ def seed_numba_rng(seed):
 
 @numba.njit(**JIT)
 def loop_kernel_rng(data, cdf, V, n, a, state, V_out, W_out, status):
-    """(b) A solver's loop: uniforms from a xoshiro256+ state (surrogate.rng.fill_uniforms), our kernel."""
+    """(b) A solver's loop: uniforms from a xoshiro256+ state (surrogate.rng.fill_uniforms), our kernel on
+    the particle's components (rebound_tuple: no array views)."""
+    u = np.empty(U_PER_DRAW)
+    for i in range(V.shape[0]):
+        fill_uniforms(state, u)
+        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
+        W_out[i, 0], W_out[i, 1], W_out[i, 2] = W_new
+
+
+@numba.njit(**JIT)
+def loop_kernel_views(data, cdf, V, n, a, state, V_out, W_out, status):
+    """(b, rows) The same loop calling rebound on the rows V[i], n[i], V_out[i], W_out[i] (array views)."""
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
@@ -185,21 +206,21 @@ def loop_kernel_nprandom(data, cdf, V, n, a, V_out, W_out, status):
     for i in range(V.shape[0]):
         for k in range(U_PER_DRAW):
             u[k] = np.random.random()
-        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], W_out[i])
+        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
+        W_out[i, 0], W_out[i, 1], W_out[i, 2] = W_new
 
 
 @numba.njit(**JIT)
-def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, W_out, status):
-    """(b') The same loop on pre-drawn uniforms U (N, U_PER_DRAW)."""
+def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, W_out, status, scaled):
+    """(b') The same loop on pre-drawn uniforms U (N, U_PER_DRAW); with scaled=False, plain stochastic
+    interpolation (no moment scaling, breakdown row)."""
     for i in range(V.shape[0]):
-        status[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V_out[i], W_out[i])
-
-
-@numba.njit(**JIT)
-def loop_kernel_predrawn_unscaled(data, cdf, V, n, a, U, V_out, W_out, status):
-    """Breakdown of (b'): the same loop with plain stochastic interpolation (no moment scaling)."""
-    for i in range(V.shape[0]):
-        status[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V_out[i], W_out[i], False)
+        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i], scaled)
+        V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
+        W_out[i, 0], W_out[i, 1], W_out[i, 2] = W_new
 
 
 @numba.njit(**JIT)
@@ -212,6 +233,27 @@ def loop_rng_only(count, state, out):
         for k in range(U_PER_DRAW):
             s += u[k]
     out[0] = s
+
+
+@numba.njit(**JIT)
+def _chase(following, steps):
+    i = 0
+    for _ in range(steps):
+        i = following[i]
+    return i
+
+
+def dependent_load_ns(nbytes: float, steps: int = 1_000_000) -> float:
+    """Memory latency at a working set of ``nbytes``: ns per read of a chain of reads, each at a random
+    cache line of the buffer that the previous read names (one random cycle through all its lines)."""
+    lines = max(2, int(nbytes // 64))
+    order = np.random.default_rng(SEED).permutation(lines) * 8        # int64 index of each line's start
+    following = np.zeros(lines * 8, dtype=np.int64)
+    following[order] = np.roll(order, -1)
+    _chase(following, 1000)
+    start = time.perf_counter()
+    _chase(following, steps)
+    return (time.perf_counter() - start) / steps * 1e9
 
 
 @numba.njit(**JIT)
@@ -370,8 +412,9 @@ def main(argv=None) -> int:
     mix = {s: 0.25 for s in SHAPES}
     cdf = surrogate.mix_cdf(table, mix)
     data = table.kernel_data
-    V_out, W_out = np.empty((count, 3)), np.empty((count, 3))
-    status = np.empty(count, dtype=np.int8)
+    # outputs and scratch written once here, so that no timed run pays the first touch of their pages
+    V_out, W_out = np.full((count, 3), np.nan), np.full((count, 3), np.nan)
+    status = np.full(count, -1, dtype=np.int8)
     print(f"  states                 N = {count}: speed U{table.speed_range} m/s, alpha1 "
           f"U({st['alpha1'].min():.2f}, {st['alpha1'].max():.2f}) deg, random unit normals, a = {HALF_SIZE:g} m, "
           f"shape mix {', '.join(f'{s} {w:g}' for s, w in mix.items())}")
@@ -384,13 +427,19 @@ def main(argv=None) -> int:
     seed_numba_rng(SEED)
     loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
     loop_kernel_nprandom(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
-    U_block = np.empty_like(U)
+    U_block = U.copy()
     loop_block_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), U_block[:m], V_out[:m], W_out[:m], status[:m])
-    loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
-    loop_kernel_predrawn_unscaled(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
+    loop_kernel_views(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
+    for scaled in (True, False):
+        loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m], scaled)
     loop_rng_only(m, seed_state(SEED), np.empty(1))
     loop_bounce(V[:m], nrm[:m], V_out[:m])
-    print(f"  threading layer        {numba.threading_layer()}\n")
+    print(f"  threading layer        {numba.threading_layer()}")
+    table_bytes = sum(x.nbytes for x in data)
+    latency = {"table_bytes": table_bytes, "ns_at_table_size": dependent_load_ns(table_bytes),
+               "ns_at_256kB": dependent_load_ns(256e3)}
+    print(f"  memory latency         {latency['ns_at_table_size']:.1f} ns per dependent read at random over "
+          f"{table_bytes / 1e6:.1f} MB (the table's size), {latency['ns_at_256kB']:.1f} ns over 0.26 MB\n")
 
     header = " ".join(f"{h:{'<' if i == 0 else '>'}{w}}" for i, (h, w, _, _) in enumerate(COLUMNS))
     print(header)
@@ -412,16 +461,18 @@ def main(argv=None) -> int:
     record("a_kernel_1", "    breakdown: rebound_batch alone, 1 thread", 1,
            lambda: rebound_batch(data, cdf, V, nrm, a, U, V_out, W_out, status), note="pre-drawn uniforms")
     trapped_api = float(np.mean(api()[2] != 0))
-    record("b", "(b) rebound in @njit loop, xoshiro256+ uniforms", 1,
+    record("b", "(b) rebound_tuple in @njit loop, xoshiro256+", 1,
            lambda: loop_kernel_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, W_out, status))
+    record("b_views", "    variant: rebound on array rows (views)", 1,
+           lambda: loop_kernel_views(data, cdf, V, nrm, a, seed_state(SEED), V_out, W_out, status))
     record("b_nprandom", "    variant: uniforms from np.random.random()", 1,
            lambda: loop_kernel_nprandom(data, cdf, V, nrm, a, V_out, W_out, status),
            setup=lambda: seed_numba_rng(SEED))
     trapped_b = float(np.mean(status != 0))
-    record("b_predrawn", "(b') rebound in @njit loop, pre-drawn uniforms", 1,
-           lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status))
+    record("b_predrawn", "(b') rebound_tuple in @njit loop, pre-drawn u", 1,
+           lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status, True))
     record("b_unscaled", "    breakdown: (b') without moment scaling", 1,
-           lambda: loop_kernel_predrawn_unscaled(data, cdf, V, nrm, a, U, V_out, W_out, status))
+           lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status, False))
     record("b_block", "(b-block) rebound_many in @njit, xoshiro256+", 1,
            lambda: loop_block_rng(data, cdf, V, nrm, a, seed_state(SEED), U_block, V_out, W_out, status))
     record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
@@ -474,6 +525,7 @@ def main(argv=None) -> int:
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"machine": info, "threading_layer": numba.threading_layer(),
+                       "memory_latency": latency,
                        "settings": {"states": count, "repeats": repeats, "min_time_s": min_time,
                                     "quick": args.quick, "seed": SEED, "half_size_m": HALF_SIZE,
                                     "table": str(path) if args.table else "built",

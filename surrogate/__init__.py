@@ -8,8 +8,9 @@ imports :mod:`tablegen`, so a flow solver installs the runtime alone::
     V_out, Omega_out, status = surrogate.sample_global(table, V, normals, half_size, shape="prism",
                                                        random_state=1)
 
-From numba code, call :func:`surrogate.kernels.rebound` with ``table.kernel_data``
-and ``U_PER_DRAW`` uniforms per call; :func:`surrogate.rng.fill_uniforms` draws
+From numba code, call :func:`surrogate.kernels.rebound_tuple` (or
+:func:`surrogate.kernels.rebound` on arrays) with ``table.kernel_data`` and
+``U_PER_DRAW`` uniforms per call; :func:`surrogate.rng.fill_uniforms` draws
 them fast from a caller-owned xoshiro256+ state (:func:`surrogate.rng.seed_state`).
 A solver that collects its wall hits of a time step should pass them all to
 :func:`surrogate.kernels.rebound_many`, which overlaps their table reads

@@ -24,9 +24,16 @@ state drawn from the neighbour is then moved to the incident state:
   the spin of a rebound of one or two collisions scale with 1 + a(V), the
   normal rebound velocity of a longer one with a(V).
 
-Entry points: :func:`rebound` (one particle, global frame), :func:`rebound_many`
-(many particles, one thread, their table reads overlapped), :func:`rebound_batch`
-(parallel), :func:`draw_local` and :func:`draw_velocity` (local frame).
+Entry points: :func:`rebound_tuple` (one particle, global frame, vectors as
+tuples: the form for a solver's per-hit loop), :func:`rebound` (the same on
+(3,) arrays), :func:`rebound_many` (many particles, one thread, their table
+reads overlapped), :func:`rebound_batch` (parallel), :func:`draw_local` and
+:func:`draw_velocity` (local frame).
+
+The hot path calls no libm function (:mod:`surrogate.trig`,
+:mod:`surrogate.restitution`) and branches only where the outcome is
+predictable (trapped, outside the grid); choices that vary from draw to draw
+(neighbour cell, alias, regime, mirror sign, quadrant) are selects.
 
 Frames and units: the local frame is the model's lab frame (wall y = 0,
 normal +Y, impact plane XY, α1 from the wall); angles in radians except α1
@@ -67,22 +74,22 @@ def locate(grid, lookup, scale, inv_spacing, x):
     k = int((x - scale[0]) * scale[1])
     k = min(max(k, 0), lookup.shape[0] - 1)
     j = lookup[k]
-    if j < n - 2 and x >= grid[j + 1]:
-        j += 1
+    j += (x >= grid[j + 1]) & (j < n - 2)     # the one-step correction, without a branch to mispredict
     w = (x - grid[j]) * inv_spacing[j]
     return j, min(max(w, 0.0), 1.0)
 
 
 @numba.njit(inline="always", **JIT)
-def _residual(row, dic, k, u):
-    """loc + scale · S(u) of chain variable k of a component (its ``row``, its cell's dictionary ``dic``):
-    multiply, floor, linear interpolation."""
-    levels = dic.shape[1] - 1
+def _residual(data, s, ia, iv, c, k, u):
+    """loc + scale · S(u) of chain variable k in component c: multiply, floor, linear interpolation."""
+    rows, dic = data.clusters, data.dictionary
+    levels = dic.shape[4] - 1
     t = u * levels
     i = min(int(t), levels - 1)
-    m = int(row[ROW_SHAPE + k])
-    lo = dic[m, i]
-    return row[ROW_LOC + k] + row[ROW_SCALE + k] * (lo + (t - i) * (dic[m, i + 1] - lo))
+    m = int(rows[s, ia, iv, c, ROW_SHAPE + k])
+    lo = dic[s, ia, iv, m, i]
+    return rows[s, ia, iv, c, ROW_LOC + k] + rows[s, ia, iv, c, ROW_SCALE + k] * (
+        lo + (t - i) * (dic[s, ia, iv, m, i + 1] - lo))
 
 
 @numba.njit(inline="always", **JIT)
@@ -94,30 +101,29 @@ def draw_folded(data, s, ia, iv, u):
     variable k (α2, |β2|, s, Ω_z, Ω_x, Ω_y) is the component's residual quantile
     function at u[5 + k], shifted by the component's slopes on the variables
     already drawn. α2 is reflected into [0, π] and |β2| capped at π/2 (the
-    linear shifts can step outside by a hair, ~1e-4 of draws). The component's
-    row and the cell's dictionary are taken as views once, so every read
-    after that is at a constant offset (the kernels run without reference
-    counting, so views cost nothing).
+    linear shifts can step outside by a hair, ~1e-4 of draws). Arrays are read
+    by scalar indices only (no views, so no reference counting on the hot path).
     """
-    rows = data.clusters[s, ia, iv]
-    n_clusters = rows.shape[0]
+    r = data.clusters
+    n_clusters = r.shape[3]
     t = u[4] * n_clusters
     c = min(int(t), n_clusters - 1)
-    if t - c >= rows[c, ROW_ALIAS_PROB]:
-        c = int(rows[c, ROW_ALIAS])
-    r, dic = rows[c], data.dictionary[s, ia, iv]
+    alias = int(r[s, ia, iv, c, ROW_ALIAS])           # same cache line: read it always, select without a branch
+    c = alias if t - c >= r[s, ia, iv, c, ROW_ALIAS_PROB] else c
     b = ROW_SLOPE      # slopes of x_k on x_j at b + k(k−1)/2 + j
-    x0 = _residual(r, dic, 0, u[5])
-    x1 = _residual(r, dic, 1, u[6]) + r[b] * x0
-    x2 = _residual(r, dic, 2, u[7]) + r[b + 1] * x0 + r[b + 2] * x1
-    x3 = _residual(r, dic, 3, u[8]) + r[b + 3] * x0 + r[b + 4] * x1 + r[b + 5] * x2
-    x4 = _residual(r, dic, 4, u[9]) + r[b + 6] * x0 + r[b + 7] * x1 + r[b + 8] * x2 + r[b + 9] * x3
-    x5 = (_residual(r, dic, 5, u[10]) + r[b + 10] * x0 + r[b + 11] * x1 + r[b + 12] * x2 + r[b + 13] * x3
-          + r[b + 14] * x4)
+    x0 = _residual(data, s, ia, iv, c, 0, u[5])
+    x1 = _residual(data, s, ia, iv, c, 1, u[6]) + r[s, ia, iv, c, b] * x0
+    x2 = _residual(data, s, ia, iv, c, 2, u[7]) + r[s, ia, iv, c, b + 1] * x0 + r[s, ia, iv, c, b + 2] * x1
+    x3 = (_residual(data, s, ia, iv, c, 3, u[8]) + r[s, ia, iv, c, b + 3] * x0 + r[s, ia, iv, c, b + 4] * x1
+          + r[s, ia, iv, c, b + 5] * x2)
+    x4 = (_residual(data, s, ia, iv, c, 4, u[9]) + r[s, ia, iv, c, b + 6] * x0 + r[s, ia, iv, c, b + 7] * x1
+          + r[s, ia, iv, c, b + 8] * x2 + r[s, ia, iv, c, b + 9] * x3)
+    x5 = (_residual(data, s, ia, iv, c, 5, u[10]) + r[s, ia, iv, c, b + 10] * x0 + r[s, ia, iv, c, b + 11] * x1
+          + r[s, ia, iv, c, b + 12] * x2 + r[s, ia, iv, c, b + 13] * x3 + r[s, ia, iv, c, b + 14] * x4)
     alpha2 = abs(x0)
     if alpha2 > math.pi:
         alpha2 = 2.0 * math.pi - alpha2
-    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, r[ROW_REGIME]
+    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, r[s, ia, iv, c, ROW_REGIME]
 
 
 @numba.njit(inline="always", **JIT)
@@ -163,11 +169,13 @@ def _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, 
     """
     a_target = 1.0 - (1.0 - restitution_at(data.restitution_pieces, jv, wv)) * sin_alpha1
     a_grid = 1.0 - (1.0 - data.speed_restitution[iv]) * sin_alpha1
-    if regime == 0.0:
-        f = (1.0 + a_target) / (1.0 + a_grid)
-        return (cos_alpha1 + f * (vx - cos_alpha1), abs(f * (vy + sin_alpha1) - sin_alpha1), f * vz,
-                f * wx, f * wy, f * wz)
-    return vx, vy * (a_target / a_grid), vz, wx, wy, wz
+    # both laws computed, the regime's picked by selects: the regime varies from draw to draw, a branch
+    # on it would be mispredicted often
+    few = regime == 0.0
+    f = (1.0 + a_target) / (1.0 + a_grid) if few else a_target / a_grid
+    g = f if few else 1.0       # factor of the spin and of V⁺ − V⁻ off the normal
+    vx_few, vy_few = cos_alpha1 + f * (vx - cos_alpha1), abs(f * (vy + sin_alpha1) - sin_alpha1)
+    return vx_few if few else vx, vy_few if few else vy * f, g * vz, g * wx, g * wy, g * wz
 
 
 @numba.njit(inline="always", **JIT)
@@ -183,8 +191,8 @@ def _cell(data, mix_cdf, alpha1, speed, u):
         shape += u[0] >= mix_cdf[k]
     ja, wa = locate(data.alpha1_deg, data.alpha1_lookup, data.alpha1_scale, data.alpha1_inv_spacing, alpha1)
     jv, wv = locate(data.speed, data.speed_lookup, data.speed_scale, data.speed_inv_spacing, speed)
-    ia = ja + 1 if u[1] < wa else ja
-    iv = jv + 1 if u[2] < wv else jv
+    ia = ja + (u[1] < wa)       # integer + comparison: no branch to mispredict
+    iv = jv + (u[2] < wv)
     return shape, ja, wa, jv, wv, ia, iv
 
 
@@ -229,9 +237,8 @@ def _draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
     if scaled and wv > 0.0:
         vx, vy, vz, wx, wy, wz = _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv,
                                            vx, vy, vz, wx, wy, wz)
-    if u[11] < 0.5:
-        return STATUS_REBOUNDED, vx, vy, -vz, -wx, -wy, wz
-    return STATUS_REBOUNDED, vx, vy, vz, wx, wy, wz
+    mirror = -1.0 if u[11] < 0.5 else 1.0
+    return STATUS_REBOUNDED, vx, vy, mirror * vz, mirror * wx, mirror * wy, wz
 
 
 @numba.njit(**KERNEL)
@@ -306,13 +313,36 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
     grid uses the law at the nearest grid edge (check ``table.alpha1_range``
     and ``table.speed_range`` beforehand if that matters).
     """
+    status, V_new, W_new = _rebound(data, mix_cdf, V, n, a, u, scaled)
+    _store(V_new, W_new, V_out, W_out)
+    return status
+
+
+@numba.njit(**KERNEL)
+def rebound_tuple(data, mix_cdf, V, n, a, u, scaled=True):
+    """:func:`rebound` returning its outputs: (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as 3-tuples.
+
+    V and n may be 3-tuples or (3,) arrays. For a solver loop over particle
+    arrays, passing ``(V[i, 0], V[i, 1], V[i, 2])`` rather than the row
+    ``V[i]`` creates no array view, so the loop does no reference counting
+    (numba's atomic counts on views cost about 15 ns per call).
+    """
+    return _rebound(data, mix_cdf, V, n, a, u, scaled)
+
+
+NAN3 = (np.nan, np.nan, np.nan)
+
+
+@numba.njit(inline="always", **JIT)
+def _rebound(data, mix_cdf, V, n, a, u, scaled):
+    """:func:`rebound_tuple`."""
     if not _moves_into_wall(V, n):
-        _fill_nan(V_out, W_out)
-        return STATUS_INVALID
+        return STATUS_INVALID, NAN3, NAN3
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
     cell = _cell(data, mix_cdf, alpha1, speed, u)
     status, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
-    return _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez, V_out, W_out)
+    V_new, W_new = _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
+    return status, V_new, W_new
 
 
 @numba.njit(inline="always", **JIT)
@@ -322,24 +352,23 @@ def _moves_into_wall(V, n):
 
 
 @numba.njit(inline="always", **JIT)
-def _fill_nan(V_out, W_out):
+def _store(V_new, W_new, V_out, W_out):
     for k in range(3):
-        V_out[k] = np.nan
-        W_out[k] = np.nan
+        V_out[k] = V_new[k]
+        W_out[k] = W_new[k]
 
 
 @numba.njit(inline="always", **JIT)
-def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez, V_out, W_out):
-    """Write a local draw (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the frame (ex, n, ez); NaN
-    unless rebounded. Returns the status."""
+def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
+    """A local draw (units |V⁻|, |V⁻|/a) as (V⁺ in m/s, Ω⁺ in rad/s) in the frame (ex, n, ez), 3-tuples;
+    NaN unless rebounded."""
     if status != STATUS_REBOUNDED:
-        _fill_nan(V_out, W_out)
-        return status
+        return NAN3, NAN3
     w = speed / a
-    for k in range(3):
-        V_out[k] = speed * (vx * ex[k] + vy * n[k] + vz * ez[k])
-        W_out[k] = w * (wx * ex[k] + wy * n[k] + wz * ez[k])
-    return status
+    return ((speed * (vx * ex[0] + vy * n[0] + vz * ez[0]), speed * (vx * ex[1] + vy * n[1] + vz * ez[1]),
+             speed * (vx * ex[2] + vy * n[2] + vz * ez[2])),
+            (w * (wx * ex[0] + wy * n[0] + wz * ez[0]), w * (wx * ex[1] + wy * n[1] + wz * ez[1]),
+             w * (wx * ex[2] + wy * n[2] + wz * ez[2])))
 
 
 BLOCK = 16      # particles whose table reads rebound_many puts in flight together
@@ -413,7 +442,9 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
             cell = (index[b, 1], index[b, 2], frame[b, 9], index[b, 3], frame[b, 10], index[b, 4], index[b, 5])
             st, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, frame[b, 1], frame[b, 2], u[i], scaled)
             ex, ez = (frame[b, 3], frame[b, 4], frame[b, 5]), (frame[b, 6], frame[b, 7], frame[b, 8])
-            status[i] = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 0], a[i], ex, n[i], ez, V_out[i], W_out[i])
+            V_new, W_new = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 0], a[i], ex, n[i], ez)
+            _store(V_new, W_new, V_out[i], W_out[i])
+            status[i] = st
 
 
 @numba.njit(parallel=True, **JIT)

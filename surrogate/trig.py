@@ -38,14 +38,10 @@ def sincos(x):
     z = r * r
     s = r + r * z * (S3 + z * (S5 + z * (S7 + z * (S9 + z * (S11 + z * (S13 + z * S15))))))
     c = 1.0 + z * (C2 + z * (C4 + z * (C6 + z * (C8 + z * (C10 + z * (C12 + z * (C14 + z * C16)))))))
-    quadrant = int(q) & 3
-    if quadrant == 0:
-        return s, c
-    if quadrant == 1:
-        return c, -s
-    if quadrant == 2:
-        return -s, -c
-    return -c, s
+    quadrant = int(q) & 3       # x = r + quadrant·π/2 (mod 2π); selects, not branches
+    odd = (quadrant & 1) == 1
+    sign = 1.0 - (quadrant & 2)
+    return sign * (c if odd else s), sign * (-s if odd else c)
 
 
 _ATAN_NODES = (0.0, 0.25, 0.5, 0.75, 1.0)

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch, rebound_many
+from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch, rebound_many, rebound_tuple
 from surrogate.table import alias_table
 
 
@@ -215,8 +215,19 @@ def test_callable_from_a_numba_loop(small_table):
     assert np.all(s1 == STATUS_REBOUNDED)
 
 
-def test_block_kernel_gives_the_row_by_row_results(small_table):
-    """rebound_many (table reads of 16 particles issued together) = rebound row by row, bit for bit.
+@numba.njit
+def _tuple_loop(data, cdf, V, n, a, U, V_out, W_out, status):
+    """A solver loop on scalars: rebound_tuple on 3-tuples built from the rows (no array views)."""
+    for i in range(V.shape[0]):
+        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i])
+        for k in range(3):
+            V_out[i, k], W_out[i, k] = V_new[k], W_new[k]
+
+
+def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
+    """rebound_many (table reads of 16 particles issued together) and rebound_tuple (outputs returned,
+    inputs as tuples) = rebound row by row, bit for bit.
 
     1001 rows (not a multiple of the block), normal impacts (trapped draws
     occur there), rows that leave the wall or are NaN (reported invalid).
@@ -238,10 +249,15 @@ def test_block_kernel_gives_the_row_by_row_results(small_table):
         s1[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V1[i], W1[i])
     V2, W2, s2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     rebound_many(data, cdf, V, n, a, U, V2, W2, s2)
-    np.testing.assert_array_equal(s1, s2)
-    np.testing.assert_array_equal(V1, V2)
-    np.testing.assert_array_equal(W1, W2)
+    V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    _tuple_loop(data, cdf, V, n, a, U, V3, W3, s3)
+    for s, V_, W_ in ((s2, V2, W2), (s3, V3, W3)):
+        np.testing.assert_array_equal(s1, s)
+        np.testing.assert_array_equal(V1, V_)
+        np.testing.assert_array_equal(W1, W_)
     assert s1[5] == s1[600] == STATUS_INVALID and np.any(s1 == STATUS_TRAPPED)
+    status, V_new, W_new = rebound_tuple(data, cdf, V[7], n[7], a[7], U[7])     # (3,) arrays work as well
+    assert status == s1[7] and V_new == tuple(V1[7]) and W_new == tuple(W1[7])
 
 
 BAD_GLOBAL = [
