@@ -49,7 +49,7 @@ import numpy as np
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.prefetch import prefetch
 from surrogate.restitution import restitution_at
-from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
+from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SIZE, ROW_SLOPE
 from surrogate.trig import atan2_first_quadrant, sincos
 
 U_PER_DRAW = 13
@@ -87,9 +87,9 @@ def _residual(data, s, ia, iv, c, k, u):
     t = u * levels
     i = min(int(t), levels - 1)
     m = int(rows[s, ia, iv, c, ROW_SHAPE + k])
-    lo = dic[s, ia, iv, m, i]
+    lo = dic[s, ia, iv, k, i, m]
     return rows[s, ia, iv, c, ROW_LOC + k] + rows[s, ia, iv, c, ROW_SCALE + k] * (
-        lo + (t - i) * (dic[s, ia, iv, m, i + 1] - lo))
+        lo + (t - i) * (dic[s, ia, iv, k, i + 1, m] - lo))
 
 
 @numba.njit(inline="always", **JIT)
@@ -211,8 +211,10 @@ def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
     means and standard deviations (:func:`_rescaled`), in |V⁻| by the wall's
     restitution law (:func:`_to_speed`).
     """
+    cell = _cell(data, mix_cdf, alpha1, speed, u)
+    _hint_draw(data, cell, u)
     sin_a1, cos_a1 = sincos(math.radians(alpha1))
-    return _draw_in_cell(data, _cell(data, mix_cdf, alpha1, speed, u), cos_a1, sin_a1, u, scaled)
+    return _draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
 
 
 @numba.njit(inline="always", **JIT)
@@ -340,9 +342,30 @@ def _rebound(data, mix_cdf, V, n, a, u, scaled):
         return STATUS_INVALID, NAN3, NAN3
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
     cell = _cell(data, mix_cdf, alpha1, speed, u)
+    _hint_draw(data, cell, u)
     status, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
     V_new, W_new = _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
     return status, V_new, W_new
+
+
+@numba.njit(inline="always", **JIT)
+def _hint_draw(data, cell, u):
+    """Cache hints (:func:`surrogate.prefetch.prefetch`) for the table reads of a draw in ``cell`` that
+    the uniforms alone locate, so that they are all in flight at once: the component row u[4] picks
+    (before its alias is resolved) and the residual-shape levels u[5:11] pick (the dictionary is
+    level-major, so these lines do not depend on the row). Without them the row and then the
+    dictionary would each wait for memory in turn. (Hints for the small arrays, the trapped
+    probabilities and the moments, measured slower: they stay cached.)"""
+    shape, ia, iv = cell[0], cell[5], cell[6]
+    rows, dic = data.clusters, data.dictionary
+    n_clusters, levels = rows.shape[3], dic.shape[4] - 1
+    c = min(int(u[4] * n_clusters), n_clusters - 1)
+    for j in range(0, ROW_SIZE, 16):   # the three cache lines of a 144-byte row (its start is 16-byte aligned)
+        prefetch(rows, (shape, ia, iv, c, j))
+    for k in range(6):
+        i = min(int(u[5 + k] * levels), levels - 1)
+        prefetch(dic, (shape, ia, iv, k, i, 0))
+        prefetch(dic, (shape, ia, iv, k, i + 1, 0))
 
 
 @numba.njit(inline="always", **JIT)
@@ -372,6 +395,7 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
 
 
 BLOCK = 16      # particles whose table reads rebound_many puts in flight together
+INDEX = 6       # integers per particle in rebound_many's index scratch
 FRAME = 11      # floats per particle in rebound_many's frame scratch
 
 
@@ -380,61 +404,53 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row, one thread, with the table reads of BLOCK particles in flight at once.
 
     Same arguments as :func:`rebound_batch` and the same results, bit for bit,
-    as calling :func:`rebound` row by row. A draw reads the table in three
-    dependent steps (the component's alias entry, then its row, then its
-    residual shapes); one particle at a time, each step waits for memory.
-    Here each step is first issued for a block of particles as cache hints
-    (:func:`surrogate.prefetch.prefetch`), so their memory latencies overlap,
-    and the draws then run on cached data. For a flow solver that collects
-    its wall hits: call this from its ``@njit`` code on the hit arrays.
+    as calling :func:`rebound` row by row. A draw's table reads are located
+    by its uniforms once its cell is known (the component row, the residual
+    levels), except the row the alias table redirects to, which waits for the
+    first row. :func:`rebound` requests them together for one particle; here
+    they are requested for a block of particles (cache hints,
+    :func:`surrogate.prefetch.prefetch`), then the redirected rows, and the
+    draws then run on cached data, so the memory latencies of the whole
+    block overlap. For a flow solver that collects its wall hits: call this
+    from its ``@njit`` code on the hit arrays.
     """
     _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled,
-                    np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, FRAME)))
+                    np.empty((BLOCK, INDEX), dtype=np.int64), np.empty((BLOCK, FRAME)))
 
 
 @numba.njit(**KERNEL)
 def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, index, frame):
-    """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, 7) int64 holds validity, shape, ja,
-    jv, ia, iv and the component of each particle of a block; ``frame`` (BLOCK, FRAME) |V⁻|, cos α1, sin α1, ex, ez, wa, wv."""
-    rows, dic, levels = data.clusters, data.dictionary, data.dictionary.shape[4] - 1
+    """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, INDEX) int64 holds validity, shape,
+    ja, jv, ia, iv of each particle of a block; ``frame`` (BLOCK, FRAME) |V⁻|, cos α1, sin α1, ex, ez, wa,
+    wv."""
+    rows = data.clusters
     n_clusters = rows.shape[3]
     for start in range(0, V.shape[0], BLOCK):
         stop = min(start + BLOCK, V.shape[0])
-        for b in range(stop - start):                 # 1: impact frame, cell, hint the alias entry
+        for b in range(stop - start):                 # 1: impact frame, cell, hint the reads u locates
             i = start + b
             index[b, 0] = _moves_into_wall(V[i], n[i])
             if not index[b, 0]:
                 continue
             alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V[i], n[i], u[i, 12])
-            shape, ja, wa, jv, wv, ia, iv = _cell(data, mix_cdf, alpha1, speed, u[i])
-            c = min(int(u[i, 4] * n_clusters), n_clusters - 1)
-            index[b, 1], index[b, 2], index[b, 3], index[b, 4], index[b, 5], index[b, 6] = shape, ja, jv, ia, iv, c
+            cell = _cell(data, mix_cdf, alpha1, speed, u[i])
+            _hint_draw(data, cell, u[i])
+            shape, ja, wa, jv, wv, ia, iv = cell
+            index[b, 1], index[b, 2], index[b, 3], index[b, 4], index[b, 5] = shape, ja, jv, ia, iv
             frame[b, 0], frame[b, 1], frame[b, 2], frame[b, 9], frame[b, 10] = speed, cos_a1, sin_a1, wa, wv
             frame[b, 3], frame[b, 4], frame[b, 5] = ex
             frame[b, 6], frame[b, 7], frame[b, 8] = ez
-            prefetch(rows, (shape, ia, iv, c, 0))
-            prefetch(data.p_trapped, (shape, ia, iv))
-            prefetch(data.moments, (shape, ja, iv, 0, 0))
-            prefetch(data.moments, (shape, ia, iv, 0, 0))
-            prefetch(data.moments, (shape, min(ja + 1, data.moments.shape[1] - 1), iv, 0, 0))
-        for b in range(stop - start):                 # 2: resolve the alias, hint the row (144 bytes)
+        for b in range(stop - start):                 # 2: where the alias table redirects, hint that row
             if not index[b, 0]:
                 continue
-            shape, ia, iv, c = index[b, 1], index[b, 4], index[b, 5], index[b, 6]
-            if u[start + b, 4] * n_clusters - c >= rows[shape, ia, iv, c, ROW_ALIAS_PROB]:
+            shape, ia, iv = index[b, 1], index[b, 4], index[b, 5]
+            t = u[start + b, 4] * n_clusters
+            c = min(int(t), n_clusters - 1)
+            if t - c >= rows[shape, ia, iv, c, ROW_ALIAS_PROB]:
                 c = int(rows[shape, ia, iv, c, ROW_ALIAS])
-                index[b, 6] = c
-                prefetch(rows, (shape, ia, iv, c, 0))
-            prefetch(rows, (shape, ia, iv, c, ROW_SHAPE))
-            prefetch(rows, (shape, ia, iv, c, ROW_REGIME))
-        for b in range(stop - start):                 # 3: hint the residual shapes at the drawn levels
-            if not index[b, 0]:
-                continue
-            shape, ia, iv, c = index[b, 1], index[b, 4], index[b, 5], index[b, 6]
-            for k in range(6):
-                level = min(int(u[start + b, 5 + k] * levels), levels - 1)
-                prefetch(dic, (shape, ia, iv, int(rows[shape, ia, iv, c, ROW_SHAPE + k]), level))
-        for b in range(stop - start):                 # 4: the draws, on cached data
+                for j in range(0, ROW_SIZE, 16):
+                    prefetch(rows, (shape, ia, iv, c, j))
+        for b in range(stop - start):                 # 3: the draws, on cached data
             i = start + b
             if not index[b, 0]:
                 status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
@@ -454,7 +470,7 @@ def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     for j in numba.prange((V.shape[0] + chunk - 1) // chunk):
         lo, hi = j * chunk, min((j + 1) * chunk, V.shape[0])
         _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u[lo:hi], V_out[lo:hi], W_out[lo:hi],
-                        status[lo:hi], scaled, np.empty((BLOCK, 7), dtype=np.int64), np.empty((BLOCK, FRAME)))
+                        status[lo:hi], scaled, np.empty((BLOCK, INDEX), dtype=np.int64), np.empty((BLOCK, FRAME)))
 
 
 @numba.njit(parallel=True, **JIT)

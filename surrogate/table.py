@@ -32,7 +32,7 @@ class KernelData(NamedTuple):
     speed_inv_spacing: np.ndarray
     p_trapped: np.ndarray      # (n_shape, n_alpha, n_speed)
     clusters: np.ndarray       # (n_shape, n_alpha, n_speed, C, ROW_SIZE) float32, one row per component
-    dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6·M, L + 1) float32 residual shapes
+    dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6, L + 1, M) float32 residual shapes, level-major
     moments: np.ndarray        # (n_shape, n_alpha, n_speed, 3, 6) mean, sd, 1/sd (0 if sd = 0) of (α2, β2, s, Ω_x, Ω_y, Ω_z)
     speed_restitution: np.ndarray  # (n_speed,) the wall's normal restitution factor exp(−k V^p) at the grid speeds
     restitution_pieces: np.ndarray  # (max(n_speed − 1, 1), S, D + 1) exp(−k V^p) between them (surrogate.restitution)
@@ -44,7 +44,7 @@ ROW_ALIAS_PROB = 0    # Walker alias table: keep the component if the fractional
 ROW_ALIAS = 1         # ... else use this component
 ROW_LOC = 2           # 6 locations (chain order)
 ROW_SCALE = 8         # 6 scales
-ROW_SHAPE = 14        # 6 rows of KernelData.dictionary (k·M + shape index)
+ROW_SHAPE = 14        # 6 residual shape indices m (KernelData.dictionary[..., k, :, m])
 ROW_SLOPE = 20        # 15 slopes, x_k on x_j at k(k−1)/2 + j
 ROW_REGIME = 35       # collision regime: 0 = at most FEW_COLLISIONS collisions, 1 = more
 ROW_SIZE = 36
@@ -92,21 +92,37 @@ def alias_table(weights: np.ndarray):
 
 
 def kernel_rows(cells: dict) -> tuple:
-    """The cell arrays of a table rearranged for the kernels: (clusters, dictionary), see :class:`KernelData`."""
+    """The cell arrays of a table rearranged for the kernels: (clusters, dictionary), see :class:`KernelData`.
+
+    The dictionary is stored level-major, S_k,m(i/L) at [..., k, i, m]: the M
+    shapes' values at one level are contiguous (one cache line for M = 16),
+    so the lines a draw reads are located by its uniforms alone, before the
+    component row that names m arrives, and can be requested together with
+    that row (:func:`surrogate.kernels.rebound`). Both arrays start on a
+    64-byte cache line, so a 144-byte row spans exactly three lines.
+    """
     weight = cells["cluster_weight"]
     lead = weight.shape[:3]
     n_clusters = weight.shape[3]
     dic = cells["shape_dictionary"]
-    size = dic.shape[4]
     rows = np.empty(lead + (n_clusters, ROW_SIZE), dtype=np.float32)
     for cell in np.ndindex(*lead):
         rows[cell + (slice(None), ROW_ALIAS_PROB)], rows[cell + (slice(None), ROW_ALIAS)] = alias_table(weight[cell])
     rows[..., ROW_LOC:ROW_LOC + N_CHAIN] = cells["cluster_loc"]
     rows[..., ROW_SCALE:ROW_SCALE + N_CHAIN] = cells["cluster_scale"]
-    rows[..., ROW_SHAPE:ROW_SHAPE + N_CHAIN] = np.arange(N_CHAIN) * size + cells["cluster_shape"]
+    rows[..., ROW_SHAPE:ROW_SHAPE + N_CHAIN] = cells["cluster_shape"]
     rows[..., ROW_SLOPE:ROW_SLOPE + N_SLOPES] = cells["cluster_slope"]
     rows[..., ROW_REGIME] = cells["cluster_regime"]
-    return rows, dic.reshape(lead + (N_CHAIN * size, dic.shape[5]))
+    return _aligned_copy(rows), _aligned_copy(np.swapaxes(dic, -1, -2))
+
+
+def _aligned_copy(a: np.ndarray, alignment: int = 64) -> np.ndarray:
+    """A C-contiguous copy of ``a`` that starts at a multiple of ``alignment`` bytes (a cache line)."""
+    buffer = np.empty(a.nbytes + alignment, dtype=np.uint8)
+    offset = -buffer.ctypes.data % alignment
+    out = buffer[offset:offset + a.nbytes].view(a.dtype).reshape(a.shape)
+    out[...] = a
+    return out
 
 
 def moments(mean: np.ndarray, std: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
 from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch, rebound_many, rebound_tuple
-from surrogate.table import alias_table
+from surrogate.table import ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
 
 def test_runtime_does_not_import_tablegen():
@@ -25,6 +25,21 @@ def test_loaded_table_is_immutable(small_table):
     with pytest.raises(ValueError):
         small_table.kernel_data.clusters[0, 0, 0, 0, 0] = 1.0
     assert all(a.flags.c_contiguous for a in small_table.kernel_data)
+
+
+def test_kernel_arrays_hold_the_file_s_law(small_table_path, small_table):
+    """The kernel layout is the file's cells rearranged: the dictionary level-major (S_k,m(i/L) at
+    [..., k, i, m]), each row's residual shape indices m, location, scale and slopes; both large arrays
+    start on a 64-byte cache line."""
+    from data_schema.table import read_table
+    cells = read_table(small_table_path).cells
+    data = small_table.kernel_data
+    np.testing.assert_array_equal(data.dictionary, np.swapaxes(cells["shape_dictionary"], -1, -2))
+    np.testing.assert_array_equal(data.clusters[..., ROW_SHAPE:ROW_SHAPE + 6], cells["cluster_shape"])
+    np.testing.assert_array_equal(data.clusters[..., ROW_LOC:ROW_LOC + 6], cells["cluster_loc"])
+    np.testing.assert_array_equal(data.clusters[..., ROW_SCALE:ROW_SCALE + 6], cells["cluster_scale"])
+    np.testing.assert_array_equal(data.clusters[..., ROW_SLOPE:ROW_SLOPE + 15], cells["cluster_slope"])
+    assert data.dictionary.ctypes.data % 64 == 0 and data.clusters.ctypes.data % 64 == 0
 
 
 @pytest.mark.parametrize("weights", [[0.25, 0.25, 0.25, 0.25], [0.7, 0.0, 0.2, 0.1, 0.0], [1.0, 0.0, 0.0],
