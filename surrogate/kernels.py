@@ -47,6 +47,7 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
+from surrogate.fused import fma
 from surrogate.prefetch import prefetch
 from surrogate.restitution import restitution_at
 from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SIZE, ROW_SLOPE
@@ -88,8 +89,14 @@ def _residual(data, s, ia, iv, c, k, u):
     i = min(int(t), levels - 1)
     m = int(rows[s, ia, iv, c, ROW_SHAPE + k])
     lo = dic[s, ia, iv, k, i, m]
-    return rows[s, ia, iv, c, ROW_LOC + k] + rows[s, ia, iv, c, ROW_SCALE + k] * (
-        lo + (t - i) * (dic[s, ia, iv, k, i + 1, m] - lo))
+    quantile = fma(t - i, dic[s, ia, iv, k, i + 1, m] - lo, lo)
+    return fma(rows[s, ia, iv, c, ROW_SCALE + k], quantile, rows[s, ia, iv, c, ROW_LOC + k])
+
+
+@numba.njit(inline="always", **JIT)
+def _slope(rows, row, j):
+    """Entry j of the 15 slopes (x_k on x_i at k(k−1)/2 + i) of the component ``row`` = (shape, ia, iv, c)."""
+    return rows[row[0], row[1], row[2], row[3], ROW_SLOPE + j]
 
 
 @numba.njit(inline="always", **JIT)
@@ -110,16 +117,17 @@ def draw_folded(data, s, ia, iv, u):
     c = min(int(t), n_clusters - 1)
     alias = int(r[s, ia, iv, c, ROW_ALIAS])           # same cache line: read it always, select without a branch
     c = alias if t - c >= r[s, ia, iv, c, ROW_ALIAS_PROB] else c
-    b = ROW_SLOPE      # slopes of x_k on x_j at b + k(k−1)/2 + j
+    # each x_k gathers its terms in the order the x_i become available: one fused multiply-add after x_{k−1}
     x0 = _residual(data, s, ia, iv, c, 0, u[5])
-    x1 = _residual(data, s, ia, iv, c, 1, u[6]) + r[s, ia, iv, c, b] * x0
-    x2 = _residual(data, s, ia, iv, c, 2, u[7]) + r[s, ia, iv, c, b + 1] * x0 + r[s, ia, iv, c, b + 2] * x1
-    x3 = (_residual(data, s, ia, iv, c, 3, u[8]) + r[s, ia, iv, c, b + 3] * x0 + r[s, ia, iv, c, b + 4] * x1
-          + r[s, ia, iv, c, b + 5] * x2)
-    x4 = (_residual(data, s, ia, iv, c, 4, u[9]) + r[s, ia, iv, c, b + 6] * x0 + r[s, ia, iv, c, b + 7] * x1
-          + r[s, ia, iv, c, b + 8] * x2 + r[s, ia, iv, c, b + 9] * x3)
-    x5 = (_residual(data, s, ia, iv, c, 5, u[10]) + r[s, ia, iv, c, b + 10] * x0 + r[s, ia, iv, c, b + 11] * x1
-          + r[s, ia, iv, c, b + 12] * x2 + r[s, ia, iv, c, b + 13] * x3 + r[s, ia, iv, c, b + 14] * x4)
+    row = (s, ia, iv, c)
+    x1 = fma(_slope(r, row, 0), x0, _residual(data, s, ia, iv, c, 1, u[6]))
+    x2 = fma(_slope(r, row, 2), x1, fma(_slope(r, row, 1), x0, _residual(data, s, ia, iv, c, 2, u[7])))
+    x3 = fma(_slope(r, row, 5), x2, fma(_slope(r, row, 4), x1, fma(_slope(r, row, 3), x0,
+                                                                   _residual(data, s, ia, iv, c, 3, u[8]))))
+    x4 = fma(_slope(r, row, 9), x3, fma(_slope(r, row, 8), x2, fma(_slope(r, row, 7), x1, fma(
+        _slope(r, row, 6), x0, _residual(data, s, ia, iv, c, 4, u[9])))))
+    x5 = fma(_slope(r, row, 14), x4, fma(_slope(r, row, 13), x3, fma(_slope(r, row, 12), x2, fma(
+        _slope(r, row, 11), x1, fma(_slope(r, row, 10), x0, _residual(data, s, ia, iv, c, 5, u[10]))))))
     alpha2 = abs(x0)
     if alpha2 > math.pi:
         alpha2 = 2.0 * math.pi - alpha2
@@ -135,13 +143,13 @@ def _rescaled(data, shape, ja, ja1, wa, ia, iv, k, x, centred):
     variables (β2, Ω_x, Ω_y: mean 0 by the mirror symmetry) are only scaled.
     """
     mo = data.moments
-    sd = (1.0 - wa) * mo[shape, ja, iv, 1, k] + wa * mo[shape, ja1, iv, 1, k]
+    sd = fma(wa, mo[shape, ja1, iv, 1, k], (1.0 - wa) * mo[shape, ja, iv, 1, k])
     inv_sd_cell = mo[shape, ia, iv, 2, k]
     ratio = sd * inv_sd_cell if inv_sd_cell > 0.0 else 1.0
     if centred:
         return x * ratio
-    mean = (1.0 - wa) * mo[shape, ja, iv, 0, k] + wa * mo[shape, ja1, iv, 0, k]
-    return mean + (x - mo[shape, ia, iv, 0, k]) * ratio
+    mean = fma(wa, mo[shape, ja1, iv, 0, k], (1.0 - wa) * mo[shape, ja, iv, 0, k])
+    return fma(x - mo[shape, ia, iv, 0, k], ratio, mean)
 
 
 @numba.njit(inline="always", **JIT)
@@ -174,7 +182,7 @@ def _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, 
     few = regime == 0.0
     f = (1.0 + a_target) / (1.0 + a_grid) if few else a_target / a_grid
     g = f if few else 1.0       # factor of the spin and of V⁺ − V⁻ off the normal
-    vx_few, vy_few = cos_alpha1 + f * (vx - cos_alpha1), abs(f * (vy + sin_alpha1) - sin_alpha1)
+    vx_few, vy_few = fma(f, vx - cos_alpha1, cos_alpha1), abs(fma(f, vy + sin_alpha1, -sin_alpha1))
     return vx_few if few else vx, vy_few if few else vy * f, g * vz, g * wx, g * wy, g * wz
 
 
@@ -235,7 +243,8 @@ def _draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
         wz = _rescaled(data, shape, ja, ja1, wa, ia, iv, 5, wz, False)
     sb, cb = sincos(beta2)
     sa, ca = sincos(alpha2)
-    vx, vy, vz = s * cb * ca, s * cb * sa, s * sb
+    scb = s * cb
+    vx, vy, vz = scb * ca, scb * sa, s * sb
     if scaled and wv > 0.0:
         vx, vy, vz, wx, wy, wz = _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv,
                                            vx, vy, vz, wx, wy, wz)
@@ -266,10 +275,10 @@ def impact_frame(V, n, u_axis):
     frame is (ex, n, ez = ex × n). Returns (α1 in degrees, |V|, cos α1, sin α1,
     ex, ez) with ex and ez as 3-tuples.
     """
-    vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
-    tx, ty, tz = V[0] - vn * n[0], V[1] - vn * n[1], V[2] - vn * n[2]
-    vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-    speed = math.sqrt(vn * vn + vt * vt)
+    vn = _dot(V, n)
+    tx, ty, tz = fma(-vn, n[0], V[0]), fma(-vn, n[1], V[1]), fma(-vn, n[2], V[2])
+    vt = math.sqrt(fma(tx, tx, fma(ty, ty, tz * tz)))
+    speed = math.sqrt(fma(vn, vn, vt * vt))
     if vt > 1e-12 * speed:
         inv = 1.0 / vt
         ex0, ex1, ex2 = tx * inv, ty * inv, tz * inv
@@ -371,7 +380,13 @@ def _hint_draw(data, cell, u):
 @numba.njit(inline="always", **JIT)
 def _moves_into_wall(V, n):
     """V·n < 0 and V finite."""
-    return V[0] * n[0] + V[1] * n[1] + V[2] * n[2] < 0.0 and math.isfinite(V[0] + V[1] + V[2])
+    return _dot(V, n) < 0.0 and math.isfinite(V[0] + V[1] + V[2])
+
+
+@numba.njit(inline="always", **JIT)
+def _dot(a, b):
+    """a·b of two 3-vectors (tuples or arrays), the same bits wherever it is inlined."""
+    return fma(a[0], b[0], fma(a[1], b[1], a[2] * b[2]))
 
 
 @numba.njit(inline="always", **JIT)
@@ -388,10 +403,10 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
     if status != STATUS_REBOUNDED:
         return NAN3, NAN3
     w = speed / a
-    return ((speed * (vx * ex[0] + vy * n[0] + vz * ez[0]), speed * (vx * ex[1] + vy * n[1] + vz * ez[1]),
-             speed * (vx * ex[2] + vy * n[2] + vz * ez[2])),
-            (w * (wx * ex[0] + wy * n[0] + wz * ez[0]), w * (wx * ex[1] + wy * n[1] + wz * ez[1]),
-             w * (wx * ex[2] + wy * n[2] + wz * ez[2])))
+    v, o = (vx, vy, vz), (wx, wy, wz)
+    return ((speed * _dot(v, (ex[0], n[0], ez[0])), speed * _dot(v, (ex[1], n[1], ez[1])),
+             speed * _dot(v, (ex[2], n[2], ez[2]))),
+            (w * _dot(o, (ex[0], n[0], ez[0])), w * _dot(o, (ex[1], n[1], ez[1])), w * _dot(o, (ex[2], n[2], ez[2]))))
 
 
 BLOCK = 16      # particles whose table reads rebound_many puts in flight together

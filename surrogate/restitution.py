@@ -23,6 +23,8 @@ import numba
 import numpy as np
 from numpy.polynomial import chebyshev
 
+from surrogate.fused import fma
+
 DEGREE = 9          # polynomial degree of a piece
 PIECE_RATIO = 1.25  # a piece [V_lo, V_hi] has V_hi ≤ PIECE_RATIO · V_lo
 
@@ -58,8 +60,7 @@ def restitution_at(pieces, j, w):
     t = w * n_pieces
     i = min(int(t), n_pieces - 1)
     x = 2.0 * (t - i) - 1.0
-    c = pieces[j, i]
-    value = c[DEGREE]
+    value = pieces[j, i, DEGREE]
     for d in range(DEGREE - 1, -1, -1):
-        value = value * x + c[d]
+        value = fma(value, x, pieces[j, i, d])
     return value

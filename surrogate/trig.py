@@ -22,10 +22,13 @@ import math
 
 import numba
 
+from surrogate.fused import fma
+
 _HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double
 _HALF_PI_LO = 6.123233995736766e-17    # π/2 − _HALF_PI_HI
 _TWO_OVER_PI = 2.0 / math.pi
 # Taylor coefficients (−1)^k / n!: sin r = r + r³ S3 + ... + r¹⁵ S15, cos r = 1 + r² C2 + ... + r¹⁶ C16
+# (Horner steps as fused multiply-adds, surrogate.fused)
 S3, S5, S7, S9, S11, S13, S15 = ((-1.0) ** k / math.factorial(2 * k + 1) for k in range(1, 8))
 C2, C4, C6, C8, C10, C12, C14, C16 = ((-1.0) ** k / math.factorial(2 * k) for k in range(1, 9))
 
@@ -36,8 +39,10 @@ def sincos(x):
     q = math.floor(x * _TWO_OVER_PI + 0.5)
     r = (x - q * _HALF_PI_HI) - q * _HALF_PI_LO
     z = r * r
-    s = r + r * z * (S3 + z * (S5 + z * (S7 + z * (S9 + z * (S11 + z * (S13 + z * S15))))))
-    c = 1.0 + z * (C2 + z * (C4 + z * (C6 + z * (C8 + z * (C10 + z * (C12 + z * (C14 + z * C16)))))))
+    p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, S15, S13), S11), S9), S7), S5), S3)
+    s = fma(r * z, p, r)
+    p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, C16, C14), C12), C10), C8), C6), C4), C2)
+    c = fma(z, p, 1.0)
     quadrant = int(q) & 3       # x = r + quadrant·π/2 (mod 2π); selects, not branches
     odd = (quadrant & 1) == 1
     sign = 1.0 - (quadrant & 2)
@@ -56,9 +61,10 @@ def atan2_first_quadrant(y, x):
     # the node c nearest to t = lo/hi, chosen without dividing (midpoints 1/8, 3/8, 5/8, 7/8)
     node = (lo > 0.125 * hi) + (lo > 0.375 * hi) + (lo > 0.625 * hi) + (lo > 0.875 * hi)
     c = _ATAN_NODES[node]
-    z = (lo - c * hi) / (hi + c * lo)
+    z = fma(-c, hi, lo) / fma(c, lo, hi)
     w = z * z
-    atan_z = z - z * w * (1.0 / 3.0 - w * (1.0 / 5.0 - w * (1.0 / 7.0 - w * (1.0 / 9.0 - w * (
-        1.0 / 11.0 - w * (1.0 / 13.0 - w * (1.0 / 15.0 - w * (1.0 / 17.0))))))))
+    p = fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, -1.0 / 17.0, 1.0 / 15.0), -1.0 / 13.0), 1.0 / 11.0),
+                                 -1.0 / 9.0), 1.0 / 7.0), -1.0 / 5.0), 1.0 / 3.0)
+    atan_z = fma(-z * w, p, z)
     angle = _ATAN_AT_NODES[node] + atan_z
     return 0.5 * math.pi - angle if swap else angle

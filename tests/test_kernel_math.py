@@ -1,5 +1,5 @@
-"""The sampler kernels' inlined functions against their closed forms: sincos, first-quadrant atan2, and the
-polynomial pieces of the wall's restitution factor exp(−k V^p)."""
+"""The sampler kernels' inlined functions against their closed forms: the fused multiply-add, sincos,
+first-quadrant atan2, and the polynomial pieces of the wall's restitution factor exp(−k V^p)."""
 
 import math
 
@@ -7,6 +7,7 @@ import numba
 import numpy as np
 import pytest
 
+from surrogate.fused import fma
 from surrogate.restitution import restitution_at, restitution_pieces
 from surrogate.trig import atan2_first_quadrant, sincos
 
@@ -29,6 +30,20 @@ def _atan2_all(y, x, out):
 def _restitution_all(pieces, j, w, out):
     for i in range(w.shape[0]):
         out[i] = restitution_at(pieces, j[i], w[i])
+
+
+@numba.njit
+def _fma(a, b, c):
+    return fma(a, b, c)
+
+
+def test_fma_rounds_once():
+    """(1 + 2⁻³⁰)(1 − 2⁻³⁰) − 1 = −2⁻⁶⁰ exactly; a multiply then an add rounds the product to 1 and gives 0.
+    float32 arguments are widened exactly."""
+    a, b = 1.0 + 2.0 ** -30, 1.0 - 2.0 ** -30
+    assert a * b - 1.0 == 0.0
+    assert _fma(a, b, -1.0) == -(2.0 ** -60)
+    assert _fma(np.float32(0.1), np.float32(3.0), 0.5) == float(np.float32(0.1)) * 3.0 + 0.5
 
 
 def test_sincos_matches_libm_on_its_domain():
