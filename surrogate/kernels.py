@@ -336,19 +336,19 @@ def rebound_tuple(data, mix_cdf, V, n, a, u, scaled=True):
     V and n may be 3-tuples or (3,) arrays. For a solver loop over particle
     arrays, passing ``(V[i, 0], V[i, 1], V[i, 2])`` rather than the row
     ``V[i]`` creates no array view, so the loop does no reference counting
-    (numba's atomic counts on views cost about 15 ns per call).
+    (numba's atomic counts on views cost tens of ns per call: bench_sampler.py, (b) and its variant).
     """
     return _rebound(data, mix_cdf, V, n, a, u, scaled)
 
 
-NAN3 = (np.nan, np.nan, np.nan)
+_NAN3 = (np.nan, np.nan, np.nan)     # the V⁺ and Ω⁺ of a draw that did not rebound
 
 
 @numba.njit(inline="always", **JIT)
 def _rebound(data, mix_cdf, V, n, a, u, scaled):
     """:func:`rebound_tuple`."""
     if not _moves_into_wall(V, n):
-        return STATUS_INVALID, NAN3, NAN3
+        return STATUS_INVALID, _NAN3, _NAN3
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
     cell = _cell(data, mix_cdf, alpha1, speed, u)
     _hint_draw(data, cell, u)
@@ -401,7 +401,7 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
     """A local draw (units |V⁻|, |V⁻|/a) as (V⁺ in m/s, Ω⁺ in rad/s) in the frame (ex, n, ez), 3-tuples;
     NaN unless rebounded."""
     if status != STATUS_REBOUNDED:
-        return NAN3, NAN3
+        return _NAN3, _NAN3
     w = speed / a
     v, o = (vx, vy, vz), (wx, wy, wz)
     return ((speed * _dot(v, (ex[0], n[0], ez[0])), speed * _dot(v, (ex[1], n[1], ez[1])),
