@@ -49,9 +49,8 @@ def _rotl(x, k):
 
 
 @numba.njit(inline="always", cache=True, nogil=True)
-def next_uniform(state):
-    """The next uniform in [0, 1) (53 bits) from a xoshiro256+ ``state`` (4,) uint64, updated in place."""
-    s0, s1, s2, s3 = state[0], state[1], state[2], state[3]
+def _step(s0, s1, s2, s3):
+    """One xoshiro256+ step on the state words: (uniform in [0, 1) with 53 bits, s0, s1, s2, s3)."""
     result = s0 + s3
     t = s1 << np.uint64(17)
     s2 ^= s0
@@ -60,12 +59,25 @@ def next_uniform(state):
     s0 ^= s3
     s2 ^= t
     s3 = _rotl(s3, 45)
-    state[0], state[1], state[2], state[3] = s0, s1, s2, s3
-    return float(result >> np.uint64(11)) * _53_BITS
+    return float(result >> np.uint64(11)) * _53_BITS, s0, s1, s2, s3
+
+
+@numba.njit(inline="always", cache=True, nogil=True)
+def next_uniform(state):
+    """The next uniform in [0, 1) (53 bits) from a xoshiro256+ ``state`` (4,) uint64, updated in place."""
+    x, state[0], state[1], state[2], state[3] = _step(state[0], state[1], state[2], state[3])
+    return x
 
 
 @numba.njit(inline="always", cache=True, nogil=True)
 def fill_uniforms(state, u):
-    """u[:] = the next len(u) uniforms of ``state`` (see :func:`next_uniform`)."""
+    """u[:] = the next len(u) uniforms of ``state`` (see :func:`next_uniform`).
+
+    The state words stay in registers for the whole fill and are stored once
+    at the end (stepping ``state`` in place per uniform would store and reload
+    them each time: the compiler cannot tell that u and state do not overlap).
+    """
+    s0, s1, s2, s3 = state[0], state[1], state[2], state[3]
     for k in range(u.shape[0]):
-        u[k] = next_uniform(state)
+        u[k], s0, s1, s2, s3 = _step(s0, s1, s2, s3)
+    state[0], state[1], state[2], state[3] = s0, s1, s2, s3

@@ -48,6 +48,9 @@ def test_fill_uniforms_continues_the_stream():
     u = np.empty(13)
     fill_uniforms(a, u)
     np.testing.assert_array_equal(u, _draw(b, 13))
+    np.testing.assert_array_equal(a, b)      # the state moved on by exactly 13 steps
+    fill_uniforms(a, u)
+    np.testing.assert_array_equal(u, _draw(b, 13))
 
 
 def test_uniform_on_the_unit_interval():
