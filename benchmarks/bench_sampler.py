@@ -404,7 +404,7 @@ def main(argv=None) -> int:
     print(f"  table                  {'built in %.1f s' % build_s if build_s is not None else path}: "
           f"shapes {', '.join(table.shapes)}; alpha1 [{', '.join(f'{x:g}' for x in table.alpha1_deg)}] deg; "
           f"speed [{', '.join(f'{x:g}' for x in table.speed_m_s)}] m/s; {table.particles_per_cell} particles per cell; "
-          f"{sum(x.nbytes for x in table.kernel_data) / 1e6:.1f} MB of kernel arrays")
+          f"{table.kernel_data.nbytes / 1e6:.1f} MB of kernel arrays")
     missing = [s for s in SHAPES if s not in table.shapes]
     if missing:
         raise SystemExit(f"the table lacks shapes {missing}; the bench draws the equal mix of all four")
@@ -437,7 +437,7 @@ def main(argv=None) -> int:
     loop_rng_only(m, seed_state(SEED), np.empty(1))
     loop_bounce(V[:m], nrm[:m], V_out[:m])
     print(f"  threading layer        {numba.threading_layer()}")
-    table_bytes = sum(x.nbytes for x in data)
+    table_bytes = data.nbytes
     latency = {"table_bytes": table_bytes, "ns_at_table_size": dependent_load_ns(table_bytes),
                "ns_at_256kB": dependent_load_ns(256e3)}
     print(f"  memory latency         {latency['ns_at_table_size']:.1f} ns per dependent read at random over "

@@ -1,7 +1,7 @@
 """Numba kernels of the runtime sampler: O(1) work per reflected state.
 
 These are plain functions over the arrays of a table (``table.kernel_data``, a
-named tuple of arrays) and pre-drawn uniforms, so a flow solver can call them
+named tuple of flat arrays and their sizes) and pre-drawn uniforms, so a flow solver can call them
 from its own ``@njit`` loop. Every draw consumes exactly :data:`U_PER_DRAW`
 uniforms from [0, 1)::
 
@@ -48,9 +48,11 @@ import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.fused import fma
-from surrogate.prefetch import prefetch
+from surrogate.memory import load, prefetch
 from surrogate.restitution import restitution_at
-from surrogate.table import ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SIZE, ROW_SLOPE
+from surrogate.table import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD,
+                             CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE,
+                             ROW_SIZE, ROW_SLOPE)
 from surrogate.trig import atan2_first_quadrant, sincos
 
 U_PER_DRAW = 13
@@ -64,92 +66,106 @@ KERNEL = dict(JIT, _nrt=False)
 
 
 @numba.njit(inline="always", **JIT)
-def locate(grid, lookup, scale, inv_spacing, x):
+def locate(axis, n, x):
     """(j, w): grid interval [g_j, g_{j+1}] holding x and the weight of g_{j+1} (O(1)).
 
+    ``axis`` is the record of an n-point grid (:func:`surrogate.table.axis_record`).
     Outside the grid, the nearest edge with weight 0 or 1; a one-point grid gives (0, 0).
     """
-    n = grid.shape[0]
     if n == 1:
         return 0, 0.0
-    k = int((x - scale[0]) * scale[1])
-    k = min(max(k, 0), lookup.shape[0] - 1)
-    j = lookup[k]
-    j += (x >= grid[j + 1]) & (j < n - 2)     # the one-step correction, without a branch to mispredict
-    w = (x - grid[j]) * inv_spacing[j]
+    inverse = AXIS_GRID + n     # where the inverse spacings start
+    lookup = inverse + n - 1    # where the look-up indices start
+    k = int((x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP))
+    k = min(max(k, 0), axis.shape[0] - 1 - lookup)
+    j = int(load(axis, lookup + k))
+    j += (x >= load(axis, AXIS_GRID + j + 1)) & (j < n - 2)     # the one-step correction, without a branch to mispredict
+    w = (x - load(axis, AXIS_GRID + j)) * load(axis, inverse + j)
     return j, min(max(w, 0.0), 1.0)
 
 
 @numba.njit(inline="always", **JIT)
-def _residual(data, s, ia, iv, c, k, u):
-    """loc + scale · S(u) of chain variable k in component c: multiply, floor, linear interpolation."""
+def _row(data, cell, c):
+    """Offset in ``data.clusters`` of component c's row in cell number ``cell``."""
+    return (cell * data.n_clusters + c) * ROW_SIZE
+
+
+@numba.njit(inline="always", **JIT)
+def _level(data, cell, k, i):
+    """Offset in ``data.dictionary`` of level i of chain variable k's residual shapes in cell number ``cell``
+    (the n_dictionary shapes follow)."""
+    return ((cell * 6 + k) * data.n_levels + i) * data.n_dictionary
+
+
+@numba.njit(inline="always", **JIT)
+def _residual(data, cell, row, k, u):
+    """loc + scale · S(u) of chain variable k in the component at offset ``row`` of cell number ``cell``:
+    multiply, floor, linear interpolation."""
     rows, dic = data.clusters, data.dictionary
-    levels = dic.shape[4] - 1
+    levels = data.n_levels - 1
     t = u * levels
     i = min(int(t), levels - 1)
-    m = int(rows[s, ia, iv, c, ROW_SHAPE + k])
-    lo = dic[s, ia, iv, k, i, m]
-    quantile = fma(t - i, dic[s, ia, iv, k, i + 1, m] - lo, lo)
-    return fma(rows[s, ia, iv, c, ROW_SCALE + k], quantile, rows[s, ia, iv, c, ROW_LOC + k])
+    at = _level(data, cell, k, i) + int(load(rows, row + ROW_SHAPE + k))
+    lo = load(dic, at)
+    quantile = fma(t - i, load(dic, at + data.n_dictionary) - lo, lo)
+    return fma(load(rows, row + ROW_SCALE + k), quantile, load(rows, row + ROW_LOC + k))
 
 
 @numba.njit(inline="always", **JIT)
-def _slope(rows, row, j):
-    """Entry j of the 15 slopes (x_k on x_i at k(k−1)/2 + i) of the component ``row`` = (shape, ia, iv, c)."""
-    return rows[row[0], row[1], row[2], row[3], ROW_SLOPE + j]
-
-
-@numba.njit(inline="always", **JIT)
-def draw_folded(data, s, ia, iv, u):
-    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell (s, ia, iv) from u[4:11], and its cluster's regime.
+def draw_folded(data, cell, u):
+    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell number ``cell`` from u[4:11], and its cluster's regime.
 
     Representation (data_schema.table): u[4] picks the mixture component c with
     the Walker alias table (one multiply, one floor, one compare); then chain
     variable k (α2, |β2|, s, Ω_z, Ω_x, Ω_y) is the component's residual quantile
     function at u[5 + k], shifted by the component's slopes on the variables
-    already drawn. α2 is reflected into [0, π] and |β2| capped at π/2 (the
-    linear shifts can step outside by a hair, ~1e-4 of draws). Arrays are read
-    by scalar indices only (no views, so no reference counting on the hot path).
+    already drawn (x_k on x_i at ROW_SLOPE + k(k−1)/2 + i). α2 is reflected
+    into [0, π] and |β2| capped at π/2 (the linear shifts can step outside by
+    a hair, ~1e-4 of draws). Arrays are read by scalar indices only (no views,
+    so no reference counting on the hot path).
     """
     r = data.clusters
-    n_clusters = r.shape[3]
+    n_clusters = data.n_clusters
     t = u[4] * n_clusters
     c = min(int(t), n_clusters - 1)
-    alias = int(r[s, ia, iv, c, ROW_ALIAS])           # same cache line: read it always, select without a branch
-    c = alias if t - c >= r[s, ia, iv, c, ROW_ALIAS_PROB] else c
+    row = _row(data, cell, c)
+    alias = int(load(r, row + ROW_ALIAS))           # same cache line: read it always, select without a branch
+    c = alias if t - c >= load(r, row + ROW_ALIAS_PROB) else c
+    row = _row(data, cell, c)
+    b = row + ROW_SLOPE
     # each x_k gathers its terms in the order the x_i become available: one fused multiply-add after x_{k−1}
-    x0 = _residual(data, s, ia, iv, c, 0, u[5])
-    row = (s, ia, iv, c)
-    x1 = fma(_slope(r, row, 0), x0, _residual(data, s, ia, iv, c, 1, u[6]))
-    x2 = fma(_slope(r, row, 2), x1, fma(_slope(r, row, 1), x0, _residual(data, s, ia, iv, c, 2, u[7])))
-    x3 = fma(_slope(r, row, 5), x2, fma(_slope(r, row, 4), x1, fma(_slope(r, row, 3), x0,
-                                                                   _residual(data, s, ia, iv, c, 3, u[8]))))
-    x4 = fma(_slope(r, row, 9), x3, fma(_slope(r, row, 8), x2, fma(_slope(r, row, 7), x1, fma(
-        _slope(r, row, 6), x0, _residual(data, s, ia, iv, c, 4, u[9])))))
-    x5 = fma(_slope(r, row, 14), x4, fma(_slope(r, row, 13), x3, fma(_slope(r, row, 12), x2, fma(
-        _slope(r, row, 11), x1, fma(_slope(r, row, 10), x0, _residual(data, s, ia, iv, c, 5, u[10]))))))
+    x0 = _residual(data, cell, row, 0, u[5])
+    x1 = fma(load(r, b), x0, _residual(data, cell, row, 1, u[6]))
+    x2 = fma(load(r, b + 2), x1, fma(load(r, b + 1), x0, _residual(data, cell, row, 2, u[7])))
+    x3 = fma(load(r, b + 5), x2, fma(load(r, b + 4), x1, fma(load(r, b + 3), x0, _residual(data, cell, row, 3, u[8]))))
+    x4 = fma(load(r, b + 9), x3, fma(load(r, b + 8), x2, fma(load(r, b + 7), x1, fma(load(r, b + 6), x0,
+                                                                    _residual(data, cell, row, 4, u[9])))))
+    x5 = fma(load(r, b + 14), x4, fma(load(r, b + 13), x3, fma(load(r, b + 12), x2, fma(load(r, b + 11), x1, fma(
+        load(r, b + 10), x0, _residual(data, cell, row, 5, u[10]))))))
     alpha2 = abs(x0)
     if alpha2 > math.pi:
         alpha2 = 2.0 * math.pi - alpha2
-    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, r[s, ia, iv, c, ROW_REGIME]
+    return alpha2, min(x1, 0.5 * math.pi), max(x2, 0.0), x4, x5, x3, load(r, row + ROW_REGIME)
 
 
 @numba.njit(inline="always", **JIT)
-def _rescaled(data, shape, ja, ja1, wa, ia, iv, k, x, centred):
-    """x drawn from cell (ia, iv), moved to the moments interpolated in α1 between cells ja and ja1 (speed iv).
+def _rescaled(data, below, wa, drawn, k, x, centred):
+    """x drawn from cell number ``drawn``, moved to the moments interpolated in α1 between cell ``below``
+    (the lower α1 neighbour, at the drawn speed) and the next one up.
 
     x' = m + (x − m_cell) σ/σ_cell with m, σ linear in α1 between the two
     cells' means and standard deviations of state variable k; ``centred``
     variables (β2, Ω_x, Ω_y: mean 0 by the mirror symmetry) are only scaled.
     """
-    mo = data.moments
-    sd = fma(wa, mo[shape, ja1, iv, 1, k], (1.0 - wa) * mo[shape, ja, iv, 1, k])
-    inv_sd_cell = mo[shape, ia, iv, 2, k]
+    cells = data.cells
+    lo, hi, here = below * CELL_SIZE + k, (below + data.n_speed) * CELL_SIZE + k, drawn * CELL_SIZE + k
+    sd = fma(wa, load(cells, hi + CELL_SD), (1.0 - wa) * load(cells, lo + CELL_SD))
+    inv_sd_cell = load(cells, here + CELL_INV_SD)
     ratio = sd * inv_sd_cell if inv_sd_cell > 0.0 else 1.0
     if centred:
         return x * ratio
-    mean = fma(wa, mo[shape, ja1, iv, 0, k], (1.0 - wa) * mo[shape, ja, iv, 0, k])
-    return fma(x - mo[shape, ia, iv, 0, k], ratio, mean)
+    mean = fma(wa, load(cells, hi + CELL_MEAN), (1.0 - wa) * load(cells, lo + CELL_MEAN))
+    return fma(x - load(cells, here + CELL_MEAN), ratio, mean)
 
 
 @numba.njit(inline="always", **JIT)
@@ -175,8 +191,8 @@ def _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, 
     reflected (the rebound must leave the wall). exp(−k V^p) comes from the
     table's polynomial pieces (:mod:`surrogate.restitution`).
     """
-    a_target = 1.0 - (1.0 - restitution_at(data.restitution_pieces, jv, wv)) * sin_alpha1
-    a_grid = 1.0 - (1.0 - data.speed_restitution[iv]) * sin_alpha1
+    a_target = 1.0 - (1.0 - restitution_at(data.restitution_pieces, data.n_pieces, jv, wv)) * sin_alpha1
+    a_grid = 1.0 - (1.0 - load(data.speed_restitution, iv)) * sin_alpha1
     # both laws computed, the regime's picked by selects: the regime varies from draw to draw, a branch
     # on it would be mispredicted often
     few = regime == 0.0
@@ -188,20 +204,23 @@ def _to_speed(data, regime, jv, wv, cos_alpha1, sin_alpha1, iv, vx, vy, vz, wx, 
 
 @numba.njit(inline="always", **JIT)
 def _cell(data, mix_cdf, alpha1, speed, u):
-    """The cell a draw reads: (shape, ja, wa, jv, wv, ia, iv).
+    """The cell a draw reads: (drawn, below, wa, jv, wv, iv).
 
     Shape from u[0] and the mix; grid intervals (ja, jv) with the weights of
     their upper points (wa, wv); the neighbour cell (ia, iv) drawn with those
-    weights from u[1], u[2] (stochastic interpolation).
+    weights from u[1], u[2] (stochastic interpolation). ``drawn`` is the
+    number of cell (shape, ia, iv) (:class:`surrogate.table.KernelData`),
+    ``below`` that of (shape, ja, iv), the lower α1 neighbour at the drawn speed.
     """
     shape = 0
     for k in range(mix_cdf.shape[0] - 1):     # the first k with u[0] < cdf[k], without data-dependent branches
         shape += u[0] >= mix_cdf[k]
-    ja, wa = locate(data.alpha1_deg, data.alpha1_lookup, data.alpha1_scale, data.alpha1_inv_spacing, alpha1)
-    jv, wv = locate(data.speed, data.speed_lookup, data.speed_scale, data.speed_inv_spacing, speed)
+    ja, wa = locate(data.alpha1_axis, data.n_alpha1, alpha1)
+    jv, wv = locate(data.speed_axis, data.n_speed, speed)
     ia = ja + (u[1] < wa)       # integer + comparison: no branch to mispredict
     iv = jv + (u[2] < wv)
-    return shape, ja, wa, jv, wv, ia, iv
+    below = (shape * data.n_alpha1 + ja) * data.n_speed + iv
+    return below + (ia - ja) * data.n_speed, below, wa, jv, wv, iv
 
 
 @numba.njit(inline="always", **JIT)
@@ -228,19 +247,18 @@ def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
 @numba.njit(inline="always", **JIT)
 def _draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
     """:func:`draw_velocity` once its cell (:func:`_cell`) is known; α1 given by its cosine and sine."""
-    shape, ja, wa, jv, wv, ia, iv = cell
-    if u[3] < data.p_trapped[shape, ia, iv]:
+    drawn, below, wa, jv, wv, iv = cell
+    if u[3] < load(data.cells, drawn * CELL_SIZE + CELL_P_TRAPPED):
         return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-    alpha2, beta2, s, wx, wy, wz, regime = draw_folded(data, shape, ia, iv, u)
+    alpha2, beta2, s, wx, wy, wz, regime = draw_folded(data, drawn, u)
     if scaled and wa > 0.0:
-        ja1 = ja + 1
-        alpha2 = abs(_rescaled(data, shape, ja, ja1, wa, ia, iv, 0, alpha2, False))
+        alpha2 = abs(_rescaled(data, below, wa, drawn, 0, alpha2, False))
         alpha2 = 2.0 * math.pi - alpha2 if alpha2 > math.pi else alpha2
-        beta2 = min(_rescaled(data, shape, ja, ja1, wa, ia, iv, 1, beta2, True), 0.5 * math.pi)
-        s = max(_rescaled(data, shape, ja, ja1, wa, ia, iv, 2, s, False), 0.0)
-        wx = _rescaled(data, shape, ja, ja1, wa, ia, iv, 3, wx, True)
-        wy = _rescaled(data, shape, ja, ja1, wa, ia, iv, 4, wy, True)
-        wz = _rescaled(data, shape, ja, ja1, wa, ia, iv, 5, wz, False)
+        beta2 = min(_rescaled(data, below, wa, drawn, 1, beta2, True), 0.5 * math.pi)
+        s = max(_rescaled(data, below, wa, drawn, 2, s, False), 0.0)
+        wx = _rescaled(data, below, wa, drawn, 3, wx, True)
+        wy = _rescaled(data, below, wa, drawn, 4, wy, True)
+        wz = _rescaled(data, below, wa, drawn, 5, wz, False)
     sb, cb = sincos(beta2)
     sa, ca = sincos(alpha2)
     scb = s * cb
@@ -359,22 +377,22 @@ def _rebound(data, mix_cdf, V, n, a, u, scaled):
 
 @numba.njit(inline="always", **JIT)
 def _hint_draw(data, cell, u):
-    """Cache hints (:func:`surrogate.prefetch.prefetch`) for the table reads of a draw in ``cell`` that
+    """Cache hints (:func:`surrogate.memory.prefetch`) for the table reads of a draw in ``cell`` that
     the uniforms alone locate, so that they are all in flight at once: the component row u[4] picks
     (before its alias is resolved) and the residual-shape levels u[5:11] pick (the dictionary is
     level-major, so these lines do not depend on the row). Without them the row and then the
     dictionary would each wait for memory in turn. (Hints for the small arrays, the trapped
     probabilities and the moments, measured slower: they stay cached.)"""
-    shape, ia, iv = cell[0], cell[5], cell[6]
-    rows, dic = data.clusters, data.dictionary
-    n_clusters, levels = rows.shape[3], dic.shape[4] - 1
-    c = min(int(u[4] * n_clusters), n_clusters - 1)
+    drawn = cell[0]
+    c = min(int(u[4] * data.n_clusters), data.n_clusters - 1)
+    row = _row(data, drawn, c)
     for j in range(0, ROW_SIZE, 16):   # the three cache lines of a 144-byte row (its start is 16-byte aligned)
-        prefetch(rows, (shape, ia, iv, c, j))
+        prefetch(data.clusters, (row + j,))
+    levels = data.n_levels - 1
     for k in range(6):
-        i = min(int(u[5 + k] * levels), levels - 1)
-        prefetch(dic, (shape, ia, iv, k, i, 0))
-        prefetch(dic, (shape, ia, iv, k, i + 1, 0))
+        level = _level(data, drawn, k, min(int(u[5 + k] * levels), levels - 1))
+        prefetch(data.dictionary, (level,))
+        prefetch(data.dictionary, (level + data.n_dictionary,))
 
 
 @numba.njit(inline="always", **JIT)
@@ -410,7 +428,7 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
 
 
 BLOCK = 16      # particles whose table reads rebound_many puts in flight together
-INDEX = 6       # integers per particle in rebound_many's index scratch
+INDEX = 5       # integers per particle in rebound_many's index scratch
 FRAME = 11      # floats per particle in rebound_many's frame scratch
 
 
@@ -424,7 +442,7 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     levels), except the row the alias table redirects to, which waits for the
     first row. :func:`rebound` requests them together for one particle; here
     they are requested for a block of particles (cache hints,
-    :func:`surrogate.prefetch.prefetch`), then the redirected rows, and the
+    :func:`surrogate.memory.prefetch`), then the redirected rows, and the
     draws then run on cached data, so the memory latencies of the whole
     block overlap. For a flow solver that collects its wall hits: call this
     from its ``@njit`` code on the hit arrays.
@@ -435,11 +453,11 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
 
 @numba.njit(**KERNEL)
 def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, index, frame):
-    """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, INDEX) int64 holds validity, shape,
-    ja, jv, ia, iv of each particle of a block; ``frame`` (BLOCK, FRAME) |V⁻|, cos α1, sin α1, ex, ez, wa,
-    wv."""
+    """:func:`rebound_many` with its scratch arrays: ``index`` (BLOCK, INDEX) int64 holds validity and the
+    cell (drawn, below, jv, iv; :func:`_cell`) of each particle of a block; ``frame`` (BLOCK, FRAME) |V⁻|,
+    cos α1, sin α1, ex, ez, wa, wv."""
     rows = data.clusters
-    n_clusters = rows.shape[3]
+    n_clusters = data.n_clusters
     for start in range(0, V.shape[0], BLOCK):
         stop = min(start + BLOCK, V.shape[0])
         for b in range(stop - start):                 # 1: impact frame, cell, hint the reads u locates
@@ -450,27 +468,28 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
             alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V[i], n[i], u[i, 12])
             cell = _cell(data, mix_cdf, alpha1, speed, u[i])
             _hint_draw(data, cell, u[i])
-            shape, ja, wa, jv, wv, ia, iv = cell
-            index[b, 1], index[b, 2], index[b, 3], index[b, 4], index[b, 5] = shape, ja, jv, ia, iv
+            drawn, below, wa, jv, wv, iv = cell
+            index[b, 1], index[b, 2], index[b, 3], index[b, 4] = drawn, below, jv, iv
             frame[b, 0], frame[b, 1], frame[b, 2], frame[b, 9], frame[b, 10] = speed, cos_a1, sin_a1, wa, wv
             frame[b, 3], frame[b, 4], frame[b, 5] = ex
             frame[b, 6], frame[b, 7], frame[b, 8] = ez
         for b in range(stop - start):                 # 2: where the alias table redirects, hint that row
             if not index[b, 0]:
                 continue
-            shape, ia, iv = index[b, 1], index[b, 4], index[b, 5]
+            drawn = index[b, 1]
             t = u[start + b, 4] * n_clusters
             c = min(int(t), n_clusters - 1)
-            if t - c >= rows[shape, ia, iv, c, ROW_ALIAS_PROB]:
-                c = int(rows[shape, ia, iv, c, ROW_ALIAS])
+            row = _row(data, drawn, c)
+            if t - c >= load(rows, row + ROW_ALIAS_PROB):
+                row = _row(data, drawn, int(load(rows, row + ROW_ALIAS)))
                 for j in range(0, ROW_SIZE, 16):
-                    prefetch(rows, (shape, ia, iv, c, j))
+                    prefetch(rows, (row + j,))
         for b in range(stop - start):                 # 3: the draws, on cached data
             i = start + b
             if not index[b, 0]:
                 status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
                 continue
-            cell = (index[b, 1], index[b, 2], frame[b, 9], index[b, 3], frame[b, 10], index[b, 4], index[b, 5])
+            cell = (index[b, 1], index[b, 2], frame[b, 9], index[b, 3], frame[b, 10], index[b, 4])
             st, vx, vy, vz, wx, wy, wz = _draw_in_cell(data, cell, frame[b, 1], frame[b, 2], u[i], scaled)
             ex, ez = (frame[b, 3], frame[b, 4], frame[b, 5]), (frame[b, 6], frame[b, 7], frame[b, 8])
             V_new, W_new = _to_global(st, vx, vy, vz, wx, wy, wz, frame[b, 0], a[i], ex, n[i], ez)

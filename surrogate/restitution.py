@@ -12,9 +12,9 @@ piece away from V = 0, where V^p is singular, so the interpolant is exact
 to about 1e-14 absolute (the factor is at most 1 and enters
 a(V) = 1 − (1 − f) sin α1 additively; tests/test_kernel_math.py checks
 ≤ 1e-12 on grids from 0.1 to 1000 m/s and laws from k V^p = 0.02 V^0.3 to
-0.1 V^1.5). :func:`restitution_at` evaluates it from the grid interval and
-weight the kernel has already located: one multiply, one floor, a Horner
-loop.
+0.1 V^1.5). :func:`restitution_at` evaluates it (on the pieces flattened,
+as the kernels hold them) from the grid interval and weight the kernel has
+already located: one multiply, one floor, a Horner loop.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ import numpy as np
 from numpy.polynomial import chebyshev
 
 from surrogate.fused import fma
+from surrogate.memory import load
 
 DEGREE = 9          # polynomial degree of a piece
 PIECE_RATIO = 1.25  # a piece [V_lo, V_hi] has V_hi ≤ PIECE_RATIO · V_lo
@@ -54,13 +55,14 @@ def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
 
 
 @numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
-def restitution_at(pieces, j, w):
-    """exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w ∈ [0, 1], from :func:`restitution_pieces`."""
-    n_pieces = pieces.shape[1]
+def restitution_at(pieces, n_pieces, j, w):
+    """exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w ∈ [0, 1], from :func:`restitution_pieces` flattened
+    (``pieces`` 1-D, ``n_pieces`` its S: piece i of interval j starts at (j S + i)(DEGREE + 1))."""
     t = w * n_pieces
     i = min(int(t), n_pieces - 1)
     x = 2.0 * (t - i) - 1.0
-    value = pieces[j, i, DEGREE]
+    start = (j * n_pieces + i) * (DEGREE + 1)
+    value = load(pieces, start + DEGREE)
     for d in range(DEGREE - 1, -1, -1):
-        value = fma(value, x, pieces[j, i, d])
+        value = fma(value, x, load(pieces, start + d))
     return value

@@ -20,22 +20,55 @@ from surrogate.restitution import restitution_pieces
 
 
 class KernelData(NamedTuple):
-    """Arrays of a table as numba kernels take them (see :mod:`surrogate.kernels`)."""
+    """A table as numba kernels take it (see :mod:`surrogate.kernels`): a few flat arrays and their sizes.
 
-    alpha1_deg: np.ndarray     # (n_alpha,) grid
-    alpha1_lookup: np.ndarray  # (m,) interval index on a uniform auxiliary grid
-    alpha1_scale: np.ndarray   # (2,) origin and inverse step of that grid
-    alpha1_inv_spacing: np.ndarray  # (max(n_alpha − 1, 1),) 1/(g_{j+1} − g_j) of each grid interval (0: one point)
-    speed: np.ndarray          # (n_speed,) grid, m/s
-    speed_lookup: np.ndarray
-    speed_scale: np.ndarray
-    speed_inv_spacing: np.ndarray
-    p_trapped: np.ndarray      # (n_shape, n_alpha, n_speed)
-    clusters: np.ndarray       # (n_shape, n_alpha, n_speed, C, ROW_SIZE) float32, one row per component
-    dictionary: np.ndarray     # (n_shape, n_alpha, n_speed, 6, L + 1, M) float32 residual shapes, level-major
-    moments: np.ndarray        # (n_shape, n_alpha, n_speed, 3, 6) mean, sd, 1/sd (0 if sd = 0) of (α2, β2, s, Ω_x, Ω_y, Ω_z)
-    speed_restitution: np.ndarray  # (n_speed,) the wall's normal restitution factor exp(−k V^p) at the grid speeds
-    restitution_pieces: np.ndarray  # (max(n_speed − 1, 1), S, D + 1) exp(−k V^p) between them (surrogate.restitution)
+    Few arrays, because numba passes every array as its data pointer, shape
+    and strides: a call to a kernel copies all of them, and the kernel keeps
+    them in registers or on its stack. Flat, because one offset per cell and
+    per component then locates every read (the layouts below). The methods
+    give shaped, read-only views for inspection and tests.
+    """
+
+    alpha1_axis: np.ndarray    # float64 axis record of the α1 grid, degrees (AXIS_* layout, axis_record)
+    speed_axis: np.ndarray     # float64 axis record of the |V⁻| grid, m/s
+    cells: np.ndarray          # float64 (n_cells · CELL_SIZE,): per cell P(trapped), mean, sd, 1/sd (CELL_* layout)
+    clusters: np.ndarray       # float32 (n_cells · n_clusters · ROW_SIZE,): one row per component (ROW_* layout)
+    dictionary: np.ndarray     # float32 (n_cells · 6 · n_levels · n_dictionary,): residual shapes, level-major
+    speed_restitution: np.ndarray  # float64 (n_speed,) the wall's restitution factor exp(−k V^p) at the grid speeds
+    restitution_pieces: np.ndarray  # float64, exp(−k V^p) between them, flat (surrogate.restitution)
+    n_shapes: int
+    n_alpha1: int
+    n_speed: int               # cell (shape, i_α1, i_speed) is number (shape · n_alpha1 + i_α1) · n_speed + i_speed
+    n_clusters: int            # mixture components per cell
+    n_levels: int              # L + 1 quantile levels of a residual shape
+    n_dictionary: int          # M residual shapes per chain variable and cell
+    n_pieces: int              # restitution pieces per speed interval
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the arrays."""
+        return sum(x.nbytes for x in self if isinstance(x, np.ndarray))
+
+    def cell_shape(self) -> tuple:
+        """(n_shapes, n_alpha1, n_speed)."""
+        return self.n_shapes, self.n_alpha1, self.n_speed
+
+    def rows(self) -> np.ndarray:
+        """The component rows as (n_shapes, n_alpha1, n_speed, n_clusters, ROW_SIZE)."""
+        return self.clusters.reshape(self.cell_shape() + (self.n_clusters, ROW_SIZE))
+
+    def shape_dictionary(self) -> np.ndarray:
+        """The residual shapes as (n_shapes, n_alpha1, n_speed, 6, n_levels, n_dictionary): S_k,m(i/L) at
+        [..., k, i, m]."""
+        return self.dictionary.reshape(self.cell_shape() + (N_CHAIN, self.n_levels, self.n_dictionary))
+
+    def p_trapped(self) -> np.ndarray:
+        """P(trapped) of every cell, (n_shapes, n_alpha1, n_speed)."""
+        return self.cells.reshape(self.cell_shape() + (CELL_SIZE,))[..., CELL_P_TRAPPED]
+
+    def with_rows(self, rows: np.ndarray) -> "KernelData":
+        """A copy whose component rows are ``rows`` (shaped as :meth:`rows`): for experiments and tests."""
+        return self._replace(clusters=_frozen(_aligned_copy(np.asarray(rows, dtype=np.float32).ravel())))
 
 
 # Layout of a component's row in KernelData.clusters: everything one draw needs
@@ -44,10 +77,22 @@ ROW_ALIAS_PROB = 0    # Walker alias table: keep the component if the fractional
 ROW_ALIAS = 1         # ... else use this component
 ROW_LOC = 2           # 6 locations (chain order)
 ROW_SCALE = 8         # 6 scales
-ROW_SHAPE = 14        # 6 residual shape indices m (KernelData.dictionary[..., k, :, m])
+ROW_SHAPE = 14        # 6 residual shape indices m (KernelData.shape_dictionary()[..., k, :, m])
 ROW_SLOPE = 20        # 15 slopes, x_k on x_j at k(k−1)/2 + j
 ROW_REGIME = 35       # collision regime: 0 = at most FEW_COLLISIONS collisions, 1 = more
 ROW_SIZE = 36
+
+# Layout of a cell's record in KernelData.cells
+CELL_P_TRAPPED = 0    # probability of the trapped outcome
+CELL_MEAN = 1         # 6 means of (α2, β2, s, Ω_x, Ω_y, Ω_z)
+CELL_SD = 7           # their 6 standard deviations
+CELL_INV_SD = 13      # 1/sd (0 where sd = 0): the kernels multiply instead of dividing
+CELL_SIZE = 19
+
+# Layout of an axis record (axis_record): a grid of n points and its O(1) look-up
+AXIS_ORIGIN = 0       # origin of the uniform auxiliary grid
+AXIS_INV_STEP = 1     # its inverse step
+AXIS_GRID = 2         # the n grid points, then max(n − 1, 1) inverse spacings, then the look-up indices
 
 
 def interval_lookup(grid: np.ndarray):
@@ -66,6 +111,16 @@ def interval_lookup(grid: np.ndarray):
     points = grid[0] + step * np.arange(m)
     lookup = np.clip(np.searchsorted(grid, points, side="right") - 1, 0, len(grid) - 2)
     return lookup.astype(np.int64), np.array([grid[0], 1.0 / step]), 1.0 / np.diff(grid)
+
+
+def axis_record(grid: np.ndarray) -> np.ndarray:
+    """The float64 record the kernels locate a value on ``grid`` with (AXIS_* layout).
+
+    [origin, 1/step, g_0 … g_{n−1}, 1/(g_1 − g_0) … (max(n − 1, 1) values), lookup_0 … lookup_{m−1}]
+    from :func:`interval_lookup`; the look-up indices are small integers, exact in float64.
+    """
+    lookup, scale, inverse = interval_lookup(grid)
+    return np.concatenate([scale, np.asarray(grid, dtype=np.float64), inverse, lookup.astype(np.float64)])
 
 
 def alias_table(weights: np.ndarray):
@@ -92,7 +147,7 @@ def alias_table(weights: np.ndarray):
 
 
 def kernel_rows(cells: dict) -> tuple:
-    """The cell arrays of a table rearranged for the kernels: (clusters, dictionary), see :class:`KernelData`.
+    """The cell arrays of a table rearranged for the kernels: (clusters, dictionary), flat (see :class:`KernelData`).
 
     The dictionary is stored level-major, S_k,m(i/L) at [..., k, i, m]: the M
     shapes' values at one level are contiguous (one cache line for M = 16),
@@ -113,7 +168,7 @@ def kernel_rows(cells: dict) -> tuple:
     rows[..., ROW_SHAPE:ROW_SHAPE + N_CHAIN] = cells["cluster_shape"]
     rows[..., ROW_SLOPE:ROW_SLOPE + N_SLOPES] = cells["cluster_slope"]
     rows[..., ROW_REGIME] = cells["cluster_regime"]
-    return _aligned_copy(rows), _aligned_copy(np.swapaxes(dic, -1, -2))
+    return _aligned_copy(rows.ravel()), _aligned_copy(np.swapaxes(dic, -1, -2).ravel())
 
 
 def _aligned_copy(a: np.ndarray, alignment: int = 64) -> np.ndarray:
@@ -125,11 +180,11 @@ def _aligned_copy(a: np.ndarray, alignment: int = 64) -> np.ndarray:
     return out
 
 
-def moments(mean: np.ndarray, std: np.ndarray) -> np.ndarray:
-    """Mean, sd and 1/sd (0 where sd = 0) of every cell's state variables stacked on a new axis 3, as
-    KernelData.moments holds them (the kernels multiply by 1/sd instead of dividing by sd)."""
+def cell_records(p_trapped: np.ndarray, mean: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """Every cell's record (CELL_* layout), flat: P(trapped), the means, sds and 1/sds (0 where sd = 0) of
+    its state variables."""
     inverse = np.divide(1.0, std, out=np.zeros_like(std, dtype=np.float64), where=std > 0.0)
-    return np.stack([mean, std, inverse], axis=3)
+    return np.concatenate([p_trapped[..., None], mean, std, inverse], axis=-1).ravel()
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -165,22 +220,21 @@ class SurrogateTable:
     def from_table(cls, table: ReboundTable, path: str = "<memory>") -> "SurrogateTable":
         counts = table.cells["status_counts"].astype(np.float64)
         landed = counts[..., STATUS_REBOUNDED] + counts[..., STATUS_TRAPPED]
-        a_lookup, a_scale, a_inv = interval_lookup(table.alpha1_deg)
-        v_lookup, v_scale, v_inv = interval_lookup(table.speed_m_s)
         rows, dictionary = kernel_rows(table.cells)
+        pieces = restitution_pieces(table.speed_m_s, table.restitution_k, table.restitution_p)
+        speed = np.asarray(table.speed_m_s, dtype=np.float64)
+        lead = counts.shape[:3]
+        dic_shape = table.cells["shape_dictionary"].shape     # (..., 6, M, L + 1)
         data = KernelData(
-            alpha1_deg=_frozen(np.asarray(table.alpha1_deg, dtype=np.float64)), alpha1_lookup=_frozen(a_lookup),
-            alpha1_scale=_frozen(a_scale), alpha1_inv_spacing=_frozen(a_inv),
-            speed=_frozen(np.asarray(table.speed_m_s, dtype=np.float64)),
-            speed_lookup=_frozen(v_lookup), speed_scale=_frozen(v_scale), speed_inv_spacing=_frozen(v_inv),
-            p_trapped=_frozen(counts[..., STATUS_TRAPPED] / landed),
+            alpha1_axis=_frozen(axis_record(table.alpha1_deg)), speed_axis=_frozen(axis_record(speed)),
+            cells=_frozen(cell_records(counts[..., STATUS_TRAPPED] / landed, table.cells["mean"], table.cells["std"])),
             clusters=_frozen(rows), dictionary=_frozen(dictionary),
-            moments=_frozen(moments(table.cells["mean"], table.cells["std"])),
-            speed_restitution=_frozen(
-                np.exp(-table.restitution_k * np.asarray(table.speed_m_s, dtype=np.float64) ** table.restitution_p)),
-            restitution_pieces=_frozen(restitution_pieces(table.speed_m_s, table.restitution_k, table.restitution_p)))
-        return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=data.alpha1_deg, speed_m_s=data.speed,
-                   particles_per_cell=table.particles_per_cell, n_max=table.n_max,
+            speed_restitution=_frozen(np.exp(-table.restitution_k * speed ** table.restitution_p)),
+            restitution_pieces=_frozen(pieces.ravel()),
+            n_shapes=lead[0], n_alpha1=lead[1], n_speed=lead[2], n_clusters=table.cells["cluster_weight"].shape[3],
+            n_levels=dic_shape[-1], n_dictionary=dic_shape[-2], n_pieces=pieces.shape[1])
+        return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=_frozen(np.asarray(table.alpha1_deg, float)),
+                   speed_m_s=_frozen(speed), particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, restitution_k=table.restitution_k,
                    restitution_p=table.restitution_p, kernel_data=data)
 

@@ -1,5 +1,6 @@
 """The sampler kernels' inlined functions against their closed forms: the fused multiply-add, sincos,
-first-quadrant atan2, and the polynomial pieces of the wall's restitution factor exp(−k V^p)."""
+first-quadrant atan2, the polynomial pieces of the wall's restitution factor exp(−k V^p), and the plain
+load of surrogate.memory."""
 
 import math
 
@@ -8,6 +9,7 @@ import numpy as np
 import pytest
 
 from surrogate.fused import fma
+from surrogate.memory import load
 from surrogate.restitution import restitution_at, restitution_pieces
 from surrogate.trig import atan2_first_quadrant, sincos
 
@@ -27,9 +29,26 @@ def _atan2_all(y, x, out):
 
 
 @numba.njit
-def _restitution_all(pieces, j, w, out):
+def _restitution_all(pieces, n_pieces, j, w, out):
     for i in range(w.shape[0]):
-        out[i] = restitution_at(pieces, j[i], w[i])
+        out[i] = restitution_at(pieces, n_pieces, j[i], w[i])
+
+
+@numba.njit
+def _load_all(a, index, out):
+    for i in range(index.shape[0]):
+        out[i] = load(a, index[i])
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64, np.int64, np.uint8])
+def test_load_reads_the_element_at_the_index(dtype):
+    """load(a, i) is a[i] for every i of a read-only array, in any order and with any integer type."""
+    a = np.random.default_rng(1).permutation(1000).astype(dtype)
+    a.setflags(write=False)
+    for index in (np.arange(1000), np.arange(1000)[::-1].astype(np.int32), np.arange(0, 1000, 7).astype(np.uint64)):
+        out = np.empty(len(index), dtype=dtype)
+        _load_all(a, index, out)
+        np.testing.assert_array_equal(out, a[index.astype(np.int64)])
 
 
 @numba.njit
@@ -90,6 +109,6 @@ def test_restitution_pieces_match_the_closed_form(grid):
         w = np.linspace(0.0, 1.0, 4001)
         for j in range(len(grid) - 1):
             got = np.empty_like(w)
-            _restitution_all(pieces, np.full(w.size, j), w, got)
+            _restitution_all(pieces.ravel(), pieces.shape[1], np.full(w.size, j), w, got)
             exact = np.exp(-k * (grid[j] + w * (grid[j + 1] - grid[j])) ** p)
             assert np.max(np.abs(got - exact)) <= 1e-12, (grid, k, p, j)

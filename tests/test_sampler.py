@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
 from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch, rebound_many, rebound_tuple
-from surrogate.table import ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
+from surrogate.table import CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
 
 def test_runtime_does_not_import_tablegen():
@@ -23,22 +23,32 @@ def test_runtime_does_not_import_tablegen():
 
 def test_loaded_table_is_immutable(small_table):
     with pytest.raises(ValueError):
-        small_table.kernel_data.clusters[0, 0, 0, 0, 0] = 1.0
-    assert all(a.flags.c_contiguous for a in small_table.kernel_data)
+        small_table.kernel_data.clusters[0] = 1.0
+    with pytest.raises(ValueError):
+        small_table.kernel_data.rows()[0, 0, 0, 0, 0] = 1.0
+    arrays = [a for a in small_table.kernel_data if isinstance(a, np.ndarray)]
+    assert len(arrays) == 7 and all(a.flags.c_contiguous and not a.flags.writeable for a in arrays)
 
 
 def test_kernel_arrays_hold_the_file_s_law(small_table_path, small_table):
     """The kernel layout is the file's cells rearranged: the dictionary level-major (S_k,m(i/L) at
-    [..., k, i, m]), each row's residual shape indices m, location, scale and slopes; both large arrays
-    start on a 64-byte cache line."""
+    [..., k, i, m]), each row's residual shape indices m, location, scale and slopes, each cell's trapped
+    fraction, means and standard deviations; both large arrays start on a 64-byte cache line."""
     from data_schema.table import read_table
     cells = read_table(small_table_path).cells
     data = small_table.kernel_data
-    np.testing.assert_array_equal(data.dictionary, np.swapaxes(cells["shape_dictionary"], -1, -2))
-    np.testing.assert_array_equal(data.clusters[..., ROW_SHAPE:ROW_SHAPE + 6], cells["cluster_shape"])
-    np.testing.assert_array_equal(data.clusters[..., ROW_LOC:ROW_LOC + 6], cells["cluster_loc"])
-    np.testing.assert_array_equal(data.clusters[..., ROW_SCALE:ROW_SCALE + 6], cells["cluster_scale"])
-    np.testing.assert_array_equal(data.clusters[..., ROW_SLOPE:ROW_SLOPE + 15], cells["cluster_slope"])
+    rows = data.rows()
+    np.testing.assert_array_equal(data.shape_dictionary(), np.swapaxes(cells["shape_dictionary"], -1, -2))
+    np.testing.assert_array_equal(rows[..., ROW_SHAPE:ROW_SHAPE + 6], cells["cluster_shape"])
+    np.testing.assert_array_equal(rows[..., ROW_LOC:ROW_LOC + 6], cells["cluster_loc"])
+    np.testing.assert_array_equal(rows[..., ROW_SCALE:ROW_SCALE + 6], cells["cluster_scale"])
+    np.testing.assert_array_equal(rows[..., ROW_SLOPE:ROW_SLOPE + 15], cells["cluster_slope"])
+    records = data.cells.reshape(data.cell_shape() + (CELL_SIZE,))
+    np.testing.assert_array_equal(records[..., CELL_MEAN:CELL_MEAN + 6], cells["mean"])
+    np.testing.assert_array_equal(records[..., CELL_SD:CELL_SD + 6], cells["std"])
+    counts = cells["status_counts"]
+    np.testing.assert_allclose(data.p_trapped() * (counts[..., STATUS_REBOUNDED] + counts[..., STATUS_TRAPPED]),
+                               counts[..., STATUS_TRAPPED], rtol=1e-12)
     assert data.dictionary.ctypes.data % 64 == 0 and data.clusters.ctypes.data % 64 == 0
 
 
@@ -175,7 +185,7 @@ def test_scaled_interpolation_has_the_interpolated_spread(small_table):
 def test_trapped_fraction_matches_the_table(small_table):
     """Ellipsoids at normal impact and 250 m/s get trapped; the drawn fraction matches the table (4σ binomial)."""
     s = small_table.shapes.index("ellipsoid")
-    p = small_table.kernel_data.p_trapped[s, 2, 2]
+    p = small_table.kernel_data.p_trapped()[s, 2, 2]
     assert p > 0.005
     n = 40000
     d = surrogate.sample_local(small_table, np.full(n, 90.0), 250.0, "ellipsoid", random_state=8)
@@ -359,13 +369,14 @@ def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
         same = _to_speed(data, regime, 1, 0.0, c, s, 1, *v, *w)
         np.testing.assert_allclose(same, np.concatenate([v, w]), rtol=1e-14)
     speed = 100.0
-    jv = int(np.searchsorted(data.speed, speed) - 1)
-    wv = (speed - data.speed[jv]) / (data.speed[jv + 1] - data.speed[jv])
+    grid = small_table.speed_m_s
+    jv = int(np.searchsorted(grid, speed) - 1)
+    wv = (speed - grid[jv]) / (grid[jv + 1] - grid[jv])
     assert 0.0 < wv < 1.0
-    f = (1 + a(speed)) / (1 + a(data.speed[1]))
+    f = (1 + a(speed)) / (1 + a(grid[1]))
     moved = _to_speed(data, 0.0, jv, wv, c, s, 1, *v, *w)
     incident = np.array([c, -s, 0.0])
     np.testing.assert_allclose(moved, np.concatenate([incident + f * (v - incident), f * w]), rtol=1e-12)
     moved = _to_speed(data, 1.0, jv, wv, c, s, 1, *v, *w)
-    np.testing.assert_allclose(moved, np.concatenate([v * [1.0, a(speed) / a(data.speed[1]), 1.0], w]),
+    np.testing.assert_allclose(moved, np.concatenate([v * [1.0, a(speed) / a(grid[1]), 1.0], w]),
                                rtol=1e-12)

@@ -85,9 +85,9 @@ def test_near_normal_speed_step_is_needed(near_normal_table):
     D = direct_states("ellipsoid", 83.75, 62.5, N_DRAWS, seed=103)
     T = table_states(near_normal_table, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9, interpolation="stochastic")
     assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
-    rows = np.array(near_normal_table.kernel_data.clusters)
+    rows = np.array(near_normal_table.kernel_data.rows())
     rows[..., ROW_REGIME] = 1.0
-    one_law = dataclasses.replace(near_normal_table, kernel_data=near_normal_table.kernel_data._replace(clusters=rows))
+    one_law = dataclasses.replace(near_normal_table, kernel_data=near_normal_table.kernel_data.with_rows(rows))
     T = table_states(one_law, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9)
     assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
 
@@ -112,7 +112,7 @@ def _without_alpha2_speed_dependence(table, weights, seed=0):
     weight (random permutation within blocks of 20 components sorted by
     weight). The s marginal is kept; its link to the direction is gone.
     """
-    rows = np.array(table.kernel_data.clusters)
+    rows = np.array(table.kernel_data.rows())
     m0 = rows[..., ROW_LOC]                                  # component means of α2 and |β2|
     m1 = rows[..., ROW_LOC + 1] + rows[..., ROW_SLOPE] * m0
     level = rows[..., ROW_LOC + 2] + rows[..., ROW_SLOPE + 1] * m0 + rows[..., ROW_SLOPE + 2] * m1
@@ -127,7 +127,7 @@ def _without_alpha2_speed_dependence(table, weights, seed=0):
             perm[block] = rng.permutation(block)
         for col in (ROW_LOC + 2, ROW_SCALE + 2, ROW_SHAPE + 2):
             rows[cell + (slice(None), col)] = rows[cell + (perm, col)]
-    return dataclasses.replace(table, kernel_data=table.kernel_data._replace(clusters=rows))
+    return dataclasses.replace(table, kernel_data=table.kernel_data.with_rows(rows))
 
 
 def test_a_table_that_drops_the_alpha2_speed_dependence_is_caught(small_table, small_table_path):

@@ -1,10 +1,15 @@
-"""A cache hint for numba kernels: ``prefetch(array, index)`` starts loading the cache line of ``array[index]``.
+"""Memory access for numba kernels: cache hints and plain loads.
 
+``prefetch(array, index)`` starts loading the cache line of ``array[index]``.
 It compiles to LLVM's ``llvm.prefetch`` (read, high locality), an instruction
 that neither waits for the data nor faults on any address. The sampler's
-block kernel (:func:`surrogate.kernels.rebound_many`) uses it to have the
-table reads of many particles in flight at once instead of one dependent
-cache miss after another per particle.
+kernels (:mod:`surrogate.kernels`) use it to have a draw's table reads, or
+those of many particles, in flight at once instead of one dependent cache
+miss after another.
+
+``load(array, index)`` reads ``array[index]`` of a 1-D array at a computed
+offset without numba's negative-index wrap-around: the kernels address the
+table's flat arrays by offsets that are ≥ 0 by construction.
 """
 
 from llvmlite import ir
@@ -34,3 +39,21 @@ def prefetch(typingctx, array, index):
         return context.get_dummy_value()
 
     return types.none(array, index), codegen
+
+
+@intrinsic
+def load(typingctx, array, index):
+    """``array[index]`` for a 1-D array and an integer ``index`` ≥ 0, read without numba's negative-index
+    wrap-around (a compare and an add per read, which the compiler cannot drop for a computed offset) and
+    without bounds check: the kernels' offsets are in range by construction."""
+    if not (isinstance(array, types.Array) and array.ndim == 1 and isinstance(index, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        array_type, index_type = signature.args
+        data = context.make_array(array_type)(context, builder, value=args[0])
+        where = context.cast(builder, args[1], index_type, types.intp)
+        pointer = cgutils.get_item_pointer(context, builder, array_type, data, [where], wraparound=False)
+        return context.unpack_value(builder, array_type.dtype, pointer)
+
+    return array.dtype(array, index), codegen
