@@ -1,0 +1,31 @@
+"""benchmarks/bench_sampler.py runs end to end on a small table and reports every figure the issue asks for.
+
+A smoke test, so the benchmark cannot silently break when the kernels' data or signatures change; the
+figures themselves are machine-dependent and are not asserted (speed is reported, never tested).
+"""
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+bench_sampler = pytest.importorskip("bench_sampler")
+
+
+def test_bench_sampler_reports_every_figure(small_table_path, tmp_path, capsys):
+    out = tmp_path / "figures.json"
+    assert bench_sampler.main(["--table", str(small_table_path), "-n", "3000", "--repeats", "1",
+                               "--min-time", "0.01", "--json", str(out)]) == 0
+    figures = json.loads(out.read_text())
+    results = figures["results"]
+    for key in ("a_all", "a_1", "a_kernel_1", "b", "b_views", "b_predrawn", "b_block", "b_rng", "c", "d"):
+        assert results[key]["ns_per_state"] > 0, key
+    b, c, d = (results[k]["ns_per_state"] for k in ("b", "c", "d"))
+    assert figures["ratios"]["direct_over_kernel"] == pytest.approx(c / b)
+    assert figures["ratios"]["kernel_over_bounce"] == pytest.approx(b / d)
+    assert 0.0 <= figures["trapped_fraction"]["a"] <= 1.0 and 0.0 <= figures["trapped_fraction"]["b"] <= 1.0
+    assert figures["memory_latency"]["table_bytes"] > 0
+    printed = capsys.readouterr().out
+    assert "(c)/(b)" in printed and "(b)/(d)" in printed and "target" in printed
