@@ -27,8 +27,9 @@ state drawn from the neighbour is then moved to the incident state:
 Entry points: :func:`rebound_tuple` (one particle, global frame, vectors as
 tuples: the form for a solver's per-hit loop), :func:`rebound` (the same on
 (3,) arrays), :func:`rebound_many` (many particles, one thread, their table
-reads overlapped), :func:`rebound_batch` (parallel), :func:`draw_local` and
-:func:`draw_velocity` (local frame).
+reads overlapped), :func:`rebound_batch` (parallel; :func:`rebound_batch_rng`
+draws its uniforms), :func:`draw_local` and :func:`draw_velocity` (local
+frame; :func:`draw_local_batch` and :func:`draw_local_batch_rng` parallel).
 
 The hot path calls no libm function (:mod:`surrogate.trig`,
 :mod:`surrogate.restitution`) and branches only where the outcome is
@@ -50,6 +51,7 @@ from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.fused import fma
 from surrogate.memory import load, prefetch
 from surrogate.restitution import restitution_at
+from surrogate.rng import ROWS_PER_STREAM, fill_uniforms
 from surrogate.table import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD,
                              CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE,
                              ROW_SIZE, ROW_SLOPE)
@@ -500,17 +502,65 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
 @numba.njit(parallel=True, **JIT)
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row (parallel over chunks of :func:`rebound_many`); u has shape (N, U_PER_DRAW)."""
-    chunk = 64 * BLOCK
-    for j in numba.prange((V.shape[0] + chunk - 1) // chunk):
-        lo, hi = j * chunk, min((j + 1) * chunk, V.shape[0])
-        _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u[lo:hi], V_out[lo:hi], W_out[lo:hi],
-                        status[lo:hi], scaled, np.empty((BLOCK, INDEX), dtype=np.int64), np.empty((BLOCK, FRAME)))
+    for j in numba.prange((V.shape[0] + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM):
+        lo, hi = _chunk(j, V.shape[0])
+        _rebound_chunk(data, mix_cdf, V, n, a, u[lo:hi], V_out, W_out, status, scaled, lo, hi)
+
+
+@numba.njit(parallel=True, **JIT)
+def rebound_batch_rng(data, mix_cdf, V, n, a, states, V_out, W_out, status, scaled=True):
+    """:func:`rebound_batch` drawing its own uniforms: the rows of chunk j (ROWS_PER_STREAM rows) from a
+    copy of the xoshiro256+ state ``states[j]`` (:func:`surrogate.rng.stream_states`; ``states`` itself is
+    not advanced), row after row. The draws are the same whatever the number of threads, and no
+    (N, U_PER_DRAW) array of uniforms is held."""
+    for j in numba.prange(states.shape[0]):
+        lo, hi = _chunk(j, V.shape[0])
+        _rebound_chunk(data, mix_cdf, V, n, a, _stream_uniforms(states[j], hi - lo), V_out, W_out, status, scaled,
+                       lo, hi)
+
+
+@numba.njit(inline="always", **JIT)
+def _chunk(j, n_rows):
+    """Rows [lo, hi) of chunk j of a batch."""
+    return j * ROWS_PER_STREAM, min((j + 1) * ROWS_PER_STREAM, n_rows)
+
+
+@numba.njit(inline="always", **JIT)
+def _stream_uniforms(state, rows):
+    """(rows, U_PER_DRAW) uniforms from a copy of the xoshiro256+ ``state``, row after row."""
+    u = np.empty((rows, U_PER_DRAW))
+    fill_uniforms(state.copy(), u.reshape(rows * U_PER_DRAW))
+    return u
+
+
+@numba.njit(inline="always", **JIT)
+def _rebound_chunk(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, lo, hi):
+    """:func:`rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows."""
+    _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, V_out[lo:hi], W_out[lo:hi], status[lo:hi],
+                    scaled, np.empty((BLOCK, INDEX), dtype=np.int64), np.empty((BLOCK, FRAME)))
 
 
 @numba.njit(parallel=True, **JIT)
 def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
     """:func:`draw_local` for every row (parallel); out has shape (N, 6)."""
-    for i in numba.prange(alpha1.shape[0]):
-        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i], scaled)
+    for j in numba.prange((alpha1.shape[0] + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM):
+        lo, hi = _chunk(j, alpha1.shape[0])
+        _draw_local_chunk(data, mix_cdf, alpha1, speed, u[lo:hi], out, status, scaled, lo, hi)
+
+
+@numba.njit(parallel=True, **JIT)
+def draw_local_batch_rng(data, mix_cdf, alpha1, speed, states, out, status, scaled=True):
+    """:func:`draw_local_batch` drawing its own uniforms, chunk by chunk as :func:`rebound_batch_rng`."""
+    for j in numba.prange(states.shape[0]):
+        lo, hi = _chunk(j, alpha1.shape[0])
+        _draw_local_chunk(data, mix_cdf, alpha1, speed, _stream_uniforms(states[j], hi - lo), out, status, scaled,
+                          lo, hi)
+
+
+@numba.njit(inline="always", **JIT)
+def _draw_local_chunk(data, mix_cdf, alpha1, speed, u, out, status, scaled, lo, hi):
+    """:func:`draw_local` on rows [lo, hi) with the uniforms ``u`` of those rows."""
+    for i in range(lo, hi):
+        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i - lo], scaled)
         status[i] = st
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = a2, b2, s, wx, wy, wz

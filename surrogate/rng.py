@@ -7,6 +7,10 @@ few integer operations from a state of four 64-bit words that the caller
 owns: one state per thread (or per particle stream) keeps a parallel solver
 reproducible whatever the scheduling.
 
+The batch kernels (:func:`surrogate.kernels.rebound_batch_rng`) draw rows in
+chunks of :data:`ROWS_PER_STREAM`, chunk j from its own state
+(:func:`stream_states`), so their draws do not depend on the number of threads.
+
 Usage from a solver's ``@njit`` loop::
 
     state = surrogate.rng.seed_state(1234)           # NumPy side, (4,) uint64
@@ -24,6 +28,7 @@ import numba
 import numpy as np
 
 _53_BITS = 1.0 / 9007199254740992.0      # 2**-53
+ROWS_PER_STREAM = 1024      # rows a batch kernel draws from one state (one chunk of its parallel loop)
 
 
 def seed_state(seed: int, n_streams: int | None = None) -> np.ndarray:
@@ -41,6 +46,15 @@ def seed_state(seed: int, n_streams: int | None = None) -> np.ndarray:
     state = np.array([child.generate_state(4, np.uint64) for child in children], dtype=np.uint64)
     state[np.all(state == 0, axis=1), 0] = 1
     return state[0] if n_streams is None else state
+
+
+def stream_states(generator: np.random.Generator, n_rows: int) -> np.ndarray:
+    """xoshiro256+ states for a batch of ``n_rows`` draws: (⌈n_rows / ROWS_PER_STREAM⌉, 4) uint64, one per
+    chunk of rows, drawn from ``generator`` (so a seeded Generator gives the same batch every time)."""
+    n_streams = -(-int(n_rows) // ROWS_PER_STREAM)
+    state = generator.integers(0, np.iinfo(np.uint64).max, size=(n_streams, 4), dtype=np.uint64, endpoint=True)
+    state[np.all(state == 0, axis=1), 0] = 1
+    return state
 
 
 @numba.njit(inline="always", cache=True, nogil=True)

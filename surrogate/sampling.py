@@ -28,7 +28,8 @@ from typing import NamedTuple
 import numpy as np
 
 from data_schema.samples import SHAPE_NAMES
-from surrogate.kernels import U_PER_DRAW, draw_local_batch, rebound_batch
+from surrogate.kernels import draw_local_batch_rng, rebound_batch_rng
+from surrogate.rng import stream_states
 from surrogate.table import SurrogateTable
 
 NORMAL_TOLERANCE = 1e-6
@@ -132,12 +133,12 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
     _check_range("alpha1", a, table.alpha1_range, clamp, "deg")
     _check_range("speed", v, table.speed_range, clamp, "m/s")
     cdf = mix_cdf(table, shape)
-    rng = check_random_state(random_state)
-    u = rng.random((len(a), U_PER_DRAW))
+    scaled = _scaled(interpolation)
+    states = stream_states(check_random_state(random_state), len(a))
     out = np.empty((len(a), 6))
     status = np.empty(len(a), dtype=np.int8)
-    draw_local_batch(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), u, out, status,
-                     _scaled(interpolation))
+    draw_local_batch_rng(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), states, out,
+                         status, scaled)
     return LocalDraws(alpha2=out[:, 0], beta2=out[:, 1], speed_ratio=out[:, 2], omega=out[:, 3:], status=status)
 
 
@@ -165,7 +166,10 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         length differs from 1 by more than 1e-6 are rejected, not normalised.
     half_size : (N,) or scalar, particle half-size a in m (half the largest extent).
     shape : shape name or mix (see :func:`mix_cdf`).
-    random_state : int, Generator or None.
+    random_state : int, Generator or None. The uniforms are drawn inside the
+        kernel, one xoshiro256+ stream per chunk of particles seeded from it
+        (:func:`surrogate.rng.stream_states`): the same seed gives the same
+        draws whatever the number of threads.
     interpolation : between grid points, ``"scaled"`` (default: the law of a
         neighbouring grid point drawn with its interpolation weight, then moved
         to the incident α1 by the interpolated means and standard deviations and
@@ -205,11 +209,11 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     _check_range("alpha1", alpha1, table.alpha1_range, clamp, "deg")
     _check_range("speed", speed, table.speed_range, clamp, "m/s")
     cdf = mix_cdf(table, shape)
-    rng = check_random_state(random_state)
-    u = rng.random((n_particles, U_PER_DRAW))
+    scaled = _scaled(interpolation)
+    states = stream_states(check_random_state(random_state), n_particles)
     V_out = np.empty((n_particles, 3))
     W_out = np.empty((n_particles, 3))
     status = np.empty(n_particles, dtype=np.int8)
-    rebound_batch(table.kernel_data, cdf, np.ascontiguousarray(V), np.ascontiguousarray(nrm),
-                  np.ascontiguousarray(a), u, V_out, W_out, status, _scaled(interpolation))
+    rebound_batch_rng(table.kernel_data, cdf, np.ascontiguousarray(V), np.ascontiguousarray(nrm),
+                      np.ascontiguousarray(a), states, V_out, W_out, status, scaled)
     return V_out, W_out, status

@@ -73,3 +73,13 @@ def test_streams_are_distinct_and_reproducible():
 def test_bad_seeds_are_rejected(kwargs, message):
     with pytest.raises(ValueError, match=message):
         seed_state(**kwargs)
+
+
+def test_stream_states_one_per_chunk_and_reproducible():
+    from surrogate.rng import ROWS_PER_STREAM, stream_states
+    for rows, streams in ((0, 0), (1, 1), (ROWS_PER_STREAM, 1), (ROWS_PER_STREAM + 1, 2)):
+        states = stream_states(np.random.default_rng(3), rows)
+        assert states.shape == (streams, 4) and states.dtype == np.uint64
+    a = stream_states(np.random.default_rng(3), 10 * ROWS_PER_STREAM)
+    np.testing.assert_array_equal(a, stream_states(np.random.default_rng(3), 10 * ROWS_PER_STREAM))
+    assert len({tuple(row) for row in a}) == 10 and not np.any(np.all(a == 0, axis=1))

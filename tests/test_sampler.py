@@ -11,7 +11,9 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, rebound, rebound_batch, rebound_many, rebound_tuple
+from surrogate.kernels import (STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch, rebound_many,
+                               rebound_tuple)
+from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, stream_states
 from surrogate.table import CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
 
@@ -205,6 +207,50 @@ def test_reproducible_and_generator_accepted(small_table):
     b = surrogate.sample_local(small_table, np.full(100, 45.0), 150.0, "prism",
                                random_state=np.random.default_rng(1))
     np.testing.assert_array_equal(a.alpha2, b.alpha2)
+
+
+def test_api_draws_do_not_depend_on_the_thread_count(small_table):
+    """sample_global and sample_local draw the rows of chunk j from the xoshiro256+ state j of
+    stream_states: the same bits on one and on two threads, and the same as rebound_many and draw_local
+    on the uniforms those states give row after row (2 full chunks and a partial one)."""
+    m = 2 * ROWS_PER_STREAM + 77
+    rng = np.random.default_rng(4)
+    speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
+    V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m)])
+    n, a = np.tile([0.0, 1.0, 0.0], (m, 1)), np.full(m, 1e-4)
+    before = numba.get_num_threads()
+    runs = []
+    try:
+        for threads in sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}):
+            numba.set_num_threads(threads)
+            runs.append((surrogate.sample_global(small_table, V, n, a, "mix", random_state=5),
+                         surrogate.sample_local(small_table, np.degrees(a1), speed, "mix", random_state=6)))
+    finally:
+        numba.set_num_threads(before)
+    (V1, W1, s1), local = runs[0]
+    for (V2, W2, s2), local2 in runs[1:]:
+        for x, y in zip((V1, W1, s1) + tuple(local), (V2, W2, s2) + tuple(local2)):
+            np.testing.assert_array_equal(x, y)
+
+    def uniforms(seed):
+        states = stream_states(np.random.default_rng(seed), m)
+        assert states.shape == (3, 4)
+        U = np.empty((m, U_PER_DRAW))
+        for j, state in enumerate(states):
+            fill_uniforms(state.copy(), U[j * ROWS_PER_STREAM:(j + 1) * ROWS_PER_STREAM].reshape(-1))
+        return U
+
+    cdf = surrogate.mix_cdf(small_table, "mix")
+    V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_many(small_table.kernel_data, cdf, V, n, a, uniforms(5), V3, W3, s3)
+    np.testing.assert_array_equal(V1, V3)
+    np.testing.assert_array_equal(W1, W3)
+    np.testing.assert_array_equal(s1, s3)
+    U = uniforms(6)
+    for i in (0, ROWS_PER_STREAM, m - 1):
+        expected = draw_local(small_table.kernel_data, cdf, np.degrees(a1[i]), speed[i], U[i])
+        got = (local.status[i], local.alpha2[i], local.beta2[i], local.speed_ratio[i], *local.omega[i])
+        np.testing.assert_array_equal(got, expected)
 
 
 @numba.njit
