@@ -8,9 +8,10 @@ and prints the cost in ns per reflected state:
 (a) ``surrogate.sample_global(table, V, normals, a, shape, random_state)``, the
     vectorised NumPy API in the global frame, with numba's default thread
     count and with one numba thread. The time covers the whole call: input
-    checks, the NumPy draw of the U_PER_DRAW uniforms per state, the parallel
-    kernel and the outputs. Two breakdown rows time
-    ``surrogate.kernels.rebound_batch`` alone on pre-drawn uniforms;
+    checks, the seeding of one xoshiro256+ stream per 1024 states, the
+    parallel kernel (which draws the U_PER_DRAW uniforms per state) and the
+    outputs. Two breakdown rows time that kernel,
+    ``surrogate.kernels.rebound_batch_rng``, alone;
 (b) ``surrogate.kernels.rebound_tuple`` called from a user's ``@njit`` loop
     on one thread, as a flow solver would call it per wall hit: the particle's
     V and n passed as 3-tuples of its components and V⁺, Ω⁺ returned as
@@ -97,8 +98,8 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch, rebound_many, rebound_tuple
-from surrogate.rng import fill_uniforms, seed_state
+from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch_rng, rebound_many, rebound_tuple
+from surrogate.rng import fill_uniforms, seed_state, stream_states
 
 SEED = 20240601
 HALF_SIZE = 1e-4                    # m, particle half-size a
@@ -425,7 +426,9 @@ def main(argv=None) -> int:
     # warm-up: compile everything timed below (a small slice; numba caches per type signature)
     m = min(count, 1000)
     surrogate.sample_global(table, V[:m], nrm[:m], a[:m], shape=mix, random_state=SEED)
-    rebound_batch(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m])
+    rebound_batch_rng(data, cdf, V[:m], nrm[:m], a[:m], stream_states(np.random.default_rng(SEED), m),
+                      V_out[:m], W_out[:m], status[:m])
+    streams = stream_states(np.random.default_rng(SEED), count)
     seed_numba_rng(SEED)
     loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
     loop_kernel_nprandom(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
@@ -458,10 +461,10 @@ def main(argv=None) -> int:
 
     record("a_all", "(a) sample_global, all cores", threads, api)
     record("a_1", "(a) sample_global, 1 numba thread", 1, api)
-    record("a_kernel_all", "    breakdown: rebound_batch alone, all cores", threads,
-           lambda: rebound_batch(data, cdf, V, nrm, a, U, V_out, W_out, status), note="pre-drawn uniforms")
-    record("a_kernel_1", "    breakdown: rebound_batch alone, 1 thread", 1,
-           lambda: rebound_batch(data, cdf, V, nrm, a, U, V_out, W_out, status), note="pre-drawn uniforms")
+    record("a_kernel_all", "    breakdown: rebound_batch_rng, all cores", threads,
+           lambda: rebound_batch_rng(data, cdf, V, nrm, a, streams, V_out, W_out, status))
+    record("a_kernel_1", "    breakdown: rebound_batch_rng, 1 thread", 1,
+           lambda: rebound_batch_rng(data, cdf, V, nrm, a, streams, V_out, W_out, status))
     trapped_api = float(np.mean(api()[2] != 0))
     record("b", "(b) rebound_tuple in @njit loop, xoshiro256+", 1,
            lambda: loop_kernel_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, W_out, status))

@@ -14,7 +14,10 @@ From numba code, call :func:`surrogate.kernels.rebound_tuple` (or
 them fast from a caller-owned xoshiro256+ state (:func:`surrogate.rng.seed_state`).
 A solver that collects its wall hits of a time step should pass them all to
 :func:`surrogate.kernels.rebound_many`, which overlaps their table reads
-(same results, a fraction of the cost on tables larger than the CPU caches).
+(same results, a fraction of the cost on tables larger than the CPU caches);
+:func:`surrogate.kernels.rebound_batch_rng` does the same on all threads,
+drawing its uniforms from one xoshiro256+ stream per chunk of rows
+(:func:`surrogate.rng.stream_states`), as :func:`sample_global` does.
 """
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED

@@ -512,11 +512,19 @@ def rebound_batch_rng(data, mix_cdf, V, n, a, states, V_out, W_out, status, scal
     """:func:`rebound_batch` drawing its own uniforms: the rows of chunk j (ROWS_PER_STREAM rows) from a
     copy of the xoshiro256+ state ``states[j]`` (:func:`surrogate.rng.stream_states`; ``states`` itself is
     not advanced), row after row. The draws are the same whatever the number of threads, and no
-    (N, U_PER_DRAW) array of uniforms is held."""
+    (N, U_PER_DRAW) array of uniforms is held. ``states`` must have one row per chunk (ValueError)."""
+    _check_streams(states, V.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, V.shape[0])
         _rebound_chunk(data, mix_cdf, V, n, a, _stream_uniforms(states[j], hi - lo), V_out, W_out, status, scaled,
                        lo, hi)
+
+
+@numba.njit(**JIT)
+def _check_streams(states, n_rows):
+    if states.shape[0] != (n_rows + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM or states.shape[1] != 4:
+        raise ValueError("'states' must hold one xoshiro256+ state (4 words) per ROWS_PER_STREAM rows, as "
+                         "surrogate.rng.stream_states(generator, n_rows) gives")
 
 
 @numba.njit(inline="always", **JIT)
@@ -551,6 +559,7 @@ def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
 @numba.njit(parallel=True, **JIT)
 def draw_local_batch_rng(data, mix_cdf, alpha1, speed, states, out, status, scaled=True):
     """:func:`draw_local_batch` drawing its own uniforms, chunk by chunk as :func:`rebound_batch_rng`."""
+    _check_streams(states, alpha1.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, alpha1.shape[0])
         _draw_local_chunk(data, mix_cdf, alpha1, speed, _stream_uniforms(states[j], hi - lo), out, status, scaled,
