@@ -29,6 +29,9 @@ import numpy as np
 
 from data_schema.samples import SHAPE_NAMES
 from surrogate.kernels import draw_local_batch_rng, rebound_batch_rng
+from surrogate.faults import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE, FAULT_NORMAL_NOT_FINITE,
+                              FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL, FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE,
+                              FAULT_VELOCITY_NOT_FINITE, FAULT_VELOCITY_ZERO, first_faults)
 from surrogate.rng import stream_states
 from surrogate.table import SurrogateTable
 
@@ -110,14 +113,22 @@ def _check_range(name, values, bounds, clamp, units) -> None:
     """
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
-        raise ValueError(f"The '{name}' value at index {bad[0]} is not finite: {values[bad[0]]!r}.")
+        raise _not_finite(name, bad[0], values[bad[0]])
     if clamp:
         return
     lo, hi = bounds
     bad = np.flatnonzero((values < lo) | (values > hi))
     if bad.size:
-        raise ValueError(f"The '{name}' value {values[bad[0]]!r} {units} (index {bad[0]}) is outside the table's "
-                         f"range [{lo:g}, {hi:g}]; pass clamp=True to use the law at the nearest grid edge.")
+        raise _outside(name, bad[0], values[bad[0]], bounds, units)
+
+
+def _not_finite(name, index, value) -> ValueError:
+    return ValueError(f"The '{name}' value at index {index} is not finite: {value!r}.")
+
+
+def _outside(name, index, value, bounds, units) -> ValueError:
+    return ValueError(f"The '{name}' value {value!r} {units} (index {index}) is outside the table's range "
+                      f"[{bounds[0]:g}, {bounds[1]:g}]; pass clamp=True to use the law at the nearest grid edge.")
 
 
 def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random_state=None,
@@ -148,10 +159,49 @@ def _vectors(name, value, n=None):
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 3 or (n is not None and arr.shape[0] not in (1, n)):
         raise ValueError(f"The '{name}' parameter must have shape (N, 3); got {np.shape(value)}.")
-    bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1))
-    if bad.size:
-        raise ValueError(f"The '{name}' vector at index {bad[0]} is not finite: {arr[bad[0]]!r}.")
     return arr
+
+
+def _rows(x, n):
+    """``x`` with n rows (its one row repeated if it has one): the kernels read row i of every input."""
+    return x if len(x) == n else np.ascontiguousarray(np.broadcast_to(x, (n,) + x.shape[1:]))
+
+
+def _check_incident(table: SurrogateTable, V, nrm, a, clamp: bool) -> None:
+    """The checks of :func:`sample_global` in one parallel pass (:func:`surrogate.faults.first_faults`):
+    raise for the first check, in FAULT_* order, that a row fails, naming that check's first such row.
+    ``nrm`` and ``a`` have N rows or one for all."""
+    first = first_faults(V, nrm, a, NORMAL_TOLERANCE, *table.alpha1_range, *table.speed_range)
+    for fault in np.flatnonzero(first >= 0):
+        if not (clamp and fault in (FAULT_ALPHA1_OUTSIDE, FAULT_SPEED_OUTSIDE)):
+            raise _fault_error(int(fault), int(first[fault]), table, V, nrm, a)
+
+
+def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueError:
+    """The error for check ``fault`` (surrogate.faults) failing first at particle i."""
+    j, k = min(i, len(nrm) - 1), min(i, len(a) - 1)      # the rows of its normal and of its half-size
+    if fault == FAULT_VELOCITY_NOT_FINITE:
+        return ValueError(f"The 'velocity' vector at index {i} is not finite: {V[i]!r}.")
+    if fault == FAULT_NORMAL_NOT_FINITE:
+        return ValueError(f"The 'normal' vector at index {j} is not finite: {nrm[j]!r}.")
+    if fault == FAULT_NORMAL_NOT_UNIT:
+        return ValueError(f"The 'normal' at index {j} has length {float(np.linalg.norm(nrm[j]))!r}; wall normals "
+                          f"must be unit vectors (|n| - 1 within {NORMAL_TOLERANCE}).")
+    if fault == FAULT_VELOCITY_ZERO:
+        return ValueError(f"The 'velocity' at index {i} is zero; a particle must move into the wall.")
+    vn, speed = float(np.dot(V[i], nrm[j])), float(np.linalg.norm(V[i]))
+    if fault == FAULT_NOT_INTO_WALL:
+        return ValueError(f"The 'velocity' at index {i} does not move into the wall: V.n = {vn!r} m/s must be < 0.")
+    if fault == FAULT_HALF_SIZE:
+        return ValueError(f"The 'half_size' at index {k} must be finite and > 0 m; got {a[k]!r}.")
+    alpha1 = float(np.degrees(np.arctan2(-vn, np.sqrt(max(speed ** 2 - vn ** 2, 0.0)))))
+    if fault == FAULT_ALPHA1_NOT_FINITE:
+        return _not_finite("alpha1", i, alpha1)
+    if fault == FAULT_ALPHA1_OUTSIDE:
+        return _outside("alpha1", i, alpha1, table.alpha1_range, "deg")
+    if fault == FAULT_SPEED_NOT_FINITE:
+        return _not_finite("speed", i, speed)
+    return _outside("speed", i, speed, table.speed_range, "m/s")
 
 
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
@@ -184,36 +234,21 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8); NaN rows for
     trapped particles.
     """
-    V = _vectors("velocity", velocity)
+    V = np.ascontiguousarray(_vectors("velocity", velocity))
     n_particles = V.shape[0]
-    nrm = np.broadcast_to(_vectors("normal", normal, n_particles), (n_particles, 3))
-    length = np.linalg.norm(nrm, axis=1)
-    bad = np.flatnonzero(np.abs(length - 1.0) > NORMAL_TOLERANCE)
-    if bad.size:
-        raise ValueError(f"The 'normal' at index {bad[0]} has length {length[bad[0]]!r}; wall normals must be "
-                         f"unit vectors (|n| - 1 within {NORMAL_TOLERANCE}).")
-    speed = np.linalg.norm(V, axis=1)
-    bad = np.flatnonzero(speed == 0)
-    if bad.size:
-        raise ValueError(f"The 'velocity' at index {bad[0]} is zero; a particle must move into the wall.")
-    vn = np.einsum("ij,ij->i", V, nrm)
-    bad = np.flatnonzero(vn >= 0)
-    if bad.size:
-        raise ValueError(f"The 'velocity' at index {bad[0]} does not move into the wall: V.n = {vn[bad[0]]!r} "
-                         f"m/s must be < 0.")
-    a = np.broadcast_to(np.asarray(half_size, dtype=np.float64), (n_particles,))
-    bad = np.flatnonzero(~(np.isfinite(a) & (a > 0)))
-    if bad.size:
-        raise ValueError(f"The 'half_size' at index {bad[0]} must be finite and > 0 m; got {a[bad[0]]!r}.")
-    alpha1 = np.degrees(np.arctan2(-vn, np.sqrt(np.maximum(speed ** 2 - vn ** 2, 0.0))))
-    _check_range("alpha1", alpha1, table.alpha1_range, clamp, "deg")
-    _check_range("speed", speed, table.speed_range, clamp, "m/s")
+    nrm = np.ascontiguousarray(_vectors("normal", normal, n_particles))
+    a = np.asarray(half_size, dtype=np.float64)
+    if a.ndim > 1 or a.size not in (1, n_particles):
+        raise ValueError(f"The 'half_size' parameter must be a scalar or have shape ({n_particles},); "
+                         f"got {a.shape}.")
+    a = np.ascontiguousarray(a.reshape(-1))
+    _check_incident(table, V, nrm, a, clamp)
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
     states = stream_states(check_random_state(random_state), n_particles)
     V_out = np.empty((n_particles, 3))
     W_out = np.empty((n_particles, 3))
     status = np.empty(n_particles, dtype=np.int8)
-    rebound_batch_rng(table.kernel_data, cdf, np.ascontiguousarray(V), np.ascontiguousarray(nrm),
-                      np.ascontiguousarray(a), states, V_out, W_out, status, scaled)
+    rebound_batch_rng(table.kernel_data, cdf, V, _rows(nrm, n_particles), _rows(a, n_particles), states, V_out, W_out,
+                      status, scaled)
     return V_out, W_out, status

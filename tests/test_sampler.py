@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import (STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch, rebound_many,
-                               rebound_tuple)
+from surrogate.kernels import (STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch, rebound_batch_rng,
+                               rebound_many, rebound_tuple)
 from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, stream_states
 from surrogate.table import CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
@@ -246,6 +246,9 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
     np.testing.assert_array_equal(V1, V3)
     np.testing.assert_array_equal(W1, W3)
     np.testing.assert_array_equal(s1, s3)
+    for wrong in (stream_states(np.random.default_rng(5), m - ROWS_PER_STREAM), np.ones((3, 3), np.uint64)):
+        with pytest.raises(ValueError, match="one xoshiro256\\+ state"):
+            rebound_batch_rng(small_table.kernel_data, cdf, V, n, a, wrong, V3, W3, s3)
     U = uniforms(6)
     for i in (0, ROWS_PER_STREAM, m - 1):
         expected = draw_local(small_table.kernel_data, cdf, np.degrees(a1[i]), speed[i], U[i])
@@ -353,6 +356,41 @@ def test_bad_input_is_rejected_with_the_value(small_table, kwargs, message):
                 random_state=0) | kwargs
     with pytest.raises(ValueError, match=message):
         surrogate.sample_global(small_table, **args)
+
+
+def test_the_error_names_the_first_failing_check_and_its_first_row(small_table):
+    """Several bad rows over three chunks of the parallel check: the error names the first check, in the
+    documented order, that any row fails, and the first row failing it; clamp=True lets the range
+    checks pass. Each step fixes the reported fault and expects the next."""
+    m = 3000
+    a1 = np.radians(60.0)
+    V = np.tile([100.0 * np.cos(a1), -100.0 * np.sin(a1), 0.0], (m, 1))
+    n = np.tile([0.0, 1.0, 0.0], (m, 1))
+    a = np.full(m, 1e-4)
+    V[2500], V[2900], V[2950] = [10.0, 5.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+    V[1500] = [100.0 * np.cos(np.radians(10.0)), -100.0 * np.sin(np.radians(10.0)), 0.0]   # α1 = 10° < 30°
+    V[700] = [0.0, -400.0, 0.0]                                                            # 400 m/s > 250
+    V[2999] = [np.nan, -100.0, 0.0]
+    n[1200] = [0.0, 2.0, 0.0]
+    a[2000] = -1.0
+    steps = [(r"'velocity' vector at index 2999 is not finite", lambda: V.__setitem__(2999, V[0])),
+             (r"'normal' at index 1200 has length 2\.0", lambda: n.__setitem__(1200, n[0])),
+             (r"'velocity' at index 2900 is zero", lambda: V.__setitem__(slice(2900, 2951, 50), V[0])),
+             (r"'velocity' at index 2500 does not move into the wall", lambda: V.__setitem__(2500, V[0])),
+             (r"'half_size' at index 2000 must be finite", lambda: a.__setitem__(2000, 1e-4))]
+    for message, fix in steps:
+        with pytest.raises(ValueError, match=message):
+            surrogate.sample_global(small_table, V, n, a, "prism", random_state=0)
+        fix()
+    with pytest.raises(ValueError, match=r"'alpha1' value [\d.]+ deg \(index 1500\)"):
+        surrogate.sample_global(small_table, V, n, a, "prism", random_state=0)
+    V_out, _, status = surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, clamp=True)
+    assert np.all(np.isfinite(V_out[status == STATUS_REBOUNDED])) and status[700] in (STATUS_REBOUNDED, STATUS_TRAPPED)
+    V[1500] = V[0]
+    with pytest.raises(ValueError, match=r"'speed' value 400\.0 m/s \(index 700\)"):
+        surrogate.sample_global(small_table, V, n, a, "prism", random_state=0)
+    with pytest.raises(ValueError, match=r"'half_size' parameter must be a scalar or have shape \(3000,\)"):
+        surrogate.sample_global(small_table, V, n, np.full(7, 1e-4), "prism")
 
 
 def test_clamp_uses_the_nearest_edge(small_table):
