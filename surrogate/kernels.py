@@ -1,9 +1,9 @@
 """Numba kernels of the runtime sampler: O(1) work per reflected state.
 
 These are plain functions over the arrays of a table (``table.kernel_data``, a
-named tuple of flat arrays and their sizes) and pre-drawn uniforms, so a flow solver can call them
-from its own ``@njit`` loop. Every draw consumes exactly :data:`U_PER_DRAW`
-uniforms from [0, 1)::
+named tuple of flat arrays and their sizes) and pre-drawn uniforms, so a flow
+solver can call them from its own ``@njit`` loop. Every draw consumes exactly
+:data:`U_PER_DRAW` uniforms from [0, 1)::
 
     u[0] shape from the mix        u[1] α1 neighbour       u[2] speed neighbour
     u[3] trapped or not            u[4] mixture component  u[5:11] the six chain variables
@@ -81,7 +81,7 @@ def locate(axis, n, x):
     k = int((x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP))
     k = min(max(k, 0), axis.shape[0] - 1 - lookup)
     j = int(load(axis, lookup + k))
-    j += (x >= load(axis, AXIS_GRID + j + 1)) & (j < n - 2)     # the one-step correction, without a branch to mispredict
+    j += (x >= load(axis, AXIS_GRID + j + 1)) & (j < n - 2)     # one-step correction, no branch to mispredict
     w = (x - load(axis, AXIS_GRID + j)) * load(axis, inverse + j)
     return j, min(max(w, 0.0), 1.0)
 
@@ -115,7 +115,7 @@ def _residual(data, cell, row, k, u):
 
 @numba.njit(inline="always", **JIT)
 def draw_folded(data, cell, u):
-    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell number ``cell`` from u[4:11], and its cluster's regime.
+    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell number ``cell`` from u[4:11], and its regime.
 
     Representation (data_schema.table): u[4] picks the mixture component c with
     the Walker alias table (one multiply, one floor, one compare); then chain
