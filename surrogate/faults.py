@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from surrogate.kernels import JIT, _dot, impact_frame
-from surrogate.rng import ROWS_PER_STREAM
+from surrogate.rng import ROWS_PER_STREAM, n_streams
 
 FAULT_VELOCITY_NOT_FINITE = 0
 FAULT_NORMAL_NOT_FINITE = 1
@@ -36,7 +36,7 @@ def first_faults(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
     """First failing row of each check (FAULT_* order; −1 if none) over V (N, 3) m/s, unit normals n (N, 3)
     or (1, 3) for all rows, half-sizes a (N,) or (1,) m; ``tolerance`` on |n| − 1, the α1 range in degrees
     and the speed range in m/s."""
-    n_chunks = (V.shape[0] + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM
+    n_chunks = n_streams(V.shape[0])
     found = np.full((n_chunks, N_FAULTS), -1, dtype=np.int64)
     last_n, last_a = n.shape[0] - 1, a.shape[0] - 1
     for j in numba.prange(n_chunks):

@@ -51,7 +51,7 @@ from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.fused import fma
 from surrogate.memory import load, prefetch
 from surrogate.restitution import restitution_at
-from surrogate.rng import ROWS_PER_STREAM, fill_uniforms
+from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, n_streams
 from surrogate.table import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD,
                              CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE,
                              ROW_SIZE, ROW_SLOPE)
@@ -502,7 +502,7 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, ind
 @numba.njit(parallel=True, **JIT)
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row (parallel over chunks of :func:`rebound_many`); u has shape (N, U_PER_DRAW)."""
-    for j in numba.prange((V.shape[0] + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM):
+    for j in numba.prange(n_streams(V.shape[0])):
         lo, hi = _chunk(j, V.shape[0])
         _rebound_chunk(data, mix_cdf, V, n, a, u[lo:hi], V_out, W_out, status, scaled, lo, hi)
 
@@ -522,7 +522,7 @@ def rebound_batch_rng(data, mix_cdf, V, n, a, states, V_out, W_out, status, scal
 
 @numba.njit(**JIT)
 def _check_streams(states, n_rows):
-    if states.shape[0] != (n_rows + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM or states.shape[1] != 4:
+    if states.shape[0] != n_streams(n_rows) or states.shape[1] != 4:
         raise ValueError("'states' must hold one xoshiro256+ state (4 words) per ROWS_PER_STREAM rows, as "
                          "surrogate.rng.stream_states(generator, n_rows) gives")
 
@@ -551,7 +551,7 @@ def _rebound_chunk(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, lo, 
 @numba.njit(parallel=True, **JIT)
 def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
     """:func:`draw_local` for every row (parallel); out has shape (N, 6)."""
-    for j in numba.prange((alpha1.shape[0] + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM):
+    for j in numba.prange(n_streams(alpha1.shape[0])):
         lo, hi = _chunk(j, alpha1.shape[0])
         _draw_local_chunk(data, mix_cdf, alpha1, speed, u[lo:hi], out, status, scaled, lo, hi)
 

@@ -48,11 +48,17 @@ def seed_state(seed: int, n_streams: int | None = None) -> np.ndarray:
     return state[0] if n_streams is None else state
 
 
+@numba.njit(inline="always", cache=True, nogil=True)
+def n_streams(n_rows):
+    """Chunks of ROWS_PER_STREAM rows (the last may be partial) in a batch of ``n_rows``."""
+    return (n_rows + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM
+
+
 def stream_states(generator: np.random.Generator, n_rows: int) -> np.ndarray:
     """xoshiro256+ states for a batch of ``n_rows`` draws: (⌈n_rows / ROWS_PER_STREAM⌉, 4) uint64, one per
     chunk of rows, drawn from ``generator`` (so a seeded Generator gives the same batch every time)."""
-    n_streams = -(-int(n_rows) // ROWS_PER_STREAM)
-    state = generator.integers(0, np.iinfo(np.uint64).max, size=(n_streams, 4), dtype=np.uint64, endpoint=True)
+    state = generator.integers(0, np.iinfo(np.uint64).max, size=(n_streams(int(n_rows)), 4), dtype=np.uint64,
+                               endpoint=True)
     state[np.all(state == 0, axis=1), 0] = 1
     return state
 
