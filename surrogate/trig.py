@@ -49,8 +49,7 @@ def sincos(x):
     return sign * (c if odd else s), sign * (-s if odd else c)
 
 
-_ATAN_NODES = (0.0, 0.25, 0.5, 0.75, 1.0)
-_ATAN_AT_NODES = tuple(math.atan(c) for c in _ATAN_NODES)
+_ATAN_AT_NODES = tuple(math.atan(0.25 * node) for node in range(5))
 
 
 @numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
@@ -58,13 +57,16 @@ def atan2_first_quadrant(y, x):
     """atan2(y, x) in radians for x ≥ 0, y ≥ 0, not both 0, to a few ulp."""
     swap = y > x
     lo, hi = (x, y) if swap else (y, x)
-    # the node c nearest to t = lo/hi, chosen without dividing (midpoints 1/8, 3/8, 5/8, 7/8)
+    # the node c = node/4 nearest to t = lo/hi, chosen without dividing (midpoints 1/8, 3/8, 5/8, 7/8)
     node = (lo > 0.125 * hi) + (lo > 0.375 * hi) + (lo > 0.625 * hi) + (lo > 0.875 * hi)
-    c = _ATAN_NODES[node]
+    c = 0.25 * node
     z = fma(-c, hi, lo) / fma(c, lo, hi)
     w = z * z
     p = fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, -1.0 / 17.0, 1.0 / 15.0), -1.0 / 13.0), 1.0 / 11.0),
                                  -1.0 / 9.0), 1.0 / 7.0), -1.0 / 5.0), 1.0 / 3.0)
     atan_z = fma(-z * w, p, z)
-    angle = _ATAN_AT_NODES[node] + atan_z
+    # atan c by selects (a tuple indexed by ``node`` would compile to a jump table, which no SIMD loop takes)
+    atan_c = _ATAN_AT_NODES[0] if node == 0 else _ATAN_AT_NODES[1] if node == 1 else _ATAN_AT_NODES[2] if node == 2 \
+        else _ATAN_AT_NODES[3] if node == 3 else _ATAN_AT_NODES[4]
+    angle = atan_c + atan_z
     return 0.5 * math.pi - angle if swap else angle

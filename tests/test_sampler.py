@@ -436,12 +436,13 @@ def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
 
 
 def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
-    """_to_speed from grid speed V_j to V, a(V) = 1 − (1 − exp(−k V^p)) sin α1 (local frame, units of |V⁻|).
+    """_to_speed from grid speed V_j to V, a(V) = 1 − (1 − exp(−k V^p)) sin α1 (local frame, units of |V⁻|),
+    with exp(−k V^p) from the table (_restitution_factors) checked against the law itself.
 
     Regime 0: V⁺ − V⁻ and Ω⁺ times (1 + a(V))/(1 + a(V_j)), V⁻ = (cos α1, −sin α1, 0);
     regime 1: v⁺_n times a(V)/a(V_j), the rest kept; at V = V_j nothing moves.
     """
-    from surrogate.kernels import _to_speed
+    from surrogate.kernels import _restitution_factors, _to_speed
     data = small_table.kernel_data
     k, p = 0.1, 0.61       # the wall law the table was built with (tablegen's default)
     assert (small_table.restitution_k, small_table.restitution_p) == (k, p)
@@ -450,7 +451,7 @@ def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
     v, w = np.array([0.2, 0.3, -0.05]), np.array([0.4, -0.1, 0.7])
     a = lambda speed: 1.0 - (1.0 - np.exp(-k * speed ** p)) * s
     for regime in (0.0, 1.0):
-        same = _to_speed(data, regime, 1, 0.0, c, s, 1, *v, *w)
+        same = _to_speed(regime, *_restitution_factors(data, 1, 0.0, 1), c, s, *v, *w)
         np.testing.assert_allclose(same, np.concatenate([v, w]), rtol=1e-14)
     speed = 100.0
     grid = small_table.speed_m_s
@@ -458,9 +459,10 @@ def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
     wv = (speed - grid[jv]) / (grid[jv + 1] - grid[jv])
     assert 0.0 < wv < 1.0
     f = (1 + a(speed)) / (1 + a(grid[1]))
-    moved = _to_speed(data, 0.0, jv, wv, c, s, 1, *v, *w)
+    factors = _restitution_factors(data, jv, wv, 1)
+    moved = _to_speed(0.0, *factors, c, s, *v, *w)
     incident = np.array([c, -s, 0.0])
     np.testing.assert_allclose(moved, np.concatenate([incident + f * (v - incident), f * w]), rtol=1e-12)
-    moved = _to_speed(data, 1.0, jv, wv, c, s, 1, *v, *w)
+    moved = _to_speed(1.0, *factors, c, s, *v, *w)
     np.testing.assert_allclose(moved, np.concatenate([v * [1.0, a(speed) / a(grid[1]), 1.0], w]),
                                rtol=1e-12)
