@@ -22,8 +22,10 @@ and prints the cost in ns per reflected state:
     ``V[i]``, ``n[i]``, ``V_out[i]``, ``W_out[i]`` (array views); the uniforms
     from numba's ``np.random.random()``; (b') the loop reading pre-drawn
     uniforms; (b-block) a solver that collects its wall hits and calls
-    ``surrogate.kernels.rebound_many`` on them from ``@njit`` code (uniforms
-    from xoshiro256+ included); breakdown row: the xoshiro256+ draws alone;
+    ``surrogate.kernels.rebound_many_rng`` on them from ``@njit`` code (its
+    xoshiro256+ uniforms included), and the variant that first draws them
+    into an (N, 13) array for ``rebound_many``; breakdown row: the xoshiro256+
+    draws alone;
 (c) the direct model, ``tablegen.simulate.simulate`` with the shape mix, one
     thread, per particle simulated (whatever its status; NumPy input draws,
     kernel and result assembly included). The states' α1 distribution
@@ -98,7 +100,8 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import U_PER_DRAW, rebound, rebound_batch_rng, rebound_many, rebound_tuple
+from surrogate.kernels import (U_PER_DRAW, rebound, rebound_batch_rng, rebound_many, rebound_many_rng,
+                               rebound_tuple)
 from surrogate.rng import fill_uniforms, seed_state, stream_states
 
 SEED = 20240601
@@ -195,8 +198,14 @@ def loop_kernel_views(data, cdf, V, n, a, state, V_out, W_out, status):
 
 
 @numba.njit(**JIT)
-def loop_block_rng(data, cdf, V, n, a, state, U, V_out, W_out, status):
-    """(b, block) A solver that collects its wall hits: their uniforms (xoshiro256+) into U, then rebound_many."""
+def loop_block_rng(data, cdf, V, n, a, state, V_out, W_out, status):
+    """(b, block) A solver that collects its wall hits and calls rebound_many_rng on them with its state."""
+    rebound_many_rng(data, cdf, V, n, a, state, V_out, W_out, status)
+
+
+@numba.njit(**JIT)
+def loop_block_given(data, cdf, V, n, a, state, U, V_out, W_out, status):
+    """(b-block, U given) The same hits: their uniforms (xoshiro256+) into U first, then rebound_many."""
     for i in range(V.shape[0]):
         fill_uniforms(state, U[i])
     rebound_many(data, cdf, V, n, a, U, V_out, W_out, status)
@@ -433,7 +442,9 @@ def main(argv=None) -> int:
     loop_kernel_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
     loop_kernel_nprandom(data, cdf, V[:m], nrm[:m], a[:m], V_out[:m], W_out[:m], status[:m])
     U_block = U.copy()
-    loop_block_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), U_block[:m], V_out[:m], W_out[:m], status[:m])
+    loop_block_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
+    loop_block_given(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), U_block[:m], V_out[:m], W_out[:m],
+                     status[:m])
     loop_kernel_views(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], W_out[:m], status[:m])
     for scaled in (True, False):
         loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], W_out[:m], status[:m], scaled)
@@ -478,8 +489,10 @@ def main(argv=None) -> int:
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status, True))
     record("b_unscaled", "    breakdown: (b') without moment scaling", 1,
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, W_out, status, False))
-    record("b_block", "(b-block) rebound_many in @njit, xoshiro256+", 1,
-           lambda: loop_block_rng(data, cdf, V, nrm, a, seed_state(SEED), U_block, V_out, W_out, status))
+    record("b_block", "(b-block) rebound_many_rng in @njit", 1,
+           lambda: loop_block_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, W_out, status))
+    record("b_block_given", "    variant: uniforms into U, rebound_many", 1,
+           lambda: loop_block_given(data, cdf, V, nrm, a, seed_state(SEED), U_block, V_out, W_out, status))
     record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
            lambda: loop_rng_only(count, seed_state(SEED), np.empty(1)))
     record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))

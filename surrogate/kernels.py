@@ -138,51 +138,44 @@ def _fifteen(x, at, step):
 
 
 @numba.njit(inline="always", **JIT)
-def _level_reads(data, cell, row, k, u):
-    """(f, S_i, S_i+1) for chain variable k of the component at offset ``row`` of cell number ``cell``:
-    u falls at fraction f between residual-shape levels i and i + 1 (one multiply, one floor)."""
+def _quantile(data, cell, row, k, u):
+    """loc + scale · S(u) of chain variable k in the component at offset ``row`` of cell number ``cell``: the
+    residual shape S interpolated linearly between the levels i, i + 1 that u falls between (one multiply,
+    one floor)."""
+    r = data.clusters
     levels = data.n_levels - 1
     t = u * levels
     i = min(int(t), levels - 1)
-    at = _level(data, cell, k, i) + int(load(data.clusters, row + ROW_SHAPE + k))
-    return t - i, np.float64(load(data.dictionary, at)), np.float64(load(data.dictionary, at + data.n_dictionary))
+    at = _level(data, cell, k, i) + int(load(r, row + ROW_SHAPE + k))
+    lo, hi = np.float64(load(data.dictionary, at)), np.float64(load(data.dictionary, at + data.n_dictionary))
+    return fma(np.float64(load(r, row + ROW_SCALE + k)), fma(t - i, hi - lo, lo), np.float64(load(r, row + ROW_LOC + k)))
 
 
 @numba.njit(inline="always", **JIT)
-def _residual_reads(data, cell, row, u):
-    """The six-tuples (f, S_i, S_i+1) of :func:`_level_reads` for the chain variables at u[5:11]."""
-    r0, r1, r2 = (_level_reads(data, cell, row, 0, u[5]), _level_reads(data, cell, row, 1, u[6]),
-                  _level_reads(data, cell, row, 2, u[7]))
-    r3, r4, r5 = (_level_reads(data, cell, row, 3, u[8]), _level_reads(data, cell, row, 4, u[9]),
-                  _level_reads(data, cell, row, 5, u[10]))
-    return ((r0[0], r1[0], r2[0], r3[0], r4[0], r5[0]), (r0[1], r1[1], r2[1], r3[1], r4[1], r5[1]),
-            (r0[2], r1[2], r2[2], r3[2], r4[2], r5[2]))
+def _quantiles(data, cell, row, u):
+    """The residual quantiles (:func:`_quantile`) of the six chain variables at u[5:11]."""
+    return (_quantile(data, cell, row, 0, u[5]), _quantile(data, cell, row, 1, u[6]),
+            _quantile(data, cell, row, 2, u[7]), _quantile(data, cell, row, 3, u[8]),
+            _quantile(data, cell, row, 4, u[9]), _quantile(data, cell, row, 5, u[10]))
 
 
 @numba.njit(inline="always", **JIT)
-def _quantile(k, f, lo, hi, loc, scale):
-    """loc + scale · S(u) of chain variable k: the residual shape interpolated linearly between levels."""
-    return fma(scale[k], fma(f[k], hi[k] - lo[k], lo[k]), loc[k])
-
-
-@numba.njit(inline="always", **JIT)
-def _chain(f, lo, hi, loc, scale, b):
-    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of one component from its residual quantiles.
+def _chain(q, b):
+    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of one component from its residual quantiles ``q``.
 
     Chain variable k (α2, |β2|, s, Ω_z, Ω_x, Ω_y) is its residual quantile
-    (:func:`_quantile`) shifted by the component's slopes ``b`` on the
-    variables already drawn (x_k on x_i at b[k(k−1)/2 + i]). α2 is reflected
-    into [0, π] and |β2| capped at π/2 (the linear shifts can step outside by
-    a hair, ~1e-4 of draws).
+    shifted by the component's slopes ``b`` on the variables already drawn
+    (x_k on x_i at b[k(k−1)/2 + i]). α2 is reflected into [0, π] and |β2|
+    capped at π/2 (the linear shifts can step outside by a hair, ~1e-4 of
+    draws).
     """
     # each x_k gathers its terms in the order the x_i become available: one fused multiply-add after x_{k−1}
-    x0 = _quantile(0, f, lo, hi, loc, scale)
-    x1 = fma(b[0], x0, _quantile(1, f, lo, hi, loc, scale))
-    x2 = fma(b[2], x1, fma(b[1], x0, _quantile(2, f, lo, hi, loc, scale)))
-    x3 = fma(b[5], x2, fma(b[4], x1, fma(b[3], x0, _quantile(3, f, lo, hi, loc, scale))))
-    x4 = fma(b[9], x3, fma(b[8], x2, fma(b[7], x1, fma(b[6], x0, _quantile(4, f, lo, hi, loc, scale)))))
-    x5 = fma(b[14], x4, fma(b[13], x3, fma(b[12], x2, fma(b[11], x1, fma(b[10], x0, _quantile(5, f, lo, hi, loc,
-                                                                                           scale))))))
+    x0 = q[0]
+    x1 = fma(b[0], x0, q[1])
+    x2 = fma(b[2], x1, fma(b[1], x0, q[2]))
+    x3 = fma(b[5], x2, fma(b[4], x1, fma(b[3], x0, q[3])))
+    x4 = fma(b[9], x3, fma(b[8], x2, fma(b[7], x1, fma(b[6], x0, q[4]))))
+    x5 = fma(b[14], x4, fma(b[13], x3, fma(b[12], x2, fma(b[11], x1, fma(b[10], x0, q[5])))))
     return _folded(x0, x1, x2, x4, x5, x3)
 
 
@@ -199,48 +192,62 @@ def draw_folded(data, cell, u):
 
     Representation (data_schema.table): u[4] picks the mixture component with
     the Walker alias table (:func:`_component`), u[5:11] the residual
-    quantiles of the chain (:func:`_chain`). Arrays are read by scalar indices
+    quantiles (:func:`_quantiles`) of the chain (:func:`_chain`). Arrays are read by scalar indices
     only (no views, so no reference counting on the hot path).
     """
     r = data.clusters
     row = _component(data, cell, u[4])
-    f, lo, hi = _residual_reads(data, cell, row, u)
-    state = _chain(f, lo, hi, _six(r, row + ROW_LOC, 1), _six(r, row + ROW_SCALE, 1), _fifteen(r, row + ROW_SLOPE, 1))
+    state = _chain(_quantiles(data, cell, row, u), _fifteen(r, row + ROW_SLOPE, 1))
     return state + (np.float64(load(r, row + ROW_REGIME)),)
 
 
 @numba.njit(inline="always", **JIT)
-def _moment_reads(data, below, wa, drawn):
-    """The moments :func:`_moved` needs, six-tuples in state order: the standard deviations of cell ``below``
-    and of the next α1 up, 1/sd of cell ``drawn``, then the three cells' means. With wa = 0 the cell
-    above is not used (nor read: ``below`` may be in the last α1 row)."""
+def _alpha1_terms(data, below, wa, drawn):
+    """What moves a state drawn from cell ``drawn`` to the incident α1: (ratio, m_cell, m), six-tuples in
+    state order, for x' = m + (x − m_cell) · ratio (:func:`_moved`).
+
+    m and σ are interpolated linearly in α1 (weight wa of the upper
+    neighbour) between cell ``below`` and the next α1 up, at the drawn speed;
+    ratio = σ/σ_cell (1 where σ_cell = 0) and m_cell are those of cell
+    ``drawn``. With wa = 0 the cell above is not read (``below`` may be in
+    the last α1 row).
+    """
     cells = data.cells
     lo, here = below * CELL_SIZE, drawn * CELL_SIZE
     hi = (below + data.n_speed) * CELL_SIZE if wa > 0.0 else lo
-    return (_six(cells, lo + CELL_SD, 1), _six(cells, hi + CELL_SD, 1), _six(cells, here + CELL_INV_SD, 1),
-            _six(cells, lo + CELL_MEAN, 1), _six(cells, hi + CELL_MEAN, 1), _six(cells, here + CELL_MEAN, 1))
+    return (_three_terms(cells, lo, hi, here, wa, 0) + _three_terms(cells, lo, hi, here, wa, 3))
 
 
 @numba.njit(inline="always", **JIT)
-def _rescaled(k, x, wa, moments, centred):
-    """State variable k drawn from one cell, moved to the moments interpolated in α1 (weight wa of the upper
-    neighbour): x' = m + (x − m_cell) σ/σ_cell with m, σ linear in α1; ``centred`` variables (β2, Ω_x, Ω_y:
-    mean 0 by the mirror symmetry) are only scaled."""
-    sd_lo, sd_hi, inv_sd, mean_lo, mean_hi, mean_here = moments
-    sd = fma(wa, sd_hi[k], (1.0 - wa) * sd_lo[k])
-    ratio = sd * inv_sd[k] if inv_sd[k] > 0.0 else 1.0
-    if centred:
-        return x * ratio
-    return fma(x - mean_here[k], ratio, fma(wa, mean_hi[k], (1.0 - wa) * mean_lo[k]))
+def _three_terms(cells, lo, hi, here, wa, k):
+    """:func:`_alpha1_terms` of state variables k, k + 1, k + 2 as (ratio, m_cell, m) triples."""
+    return (_term(cells, lo, hi, here, wa, k), _term(cells, lo, hi, here, wa, k + 1),
+            _term(cells, lo, hi, here, wa, k + 2))
 
 
 @numba.njit(inline="always", **JIT)
-def _moved(state, wa, moments):
-    """The folded ``state`` of a draw moved in α1 to the incident α1 (:func:`_rescaled` variable by
-    variable, like the unit-base interpolation of transport codes), then folded again."""
-    return _folded(_rescaled(0, state[0], wa, moments, False), _rescaled(1, state[1], wa, moments, True),
-                   _rescaled(2, state[2], wa, moments, False), _rescaled(3, state[3], wa, moments, True),
-                   _rescaled(4, state[4], wa, moments, True), _rescaled(5, state[5], wa, moments, False))
+def _term(cells, lo, hi, here, wa, k):
+    """(ratio, m_cell, m) of state variable k (:func:`_alpha1_terms`)."""
+    sd = fma(wa, load(cells, hi + CELL_SD + k), (1.0 - wa) * load(cells, lo + CELL_SD + k))
+    inv_sd = load(cells, here + CELL_INV_SD + k)
+    mean = fma(wa, load(cells, hi + CELL_MEAN + k), (1.0 - wa) * load(cells, lo + CELL_MEAN + k))
+    return sd * inv_sd if inv_sd > 0.0 else 1.0, load(cells, here + CELL_MEAN + k), mean
+
+
+@numba.njit(inline="always", **JIT)
+def _moved(state, terms):
+    """The folded ``state`` of a draw moved to the incident α1 with the :func:`_alpha1_terms` ``terms``,
+    variable by variable, like the unit-base interpolation of transport codes, then folded again. The
+    centred variables (β2, Ω_x, Ω_y: mean 0 by the mirror symmetry) are only scaled."""
+    return _folded(_shifted(state[0], terms[0]), state[1] * terms[1][0], _shifted(state[2], terms[2]),
+                   state[3] * terms[3][0], state[4] * terms[4][0], _shifted(state[5], terms[5]))
+
+
+@numba.njit(inline="always", **JIT)
+def _shifted(x, term):
+    """m + (x − m_cell) · ratio."""
+    ratio, mean_cell, mean = term
+    return fma(x - mean_cell, ratio, mean)
 
 
 @numba.njit(inline="always", **JIT)
@@ -343,7 +350,7 @@ def _draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
     folded = draw_folded(data, drawn, u)
     state, regime = folded[:6], folded[6]
     if scaled and wa > 0.0:
-        state = _moved(state, wa, _moment_reads(data, below, wa, drawn))
+        state = _moved(state, _alpha1_terms(data, below, wa, drawn))
     alpha2, beta2, s, wx, wy, wz = state
     vx, vy, vz = _velocity(alpha2, beta2, s)
     if scaled and wv > 0.0:
@@ -472,10 +479,21 @@ def _hint_draw(data, cell, u):
     level-major, so these lines do not depend on the row). Without them the row and then the
     dictionary would each wait for memory in turn. (Hints for the small arrays, the trapped
     probabilities and the moments, measured slower: they stay cached.)"""
-    drawn = cell[0]
-    row = _first_row(data, drawn, u[4])[2]
-    for j in range(0, ROW_SIZE, 16):   # the three cache lines of a 144-byte row (its start is 16-byte aligned)
+    _hint_row(data, _first_row(data, cell[0], u[4])[2])
+    _hint_levels(data, cell[0], u)
+
+
+@numba.njit(inline="always", **JIT)
+def _hint_row(data, row):
+    """Cache hints for the component row at offset ``row``: its three cache lines (144 bytes, the start
+    16-byte aligned)."""
+    for j in range(0, ROW_SIZE, 16):
         prefetch(data.clusters, (row + j,))
+
+
+@numba.njit(inline="always", **JIT)
+def _hint_levels(data, drawn, u):
+    """Cache hints for the residual-shape levels u[5:11] pick in cell number ``drawn`` (two per variable)."""
     levels = data.n_levels - 1
     for k in range(6):
         level = _level(data, drawn, k, min(int(u[5 + k] * levels), levels - 1))
@@ -515,16 +533,16 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
             (w * _dot(o, (ex[0], n[0], ez[0])), w * _dot(o, (ex[1], n[1], ez[1])), w * _dot(o, (ex[2], n[2], ez[2]))))
 
 
-BLOCK = 16      # particles whose table reads rebound_many puts in flight together
+BLOCK = 32      # particles whose table reads rebound_many puts in flight together
 INDEX = 6       # integers per particle in rebound_many's index scratch: the cell (_cell), the component row
 I_DRAWN, I_BELOW, I_JV, I_IV, I_ROW = 0, 1, 2, 3, 4
 # Fields of rebound_many's scratch (float64, field f of particle b at f · BLOCK + b): what the arithmetic
 # of a draw reads, so that it runs as one loop over the block on these arrays alone
 G_VALID, G_ALPHA1, G_SPEED, G_COS, G_SIN, G_A, G_EX, G_EZ, G_N = 0, 1, 2, 3, 4, 5, 6, 9, 12    # frame
 G_WA, G_WV, G_TRAPPED, G_MIRROR, G_REGIME, G_F_TARGET, G_F_GRID = 15, 16, 17, 18, 19, 20, 21   # weights, flags
-G_F, G_LO, G_HI, G_LOC, G_SCALE, G_SLOPE = 22, 28, 34, 40, 46, 52           # _chain's six-tuples, 15 slopes
-G_MOMENTS = 67                                                              # _moment_reads: 6 six-tuples
-G_FIELDS = 103
+G_Q, G_SLOPE = 22, 28          # _chain's residual quantiles (6) and slopes (15)
+G_RATIO, G_SHIFT = 43, 49       # _alpha1_terms: 6 ratios; (m_cell, m) of α2, s, Ω_z (the others are centred)
+G_FIELDS = 55
 OUT_STATUS, OUT_V, OUT_W, OUT_FIELDS = 0, 1, 4, 7                           # the draws' results, same layout
 
 
@@ -547,74 +565,114 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     5. the arithmetic of the draws on that scratch, one branch-free SIMD loop.
 
     For a flow solver that collects its wall hits: call this from its
-    ``@njit`` code on the hit arrays.
+    ``@njit`` code on the hit arrays (or :func:`rebound_many_rng`, which
+    draws the uniforms itself).
     """
-    _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, *_block_scratch())
+    _rebound_blocks(data, mix_cdf, V, n, a, u, _no_state(), V_out, W_out, status, scaled, *_block_scratch())
+
+
+@numba.njit(**JIT)
+def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, W_out, status, scaled=True):
+    """:func:`rebound_many` drawing the uniforms from the xoshiro256+ ``state`` ((4,) uint64,
+    :func:`surrogate.rng.seed_state`), which it advances: the same results, bit for bit, as
+    ``fill_uniforms(state, u.ravel())`` followed by ``rebound_many`` on that (N, U_PER_DRAW) array ``u``,
+    without holding it (the uniforms of a block are drawn when it enters the pipeline)."""
+    if state.shape[0] != 4:
+        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.rng.seed_state gives")
+    _rebound_blocks(data, mix_cdf, V, n, a, _no_uniforms(), state, V_out, W_out, status, scaled, *_block_scratch())
+
+
+@numba.njit(inline="always", **JIT)
+def _no_state():
+    """The ``state`` argument of :func:`_rebound_blocks` when the uniforms are given (no state)."""
+    return np.zeros(0, dtype=np.uint64)
+
+
+@numba.njit(inline="always", **JIT)
+def _no_uniforms():
+    """The ``u`` argument of :func:`_rebound_blocks` when it draws the uniforms (no rows)."""
+    return np.zeros((0, U_PER_DRAW))
 
 
 @numba.njit(inline="always", **JIT)
 def _block_scratch():
-    """The scratch arrays of :func:`_rebound_blocks`, one slot per block in the pipeline: index, gathered
-    fields, and the results of the block being drawn."""
-    return (np.zeros((STAGES, BLOCK, INDEX), dtype=np.int64), np.zeros((STAGES, G_FIELDS * BLOCK)),
-            np.zeros(OUT_FIELDS * BLOCK))
+    """The scratch arrays of :func:`_rebound_blocks`, one slot per block in the pipeline: uniforms, index,
+    gathered fields; and the results of the block being drawn."""
+    return (np.zeros((STAGES, BLOCK * U_PER_DRAW)), np.zeros((STAGES, BLOCK, INDEX), dtype=np.int64),
+            np.zeros((STAGES, G_FIELDS * BLOCK)), np.zeros(OUT_FIELDS * BLOCK))
 
 
 STAGES = 3      # blocks in rebound_many's pipeline: located, resolved, drawn
 
 
 @numba.njit(**KERNEL)
-def _rebound_blocks(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, index, g, out):
-    """:func:`rebound_many` with its scratch arrays (:func:`_block_scratch`).
+def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled, us, index, g, out):
+    """:func:`rebound_many` (uniforms ``u``) or :func:`rebound_many_rng` (uniforms drawn from ``state``)
+    with its scratch arrays (:func:`_block_scratch`).
 
     A pipeline of three blocks, so that a block's table reads have a whole
-    step to arrive before they are used: while block k is located (steps 1,
-    2), block k − 1 has its components resolved (step 3) and block k − 2 is
-    drawn (steps 4, 5).
+    step to arrive before they are used: while block k is located (its
+    uniforms, steps 1, 2), block k − 1 has its components resolved (step 3)
+    and block k − 2 is drawn (steps 4, 5).
     """
     n_blocks = (V.shape[0] + BLOCK - 1) // BLOCK
     for k in range(n_blocks + STAGES - 1):
         if k < n_blocks:
-            _locate_block(data, mix_cdf, V, n, a, u, k * BLOCK, index[k % STAGES], g[k % STAGES])
+            j = k % STAGES
+            _block_uniforms(u, state, k * BLOCK, min(BLOCK, V.shape[0] - k * BLOCK), us[j])
+            _locate_block(data, mix_cdf, V, n, a, us[j].reshape((BLOCK, U_PER_DRAW)), k * BLOCK, index[j], g[j])
         if 1 <= k <= n_blocks:
             j = (k - 1) % STAGES
-            _resolve_block(data, u, (k - 1) * BLOCK, index[j], g[j])
+            _resolve_block(data, us[j].reshape((BLOCK, U_PER_DRAW)), (k - 1) * BLOCK, V.shape[0], index[j], g[j])
         if k >= 2:
             j = (k - 2) % STAGES
-            _draw_block(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, (k - 2) * BLOCK, index[j], g[j],
-                        out)
+            _draw_block(data, mix_cdf, V, n, a, us[j].reshape((BLOCK, U_PER_DRAW)), V_out, W_out, status, scaled,
+                        (k - 2) * BLOCK, index[j], g[j], out)
 
 
 @numba.njit(inline="always", **JIT)
-def _locate_block(data, mix_cdf, V, n, a, u, start, index, g):
-    """Steps 1 and 2 on the block of rows from ``start``: impact frames (SIMD), cells and cache hints."""
+def _block_uniforms(u, state, start, m, ub):
+    """The uniforms of the m rows from ``start`` into ``ub`` (row after row): drawn from ``state`` when it
+    is a state (rebound_many_rng), else copied from ``u``."""
+    if state.shape[0] == 4:
+        fill_uniforms(state, ub[:m * U_PER_DRAW])
+    else:
+        for b in range(m):
+            for k in range(U_PER_DRAW):
+                ub[b * U_PER_DRAW + k] = u[start + b, k]
+
+
+@numba.njit(inline="always", **JIT)
+def _locate_block(data, mix_cdf, V, n, a, ub, start, index, g):
+    """Steps 1 and 2 on the block of rows from ``start`` (their uniforms ``ub``): impact frames (SIMD),
+    cells and cache hints."""
     m = min(BLOCK, V.shape[0] - start)
     for b in range(m):      # no branch and no table read: SIMD across the block
-        _frame(V, n, a, u, start + b, g, b)
+        _frame(V, n, a, ub, start + b, g, b)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
-            _cell_and_hints(data, mix_cdf, u[start + b], index, g, b)
+            _cell_and_hints(data, mix_cdf, ub[b], index, g, b)
 
 
 @numba.njit(inline="always", **JIT)
-def _resolve_block(data, u, start, index, g):
-    """Step 3: each particle's component (the alias table read on the row hinted in step 2), and a cache
-    hint for its row (the same lines again unless the alias table redirected the draw)."""
-    for b in range(min(BLOCK, u.shape[0] - start)):
+def _resolve_block(data, ub, start, n_rows, index, g):
+    """Step 3: each particle's component (the alias table read on the row hinted in step 2), and cache
+    hints for its row (the same lines again unless the alias table redirected the draw) and its levels."""
+    for b in range(min(BLOCK, n_rows - start)):
         if _field(g, G_VALID, b) != 0.0:
-            row = _component(data, index[b, I_DRAWN], u[start + b, 4])
+            row = _component(data, index[b, I_DRAWN], ub[b, 4])
             index[b, I_ROW] = row
-            for j in range(0, ROW_SIZE, 16):
-                prefetch(data.clusters, (row + j,))
+            _hint_row(data, row)
+            _hint_levels(data, index[b, I_DRAWN], ub[b])
 
 
 @numba.njit(inline="always", **JIT)
-def _draw_block(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, start, index, g, out):
+def _draw_block(data, mix_cdf, V, n, a, ub, V_out, W_out, status, scaled, start, index, g, out):
     """Steps 4 and 5: gather the table values of every draw, draw (SIMD), store the results."""
     m = min(BLOCK, V.shape[0] - start)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
-            _gather_component(data, u[start + b], index, g, b)
+            _gather_component(data, ub[b], index, g, b)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
             _gather_cell(data, index, g, b)
@@ -627,7 +685,7 @@ def _draw_block(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, start, 
             for k in range(3):
                 V_out[i, k], W_out[i, k] = out[(OUT_V + k) * BLOCK + b], out[(OUT_W + k) * BLOCK + b]
         else:
-            status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], u[i], V_out[i], W_out[i], scaled)
+            status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], ub[b], V_out[i], W_out[i], scaled)
 
 
 @numba.njit(inline="always", **JIT)
@@ -645,10 +703,11 @@ def _put6(g, field, b, values):
 
 
 @numba.njit(inline="always", **JIT)
-def _frame(V, n, a, u, i, g, b):
-    """Block step 1, row i as particle b: validity and impact frame (computed for invalid rows too)."""
+def _frame(V, n, a, ub, i, g, b):
+    """Block step 1, row i as particle b (uniforms ``ub[b]``): validity and impact frame (computed for invalid
+    rows too)."""
     Vi, ni = (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2])
-    alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, u[i, 12])
+    alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[b, 12])
     _put3(g, G_VALID, b, (1.0 if _moves_into_wall(Vi, ni) else 0.0, alpha1, speed))
     _put3(g, G_COS, b, (cos_a1, sin_a1, a[i]))
     _put3(g, G_EX, b, ex)
@@ -660,7 +719,7 @@ def _frame(V, n, a, u, i, g, b):
 def _cell_and_hints(data, mix_cdf, u, index, g, b):
     """Block step 2 for particle b: its cell, and the cache hints its uniforms locate."""
     cell = _cell(data, mix_cdf, _field(g, G_ALPHA1, b), _field(g, G_SPEED, b), u)
-    _hint_draw(data, cell, u)
+    _hint_row(data, _first_row(data, cell[0], u[4])[2])
     drawn, below, wa, jv, wv, iv = cell
     index[b, I_DRAWN], index[b, I_BELOW], index[b, I_JV], index[b, I_IV] = drawn, below, jv, iv
     g[G_WA * BLOCK + b], g[G_WV * BLOCK + b] = wa, wv
@@ -674,12 +733,7 @@ def _gather_component(data, u, index, g, b):
     r = data.clusters
     trapped = u[3] < load(data.cells, drawn * CELL_SIZE + CELL_P_TRAPPED)
     _put3(g, G_TRAPPED, b, (1.0 if trapped else 0.0, u[11], np.float64(load(r, row + ROW_REGIME))))
-    f, lo, hi = _residual_reads(data, drawn, row, u)
-    _put6(g, G_F, b, f)
-    _put6(g, G_LO, b, lo)
-    _put6(g, G_HI, b, hi)
-    _put6(g, G_LOC, b, _six(r, row + ROW_LOC, 1))
-    _put6(g, G_SCALE, b, _six(r, row + ROW_SCALE, 1))
+    _put6(g, G_Q, b, _quantiles(data, drawn, row, u))
     _put6(g, G_SLOPE, b, _six(r, row + ROW_SLOPE, 1))
     _put6(g, G_SLOPE + 6, b, _six(r, row + ROW_SLOPE + 6, 1))
     _put3(g, G_SLOPE + 12, b, _three(r, row + ROW_SLOPE + 12, 1))
@@ -687,16 +741,12 @@ def _gather_component(data, u, index, g, b):
 
 @numba.njit(inline="always", **JIT)
 def _gather_cell(data, index, g, b):
-    """Block step 4 for particle b: the cell moments (:func:`_moment_reads`) and restitution factors."""
+    """Block step 4 for particle b: the α1 move (:func:`_alpha1_terms`) and the restitution factors."""
     drawn, below, jv, iv = index[b, I_DRAWN], index[b, I_BELOW], index[b, I_JV], index[b, I_IV]
     g[G_F_TARGET * BLOCK + b], g[G_F_GRID * BLOCK + b] = _restitution_factors(data, jv, _field(g, G_WV, b), iv)
-    sd_lo, sd_hi, inv_sd, mean_lo, mean_hi, mean_here = _moment_reads(data, below, _field(g, G_WA, b), drawn)
-    _put6(g, G_MOMENTS, b, sd_lo)
-    _put6(g, G_MOMENTS + 6, b, sd_hi)
-    _put6(g, G_MOMENTS + 12, b, inv_sd)
-    _put6(g, G_MOMENTS + 18, b, mean_lo)
-    _put6(g, G_MOMENTS + 24, b, mean_hi)
-    _put6(g, G_MOMENTS + 30, b, mean_here)
+    t = _alpha1_terms(data, below, _field(g, G_WA, b), drawn)
+    _put6(g, G_RATIO, b, (t[0][0], t[1][0], t[2][0], t[3][0], t[4][0], t[5][0]))
+    _put6(g, G_SHIFT, b, t[0][1:] + t[2][1:] + t[5][1:])
 
 
 @numba.njit(inline="always", **JIT)
@@ -720,12 +770,12 @@ def _pick6(c, x, y):
 def _arithmetic(g, out, b, scaled):
     """Block step 4: :func:`_draw_in_cell` and :func:`_to_global` for particle b on its gathered fields, the
     same operations in the same order (so the same bits), with every branch a select."""
-    state = _chain(_fields6(g, G_F, b), _fields6(g, G_LO, b), _fields6(g, G_HI, b), _fields6(g, G_LOC, b),
-                   _fields6(g, G_SCALE, b), _fifteen(g, G_SLOPE * BLOCK + b, BLOCK))
+    state = _chain(_fields6(g, G_Q, b), _fifteen(g, G_SLOPE * BLOCK + b, BLOCK))
     wa, wv = _field(g, G_WA, b), _field(g, G_WV, b)
-    moments = (_fields6(g, G_MOMENTS, b), _fields6(g, G_MOMENTS + 6, b), _fields6(g, G_MOMENTS + 12, b),
-               _fields6(g, G_MOMENTS + 18, b), _fields6(g, G_MOMENTS + 24, b), _fields6(g, G_MOMENTS + 30, b))
-    state = _pick6(scaled and wa > 0.0, _moved(state, wa, moments), state)
+    ratio, shift = _fields6(g, G_RATIO, b), _fields6(g, G_SHIFT, b)
+    terms = ((ratio[0], shift[0], shift[1]), (ratio[1], 0.0, 0.0), (ratio[2], shift[2], shift[3]),
+             (ratio[3], 0.0, 0.0), (ratio[4], 0.0, 0.0), (ratio[5], shift[4], shift[5]))
+    state = _pick6(scaled and wa > 0.0, _moved(state, terms), state)
     vx, vy, vz = _velocity(state[0], state[1], state[2])
     cos_a1, sin_a1 = _field(g, G_COS, b), _field(g, G_SIN, b)
     local = (vx, vy, vz, state[3], state[4], state[5])
@@ -747,20 +797,19 @@ def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row (parallel over chunks of :func:`rebound_many`); u has shape (N, U_PER_DRAW)."""
     for j in numba.prange(n_streams(V.shape[0])):
         lo, hi = _chunk(j, V.shape[0])
-        _rebound_chunk(data, mix_cdf, V, n, a, u[lo:hi], V_out, W_out, status, scaled, lo, hi)
+        _rebound_chunk(data, mix_cdf, V, n, a, u[lo:hi], _no_state(), V_out, W_out, status, scaled, lo, hi)
 
 
 @numba.njit(parallel=True, **JIT)
 def rebound_batch_rng(data, mix_cdf, V, n, a, states, V_out, W_out, status, scaled=True):
     """:func:`rebound_batch` drawing its own uniforms: the rows of chunk j (ROWS_PER_STREAM rows) from a
     copy of the xoshiro256+ state ``states[j]`` (:func:`surrogate.rng.stream_states`; ``states`` itself is
-    not advanced), row after row. The draws are the same whatever the number of threads, and no
-    (N, U_PER_DRAW) array of uniforms is held. ``states`` must have one row per chunk (ValueError)."""
+    not advanced), row after row (:func:`rebound_many_rng`). The draws are the same whatever the number of
+    threads, and no (N, U_PER_DRAW) array of uniforms is held. ``states`` must have one row per chunk (ValueError)."""
     _check_streams(states, V.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, V.shape[0])
-        _rebound_chunk(data, mix_cdf, V, n, a, _stream_uniforms(states[j], hi - lo), V_out, W_out, status, scaled,
-                       lo, hi)
+        _rebound_chunk(data, mix_cdf, V, n, a, _no_uniforms(), states[j].copy(), V_out, W_out, status, scaled, lo, hi)
 
 
 @numba.njit(**JIT)
@@ -785,10 +834,11 @@ def _stream_uniforms(state, rows):
 
 
 @numba.njit(inline="always", **JIT)
-def _rebound_chunk(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled, lo, hi):
-    """:func:`rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows."""
-    _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, V_out[lo:hi], W_out[lo:hi], status[lo:hi],
-                    scaled, *_block_scratch())
+def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled, lo, hi):
+    """:func:`rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows, or
+    :func:`rebound_many_rng` with ``state``."""
+    _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], W_out[lo:hi],
+                    status[lo:hi], scaled, *_block_scratch())
 
 
 @numba.njit(parallel=True, **JIT)

@@ -11,9 +11,9 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import (STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch, rebound_batch_rng,
-                               rebound_many, rebound_tuple)
-from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, stream_states
+from surrogate.kernels import (BLOCK, STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch,
+                               rebound_batch_rng, rebound_many, rebound_many_rng, rebound_tuple)
+from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, seed_state, stream_states
 from surrogate.table import CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
 
@@ -333,6 +333,32 @@ def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
     status, V_new, W_new = rebound_tuple(data, cdf, V[7], n[7], a[7], U[7])     # (3,) arrays work as well
     assert status == s1[7] and V_new == tuple(V1[7]) and W_new == tuple(W1[7])
 
+
+
+def test_block_kernel_drawing_its_uniforms_equals_the_one_given_them(small_table):
+    """rebound_many_rng(state) = fill_uniforms(state, U) then rebound_many(U), bit for bit, and leaves the
+    state where fill_uniforms leaves it (rows: two pipelines' worth of blocks and a partial one, an invalid
+    row); a state of the wrong size is rejected."""
+    m = 7 * BLOCK + 5
+    rng = np.random.default_rng(8)
+    speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
+    V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m)])
+    V[3] = [10.0, 5.0, 0.0]
+    n, a = np.tile([0.0, 1.0, 0.0], (m, 1)), np.full(m, 1e-4)
+    data, cdf = small_table.kernel_data, surrogate.mix_cdf(small_table, "mix")
+    state_given, state_drawn = seed_state(9), seed_state(9)
+    U = np.empty((m, U_PER_DRAW))
+    fill_uniforms(state_given, U.reshape(-1))
+    given = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_many(data, cdf, V, n, a, U, *given)
+    drawn = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_many_rng(data, cdf, V, n, a, state_drawn, *drawn)
+    for x, y in zip(given, drawn):
+        np.testing.assert_array_equal(x, y)
+    np.testing.assert_array_equal(state_given, state_drawn)
+    assert drawn[2][3] == STATUS_INVALID and np.all(drawn[2][np.arange(m) != 3] != STATUS_INVALID)
+    with pytest.raises(ValueError, match="one xoshiro256\\+ state"):
+        rebound_many_rng(data, cdf, V, n, a, np.ones(3, np.uint64), *drawn)
 
 BAD_GLOBAL = [
     (dict(velocity=[[10.0, 5.0, 0.0]]), "does not move into the wall"),
