@@ -13,8 +13,10 @@ From numba code, call :func:`surrogate.kernels.rebound_tuple` (or
 ``U_PER_DRAW`` uniforms per call; :func:`surrogate.rng.fill_uniforms` draws
 them fast from a caller-owned xoshiro256+ state (:func:`surrogate.rng.seed_state`).
 A solver that collects its wall hits of a time step should pass them all to
-:func:`surrogate.kernels.rebound_many`, which overlaps their table reads
-(same results, a fraction of the cost on tables larger than the CPU caches);
+:func:`surrogate.kernels.rebound_many_rng` (uniforms from a state) or
+:func:`surrogate.kernels.rebound_many` (uniforms given), which pipeline
+blocks of particles, overlap their table reads and compute their draws as
+SIMD loops (same results, about a third of the cost on the default table);
 :func:`surrogate.kernels.rebound_batch_rng` does the same on all threads,
 drawing its uniforms from one xoshiro256+ stream per chunk of rows
 (:func:`surrogate.rng.stream_states`), as :func:`sample_global` does.
