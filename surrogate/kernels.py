@@ -534,7 +534,7 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
 
 
 BLOCK = 32      # particles whose table reads rebound_many puts in flight together
-INDEX = 6       # integers per particle in rebound_many's index scratch: the cell (_cell), the component row
+INDEX = 5       # integers per particle in rebound_many's index scratch: the cell (_cell), the component row
 I_DRAWN, I_BELOW, I_JV, I_IV, I_ROW = 0, 1, 2, 3, 4
 # Fields of rebound_many's scratch (float64, field f of particle b at f · BLOCK + b): what the arithmetic
 # of a draw reads, so that it runs as one loop over the block on these arrays alone
