@@ -558,11 +558,15 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     1. the impact frames, as one branch-free loop that the compiler turns
        into SIMD instructions (8 particles per instruction with AVX-512);
     2. the cells, with cache hints (:func:`surrogate.memory.prefetch`) for
-       the table reads the uniforms locate (the component row, the residual
-       levels), so the memory latencies of the whole block overlap;
-    3. hints for the rows the alias table redirects to;
-    4. the table values every draw needs, copied into a scratch array;
+       the component rows the uniforms pick;
+    3. (a block later) the components, through the alias table on those
+       rows, with hints for the resolved rows and the residual levels;
+    4. (a block later) the table values every draw needs, copied into a
+       scratch array;
     5. the arithmetic of the draws on that scratch, one branch-free SIMD loop.
+
+    So the memory latencies of a whole block overlap, and each has a block's
+    worth of work to arrive in.
 
     For a flow solver that collects its wall hits: call this from its
     ``@njit`` code on the hit arrays (or :func:`rebound_many_rng`, which
@@ -768,7 +772,7 @@ def _pick6(c, x, y):
 
 @numba.njit(inline="always", **JIT)
 def _arithmetic(g, out, b, scaled):
-    """Block step 4: :func:`_draw_in_cell` and :func:`_to_global` for particle b on its gathered fields, the
+    """Block step 5: :func:`_draw_in_cell` and :func:`_to_global` for particle b on its gathered fields, the
     same operations in the same order (so the same bits), with every branch a select."""
     state = _chain(_fields6(g, G_Q, b), _fifteen(g, G_SLOPE * BLOCK + b, BLOCK))
     wa, wv = _field(g, G_WA, b), _field(g, G_WV, b)
