@@ -51,7 +51,7 @@ from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.fused import fma
 from surrogate.memory import load, prefetch
 from surrogate.restitution import restitution_at
-from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, n_streams
+from surrogate.rng import ROWS_PER_STREAM, fill_lanes, n_streams, seed_lanes
 from surrogate.table import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD,
                              CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE,
                              ROW_SIZE, ROW_SLOPE)
@@ -493,12 +493,23 @@ def _hint_row(data, row):
 
 @numba.njit(inline="always", **JIT)
 def _hint_levels(data, drawn, u):
-    """Cache hints for the residual-shape levels u[5:11] pick in cell number ``drawn`` (two per variable)."""
+    """Cache hints for the residual-shape levels u[5:11] pick in cell number ``drawn`` (two per variable;
+    ``u`` a row of uniforms or a tuple)."""
+    _hint_level(data, drawn, 0, u[5])
+    _hint_level(data, drawn, 1, u[6])
+    _hint_level(data, drawn, 2, u[7])
+    _hint_level(data, drawn, 3, u[8])
+    _hint_level(data, drawn, 4, u[9])
+    _hint_level(data, drawn, 5, u[10])
+
+
+@numba.njit(inline="always", **JIT)
+def _hint_level(data, drawn, k, u):
+    """Cache hints for the two residual-shape levels of chain variable k that u picks (:func:`_quantile`)."""
     levels = data.n_levels - 1
-    for k in range(6):
-        level = _level(data, drawn, k, min(int(u[5 + k] * levels), levels - 1))
-        prefetch(data.dictionary, (level,))
-        prefetch(data.dictionary, (level + data.n_dictionary,))
+    level = _level(data, drawn, k, min(int(u * levels), levels - 1))
+    prefetch(data.dictionary, (level,))
+    prefetch(data.dictionary, (level + data.n_dictionary,))
 
 
 @numba.njit(inline="always", **JIT)
@@ -534,7 +545,8 @@ def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
 
 
 BLOCK = 32      # particles whose table reads rebound_many puts in flight together
-INDEX = 5       # integers per particle in rebound_many's index scratch: the cell (_cell), the component row
+INDEX = 5       # integers per particle in rebound_many's index scratch (field f of particle b at f · BLOCK + b): the
+                # cell (_cell), the component row
 I_DRAWN, I_BELOW, I_JV, I_IV, I_ROW = 0, 1, 2, 3, 4
 # Fields of rebound_many's scratch (float64, field f of particle b at f · BLOCK + b): what the arithmetic
 # of a draw reads, so that it runs as one loop over the block on these arrays alone
@@ -578,12 +590,40 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
 @numba.njit(**JIT)
 def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, W_out, status, scaled=True):
     """:func:`rebound_many` drawing the uniforms from the xoshiro256+ ``state`` ((4,) uint64,
-    :func:`surrogate.rng.seed_state`), which it advances: the same results, bit for bit, as
-    ``fill_uniforms(state, u.ravel())`` followed by ``rebound_many`` on that (N, U_PER_DRAW) array ``u``,
-    without holding it (the uniforms of a block are drawn when it enters the pipeline)."""
+    :func:`surrogate.rng.seed_state`), which it advances by one step.
+
+    The uniforms come from BLOCK xoshiro256+ lanes seeded from ``state``
+    (:func:`surrogate.rng.seed_lanes`): row b of every block of BLOCK rows
+    from lane b (:func:`surrogate.rng.fill_lanes`, SIMD across the lanes).
+    The results are the same, bit for bit, as ``rebound_many`` on the array
+    :func:`rebound_uniforms` returns for the same state, without holding it
+    (a block's uniforms are drawn when it enters the pipeline). Seeding the
+    lanes costs about 0.1 µs per call, so call it on many rows at once.
+    """
     if state.shape[0] != 4:
         raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.rng.seed_state gives")
     _rebound_blocks(data, mix_cdf, V, n, a, _no_uniforms(), state, V_out, W_out, status, scaled, *_block_scratch())
+
+
+@numba.njit(**JIT)
+def rebound_uniforms(state, n_rows):
+    """The (n_rows, U_PER_DRAW) uniforms :func:`rebound_many_rng` draws from ``state`` for n_rows rows,
+    advancing ``state`` as it does (for tests, and to replay a draw through :func:`rebound_many`)."""
+    lanes, u = _lanes(), np.empty((n_rows, U_PER_DRAW))
+    seed_lanes(state, lanes)
+    ub = np.empty(BLOCK * U_PER_DRAW)
+    for start in range(0, n_rows, BLOCK):
+        fill_lanes(lanes, ub, BLOCK, U_PER_DRAW)
+        for b in range(min(BLOCK, n_rows - start)):
+            for k in range(U_PER_DRAW):
+                u[start + b, k] = ub[k * BLOCK + b]
+    return u
+
+
+@numba.njit(inline="always", **JIT)
+def _lanes():
+    """The BLOCK xoshiro256+ lanes of :func:`rebound_many_rng` (:func:`surrogate.rng.seed_lanes` layout)."""
+    return np.zeros(4 * BLOCK, dtype=np.uint64)
 
 
 @numba.njit(inline="always", **JIT)
@@ -601,16 +641,16 @@ def _no_uniforms():
 @numba.njit(inline="always", **JIT)
 def _block_scratch():
     """The scratch arrays of :func:`_rebound_blocks`, one slot per block in the pipeline: uniforms, index,
-    gathered fields; and the results of the block being drawn."""
-    return (np.zeros((STAGES, BLOCK * U_PER_DRAW)), np.zeros((STAGES, BLOCK, INDEX), dtype=np.int64),
-            np.zeros((STAGES, G_FIELDS * BLOCK)), np.zeros(OUT_FIELDS * BLOCK))
+    gathered fields; the results of the block being drawn, and the random lanes."""
+    return (np.zeros((STAGES, BLOCK * U_PER_DRAW)), np.zeros((STAGES, INDEX * BLOCK), dtype=np.int64),
+            np.zeros((STAGES, G_FIELDS * BLOCK)), np.zeros(OUT_FIELDS * BLOCK), _lanes())
 
 
 STAGES = 3      # blocks in rebound_many's pipeline: located, resolved, drawn
 
 
 @numba.njit(**KERNEL)
-def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled, us, index, g, out):
+def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled, us, index, g, out, lanes):
     """:func:`rebound_many` (uniforms ``u``) or :func:`rebound_many_rng` (uniforms drawn from ``state``)
     with its scratch arrays (:func:`_block_scratch`).
 
@@ -619,43 +659,58 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scal
     uniforms, steps 1, 2), block k − 1 has its components resolved (step 3)
     and block k − 2 is drawn (steps 4, 5).
     """
+    if state.shape[0] == 4:
+        seed_lanes(state, lanes)
     n_blocks = (V.shape[0] + BLOCK - 1) // BLOCK
     for k in range(n_blocks + STAGES - 1):
         if k < n_blocks:
             j = k % STAGES
-            _block_uniforms(u, state, k * BLOCK, min(BLOCK, V.shape[0] - k * BLOCK), us[j])
-            _locate_block(data, mix_cdf, V, n, a, us[j].reshape((BLOCK, U_PER_DRAW)), k * BLOCK, index[j], g[j])
+            _block_uniforms(u, state, lanes, k * BLOCK, min(BLOCK, V.shape[0] - k * BLOCK), us[j])
+            _locate_block(data, mix_cdf, V.reshape(3 * V.shape[0]), n.reshape(3 * V.shape[0]), a, us[j], k * BLOCK,
+                          index[j], g[j])
         if 1 <= k <= n_blocks:
             j = (k - 1) % STAGES
-            _resolve_block(data, us[j].reshape((BLOCK, U_PER_DRAW)), (k - 1) * BLOCK, V.shape[0], index[j], g[j])
+            _resolve_block(data, us[j], (k - 1) * BLOCK, V.shape[0], index[j], g[j])
         if k >= 2:
             j = (k - 2) % STAGES
-            _draw_block(data, mix_cdf, V, n, a, us[j].reshape((BLOCK, U_PER_DRAW)), V_out, W_out, status, scaled,
-                        (k - 2) * BLOCK, index[j], g[j], out)
+            _draw_block(data, us[j], V_out, W_out, status, scaled, (k - 2) * BLOCK, index[j], g[j], out)
 
 
 @numba.njit(inline="always", **JIT)
-def _block_uniforms(u, state, start, m, ub):
-    """The uniforms of the m rows from ``start`` into ``ub`` (row after row): drawn from ``state`` when it
-    is a state (rebound_many_rng), else copied from ``u``."""
+def _block_uniforms(u, state, lanes, start, m, ub):
+    """The uniforms of the m rows from ``start`` into ``ub``, uniform k of row start + b at k · BLOCK + b:
+    drawn from the ``lanes`` when ``state`` is a state (rebound_many_rng), else copied from ``u``."""
     if state.shape[0] == 4:
-        fill_uniforms(state, ub[:m * U_PER_DRAW])
+        fill_lanes(lanes, ub, BLOCK, U_PER_DRAW)
     else:
-        for b in range(m):
-            for k in range(U_PER_DRAW):
-                ub[b * U_PER_DRAW + k] = u[start + b, k]
+        for k in range(U_PER_DRAW):
+            for b in range(m):
+                ub[k * BLOCK + b] = u[start + b, k]
+
+
+@numba.njit(inline="always", **JIT)
+def _uniforms(ub, b):
+    """The U_PER_DRAW uniforms of particle b of a block as a tuple, from the block's uniforms ``ub``
+    (:func:`_block_uniforms`)."""
+    return _six(ub, b, BLOCK) + _six(ub, 6 * BLOCK + b, BLOCK) + (np.float64(load(ub, 12 * BLOCK + b)),)
 
 
 @numba.njit(inline="always", **JIT)
 def _locate_block(data, mix_cdf, V, n, a, ub, start, index, g):
     """Steps 1 and 2 on the block of rows from ``start`` (their uniforms ``ub``): impact frames (SIMD),
-    cells and cache hints."""
-    m = min(BLOCK, V.shape[0] - start)
+    cells and cache hints. V and n flat, row after row: a compile-time stride, which keeps the SIMD loop
+    free of run-time stride checks."""
+    m = min(BLOCK, a.shape[0] - start)
     for b in range(m):      # no branch and no table read: SIMD across the block
         _frame(V, n, a, ub, start + b, g, b)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
-            _cell_and_hints(data, mix_cdf, ub[b], index, g, b)
+            _cell_and_hints(data, mix_cdf, _uniforms(ub, b), index, g, b)
+        else:
+            _no_cell(index, g, b)
+    for b in range(m):
+        if _field(g, G_VALID, b) != 0.0:
+            _hint_row(data, index[I_ROW * BLOCK + b])
 
 
 @numba.njit(inline="always", **JIT)
@@ -664,22 +719,21 @@ def _resolve_block(data, ub, start, n_rows, index, g):
     hints for its row (the same lines again unless the alias table redirected the draw) and its levels."""
     for b in range(min(BLOCK, n_rows - start)):
         if _field(g, G_VALID, b) != 0.0:
-            row = _component(data, index[b, I_DRAWN], ub[b, 4])
-            index[b, I_ROW] = row
+            row = _component(data, index[I_DRAWN * BLOCK + b], ub[4 * BLOCK + b])
+            index[I_ROW * BLOCK + b] = row
             _hint_row(data, row)
-            _hint_levels(data, index[b, I_DRAWN], ub[b])
+            _hint_levels(data, index[I_DRAWN * BLOCK + b], _uniforms(ub, b))
 
 
 @numba.njit(inline="always", **JIT)
-def _draw_block(data, mix_cdf, V, n, a, ub, V_out, W_out, status, scaled, start, index, g, out):
+def _draw_block(data, ub, V_out, W_out, status, scaled, start, index, g, out):
     """Steps 4 and 5: gather the table values of every draw, draw (SIMD), store the results."""
-    m = min(BLOCK, V.shape[0] - start)
+    m = min(BLOCK, status.shape[0] - start)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
-            _gather_component(data, ub[b], index, g, b)
-    for b in range(m):
-        if _field(g, G_VALID, b) != 0.0:
-            _gather_cell(data, index, g, b)
+            _gather_component(data, _uniforms(ub, b), index, g, b)
+    for b in range(m):      # no branch: SIMD across the block (invalid rows read cell 0, see _no_cell)
+        _gather_cell(data, index, g, b)
     for b in range(m):      # no branch and no table read: SIMD across the block
         _arithmetic(g, out, b, scaled)
     for b in range(m):
@@ -688,8 +742,10 @@ def _draw_block(data, mix_cdf, V, n, a, ub, V_out, W_out, status, scaled, start,
             status[i] = int(out[OUT_STATUS * BLOCK + b])
             for k in range(3):
                 V_out[i, k], W_out[i, k] = out[(OUT_V + k) * BLOCK + b], out[(OUT_W + k) * BLOCK + b]
-        else:
-            status[i] = rebound(data, mix_cdf, V[i], n[i], a[i], ub[b], V_out[i], W_out[i], scaled)
+        else:       # what rebound returns for a row that does not move into the wall
+            status[i] = STATUS_INVALID
+            for k in range(3):
+                V_out[i, k], W_out[i, k] = np.nan, np.nan
 
 
 @numba.njit(inline="always", **JIT)
@@ -708,10 +764,10 @@ def _put6(g, field, b, values):
 
 @numba.njit(inline="always", **JIT)
 def _frame(V, n, a, ub, i, g, b):
-    """Block step 1, row i as particle b (uniforms ``ub[b]``): validity and impact frame (computed for invalid
-    rows too)."""
-    Vi, ni = (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2])
-    alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[b, 12])
+    """Block step 1, row i as particle b (uniforms ``ub``, :func:`_block_uniforms`): validity and impact
+    frame (computed for invalid rows too)."""
+    Vi, ni = (V[3 * i], V[3 * i + 1], V[3 * i + 2]), (n[3 * i], n[3 * i + 1], n[3 * i + 2])
+    alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[12 * BLOCK + b])
     _put3(g, G_VALID, b, (1.0 if _moves_into_wall(Vi, ni) else 0.0, alpha1, speed))
     _put3(g, G_COS, b, (cos_a1, sin_a1, a[i]))
     _put3(g, G_EX, b, ex)
@@ -723,17 +779,26 @@ def _frame(V, n, a, ub, i, g, b):
 def _cell_and_hints(data, mix_cdf, u, index, g, b):
     """Block step 2 for particle b: its cell, and the cache hints its uniforms locate."""
     cell = _cell(data, mix_cdf, _field(g, G_ALPHA1, b), _field(g, G_SPEED, b), u)
-    _hint_row(data, _first_row(data, cell[0], u[4])[2])
+    index[I_ROW * BLOCK + b] = _first_row(data, cell[0], u[4])[2]
     drawn, below, wa, jv, wv, iv = cell
-    index[b, I_DRAWN], index[b, I_BELOW], index[b, I_JV], index[b, I_IV] = drawn, below, jv, iv
+    index[I_DRAWN * BLOCK + b], index[I_BELOW * BLOCK + b], index[I_JV * BLOCK + b], index[I_IV * BLOCK + b] = drawn, below, jv, iv
     g[G_WA * BLOCK + b], g[G_WV * BLOCK + b] = wa, wv
+
+
+@numba.njit(inline="always", **JIT)
+def _no_cell(index, g, b):
+    """Block step 2 for an invalid particle b: cell 0 at grid weights 0, so that the steps that run on
+    every particle of a block read the table in range (their results for b are discarded)."""
+    for k in range(INDEX):
+        index[k * BLOCK + b] = 0
+    g[G_WA * BLOCK + b], g[G_WV * BLOCK + b] = 0.0, 0.0
 
 
 @numba.njit(inline="always", **JIT)
 def _gather_component(data, u, index, g, b):
     """Block step 4 for particle b: what its draw reads from its component row (:func:`draw_folded`) and
     the residual shapes, with the flags its uniforms set (trapped, mirror)."""
-    drawn, row = index[b, I_DRAWN], index[b, I_ROW]
+    drawn, row = index[I_DRAWN * BLOCK + b], index[I_ROW * BLOCK + b]
     r = data.clusters
     trapped = u[3] < load(data.cells, drawn * CELL_SIZE + CELL_P_TRAPPED)
     _put3(g, G_TRAPPED, b, (1.0 if trapped else 0.0, u[11], np.float64(load(r, row + ROW_REGIME))))
@@ -746,7 +811,7 @@ def _gather_component(data, u, index, g, b):
 @numba.njit(inline="always", **JIT)
 def _gather_cell(data, index, g, b):
     """Block step 4 for particle b: the α1 move (:func:`_alpha1_terms`) and the restitution factors."""
-    drawn, below, jv, iv = index[b, I_DRAWN], index[b, I_BELOW], index[b, I_JV], index[b, I_IV]
+    drawn, below, jv, iv = index[I_DRAWN * BLOCK + b], index[I_BELOW * BLOCK + b], index[I_JV * BLOCK + b], index[I_IV * BLOCK + b]
     g[G_F_TARGET * BLOCK + b], g[G_F_GRID * BLOCK + b] = _restitution_factors(data, jv, _field(g, G_WV, b), iv)
     t = _alpha1_terms(data, below, _field(g, G_WA, b), drawn)
     _put6(g, G_RATIO, b, (t[0][0], t[1][0], t[2][0], t[3][0], t[4][0], t[5][0]))
@@ -808,7 +873,7 @@ def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
 def rebound_batch_rng(data, mix_cdf, V, n, a, states, V_out, W_out, status, scaled=True):
     """:func:`rebound_batch` drawing its own uniforms: the rows of chunk j (ROWS_PER_STREAM rows) from a
     copy of the xoshiro256+ state ``states[j]`` (:func:`surrogate.rng.stream_states`; ``states`` itself is
-    not advanced), row after row (:func:`rebound_many_rng`). The draws are the same whatever the number of
+    not advanced), as :func:`rebound_many_rng` draws them (:func:`rebound_uniforms`). The draws are the same whatever the number of
     threads, and no (N, U_PER_DRAW) array of uniforms is held. ``states`` must have one row per chunk (ValueError)."""
     _check_streams(states, V.shape[0])
     for j in numba.prange(states.shape[0]):
@@ -830,14 +895,6 @@ def _chunk(j, n_rows):
 
 
 @numba.njit(inline="always", **JIT)
-def _stream_uniforms(state, rows):
-    """(rows, U_PER_DRAW) uniforms from a copy of the xoshiro256+ ``state``, row after row."""
-    u = np.empty((rows, U_PER_DRAW))
-    fill_uniforms(state.copy(), u.reshape(rows * U_PER_DRAW))
-    return u
-
-
-@numba.njit(inline="always", **JIT)
 def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled, lo, hi):
     """:func:`rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows, or
     :func:`rebound_many_rng` with ``state``."""
@@ -855,12 +912,13 @@ def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
 
 @numba.njit(parallel=True, **JIT)
 def draw_local_batch_rng(data, mix_cdf, alpha1, speed, states, out, status, scaled=True):
-    """:func:`draw_local_batch` drawing its own uniforms, chunk by chunk as :func:`rebound_batch_rng`."""
+    """:func:`draw_local_batch` drawing its own uniforms, chunk by chunk as :func:`rebound_batch_rng`
+    (chunk j's are ``rebound_uniforms(states[j].copy(), rows)``)."""
     _check_streams(states, alpha1.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, alpha1.shape[0])
-        _draw_local_chunk(data, mix_cdf, alpha1, speed, _stream_uniforms(states[j], hi - lo), out, status, scaled,
-                          lo, hi)
+        _draw_local_chunk(data, mix_cdf, alpha1, speed, rebound_uniforms(states[j].copy(), hi - lo), out, status,
+                          scaled, lo, hi)
 
 
 @numba.njit(inline="always", **JIT)

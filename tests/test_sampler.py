@@ -12,8 +12,8 @@ from scipy.spatial.transform import Rotation
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
 from surrogate.kernels import (BLOCK, STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch,
-                               rebound_batch_rng, rebound_many, rebound_many_rng, rebound_tuple)
-from surrogate.rng import ROWS_PER_STREAM, fill_uniforms, seed_state, stream_states
+                               rebound_batch_rng, rebound_many, rebound_many_rng, rebound_tuple, rebound_uniforms)
+from surrogate.rng import ROWS_PER_STREAM, seed_state, stream_states
 from surrogate.table import CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
 
@@ -235,10 +235,8 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
     def uniforms(seed):
         states = stream_states(np.random.default_rng(seed), m)
         assert states.shape == (3, 4)
-        U = np.empty((m, U_PER_DRAW))
-        for j, state in enumerate(states):
-            fill_uniforms(state.copy(), U[j * ROWS_PER_STREAM:(j + 1) * ROWS_PER_STREAM].reshape(-1))
-        return U
+        return np.concatenate([rebound_uniforms(state.copy(), min(ROWS_PER_STREAM, m - j * ROWS_PER_STREAM))
+                               for j, state in enumerate(states)])
 
     cdf = surrogate.mix_cdf(small_table, "mix")
     V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
@@ -336,9 +334,9 @@ def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
 
 
 def test_block_kernel_drawing_its_uniforms_equals_the_one_given_them(small_table):
-    """rebound_many_rng(state) = fill_uniforms(state, U) then rebound_many(U), bit for bit, and leaves the
-    state where fill_uniforms leaves it (rows: two pipelines' worth of blocks and a partial one, an invalid
-    row); a state of the wrong size is rejected."""
+    """rebound_many_rng(state) = rebound_uniforms(state) then rebound_many, bit for bit, and leaves the
+    state where rebound_uniforms leaves it (rows: two pipelines' worth of blocks and a partial one, an
+    invalid row); a state of the wrong size is rejected."""
     m = 7 * BLOCK + 5
     rng = np.random.default_rng(8)
     speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
@@ -347,8 +345,7 @@ def test_block_kernel_drawing_its_uniforms_equals_the_one_given_them(small_table
     n, a = np.tile([0.0, 1.0, 0.0], (m, 1)), np.full(m, 1e-4)
     data, cdf = small_table.kernel_data, surrogate.mix_cdf(small_table, "mix")
     state_given, state_drawn = seed_state(9), seed_state(9)
-    U = np.empty((m, U_PER_DRAW))
-    fill_uniforms(state_given, U.reshape(-1))
+    U = rebound_uniforms(state_given, m)
     given = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     rebound_many(data, cdf, V, n, a, U, *given)
     drawn = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
