@@ -23,7 +23,7 @@ and prints the cost in ns per reflected state:
     from numba's ``np.random.random()``; (b') the loop reading pre-drawn
     uniforms; (b-block) a solver that collects its wall hits and calls
     ``surrogate.kernels.rebound_many_rng`` on them from ``@njit`` code (its
-    xoshiro256+ uniforms included), and the variant that first draws them
+    uniforms, from 32 xoshiro256+ lanes stepped as SIMD, included), and the variant that first draws them
     into an (N, 13) array for ``rebound_many``; breakdown row: the xoshiro256+
     draws alone;
 (c) the direct model, ``tablegen.simulate.simulate`` with the shape mix, one

@@ -16,10 +16,12 @@ A solver that collects its wall hits of a time step should pass them all to
 :func:`surrogate.kernels.rebound_many_rng` (uniforms from a state) or
 :func:`surrogate.kernels.rebound_many` (uniforms given), which pipeline
 blocks of particles, overlap their table reads and compute their draws as
-SIMD loops (same results, about a third of the cost on the default table);
+SIMD loops (about a quarter of the per-particle cost on the default table;
+``rebound_many`` gives the per-particle results bit for bit);
 :func:`surrogate.kernels.rebound_batch_rng` does the same on all threads,
-drawing its uniforms from one xoshiro256+ stream per chunk of rows
-(:func:`surrogate.rng.stream_states`), as :func:`sample_global` does.
+drawing its uniforms from one xoshiro256+ state per chunk of rows
+(:func:`surrogate.rng.stream_states`; each seeds 32 SIMD lanes,
+:func:`surrogate.rng.seed_lanes`), as :func:`sample_global` does.
 """
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED

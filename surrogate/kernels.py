@@ -27,7 +27,8 @@ state drawn from the neighbour is then moved to the incident state:
 Entry points: :func:`rebound_tuple` (one particle, global frame, vectors as
 tuples: the form for a solver's per-hit loop), :func:`rebound` (the same on
 (3,) arrays), :func:`rebound_many` (many particles, one thread, their table
-reads overlapped), :func:`rebound_batch` (parallel; :func:`rebound_batch_rng`
+reads overlapped; :func:`rebound_many_rng` draws their uniforms from 32 SIMD
+lanes, :func:`rebound_uniforms` returns those), :func:`rebound_batch` (parallel; :func:`rebound_batch_rng`
 draws its uniforms), :func:`draw_local` and :func:`draw_velocity` (local
 frame; :func:`draw_local_batch` and :func:`draw_local_batch_rng` parallel).
 
@@ -111,8 +112,7 @@ def _first_row(data, cell, u4):
 @numba.njit(inline="always", **JIT)
 def _component(data, cell, u4):
     """Offset in ``data.clusters`` of the mixture component u4 draws in cell number ``cell``: Walker's
-    alias table (one multiply, one floor, one compare; the alias sits in the row's first cache line and
-    is read always, then selected without a branch)."""
+    alias table (one multiply, one floor, one compare; the alias sits in the row's first cache line)."""
     t, c, row = _first_row(data, cell, u4)
     alias = int(load(data.clusters, row + ROW_ALIAS))
     c = alias if t - c >= load(data.clusters, row + ROW_ALIAS_PROB) else c
