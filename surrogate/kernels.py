@@ -28,9 +28,10 @@ Entry points: :func:`rebound_tuple` (one particle, global frame, vectors as
 tuples: the form for a solver's per-hit loop), :func:`rebound` (the same on
 (3,) arrays), :func:`rebound_many` (many particles, one thread, their table
 reads overlapped; :func:`rebound_many_rng` draws their uniforms from 32 SIMD
-lanes, :func:`rebound_uniforms` returns those), :func:`rebound_batch` (parallel; :func:`rebound_batch_rng`
-draws its uniforms), :func:`draw_local` and :func:`draw_velocity` (local
-frame; :func:`draw_local_batch` and :func:`draw_local_batch_rng` parallel).
+lanes, :func:`rebound_uniforms` returns those), :func:`rebound_batch`
+(parallel; :func:`rebound_batch_rng` draws its uniforms), :func:`draw_local`
+and :func:`draw_velocity` (local frame; :func:`draw_local_batch` and
+:func:`draw_local_batch_rng` parallel).
 
 The hot path calls no libm function (:mod:`surrogate.trig`,
 :mod:`surrogate.restitution`) and branches only where the outcome is
@@ -563,7 +564,9 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row, one thread, by blocks of BLOCK particles.
 
     Same arguments as :func:`rebound_batch` and the same results, bit for bit,
-    as calling :func:`rebound` row by row. Per block, each step a loop over
+    as calling :func:`rebound` row by row. Every array must have one row per
+    particle (ValueError naming the first that has not); V, n and a are
+    copied if they are not C-contiguous. Per block, each step a loop over
     the block whose iterations do not depend on each other (so the processor
     overlaps them):
 
@@ -584,7 +587,9 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     ``@njit`` code on the hit arrays (or :func:`rebound_many_rng`, which
     draws the uniforms itself).
     """
-    _rebound_blocks(data, mix_cdf, V, n, a, u, _no_state(), V_out, W_out, status, scaled, *_block_scratch())
+    _check_rows(V, n, a, V_out, W_out, status)
+    _check_uniforms(u, V.shape[0])
+    _run_blocks(data, mix_cdf, V, n, a, u, _no_state(), V_out, W_out, status, scaled)
 
 
 @numba.njit(**JIT)
@@ -602,7 +607,8 @@ def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, W_out, status, scaled
     """
     if state.shape[0] != 4:
         raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.rng.seed_state gives")
-    _rebound_blocks(data, mix_cdf, V, n, a, _no_uniforms(), state, V_out, W_out, status, scaled, *_block_scratch())
+    _check_rows(V, n, a, V_out, W_out, status)
+    _run_blocks(data, mix_cdf, V, n, a, _no_uniforms(), state, V_out, W_out, status, scaled)
 
 
 @numba.njit(**JIT)
@@ -624,6 +630,36 @@ def rebound_uniforms(state, n_rows):
 def _lanes():
     """The BLOCK xoshiro256+ lanes of :func:`rebound_many_rng` (:func:`surrogate.rng.seed_lanes` layout)."""
     return np.zeros(4 * BLOCK, dtype=np.uint64)
+
+
+_ROWS = "rebound_many: V, n, V_out, W_out must have shape (N, 3), a and status (N,) with N = len(V); not"
+
+
+@numba.njit(**JIT)
+def _check_rows(V, n, a, V_out, W_out, status):
+    """ValueError naming the first array of a block kernel's call that has not one row per particle.
+    Called before the parallel loops: a raise inside one keeps numba from running it in parallel."""
+    rows = V.shape[0]
+    for name, shape in (("V", V.shape), ("n", n.shape), ("V_out", V_out.shape), ("W_out", W_out.shape)):
+        if shape[0] != rows or shape[1] != 3:
+            raise ValueError(_ROWS, name, shape)
+    for name, shape in (("a", a.shape), ("status", status.shape)):
+        if shape[0] != rows:
+            raise ValueError(_ROWS, name, shape)
+
+
+@numba.njit(**JIT)
+def _check_uniforms(u, rows):
+    """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW)."""
+    if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
+        raise ValueError("rebound_many: u must have shape (len(V), U_PER_DRAW); its shape is", u.shape)
+
+
+@numba.njit(inline="always", **JIT)
+def _run_blocks(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled):
+    """:func:`_rebound_blocks` with its scratch, V, n, a made C-contiguous (copied if they are not)."""
+    _rebound_blocks(data, mix_cdf, np.ascontiguousarray(V), np.ascontiguousarray(n), np.ascontiguousarray(a), u,
+                    state, V_out, W_out, status, scaled, *_block_scratch())
 
 
 @numba.njit(inline="always", **JIT)
@@ -661,13 +697,13 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scal
     """
     if state.shape[0] == 4:
         seed_lanes(state, lanes)
+    V_flat, n_flat = V.reshape(3 * V.shape[0]), n.reshape(3 * V.shape[0])
     n_blocks = (V.shape[0] + BLOCK - 1) // BLOCK
     for k in range(n_blocks + STAGES - 1):
         if k < n_blocks:
             j = k % STAGES
             _block_uniforms(u, state, lanes, k * BLOCK, min(BLOCK, V.shape[0] - k * BLOCK), us[j])
-            _locate_block(data, mix_cdf, V.reshape(3 * V.shape[0]), n.reshape(3 * V.shape[0]), a, us[j], k * BLOCK,
-                          index[j], g[j])
+            _locate_block(data, mix_cdf, V_flat, n_flat, a, us[j], k * BLOCK, index[j], g[j])
         if 1 <= k <= n_blocks:
             j = (k - 1) % STAGES
             _resolve_block(data, us[j], (k - 1) * BLOCK, V.shape[0], index[j], g[j])
@@ -781,7 +817,8 @@ def _cell_and_hints(data, mix_cdf, u, index, g, b):
     cell = _cell(data, mix_cdf, _field(g, G_ALPHA1, b), _field(g, G_SPEED, b), u)
     index[I_ROW * BLOCK + b] = _first_row(data, cell[0], u[4])[2]
     drawn, below, wa, jv, wv, iv = cell
-    index[I_DRAWN * BLOCK + b], index[I_BELOW * BLOCK + b], index[I_JV * BLOCK + b], index[I_IV * BLOCK + b] = drawn, below, jv, iv
+    for field, value in ((I_DRAWN, drawn), (I_BELOW, below), (I_JV, jv), (I_IV, iv)):
+        index[field * BLOCK + b] = value
     g[G_WA * BLOCK + b], g[G_WV * BLOCK + b] = wa, wv
 
 
@@ -811,7 +848,8 @@ def _gather_component(data, u, index, g, b):
 @numba.njit(inline="always", **JIT)
 def _gather_cell(data, index, g, b):
     """Block step 4 for particle b: the α1 move (:func:`_alpha1_terms`) and the restitution factors."""
-    drawn, below, jv, iv = index[I_DRAWN * BLOCK + b], index[I_BELOW * BLOCK + b], index[I_JV * BLOCK + b], index[I_IV * BLOCK + b]
+    drawn, below, jv, iv = _field(index, I_DRAWN, b), _field(index, I_BELOW, b), _field(index, I_JV, b), _field(
+        index, I_IV, b)
     g[G_F_TARGET * BLOCK + b], g[G_F_GRID * BLOCK + b] = _restitution_factors(data, jv, _field(g, G_WV, b), iv)
     t = _alpha1_terms(data, below, _field(g, G_WA, b), drawn)
     _put6(g, G_RATIO, b, (t[0][0], t[1][0], t[2][0], t[3][0], t[4][0], t[5][0]))
@@ -864,6 +902,8 @@ def _arithmetic(g, out, b, scaled):
 @numba.njit(parallel=True, **JIT)
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row (parallel over chunks of :func:`rebound_many`); u has shape (N, U_PER_DRAW)."""
+    _check_rows(V, n, a, V_out, W_out, status)
+    _check_uniforms(u, V.shape[0])
     for j in numba.prange(n_streams(V.shape[0])):
         lo, hi = _chunk(j, V.shape[0])
         _rebound_chunk(data, mix_cdf, V, n, a, u[lo:hi], _no_state(), V_out, W_out, status, scaled, lo, hi)
@@ -873,8 +913,10 @@ def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
 def rebound_batch_rng(data, mix_cdf, V, n, a, states, V_out, W_out, status, scaled=True):
     """:func:`rebound_batch` drawing its own uniforms: the rows of chunk j (ROWS_PER_STREAM rows) from a
     copy of the xoshiro256+ state ``states[j]`` (:func:`surrogate.rng.stream_states`; ``states`` itself is
-    not advanced), as :func:`rebound_many_rng` draws them (:func:`rebound_uniforms`). The draws are the same whatever the number of
-    threads, and no (N, U_PER_DRAW) array of uniforms is held. ``states`` must have one row per chunk (ValueError)."""
+    not advanced), as :func:`rebound_many_rng` draws them (:func:`rebound_uniforms`). The draws are the
+    same whatever the number of threads, and no (N, U_PER_DRAW) array of uniforms is held. ``states`` must
+    have one row per chunk (ValueError)."""
+    _check_rows(V, n, a, V_out, W_out, status)
     _check_streams(states, V.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, V.shape[0])
@@ -898,8 +940,8 @@ def _chunk(j, n_rows):
 def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scaled, lo, hi):
     """:func:`rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows, or
     :func:`rebound_many_rng` with ``state``."""
-    _rebound_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], W_out[lo:hi],
-                    status[lo:hi], scaled, *_block_scratch())
+    _run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], W_out[lo:hi], status[lo:hi],
+                scaled)
 
 
 @numba.njit(parallel=True, **JIT)

@@ -357,6 +357,35 @@ def test_block_kernel_drawing_its_uniforms_equals_the_one_given_them(small_table
     with pytest.raises(ValueError, match="one xoshiro256\\+ state"):
         rebound_many_rng(data, cdf, V, n, a, np.ones(3, np.uint64), *drawn)
 
+def test_block_kernel_takes_strided_rows_and_rejects_short_arrays(small_table):
+    """V and n as column slices of wider arrays give the results of their contiguous copies; an array with
+    another number of rows, or u with another width, is a ValueError naming it and its shape."""
+    m = 2 * BLOCK + 3
+    rng = np.random.default_rng(10)
+    speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
+    wide_V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m), np.ones(m)])
+    wide_n = np.column_stack([np.ones(m), np.zeros(m), np.ones(m), np.zeros(m)])
+    V, n, a = wide_V[:, :3], wide_n[:, 1:], np.full(m, 1e-4)
+    assert not V.flags.c_contiguous and not n.flags.c_contiguous
+    data, cdf = small_table.kernel_data, surrogate.mix_cdf(small_table, "mix")
+    strided = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_many_rng(data, cdf, V, n, a, seed_state(3), *strided)
+    copied = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
+    rebound_many_rng(data, cdf, V.copy(), n.copy(), a, seed_state(3), *copied)
+    for x, y in zip(strided, copied):
+        np.testing.assert_array_equal(x, y)
+    assert np.all(strided[2] != STATUS_INVALID)
+    with pytest.raises(ValueError, match="'n', \\(66, 3\\)"):
+        rebound_many_rng(data, cdf, V, n[:-1], a, seed_state(3), *copied)
+    with pytest.raises(ValueError, match="'status', \\(66,\\)"):
+        rebound_many_rng(data, cdf, V, n, a, seed_state(3), *copied[:2], copied[2][:-1])
+    with pytest.raises(ValueError, match="u must have shape"):
+        rebound_many(data, cdf, V, n, a, np.zeros((m, U_PER_DRAW - 1)), *copied)
+    with pytest.raises(ValueError, match="'W_out', \\(65, 3\\)"):     # the parallel kernels check before their loop
+        rebound_batch_rng(data, cdf, V, n, a, stream_states(np.random.default_rng(3), m), copied[0], copied[1][:-2],
+                          copied[2])
+
+
 BAD_GLOBAL = [
     (dict(velocity=[[10.0, 5.0, 0.0]]), "does not move into the wall"),
     (dict(velocity=[[0.0, 0.0, 0.0]]), "is zero"),
