@@ -632,7 +632,7 @@ def _lanes():
     return np.zeros(4 * BLOCK, dtype=np.uint64)
 
 
-_ROWS = "rebound_many: V, n, V_out, W_out must have shape (N, 3), a and status (N,) with N = len(V); not"
+_ROWS = "V, n, V_out, W_out must have shape (N, 3), a and status (N,), with N = len(V); not so"
 
 
 @numba.njit(**JIT)
@@ -652,7 +652,7 @@ def _check_rows(V, n, a, V_out, W_out, status):
 def _check_uniforms(u, rows):
     """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW)."""
     if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
-        raise ValueError("rebound_many: u must have shape (len(V), U_PER_DRAW); its shape is", u.shape)
+        raise ValueError("u must have shape (len(V), U_PER_DRAW); its shape is", u.shape)
 
 
 @numba.njit(inline="always", **JIT)
