@@ -746,7 +746,7 @@ def _locate_block(data, mix_cdf, V, n, a, ub, start, index, g):
             _no_cell(index, g, b)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
-            _hint_row(data, index[I_ROW * BLOCK + b])
+            _hint_row(data, _field(index, I_ROW, b))
 
 
 @numba.njit(inline="always", **JIT)
@@ -755,10 +755,10 @@ def _resolve_block(data, ub, start, n_rows, index, g):
     hints for its row (the same lines again unless the alias table redirected the draw) and its levels."""
     for b in range(min(BLOCK, n_rows - start)):
         if _field(g, G_VALID, b) != 0.0:
-            row = _component(data, index[I_DRAWN * BLOCK + b], ub[4 * BLOCK + b])
+            row = _component(data, _field(index, I_DRAWN, b), ub[4 * BLOCK + b])
             index[I_ROW * BLOCK + b] = row
             _hint_row(data, row)
-            _hint_levels(data, index[I_DRAWN * BLOCK + b], _uniforms(ub, b))
+            _hint_levels(data, _field(index, I_DRAWN, b), _uniforms(ub, b))
 
 
 @numba.njit(inline="always", **JIT)
@@ -835,7 +835,7 @@ def _no_cell(index, g, b):
 def _gather_component(data, u, index, g, b):
     """Block step 4 for particle b: what its draw reads from its component row (:func:`draw_folded`) and
     the residual shapes, with the flags its uniforms set (trapped, mirror)."""
-    drawn, row = index[I_DRAWN * BLOCK + b], index[I_ROW * BLOCK + b]
+    drawn, row = _field(index, I_DRAWN, b), _field(index, I_ROW, b)
     r = data.clusters
     trapped = u[3] < load(data.cells, drawn * CELL_SIZE + CELL_P_TRAPPED)
     _put3(g, G_TRAPPED, b, (1.0 if trapped else 0.0, u[11], np.float64(load(r, row + ROW_REGIME))))
@@ -848,8 +848,8 @@ def _gather_component(data, u, index, g, b):
 @numba.njit(inline="always", **JIT)
 def _gather_cell(data, index, g, b):
     """Block step 4 for particle b: the α1 move (:func:`_alpha1_terms`) and the restitution factors."""
-    drawn, below, jv, iv = _field(index, I_DRAWN, b), _field(index, I_BELOW, b), _field(index, I_JV, b), _field(
-        index, I_IV, b)
+    drawn, below = _field(index, I_DRAWN, b), _field(index, I_BELOW, b)
+    jv, iv = _field(index, I_JV, b), _field(index, I_IV, b)
     g[G_F_TARGET * BLOCK + b], g[G_F_GRID * BLOCK + b] = _restitution_factors(data, jv, _field(g, G_WV, b), iv)
     t = _alpha1_terms(data, below, _field(g, G_WA, b), drawn)
     _put6(g, G_RATIO, b, (t[0][0], t[1][0], t[2][0], t[3][0], t[4][0], t[5][0]))
