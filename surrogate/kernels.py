@@ -632,27 +632,33 @@ def _lanes():
     return np.zeros(4 * BLOCK, dtype=np.uint64)
 
 
-_ROWS = "V, n, V_out, W_out must have shape (N, 3), a and status (N,), with N = len(V); not so"
-
-
 @numba.njit(**JIT)
 def _check_rows(V, n, a, V_out, W_out, status):
-    """ValueError naming the first array of a block kernel's call that has not one row per particle.
-    Called before the parallel loops: a raise inside one keeps numba from running it in parallel."""
+    """ValueError naming the first array of a block kernel's call that has not one row per particle, with
+    its shape and the shape needed. Called before the parallel loops: a raise inside one keeps numba from
+    running it in parallel."""
     rows = V.shape[0]
     for name, shape in (("V", V.shape), ("n", n.shape), ("V_out", V_out.shape), ("W_out", W_out.shape)):
         if shape[0] != rows or shape[1] != 3:
-            raise ValueError(_ROWS, name, shape)
+            raise ValueError(_shape_error(name, shape, "(" + str(rows) + ", 3)"))
     for name, shape in (("a", a.shape), ("status", status.shape)):
         if shape[0] != rows:
-            raise ValueError(_ROWS, name, shape)
+            raise ValueError(_shape_error(name, shape, "(" + str(rows) + ",)"))
 
 
 @numba.njit(**JIT)
 def _check_uniforms(u, rows):
     """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW)."""
     if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
-        raise ValueError("u must have shape (len(V), U_PER_DRAW); its shape is", u.shape)
+        raise ValueError(_shape_error("u", u.shape, "(" + str(rows) + ", " + str(U_PER_DRAW) + ")"))
+
+
+@numba.njit(**JIT)
+def _shape_error(name, shape, needed):
+    """The message of a shape error of the kernels over many particles: one row per particle, N = len(V)."""
+    text = ", ".join([str(x) for x in shape]) + ("," if len(shape) == 1 else "")
+    return ("'" + name + "' has shape (" + text + "); needed " + needed
+            + ": one row per particle, as many as V has")
 
 
 @numba.njit(inline="always", **JIT)

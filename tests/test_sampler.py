@@ -375,13 +375,14 @@ def test_block_kernel_takes_strided_rows_and_rejects_short_arrays(small_table):
     for x, y in zip(strided, copied):
         np.testing.assert_array_equal(x, y)
     assert np.all(strided[2] != STATUS_INVALID)
-    with pytest.raises(ValueError, match="'n', \\(66, 3\\)"):
+    with pytest.raises(ValueError, match="'n' has shape \\(66, 3\\); needed \\(67, 3\\)"):
         rebound_many_rng(data, cdf, V, n[:-1], a, seed_state(3), *copied)
-    with pytest.raises(ValueError, match="'status', \\(66,\\)"):
+    with pytest.raises(ValueError, match="'status' has shape \\(66,\\); needed \\(67,\\)"):
         rebound_many_rng(data, cdf, V, n, a, seed_state(3), *copied[:2], copied[2][:-1])
-    with pytest.raises(ValueError, match="u must have shape"):
+    with pytest.raises(ValueError, match="'u' has shape \\(67, 12\\); needed \\(67, 13\\)"):
         rebound_many(data, cdf, V, n, a, np.zeros((m, U_PER_DRAW - 1)), *copied)
-    with pytest.raises(ValueError, match="'W_out', \\(65, 3\\)"):     # the parallel kernels check before their loop
+    # the parallel kernels check before their loop
+    with pytest.raises(ValueError, match="'W_out' has shape \\(65, 3\\); needed \\(67, 3\\)"):
         rebound_batch_rng(data, cdf, V, n, a, stream_states(np.random.default_rng(3), m), copied[0], copied[1][:-2],
                           copied[2])
 
