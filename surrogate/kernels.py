@@ -588,7 +588,7 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     draws the uniforms itself).
     """
     _check_rows(V, n, a, V_out, W_out, status)
-    _check_uniforms(u, V.shape[0])
+    _check_uniforms(u, V.shape[0], "V")
     _run_blocks(data, mix_cdf, V, n, a, u, _no_state(), V_out, W_out, status, scaled)
 
 
@@ -647,18 +647,30 @@ def _check_rows(V, n, a, V_out, W_out, status):
 
 
 @numba.njit(**JIT)
-def _check_uniforms(u, rows):
-    """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW)."""
-    if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
-        raise ValueError(_shape_error("u", u.shape, "(" + str(rows) + ", " + str(U_PER_DRAW) + ")"))
+def _check_local_rows(alpha1, speed, out, status):
+    """ValueError naming the first array of a local-frame batch that has not one row per incident state."""
+    rows = alpha1.shape[0]
+    for name, shape in (("speed", speed.shape), ("status", status.shape)):
+        if shape[0] != rows:
+            raise ValueError(_shape_error(name, shape, "(" + str(rows) + ",)", "alpha1"))
+    if out.shape[0] != rows or out.shape[1] != 6:
+        raise ValueError(_shape_error("out", out.shape, "(" + str(rows) + ", 6)", "alpha1"))
 
 
 @numba.njit(**JIT)
-def _shape_error(name, shape, needed):
-    """The message of a shape error of the kernels over many particles: one row per particle, N = len(V)."""
+def _check_uniforms(u, rows, first):
+    """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW), rows = len(first)."""
+    if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
+        raise ValueError(_shape_error("u", u.shape, "(" + str(rows) + ", " + str(U_PER_DRAW) + ")", first))
+
+
+@numba.njit(**JIT)
+def _shape_error(name, shape, needed, first="V"):
+    """The message of a shape error of the kernels over many particles: one row per particle, as many as
+    the array ``first`` has."""
     text = ", ".join([str(x) for x in shape]) + ("," if len(shape) == 1 else "")
     return ("'" + name + "' has shape (" + text + "); needed " + needed
-            + ": one row per particle, as many as V has")
+            + ": one row per particle, as many as " + first + " has")
 
 
 @numba.njit(inline="always", **JIT)
@@ -909,7 +921,7 @@ def _arithmetic(g, out, b, scaled):
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`rebound` for every row (parallel over chunks of :func:`rebound_many`); u has shape (N, U_PER_DRAW)."""
     _check_rows(V, n, a, V_out, W_out, status)
-    _check_uniforms(u, V.shape[0])
+    _check_uniforms(u, V.shape[0], "V")
     for j in numba.prange(n_streams(V.shape[0])):
         lo, hi = _chunk(j, V.shape[0])
         _rebound_chunk(data, mix_cdf, V, n, a, u[lo:hi], _no_state(), V_out, W_out, status, scaled, lo, hi)
@@ -952,7 +964,10 @@ def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, W_out, status, scale
 
 @numba.njit(parallel=True, **JIT)
 def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
-    """:func:`draw_local` for every row (parallel); out has shape (N, 6)."""
+    """:func:`draw_local` for every row (parallel): alpha1 and speed (N,), u (N, U_PER_DRAW), out (N, 6)
+    (α2, β2, s, Ω_x, Ω_y, Ω_z), status (N,); a ValueError names an array of another shape."""
+    _check_local_rows(alpha1, speed, out, status)
+    _check_uniforms(u, alpha1.shape[0], "alpha1")
     for j in numba.prange(n_streams(alpha1.shape[0])):
         lo, hi = _chunk(j, alpha1.shape[0])
         _draw_local_chunk(data, mix_cdf, alpha1, speed, u[lo:hi], out, status, scaled, lo, hi)
@@ -962,6 +977,7 @@ def draw_local_batch(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
 def draw_local_batch_rng(data, mix_cdf, alpha1, speed, states, out, status, scaled=True):
     """:func:`draw_local_batch` drawing its own uniforms, chunk by chunk as :func:`rebound_batch_rng`
     (chunk j's are ``rebound_uniforms(states[j].copy(), rows)``)."""
+    _check_local_rows(alpha1, speed, out, status)
     _check_streams(states, alpha1.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, alpha1.shape[0])

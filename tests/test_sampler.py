@@ -11,8 +11,9 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels import (BLOCK, STATUS_INVALID, U_PER_DRAW, draw_local, rebound, rebound_batch,
-                               rebound_batch_rng, rebound_many, rebound_many_rng, rebound_tuple, rebound_uniforms)
+from surrogate.kernels import (BLOCK, STATUS_INVALID, U_PER_DRAW, draw_local, draw_local_batch,
+                               draw_local_batch_rng, rebound, rebound_batch, rebound_batch_rng, rebound_many,
+                               rebound_many_rng, rebound_tuple, rebound_uniforms)
 from surrogate.rng import ROWS_PER_STREAM, seed_state, stream_states
 from surrogate.table import CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE, alias_table
 
@@ -252,6 +253,19 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
         expected = draw_local(small_table.kernel_data, cdf, np.degrees(a1[i]), speed[i], U[i])
         got = (local.status[i], local.alpha2[i], local.beta2[i], local.speed_ratio[i], *local.omega[i])
         np.testing.assert_array_equal(got, expected)
+    out, status = np.empty((m, 6)), np.empty(m, dtype=np.int8)
+    draw_local_batch(small_table.kernel_data, cdf, np.degrees(a1), speed, U, out, status)
+    np.testing.assert_array_equal(status, local.status)
+    np.testing.assert_array_equal(out, np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega]))
+    for args, message in (((speed[:-1], U, out, status), f"'speed' has shape \\({m - 1},\\); needed \\({m},\\)"),
+                          ((speed, U[:, :-1], out, status), f"'u' has shape \\({m}, 12\\); needed \\({m}, 13\\)"),
+                          ((speed, U, out[:, :5], status), f"'out' has shape \\({m}, 5\\); needed \\({m}, 6\\)")):
+        with pytest.raises(ValueError, match=message):
+            draw_local_batch(small_table.kernel_data, cdf, np.degrees(a1), *args)
+    with pytest.raises(ValueError, match=f"'status' has shape \\({m - 1},\\); needed \\({m},\\): one row per "
+                       "particle, as many as alpha1 has"):
+        draw_local_batch_rng(small_table.kernel_data, cdf, np.degrees(a1), speed, stream_states(rng, m), out,
+                             status[:-1])
 
 
 @numba.njit
