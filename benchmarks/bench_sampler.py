@@ -48,7 +48,12 @@ Incident states: speed uniform over the table's speed range, α1 uniform over
 10–90° (within the table's α1 range), random unit wall normals, the
 tangential direction uniform in the wall plane, half-size a = 0.1 mm, the
 four shapes with equal weights. Trapped draws count as reflected states (the
-sampler returns their status, as the direct model does).
+sampler returns their status, as the direct model does). These states read
+the whole table at random, the worst case for its caches. Two more rows time
+(b) and (b-block) on the states of the wall beam of
+``examples/particle_beam.py`` (α1 uniform over 28.5–31.5°, |V⁻| over
+150–200 m/s, within the table's ranges; normals and tangents random as
+above): the hits of one jet on one wall, which read a few cells only.
 
 The table is built by the script into a temporary folder (α1 ∈ {10, 30, 50,
 70, 90}°, |V⁻| ∈ {100, 200, 300} m/s, the four shapes, 20000 particles per
@@ -107,6 +112,8 @@ from surrogate.rng import fill_uniforms, seed_state, stream_states
 SEED = 20240601
 HALF_SIZE = 1e-4                    # m, particle half-size a
 ALPHA1_RANGE = (10.0, 90.0)         # deg, incident states
+BEAM_ALPHA1 = (28.5, 31.5)          # deg, the wall beam of examples/particle_beam.py
+BEAM_SPEED = (150.0, 200.0)         # m/s, the same
 SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
 TABLE_TOML = """
 [grid]
@@ -287,17 +294,18 @@ def build_bench_table(folder: Path, particles: int) -> tuple:
     return path, time.perf_counter() - start
 
 
-def incident_states(table, count: int, seed: int) -> dict:
-    """Random incident states within the table's grid (see the module doc).
+def incident_states(table, count: int, seed: int, alpha1_range=ALPHA1_RANGE, speed_range=(0.0, math.inf)) -> dict:
+    """Random incident states within the table's grid and the given ranges (deg, m/s; see the module doc).
 
     α1 and |V⁻| are drawn from ranges shrunk by a relative 1e-9 so that the
     values recomputed from V (rounding) stay inside the grid.
     """
     rng = np.random.default_rng(seed)
-    a_lo, a_hi = max(ALPHA1_RANGE[0], table.alpha1_range[0]), min(ALPHA1_RANGE[1], table.alpha1_range[1])
-    v_lo, v_hi = table.speed_range
-    if a_lo > a_hi:
-        raise SystemExit(f"the table's alpha1 range {table.alpha1_range} does not meet {ALPHA1_RANGE} deg")
+    a_lo, a_hi = max(alpha1_range[0], table.alpha1_range[0]), min(alpha1_range[1], table.alpha1_range[1])
+    v_lo, v_hi = max(speed_range[0], table.speed_range[0]), min(speed_range[1], table.speed_range[1])
+    if a_lo > a_hi or v_lo > v_hi:
+        raise SystemExit(f"the table's alpha1 range {table.alpha1_range} deg and speed range {table.speed_range} "
+                         f"m/s do not meet {alpha1_range} deg and {speed_range} m/s")
     alpha1 = rng.uniform(a_lo * (1 + 1e-9), a_hi * (1 - 1e-9), count) if a_hi > a_lo else np.full(count, a_lo)
     speed = rng.uniform(v_lo * (1 + 1e-9), v_hi * (1 - 1e-9), count) if v_hi > v_lo else np.full(count, v_lo)
     normal = rng.standard_normal((count, 3))
@@ -420,6 +428,7 @@ def main(argv=None) -> int:
         raise SystemExit(f"the table lacks shapes {missing}; the bench draws the equal mix of all four")
 
     st = incident_states(table, count, SEED)
+    beam = incident_states(table, count, SEED + 1, BEAM_ALPHA1, BEAM_SPEED)
     V, nrm, a, U = st["V"], st["normal"], st["half_size"], st["U"]
     mix = {s: 0.25 for s in SHAPES}
     cdf = surrogate.mix_cdf(table, mix)
@@ -430,6 +439,8 @@ def main(argv=None) -> int:
     print(f"  states                 N = {count}: speed U{table.speed_range} m/s, alpha1 "
           f"U({st['alpha1'].min():.2f}, {st['alpha1'].max():.2f}) deg, random unit normals, a = {HALF_SIZE:g} m, "
           f"shape mix {', '.join(f'{s} {w:g}' for s, w in mix.items())}")
+    print(f"  wall-beam states       the same, with alpha1 U({beam['alpha1'].min():.2f}, {beam['alpha1'].max():.2f}) "
+          f"deg and speed U({beam['speed'].min():.1f}, {beam['speed'].max():.1f}) m/s")
     print(f"  best of {repeats}; seed {SEED}; U_PER_DRAW = {U_PER_DRAW}")
 
     # warm-up: compile everything timed below (a small slice; numba caches per type signature)
@@ -493,6 +504,10 @@ def main(argv=None) -> int:
            lambda: loop_block_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, W_out, status))
     record("b_block_given", "    variant: uniforms into U, rebound_many", 1,
            lambda: loop_block_given(data, cdf, V, nrm, a, seed_state(SEED), U_block, V_out, W_out, status))
+    record("b_beam", "(b) on the wall-beam states", 1,
+           lambda: loop_kernel_rng(data, cdf, beam["V"], beam["normal"], a, seed_state(SEED), V_out, W_out, status))
+    record("b_block_beam", "(b-block) on the wall-beam states", 1,
+           lambda: loop_block_rng(data, cdf, beam["V"], beam["normal"], a, seed_state(SEED), V_out, W_out, status))
     record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
            lambda: loop_rng_only(count, seed_state(SEED), np.empty(1)))
     record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))
@@ -515,6 +530,7 @@ def main(argv=None) -> int:
     ratios = {"direct_over_kernel": c / b, "kernel_over_bounce": b / d, "kernel_ns": b,
               "direct_over_block": c / bb, "block_over_bounce": bb / d, "block_ns": bb,
               "kernel_predrawn_over_bounce": rows["b_predrawn"]["ns_per_state"] / d,
+              "kernel_beam_ns": rows["b_beam"]["ns_per_state"], "block_beam_ns": rows["b_block_beam"]["ns_per_state"],
               "api_1thread_over_kernel": rows["a_1"]["ns_per_state"] / b,
               "rng_share_of_kernel": rows["b_rng"]["ns_per_state"] / b}
     targets = {"direct_over_kernel": bool(c / b >= TARGET_DIRECT_OVER_KERNEL),
@@ -531,6 +547,8 @@ def main(argv=None) -> int:
     print(f"  (c)/(b-block) direct model / block kernel     {c / bb:12.4g}")
     print(f"  (b-block)/(d) block kernel / Grant-Tabakoff   {bb / d:12.4g}")
     print(f"  (b-block) block kernel, ns per state per core {bb:11.4g}")
+    print(f"  (b), (b-block) on the wall-beam states, ns     {ratios['kernel_beam_ns']:11.4g} "
+          f"{ratios['block_beam_ns']:11.4g}")
     print(f"  (b')/(d) kernel on pre-drawn uniforms / G-T   {ratios['kernel_predrawn_over_bounce']:12.4g}")
     print(f"  (a, 1 thread)/(b) NumPy API / @njit loop      {ratios['api_1thread_over_kernel']:12.4g}")
     print(f"  RNG share of (b)                              {ratios['rng_share_of_kernel']:12.4g}")
