@@ -128,7 +128,7 @@ TARGET_DIRECT_OVER_KERNEL = 1e4            # (c)/(b) at least
 TARGET_KERNEL_OVER_BOUNCE = 3.0            # (b)/(d) at most
 TARGET_KERNEL_NS = 100.0                   # (b) at most, ns per state per core
 
-# the bench's own kernels: the options of surrogate.kernels.JIT, without the on-disk cache
+# the bench's own kernels: the options of surrogate.jit.JIT, without the on-disk cache
 JIT = dict(nogil=True, fastmath=False, error_model="numpy")
 
 # Grant & Tabakoff (1975), sand on 2024 aluminium: coefficients of 1, β1, β1², β1³ (β1 in rad)

@@ -6,7 +6,7 @@ passes over (N, 3) temporaries (norms, dot products, arctangents), as much
 as the draws themselves. :func:`first_faults` makes one pass in numba and
 returns, for every check in the order the API reports them (the FAULT_*
 constants), the first row that fails it, or −1. It computes α1 and |V⁻| as
-the sampler's kernel does (:func:`surrogate.kernels.impact_frame`), so the
+the sampler's kernel does (:func:`surrogate.frame.impact_frame`), so the
 range check sees the values the draw will use.
 """
 
@@ -15,7 +15,8 @@ import math
 import numba
 import numpy as np
 
-from surrogate.kernels import JIT, _dot, impact_frame
+from surrogate.frame import _dot, impact_frame
+from surrogate.jit import JIT
 from surrogate.rng import ROWS_PER_STREAM, n_streams
 
 FAULT_VELOCITY_NOT_FINITE = 0

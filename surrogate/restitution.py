@@ -1,6 +1,6 @@
 """The wall's normal restitution factor exp(−k V^p) between grid speeds, as precomputed polynomial pieces.
 
-The sampler's speed step (:func:`surrogate.kernels._to_speed`) needs
+The sampler's speed step (:func:`surrogate.draw._to_speed`) needs
 f(V) = exp(−k V^p) (V in m/s) at every particle's incident speed. Computed
 directly that is a ``pow`` and an ``exp`` call per draw, about a tenth of the
 kernel's cost. Instead, :func:`restitution_pieces` cuts every interval
@@ -24,6 +24,7 @@ import numpy as np
 from numpy.polynomial import chebyshev
 
 from surrogate.fused import fma
+from surrogate.jit import JIT
 from surrogate.memory import load
 
 DEGREE = 9          # polynomial degree of a piece
@@ -54,7 +55,7 @@ def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
     return coef
 
 
-@numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
+@numba.njit(inline="always", **JIT)
 def restitution_at(pieces, n_pieces, j, w):
     """exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w ∈ [0, 1], from :func:`restitution_pieces` flattened
     (``pieces`` 1-D, ``n_pieces`` its S: piece i of interval j starts at (j S + i)(DEGREE + 1))."""

@@ -23,6 +23,7 @@ import math
 import numba
 
 from surrogate.fused import fma
+from surrogate.jit import JIT
 
 _HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double
 _HALF_PI_LO = 6.123233995736766e-17    # π/2 − _HALF_PI_HI
@@ -33,7 +34,7 @@ S3, S5, S7, S9, S11, S13, S15 = ((-1.0) ** k / math.factorial(2 * k + 1) for k i
 C2, C4, C6, C8, C10, C12, C14, C16 = ((-1.0) ** k / math.factorial(2 * k) for k in range(1, 9))
 
 
-@numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
+@numba.njit(inline="always", **JIT)
 def sincos(x):
     """(sin x, cos x) for |x| ≤ 2π (x in radians), to a few ulp."""
     q = math.floor(x * _TWO_OVER_PI + 0.5)
@@ -52,7 +53,7 @@ def sincos(x):
 _ATAN_AT_NODES = tuple(math.atan(0.25 * node) for node in range(5))
 
 
-@numba.njit(inline="always", cache=True, nogil=True, fastmath=False, error_model="numpy")
+@numba.njit(inline="always", **JIT)
 def atan2_first_quadrant(y, x):
     """atan2(y, x) in radians for x ≥ 0, y ≥ 0, not both 0, to a few ulp."""
     swap = y > x

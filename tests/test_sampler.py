@@ -509,7 +509,7 @@ def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
     Regime 0: V⁺ − V⁻ and Ω⁺ times (1 + a(V))/(1 + a(V_j)), V⁻ = (cos α1, −sin α1, 0);
     regime 1: v⁺_n times a(V)/a(V_j), the rest kept; at V = V_j nothing moves.
     """
-    from surrogate.kernels import _restitution_factors, _to_speed
+    from surrogate.draw import _restitution_factors, _to_speed
     data = small_table.kernel_data
     k, p = 0.1, 0.61       # the wall law the table was built with (tablegen's default)
     assert (small_table.restitution_k, small_table.restitution_p) == (k, p)
