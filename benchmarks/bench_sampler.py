@@ -10,8 +10,9 @@ and prints the cost in ns per reflected state:
     count and with one numba thread. The time covers the whole call: input
     checks, the seeding of one xoshiro256+ stream per 1024 states, the
     parallel kernel (which draws the U_PER_DRAW uniforms per state) and the
-    outputs. Two breakdown rows time that kernel,
-    ``surrogate.kernels.rebound_batch_rng``, alone;
+    outputs; variants pass ``out=`` arrays that the caller keeps (no
+    allocation, no first touch of fresh pages). Two breakdown rows time that
+    kernel, ``surrogate.kernels.rebound_batch_rng``, alone;
 (b) ``surrogate.kernels.rebound_tuple`` called from a user's ``@njit`` loop
     on one thread, as a flow solver would call it per wall hit: the particle's
     V and n passed as 3-tuples of its components and V⁺, Ω⁺ returned as
@@ -481,8 +482,13 @@ def main(argv=None) -> int:
     def api():
         return surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED)
 
+    def api_out():
+        return surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED, out=(V_out, W_out, status))
+
     record("a_all", "(a) sample_global, all cores", threads, api)
     record("a_1", "(a) sample_global, 1 numba thread", 1, api)
+    record("a_out_all", "    variant: with out= arrays kept, all cores", threads, api_out)
+    record("a_out_1", "    variant: with out= arrays kept, 1 thread", 1, api_out)
     record("a_kernel_all", "    breakdown: rebound_batch_rng, all cores", threads,
            lambda: rebound_batch_rng(data, cdf, V, nrm, a, streams, V_out, W_out, status))
     record("a_kernel_1", "    breakdown: rebound_batch_rng, 1 thread", 1,

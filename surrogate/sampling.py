@@ -204,8 +204,32 @@ def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueE
     return _outside("speed", i, speed, table.speed_range, "m/s")
 
 
+OUT_NAMES = ("V_out", "Omega_out", "status")
+
+
+def _outputs(out, n: int, inputs) -> tuple:
+    """The (V_out, Omega_out, status) arrays of :func:`sample_global`: new ones, or the ``out`` arrays once
+    checked (ValueError naming the first that is not as documented)."""
+    if out is None:
+        return np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int8)
+    if not isinstance(out, tuple) or len(out) != 3:
+        raise ValueError(f"The 'out' parameter must be None or a tuple of 3 arrays ({', '.join(OUT_NAMES)}); "
+                         f"got {type(out).__name__}.")
+    wanted = ((n, 3), np.float64), ((n, 3), np.float64), ((n,), np.int8)
+    for i, (name, arr, (shape, dtype)) in enumerate(zip(OUT_NAMES, out, wanted)):
+        if not isinstance(arr, np.ndarray) or arr.shape != shape or arr.dtype != dtype:
+            got = f"dtype {arr.dtype}, shape {arr.shape}" if isinstance(arr, np.ndarray) else type(arr).__name__
+            raise ValueError(f"out[{i}] ({name}) must be an array of dtype {np.dtype(dtype)} and shape {shape}; "
+                             f"got {got}.")
+        if not (arr.flags.c_contiguous and arr.flags.writeable):
+            raise ValueError(f"out[{i}] ({name}) must be C-contiguous and writeable.")
+        if any(np.may_share_memory(arr, x) for x in (*inputs, *out[:i])):
+            raise ValueError(f"out[{i}] ({name}) shares memory with an input or another output array.")
+    return out
+
+
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
-                  clamp: bool = False, interpolation: str = "scaled"):
+                  clamp: bool = False, interpolation: str = "scaled", out=None):
     """Reflected velocities and spins of particles hitting walls, in the global frame.
 
     Parameters
@@ -228,11 +252,17 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         and docs/VALIDATION.md for how they compare.
     clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
         edge instead of raising.
+    out : None (default: new arrays) or a tuple (V_out, Omega_out, status) of
+        arrays to write the results into and return: C-contiguous, writeable,
+        float64 (N, 3), float64 (N, 3) and int8 (N,), sharing no memory with
+        the inputs. A solver calling this every time step can keep them, which
+        spares it the allocation and the first touch of fresh pages.
 
     Returns
     -------
     (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8); NaN rows for
-    trapped particles.
+    trapped particles. Every check runs before anything is written: on a
+    ValueError the ``out`` arrays are unchanged.
     """
     V = np.ascontiguousarray(_vectors("velocity", velocity))
     n_particles = V.shape[0]
@@ -245,10 +275,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     _check_incident(table, V, nrm, a, clamp)
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
+    V_out, W_out, status = _outputs(out, n_particles, (V, nrm, a))
     states = stream_states(check_random_state(random_state), n_particles)
-    V_out = np.empty((n_particles, 3))
-    W_out = np.empty((n_particles, 3))
-    status = np.empty(n_particles, dtype=np.int8)
     rebound_batch_rng(table.kernel_data, cdf, V, _rows(nrm, n_particles), _rows(a, n_particles), states, V_out, W_out,
                       status, scaled)
     return V_out, W_out, status

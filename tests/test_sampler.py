@@ -425,6 +425,45 @@ def test_bad_input_is_rejected_with_the_value(small_table, kwargs, message):
         surrogate.sample_global(small_table, **args)
 
 
+def test_global_writes_into_given_outputs_or_leaves_them_untouched(small_table):
+    """out=(V_out, Omega_out, status): the same bits as new arrays, written into those objects; an out array
+    of the wrong dtype, shape or layout, read-only, or overlapping an input is a ValueError naming it, and
+    no out array is written when any check (theirs or the inputs') fails."""
+    m = 2 * ROWS_PER_STREAM + 5
+    rng = np.random.default_rng(12)
+    speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
+    V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m)])
+    n, a = np.tile([0.0, 1.0, 0.0], (m, 1)), np.full(m, 1e-4)
+    fresh = surrogate.sample_global(small_table, V, n, a, "mix", random_state=8)
+    out = np.full((m, 3), 7.0), np.full((m, 3), 7.0), np.full(m, 7, dtype=np.int8)
+    got = surrogate.sample_global(small_table, V, n, a, "mix", random_state=8, out=out)
+    assert all(x is y for x, y in zip(got, out))
+    for x, y in zip(fresh, got):
+        np.testing.assert_array_equal(x, y)
+
+    untouched = np.full((m, 3), 7.0), np.full((m, 3), 7.0), np.full(m, 7, dtype=np.int8)
+    read_only = np.full((m, 3), 7.0)
+    read_only.flags.writeable = False
+    bad = [((untouched[0], untouched[1], untouched[2].astype(np.int64)),
+            rf"out\[2\] \(status\) must be an array of dtype int8 and shape \({m},\); got dtype int64"),
+           ((untouched[0][:-1], untouched[1], untouched[2]),
+            rf"out\[0\] \(V_out\) must be an array of dtype float64 and shape \({m}, 3\); got dtype float64, "
+            rf"shape \({m - 1}, 3\)"),
+           ((untouched[0], np.full((3, m), 7.0).T, untouched[2]), r"out\[1\] \(Omega_out\) must be C-contiguous"),
+           ((untouched[0], read_only, untouched[2]), r"out\[1\] \(Omega_out\) must be C-contiguous and writeable"),
+           ((V, untouched[1], untouched[2]), r"out\[0\] \(V_out\) shares memory with an input"),
+           ((untouched[0], untouched[0], untouched[2]), r"out\[1\] \(Omega_out\) shares memory"),
+           (untouched[:2], "tuple of 3 arrays")]
+    for arrays, message in bad:
+        with pytest.raises(ValueError, match=message):
+            surrogate.sample_global(small_table, V, n, a, "mix", random_state=8, out=arrays)
+    V_bad = V.copy()
+    V_bad[m - 1] = [0.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match="is zero"):
+        surrogate.sample_global(small_table, V_bad, n, a, "mix", random_state=8, out=untouched)
+    assert np.all(untouched[0] == 7.0) and np.all(untouched[1] == 7.0) and np.all(untouched[2] == 7)
+
+
 def test_the_error_names_the_first_failing_check_and_its_first_row(small_table):
     """Several bad rows over three chunks of the parallel check: the error names the first check, in the
     documented order, that any row fails, and the first row failing it; clamp=True lets the range
