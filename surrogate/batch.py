@@ -16,6 +16,7 @@ from surrogate.draw import draw_local
 from surrogate.jit import JIT
 from surrogate.rng import ROWS_PER_STREAM, n_streams
 
+
 @numba.njit(parallel=True, **JIT)
 def rebound_batch(data, mix_cdf, V, n, a, u, V_out, W_out, status, scaled=True):
     """:func:`surrogate.kernels.rebound` for every row (parallel over chunks of

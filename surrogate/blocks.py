@@ -32,6 +32,7 @@ from surrogate.memory import load
 from surrogate.rng import fill_lanes, seed_lanes
 from surrogate.table import CELL_P_TRAPPED, CELL_SIZE, ROW_REGIME, ROW_SLOPE
 
+
 BLOCK = 32      # particles whose table reads rebound_many puts in flight together
 
 

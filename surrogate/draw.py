@@ -50,6 +50,7 @@ from surrogate.table import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD,
                              ROW_SIZE, ROW_SLOPE)
 from surrogate.trig import sincos
 
+
 U_PER_DRAW = 13
 
 

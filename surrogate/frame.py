@@ -17,6 +17,7 @@ from surrogate.fused import fma
 from surrogate.jit import JIT
 from surrogate.trig import atan2_first_quadrant, sincos
 
+
 STATUS_INVALID = -1     # returned by :func:`surrogate.kernels.rebound` for an incident state that does not hit the wall
 
 

@@ -33,9 +33,11 @@ from surrogate.draw import U_PER_DRAW, _cell, _draw_in_cell, _hint_draw, draw_lo
 from surrogate.frame import _NAN3, STATUS_INVALID, _moves_into_wall, _to_global, impact_frame
 from surrogate.jit import JIT, KERNEL
 
+
 __all__ = ["BLOCK", "STATUS_INVALID", "U_PER_DRAW", "draw_local", "draw_local_batch", "draw_local_batch_rng",
            "draw_velocity", "impact_frame", "locate", "rebound", "rebound_batch", "rebound_batch_rng",
            "rebound_many", "rebound_many_rng", "rebound_tuple", "rebound_uniforms"]
+
 
 @numba.njit(**KERNEL)
 def rebound(data, mix_cdf, V, n, a, u, V_out, W_out, scaled=True):
