@@ -66,7 +66,7 @@ the table's size: the script prints it (a pointer chase over a buffer as
 large as the table's arrays). On the reference VM that latency was 25–142 ns
 at the bench table's 4.9 MB (it sits at the edge of the share of the
 last-level cache the VM gets, which varies with other work on the host) and
-133–166 ns at the default table's 51 MB (main memory), so the per-particle
+133–166 ns at the default table's 51–60 MB (main memory), so the per-particle
 figures vary between runs far more than the block kernel's.
 
 How

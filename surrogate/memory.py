@@ -8,7 +8,7 @@ kernels (:mod:`surrogate.kernels`) use it to have a draw's table reads, or
 those of many particles, in flight at once instead of one dependent cache
 miss after another. Into level 2 rather than level 1 because the level-2
 cache keeps more misses in flight: ``rebound_many`` requests about 15 lines
-per particle for 16 particles at once, and on the 51 MB default table it
+per particle for 16 particles at once, and on the 51 MB (six-speed) default table it
 cost 157–160 ns per draw with level-1 hints (locality 3) and 141–142 ns with
 level-2 hints (interleaved runs, one process; locality 1 measured the same
 as 2, non-temporal 159 ns; the per-particle kernel did not change).
