@@ -151,9 +151,8 @@ def _chain(q, b):
 
     Chain variable k (α2, |β2|, s, Ω_z, Ω_x, Ω_y) is its residual quantile
     shifted by the component's slopes ``b`` on the variables already drawn
-    (x_k on x_i at b[k(k−1)/2 + i]). α2 is reflected into [0, π] and |β2|
-    capped at π/2 (the linear shifts can step outside by a hair, ~1e-4 of
-    draws).
+    (x_k on x_i at b[k(k−1)/2 + i]), then folded into the physical ranges
+    (:func:`_folded`).
     """
     # each x_k gathers its terms in the order the x_i become available: one fused multiply-add after x_{k−1}
     x0 = q[0]
@@ -167,9 +166,20 @@ def _chain(q, b):
 
 @numba.njit(inline="always", **JIT)
 def _folded(alpha2, beta2, s, wx, wy, wz):
-    """α2 reflected into [0, π], β2 capped at π/2, s at 0 (state order)."""
-    alpha2 = abs(alpha2)
-    return 2.0 * math.pi - alpha2 if alpha2 > math.pi else alpha2, min(beta2, 0.5 * math.pi), max(s, 0.0), wx, wy, wz
+    """The state (state order) reflected into the range of a rebound: α2 into [0, π], β2 below π/2, s into [0, 1].
+
+    The linear shifts of the chain and of the α1 move can step outside by a
+    hair (up to ~1e-3 of the draws of a cell on a coarse grid, ~1e-5 on the
+    default one). Reflected at the edge, such a draw stays a rebound that
+    leaves the wall (V⁺·n = s sin α2 cos β2 > 0) and gains no kinetic energy
+    (s ≤ 1: tables are built with Ω⁻ = 0, so |V⁺| ≤ |V⁻|); a cap would put it
+    on the edge, where s = 0 or β2 = π/2 gives V⁺·n = 0 and s = 1 an elastic
+    rebound. β2 < 0 is left as drawn: it is a valid state (the mirror sign is
+    drawn afterwards).
+    """
+    alpha2, s = abs(alpha2), abs(s)
+    return (2.0 * math.pi - alpha2 if alpha2 > math.pi else alpha2, math.pi - beta2 if beta2 > 0.5 * math.pi else beta2,
+            2.0 - s if s > 1.0 else s, wx, wy, wz)
 
 
 @numba.njit(inline="always", **JIT)

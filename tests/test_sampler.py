@@ -128,6 +128,45 @@ def test_mirror_sign_and_ranges(small_table):
     assert np.all((d.speed_ratio[ok] > 0) & (d.speed_ratio[ok] <= 1))
 
 
+# (table fixture, α1 values, speeds): grid points and points between them, on the coarse 3 × 3 table
+# and near grazing on the off-grid table
+PHYSICAL_RANGE_POINTS = [("small_table", np.linspace(30.0, 90.0, 9), (50.0, 100.0, 175.0, 250.0)),
+                         ("off_grid_table", (3.0, 3.5, 4.0, 40.0, 42.5, 45.0), (150.0, 175.0, 200.0))]
+
+
+@pytest.mark.parametrize("fixture, alpha1s, speeds", PHYSICAL_RANGE_POINTS)
+def test_every_rebound_leaves_the_wall_without_gaining_energy(request, fixture, alpha1s, speeds):
+    """Every rebounded draw has 0 < s ≤ 1, 0 < α2 < π and |β2| < π/2: it leaves the wall (V⁺·n > 0) and
+    gains no kinetic energy (tables are built with Ω⁻ = 0 and the direct model never gains energy).
+
+    The chain's linear shifts step outside these ranges at the tails; before the fold
+    (surrogate.draw._folded) reflected them, the 3 × 3 table gave s = 0 exactly (V⁺ = 0) in up to
+    4e-3 of the draws between grid points, and the default table s up to 1.01 near grazing.
+    2·10⁴ draws per point and shape (at that rate, ~80 per point would fail), 1.4·10⁶ and 2.9·10⁶ in all.
+    """
+    table = request.getfixturevalue(fixture)
+    n = 20_000
+    for shape in table.shapes:
+        for k, alpha1 in enumerate(alpha1s):
+            for speed in speeds:
+                d = surrogate.sample_local(table, np.full(n, alpha1), speed, shape, random_state=k)
+                ok = d.status == STATUS_REBOUNDED
+                where = f"{shape} at {alpha1:g} deg, {speed:g} m/s"
+                assert np.all((d.speed_ratio[ok] > 0) & (d.speed_ratio[ok] <= 1)), where
+                assert np.all((d.alpha2[ok] > 0) & (d.alpha2[ok] < np.pi)), where
+                assert np.all(np.abs(d.beta2[ok]) < np.pi / 2), where
+        # the same through the global frame: wall y = 0, V⁻ in the XY plane at the α1 values
+        a = np.radians(np.repeat(alpha1s, n // 10))
+        speed = np.resize(speeds, a.size)
+        V = speed[:, None] * np.column_stack([np.cos(a), -np.sin(a), np.zeros(a.size)])
+        normals = np.tile([0.0, 1.0, 0.0], (a.size, 1))
+        V_out, _, status = surrogate.sample_global(table, V, normals, np.full(a.size, 1e-4), shape=shape,
+                                                   random_state=1, clamp=True)
+        ok = status == STATUS_REBOUNDED
+        assert np.all(V_out[ok, 1] > 0.0)
+        assert np.all(np.linalg.norm(V_out[ok], axis=1) <= speed[ok] * (1 + 1e-12))
+
+
 @pytest.mark.parametrize("interpolation", ["stochastic", "scaled"])
 def test_interpolation_mean_is_the_weighted_mean_of_the_neighbours(small_table, interpolation):
     """Between grid points the mean of α2 is the weighted mean of the neighbouring cells' means.
