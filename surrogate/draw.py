@@ -169,8 +169,8 @@ def _folded(alpha2, beta2, s, wx, wy, wz):
     """The state (state order) reflected into the range of a rebound: α2 into [0, π], β2 below π/2, s into [0, 1].
 
     The linear shifts of the chain and of the α1 move can step outside by a
-    hair (up to ~1e-3 of the draws of a cell on a coarse grid, ~1e-5 on the
-    default one). Reflected at the edge, such a draw stays a rebound that
+    hair (up to 4e-3 of the draws at a point between the grid points of a
+    coarse 3 × 3 table, 1.5e-4 on the default table). Reflected at the edge, such a draw stays a rebound that
     leaves the wall (V⁺·n = s sin α2 cos β2 > 0) and gains no kinetic energy
     (s ≤ 1: tables are built with Ω⁻ = 0, so |V⁺| ≤ |V⁻|); a cap would put it
     on the edge, where s = 0 or β2 = π/2 gives V⁺·n = 0 and s = 1 an elastic
