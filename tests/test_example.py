@@ -76,8 +76,8 @@ def test_cylinder_every_particle_hits_and_rebounds_outside(beam, small_table):
     pos, vel = beam.cylinder_beam(N, np.random.default_rng(4))
     t_end = 5 * beam.RADIUS / np.mean(beam.SPEED_RANGE)
     cdf = surrogate.mix_cdf(small_table, "mix")
-    for model, e in ((beam.SPECULAR, 1.0), (beam.TABLE, 1.0)):
-        p_end, v_out, outcome = beam.run(pos, vel, t_end, beam.CYLINDER, model, small_table, cdf, e, 5)
+    for model in (beam.SPECULAR, beam.TABLE):           # the sphere with e = 1
+        p_end, v_out, outcome = beam.run(pos, vel, t_end, beam.CYLINDER, model, small_table, cdf, 1.0, 5)
         assert not np.any(outcome == beam.MISSED)       # the beam covers |y| < R
         ok = outcome == beam.REBOUNDED
         r_end = np.hypot(p_end[ok, 0], p_end[ok, 1])
@@ -101,6 +101,8 @@ def test_the_script_writes_its_plots(beam, small_table_path, tmp_path, capsys):
     assert "1. flat wall" in out and "2. cylinder" in out
 
 
-def test_the_script_rejects_bad_options(beam, tmp_path):
-    with pytest.raises(SystemExit):
+def test_the_script_rejects_bad_options(beam, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
         beam.main(["--angle", "95", "--out", str(tmp_path)])
+    assert exit_info.value.code == 2                    # argparse's usage error
+    assert "0 < --angle < 90" in capsys.readouterr().err

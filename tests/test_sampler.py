@@ -142,7 +142,7 @@ def test_every_rebound_leaves_the_wall_without_gaining_energy(request, fixture, 
     The chain's linear shifts step outside these ranges at the tails; before the fold
     (surrogate.draw._folded) reflected them, the 3 × 3 table gave s = 0 exactly (V⁺ = 0) in up to
     4e-3 of the draws between grid points, and the default table s up to 1.01 near grazing.
-    2·10⁴ draws per point and shape (at that rate, ~80 per point would fail), 1.4·10⁶ and 2.9·10⁶ in all.
+    2·10⁴ draws per point and shape (at that rate, ~80 per point would fail), 2.9·10⁶ and 1.4·10⁶ in all.
     """
     table = request.getfixturevalue(fixture)
     n = 20_000
