@@ -20,9 +20,10 @@ def _build(tmp_path_factory, name, config_text):
 SMALL_TABLE_CONFIG = _table_config([30.0, 60.0, 90.0], [50.0, 150.0, 250.0], seed=11)
 # grid points around (3.5°, 175 m/s) and (42.5°, 175 m/s), with the default preset's α1 steps there
 OFF_GRID_TABLE_CONFIG = _table_config([3.0, 4.0, 40.0, 45.0], [150.0, 200.0], seed=12)
-# grid points around (83.75°, 62.5 m/s): near normal impact at low speed, where the law moves
-# fastest with speed (the production preset's steps there)
-NEAR_NORMAL_TABLE_CONFIG = _table_config([82.5, 85.0], [50.0, 75.0], seed=13)
+# grid points around NEAR_NORMAL_POINT (α1 deg, |V⁻| m/s): near normal impact at low speed, where
+# the law moves fastest with speed (the presets' steps there)
+NEAR_NORMAL_POINT = (84.375, 62.5)
+NEAR_NORMAL_TABLE_CONFIG = _table_config([83.75, 85.0], [50.0, 75.0], seed=13)
 
 
 @pytest.fixture(scope="session")

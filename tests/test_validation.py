@@ -22,6 +22,8 @@ from tablegen.validation import (
 )
 from tablegen.validation_report import precision
 
+from conftest import NEAR_NORMAL_POINT
+
 N_DRAWS = 20_000
 KS_TARGET = 0.03
 
@@ -66,8 +68,8 @@ def test_off_grid_draws_match_the_direct_model(off_grid_table, shape, alpha1):
 # laws as they are (interpolation="stochastic") are detected by the classifier.
 @pytest.mark.parametrize("shape", ["ellipsoid", "prism", "cut_prism", "tetrahedron", "mix"])
 def test_between_grid_speeds_near_normal_impact(near_normal_table, shape):
-    T = table_states(near_normal_table, shape, 83.75, 62.5, N_DRAWS, seed=9)
-    D = direct_states(shape, 83.75, 62.5, N_DRAWS, seed=103)
+    T = table_states(near_normal_table, shape, *NEAR_NORMAL_POINT, N_DRAWS, seed=9)
+    D = direct_states(shape, *NEAR_NORMAL_POINT, N_DRAWS, seed=103)
     result = compare(T, D)
     worst = max(result["ks"], key=result["ks"].get)
     assert result["ks"][worst] <= KS_TARGET, f"{worst}: KS = {result['ks'][worst]:.4f}"
@@ -82,13 +84,13 @@ def test_near_normal_speed_step_is_needed(near_normal_table):
     previous law, measured 0.68–0.71 for the ellipsoid there), the classifier
     exceeds the off-grid target.
     """
-    D = direct_states("ellipsoid", 83.75, 62.5, N_DRAWS, seed=103)
-    T = table_states(near_normal_table, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9, interpolation="stochastic")
+    D = direct_states("ellipsoid", *NEAR_NORMAL_POINT, N_DRAWS, seed=103)
+    T = table_states(near_normal_table, "ellipsoid", *NEAR_NORMAL_POINT, N_DRAWS, seed=9, interpolation="stochastic")
     assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
     rows = np.array(near_normal_table.kernel_data.rows())
     rows[..., ROW_REGIME] = 1.0
     one_law = dataclasses.replace(near_normal_table, kernel_data=near_normal_table.kernel_data.with_rows(rows))
-    T = table_states(one_law, "ellipsoid", 83.75, 62.5, N_DRAWS, seed=9)
+    T = table_states(one_law, "ellipsoid", *NEAR_NORMAL_POINT, N_DRAWS, seed=9)
     assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
 
 
