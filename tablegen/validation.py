@@ -92,10 +92,21 @@ def midpoints(grid, targets) -> list:
 
 
 def matrix_points(table) -> list:
-    """(where, α1, speed) of the validation matrix: on-grid points and off-grid midpoints in both coordinates."""
-    on = [("on grid", a, v) for a in grid_points(table.alpha1_deg, ALPHA1_TARGETS)
+    """(where, α1, speed) of the validation matrix.
+
+    On grid: the grid values nearest to ALPHA1_TARGETS × SPEED_TARGETS. Off
+    grid (between grid points in both coordinates): the midpoint of every α1
+    interval × the midpoints of the speed intervals nearest to SPEED_TARGETS.
+    Every α1 interval is tested because one too wide is found nowhere else:
+    with the off-grid α1 points at five targets only, the ellipsoid's Ω_z at
+    17.5° (the default preset's 15–20° step) had KS 0.044–0.054 and its
+    classifier accuracy at 1.5° (both presets' 1–2° step) 0.61–0.62, and
+    the matrix passed.
+    """
+    alpha1 = np.asarray(table.alpha1_deg, dtype=float)
+    on = [("on grid", a, v) for a in grid_points(alpha1, ALPHA1_TARGETS)
           for v in grid_points(table.speed_m_s, SPEED_TARGETS)]
-    off = [("off grid", a, v) for a in midpoints(table.alpha1_deg, ALPHA1_TARGETS)
+    off = [("off grid", float(a), v) for a in (alpha1[1:] + alpha1[:-1]) / 2
            for v in midpoints(table.speed_m_s, SPEED_TARGETS)]
     return on + off
 

@@ -38,6 +38,8 @@ _TABLES = {}
 
 
 def _worker_init() -> None:
+    """One thread per worker process: numba's, and OpenMP's for scikit-learn (read when it loads)."""
+    os.environ["OMP_NUM_THREADS"] = "1"
     import numba
     numba.set_num_threads(1)
 

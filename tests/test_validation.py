@@ -18,7 +18,8 @@ from scipy.stats import ks_2samp
 from data_schema.table import read_table
 from surrogate.table import ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 from tablegen.validation import (
-    classifier_accuracy, compare, direct_states, grid_points, midpoints, table_states,
+    SPEED_TARGETS, classifier_accuracy, compare, direct_states, grid_points, matrix_points, midpoints,
+    table_states,
 )
 from tablegen.validation_report import precision
 
@@ -43,7 +44,7 @@ def test_marginals_match_the_direct_model_on_the_grid(small_table, shape, alpha1
 
 
 # Off grid: both α1 and |V⁻| between grid points, with the default preset's α1
-# steps there (1° near grazing, 5° at 40–45°) and a 50 m/s speed step. The
+# steps there (½° from 1° to 2°, 1° to 5°, 5° at 40–45°) and a 50 m/s speed step. The
 # table's law is interpolated, so beyond the noise above it carries an
 # interpolation error; the default-table target (KS ≤ 0.03) is the allowance.
 # Joint law: the production off-grid target, classifier accuracy ≤ 0.58
@@ -52,7 +53,7 @@ OFF_GRID_ACCURACY = 0.58
 
 
 @pytest.mark.parametrize("shape", ["ellipsoid", "prism", "cut_prism", "tetrahedron", "mix"])
-@pytest.mark.parametrize("alpha1", [3.5, 42.5])
+@pytest.mark.parametrize("alpha1", [1.25, 3.5, 42.5])
 def test_off_grid_draws_match_the_direct_model(off_grid_table, shape, alpha1):
     T = table_states(off_grid_table, shape, alpha1, 175.0, N_DRAWS, seed=8)
     D = direct_states(shape, alpha1, 175.0, N_DRAWS, seed=102)
@@ -60,6 +61,18 @@ def test_off_grid_draws_match_the_direct_model(off_grid_table, shape, alpha1):
     worst = max(result["ks"], key=result["ks"].get)
     assert result["ks"][worst] <= KS_TARGET, f"{worst}: KS = {result['ks'][worst]:.4f}"
     assert result["classifier_accuracy"] <= OFF_GRID_ACCURACY
+
+
+def test_grazing_alpha1_step_of_one_degree_is_too_wide(wide_grazing_table):
+    """Near grazing the law changes fastest relative to α1 (the normal speed doubles from 1° to 2°).
+
+    With 1–2° as one interval the ellipsoid at 1.5° is told from the direct
+    model (measured 0.61–0.62 on the default and production tables), so the
+    1.25° case of the test above, on the presets' half-degree steps, can fail.
+    """
+    T = table_states(wide_grazing_table, "ellipsoid", 1.5, 175.0, N_DRAWS, seed=8)
+    D = direct_states("ellipsoid", 1.5, 175.0, N_DRAWS, seed=102)
+    assert compare(T, D)["classifier_accuracy"] > OFF_GRID_ACCURACY
 
 
 # Near normal impact at low speed the law changes fastest with |V⁻| (the speed
@@ -155,6 +168,19 @@ def test_matrix_points_are_on_the_grid_or_between_neighbours():
     assert grid_points(grid, [3.0, 12.0, 30.0]) == [3.0, 12.5, 20.0]
     assert midpoints(grid, [3.0, 12.0, 30.0]) == [2.5, 11.25, 17.5]
     assert midpoints([45.0], [30.0]) == []
+
+
+def test_matrix_tests_every_alpha1_interval_off_grid():
+    """A too-wide α1 step anywhere must show: every interval's midpoint is an off-grid point."""
+    table = dataclasses.make_dataclass("Grid", ["alpha1_deg", "speed_m_s"])(
+        np.array([1.0, 1.5, 2.0, 5.0, 15.0, 20.0, 90.0]), np.array([50.0, 75.0, 100.0, 200.0, 300.0]))
+    points = matrix_points(table)
+    off = [(a, v) for where, a, v in points if where == "off grid"]
+    speeds = midpoints(table.speed_m_s, SPEED_TARGETS)
+    assert speeds == [62.5, 150.0, 250.0]
+    assert off == [(a, v) for a in [1.25, 1.75, 3.5, 10.0, 17.5, 55.0] for v in speeds]
+    on = {(a, v) for where, a, v in points if where == "on grid"}
+    assert all(a in table.alpha1_deg and v in table.speed_m_s for a, v in on)
 
 
 def test_stated_ks_precision_matches_simulation():
