@@ -2,7 +2,7 @@
 
 Each comparison draws n = 2·10⁴ states from a table and 2·10⁴ from the direct
 model (independent seed) at the on-grid and off-grid points of
-:func:`tablegen.validation.matrix_points`, for the four shapes and the mix.
+:func:`tablegen.validation.matrix_points` (off grid: every α1 interval), for the four shapes and the mix.
 
 Targets (the validation plan): the ``default`` preset table, every marginal's
 KS ≤ 0.03 on and off grid; the ``production`` table, classifier accuracy
@@ -15,7 +15,7 @@ build particles), leaving ~0.015 for the representation and interpolation.
 The production table takes about an hour to build on 2 cores, so its test
 reads it from the path in the environment variable REBOUND_PRODUCTION_TABLE
 (``tablegen build --preset production -o production.h5``) and is skipped
-without it. The default table is built by the test (about 3 minutes).
+without it. The default table is built by the test (about 4 minutes on 2 cores).
 """
 
 import os
