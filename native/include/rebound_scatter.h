@@ -1,0 +1,252 @@
+/*
+ * rebound_scatter.h: the native runtime of rebound-scatter.
+ *
+ * A C library that reads the tables `tablegen build` writes (table format 3.x,
+ * docs/format.md) and draws reflected states of non-spherical particles hitting
+ * a wall, with the same law and the same bits as the numba kernels of the
+ * Python package `surrogate` (surrogate.kernels.rebound_tuple, rebound_many,
+ * rebound_many_rng, draw_local), for the same uniforms. See docs/native.md.
+ *
+ * Frames and units
+ * ----------------
+ * Global frame: any right-handed Cartesian frame of the caller. V⁻ (incident
+ * velocity) and V⁺ (reflected) in m/s, Ω⁺ (reflected angular velocity) in
+ * rad/s, n the unit wall normal pointing into the gas (|n| = 1 within ~1e-6;
+ * not normalised, not checked by the draw functions), a the particle's
+ * half-size (half its largest extent) in m, > 0.
+ * Impact frame of a hit: ex the direction of the tangential part of V⁻ (at
+ * normal impact, |V⁻_t| <= 1e-12 |V⁻|, a direction in the wall plane drawn
+ * from u[12]), n, ez = ex × n. α1 = angle of V⁻ from the wall, degrees in
+ * [0, 90].
+ * Local frame (the model's lab frame): wall y = 0, normal +Y, impact plane XY,
+ * V⁻ = |V⁻| (cos α1, −sin α1, 0). Local draws give α2 (rad, from the wall
+ * in the XY plane), β2 (rad, out of the impact plane), s = |V⁺|/|V⁻| and
+ * Ω⁺ a/|V⁻| (dimensionless).
+ *
+ * Uniforms
+ * --------
+ * A draw consumes RBS_U_PER_DRAW = 13 uniforms in [0, 1):
+ *   u[0] shape from the mix       u[1] α1 neighbour        u[2] speed neighbour
+ *   u[3] trapped or not           u[4] mixture component   u[5..10] the six chain variables
+ *   u[11] mirror sign             u[12] in-wall axis at normal impact
+ * Give them yourself, or draw them with rbs_rng_fill from an rbs_rng
+ * (xoshiro256+, the generator of surrogate.fill_uniforms).
+ *
+ * Threads
+ * -------
+ * No global mutable state. An rbs_table is immutable once opened: any number
+ * of threads may draw from one table at once. An rbs_mix is a plain value.
+ * An rbs_rng is mutable: one per thread (or per MPI rank, per stream), e.g.
+ * rbs_rng_seed_stream(&rng, seed, thread_or_rank). rbs_table_open and
+ * rbs_table_close call HDF5: call them from one thread at a time unless your
+ * HDF5 is built thread-safe.
+ *
+ * Errors
+ * ------
+ * Functions that can fail return an RBS_ERR_* code (RBS_OK = 0) and, when
+ * `message` is not NULL, write a NUL-terminated message of at most
+ * message_size bytes naming the file and what is wrong. The draw functions
+ * never fail: a particle that does not move into the wall (V·n >= 0, zero or
+ * non-finite V) gets status RBS_INVALID and NaN outputs; an α1 or |V⁻|
+ * outside the table's grid uses the law at the nearest grid edge (check
+ * rbs_table_alpha1_range / rbs_table_speed_range beforehand if that matters).
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#ifndef REBOUND_SCATTER_H
+#define REBOUND_SCATTER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RBS_VERSION_MAJOR 0
+#define RBS_VERSION_MINOR 1
+#define RBS_VERSION_PATCH 0
+
+#define RBS_U_PER_DRAW 13       /* uniforms per draw (surrogate.U_PER_DRAW) */
+#define RBS_MAX_SHAPES 4        /* ellipsoid, prism, cut_prism, tetrahedron */
+#define RBS_TABLE_MAJOR 3       /* the table format major version read (any minor) */
+#define RBS_BLOCK 32            /* rows per block of rbs_rebound_many*, lanes of rbs_rebound_many_rng */
+#define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */
+
+/* Status of a draw: the codes of surrogate (STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_INVALID). */
+enum { RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_INVALID = -1 };
+
+/* Error codes. */
+enum {
+    RBS_OK = 0,
+    RBS_ERR_IO = 1,         /* the file does not exist or cannot be opened */
+    RBS_ERR_FORMAT = 2,     /* not a readable table: not HDF5, truncated, corrupt (checksum), another file
+                               type, a group, dataset or attribute missing or of the wrong shape, a
+                               non-finite value */
+    RBS_ERR_VERSION = 3,    /* a table of another major format version */
+    RBS_ERR_ARGUMENT = 4,   /* a bad argument (NULL pointer, unknown shape name, bad weights, ...) */
+    RBS_ERR_MEMORY = 5      /* out of memory */
+};
+
+/* Interpolation between grid points (surrogate's `interpolation` / the kernels' `scaled`). */
+enum {
+    RBS_SCALED = 0,         /* a neighbour's cell drawn with its weight, then moved to the incident α1
+                               (interpolated means and sds) and |V⁻| (wall restitution law): the default */
+    RBS_STOCHASTIC = 1      /* the neighbour's law as is */
+};
+
+/* Element types of rbs_table_kernel_array. */
+enum { RBS_FLOAT64 = 0, RBS_FLOAT32 = 1 };
+
+/* A loaded table: opaque, immutable after rbs_table_open, shareable by threads. */
+typedef struct rbs_table rbs_table;
+
+/* Cumulative shape weights in the table's shape order (cdf[n_shapes - 1] = 1): surrogate.mix_cdf. */
+typedef struct rbs_mix {
+    int n_shapes;
+    double cdf[RBS_MAX_SHAPES];
+} rbs_mix;
+
+/* One xoshiro256+ state (four 64-bit words, not all zero): one per thread / MPI rank / stream. */
+typedef struct rbs_rng {
+    uint64_t s[4];
+} rbs_rng;
+
+/* Sizes and provenance of a table (rbs_table_info). */
+typedef struct rbs_table_info {
+    int n_shapes, n_alpha1, n_speed;    /* cell (shape, i_α1, i_speed) is number (shape·n_alpha1 + i_α1)·n_speed + i_speed */
+    int n_clusters;                     /* mixture components per cell (C) */
+    int n_levels;                       /* L + 1 quantile levels of a residual shape */
+    int n_dictionary;                   /* M residual shapes per chain variable and cell */
+    int n_pieces;                       /* restitution polynomial pieces per speed interval */
+    int format_major, format_minor;     /* the file's table format version */
+    long long particles_per_cell, n_max;
+    double restitution_k;               /* the wall law exp(−k V^p) of the table, (m/s)^(−p) */
+    double restitution_p;
+    size_t kernel_bytes;                /* bytes held by the kernel arrays */
+} rbs_table_info;
+
+/* ---------------------------------------------------------------- tables */
+
+/* Open and check a table file, derive the kernel arrays; *table = NULL on error.
+ * Checks as data_schema.table.check_file / read_table: the file exists and is HDF5, file_type
+ * "rebound_table", format_version (3, any minor), the groups grid, resolution, cells, every cell
+ * dataset with its shape, the grids (increasing, finite), the wall law attributes restitution_k,
+ * restitution_p (finite, > 0); then the derived arrays are checked finite.
+ * Returns RBS_OK, RBS_ERR_IO, RBS_ERR_FORMAT, RBS_ERR_VERSION, RBS_ERR_MEMORY or RBS_ERR_ARGUMENT. */
+int rbs_table_open(const char *path, rbs_table **table, char *message, size_t message_size);
+
+/* Free everything the table holds (NULL: nothing). No draw may use it afterwards. */
+void rbs_table_close(rbs_table *table);
+
+/* The path the table was opened from. */
+const char *rbs_table_path(const rbs_table *table);
+
+/* Number of shapes and the name of shape i (table order; NULL if i is out of range). */
+int rbs_table_n_shapes(const rbs_table *table);
+const char *rbs_table_shape_name(const rbs_table *table, int i);
+
+/* The α1 grid's first and last points, degrees; the |V⁻| grid's, m/s. */
+void rbs_table_alpha1_range(const rbs_table *table, double *lo_deg, double *hi_deg);
+void rbs_table_speed_range(const rbs_table *table, double *lo_m_s, double *hi_m_s);
+
+/* The grids themselves: *count points, returned pointer valid until rbs_table_close. */
+const double *rbs_table_alpha1_grid(const rbs_table *table, int *count);
+const double *rbs_table_speed_grid(const rbs_table *table, int *count);
+
+/* Sizes and provenance. */
+void rbs_table_info_get(const rbs_table *table, rbs_table_info *info);
+
+/* A derived kernel array, equal element for element to the field of surrogate's table.kernel_data of
+ * the same name: "alpha1_axis", "speed_axis", "cells", "speed_restitution", "restitution_pieces"
+ * (float64), "clusters", "dictionary" (float32). *data points into the table (read-only, valid until
+ * rbs_table_close), *count is its number of elements, *dtype RBS_FLOAT64 or RBS_FLOAT32 (any of the
+ * three output pointers may be NULL). Returns RBS_OK or RBS_ERR_ARGUMENT (unknown name). */
+int rbs_table_kernel_array(const rbs_table *table, const char *name, const void **data, size_t *count,
+                           int *dtype);
+
+/* ---------------------------------------------------------------- shape mixes */
+
+/* A mix from named weights (surrogate.mix_cdf with a dict): names among ellipsoid, prism, cut_prism,
+ * tetrahedron, each at most once; weights finite and >= 0, summing to 1 within 1e-9 (summed in the
+ * order given); a shape with a positive weight must be in the table. Shapes not named get weight 0.
+ * Returns RBS_OK or RBS_ERR_ARGUMENT with a message. */
+int rbs_mix_from_weights(const rbs_table *table, int n, const char *const names[], const double weights[],
+                         rbs_mix *mix, char *message, size_t message_size);
+
+/* One shape alone (surrogate.mix_cdf(table, name)); "mix" gives rbs_mix_equal. RBS_OK or RBS_ERR_ARGUMENT. */
+int rbs_mix_from_shape(const rbs_table *table, const char *name, rbs_mix *mix, char *message,
+                       size_t message_size);
+
+/* The equal mix over the table's shapes (surrogate.mix_cdf(table, "mix")). RBS_OK or RBS_ERR_ARGUMENT. */
+int rbs_mix_equal(const rbs_table *table, rbs_mix *mix);
+
+/* ---------------------------------------------------------------- draws */
+
+/* The reflected state of one particle, global frame (surrogate.kernels.rebound_tuple).
+ *   V        incident velocity V⁻, m/s (must move into the wall: V·n < 0)
+ *   n        unit wall normal into the gas
+ *   a        half-size, m (> 0)
+ *   u        RBS_U_PER_DRAW uniforms in [0, 1)
+ *   interpolation  RBS_SCALED or RBS_STOCHASTIC
+ *   V_out    V⁺, m/s;  Omega_out  Ω⁺, rad/s  (NaN unless rebounded)
+ * Returns RBS_REBOUNDED, RBS_TRAPPED (rolling along or deposited; drawn with the cell's tabulated
+ * probability) or RBS_INVALID (V does not move into the wall, or a NULL table or mix, a mix of
+ * another table's shape count, an unknown interpolation). */
+int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
+                const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
+
+/* rbs_rebound for `count` particles, one thread: V, n, V_out, Omega_out row-major (count, 3), a (count,),
+ * u (count, RBS_U_PER_DRAW), status (count,). The same bits as rbs_rebound row by row (and as
+ * surrogate.kernels.rebound_many); faster, because the table reads of RBS_BLOCK rows are in flight
+ * together. */
+void rbs_rebound_many(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V, const double *n,
+                      const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
+                      signed char *status);
+
+/* rbs_rebound_many drawing the uniforms from `rng`, as surrogate.kernels.rebound_many_rng does, bit for
+ * bit: rng is advanced one step to seed RBS_BLOCK xoshiro256+ lanes (splitmix64), and row b of every
+ * block of RBS_BLOCK rows takes its 13 uniforms from lane b. rbs_rebound_uniforms gives those uniforms. */
+void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V,
+                          const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
+                          double *Omega_out, signed char *status);
+
+/* One reflected state at (α1 deg, |V⁻| m/s) in the local frame (surrogate.kernels.draw_local):
+ * out = (α2 rad, β2 rad, s = |V⁺|/|V⁻|, Ω_x, Ω_y, Ω_z in units of |V⁻|/a), NaN unless rebounded.
+ * Returns RBS_REBOUNDED or RBS_TRAPPED (RBS_INVALID for a NULL table or mix, a mix of another table's
+ * shape count, an unknown interpolation). Outside the grid, the law at the nearest grid edge. */
+int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
+                   const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE]);
+
+/* ---------------------------------------------------------------- random numbers */
+
+/* The state surrogate.seed_state(seed) gives (numpy's SeedSequence(seed).spawn(1)[0], 4 uint64 words). */
+void rbs_rng_seed(rbs_rng *rng, uint64_t seed);
+
+/* The state surrogate.seed_state(seed, n_streams=n)[k] gives, for any n > k: stream k of a seed
+ * (SeedSequence(seed) child k). Use k = thread number or MPI rank. */
+void rbs_rng_seed_stream(rbs_rng *rng, uint64_t seed, uint64_t k);
+
+/* The next uniform in [0, 1) (53 bits; surrogate.rng.next_uniform). */
+double rbs_rng_uniform(rbs_rng *rng);
+
+/* u[0..count) = the next count uniforms (surrogate.fill_uniforms). */
+void rbs_rng_fill(rbs_rng *rng, double *u, size_t count);
+
+/* The (count, RBS_U_PER_DRAW) uniforms rbs_rebound_many_rng draws for count rows from rng, advancing
+ * rng as it does (surrogate.kernels.rebound_uniforms). */
+void rbs_rebound_uniforms(rbs_rng *rng, size_t count, double *u);
+
+/* ---------------------------------------------------------------- misc */
+
+/* A static description of an error code. */
+const char *rbs_error_string(int code);
+
+/* The library version, "MAJOR.MINOR.PATCH". */
+const char *rbs_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* REBOUND_SCATTER_H */
