@@ -1,0 +1,537 @@
+/*---------------------------------------------------------------------------*\
+    stochasticRebound: a patch interaction model for OpenFOAM's Lagrangian
+    clouds that draws the rebound of non-spherical particles from a
+    rebound-scatter table through the rebound-scatter C runtime.
+
+    Copyright (C) 2026 the rebound-scatter authors
+-------------------------------------------------------------------------------
+License
+    This file is part of the rebound-scatter OpenFOAM adapter, which is
+    derived from and links with OpenFOAM.
+
+    This program is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version.
+
+    This program is distributed in the hope that it will be useful, but
+    WITHOUT ANY WARRANTY; without even the implied warranty of
+    MERCHANTABILITY or FITNESS FOR A PARTICULAR PURPOSE.  See the GNU General
+    Public License for more details.
+
+    You should have received a copy of the GNU General Public License along
+    with this program (integrations/openfoam/LICENSE).  If not, see
+    <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "StochasticRebound.H"
+#include "Pstream.H"
+#include "OSspecific.H"
+
+#include <cmath>
+#include <cstdio>
+#include <type_traits>
+#include <utility>
+
+// * * * * * * * * * * * * * * * * Spin helpers  * * * * * * * * * * * * * * //
+
+namespace Foam
+{
+namespace stochasticReboundDetail
+{
+
+// Colliding parcels carry an angular momentum; the others no spin.
+
+template<class P>
+auto angularVelocity(const P& p, int)
+    -> decltype(p.angularMomentum(), vector())
+{
+    const scalar I = p.momentOfInertia();
+    return I > 0 ? vector(p.angularMomentum()/I) : vector(Zero);
+}
+
+template<class P>
+vector angularVelocity(const P&, long)
+{
+    return Zero;
+}
+
+template<class P>
+auto setAngularVelocity(P& p, const vector& omega, int)
+    -> decltype(p.angularMomentum() = omega, void())
+{
+    p.angularMomentum() = p.momentOfInertia()*omega;
+}
+
+template<class P>
+void setAngularVelocity(P&, const vector&, long)
+{}
+
+template<class P>
+struct hasSpin
+{
+    template<class Q>
+    static auto test(int)
+        -> decltype(std::declval<const Q&>().angularMomentum(), std::true_type());
+
+    template<class>
+    static std::false_type test(...);
+
+    static constexpr bool value = decltype(test<P>(0))::value;
+};
+
+} // End namespace stochasticReboundDetail
+} // End namespace Foam
+
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+template<class CloudType>
+void Foam::StochasticRebound<CloudType>::openTable(const dictionary& dict)
+{
+    tableFile_ = dict.get<fileName>("table");
+    tableFile_.expand();
+    if (!tableFile_.isAbsolute())
+    {
+        tableFile_ = this->owner().mesh().time().globalPath()/tableFile_;
+    }
+
+    char message[512] = "";
+    rbs_table* table = nullptr;
+    const int err =
+        rbs_table_open(tableFile_.c_str(), &table, message, sizeof(message));
+    if (err != RBS_OK)
+    {
+        FatalIOErrorInFunction(dict)
+            << "Cannot open the rebound table " << tableFile_ << ": "
+            << rbs_error_string(err) << ": " << message
+            << exit(FatalIOError);
+    }
+    table_.reset(table, rbs_table_close);
+
+    double lo, hi;
+    rbs_table_speed_range(table, &lo, &hi);
+    speedLo_ = lo;
+    speedHi_ = hi;
+
+    // The shape mix: `weights { prism 0.7; tetrahedron 0.3; }` or `shape`
+    if (dict.found("weights"))
+    {
+        const dictionary& wd = dict.subDict("weights");
+        const wordList names(wd.toc());
+        List<std::string> keep(names.size());
+        List<const char*> cnames(names.size());
+        List<double> weights(names.size());
+        OStringStream desc;
+        forAll(names, i)
+        {
+            keep[i] = names[i];
+            cnames[i] = keep[i].c_str();
+            weights[i] = wd.get<scalar>(names[i]);
+            desc<< (i ? ", " : "") << names[i] << ' ' << weights[i];
+        }
+        const int e = rbs_mix_from_weights
+        (
+            table, names.size(), cnames.cdata(), weights.cdata(), &mix_,
+            message, sizeof(message)
+        );
+        if (e != RBS_OK)
+        {
+            FatalIOErrorInFunction(dict)
+                << "Bad shape weights: " << message << exit(FatalIOError);
+        }
+        mixName_ = "weights (" + desc.str() + ")";
+    }
+    else
+    {
+        const word shape(dict.getOrDefault<word>("shape", "mix"));
+        const int e = rbs_mix_from_shape
+        (
+            table, shape.c_str(), &mix_, message, sizeof(message)
+        );
+        if (e != RBS_OK)
+        {
+            FatalIOErrorInFunction(dict)
+                << "Bad shape " << shape << ": " << message
+                << exit(FatalIOError);
+        }
+        mixName_ = shape;
+    }
+}
+
+
+template<class CloudType>
+void Foam::StochasticRebound<CloudType>::recordHit
+(
+    const typename CloudType::parcelType& p,
+    const polyPatch& pp,
+    const double V[3],
+    const double n[3],
+    const vector& Uwall,
+    double a,
+    int status,
+    const double Vout[3],
+    const double Wout[3],
+    scalar spinRatio,
+    double u0
+)
+{
+    State& s = *state_;
+    if (!s.hits.is_open() || s.nRecorded >= maxHitRecords_)
+    {
+        return;
+    }
+    ++s.nRecorded;
+    char line[1024];
+    std::snprintf
+    (
+        line, sizeof(line),
+        "%.9g,%d,%s,%d,%d,%.9g,%.9g,"
+        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g,"
+        "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.17g\n",
+        this->owner().mesh().time().value(),
+        int(Pstream::myProcNo()), pp.name().c_str(),
+        int(p.origProc()), int(p.origId()), p.d(), a,
+        V[0], V[1], V[2], n[0], n[1], n[2], Uwall.x(), Uwall.y(), Uwall.z(),
+        status, Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2],
+        spinRatio, u0
+    );
+    s.hits << line;
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+template<class CloudType>
+Foam::StochasticRebound<CloudType>::StochasticRebound
+(
+    const dictionary& dict,
+    CloudType& cloud
+)
+:
+    PatchInteractionModel<CloudType>(dict, cloud, typeName),
+    tableFile_(),
+    table_(),
+    mix_(),
+    mixName_(),
+    halfSizeFactor_
+    (
+        this->coeffDict().template getOrDefault<scalar>("halfSizeFactor", 1)
+    ),
+    removeTrapped_(false),
+    seed_(0),
+    interpolation_(RBS_SCALED),
+    speedLo_(0),
+    speedHi_(0),
+    writeHits_
+    (
+        this->coeffDict().template getOrDefault<bool>("writeHits", false)
+    ),
+    maxHitRecords_
+    (
+        this->coeffDict().template getOrDefault<label>
+        (
+            "maxHitRecords", 1000000
+        )
+    ),
+    state_(new State())
+{
+    const dictionary& coeffs = this->coeffDict();
+
+    if (halfSizeFactor_ <= 0)
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "halfSizeFactor must be > 0, not " << halfSizeFactor_
+            << exit(FatalIOError);
+    }
+
+    const word trapped(coeffs.getOrDefault<word>("trapped", "stick"));
+    if (trapped == "remove")
+    {
+        removeTrapped_ = true;
+    }
+    else if (trapped != "stick")
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "trapped must be stick or remove, not " << trapped
+            << exit(FatalIOError);
+    }
+
+    const word interp(coeffs.getOrDefault<word>("interpolation", "scaled"));
+    if (interp == "stochastic")
+    {
+        interpolation_ = RBS_STOCHASTIC;
+    }
+    else if (interp != "scaled")
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "interpolation must be scaled or stochastic, not " << interp
+            << exit(FatalIOError);
+    }
+
+    const label seed = coeffs.getOrDefault<label>("seed", 1);
+    if (seed < 0)
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "seed must be >= 0, not " << seed << exit(FatalIOError);
+    }
+    seed_ = uint64_t(seed);
+
+    openTable(coeffs);
+
+    // Rank r draws stream r of the seed: no two ranks share draws
+    const label stream = Pstream::myProcNo();
+    rbs_rng_seed_stream(&state_->rng, seed_, uint64_t(stream));
+
+    if (writeHits_)
+    {
+        const fileName dir
+        (
+            this->owner().mesh().time().globalPath()/"postProcessing"
+           /"lagrangian"/this->owner().name()/typeName
+        );
+        mkDir(dir);
+        const fileName file(dir/("hits_" + Foam::name(stream) + ".csv"));
+        state_->hits.open(file.c_str(), std::ios::out | std::ios::trunc);
+        if (!state_->hits)
+        {
+            FatalErrorInFunction
+                << "Cannot write " << file << exit(FatalError);
+        }
+        state_->hits
+            << "# stochasticRebound hits: seed " << seed_ << ", stream "
+            << stream << ", table " << tableFile_.c_str() << ", mix "
+            << mixName_.c_str() << ", halfSizeFactor " << halfSizeFactor_
+            << ", interpolation " << interp.c_str() << "\n"
+            << "# V: incident velocity relative to the wall, n: unit normal"
+               " into the gas, Uw: wall velocity, Vout/Wout: rebound"
+               " velocity (relative to the wall) and angular velocity,"
+               " spin_ratio: |Omega-| a/|V| (colliding parcels), u0: first"
+               " uniform of the draw\n"
+            << "time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,nx,ny,nz,"
+               "Uwx,Uwy,Uwz,status,Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0\n";
+    }
+
+    const rbs_table* t = table_.get();
+    double alo, ahi;
+    rbs_table_alpha1_range(t, &alo, &ahi);
+    Info<< "    stochasticRebound: table " << tableFile_
+        << " (" << rbs_table_n_shapes(t) << " shapes, alpha1 " << alo
+        << "-" << ahi << " deg, |V| " << speedLo_ << "-" << speedHi_
+        << " m/s)" << nl
+        << "        shape " << mixName_.c_str() << ", a = " << halfSizeFactor_
+        << "*d/2, trapped parcels " << (removeTrapped_ ? "removed" : "stick")
+        << ", interpolation " << interp << ", seed " << seed_
+        << " (rank r draws stream r)" << endl;
+}
+
+
+template<class CloudType>
+Foam::StochasticRebound<CloudType>::StochasticRebound
+(
+    const StochasticRebound<CloudType>& pim
+)
+:
+    PatchInteractionModel<CloudType>(pim),
+    tableFile_(pim.tableFile_),
+    table_(pim.table_),
+    mix_(pim.mix_),
+    mixName_(pim.mixName_),
+    halfSizeFactor_(pim.halfSizeFactor_),
+    removeTrapped_(pim.removeTrapped_),
+    seed_(pim.seed_),
+    interpolation_(pim.interpolation_),
+    speedLo_(pim.speedLo_),
+    speedHi_(pim.speedHi_),
+    writeHits_(pim.writeHits_),
+    maxHitRecords_(pim.maxHitRecords_),
+    state_(pim.state_)
+{}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+template<class CloudType>
+bool Foam::StochasticRebound<CloudType>::correct
+(
+    typename CloudType::parcelType& p,
+    const polyPatch& pp,
+    bool& keepParticle
+)
+{
+    if (!isA<wallPolyPatch>(pp))
+    {
+        // Stock behaviour for every other patch type
+        return false;
+    }
+
+    State& s = *state_;
+    Counters& c = s.counters;
+
+    // OpenFOAM's normal at the hit point points out of the domain (into the
+    // wall); the wall velocity includes a moving wall's tangential velocity
+    vector nw, Uwall;
+    this->owner().patchData(p, pp, nw, Uwall);
+
+    vector& U = p.U();
+    const vector Vin(U - Uwall);
+    const scalar nMag = mag(nw);
+    const scalar a = halfSizeFactor_*0.5*p.d();
+
+    double V[3] = {Vin.x(), Vin.y(), Vin.z()};
+    double n[3] = {0, 0, 0};
+    if (nMag > 0)
+    {
+        // Ours points into the gas, unit length in double precision
+        n[0] = -nw.x()/nMag;
+        n[1] = -nw.y()/nMag;
+        n[2] = -nw.z()/nMag;
+    }
+
+    double u[RBS_U_PER_DRAW];
+    rbs_rng_fill(&s.rng, u, RBS_U_PER_DRAW);
+
+    double Vout[3], Wout[3];
+    int status = RBS_INVALID;
+    if (nMag > 0 && a > 0)
+    {
+        status = rbs_rebound
+        (
+            table_.get(), &mix_, V, n, a, u, interpolation_, Vout, Wout
+        );
+    }
+
+    ++c.hits;
+
+    const scalar speed = mag(Vin);
+    scalar spinRatio = 0;
+    if (stochasticReboundDetail::hasSpin<typename CloudType::parcelType>::value)
+    {
+        if (speed > 0)
+        {
+            spinRatio =
+                mag(stochasticReboundDetail::angularVelocity(p, 0))*a/speed;
+        }
+        ++c.spinSamples;
+        c.spinRatioSum += spinRatio;
+        c.spinRatioMax = max(c.spinRatioMax, spinRatio);
+    }
+
+    switch (status)
+    {
+        case RBS_REBOUNDED:
+        {
+            ++c.rebounded;
+            if (speed < speedLo_ || speed > speedHi_)
+            {
+                // Drawn from the law at the nearest grid edge
+                ++c.outsideSpeedRange;
+            }
+            keepParticle = true;
+            p.active(true);
+            U = vector(Vout[0], Vout[1], Vout[2]) + Uwall;
+            stochasticReboundDetail::setAngularVelocity
+            (
+                p, vector(Wout[0], Wout[1], Wout[2]), 0
+            );
+            break;
+        }
+        case RBS_TRAPPED:
+        {
+            ++c.trapped;
+            c.trappedMass += p.nParticle()*p.mass();
+            // stick: kept, inactive, at rest on the wall; remove: deleted
+            keepParticle = !removeTrapped_;
+            p.active(false);
+            U = Zero;
+            stochasticReboundDetail::setAngularVelocity(p, vector(Zero), 0);
+            break;
+        }
+        default:
+        {
+            // Not moving into the wall (or a degenerate normal): the stock
+            // rebound leaves such a parcel's velocity as it is
+            ++c.invalid;
+            keepParticle = true;
+            break;
+        }
+    }
+
+    if (s.hits.is_open())
+    {
+        recordHit(p, pp, V, n, Uwall, a, status, Vout, Wout, spinRatio, u[0]);
+    }
+
+    return true;
+}
+
+
+template<class CloudType>
+void Foam::StochasticRebound<CloudType>::info(Ostream& os)
+{
+    PatchInteractionModel<CloudType>::info(os);
+
+    State& s = *state_;
+    const Counters& c = s.counters;
+
+    // Totals: the values stored at the last write plus this run's since then
+    label nHits = this->template getModelProperty<label>("nHits");
+    label nRebounded = this->template getModelProperty<label>("nRebounded");
+    label nTrapped = this->template getModelProperty<label>("nTrapped");
+    label nInvalid = this->template getModelProperty<label>("nInvalid");
+    label nOutside =
+        this->template getModelProperty<label>("nOutsideSpeedRange");
+    scalar mTrapped = this->template getModelProperty<scalar>("massTrapped");
+    label nSpin = this->template getModelProperty<label>("nSpinSamples");
+    scalar spinSum = this->template getModelProperty<scalar>("spinRatioSum");
+    scalar spinMax = this->template getModelProperty<scalar>("spinRatioMax");
+
+    nHits += returnReduce(c.hits, sumOp<label>());
+    nRebounded += returnReduce(c.rebounded, sumOp<label>());
+    nTrapped += returnReduce(c.trapped, sumOp<label>());
+    nInvalid += returnReduce(c.invalid, sumOp<label>());
+    nOutside += returnReduce(c.outsideSpeedRange, sumOp<label>());
+    mTrapped += returnReduce(c.trappedMass, sumOp<scalar>());
+
+    os  << "    Stochastic rebound (" << mixName_.c_str() << ')' << nl
+        << "      - wall hits                   = " << nHits << nl
+        << "      - rebounded                   = " << nRebounded << nl
+        << "      - trapped ("
+        << (removeTrapped_ ? "removed" : "stick  ")
+        << ", number, mass) = " << nTrapped << ", " << mTrapped << nl
+        << "      - invalid (left as stock)     = " << nInvalid << nl
+        << "      - |V| outside table range     = " << nOutside << nl;
+
+    if (stochasticReboundDetail::hasSpin<typename CloudType::parcelType>::value)
+    {
+        nSpin += returnReduce(c.spinSamples, sumOp<label>());
+        spinSum += returnReduce(c.spinRatioSum, sumOp<scalar>());
+        spinMax = max(spinMax, returnReduce(c.spinRatioMax, maxOp<scalar>()));
+        os  << "      - incoming spin |Omega|a/|V|  = mean "
+            << (nSpin > 0 ? spinSum/nSpin : 0) << ", max " << spinMax
+            << " (not used: tables are for non-spinning particles)" << nl;
+    }
+
+    if (s.hits.is_open())
+    {
+        s.hits.flush();
+    }
+
+    if (this->writeTime())
+    {
+        this->setModelProperty("nHits", nHits);
+        this->setModelProperty("nRebounded", nRebounded);
+        this->setModelProperty("nTrapped", nTrapped);
+        this->setModelProperty("nInvalid", nInvalid);
+        this->setModelProperty("nOutsideSpeedRange", nOutside);
+        this->setModelProperty("massTrapped", mTrapped);
+        this->setModelProperty("nSpinSamples", nSpin);
+        this->setModelProperty("spinRatioSum", spinSum);
+        this->setModelProperty("spinRatioMax", spinMax);
+        s.counters = Counters();
+    }
+}
+
+
+// ************************************************************************* //
