@@ -497,9 +497,10 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
     os  << "    Stochastic rebound (" << mixName_.c_str() << ')' << nl
         << "      - wall hits                   = " << nHits << nl
         << "      - rebounded                   = " << nRebounded << nl
-        << "      - trapped ("
-        << (removeTrapped_ ? "removed" : "stick  ")
-        << ", number, mass) = " << nTrapped << ", " << mTrapped << nl
+        << (removeTrapped_
+          ? "      - trapped, removed (number, mass) = "
+          : "      - trapped, stuck (number, mass) = ")
+        << nTrapped << ", " << mTrapped << nl
         << "      - invalid (left as stock)     = " << nInvalid << nl
         << "      - |V| outside table range     = " << nOutside << nl;
 

@@ -1,0 +1,20 @@
+"""The rebound-scatter Python API as the OpenFOAM integration uses it.
+
+Every import of the project's packages by integrations/openfoam and
+tests/openfoam goes through this module, so a refactoring of the packages
+re-points these few lines only. Public API only: ``surrogate.load``,
+``surrogate.sample_global``, ``surrogate.STATUS_*`` and, to build a table,
+``tablegen.build.build_table(tablegen.config.parse_config(text), path)``.
+"""
+
+from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, sample_global
+
+__all__ = ["STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "build_table_from_text", "load",
+           "sample_global"]
+
+
+def build_table_from_text(config_text: str, path, **kwargs):
+    """Build the table a TOML configuration describes into ``path`` (tablegen's build)."""
+    from tablegen.build import build_table
+    from tablegen.config import parse_config
+    return build_table(parse_config(config_text), path, **kwargs)
