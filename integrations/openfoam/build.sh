@@ -43,7 +43,7 @@ if [ -z "$native_given" ]; then
         -DCMAKE_BUILD_TYPE=Release \
         -DCMAKE_INSTALL_PREFIX="$RBS_NATIVE_PREFIX" \
         -DCMAKE_INSTALL_LIBDIR=lib \
-        -DBUILD_TESTING=OFF >/dev/null
+        -DRBS_BUILD_STATIC=OFF -DBUILD_TESTING=OFF >/dev/null
     cmake --build "$RBS_OPENFOAM_CACHE/native-build" -j "$jobs" >/dev/null
     cmake --install "$RBS_OPENFOAM_CACHE/native-build" >/dev/null
     step_done
@@ -57,6 +57,9 @@ step "stochasticRebound adapter (wmake libso)"
 # objects next to Make/)
 src="$RBS_OPENFOAM_CACHE/adapter/stochasticRebound"
 mkdir -p "$src/Make" "$FOAM_USER_LIBBIN"
+for f in "$src"/*.[CH]; do  # sources since removed
+    if [ -e "$f" ] && [ ! -e "$here/stochasticRebound/${f##*/}" ]; then rm -f "$f"; fi
+done
 for f in "$here"/stochasticRebound/*.[CH] "$here"/stochasticRebound/Make/files "$here"/stochasticRebound/Make/options; do
     rel=${f#"$here"/stochasticRebound/}
     cmp -s "$f" "$src/$rel" 2>/dev/null || cp "$f" "$src/$rel"

@@ -2,7 +2,7 @@
 # Install what the OpenFOAM adapter needs on Debian bookworm, as root:
 #
 #   1. Debian's OpenFOAM v1912 (openfoam, libopenfoam), Open MPI, a compiler,
-#      CMake (for native/) and lbzip2;
+#      CMake and HDF5 (for native/) and lbzip2;
 #   2. the OpenFOAM v1912 source, from `apt-get source openfoam` (Debian ships
 #      no OpenFOAM headers): its src/, wmake/, etc/ and the lagrangian
 #      tutorials are unpacked into $RBS_OPENFOAM_CACHE/OpenFOAM-v1912;
@@ -37,7 +37,7 @@ as_root() {
 }
 
 # ---------------------------------------------------------------- 1. packages
-packages=(openfoam libopenfoam openmpi-bin g++ make cmake lbzip2 dpkg-dev)
+packages=(openfoam libopenfoam openmpi-bin g++ make cmake libhdf5-dev lbzip2 dpkg-dev)
 step "Debian packages (${packages[*]})"
 missing=()
 for p in "${packages[@]}"; do
