@@ -7,7 +7,8 @@ version of its major version. Every reader opens files through
 The prose description of each layout is in ``docs/format.md``.
 """
 
-from data_schema.common import DataFormatError, atomic_output, check_file
+from data_schema.common import DataFormatError, check_file
+from data_schema.output import OutputError, check_output
 from data_schema.samples import (
     SAMPLES_FILE_TYPE,
     SAMPLES_VERSION,
@@ -21,7 +22,7 @@ from data_schema.samples import (
 )
 
 __all__ = [
-    "DataFormatError", "atomic_output", "check_file",
+    "DataFormatError", "OutputError", "check_file", "check_output",
     "SAMPLES_FILE_TYPE", "SAMPLES_VERSION", "STATUS_FAILED", "STATUS_NAMES",
     "STATUS_REBOUNDED", "STATUS_TRAPPED", "SampleSet", "read_samples", "write_samples",
 ]

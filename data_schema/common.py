@@ -1,10 +1,7 @@
-"""File identification, version checks and atomic writes common to every layout."""
+"""File identification and version checks common to every layout."""
 
 from __future__ import annotations
 
-import contextlib
-import os
-import tempfile
 from pathlib import Path
 
 import h5py
@@ -27,6 +24,8 @@ def check_file(path, file_type: str, major: int) -> None:
         or another major format version.
     """
     path = Path(path)
+    if path.is_dir():
+        raise DataFormatError(f"{path}: is a folder; give a {file_type} file")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     try:
@@ -52,39 +51,6 @@ def write_header(f: h5py.File, file_type: str, version: tuple[int, int]) -> None
     """Write the identification attributes every file carries."""
     f.attrs["file_type"] = file_type
     f.attrs["format_version"] = np.array(version, dtype=np.int64)
-
-
-@contextlib.contextmanager
-def atomic_output(path, overwrite: bool = False):
-    """Yield a temporary path next to ``path``; move it into place only on success.
-
-    The target never holds a half-written file: the temporary file is in the
-    same directory and replaces the target with :func:`os.replace`. An
-    existing target is refused unless ``overwrite``; on error the temporary
-    file is removed and the target is untouched.
-    """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --overwrite) to replace it")
-    directory = path.parent if str(path.parent) else Path(".")
-    if not directory.is_dir():
-        raise FileNotFoundError(f"{directory}: output directory does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    os.close(fd)
-    try:
-        yield Path(tmp)
-        os.chmod(tmp, 0o666 & ~_umask())      # as an ordinary new file, not mkstemp's 0600
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(tmp)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def package_version() -> str:

@@ -26,7 +26,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from data_schema.common import DataFormatError, atomic_output, check_file, write_header
+from data_schema.common import DataFormatError, check_file, write_header
+from data_schema.output import hdf5_bytes, write_output
 
 # particle shapes; a shape's code in files (dataset ``shape_code``) is its index here
 SHAPE_NAMES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
@@ -189,13 +190,16 @@ class SampleSet:
             producer=str(known["producer"]), extra=extra, provenance=attrs)
 
 
-def write_samples(path, samples: SampleSet, overwrite: bool = False) -> Path:
-    """Write ``samples`` to a new HDF5 file at ``path`` atomically; return the path."""
-    with atomic_output(path, overwrite) as tmp:
-        with h5py.File(tmp, "w") as f:
-            write_header(f, SAMPLES_FILE_TYPE, SAMPLES_VERSION)
-            samples.to_hdf5(f.create_group("samples"))
-    return Path(path)
+def write_samples(path, samples: SampleSet, overwrite: bool = False, inputs=()) -> Path:
+    """Write ``samples`` to an HDF5 file at ``path``, whole or not at all; return the path.
+
+    ``overwrite`` replaces only a samples file, never one of ``inputs`` (:func:`data_schema.output.check_output`).
+    """
+    def write(f):
+        write_header(f, SAMPLES_FILE_TYPE, SAMPLES_VERSION)
+        samples.to_hdf5(f.create_group("samples"))
+
+    return write_output(path, hdf5_bytes(write), SAMPLES_FILE_TYPE, overwrite, inputs)
 
 
 def read_samples(path) -> SampleSet:

@@ -2,14 +2,17 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (3, 0),
-                           created (ISO 8601 UTC), package_version, config (TOML text),
+    /                      attrs: file_type = "rebound_table", format_version = (3, 1),
+                           created (ISO 8601 UTC), package_version, model_sha256, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
                            attrs: kappa, n_max, particles_per_cell,
                            restitution_k, restitution_p (the wall's normal-restitution law)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
+
+Every numeric dataset carries HDF5's Fletcher-32 checksum (since 3.1), so a
+corrupted file fails to load with an error naming the dataset.
 
 Representation of one cell (docs/format.md): the reflected state of the
 rebounded particles, folded by the mirror symmetry Z → −Z to β2 ≥ 0 (Ω_x, Ω_y
@@ -44,10 +47,11 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from data_schema.common import DataFormatError, atomic_output, check_file, write_header
+from data_schema.common import DataFormatError, check_file, write_header
+from data_schema.output import hdf5_bytes, write_output
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (3, 0)
+TABLE_VERSION = (3, 1)
 
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
 FEW_COLLISIONS = 2                  # regime 0 of a cluster: rebounds of at most this many collisions
@@ -86,6 +90,11 @@ class TableResolution:
         if self.dictionary_size > 256:
             raise ValueError(f"The table resolution 'dictionary_size' must be <= 256 (stored as uint8); "
                              f"got {self.dictionary_size!r}.")
+
+    def cell_nbytes(self) -> int:
+        """Bytes of one cell's datasets (:data:`CELL_DATASETS`)."""
+        return sum(int(np.prod(shape)) * np.dtype(CELL_DATASETS[name][0]).itemsize
+                   for name, shape in self.cell_shapes().items())
 
     def cell_shapes(self) -> dict:
         """Shape of each per-cell dataset (without the three leading grid dimensions)."""
@@ -172,6 +181,7 @@ class ReboundTable:
     package_version: str
     restitution_k: float                 # normal restitution exp(−k |V_c|^p) of the wall law, (m/s)^(−p)
     restitution_p: float
+    model_sha256: str = ""               # hash of the direct model's source that computed the cells ("" before 3.1)
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -194,12 +204,14 @@ class ReboundTable:
         """Write the table into an open file (header attributes excluded)."""
         f.attrs["created"] = self.created
         f.attrs["package_version"] = self.package_version
+        f.attrs["model_sha256"] = self.model_sha256
         f.attrs["config"] = self.config_text
         f.attrs["config_sha256"] = self.config_sha256
         f.attrs["master_seed"] = np.uint64(self.master_seed)
         grid = f.create_group("grid")
-        grid.create_dataset("alpha1_deg", data=np.asarray(self.alpha1_deg, dtype=np.float64)).attrs["units"] = "deg"
-        grid.create_dataset("speed_m_s", data=np.asarray(self.speed_m_s, dtype=np.float64)).attrs["units"] = "m/s"
+        for name, units in (("alpha1_deg", "deg"), ("speed_m_s", "m/s")):
+            values = np.asarray(getattr(self, name), dtype=np.float64)
+            grid.create_dataset(name, data=values, fletcher32=True).attrs["units"] = units
         grid.create_dataset("shapes", data=np.array(self.shapes, dtype=h5py.string_dtype()))
         grid.attrs["kappa"] = self.kappa
         grid.attrs["n_max"] = self.n_max
@@ -211,7 +223,7 @@ class ReboundTable:
             res.attrs[field.name] = getattr(self.resolution, field.name)
         cells = f.create_group("cells")
         for name, (dtype, units, meaning) in CELL_DATASETS.items():
-            ds = cells.create_dataset(name, data=np.asarray(self.cells[name], dtype=dtype))
+            ds = cells.create_dataset(name, data=np.asarray(self.cells[name], dtype=dtype), fletcher32=True)
             ds.attrs["units"] = units
             ds.attrs["meaning"] = meaning
 
@@ -228,18 +240,20 @@ class ReboundTable:
         missing = [n for n in CELL_DATASETS if n not in f["cells"]]
         if missing:
             raise DataFormatError(f"{where}: missing dataset(s) {', '.join('cells/' + n for n in missing)}")
+        grid = f["grid"]
+        alpha1_deg, speed_m_s = (_read(grid, name) for name in ("alpha1_deg", "speed_m_s"))
+        cells = {name: _read(f["cells"], name) for name in CELL_DATASETS}
         try:
             resolution = TableResolution(**{k: int(v) for k, v in f["resolution"].attrs.items()})
-            cells = {name: f["cells"][name][()] for name in CELL_DATASETS}
-            grid = f["grid"]
             return cls(
-                alpha1_deg=grid["alpha1_deg"][()], speed_m_s=grid["speed_m_s"][()],
+                alpha1_deg=alpha1_deg, speed_m_s=speed_m_s,
                 shapes=tuple(s.decode() if isinstance(s, bytes) else str(s) for s in grid["shapes"][()]),
                 resolution=resolution, cells=cells, kappa=float(grid.attrs["kappa"]),
                 n_max=int(grid.attrs["n_max"]), particles_per_cell=int(grid.attrs["particles_per_cell"]),
                 config_text=str(f.attrs["config"]), config_sha256=str(f.attrs["config_sha256"]),
                 master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
                 package_version=str(f.attrs["package_version"]),
+                model_sha256=str(f.attrs.get("model_sha256", "")),
                 restitution_k=float(grid.attrs["restitution_k"]), restitution_p=float(grid.attrs["restitution_p"]))
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
@@ -247,13 +261,25 @@ class ReboundTable:
             raise DataFormatError(f"{where}: inconsistent table: {exc}") from exc
 
 
+def _read(group: h5py.Group, name: str) -> np.ndarray:
+    """A dataset's array; DataFormatError naming it if it cannot be read (its checksum fails, say)."""
+    try:
+        return group[name][()]
+    except (OSError, ValueError) as exc:
+        raise DataFormatError(f"{group.file.filename}: dataset '{group[name].name.lstrip('/')}' cannot be read "
+                              f"(corrupt file: {' '.join(str(exc).split())})") from exc
+
+
 def write_table(path, table: ReboundTable, overwrite: bool = False) -> Path:
-    """Write ``table`` to a new HDF5 file at ``path`` atomically; return the path."""
-    with atomic_output(path, overwrite) as tmp:
-        with h5py.File(tmp, "w") as f:
-            write_header(f, TABLE_FILE_TYPE, TABLE_VERSION)
-            table.to_hdf5(f)
-    return Path(path)
+    """Write ``table`` to an HDF5 file at ``path``, whole or not at all; return the path.
+
+    ``overwrite`` replaces only a table file (:func:`data_schema.output.check_output`).
+    """
+    def write(f):
+        write_header(f, TABLE_FILE_TYPE, TABLE_VERSION)
+        table.to_hdf5(f)
+
+    return write_output(path, hdf5_bytes(write), TABLE_FILE_TYPE, overwrite)
 
 
 def read_table(path) -> ReboundTable:

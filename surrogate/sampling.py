@@ -84,12 +84,13 @@ def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
         if name not in SHAPE_NAMES:
             raise ValueError(f"The 'shape' parameter must name one of {', '.join(SHAPE_NAMES)}; got {name!r}.")
         if not (np.isfinite(w) and w >= 0):
-            raise ValueError(f"The mix weight of {name!r} must be finite and >= 0; got {w!r}.")
+            raise ValueError(f"The mix weight of {name!r} must be finite and >= 0; got {float(w)!r}.")
         if w > 0 and name not in table.shapes:
             raise ValueError(f"shape {name!r} is not in the table {table.path} (it holds {', '.join(table.shapes)}).")
     total = sum(weights.values())
     if abs(total - 1.0) > 1e-9:
-        raise ValueError(f"The mix weights must sum to 1; got {total!r} from {weights!r}.")
+        raise ValueError(f"The mix weights must sum to 1; got {float(total)!r} from "
+                         f"{ {k: float(v) for k, v in weights.items()} }.")
     cdf = np.cumsum([weights.get(name, 0.0) for name in table.shapes])
     cdf[-1] = 1.0
     return cdf
@@ -105,8 +106,13 @@ def _scaled(interpolation: str) -> bool:
     return interpolation == "scaled"
 
 
+# physical range of the incident state: (low, high, high included); clamp=True never reaches beyond it
+PHYSICAL_RANGE = {"alpha1": (0.0, 90.0, True), "speed": (0.0, np.inf, False)}
+
+
 def _check_range(name, values, bounds, clamp, units) -> None:
-    """Non-finite values are always an error; out-of-range ones unless ``clamp``.
+    """Non-finite values and values outside the physical range are always an error (PHYSICAL_RANGE);
+    values outside the table's range unless ``clamp``.
 
     With ``clamp`` the kernels use the law of the nearest grid edge (the
     dimensionless reflected state), applied to the particle's actual speed.
@@ -114,6 +120,14 @@ def _check_range(name, values, bounds, clamp, units) -> None:
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         raise _not_finite(name, bad[0], values[bad[0]])
+    low, high, closed = PHYSICAL_RANGE[name]
+    bad = np.flatnonzero((values <= low) | ((values > high) if closed else (values >= high)))
+    if bad.size:
+        value = float(values[bad[0]])
+        shown = f"({low:g}, {high:g}{']' if closed else ')'}"
+        raise ValueError(f"The '{name}' value {value!r} {units} (index {bad[0]}) is outside the physical range "
+                         f"{shown} {units}; clamp=True extends only the table's range [{bounds[0]:g}, "
+                         f"{bounds[1]:g}] up to it.")
     if clamp:
         return
     lo, hi = bounds
@@ -123,11 +137,11 @@ def _check_range(name, values, bounds, clamp, units) -> None:
 
 
 def _not_finite(name, index, value) -> ValueError:
-    return ValueError(f"The '{name}' value at index {index} is not finite: {value!r}.")
+    return ValueError(f"The '{name}' value at index {index} is not finite: {float(value)!r}.")
 
 
 def _outside(name, index, value, bounds, units) -> ValueError:
-    return ValueError(f"The '{name}' value {value!r} {units} (index {index}) is outside the table's range "
+    return ValueError(f"The '{name}' value {float(value)!r} {units} (index {index}) is outside the table's range "
                       f"[{bounds[0]:g}, {bounds[1]:g}]; pass clamp=True to use the law at the nearest grid edge.")
 
 
@@ -137,7 +151,10 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
 
     ``alpha1`` and ``speed`` are broadcast together; their common shape is
     flattened to n draws. ``interpolation``: ``"scaled"`` (default) or
-    ``"stochastic"`` (see :func:`sample_global`).
+    ``"stochastic"`` (see :func:`sample_global`). ``clamp``: an α1 or |V⁻|
+    outside the table's range uses the law at the nearest grid edge instead of
+    raising; α1 outside (0, 90] deg or |V⁻| ≤ 0 m/s is non-physical and always
+    raises.
     """
     a, v = np.broadcast_arrays(np.asarray(alpha1, dtype=np.float64), np.asarray(speed, dtype=np.float64))
     a, v = a.ravel(), v.ravel()
@@ -181,9 +198,9 @@ def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueE
     """The error for check ``fault`` (surrogate.faults) failing first at particle i."""
     j, k = min(i, len(nrm) - 1), min(i, len(a) - 1)      # the rows of its normal and of its half-size
     if fault == FAULT_VELOCITY_NOT_FINITE:
-        return ValueError(f"The 'velocity' vector at index {i} is not finite: {V[i]!r}.")
+        return ValueError(f"The 'velocity' vector at index {i} is not finite: {V[i].tolist()}.")
     if fault == FAULT_NORMAL_NOT_FINITE:
-        return ValueError(f"The 'normal' vector at index {j} is not finite: {nrm[j]!r}.")
+        return ValueError(f"The 'normal' vector at index {j} is not finite: {nrm[j].tolist()}.")
     if fault == FAULT_NORMAL_NOT_UNIT:
         return ValueError(f"The 'normal' at index {j} has length {float(np.linalg.norm(nrm[j]))!r}; wall normals "
                           f"must be unit vectors (|n| - 1 within {NORMAL_TOLERANCE}).")
@@ -193,7 +210,7 @@ def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueE
     if fault == FAULT_NOT_INTO_WALL:
         return ValueError(f"The 'velocity' at index {i} does not move into the wall: V.n = {vn!r} m/s must be < 0.")
     if fault == FAULT_HALF_SIZE:
-        return ValueError(f"The 'half_size' at index {k} must be finite and > 0 m; got {a[k]!r}.")
+        return ValueError(f"The 'half_size' at index {k} must be finite and > 0 m; got {float(a[k])!r}.")
     alpha1 = float(np.degrees(np.arctan2(-vn, np.sqrt(max(speed ** 2 - vn ** 2, 0.0)))))
     if fault == FAULT_ALPHA1_NOT_FINITE:
         return _not_finite("alpha1", i, alpha1)
@@ -251,7 +268,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         (the neighbour's law as is); see :func:`surrogate.kernels.draw_velocity`
         and docs/VALIDATION.md for how they compare.
     clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
-        edge instead of raising.
+        edge instead of raising. Never beyond the physical range: here every
+        state that moves into its wall is physical (α1 in (0, 90], |V⁻| > 0).
     out : None (default: new arrays) or a tuple (V_out, Omega_out, status) of
         arrays to write the results into and return: C-contiguous, writeable,
         float64 (N, 3), float64 (N, 3) and int8 (N,), sharing no memory with

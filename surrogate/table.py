@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from data_schema.common import DataFormatError
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import N_CHAIN, N_SLOPES, ReboundTable, read_table
 from surrogate.restitution import restitution_pieces
@@ -233,10 +234,36 @@ class SurrogateTable:
             restitution_pieces=_frozen(pieces.ravel()),
             n_shapes=lead[0], n_alpha1=lead[1], n_speed=lead[2], n_clusters=table.cells["cluster_weight"].shape[3],
             n_levels=dic_shape[-1], n_dictionary=dic_shape[-2], n_pieces=pieces.shape[1])
+        _check_derived(data, path)
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=_frozen(np.asarray(table.alpha1_deg, float)),
                    speed_m_s=_frozen(speed), particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, restitution_k=table.restitution_k,
                    restitution_p=table.restitution_p, kernel_data=data)
+
+
+# the stored datasets each kernel array is derived from, for error messages
+DERIVED_FROM = {
+    "alpha1_axis": "grid/alpha1_deg", "speed_axis": "grid/speed_m_s",
+    "cells": "cells/status_counts, cells/mean, cells/std",
+    "clusters": "cells/cluster_weight, cluster_loc, cluster_scale, cluster_shape, cluster_slope, cluster_regime",
+    "dictionary": "cells/shape_dictionary", "speed_restitution": "grid/speed_m_s and the wall law",
+    "restitution_pieces": "grid/speed_m_s and the wall law",
+}
+
+
+def _check_derived(data: KernelData, path: str) -> None:
+    """DataFormatError unless every kernel array is finite and both grids strictly increase: a draw from
+    the table can then never be non-finite with status "rebounded"."""
+    for name, source in DERIVED_FROM.items():
+        values = getattr(data, name)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise DataFormatError(f"{path}: {bad.size} non-finite values in the kernel array '{name}' derived "
+                                  f"from {source} (first at flat index {bad[0]}); the table is corrupt")
+    for name, axis, n in (("alpha1", data.alpha1_axis, data.n_alpha1), ("speed", data.speed_axis, data.n_speed)):
+        grid = axis[AXIS_GRID:AXIS_GRID + n]
+        if np.any(np.diff(grid) <= 0) or grid[0] <= 0:
+            raise DataFormatError(f"{path}: the {name} grid must be positive and strictly increasing; got {grid}")
 
 
 def load(path) -> SurrogateTable:

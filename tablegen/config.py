@@ -39,6 +39,7 @@ from tablegen.shapes import SHAPES, AspectRatioLaw, check_kappa
 from tablegen.tabulate import resolution_for
 
 PRESETS = ("default", "production", "paper")
+MAX_GRID_POINTS = 1000      # per axis: far beyond any useful table, small enough to check before allocating
 
 
 class ConfigError(ValueError):
@@ -113,9 +114,12 @@ def load_config(path=None, preset: str = "default") -> BuildConfig:
         return parse_config(preset_text(preset), f"preset '{preset}'")
     try:
         with open(path, "rb") as f:
-            text = f.read().decode()
+            text = f.read().decode("utf-8")
     except OSError as exc:
-        raise ConfigError(f"{path}: cannot read the configuration: {exc}") from exc
+        raise ConfigError(f"{path}: cannot read the configuration: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: the configuration is not UTF-8 text (byte {exc.start}); TOML files are "
+                          f"UTF-8") from None
     return parse_config(text, str(path))
 
 
@@ -213,9 +217,14 @@ def _grid_values(spec, key, source) -> list:
             start, stop, step = (float(spec[k]) for k in ("start", "stop", "step"))
         except (TypeError, ValueError):
             raise ConfigError(f"{source}: '{key}' start, stop, step must be numbers; got {spec!r}") from None
-        if not (step > 0 and stop >= start):
-            raise ConfigError(f"{source}: '{key}' needs step > 0 and stop >= start; got {spec!r}")
-        count = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if not (all(map(math.isfinite, (start, stop, step))) and step > 0 and stop >= start):
+            raise ConfigError(f"{source}: '{key}' needs finite numbers with step > 0 and stop >= start; "
+                              f"got {spec!r}")
+        span = (stop - start) / step
+        if not span < MAX_GRID_POINTS:
+            raise ConfigError(f"{source}: '{key}' = {spec!r} gives {span + 1:.3g} grid points; allowed: at most "
+                              f"{MAX_GRID_POINTS} (a larger step)")
+        count = math.floor(span + 1e-9) + 1
         values = [start + k * step for k in range(count)]
     elif isinstance(spec, list):
         values = spec
@@ -223,6 +232,8 @@ def _grid_values(spec, key, source) -> list:
         raise ConfigError(f"{source}: '{key}' must be a list of numbers or {{start, stop, step}}; got {spec!r}")
     if not values:
         raise ConfigError(f"{source}: '{key}' is empty; give at least one value")
+    if len(values) > MAX_GRID_POINTS:
+        raise ConfigError(f"{source}: '{key}' has {len(values)} values; allowed: at most {MAX_GRID_POINTS}")
     if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
         raise ConfigError(f"{source}: '{key}' values must be numbers; got {values!r}")
     values = [float(v) for v in values]

@@ -20,12 +20,8 @@ interface and in radians inside the samples. V stands for |V⁻|.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import datetime
-import os
-import shutil
-import tempfile
 import tomllib
 from pathlib import Path
 from typing import NamedTuple
@@ -33,6 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from data_schema.common import package_version
+from data_schema.output import atomic_folder
 from data_schema.samples import STATUS_FAILED, STATUS_NAMES, STATUS_REBOUNDED, STATUS_TRAPPED, SampleSet
 from tablegen.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_factor
 from tablegen.summary import COLLISION_CLASSES
@@ -343,6 +340,9 @@ def _progress_bar(total: int, enabled: bool):
 
 # -- output -----------------------------------------------------------------
 
+REPORT_KIND = "study_report"      # the kind a report folder's marker names (data_schema.output)
+
+
 def study_statistics(data: ReportData) -> dict:
     """{(shape, α1): :func:`point_statistics`} over every reported point."""
     return {key: point_statistics(p) for key, p in data.points.items()}
@@ -351,53 +351,21 @@ def study_statistics(data: ReportData) -> dict:
 def write_report(data: ReportData, out, overwrite: bool = False) -> Path:
     """Write the figures and ``index.md`` into the new folder ``out``; return its path.
 
-    The folder is written under a temporary name next to ``out`` and renamed
-    into place when complete, so ``out`` never holds a half-written report. An
-    existing ``out`` is refused (FileExistsError) unless ``overwrite``.
+    The folder is written under a temporary name next to ``out`` and swapped
+    into place when complete, so ``out`` never holds a half-written report.
+    An existing ``out`` is replaced only with ``overwrite`` and only if it is a
+    report folder this function wrote (its marker file); anything else is
+    refused with :class:`data_schema.output.OutputError`.
     Raises ImportError naming the ``plots`` extra if matplotlib is missing.
     """
     from tablegen.report_plots import require_matplotlib, write_figures
 
     require_matplotlib()
     stats = study_statistics(data)
-    with atomic_folder(out, overwrite) as tmp:
+    with atomic_folder(out, REPORT_KIND, overwrite) as tmp:
         figures = write_figures(data, stats, tmp)
         (tmp / "index.md").write_text(render_index(data, stats, figures), encoding="utf-8")
     return Path(out)
-
-
-def check_output_folder(out, overwrite: bool) -> Path:
-    """``out`` as a Path if a report may be written there; FileExistsError or FileNotFoundError if not."""
-    out = Path(out)
-    if out.exists() and not overwrite:
-        raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
-    if out.exists() and not out.is_dir():
-        raise FileExistsError(f"{out} exists and is not a folder")
-    if not out.parent.is_dir():
-        raise FileNotFoundError(f"{out.parent}: output directory does not exist")
-    return out
-
-
-@contextlib.contextmanager
-def atomic_folder(out, overwrite: bool = False):
-    """Yield a new temporary folder next to ``out``; on success it replaces ``out``, on error it is removed."""
-    out = check_output_folder(out, overwrite)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
-    try:
-        yield tmp
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o777 & ~mask)          # as an ordinary new folder, not mkdtemp's 0700
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-            os.replace(out, old / out.name)
-            os.replace(tmp, out)
-            shutil.rmtree(old)
-        else:
-            os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def _fmt(x: float) -> str:

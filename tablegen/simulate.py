@@ -34,7 +34,7 @@ def check_alpha1(alpha1) -> float:
     except (TypeError, ValueError):
         raise ValueError(f"The 'alpha1' parameter must be a number in (0, 90] degrees; got {alpha1!r}.") from None
     if not (0.0 < value <= 90.0):
-        raise ValueError(f"The 'alpha1' parameter must be in (0, 90] degrees; got {alpha1!r}.")
+        raise ValueError(f"The 'alpha1' parameter must be in (0, 90] degrees; got {value!r}.")
     return value
 
 
@@ -45,20 +45,21 @@ def check_speed(speed) -> float:
     except (TypeError, ValueError):
         raise ValueError(f"The 'speed' parameter must be a finite number > 0 m/s; got {speed!r}.") from None
     if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"The 'speed' parameter must be finite and > 0 m/s; got {speed!r}.")
+        raise ValueError(f"The 'speed' parameter must be finite and > 0 m/s; got {value!r}.")
     return value
 
 
 def _check_count(name, value, minimum) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"The '{name}' parameter must be an integer >= {minimum}; got {value!r}.")
+        shown = int(value) if isinstance(value, np.integer) else value
+        raise ValueError(f"The '{name}' parameter must be an integer >= {minimum}; got {shown!r}.")
     return int(value)
 
 
 def _check_positive(name, value) -> float:
     value_f = float(value)
     if not (math.isfinite(value_f) and value_f > 0.0):
-        raise ValueError(f"The '{name}' parameter must be finite and > 0; got {value!r}.")
+        raise ValueError(f"The '{name}' parameter must be finite and > 0; got {value_f!r}.")
     return value_f
 
 

@@ -12,7 +12,8 @@ import pytest
 
 from data_schema.common import DataFormatError
 from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table
-from tablegen.build import BuildError, build_table
+from data_schema.output import OutputError
+from tablegen.build import BuildError, Checkpoint, CheckpointError, build_table
 from tablegen.config import parse_config
 
 TINY = """
@@ -110,7 +111,8 @@ def test_checkpoint_of_another_config_is_refused(tmp_path):
     partial = tmp_path / "t.h5.partial"
     partial.mkdir()
     (partial / "config.toml").write_text("something else\n")
-    with pytest.raises(BuildError, match="another configuration"):
+    with pytest.raises(CheckpointError, match="another table format, package version, model source hash, "
+                                              "configuration"):
         build_table(parse_config(TINY), out, workers=1)
     assert not out.exists()
 
@@ -118,10 +120,11 @@ def test_checkpoint_of_another_config_is_refused(tmp_path):
 def test_checkpoint_of_another_table_format_is_refused(tmp_path):
     """Cells checkpointed by a package writing another table format are not mixed into this one."""
     out = tmp_path / "t.h5"
-    partial = tmp_path / "t.h5.partial"
-    partial.mkdir()
-    (partial / "config.toml").write_text("# table format 2.1\n" + parse_config(TINY).to_toml())
-    with pytest.raises(BuildError, match="table format"):
+    with Checkpoint(out, parse_config(TINY)) as checkpoint:
+        marker = checkpoint.path / "config.toml"
+    marker.write_text(marker.read_text().replace(f"# table format {TABLE_VERSION[0]}.{TABLE_VERSION[1]}",
+                                                 "# table format 2.1"))
+    with pytest.raises(CheckpointError, match="another table format "):
         build_table(parse_config(TINY), out, workers=1)
     assert not out.exists()
 
@@ -129,7 +132,7 @@ def test_checkpoint_of_another_table_format_is_refused(tmp_path):
 def test_existing_output_needs_overwrite(tiny_table, tmp_path):
     out = tmp_path / "t.h5"
     out.write_bytes(b"keep")
-    with pytest.raises(FileExistsError, match="overwrite"):
+    with pytest.raises(OutputError, match="overwrite"):
         build_table(parse_config(TINY), out, workers=1)
     assert out.read_bytes() == b"keep"
 

@@ -2,6 +2,8 @@
 
 import pytest
 
+from cli_helpers import user_error
+
 from tablegen.cli import main as tablegen_main
 from tablegen.config import PRESETS, ConfigError, load_config, parse_config
 
@@ -61,9 +63,7 @@ def test_cli_exits_2_and_leaves_the_output_untouched(text, key, tmp_path, capsys
     cfg.write_text(text)
     out = tmp_path / "table.h5"
     out.write_bytes(b"previous content")
-    with pytest.raises(SystemExit) as info:
-        tablegen_main(["build", "--config", str(cfg), "-o", str(out), "--overwrite"])
-    assert info.value.code == 2
-    assert key in capsys.readouterr().err
+    line, _ = user_error(tablegen_main, ["build", "--config", str(cfg), "-o", str(out), "--overwrite"], capsys, key)
+    assert line.startswith("tablegen build: error: ")
     assert out.read_bytes() == b"previous content"
     assert not (tmp_path / "table.h5.partial").exists()

@@ -6,6 +6,8 @@ import sys
 import numpy as np
 import pytest
 
+from cli_helpers import user_error
+from data_schema.output import FOLDER_MARKER
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from tablegen.cli import main as tablegen_main
 from tablegen.report import (
@@ -16,7 +18,7 @@ from tablegen.report_plots import FIGURES
 from tablegen.shapes import AspectRatioLaw, second_moment_factor
 from tablegen.simulate import simulate
 
-EXPECTED_FILES = {f[0] for f in FIGURES} | {"index.md"}
+EXPECTED_FILES = {f[0] for f in FIGURES} | {"index.md", FOLDER_MARKER}
 
 
 def _synthetic(m=1000, seed=0, status=(0, 0, 0), collisions=(0,) * 6) -> PointSamples:
@@ -130,9 +132,9 @@ def test_cli_direct_writes_every_figure_and_refuses_an_existing_folder(tmp_path,
             "--alpha1", "30,90", "--no-progress"]
     assert tablegen_main(argv) == 0
     assert {p.name for p in out.iterdir()} == EXPECTED_FILES
-    assert all((out / f).read_bytes().startswith(b"\x89PNG") for f in EXPECTED_FILES - {"index.md"})
+    assert all((out / f).read_bytes().startswith(b"\x89PNG") for f in EXPECTED_FILES - {"index.md", FOLDER_MARKER})
     index = (out / "index.md").read_text(encoding="utf-8")
-    assert _figure_links(index) == EXPECTED_FILES - {"index.md"}
+    assert _figure_links(index) == EXPECTED_FILES - {"index.md", FOLDER_MARKER}
     assert "## Collisions per rebound at α1 = 90°" in index and "| cut_prism |" in index
     assert "**E_Ω⁺/E_V⁻** is exact" in index
     # the numbers table: one row per α1, with the statistics of the same run
@@ -142,9 +144,7 @@ def test_cli_direct_writes_every_figure_and_refuses_an_existing_folder(tmp_path,
     assert [p.name for p in tmp_path.iterdir()] == ["report"]                      # no temporary folder left
     # an existing folder is refused and left intact without --overwrite, replaced with it
     before = (out / "index.md").read_bytes()
-    with pytest.raises(SystemExit) as info:
-        tablegen_main(argv)
-    assert info.value.code == 2 and "--overwrite" in capsys.readouterr().err
+    user_error(tablegen_main, argv, capsys, "--overwrite")
     assert (out / "index.md").read_bytes() == before
     (out / "stale.txt").write_text("old")
     assert tablegen_main(argv + ["--overwrite"]) == 0
@@ -161,10 +161,7 @@ def test_cli_direct_writes_every_figure_and_refuses_an_existing_folder(tmp_path,
 ])
 def test_cli_bad_arguments_exit_2_naming_the_argument(extra, word, tmp_path, capsys):
     out = tmp_path / "r"
-    with pytest.raises(SystemExit) as info:
-        tablegen_main(["report", "-o", str(out)] + extra)
-    assert info.value.code == 2
-    assert word in capsys.readouterr().err
+    user_error(tablegen_main, ["report", "-o", str(out)] + extra, capsys, word)
     assert not out.exists()
 
 
@@ -173,8 +170,8 @@ def test_cli_tells_what_to_install_without_matplotlib(tmp_path, monkeypatch, cap
         monkeypatch.delitem(sys.modules, name)
     monkeypatch.setitem(sys.modules, "matplotlib", None)          # import matplotlib raises ImportError
     out = tmp_path / "r"
-    assert tablegen_main(["report", "--direct", "-o", str(out), "-n", "10"]) == 1
-    assert 'pip install "rebound-scatter[plots]"' in capsys.readouterr().err
+    user_error(tablegen_main, ["report", "--direct", "-o", str(out), "-n", "10"], capsys,
+               'pip install "rebound-scatter[plots]"')
     assert not out.exists()
 
 
@@ -186,7 +183,7 @@ def test_cli_from_a_table(small_table_path, tmp_path, capsys):
                           "mix", "-n", "400", "--seed", "1"]) == 0
     assert {p.name for p in out.iterdir()} == EXPECTED_FILES
     index = (out / "index.md").read_text(encoding="utf-8")
-    assert _figure_links(index) == EXPECTED_FILES - {"index.md"}
+    assert _figure_links(index) == EXPECTED_FILES - {"index.md", FOLDER_MARKER}
     # grid α1, the grid speed nearest 200 m/s (150 and 250 tie: the lower), the approximate rotational energy
     assert "| α1 (deg) | 30, 60, 90 |" in index and "150 m/s (the table's grid speed nearest 200 m/s)" in index
     assert "**E_Ω⁺/E_V⁻** is approximate" in index
@@ -196,6 +193,5 @@ def test_cli_from_a_table(small_table_path, tmp_path, capsys):
     one = 100.0 * cell[0] / cell.sum()
     assert re.search(rf"\| prism \| {one:.1f} % \|", index)
     # α1 off the table's grid: exit 2 naming alpha1 and the grid
-    with pytest.raises(SystemExit) as info:
-        tablegen_main(["report", "--table", str(small_table_path), "-o", str(tmp_path / "r2"), "--alpha1", "45"])
-    assert info.value.code == 2 and "alpha1" in capsys.readouterr().err
+    user_error(tablegen_main, ["report", "--table", str(small_table_path), "-o", str(tmp_path / "r2"),
+                               "--alpha1", "45"], capsys, "alpha1")
