@@ -1,0 +1,266 @@
+"""The OpenFOAM adapter (integrations/openfoam) on a real Lagrangian case.
+
+Builds the C runtime and the stochasticRebound patch interaction model
+against Debian's OpenFOAM v1912 (integrations/openfoam/build.sh, on the
+outputs of install-deps.sh), runs the case hopperRebound serially and on 2
+MPI ranks, and checks the hit counts, the rebounds against
+surrogate.sample_global on the same incident states, the random streams per
+rank, a moving wall, and times the runs against standardWallInteraction.
+
+These tests need OpenFOAM: they fail (they are not skipped) when it is
+missing, with a message naming integrations/openfoam/install-deps.sh.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+OPENFOAM_DIR = REPO / "integrations" / "openfoam"
+CASE = OPENFOAM_DIR / "cases" / "hopperRebound"
+SOLVER = "icoUncoupledKinematicParcelFoam"
+HITS = Path("postProcessing/lagrangian/kinematicCloud/stochasticRebound")
+
+sys.path.insert(0, str(OPENFOAM_DIR))
+
+import compare_rebounds  # noqa: E402
+import make_case_table  # noqa: E402
+from rbs_api import build_table_from_text  # noqa: E402
+
+INSTALL_HINT = ("run `bash integrations/openfoam/install-deps.sh` (as root on Debian bookworm: it installs "
+                "Debian's OpenFOAM v1912 and Open MPI, unpacks the v1912 headers from the source package "
+                "and builds wmake)")
+
+
+def _cache() -> Path:
+    return Path(os.environ.get("RBS_OPENFOAM_CACHE", OPENFOAM_DIR / ".build"))
+
+
+def _run(cmd, cwd, env=None, timeout=600) -> subprocess.CompletedProcess:
+    proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    if proc.returncode != 0:
+        pytest.fail(f"{' '.join(map(str, cmd))} failed ({proc.returncode}):\n{proc.stdout[-4000:]}\n"
+                    f"{proc.stderr[-4000:]}")
+    return proc
+
+
+def _timings(case: Path) -> dict:
+    return {k: float(v) for k, v in (line.split() for line in (case / "log.timings").read_text().splitlines())}
+
+
+def _cloud_info(log: str) -> dict:
+    """The stochasticRebound counts of the last time step in a solver log."""
+    block = log[log.rindex("Stochastic rebound"):]
+    spin = re.search(r"incoming spin \|Omega\|a/\|V\|\s*= mean\s*([-0-9.eE+]+), max\s*([-0-9.eE+]+)", block)
+    def number(label):
+        return float(re.search(re.escape(label) + r"[^=]*=\s*([-0-9.eE+]+)", block).group(1))
+    return {"hits": int(number("- wall hits")), "rebounded": int(number("- rebounded")),
+            "trapped": int(number("- trapped")), "invalid": int(number("- invalid")),
+            "outside": int(number("- |V| outside")),
+            "spin_mean": float(spin.group(1)), "spin_max": float(spin.group(2))}
+
+
+@pytest.fixture(scope="session")
+def openfoam_build():
+    """install-deps.sh's outputs checked, then the C runtime and the adapter built (build.sh)."""
+    missing = [tool for tool in (SOLVER, "blockMesh", "decomposePar", "mpirun") if shutil.which(tool) is None]
+    tree = _cache() / "OpenFOAM-v1912"
+    if missing:
+        pytest.fail(f"OpenFOAM is missing ({', '.join(missing)} not on PATH): {INSTALL_HINT}")
+    if not (tree / "src" / "lagrangian" / "intermediate" / "lnInclude").is_dir():
+        pytest.fail(f"the OpenFOAM v1912 headers are missing ({tree}): {INSTALL_HINT}")
+    proc = _run(["bash", str(OPENFOAM_DIR / "build.sh")], cwd=REPO)
+    lib = _cache() / "lib" / "libstochasticRebound.so"
+    assert lib.is_file(), proc.stdout
+    return {"lib": lib, "log": proc.stdout}
+
+
+@pytest.fixture(scope="session")
+def case_table(tmp_path_factory):
+    """The case's table (make_case_table.py's configuration), built once."""
+    path = tmp_path_factory.mktemp("openfoam_table") / "rebound_table.h5"
+    build_table_from_text(make_case_table.CASE_TABLE_CONFIG, path)
+    return path
+
+
+def _run_case(tmp_path_factory, name, table, np_=1, model="stochasticRebound", edit=None) -> Path:
+    case = tmp_path_factory.mktemp(name) / "hopperRebound"
+    shutil.copytree(CASE, case, ignore=shutil.ignore_patterns("log.*", "processor*", "postProcessing",
+                                                              "rebound_table.h5"))
+    if edit:
+        edit(case)
+    env = dict(os.environ, RBS_OPENFOAM_DIR=str(OPENFOAM_DIR), RBS_TABLE=str(table))
+    _run(["bash", "./Allrun", "-np", str(np_), "-model", model], cwd=case, env=env)
+    return case
+
+
+@pytest.fixture(scope="session")
+def serial_case(openfoam_build, case_table, tmp_path_factory):
+    return _run_case(tmp_path_factory, "serial", case_table)
+
+
+@pytest.fixture(scope="session")
+def parallel_case(openfoam_build, case_table, tmp_path_factory):
+    return _run_case(tmp_path_factory, "parallel", case_table, np_=2)
+
+
+# ----------------------------------------------------------------------------- build
+
+def test_adapter_registers_the_model_for_three_clouds(openfoam_build):
+    symbols = subprocess.run(["nm", "-DC", str(openfoam_build["lib"])], capture_output=True, text=True,
+                             check=True).stdout
+    names = [line for line in symbols.splitlines() if "StochasticRebound<" in line and "::typeName" in line]
+    parcels = {p for p in ("KinematicParcel<Foam::particle> > > >::typeName", "CollidingParcel", "MPPICParcel")
+               if any(p in line for line in names)}
+    assert len(parcels) == 3, names
+    linked = subprocess.run(["ldd", str(openfoam_build["lib"])], capture_output=True, text=True).stdout
+    assert "librebound_scatter" in linked and "not found" not in linked, linked
+
+
+def test_adapter_sources_carry_the_gpl_notice():
+    sources = sorted((OPENFOAM_DIR / "stochasticRebound").glob("*.[CH]"))
+    assert sources
+    for f in sources:
+        assert "GNU General Public License" in f.read_text(), f
+    assert "GNU GENERAL PUBLIC LICENSE" in (OPENFOAM_DIR / "LICENSE").read_text()[:200]
+    assert "Version 3" in (OPENFOAM_DIR / "LICENSE").read_text()[:200]
+
+
+# ----------------------------------------------------------------------------- the case
+
+def _check_counts(case: Path, n_ranks: int) -> dict:
+    info = _cloud_info((case / f"log.{SOLVER}").read_text())
+    hits, headers = compare_rebounds.read_hits(case)
+    post = compare_rebounds.read_patch_post(case)
+    assert len(headers) == n_ranks
+    assert info["hits"] == info["rebounded"] + info["trapped"] + info["invalid"]
+    assert info["hits"] == len(hits["status"]), "the adapter's log and its hit records disagree"
+    assert info["hits"] == sum(len(r["time"]) for r in post.values()), \
+        "the adapter's hits and patchPostProcessing's wall hits disagree"
+    # 8000 sand parcels at 150 m/s: about 14 000 wall hits in 5 ms, some on every wall patch
+    assert 8000 < info["hits"] < 30000, info
+    assert set(post) == {"walls", "frontAndBack"} and min(len(r["time"]) for r in post.values()) > 1000
+    # every parcel moves into the wall when it hits it: nothing is left to the stock behaviour
+    assert info["invalid"] == 0
+    # colliding parcels: Ω⁺ set as angular momentum, so later hits see incoming spin, reported
+    assert 0.05 < info["spin_mean"] < info["spin_max"], info
+    return info
+
+
+def test_serial_run_hit_counts_and_rebounds_against_the_sampler(serial_case, tmp_path):
+    info = _check_counts(serial_case, 1)
+    res = compare_rebounds.compare(serial_case)
+    res["records"] = compare_rebounds.check_records(*[compare_rebounds.read_hits(serial_case)[0],
+                                                      compare_rebounds.read_patch_post(serial_case)])
+    print(compare_rebounds.report(res))
+    r = res["records"]
+    assert r["hits_per_patch_adapter"] == r["hits_per_patch_patchPostProcessing"]
+    assert r["parcels_mismatched"] == 0 and r["max_relative_difference_of_incident_velocity"] < 1e-5
+    s = res["solver_vs_sampler"]
+    assert s["ks_ok"], s
+    assert s["classifier_ok"], s
+    assert res["trapped_fraction"]["ok"], res["trapped_fraction"]
+    # far from the stock specular bounce
+    sp = res["solver_vs_specular"]
+    assert sp["ks"]["speed_ratio"] > 0.5 and sp["ks"]["beta2"] > 0.3, sp
+    assert res["incidence"]["fraction_outside_speed_range"] < 0.2
+    assert info["outside"] == pytest.approx(res["incidence"]["fraction_outside_speed_range"] * info["hits"],
+                                            abs=1)
+    png = tmp_path / "rebounds.png"
+    compare_rebounds.plot(res, png)
+    assert png.stat().st_size > 10_000
+
+
+def test_comparison_script_command_line(serial_case, tmp_path):
+    out = subprocess.run([sys.executable, str(OPENFOAM_DIR / "compare_rebounds.py"), str(serial_case),
+                          "--check", "--json", str(tmp_path / "c.json")], capture_output=True, text=True)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "threshold" in out.stdout and (tmp_path / "c.json").stat().st_size > 0
+
+
+def test_two_rank_run_hit_counts_and_rebounds(parallel_case, serial_case):
+    info = _check_counts(parallel_case, 2)
+    serial = _cloud_info((serial_case / f"log.{SOLVER}").read_text())
+    # the same case: the hit count moves only with the draws (about 1 %)
+    assert abs(info["hits"] - serial["hits"]) < 0.05 * serial["hits"], (info, serial)
+    hits, _ = compare_rebounds.read_hits(parallel_case)
+    assert min(np.sum(hits["rank"] == r) for r in (0, 1)) > 1000, "both ranks see wall hits"
+    res = compare_rebounds.compare(parallel_case)
+    print(compare_rebounds.report(res))
+    assert res["solver_vs_sampler"]["ks_ok"] and res["solver_vs_sampler"]["classifier_ok"], res
+    assert res["trapped_fraction"]["ok"]
+
+
+def test_each_rank_draws_its_own_stream(parallel_case, serial_case):
+    _, headers = compare_rebounds.read_hits(parallel_case)
+    assert [h["stream"] for h in headers] == [0, 1]
+    assert len({h["seed"] for h in headers}) == 1
+    hits, _ = compare_rebounds.read_hits(parallel_case)
+    u0 = {r: hits["u0"][hits["rank"] == r] for r in (0, 1)}
+    # the first uniform of every draw: a repeated stream would repeat them, rank against rank
+    assert len(np.intersect1d(u0[0], u0[1])) == 0
+    assert len(np.unique(hits["u0"])) == len(hits["u0"])
+    # rank 0 draws stream 0 of the seed, as a serial run does: the first draw is the same
+    serial, serial_headers = compare_rebounds.read_hits(serial_case)
+    assert serial_headers[0]["stream"] == 0
+    assert serial["u0"][0] == u0[0][0] and serial["u0"][0] != u0[1][0]
+
+
+def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(openfoam_build, case_table,
+                                                                     tmp_path_factory):
+    def moving_walls(case):
+        # the side and funnel walls slide along z (tangential to all of them) at 20 m/s
+        u = case / "0.orig" / "U"
+        text = u.read_text()
+        text = text.replace("    walls\n    {\n        type            noSlip;\n    }",
+                            "    walls\n    {\n        type            fixedValue;\n"
+                            "        value           uniform (0 0 20);\n    }")
+        assert "uniform (0 0 20)" in text
+        u.write_text(text)
+
+    case = _run_case(tmp_path_factory, "moving", case_table, edit=moving_walls)
+    hits, _ = compare_rebounds.read_hits(case)
+    on_walls = hits["patch"] == "walls"
+    assert on_walls.sum() > 1000
+    np.testing.assert_allclose(hits["Uw"][on_walls], np.tile([0.0, 0.0, 20.0], (on_walls.sum(), 1)), atol=1e-9)
+    np.testing.assert_allclose(hits["Uw"][~on_walls], 0.0, atol=1e-9)
+    # V⁻ is relative to the wall: patchPostProcessing's absolute U = V⁻ + Uw, per parcel and hit
+    r = compare_rebounds.check_records(hits, compare_rebounds.read_patch_post(case))
+    assert r["parcels_mismatched"] == 0 and r["max_relative_difference_of_incident_velocity"] < 1e-5, r
+    res = compare_rebounds.compare(case)
+    assert res["solver_vs_sampler"]["ks_ok"] and res["solver_vs_sampler"]["classifier_ok"], res
+
+
+def test_run_times_against_standard_wall_interaction(serial_case, parallel_case, case_table, tmp_path_factory,
+                                                     capsys):
+    standard = {np_: _run_case(tmp_path_factory, f"standard{np_}", case_table, np_=np_,
+                               model="standardWallInteraction") for np_ in (1, 2)}
+    standard_hits = {}
+    for np_, case in standard.items():
+        log = (case / f"log.{SOLVER}").read_text()
+        assert "Stochastic rebound" not in log and not (case / HITS).exists()
+        post = compare_rebounds.read_patch_post(case)
+        standard_hits[np_] = sum(len(r["time"]) for r in post.values())
+        assert standard_hits[np_] > 5000
+    t = {("stochasticRebound", 1): _timings(serial_case)[SOLVER],
+         ("stochasticRebound", 2): _timings(parallel_case)[SOLVER],
+         ("standardWallInteraction", 1): _timings(standard[1])[SOLVER],
+         ("standardWallInteraction", 2): _timings(standard[2])[SOLVER]}
+    hits = {1: _cloud_info((serial_case / f"log.{SOLVER}").read_text())["hits"],
+            2: _cloud_info((parallel_case / f"log.{SOLVER}").read_text())["hits"]}
+    with capsys.disabled():
+        print("\nhopperRebound solver wall time (s; one run each, on a machine others may share; the specular "
+              "bounce keeps the parcels fast, so they cross more cells and hit the walls more often):")
+        for np_ in (1, 2):
+            a, b = t[("stochasticRebound", np_)], t[("standardWallInteraction", np_)]
+            print(f"  {np_} rank(s): stochasticRebound {a:.2f} ({hits[np_]} wall hits), "
+                  f"standardWallInteraction {b:.2f} ({standard_hits[np_]} wall hits), ratio {a / b:.2f}")
+    assert all(v > 0 for v in t.values())
