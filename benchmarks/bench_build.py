@@ -29,8 +29,8 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from tablegen.build import build_table, compute_cell
-from tablegen.config import load_config, parse_config
+from tablegen import build_table, load_config, parse_config
+from tablegen.build.cells import compute_cell
 
 SUBSET_ALPHA1 = (2.0, 30.0, 60.0, 90.0)
 SUBSET_SPEED = (50.0, 175.0, 300.0)

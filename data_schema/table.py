@@ -7,7 +7,8 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
                            attrs: kappa, n_max, particles_per_cell,
-                           restitution_k, restitution_p (the wall's normal-restitution law)
+                           restitution_k, restitution_p (the wall's normal-restitution law),
+                           friction_q, wall_law (its friction exponent and name; since 3.1, optional)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
@@ -182,6 +183,8 @@ class ReboundTable:
     restitution_k: float                 # normal restitution exp(−k |V_c|^p) of the wall law, (m/s)^(−p)
     restitution_p: float
     model_sha256: str = ""               # hash of the direct model's source that computed the cells ("" before 3.1)
+    friction_q: float = float("nan")     # friction factor exp(q cos γ) of the wall law (NaN if not recorded)
+    wall_law: str = ""                   # name of the wall law ("" if not recorded)
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -218,6 +221,8 @@ class ReboundTable:
         grid.attrs["particles_per_cell"] = self.particles_per_cell
         grid.attrs["restitution_k"] = self.restitution_k
         grid.attrs["restitution_p"] = self.restitution_p
+        grid.attrs["friction_q"] = self.friction_q
+        grid.attrs["wall_law"] = self.wall_law
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -254,7 +259,9 @@ class ReboundTable:
                 master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
                 package_version=str(f.attrs["package_version"]),
                 model_sha256=str(f.attrs.get("model_sha256", "")),
-                restitution_k=float(grid.attrs["restitution_k"]), restitution_p=float(grid.attrs["restitution_p"]))
+                restitution_k=float(grid.attrs["restitution_k"]), restitution_p=float(grid.attrs["restitution_p"]),
+                friction_q=float(grid.attrs.get("friction_q", float("nan"))),
+                wall_law=str(grid.attrs.get("wall_law", "")))
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:

@@ -9,17 +9,22 @@ before any work and never replace what is not ours (:mod:`data_schema.output`).
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
 from data_schema.command_line import CommandParser, count_argument, run, seed_argument
 from data_schema.output import check_memory, check_output
 from data_schema.samples import SAMPLES_FILE_TYPE, write_samples
-from tablegen.config import PRESETS
-from tablegen.shapes import MIX, SHAPES
+from tablegen.build.config import PRESETS
+from tablegen.model.shapes import DEFAULT_KAPPA, MIX, SHAPES
+from tablegen.model.simulate import DEFAULT_N_MAX
+from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from tablegen.study.report import DEFAULT_N as REPORT_DEFAULT_N
 
 # memory per simulated particle: its arrays, their merge and the file made in memory
 BYTES_PER_PARTICLE = 400
+CUSTOM_WALL = "custom"      # the name of a wall law given by --wall-k/-p/-q other than the default
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -37,8 +42,18 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="random seed in [0, 2**63) (default: fresh, printed)")
     sim.add_argument("--omega", type=float, nargs=3, default=(0.0, 0.0, 0.0), metavar=("WX", "WY", "WZ"),
                      help="incident angular velocity Omega- a/|V-|, lab frame (default 0 0 0)")
-    sim.add_argument("--kappa", type=float, default=0.3, help="cut_prism corner truncation, [0, 1) (default 0.3)")
-    sim.add_argument("--n-max", type=int, default=1000, help="collisions before a particle is trapped (default 1000)")
+    sim.add_argument("--kappa", type=float, default=DEFAULT_KAPPA,
+                     help="cut_prism corner truncation, [0, 1) (default %(default)s)")
+    sim.add_argument("--n-max", type=int, default=DEFAULT_N_MAX,
+                     help="collisions before a particle is trapped (default %(default)s)")
+    law = CORUNDUM_ON_STEEL
+    sim.add_argument("--wall-k", type=float, default=law.k, metavar="K",
+                     help="wall law: restitution rate constant k, (m/s)^-p, > 0 (default %(default)s)")
+    sim.add_argument("--wall-p", type=float, default=law.p, metavar="P",
+                     help="wall law: restitution speed exponent p, > 0 (default %(default)s)")
+    sim.add_argument("--wall-q", type=float, default=law.q, metavar="Q",
+                     help=f"wall law: friction factor exp(q cos gamma), finite (default %(default)s; the three "
+                          f"defaults are the law {law.name}; another is recorded as '{CUSTOM_WALL}')")
     sim.add_argument("--out", metavar="FILE.h5", help="write the per-particle samples (HDF5, docs/format.md)")
     sim.add_argument("--overwrite", action="store_true",
                      help="replace an existing --out file if it is a samples file (nothing else is replaced)")
@@ -77,7 +92,7 @@ def _build_parser() -> argparse.ArgumentParser:
     report.add_argument("-o", "--out", required=True, metavar="FOLDER", help="output folder (must not exist)")
     report.add_argument("--shapes", nargs="+", choices=SHAPES + (MIX,), default=list(SHAPES + (MIX,)),
                         help="shapes to report, and 'mix' for the equal-weight mix (default: all)")
-    report.add_argument("-n", type=count_argument, default=20_000, metavar="N",
+    report.add_argument("-n", type=count_argument, default=REPORT_DEFAULT_N, metavar="N",
                         help="particles (--direct) or draws (--table) per shape and alpha1, >= 1 "
                              "(default %(default)s)")
     report.add_argument("--seed", type=seed_argument, default=None,
@@ -93,7 +108,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
 def _alpha1_list(text: str) -> tuple:
     """Comma-separated angles in (0, 90] degrees, as a tuple (argparse type)."""
-    from tablegen.simulate import check_alpha1
+    from tablegen.model.simulate import check_alpha1
 
     try:
         return tuple(check_alpha1(v) for v in text.split(","))
@@ -106,23 +121,36 @@ def _progress(args) -> bool:
 
 
 def _simulate(args) -> int:
-    from tablegen.simulate import simulate
-    from tablegen.summary import format_summary, summarize
+    from tablegen.model.simulate import simulate
+    from tablegen.study.statistics import format_summary, summarize
 
     if args.out is not None:
         check_output(args.out, SAMPLES_FILE_TYPE, args.overwrite)
     check_memory(args.n, BYTES_PER_PARTICLE, "-n")
     samples = simulate(args.shape, args.alpha1, args.speed, args.n, seed=args.seed, omega_in=args.omega,
-                       kappa=args.kappa, n_max=args.n_max, progress=_progress(args))
+                       kappa=args.kappa, n_max=args.n_max, wall=_wall(args), progress=_progress(args))
     print(format_summary(samples, summarize(samples)))
     if args.out is not None:
         print(f"samples written to {write_samples(args.out, samples, overwrite=args.overwrite)}")
     return 0
 
 
+def _wall(args) -> WallMaterial:
+    """The wall law of --wall-k/-p/-q: the default law, or a custom one; ValueError naming the flag."""
+    values = {"k": args.wall_k, "p": args.wall_p, "q": args.wall_q}
+    law = CORUNDUM_ON_STEEL
+    if values == {"k": law.k, "p": law.p, "q": law.q}:
+        return law
+    for key, value in values.items():
+        positive = key != "q"
+        if not (math.isfinite(value) and (value > 0 or not positive)):
+            raise ValueError(f"--wall-{key} must be finite{' and > 0' if positive else ''}; got {value!r}")
+    return WallMaterial(**values, name=CUSTOM_WALL)
+
+
 def _build(args) -> int:
-    from tablegen.build import BuildError, build_table
-    from tablegen.config import load_config
+    from tablegen.build.driver import BuildError, build_table
+    from tablegen.build.config import load_config
 
     config = load_config(args.config, args.preset)
     if args.print_config:
@@ -154,16 +182,16 @@ def _build_interrupted(args) -> str | None:
 
 def _info(args) -> int:
     from data_schema.table import read_table
-    from tablegen.info import describe_table
+    from tablegen.build.info import describe_table
 
     print(describe_table(read_table(args.table), Path(args.table)))
     return 0
 
 
 def _report(args) -> int:
-    from tablegen.report import DEFAULT_ALPHA1, REPORT_KIND, direct_data, table_data, write_report
-    from tablegen.report_plots import require_matplotlib
-    from tablegen.simulate import check_seed
+    from tablegen.model.simulate import check_seed
+    from tablegen.study.figures import require_matplotlib
+    from tablegen.study.report import DEFAULT_ALPHA1, REPORT_KIND, direct_data, table_data, write_report
 
     seed = check_seed(args.seed)
     check_output(args.out, REPORT_KIND, args.overwrite, folder=True)

@@ -2,8 +2,7 @@
 
 import pytest
 
-from tablegen.build import build_table
-from tablegen.config import parse_config
+from tablegen import build_table, parse_config
 
 
 def _table_config(alpha1_deg, speed_m_s, seed):

@@ -4,7 +4,7 @@ Every import of the project's packages by integrations/openfoam and
 tests/openfoam goes through this module, so a refactoring of the packages
 re-points these few lines only. Public API only: ``surrogate.load``,
 ``surrogate.sample_global``, ``surrogate.STATUS_*`` and, to build a table,
-``tablegen.build.build_table(tablegen.config.parse_config(text), path)``.
+``tablegen.build_table(tablegen.parse_config(text), path)``.
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 (see LICENSE in this folder).
@@ -18,12 +18,5 @@ __all__ = ["STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "build_table_
 
 def build_table_from_text(config_text: str, path, **kwargs):
     """Build the table a TOML configuration describes into ``path`` (tablegen's build)."""
-    try:
-        from tablegen.build import build_table
-    except ImportError:                      # tablegen.build as a package without the re-export
-        from tablegen.build.driver import build_table
-    try:
-        from tablegen.config import parse_config
-    except ImportError:                      # the configuration moved into tablegen.build
-        from tablegen.build.config import parse_config
+    from tablegen import build_table, parse_config
     return build_table(parse_config(config_text), path, **kwargs)

@@ -1,0 +1,51 @@
+"""One cell of a table: its seed, its direct-model run and its stored representation.
+
+Each cell is an independent task whose seed derives from (master seed, shape,
+α1 index, speed index) (:func:`cell_seed`), so a table is bit-identical
+whatever the number of workers, the scheduler or the order in which cells
+finish. This module and :mod:`tablegen.build.tabulate` decide a cell's content
+with the direct model (:data:`tablegen.build.driver.MODEL_SOURCES`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from data_schema.table import CellTable
+from tablegen.build.config import BuildConfig
+from tablegen.build.tabulate import CellAccumulator
+from tablegen.model.shapes import SHAPES
+from tablegen.model.simulate import simulate
+
+CHUNK_PARTICLES = 1_000_000      # particles simulated at a time within one cell: bounds a worker's memory
+REPRESENTATION_KEY = 2 ** 31     # spawn key of the k-means seed (chunks use keys 0, 1, ...)
+
+
+def derive_seed(seed: int, *key: int) -> int:
+    """A 63-bit seed derived from ``seed`` and a spawn key (independent streams per key)."""
+    hi, lo = np.random.SeedSequence(seed, spawn_key=key).generate_state(2, np.uint32)
+    return (int(hi) << 31) ^ int(lo)
+
+
+def cell_seed(master_seed: int, shape: str, i_alpha: int, i_speed: int) -> int:
+    """The seed of one cell, derived from the master seed, the shape and the grid indices."""
+    return derive_seed(master_seed, SHAPES.index(shape), i_alpha, i_speed)
+
+
+def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> str:
+    """The cell's name in messages: shape, α1 and speed."""
+    return (f"cell (shape={shape}, alpha1={config.alpha1_deg[i_alpha]:g} deg, "
+            f"speed={config.speed_m_s[i_speed]:g} m/s)")
+
+
+def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> CellTable:
+    """Simulate one cell and build its stored representation (runs in a worker)."""
+    seed = cell_seed(config.seed, shape, i_alpha, i_speed)
+    acc = CellAccumulator()
+    for chunk, start in enumerate(range(0, config.particles_per_cell, CHUNK_PARTICLES)):
+        n = min(CHUNK_PARTICLES, config.particles_per_cell - start)
+        acc.add(simulate(shape, config.alpha1_deg[i_alpha], config.speed_m_s[i_speed], n,
+                         seed=derive_seed(seed, chunk), kappa=config.kappa,
+                         aspect=config.aspect, wall=config.wall, n_max=config.n_max))
+    return acc.finish(config.resolution, derive_seed(seed, REPRESENTATION_KEY),
+                      cell_label(config, shape, i_alpha, i_speed))

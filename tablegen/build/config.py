@@ -1,0 +1,276 @@
+"""Table-build configuration: TOML files and the embedded presets.
+
+A configuration has four sections (every key optional; defaults are those of
+the ``default`` preset, and the published corundum-on-steel wall law)::
+
+    [grid]
+    alpha1_deg = [1, 2, 3, ...] or {start = 5, stop = 90, step = 5}    # degrees, in (0, 90]
+    speed_m_s  = [50, 100, ...]  or {start = 50, stop = 300, step = 50}  # m/s, > 0
+    shapes     = ["ellipsoid", "prism", "cut_prism", "tetrahedron"]
+
+    [simulation]
+    particles_per_cell = 20000        # direct-model particles per (shape, α1, |V⁻|) cell
+    seed = 20261121                   # master seed; each cell's seed derives from it
+    kappa = 0.3                       # cut-prism corner truncation
+    n_max = 1000                      # collisions before a particle counts as trapped
+    aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}   # b/a and c/b
+
+    [table]
+    resolution = "auto"               # or {clusters = .., dictionary_size = .., levels = ..}
+
+    [wall]                            # the wall law of docs/model.md §4
+    k = 0.1                           # restitution rate constant, (m/s)^-p, > 0
+    p = 0.61                          # restitution speed exponent, > 0
+    q = 1.0                           # friction factor exp(q cos gamma), finite
+    name = "corundum_on_St3_Lashkov1991"
+
+Unknown keys and invalid values raise :class:`ConfigError` naming the key.
+Presets: ``default`` (the README's main job, a few minutes on 2 cores),
+``production`` (the table users should run with) and ``paper`` (the study of
+Panfilov & Tsirkunov 2022 at 10⁸ particles per cell; for a cluster).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import tomllib
+from importlib import resources
+
+from data_schema.table import TableResolution
+from tablegen.build.resolution import MIN_PARTICLES_PER_CELL, resolution_for
+from tablegen.model.shapes import SHAPES, AspectRatioLaw, check_kappa
+from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+
+PRESETS = ("default", "production", "paper")
+MAX_GRID_POINTS = 1000      # per axis: far beyond any useful table, small enough to check before allocating
+MAX_SEED = 2 ** 63          # seeds are 63-bit (numpy SeedSequence entropy, HDF5 uint64 attribute)
+GRID_ROUNDING = 1e-9        # a {start, stop, step} grid keeps a stop that round-off puts just past it
+
+
+class ConfigError(ValueError):
+    """An invalid build configuration; the message names the offending key."""
+
+
+@dataclasses.dataclass(frozen=True)
+class BuildConfig:
+    """A fully resolved build configuration (every value explicit)."""
+
+    alpha1_deg: tuple
+    speed_m_s: tuple
+    shapes: tuple
+    particles_per_cell: int
+    seed: int
+    kappa: float
+    n_max: int
+    aspect: AspectRatioLaw
+    resolution: TableResolution
+    wall: WallMaterial = CORUNDUM_ON_STEEL
+
+    @property
+    def n_cells(self) -> int:
+        return len(self.shapes) * len(self.alpha1_deg) * len(self.speed_m_s)
+
+    def to_toml(self) -> str:
+        """The resolved configuration as TOML text (reads back to an equal config)."""
+        def fmt(values):
+            return "[" + ", ".join(repr(float(v)) for v in values) + "]"
+        res = ", ".join(f"{f.name} = {getattr(self.resolution, f.name)}"
+                        for f in dataclasses.fields(self.resolution))
+        a = self.aspect
+        w = self.wall
+        return "\n".join([
+            "[grid]",
+            f"alpha1_deg = {fmt(self.alpha1_deg)}",
+            f"speed_m_s = {fmt(self.speed_m_s)}",
+            "shapes = [" + ", ".join(f'"{s}"' for s in self.shapes) + "]",
+            "",
+            "[simulation]",
+            f"particles_per_cell = {self.particles_per_cell}",
+            f"seed = {self.seed}",
+            f"kappa = {self.kappa!r}",
+            f"n_max = {self.n_max}",
+            f"aspect_ratio = {{mean = {a.mean!r}, sd = {a.sd!r}, low = {a.low!r}, high = {a.high!r}}}",
+            "",
+            "[table]",
+            f"resolution = {{{res}}}",
+            "",
+            "[wall]",
+            f"k = {w.k!r}",
+            f"p = {w.p!r}",
+            f"q = {w.q!r}",
+            f"name = {json.dumps(w.name)}",
+            "",
+        ])
+
+    def sha256(self) -> str:
+        """Hash of :meth:`to_toml`: identifies the configuration in files and checkpoints."""
+        return hashlib.sha256(self.to_toml().encode()).hexdigest()
+
+
+CONFIG_KEYS = {
+    "grid": {"alpha1_deg", "speed_m_s", "shapes"},
+    "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
+    "table": {"resolution"},
+    "wall": {"k", "p", "q", "name"},
+}
+
+
+def preset_text(name: str) -> str:
+    """The TOML text of an embedded preset."""
+    if name not in PRESETS:
+        raise ConfigError(f"unknown preset {name!r}; presets: {', '.join(PRESETS)}")
+    return resources.files("tablegen.build.presets").joinpath(f"{name}.toml").read_text()
+
+
+def load_config(path=None, preset: str = "default") -> BuildConfig:
+    """Read a configuration file (or the named preset when ``path`` is None)."""
+    if path is None:
+        return parse_config(preset_text(preset), f"preset '{preset}'")
+    try:
+        with open(path, "rb") as f:
+            text = f.read().decode("utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read the configuration: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: the configuration is not UTF-8 text (byte {exc.start}); TOML files are "
+                          f"UTF-8") from None
+    return parse_config(text, str(path))
+
+
+def parse_config(text: str, source: str = "<config>") -> BuildConfig:
+    """Parse and validate TOML text; defaults come from the ``default`` preset."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: not valid TOML: {exc}") from exc
+    _check_keys(data, source)
+    base = {} if source == "preset 'default'" else tomllib.loads(preset_text("default"))
+    merged = {section: {**base.get(section, {}), **data.get(section, {})} for section in CONFIG_KEYS}
+    grid, sim, table, wall = merged["grid"], merged["simulation"], merged["table"], merged["wall"]
+
+    alpha1 = _grid_values(grid.get("alpha1_deg"), "grid.alpha1_deg", source)
+    bad = [a for a in alpha1 if not 0.0 < a <= 90.0]
+    if bad:
+        raise ConfigError(f"{source}: 'grid.alpha1_deg' values must be in (0, 90] degrees; got {bad[0]!r}")
+    speeds = _grid_values(grid.get("speed_m_s"), "grid.speed_m_s", source)
+    bad = [v for v in speeds if not (math.isfinite(v) and v > 0.0)]
+    if bad:
+        raise ConfigError(f"{source}: 'grid.speed_m_s' values must be finite and > 0 m/s; got {bad[0]!r}")
+    shapes = grid.get("shapes")
+    if not isinstance(shapes, list) or not shapes:
+        raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(SHAPES)}; got {shapes!r}")
+    for s in shapes:
+        if s not in SHAPES:
+            raise ConfigError(f"{source}: 'grid.shapes' entries must be one of {', '.join(SHAPES)}; got {s!r}")
+    if len(set(shapes)) != len(shapes):
+        raise ConfigError(f"{source}: 'grid.shapes' has duplicates: {shapes!r}")
+
+    n = _integer(sim.get("particles_per_cell"), "simulation.particles_per_cell", MIN_PARTICLES_PER_CELL, source)
+    seed = _integer(sim.get("seed"), "simulation.seed", 0, source)
+    if seed >= MAX_SEED:
+        raise ConfigError(f"{source}: 'simulation.seed' must be < 2**63; got {seed!r}")
+    n_max = _integer(sim.get("n_max"), "simulation.n_max", 1, source)
+    try:
+        kappa = check_kappa(sim.get("kappa"))
+    except (TypeError, ValueError):
+        raise ConfigError(f"{source}: 'simulation.kappa' must be in [0, 1); got {sim.get('kappa')!r}") from None
+    aspect_raw = sim.get("aspect_ratio")
+    if not isinstance(aspect_raw, dict) or set(aspect_raw) - {"mean", "sd", "low", "high"}:
+        raise ConfigError(f"{source}: 'simulation.aspect_ratio' must be a table with keys mean, sd, low, "
+                          f"high; got {aspect_raw!r}")
+    try:
+        aspect = AspectRatioLaw(**{k: float(v) for k, v in aspect_raw.items()})
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{source}: 'simulation.aspect_ratio': {exc}") from None
+
+    res_raw = table.get("resolution")
+    if res_raw == "auto":
+        resolution = resolution_for(n)
+    elif isinstance(res_raw, dict):
+        allowed = {f.name for f in dataclasses.fields(TableResolution)}
+        unknown = set(res_raw) - allowed
+        if unknown:
+            raise ConfigError(f"{source}: unknown key 'table.resolution.{sorted(unknown)[0]}'; "
+                              f"allowed: {', '.join(sorted(allowed))}")
+        try:
+            resolution = TableResolution(**res_raw)
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(f"{source}: 'table.resolution': {exc}") from None
+    else:
+        raise ConfigError(f"{source}: 'table.resolution' must be \"auto\" or a table of sizes; got {res_raw!r}")
+
+    return BuildConfig(alpha1_deg=tuple(alpha1), speed_m_s=tuple(speeds), shapes=tuple(shapes),
+                       particles_per_cell=n, seed=seed, kappa=kappa, n_max=n_max, aspect=aspect,
+                       resolution=resolution, wall=_wall(wall, source))
+
+
+def _wall(raw: dict, source: str) -> WallMaterial:
+    """The wall law of the ``[wall]`` section; missing keys take the corundum-on-steel law's values."""
+    def number(key, positive):
+        value = raw.get(key, getattr(CORUNDUM_ON_STEEL, key))
+        ok = (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+              and (value > 0 or not positive))
+        if not ok:
+            allowed = "a finite number > 0" if positive else "a finite number"
+            raise ConfigError(f"{source}: 'wall.{key}' must be {allowed}; got {value!r}")
+        return float(value)
+
+    name = raw.get("name", CORUNDUM_ON_STEEL.name)
+    if not isinstance(name, str) or not name.strip():
+        raise ConfigError(f"{source}: 'wall.name' must be a non-empty string; got {name!r}")
+    return WallMaterial(k=number("k", True), p=number("p", True), q=number("q", False), name=name)
+
+
+def _check_keys(data: dict, source: str) -> None:
+    for section, value in data.items():
+        if section not in CONFIG_KEYS:
+            raise ConfigError(f"{source}: unknown section '[{section}]'; sections: {', '.join(CONFIG_KEYS)}")
+        if not isinstance(value, dict):
+            raise ConfigError(f"{source}: '{section}' must be a table ([{section}])")
+        for key in value:
+            if key not in CONFIG_KEYS[section]:
+                raise ConfigError(f"{source}: unknown key '{section}.{key}'; allowed in [{section}]: "
+                                  f"{', '.join(sorted(CONFIG_KEYS[section]))}")
+
+
+def _integer(value, key, minimum, source) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ConfigError(f"{source}: '{key}' must be an integer >= {minimum}; got {value!r}")
+    return value
+
+
+def _grid_values(spec, key, source) -> list:
+    """A grid from a list of numbers or {start, stop, step} (stop included)."""
+    if isinstance(spec, dict):
+        if set(spec) != {"start", "stop", "step"}:
+            raise ConfigError(f"{source}: '{key}' as a table needs exactly start, stop, step; got {spec!r}")
+        try:
+            start, stop, step = (float(spec[k]) for k in ("start", "stop", "step"))
+        except (TypeError, ValueError):
+            raise ConfigError(f"{source}: '{key}' start, stop, step must be numbers; got {spec!r}") from None
+        if not (all(map(math.isfinite, (start, stop, step))) and step > 0 and stop >= start):
+            raise ConfigError(f"{source}: '{key}' needs finite numbers with step > 0 and stop >= start; "
+                              f"got {spec!r}")
+        span = (stop - start) / step
+        if not span < MAX_GRID_POINTS:
+            raise ConfigError(f"{source}: '{key}' = {spec!r} gives {span + 1:.3g} grid points; allowed: at most "
+                              f"{MAX_GRID_POINTS} (a larger step)")
+        count = math.floor(span + GRID_ROUNDING) + 1
+        values = [start + k * step for k in range(count)]
+    elif isinstance(spec, list):
+        values = spec
+    else:
+        raise ConfigError(f"{source}: '{key}' must be a list of numbers or {{start, stop, step}}; got {spec!r}")
+    if not values:
+        raise ConfigError(f"{source}: '{key}' is empty; give at least one value")
+    if len(values) > MAX_GRID_POINTS:
+        raise ConfigError(f"{source}: '{key}' has {len(values)} values; allowed: at most {MAX_GRID_POINTS}")
+    if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
+        raise ConfigError(f"{source}: '{key}' values must be numbers; got {values!r}")
+    values = [float(v) for v in values]
+    if any(b <= a for a, b in zip(values, values[1:])):
+        raise ConfigError(f"{source}: '{key}' values must be strictly increasing; got {values!r}")
+    return values

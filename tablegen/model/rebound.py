@@ -1,0 +1,207 @@
+"""A whole rebound: alternate free flights and collisions (docs/model.md §5).
+
+Units inside the kernels: lengths in units of the particle's half-size a
+(a = 1, b = b/a, c = (c/b)(b/a)), velocities in m/s, angular velocities in
+(m/s)/a — so Ω a/|V⁻| = Ω / |V⁻| — and times in a/(m/s). Frames: lab (wall
+y = 0, normal +Y) unless stated.
+
+Sequence for one particle:
+
+1. With Ω⁻ = 0 the body starts touching the wall (its lowest point at y = 0)
+   and the first collision is at t = 0; otherwise its centre starts at the
+   bounding radius and the flight in to the first contact is simulated.
+2. Search the flight for the next contact (:func:`tablegen.model.flight.find_contact`).
+   None: the particle has rebounded. A contact: apply one collision
+   (:func:`tablegen.model.collision.collide`) and start a new flight there.
+3. A particle that needs a collision beyond ``n_max`` is ``trapped``; a
+   search that exhausts its step budget or a collision that fails is ``failed``.
+
+All random inputs (orientation, aspect ratios, hand, shape) are drawn by the
+caller and passed in, so each particle's result depends on its own inputs only:
+the batch is bit-identical whatever the number of threads.
+"""
+
+import numba
+import numpy as np
+
+from data_schema.samples import (
+    FAILURE_COLLISION_SOLVER, FAILURE_NONE, FAILURE_NOT_APPROACHING, FAILURE_SEARCH_BUDGET,
+    STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED,
+)
+from tablegen.model.options import JIT
+from tablegen.model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
+from tablegen.model.flight import SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, lowest_points
+from tablegen.model.rotation import ROT_PARAMS_SIZE, rotation_init
+from tablegen.model.shapes import MAX_VERTICES, body_vertices, bounding_radius
+
+HISTORY_COLUMNS = 17
+
+# layout of the scratch array of :func:`rebound`
+_VERTS = 0
+_HEIGHTS = _VERTS + 3 * MAX_VERTICES
+_OFFSETS = _HEIGHTS + MAX_VERTICES
+_PARAMS = _OFFSETS + 3 * MAX_VERTICES
+_R = _PARAMS + ROT_PARAMS_SIZE
+_K_LAB = _R + 9
+_KINV_LAB = _K_LAB + 9
+_K = _KINV_LAB + 9                 # then seven 3-vectors: K, 1/K, ℓ, r_c, ΔV, ΔΩ, Ω(t)
+WORK_SIZE = _K + 21
+_BLOCKS = 1024                     # parallel work units of rebound_batch (scratch allocated per block)
+
+
+@numba.njit(**JIT)
+def quaternion_to_matrix(q, R):
+    """Rotation matrix of the quaternion q = (w, x, y, z) (normalised here) into R."""
+    n = np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
+    w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    R[0, 0], R[0, 1], R[0, 2] = 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)
+    R[1, 0], R[1, 1], R[1, 2] = 2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)
+    R[2, 0], R[2, 1], R[2, 2] = 2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)
+
+
+@numba.njit(**JIT)
+def lab_tensor(R, diag, out):
+    """out = R diag(diag) Rᵀ: a body-frame principal tensor in the lab frame."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = R[i, 0] * diag[0] * R[j, 0] + R[i, 1] * diag[1] * R[j, 1] + R[i, 2] * diag[2] * R[j, 2]
+
+
+@numba.njit(**JIT)
+def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol, set_tol,
+            max_steps, V, W, history, work):
+    """Simulate one particle's rebound.
+
+    Parameters
+    ----------
+    shape : int shape code; semi : (3,) half-extents (a, b, c) in units of a.
+    kappa : cut-prism truncation; hand : ±1 tetrahedron hand.
+    kfac : second-moment factor s of the shape (J/m = s·(b²+c², a²+c², a²+b²)).
+    R0 : (3, 3) body→lab orientation at the start.
+    V0 : (3,) incident velocity, m/s; W0 : (3,) incident angular velocity, (m/s)/a.
+    wall : (3,) wall-law coefficients.
+    n_max : collisions allowed before the particle is trapped.
+    contact_tol, set_tol : contact and contact-set tolerances, units of a.
+    max_steps : search-step budget per flight.
+    V, W : (3,) outputs, velocity and angular velocity just after the last collision.
+    history : (H, HISTORY_COLUMNS) output; row k receives the state at the start
+        of flight k (k < H): time (a/(m/s)), centre height y (a), V (3), Ω (3),
+        R (9, row-major). Pass an array with H = 0 to record nothing.
+    work : (WORK_SIZE,) float64 scratch space (no allocation per particle).
+
+    Returns
+    -------
+    (status, failure_reason, n_collisions, n_search_steps, n_multiple_root_events, e_rot)
+    with e_rot = ½ Ω·KΩ, the rotational energy per unit mass after the rebound, and
+    failure_reason one of the FAILURE_* codes of :mod:`data_schema.samples`.
+    """
+    verts = work[_VERTS:_VERTS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
+    h = work[_HEIGHTS:_HEIGHTS + MAX_VERTICES]
+    r_all = work[_OFFSETS:_OFFSETS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
+    params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
+    R = work[_R:_R + 9].reshape((3, 3))
+    K_lab = work[_K_LAB:_K_LAB + 9].reshape((3, 3))
+    Kinv_lab = work[_KINV_LAB:_KINV_LAB + 9].reshape((3, 3))
+    K = work[_K:_K + 3]
+    Kinv = work[_K + 3:_K + 6]
+    ell = work[_K + 6:_K + 9]
+    rc = work[_K + 9:_K + 12]
+    dV = work[_K + 12:_K + 15]
+    dW = work[_K + 15:_K + 18]
+    Wt = work[_K + 18:_K + 21]          # angular velocity during the search
+
+    nv = body_vertices(shape, semi[0], semi[1], semi[2], kappa, hand, verts)
+    Rb = bounding_radius(shape, semi[0], semi[1], semi[2], verts, nv)
+    a2, b2, c2 = semi[0] ** 2, semi[1] ** 2, semi[2] ** 2
+    K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
+    Kinv[:] = 1.0 / K
+    R[:] = R0
+    V[:] = V0
+    W[:] = W0
+
+    if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
+        n = lowest_points(shape, verts, nv, semi, R, 0.0, h, r_all)
+        y = -h[:n].min()
+    else:
+        y = Rb
+    n_coll = 0
+    n_steps = 0
+    n_multi = 0
+    status = STATUS_FAILED
+    failure = FAILURE_NONE
+    e_rot = 0.0
+    t_abs = 0.0
+    n_flights = 0
+    while True:
+        if n_flights < history.shape[0]:
+            row = history[n_flights]
+            row[0], row[1] = t_abs, y
+            row[2:5] = V
+            row[5:8] = W
+            row[8:17] = R.ravel()
+        n_flights += 1
+        lab_tensor(R, K, K_lab)
+        for i in range(3):
+            ell[i] = K_lab[i, 0] * W[0] + K_lab[i, 1] * W[1] + K_lab[i, 2] * W[2]
+        e_rot = 0.5 * (W[0] * ell[0] + W[1] * ell[1] + W[2] * ell[2])
+        rotation_init(K, R, ell, params)
+        M = curvature_bound(shape, semi, Rb, K, ell, W)
+        Wt[:] = W
+        code, t, steps = find_contact(shape, verts, nv, semi, Rb, M, params, y, V[1],
+                                      contact_tol, set_tol, max_steps, 0.0, R, Wt, h, r_all, rc)
+        n_steps += steps
+        if code == SEARCH_ESCAPED:
+            status = STATUS_REBOUNDED
+            break
+        if code == SEARCH_STALLED:
+            failure = FAILURE_SEARCH_BUDGET
+            break
+        if n_coll == n_max:
+            status = STATUS_TRAPPED
+            break
+        y += V[1] * t
+        t_abs += t
+        W[:] = Wt
+        lab_tensor(R, Kinv, Kinv_lab)
+        outcome = collide(V, W, rc, Kinv_lab, wall, dV, dW)
+        if outcome != COLLISION_OK and outcome != COLLISION_MULTIPLE_ROOTS:
+            failure = FAILURE_COLLISION_SOLVER if outcome == COLLISION_FAILED else FAILURE_NOT_APPROACHING
+            break
+        n_multi += outcome == COLLISION_MULTIPLE_ROOTS
+        V += dV
+        W += dW
+        n_coll += 1
+    return status, failure, n_coll, n_steps, n_multi, e_rot
+
+
+@numba.njit(parallel=True, **JIT)
+def rebound_batch(shapes, ratios, hands, quats, V0, W0, kfacs, kappa, wall, n_max,
+                  contact_tol, set_tol, max_steps,
+                  out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi):
+    """Run :func:`rebound` for every particle i (parallel over blocks of particles).
+
+    Inputs per particle: ``shapes[i]`` code, ``ratios[i] = (b/a, c/b)``,
+    ``hands[i]`` = ±1, ``quats[i]`` orientation quaternion (any norm > 0).
+    Common: V0, W0 (lab; m/s and (m/s)/a), ``kfacs[code]`` second-moment
+    factors, kappa, wall and the tolerances. Outputs are filled per particle;
+    each particle's result depends on its inputs only, not on the blocking.
+    """
+    n = shapes.shape[0]
+    n_blocks = min(n, _BLOCKS)
+    for block in numba.prange(n_blocks):
+        no_history = np.empty((0, HISTORY_COLUMNS))
+        work = np.empty(WORK_SIZE)
+        semi = np.empty(3)
+        R0 = np.empty((3, 3))
+        for i in range(block * n // n_blocks, (block + 1) * n // n_blocks):
+            semi[0], semi[1], semi[2] = 1.0, ratios[i, 0], ratios[i, 0] * ratios[i, 1]
+            quaternion_to_matrix(quats[i], R0)
+            status, failure, ncoll, steps, multi, erot = rebound(
+                shapes[i], semi, kappa, float(hands[i]), kfacs[shapes[i]], R0, V0, W0, wall,
+                n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
+            out_status[i] = status
+            out_failure[i] = failure
+            out_ncoll[i] = ncoll
+            out_steps[i] = steps
+            out_multi[i] = multi
+            out_erot[i] = erot

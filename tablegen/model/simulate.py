@@ -1,0 +1,201 @@
+"""Batch API of the direct model: n particles at one incident state (docs/model.md §5–6).
+
+Reproducibility: random inputs are drawn in NumPy, chunk by chunk, chunk k
+from ``SeedSequence(seed, spawn_key=(k,))`` with a fixed chunk size, and the
+kernel is deterministic per particle. The result for a seed is therefore
+bit-identical whatever the number of threads, and the first m particles of a
+run of n > m equal a run of m.
+"""
+
+from __future__ import annotations
+
+import math
+import secrets
+import warnings
+
+import numpy as np
+
+from data_schema.common import package_version
+from data_schema.samples import SampleSet
+from tablegen.model.rebound import rebound_batch
+from tablegen.model.shapes import (
+    DEFAULT_KAPPA, MIX, SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
+)
+from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+
+CHUNK_SIZE = 16384                  # particles drawn at a time: fixed, so a seed gives the same bits for any n
+VALID_SPEED_RANGE = (50.0, 300.0)   # m/s, range of the default restitution correlation
+DEFAULT_N_MAX = 1000                # collisions before a particle counts as trapped
+DEFAULT_CONTACT_TOL = 1e-10         # contact distance, units of a
+DEFAULT_SET_TOL = 1e-9              # points this close to the lowest share a contact, units of a
+DEFAULT_MAX_STEPS = 100_000         # contact-search steps per flight before a particle fails
+
+
+def check_alpha1(alpha1) -> float:
+    """Incidence angle in degrees from the wall, in (0, 90]."""
+    try:
+        value = float(alpha1)
+    except (TypeError, ValueError):
+        raise ValueError(f"The 'alpha1' parameter must be a number in (0, 90] degrees; got {alpha1!r}.") from None
+    if not (0.0 < value <= 90.0):
+        raise ValueError(f"The 'alpha1' parameter must be in (0, 90] degrees; got {value!r}.")
+    return value
+
+
+def check_speed(speed) -> float:
+    """Incident speed in m/s: finite and > 0."""
+    try:
+        value = float(speed)
+    except (TypeError, ValueError):
+        raise ValueError(f"The 'speed' parameter must be a finite number > 0 m/s; got {speed!r}.") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"The 'speed' parameter must be finite and > 0 m/s; got {value!r}.")
+    return value
+
+
+def _check_count(name, value, minimum) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        shown = int(value) if isinstance(value, np.integer) else value
+        raise ValueError(f"The '{name}' parameter must be an integer >= {minimum}; got {shown!r}.")
+    return int(value)
+
+
+def _check_positive(name, value) -> float:
+    value_f = float(value)
+    if not (math.isfinite(value_f) and value_f > 0.0):
+        raise ValueError(f"The '{name}' parameter must be finite and > 0; got {value_f!r}.")
+    return value_f
+
+
+def check_seed(seed) -> int:
+    """A non-negative integer seed; None draws a fresh one (recorded with the result)."""
+    if seed is None:
+        return secrets.randbits(63)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2 ** 63:
+        raise ValueError(f"The 'seed' parameter must be an integer in [0, 2**63) or None; got {seed!r}.")
+    return int(seed)
+
+
+def incident_velocity(alpha1: float, speed: float) -> np.ndarray:
+    """V⁻ = |V⁻| (cos α1, −sin α1, 0) in m/s, α1 in degrees (lab frame)."""
+    a = math.radians(alpha1)
+    return np.array([speed * math.cos(a), -speed * math.sin(a), 0.0])
+
+
+def draw_inputs(rng: np.random.Generator, m: int, shape: str, aspect: AspectRatioLaw):
+    """Random inputs of m particles: shape codes, (b/a, c/b), hands, quaternions.
+
+    The orientation is uniform on SO(3) (normalised 4-D Gaussian quaternion).
+    The tetrahedron's hand is ±1 with probability ½ each; other shapes get +1.
+    The same number of variates is drawn whatever the shape.
+    """
+    quats = rng.standard_normal((m, 4))
+    ratios = aspect.sample(rng, m)
+    hands = np.where(rng.random(m) < 0.5, 1, -1).astype(np.int8)
+    mixed = rng.integers(0, len(SHAPES), m).astype(np.int8)
+    codes = mixed if shape == MIX else np.full(m, shape_code(shape), dtype=np.int8)
+    hands[codes != TETRAHEDRON] = 1
+    return codes, ratios, hands, quats
+
+
+def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None = None,
+             omega_in=(0.0, 0.0, 0.0), *, kappa: float = DEFAULT_KAPPA,
+             aspect: AspectRatioLaw = AspectRatioLaw(), wall: WallMaterial = CORUNDUM_ON_STEEL,
+             n_max: int = DEFAULT_N_MAX, contact_tol: float = DEFAULT_CONTACT_TOL, set_tol: float = DEFAULT_SET_TOL,
+             max_steps: int = DEFAULT_MAX_STEPS, progress: bool = False) -> SampleSet:
+    """Simulate the rebound of ``n`` particles at one incident state.
+
+    Parameters
+    ----------
+    shape : ``"ellipsoid"``, ``"prism"``, ``"cut_prism"``, ``"tetrahedron"`` or
+        ``"mix"`` (each particle's shape drawn from the four with weight ¼).
+    alpha1 : incidence angle from the wall, degrees, in (0, 90].
+    speed : incident speed |V⁻|, m/s, > 0 (the default wall law is validated
+        for 50–300 m/s; outside it a warning is issued).
+    n : number of particles, ≥ 1.
+    seed : integer seed; None draws one, recorded in the result.
+    omega_in : incident angular velocity Ω⁻ a/|V⁻|, lab frame (3 numbers).
+    kappa : cut-prism truncation fraction in [0, 1).
+    aspect : distribution of b/a and c/b.
+    wall : wall-material law.
+    n_max : collisions allowed before a particle counts as trapped, ≥ 1.
+    contact_tol : contact distance, units of a (> 0).
+    set_tol : points within this of the lowest share a contact, units of a (> 0).
+    max_steps : contact-search steps allowed per flight before ``failed``.
+    progress : show a progress bar (tqdm) on standard error.
+
+    Returns
+    -------
+    SampleSet with V⁺ (m/s), Ω⁺a/|V⁻| (lab frame), collision counts, status and
+    per-particle extras (shape code, hand, b/a, c/b, E_Ω⁺/E_V⁻, search steps).
+    """
+    if shape != MIX:
+        shape_code(shape)
+    alpha1 = check_alpha1(alpha1)
+    speed = check_speed(speed)
+    n = _check_count("n", n, 1)
+    seed = check_seed(seed)
+    kappa = check_kappa(kappa)
+    n_max = _check_count("n_max", n_max, 1)
+    max_steps = _check_count("max_steps", max_steps, 1)
+    contact_tol = _check_positive("contact_tol", contact_tol)
+    set_tol = _check_positive("set_tol", set_tol)
+    omega_arr = np.asarray(omega_in, dtype=float)
+    if omega_arr.shape != (3,) or not np.all(np.isfinite(omega_arr)):
+        raise ValueError(f"The 'omega_in' parameter must be 3 finite numbers; got {omega_in!r}.")
+    if not VALID_SPEED_RANGE[0] <= speed <= VALID_SPEED_RANGE[1]:
+        warnings.warn(f"speed {speed} m/s is outside {VALID_SPEED_RANGE} m/s, the range of the "
+                      f"restitution correlation {wall.name!r}", stacklevel=2)
+
+    V0 = incident_velocity(alpha1, speed)
+    W0 = omega_arr * speed                      # (m/s)/a
+    kfacs = second_moment_factors(kappa)
+    wall_arr = wall.as_array()
+    out_V = np.empty((n, 3))
+    out_W = np.empty((n, 3))
+    out_erot = np.empty(n)
+    out_ncoll = np.empty(n, dtype=np.int32)
+    out_status = np.empty(n, dtype=np.int8)
+    out_failure = np.empty(n, dtype=np.int8)
+    out_steps = np.empty(n, dtype=np.int32)
+    out_multi = np.empty(n, dtype=np.int32)
+    codes = np.empty(n, dtype=np.int8)
+    hands = np.empty(n, dtype=np.int8)
+    ratios = np.empty((n, 2))
+
+    bar = _progress_bar(n, progress)
+    for k, start in enumerate(range(0, n, CHUNK_SIZE)):
+        stop = min(start + CHUNK_SIZE, n)
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
+        c, r, hnd, q = draw_inputs(rng, CHUNK_SIZE, shape, aspect)
+        m = stop - start
+        codes[start:stop], ratios[start:stop], hands[start:stop] = c[:m], r[:m], hnd[:m]
+        sl = slice(start, stop)
+        rebound_batch(codes[sl], ratios[sl], hands[sl], q[:m], V0, W0, kfacs, kappa, wall_arr,
+                      n_max, contact_tol, set_tol, max_steps,
+                      out_V[sl], out_W[sl], out_erot[sl], out_ncoll[sl], out_status[sl],
+                      out_failure[sl], out_steps[sl], out_multi[sl])
+        if bar is not None:
+            bar.update(m)
+    if bar is not None:
+        bar.close()
+
+    return SampleSet(
+        velocity=out_V, omega=out_W / speed, n_collisions=out_ncoll, status=out_status,
+        alpha1=alpha1, speed=speed, shape=shape, seed=seed, producer="tablegen simulate",
+        extra={"shape_code": codes, "hand": hands, "b_over_a": ratios[:, 0], "c_over_b": ratios[:, 1],
+               "e_rot_ratio": out_erot / (0.5 * speed ** 2), "n_search_steps": out_steps,
+               "n_multiple_roots": out_multi, "failure_reason": out_failure},
+        provenance={"omega_in": omega_arr, "kappa": kappa, "n_max": n_max,
+                    "contact_tol": contact_tol, "set_tol": set_tol, "max_steps": max_steps,
+                    "aspect_mean": aspect.mean, "aspect_sd": aspect.sd,
+                    "aspect_low": aspect.low, "aspect_high": aspect.high,
+                    "wall_law": wall.name, "wall_k": wall.k, "wall_p": wall.p, "wall_q": wall.q,
+                    "chunk_size": CHUNK_SIZE, "package_version": package_version()})
+
+
+def _progress_bar(total: int, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm.auto import tqdm
+    return tqdm(total=total, unit="particle", unit_scale=True, desc="rebounds")

@@ -1,0 +1,3 @@
+"""Studies of the model's output: statistics (the one definition of means and most probable values),
+report and figures (``tablegen report``, docs/report.md), validation and validation_report (table draws
+against the direct model, docs/VALIDATION.md)."""

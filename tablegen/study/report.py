@@ -1,0 +1,326 @@
+"""The paper's study as a report folder (``tablegen report``; docs/report.md).
+
+Panfilov & Tsirkunov (2022) study the rebound at |V⁻| = 200 m/s with no
+incident spin (Ω⁻ = 0) as a function of the incidence angle α1, for each shape
+and for the equal-weight mix. This module
+
+1. gathers, per (shape, α1), the reflected states of the rebounded particles
+   (α2, β2, s = |V⁺|/|V⁻|, Ω⁺a/|V⁻|, E_Ω⁺/E_V⁻) and the counts by status and by
+   number of collisions, from the direct model (:func:`direct_data`) or from a
+   table (:func:`table_data`);
+2. derives u⁺/|V⁻|, v⁺/|V⁻|, Ω_z a/|V⁻|, E_V⁺/E_V⁻ and E_Ω⁺/E_V⁻ (docs/model.md
+   §6), their means and most probable values, and the scattering indicatrices
+   (:mod:`tablegen.study.statistics`);
+3. writes the figures (:mod:`tablegen.study.figures`) and an ``index.md`` with
+   the numbers into a new folder (:func:`write_report`).
+
+Frame: the lab frame of docs/model.md §2 (wall y = 0, normal +Y into the gas,
+impact plane XY, V⁻ = |V⁻|(cos α1, −sin α1, 0)). Angles are in degrees at the
+interface and in radians inside the samples. V stands for |V⁻|.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from data_schema.common import package_version
+from data_schema.output import atomic_folder
+from data_schema.samples import STATUS_REBOUNDED
+from tablegen.model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_factor
+from tablegen.study.figures import require_matplotlib, write_figures
+from tablegen.study.statistics import (
+    COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, from_sample_set, nearest_alpha1,
+    point_statistics,
+)
+
+PAPER_SPEED = 200.0                                    # m/s, incident speed of the paper's study
+DEFAULT_ALPHA1 = tuple(float(a) for a in range(5, 91, 5))   # deg
+DEFAULT_N = 20_000
+REPORT_SHAPES = SHAPES + (MIX,)
+INERTIA_QUADRATURE_POINTS = 4096                       # midpoint rule of ⟨r²⟩ over the aspect-ratio law
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class ReportData:
+    """Everything the report shows, before statistics.
+
+    source : markdown line naming where the samples come from.
+    speed : incident speed |V⁻|, m/s.
+    alpha1 : incidence angles, deg, ascending.
+    shapes : reported shapes, in :data:`REPORT_SHAPES` order (may hold ``"mix"``).
+    mix_of : the shapes pooled with equal weight into ``"mix"``.
+    n : particles (direct model) or draws (table) per (shape, α1).
+    seed : the seed of every run.
+    counts_note, e_rot_method : markdown sentences on the collision counts and on E_Ω⁺/E_V⁻.
+    points : {(shape, α1): PointSamples}.
+    """
+
+    source: str
+    speed: float
+    alpha1: tuple
+    shapes: tuple
+    mix_of: tuple
+    n: int
+    seed: int
+    counts_note: str
+    e_rot_method: str
+    points: dict
+
+
+# -- derived quantities -------------------------------------------------------
+
+def isotropic_inertia(shape: str, kappa: float, aspect: AspectRatioLaw) -> float:
+    """Mean of tr J/(3 m a²) over the aspect-ratio law: the isotropic inertia per unit mass, units of a².
+
+    J/m = s (b² + c², a² + c², a² + b²) in the body frame (docs/model.md §3), so
+    tr J/(3 m a²) = (2/3) s (1 + (b/a)² + (c/a)²). With b/a and c/b independent
+    and alike, ⟨(c/a)²⟩ = ⟨r²⟩² where ⟨r²⟩ = ∫₀¹ ppf(u)² du (midpoint rule,
+    :data:`INERTIA_QUADRATURE_POINTS` points).
+    """
+    u = (np.arange(INERTIA_QUADRATURE_POINTS) + 0.5) / INERTIA_QUADRATURE_POINTS
+    r2 = float(np.mean(aspect.ppf(u) ** 2))
+    return 2.0 / 3.0 * second_moment_factor(shape, kappa) * (1.0 + r2 + r2 * r2)
+
+
+# -- data stage -------------------------------------------------------------
+
+def _constituents(shapes, available) -> tuple:
+    """Shapes to sample: the pure shapes asked for, and every available shape if the mix is."""
+    return tuple(s for s in available if s in shapes or MIX in shapes)
+
+
+def pool(parts) -> PointSamples:
+    """Union of several shapes' samples; the equal-weight mix when each part has as many particles."""
+    counts = ("status_counts", "collision_counts")
+    merged = {name: sum(getattr(p, name) for p in parts) for name in counts}
+    for f in dataclasses.fields(PointSamples):
+        if f.name not in counts:
+            merged[f.name] = np.concatenate([getattr(p, f.name) for p in parts])
+    return PointSamples(**merged)
+
+
+def _with_mix(parts: dict, shapes, alpha1, mix_of) -> dict:
+    """The reported points: the pure shapes asked for, and the mix pooled from ``mix_of``."""
+    points = {}
+    for shape in shapes:
+        for a in alpha1:
+            points[shape, a] = pool([parts[s, a] for s in mix_of]) if shape == MIX else parts[shape, a]
+    return points
+
+
+def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0,
+                progress: bool = False) -> ReportData:
+    """Run the direct model at 200 m/s, Ω⁻ = 0, for each shape and α1 (deg); ``n`` particles each.
+
+    Every run uses the same ``seed`` (common random numbers: the same
+    orientations and aspect ratios at every point). The mix pools the four
+    shapes' runs; it has no run of its own.
+    """
+    from tablegen.model.simulate import simulate
+
+    alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
+    mix_of = _constituents(shapes, SHAPES)
+    bar = _progress_bar(len(mix_of) * len(alpha1) * n, progress)
+    parts = {}
+    for shape in mix_of:
+        for a in alpha1:
+            parts[shape, a] = from_sample_set(simulate(shape, a, PAPER_SPEED, n, seed=seed))
+            if bar is not None:
+                bar.update(n)
+    if bar is not None:
+        bar.close()
+    return ReportData(
+        source="direct model (`tablegen.model.simulate.simulate`)", speed=PAPER_SPEED, alpha1=alpha1,
+        shapes=_ordered(shapes), mix_of=SHAPES, n=n, seed=seed,
+        counts_note=f"Counted over the {n} simulated particles per shape.",
+        e_rot_method="exact: E_Ω⁺ = ½ Ω⁺·JΩ⁺ with each particle's own inertia tensor and orientation "
+                     "(docs/model.md §5.4).",
+        points=_with_mix(parts, shapes, alpha1, SHAPES))
+
+
+def table_data(path, shapes, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> ReportData:
+    """Draw ``n`` reflected states per shape and α1 from a table, at its grid speed nearest 200 m/s.
+
+    ``alpha1`` (deg) must be grid points of the table (default: all of them),
+    so every draw comes from one cell. The statuses and collision counts are
+    those the table stores per cell (its build's particles). E_Ω⁺/E_V⁻ uses
+    :func:`isotropic_inertia`: a table holds Ω⁺ but not the particle's
+    orientation or aspect ratio. The mix pools the table's shapes.
+    """
+    import surrogate
+    from data_schema.table import read_table
+
+    table = read_table(path)
+    sampler = surrogate.load(path)
+    grid = np.asarray(table.alpha1_deg, dtype=float)
+    alpha1 = tuple(float(a) for a in grid) if alpha1 is None else _grid_points(alpha1, grid)
+    missing = [s for s in shapes if s != MIX and s not in table.shapes]
+    if missing:
+        raise ValueError(f"The 'shapes' {', '.join(missing)} are not in the table {path} "
+                         f"(it holds {', '.join(table.shapes)}).")
+    i_speed = int(np.argmin(np.abs(np.asarray(table.speed_m_s) - PAPER_SPEED)))
+    speed = float(table.speed_m_s[i_speed])
+    mix_of = _constituents(shapes, tuple(table.shapes))
+    aspect = _aspect_law(table.config_text)
+    parts = {}
+    for shape in mix_of:
+        inertia = isotropic_inertia(shape, table.kappa, aspect)
+        for a in alpha1:
+            cell = (table.shapes.index(shape), int(np.argmin(np.abs(grid - a))), i_speed)
+            d = surrogate.sample_local(sampler, np.full(n, a), speed, shape, random_state=seed)
+            ok = d.status == STATUS_REBOUNDED
+            collisions = table.cells["collision_counts"][cell]
+            parts[shape, a] = PointSamples(
+                alpha2=d.alpha2[ok], beta2=d.beta2[ok], speed_ratio=d.speed_ratio[ok], omega=d.omega[ok],
+                e_rot_ratio=inertia * np.sum(d.omega[ok] ** 2, axis=1),
+                status_counts=np.asarray(table.cells["status_counts"][cell], dtype=np.int64),
+                collision_counts=np.r_[collisions[:5], collisions[5:].sum()].astype(np.int64))
+    inertias = ", ".join(f"{s} {isotropic_inertia(s, table.kappa, aspect):.4f}" for s in mix_of)
+    return ReportData(
+        source=f"table `{path}` (made {table.created}, config sha256 {table.config_sha256[:12]}…), "
+               f"drawn with `surrogate.sample_local`",
+        speed=speed, alpha1=alpha1, shapes=_ordered(shapes), mix_of=tuple(table.shapes), n=n, seed=seed,
+        counts_note=f"From the table's cells: {table.particles_per_cell} direct-model particles per shape.",
+        e_rot_method="approximate: a table stores Ω⁺ but not the particle's orientation or aspect ratio, so "
+                     "E_Ω⁺/E_V⁻ = k̄ |Ω⁺a/V|² with k̄ the isotropic inertia ⟨tr J⟩/(3 m a²) averaged over the "
+                     f"aspect-ratio law of the table ({inertias}). Against the direct model at 200 m/s this "
+                     "overestimates the mean E_Ω⁺/E_V⁻ by 4–11 %, and by up to 21 % for ellipsoids near "
+                     "normal impact (docs/report.md).",
+        points=_with_mix(parts, shapes, alpha1, tuple(table.shapes)))
+
+
+def _ordered(shapes) -> tuple:
+    return tuple(s for s in REPORT_SHAPES if s in shapes)
+
+
+def _grid_points(alpha1, grid) -> tuple:
+    """``alpha1`` (deg) as grid points; ValueError naming the grid if one is not on it."""
+    values = sorted(set(float(a) for a in alpha1))
+    off = [a for a in values if not np.any(np.isclose(grid, a, rtol=0.0, atol=1e-9))]
+    if off:
+        raise ValueError(f"The 'alpha1' values must be grid points of the table "
+                         f"({', '.join(f'{g:g}' for g in grid)} deg); got {', '.join(f'{a:g}' for a in off)}.")
+    return tuple(values)
+
+
+def _aspect_law(config_text: str) -> AspectRatioLaw:
+    """The aspect-ratio law recorded in a table's build configuration (default law if absent)."""
+    raw = tomllib.loads(config_text).get("simulation", {}).get("aspect_ratio")
+    return AspectRatioLaw(**{k: float(v) for k, v in raw.items()}) if raw else AspectRatioLaw()
+
+
+def _progress_bar(total: int, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm.auto import tqdm
+    return tqdm(total=total, unit="particle", unit_scale=True, desc="report runs")
+
+
+# -- output -----------------------------------------------------------------
+
+REPORT_KIND = "study_report"      # the kind a report folder's marker names (data_schema.output)
+
+
+def study_statistics(data: ReportData) -> dict:
+    """{(shape, α1): :func:`point_statistics`} over every reported point."""
+    return {key: point_statistics(p) for key, p in data.points.items()}
+
+
+def write_report(data: ReportData, out, overwrite: bool = False) -> Path:
+    """Write the figures and ``index.md`` into the new folder ``out``; return its path.
+
+    The folder is written under a temporary name next to ``out`` and swapped
+    into place when complete, so ``out`` never holds a half-written report.
+    An existing ``out`` is replaced only with ``overwrite`` and only if it is a
+    report folder this function wrote (its marker file); anything else is
+    refused with :class:`data_schema.output.OutputError`.
+    Raises ImportError naming the ``plots`` extra if matplotlib is missing.
+    """
+    require_matplotlib()
+    stats = study_statistics(data)
+    with atomic_folder(out, REPORT_KIND, overwrite) as tmp:
+        figures = write_figures(data, stats, tmp)
+        (tmp / "index.md").write_text(render_index(data, stats, figures), encoding="utf-8")
+    return Path(out)
+
+
+def _fmt(x: float) -> str:
+    return "–" if not np.isfinite(x) else f"{x:.4f}"
+
+
+def markdown_table(header, rows) -> str:
+    """A markdown table from a header and rows of cells (strings)."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def render_index(data: ReportData, stats: dict, figures) -> str:
+    """The text of ``index.md``: conditions, frames, every figure (``figures``: (file, title, caption)), numbers."""
+    parts = [_conditions(data)]
+    for file, title, caption in figures:
+        parts.append(f"## {title}\n\n{caption}\n\n![{title}]({file})")
+    parts.append(_collision_section(data, stats))
+    parts.append("## Numbers\n\nMeans and most probable (m.p.) values over the rebounded particles; "
+                 "\"rebounds\" is the number of rebounded samples, \"trapped %\" is of all particles.")
+    for shape in data.shapes:
+        parts.append(f"### {shape}\n\n" + _numbers_table(data, stats, shape))
+    return "\n\n".join(parts) + "\n"
+
+
+def _conditions(data: ReportData) -> str:
+    mix = (f"; mix = the equal-weight union of {', '.join(data.mix_of)} (as many particles of each)"
+           if MIX in data.shapes else "")
+    rows = [("source", data.source),
+            ("incident speed \\|V⁻\\|", f"{data.speed:g} m/s" + ("" if data.speed == PAPER_SPEED else
+                                                               " (the table's grid speed nearest 200 m/s)")),
+            ("incident spin Ω⁻", "0"),
+            ("α1 (deg)", ", ".join(f"{a:g}" for a in data.alpha1)),
+            ("shapes", ", ".join(data.shapes) + mix),
+            ("samples per (shape, α1)", f"{data.n}"),
+            ("seed", f"{data.seed} (the same for every (shape, α1))"),
+            ("made", f"{datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')} by "
+                     f"`tablegen report`, package version {package_version()}")]
+    widths = markdown_table(["quantity", "bin width"], [(q.text, f"{q.mode_bin:g}") for q in QUANTITIES])
+    return "\n\n".join([
+        "# Rebound study at the conditions of Panfilov & Tsirkunov (2022)",
+        markdown_table(["", ""], rows),
+        "**Frame** (docs/model.md §2): lab frame, wall y = 0 with normal +Y into the gas, impact plane XY, "
+        "V⁻ = V (cos α1, −sin α1, 0) with V = |V⁻|. α1 is measured from the wall (90° is a normal impact); "
+        "α2 = atan2(v⁺, u⁺) is the in-plane rebound angle from +X and β2 = asin(w⁺/|V⁺|) the out-of-plane "
+        "angle. u⁺ and v⁺ are the tangential and wall-normal components of V⁺, Ω_z a/V the spin about the "
+        "normal of the impact plane. E_V⁺/E_V⁻ = (|V⁺|/V)² and E_Ω⁺/E_V⁻ are the translational and "
+        "rotational kinetic energies after the rebound over the incident kinetic energy ½ m V². All "
+        "statistics are over the rebounded particles; trapped and failed particles are only counted.",
+        f"**E_Ω⁺/E_V⁻** is {data.e_rot_method}",
+        "**Most probable value**: the centre of the fullest bin of a histogram with bins "
+        "[k·w, (k+1)·w) of fixed width w (the lowest bin on a tie). Modes are fragile where a "
+        "distribution has two near-equal peaks or a sharp edge (docs/model.md §6).\n\n" + widths,
+    ])
+
+
+def _collision_section(data: ReportData, stats: dict) -> str:
+    a = nearest_alpha1(data.alpha1, [NORMAL_IMPACT])[0]
+    header = ["shape"] + list(COLLISION_CLASSES) + ["trapped %", "failed %"]
+    rows = [[shape] + [f"{c:.1f} %" for c in stats[shape, a]["collision_percent"]]
+            + [f"{stats[shape, a]['trapped_percent']:.2f}", f"{stats[shape, a]['failed_percent']:.2f}"]
+            for shape in data.shapes]
+    return (f"## Collisions per rebound at α1 = {a:g}°\n\nPercentages of the rebounds with 1, 2, 3, 4, 5 and "
+            f"more than 5 collisions; trapped and failed are percentages of all particles. "
+            f"{data.counts_note}\n\n" + markdown_table(header, rows))
+
+
+def _numbers_table(data: ReportData, stats: dict, shape: str) -> str:
+    header = ["α1 (deg)", "rebounds", "trapped %"] + [f"{kind} {q.text}" for q in QUANTITIES
+                                                      for kind in ("mean", "m.p.")]
+    rows = []
+    for a in data.alpha1:
+        st = stats[shape, a]
+        rows.append([f"{a:g}", f"{st['rebounds']}", f"{st['trapped_percent']:.2f}"]
+                    + [_fmt(st[kind][q.key]) for q in QUANTITIES for kind in ("mean", "mode")])
+    return markdown_table(header, rows)

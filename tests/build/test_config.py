@@ -1,0 +1,86 @@
+"""Build configuration: presets, TOML parsing, errors naming the key."""
+
+import pytest
+
+from cli_helpers import user_error
+
+from tablegen.cli import main as tablegen_main
+from tablegen.build.config import PRESETS, ConfigError, load_config, parse_config
+from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+
+
+@pytest.mark.parametrize("preset", PRESETS)
+def test_presets_parse_and_round_trip(preset):
+    config = load_config(preset=preset)
+    assert parse_config(config.to_toml()) == config
+    assert config.alpha1_deg[-1] == 90.0
+    assert max(b - a for a, b in zip(config.alpha1_deg, config.alpha1_deg[1:])) <= 5.0
+
+
+def test_production_and_paper_presets_meet_their_definitions():
+    prod = load_config(preset="production")
+    assert max(b - a for a, b in zip(prod.alpha1_deg, prod.alpha1_deg[1:])) <= 2.5
+    assert max(b - a for a, b in zip(prod.speed_m_s, prod.speed_m_s[1:])) <= 25.0
+    assert prod.particles_per_cell >= 200_000
+    paper = load_config(preset="paper")
+    assert paper.speed_m_s == (200.0,) and paper.particles_per_cell == 10 ** 8 and len(paper.shapes) == 4
+
+
+def test_wall_law_defaults_to_corundum_on_steel_and_round_trips():
+    assert load_config().wall == CORUNDUM_ON_STEEL
+    config = parse_config('[wall]\nk = 0.2\np = 0.5\nq = -0.5\nname = "glass \\"A\\" on steel"\n')
+    assert config.wall == WallMaterial(k=0.2, p=0.5, q=-0.5, name='glass "A" on steel')
+    assert parse_config(config.to_toml()) == config
+    assert config.sha256() != load_config().sha256()      # the wall law is part of the configuration's hash
+    assert parse_config("[wall]\nk = 0.2\n").wall == WallMaterial(k=0.2, p=CORUNDUM_ON_STEEL.p,
+                                                                   q=CORUNDUM_ON_STEEL.q, name=CORUNDUM_ON_STEEL.name)
+
+
+def test_range_grid_includes_stop_and_defaults_fill_in():
+    config = parse_config("[grid]\nspeed_m_s = {start = 100, stop = 200, step = 50}\n")
+    assert config.speed_m_s == (100.0, 150.0, 200.0)
+    assert config.alpha1_deg == load_config().alpha1_deg
+
+
+BAD = [
+    ("[grid]\nalpha1_deg = []", "grid.alpha1_deg"),
+    ("[grid]\nalpha1_deg = [0.0, 10.0]", "grid.alpha1_deg"),
+    ("[grid]\nalpha1_deg = [45.0, 95.0]", "grid.alpha1_deg"),
+    ("[grid]\nspeed_m_s = [0.0, 100.0]", "grid.speed_m_s"),
+    ("[grid]\nspeed_m_s = [-50.0]", "grid.speed_m_s"),
+    ("[grid]\nspeed_m_s = [200.0, 100.0]", "grid.speed_m_s"),
+    ("[grid]\nshapes = [\"sphere\"]", "grid.shapes"),
+    ("[grid]\nshapes = []", "grid.shapes"),
+    ("[simulation]\nparticles_per_cell = 0", "simulation.particles_per_cell"),
+    ("[simulation]\nparticles_per_cell = -5", "simulation.particles_per_cell"),
+    ("[simulation]\nn_max = 0", "simulation.n_max"),
+    ("[simulation]\nkappa = 1.5", "simulation.kappa"),
+    ("[simulation]\nparticle_count = 10", "simulation.particle_count"),
+    ("[grids]\nalpha1_deg = [10.0]", "[grids]"),
+    ("[table]\nresolution = {clusters = 0}", "table.resolution"),
+    ("[table]\nresolution = {atoms = 8}", "table.resolution.atoms"),
+    ("[wall]\nk = 0.0", "wall.k"),
+    ("[wall]\np = -0.5", "wall.p"),
+    ("[wall]\nq = nan", "wall.q"),
+    ("[wall]\nk = true", "wall.k"),
+    ("[wall]\nname = \"\"", "wall.name"),
+    ("[wall]\nfriction = 1.0", "wall.friction"),
+]
+
+
+@pytest.mark.parametrize("text, key", BAD)
+def test_bad_values_name_the_key(text, key):
+    with pytest.raises(ConfigError, match=key.replace("[", r"\[").replace("]", r"\]")):
+        parse_config(text)
+
+
+@pytest.mark.parametrize("text, key", BAD)
+def test_cli_exits_2_and_leaves_the_output_untouched(text, key, tmp_path, capsys):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text(text)
+    out = tmp_path / "table.h5"
+    out.write_bytes(b"previous content")
+    line, _ = user_error(tablegen_main, ["build", "--config", str(cfg), "-o", str(out), "--overwrite"], capsys, key)
+    assert line.startswith("tablegen build: error: ")
+    assert out.read_bytes() == b"previous content"
+    assert not (tmp_path / "table.h5.partial").exists()

@@ -1,0 +1,138 @@
+"""Whole rebounds (docs/model.md §5): sphere limit, contacts, symmetry, convergence, energy."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
+from tablegen.model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
+from tablegen.model.shapes import MAX_VERTICES, body_vertices, second_moment_factor, shape_code
+
+from kernel_helpers import MIRROR, random_bodies, run_one
+
+BODIES = random_bodies(200, seed=7)
+
+
+@pytest.mark.parametrize("alpha1", [5.0, 30.0, 60.0, 90.0])
+def test_sphere_single_collision_no_scatter(alpha1):
+    """A sphere bounces once, in the impact plane, identically for every orientation (closed form)."""
+    speed = 200.0
+    rng = np.random.default_rng(0)
+    results = []
+    for _ in range(20):
+        R0 = Rotation.from_quat(rng.standard_normal(4)).as_matrix()
+        V, W, status, ncoll, _, _ = run_one("ellipsoid", [1.0, 1.0, 1.0], R0, alpha1=alpha1, speed=speed)
+        assert status == STATUS_REBOUNDED and ncoll == 1
+        results.append(np.concatenate([V, W]))
+    results = np.array(results)
+    a1 = np.radians(alpha1)
+    u, v = speed * np.cos(a1), speed * np.sin(a1)
+    a_nc = 1 - (1 - np.exp(-0.1 * speed ** 0.61)) * v / speed
+    lam = (1 + a_nc) * v
+    cf = np.exp(v / speed)
+    du = -cf * lam * u / (speed + 1.75 * cf * lam)     # derivation in test_collision.py
+    expected = [u + du, -v + lam, 0.0, 0.0, 0.0, 2.5 * du]
+    np.testing.assert_allclose(results, np.tile(expected, (20, 1)), rtol=1e-12, atol=1e-12 * speed)
+
+
+def _vertex_heights(shape, semi, hand, y, R):
+    verts = np.empty((MAX_VERTICES, 3))
+    n = body_vertices(shape_code(shape), *semi, 0.3, float(hand), verts)
+    if n == 0:   # ellipsoid: support function
+        return np.array([y - np.linalg.norm(semi * R[1])])
+    return y + verts[:n] @ R[1]
+
+
+@pytest.mark.parametrize("body", BODIES[:120], ids=lambda b: b[0])
+def test_no_missed_contact_against_fine_time_stepping(body):
+    """Between recorded collisions, no point of the body dips below the wall.
+
+    Each flight is replayed with 4000 uniform time steps from its start to the
+    next recorded collision (or, for the last flight, until the centre is above
+    the bounding radius): a contact the search had stepped over would show as a
+    height below −1e-9 a (far above the 1e-10 a contact tolerance).
+    """
+    shape, semi, R0, hand = body
+    V, W, status, ncoll, _, hist = run_one(shape, semi, R0, alpha1=45.0, omega_in=(0.0, 0.0, 0.3),
+                                           hand=hand, history_rows=200)
+    assert status == STATUS_REBOUNDED
+    K = second_moment_factor(shape) * np.array([semi[1] ** 2 + semi[2] ** 2, semi[0] ** 2 + semi[2] ** 2,
+                                                semi[0] ** 2 + semi[1] ** 2])
+    params = np.empty(ROT_PARAMS_SIZE)
+    R, Wt = np.empty((3, 3)), np.empty(3)
+    nflights = ncoll + 1
+    rb = max(np.linalg.norm(semi), 1.0)
+    for k in range(nflights):
+        row = hist[k]
+        t0, y0, Vk, Wk, Rk = row[0], row[1], row[2:5], row[5:8], row[8:17].reshape(3, 3)
+        ell = Rk @ np.diag(K) @ Rk.T @ Wk
+        rotation_init(K, Rk, ell, params)
+        if k + 1 < nflights:
+            t_end = hist[k + 1, 0] - t0
+        else:
+            assert Vk[1] > 0
+            t_end = max(rb - y0, 0.0) / Vk[1]
+        lowest = np.inf
+        for t in np.linspace(0.0, t_end, 4001)[1:-1]:
+            rotation_at(params, t, R, Wt)
+            lowest = min(lowest, _vertex_heights(shape, semi, hand, y0 + Vk[1] * t, R).min())
+        assert lowest > -1e-9, f"flight {k}: body reaches {lowest:.3e} a below the wall"
+
+
+@pytest.mark.parametrize("body", BODIES, ids=lambda b: b[0])
+def test_mirror_symmetry_per_particle(body):
+    """Reflecting the whole configuration through the impact plane reflects the outcome.
+
+    Body vertex x ↦ P_lab R x = (P_lab R P_body)(P_body x): an achiral body is
+    unchanged by P_body, the tetrahedron changes hand. Outcome: w, Ω_x, Ω_y
+    change sign (Ω is axial), the rest is equal — to round-off, amplified at
+    most ~1e3 times over a rebound's collisions.
+    """
+    shape, semi, R0, hand = body
+    omega_in = np.array([0.1, -0.2, 0.3])
+    V1, W1, s1, n1, e1, _ = run_one(shape, semi, R0, alpha1=40.0, omega_in=omega_in, hand=hand)
+    V2, W2, s2, n2, e2, _ = run_one(shape, semi, MIRROR @ R0 @ MIRROR, alpha1=40.0,
+                                    omega_in=-MIRROR @ omega_in, hand=-hand if shape == "tetrahedron" else hand)
+    assert (s1, n1) == (s2, n2)
+    np.testing.assert_allclose(V2, MIRROR @ V1, rtol=0, atol=1e-9 * 200)
+    np.testing.assert_allclose(W2, -MIRROR @ W1, rtol=0, atol=1e-9 * 200)
+    assert e2 == pytest.approx(e1, rel=1e-9)
+
+
+@pytest.mark.parametrize("body", BODIES[:100], ids=lambda b: b[0])
+def test_converges_as_tolerances_are_halved(body):
+    """Halving the contact and contact-set tolerances changes a rebound by < 1e-8 (relative).
+
+    The rotation between collisions is exact (no flight step), so the contact
+    tolerances are the only discretisation parameters of a rebound.
+    """
+    shape, semi, R0, hand = body
+    V1, W1, s1, n1, _, _ = run_one(shape, semi, R0, alpha1=45.0, hand=hand)
+    V2, W2, s2, n2, _, _ = run_one(shape, semi, R0, alpha1=45.0, hand=hand, contact_tol=5e-11, set_tol=5e-10)
+    assert (s1, n1) == (s2, n2)
+    scale = 200.0
+    assert np.abs(V1 - V2).max() < 1e-8 * scale
+    assert np.abs(W1 - W2).max() < 1e-8 * scale
+
+
+@pytest.mark.parametrize("body", BODIES, ids=lambda b: b[0])
+def test_energy_does_not_increase(body):
+    shape, semi, R0, hand = body
+    speed = 200.0
+    V, W, status, ncoll, e_rot, _ = run_one(shape, semi, R0, alpha1=60.0, speed=speed, hand=hand)
+    assert ncoll >= 1
+    assert 0.5 * V @ V + e_rot <= 0.5 * speed ** 2 * (1 + 1e-12)
+
+
+def test_trapped_after_n_max():
+    """With n_max = 1, a body that needs a second collision is reported trapped."""
+    trapped = 0
+    for shape, semi, R0, hand in BODIES[:40]:
+        _, _, status_full, ncoll, _, _ = run_one(shape, semi, R0, hand=hand)
+        _, _, status_one, ncoll_one, _, _ = run_one(shape, semi, R0, hand=hand, n_max=1)
+        if ncoll >= 2:
+            assert status_one == STATUS_TRAPPED and ncoll_one == 1
+            trapped += 1
+        else:
+            assert status_one == status_full == STATUS_REBOUNDED
+    assert trapped > 0

@@ -1,0 +1,198 @@
+"""tablegen report: derived quantities, modes, indicatrices, data sources, output folder, CLI."""
+
+import re
+import sys
+
+import numpy as np
+import pytest
+
+from cli_helpers import user_error
+from data_schema.output import FOLDER_MARKER
+from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
+from tablegen.cli import main as tablegen_main
+from tablegen.model.shapes import AspectRatioLaw, second_moment_factor
+from tablegen.model.simulate import simulate
+from tablegen.study.figures import FIGURES
+from tablegen.study.report import direct_data, isotropic_inertia, pool
+from tablegen.study.statistics import (
+    PointSamples, collision_classes, derived, histogram_mode, indicatrix_2d, indicatrix_3d, lab_velocity,
+    nearest_alpha1, point_statistics,
+)
+
+EXPECTED_FILES = {f[0] for f in FIGURES} | {"index.md", FOLDER_MARKER}
+
+
+def _synthetic(m=1000, seed=0, status=(0, 0, 0), collisions=(0,) * 6) -> PointSamples:
+    rng = np.random.default_rng(seed)
+    return PointSamples(alpha2=rng.uniform(0, np.pi, m), beta2=rng.uniform(-1.2, 1.2, m),
+                        speed_ratio=rng.uniform(0.1, 1.0, m), omega=rng.normal(size=(m, 3)),
+                        e_rot_ratio=rng.uniform(0, 0.3, m), status_counts=np.array(status),
+                        collision_counts=np.array(collisions))
+
+
+def test_lab_velocity_is_the_specular_direction_for_a_mirror_bounce():
+    alpha1 = np.radians([10.0, 45.0, 80.0])
+    v = lab_velocity(alpha1, np.zeros(3), np.ones(3))
+    np.testing.assert_allclose(v, np.column_stack([np.cos(alpha1), np.sin(alpha1), np.zeros(3)]), atol=1e-15)
+
+
+def test_derived_quantities_against_closed_forms():
+    p = _synthetic()
+    q = derived(p)
+    V = lab_velocity(p.alpha2, p.beta2, p.speed_ratio)
+    # the lab-frame vector gives back the state it was built from (docs/model.md §2)
+    np.testing.assert_allclose(np.linalg.norm(V, axis=1), p.speed_ratio, rtol=1e-14)
+    np.testing.assert_allclose(np.arctan2(V[:, 1], V[:, 0]), p.alpha2, rtol=1e-13)
+    np.testing.assert_allclose(np.arcsin(V[:, 2] / p.speed_ratio), p.beta2, rtol=1e-12)
+    np.testing.assert_allclose(q["u"], p.speed_ratio * np.cos(p.beta2) * np.cos(p.alpha2), rtol=1e-14)
+    np.testing.assert_allclose(q["v"], p.speed_ratio * np.cos(p.beta2) * np.sin(p.alpha2), rtol=1e-14)
+    np.testing.assert_array_equal(q["omega_z"], p.omega[:, 2])
+    np.testing.assert_allclose(q["e_trans"], p.speed_ratio ** 2, rtol=1e-15)
+    np.testing.assert_array_equal(q["e_rot"], p.e_rot_ratio)
+
+
+def test_histogram_mode_of_known_histograms():
+    assert histogram_mode([0.21, 0.22, 0.55, 0.56, 0.57, -0.25], 0.1) == pytest.approx(0.55)
+    assert histogram_mode([-0.25, -0.26, -0.27, 0.1, 0.15], 0.1) == pytest.approx(-0.25)
+    assert histogram_mode([0.31, 0.32, 0.71, 0.72], 0.1) == pytest.approx(0.35)    # tie: the lower bin
+    assert histogram_mode(np.full(7, 0.4999), 0.5) == pytest.approx(0.25)
+    assert np.isnan(histogram_mode([], 0.1))
+    # a Gaussian's mode within a bin of its peak
+    x = np.random.default_rng(1).normal(0.3, 0.1, 200_000)
+    assert abs(histogram_mode(x, 0.01) - 0.3) <= 0.01
+
+
+def test_collision_classes_and_point_statistics():
+    np.testing.assert_array_equal(collision_classes([1, 1, 2, 5, 6, 7, 12, -1]), [2, 1, 0, 0, 1, 3])
+    p = _synthetic(status=(90, 8, 2), collisions=(45, 20, 10, 5, 5, 5))
+    st = point_statistics(p)
+    assert st["trapped_percent"] == pytest.approx(8.0) and st["failed_percent"] == pytest.approx(2.0)
+    np.testing.assert_allclose(st["collision_percent"], [50, 20 / 0.9, 10 / 0.9, 5 / 0.9, 5 / 0.9, 5 / 0.9])
+    assert st["mean"]["e_trans"] == pytest.approx(np.mean(p.speed_ratio ** 2))
+    assert st["mode"]["omega_z"] == histogram_mode(p.omega[:, 2], 0.02)
+
+
+def test_indicatrices_integrate_to_one():
+    p = _synthetic(m=5000)
+    edges, density = indicatrix_2d(p.alpha2)
+    assert np.degrees(edges[1] - edges[0]) == pytest.approx(2.5)
+    assert np.sum(density * np.diff(edges)) == pytest.approx(1.0)
+    a_edges, b_edges, density = indicatrix_3d(p.alpha2, p.beta2)
+    assert density.shape == (36, 36)
+    assert np.sum(density * np.outer(np.diff(a_edges), np.diff(b_edges))) == pytest.approx(1.0)
+
+
+def test_nearest_alpha1():
+    assert nearest_alpha1([30, 60, 90], [15, 30, 45, 60, 75, 90]) == (30.0, 60.0, 90.0)
+    assert nearest_alpha1([5, 10, 85], [90]) == (85.0,)
+
+
+def test_isotropic_inertia_against_closed_forms():
+    """tr J/(3 m a²): 2/3 for the cube, 2/5 for the sphere; the aspect-ratio mean by Monte Carlo."""
+    near_one = AspectRatioLaw(mean=1.0, sd=0.2, low=1.0 - 1e-9, high=1.0)
+    assert isotropic_inertia("prism", 0.3, near_one) == pytest.approx(2.0 / 3.0, rel=1e-8)
+    assert isotropic_inertia("ellipsoid", 0.3, near_one) == pytest.approx(0.4, rel=1e-8)
+    law = AspectRatioLaw()
+    r = law.sample(np.random.default_rng(2), 400_000)
+    mc = 2.0 / 3.0 * second_moment_factor("tetrahedron") * np.mean(1 + r[:, 0] ** 2 + (r[:, 0] * r[:, 1]) ** 2)
+    assert isotropic_inertia("tetrahedron", 0.3, law) == pytest.approx(mc, rel=2e-3)
+
+
+def test_pool_is_the_union_with_summed_counts():
+    a, b = _synthetic(10, 1, (9, 1, 0), (5, 4, 0, 0, 0, 0)), _synthetic(20, 2, (20, 0, 0), (1, 1, 1, 1, 1, 15))
+    m = pool([a, b])
+    np.testing.assert_array_equal(m.alpha2, np.r_[a.alpha2, b.alpha2])
+    np.testing.assert_array_equal(m.omega, np.vstack([a.omega, b.omega]))
+    np.testing.assert_array_equal(m.status_counts, [29, 1, 0])
+    np.testing.assert_array_equal(m.collision_counts, [6, 5, 1, 1, 1, 15])
+
+
+def test_direct_data_holds_the_rebounds_of_the_direct_model():
+    data = direct_data(["prism", "mix"], (90.0, 45.0), n=200, seed=5)
+    assert data.alpha1 == (45.0, 90.0) and data.shapes == ("prism", "mix") and data.speed == 200.0
+    s = simulate("prism", 45.0, 200.0, 200, seed=5)
+    p = data.points["prism", 45.0]
+    ok = s.rebounded
+    np.testing.assert_array_equal(p.speed_ratio, s.speed_ratio[ok])
+    np.testing.assert_array_equal(p.e_rot_ratio, s.extra["e_rot_ratio"][ok])      # exact, not approximated
+    np.testing.assert_array_equal(p.status_counts, [np.sum(s.status == c) for c in
+                                                    (STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED)])
+    mix = data.points["mix", 90.0]
+    assert mix.status_counts.sum() == 4 * 200                                     # four shapes, 200 each
+    assert mix.alpha2.size == mix.status_counts[STATUS_REBOUNDED]
+    assert mix.collision_counts.sum() == mix.status_counts[STATUS_REBOUNDED]
+
+
+def _figure_links(index: str) -> set:
+    return set(re.findall(r"!\[[^\]]*\]\(([^)]+)\)", index))
+
+
+def test_cli_direct_writes_every_figure_and_refuses_an_existing_folder(tmp_path, capsys):
+    out = tmp_path / "report"
+    argv = ["report", "--direct", "-o", str(out), "--shapes", "cut_prism", "-n", "300", "--seed", "3",
+            "--alpha1", "30,90", "--no-progress"]
+    assert tablegen_main(argv) == 0
+    assert {p.name for p in out.iterdir()} == EXPECTED_FILES
+    assert all((out / f).read_bytes().startswith(b"\x89PNG") for f in EXPECTED_FILES - {"index.md", FOLDER_MARKER})
+    index = (out / "index.md").read_text(encoding="utf-8")
+    assert _figure_links(index) == EXPECTED_FILES - {"index.md", FOLDER_MARKER}
+    assert "## Collisions per rebound at α1 = 90°" in index and "| cut_prism |" in index
+    assert "**E_Ω⁺/E_V⁻** is exact" in index
+    # the numbers table: one row per α1, with the statistics of the same run
+    data = direct_data(["cut_prism"], (30.0, 90.0), n=300, seed=3)
+    st = point_statistics(data.points["cut_prism", 30.0])
+    assert f"| 30 | {st['rebounds']} | " in index and f"{st['mean']['u']:.4f}" in index
+    assert [p.name for p in tmp_path.iterdir()] == ["report"]                      # no temporary folder left
+    # an existing folder is refused and left intact without --overwrite, replaced with it
+    before = (out / "index.md").read_bytes()
+    user_error(tablegen_main, argv, capsys, "--overwrite")
+    assert (out / "index.md").read_bytes() == before
+    (out / "stale.txt").write_text("old")
+    assert tablegen_main(argv + ["--overwrite"]) == 0
+    assert {p.name for p in out.iterdir()} == EXPECTED_FILES
+    assert [p.name for p in tmp_path.iterdir()] == ["report"]
+
+
+@pytest.mark.parametrize("extra, word", [
+    (["--direct", "--alpha1", "0"], "--alpha1"), (["--direct", "--alpha1", "30,abc"], "--alpha1"),
+    (["--direct", "--alpha1", "95"], "--alpha1"), (["--direct", "-n", "0"], "-n"),
+    (["--direct", "--shapes", "sphere"], "--shapes"), (["--direct", "--seed", "-1"], "seed"),
+    ([], "--table"), (["--direct", "--table", "t.h5"], "--table"),
+    (["--table", "missing.h5"], "missing.h5"),
+])
+def test_cli_bad_arguments_exit_2_naming_the_argument(extra, word, tmp_path, capsys):
+    out = tmp_path / "r"
+    user_error(tablegen_main, ["report", "-o", str(out)] + extra, capsys, word)
+    assert not out.exists()
+
+
+def test_cli_tells_what_to_install_without_matplotlib(tmp_path, monkeypatch, capsys):
+    for name in [m for m in sys.modules if m == "matplotlib" or m.startswith("matplotlib.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "matplotlib", None)          # import matplotlib raises ImportError
+    out = tmp_path / "r"
+    user_error(tablegen_main, ["report", "--direct", "-o", str(out), "-n", "10"], capsys,
+               'pip install "rebound-scatter[plots]"')
+    assert not out.exists()
+
+
+def test_cli_from_a_table(small_table_path, tmp_path, capsys):
+    from data_schema.table import read_table
+
+    out = tmp_path / "report"
+    assert tablegen_main(["report", "--table", str(small_table_path), "-o", str(out), "--shapes", "prism",
+                          "mix", "-n", "400", "--seed", "1"]) == 0
+    assert {p.name for p in out.iterdir()} == EXPECTED_FILES
+    index = (out / "index.md").read_text(encoding="utf-8")
+    assert _figure_links(index) == EXPECTED_FILES - {"index.md", FOLDER_MARKER}
+    # grid α1, the grid speed nearest 200 m/s (150 and 250 tie: the lower), the approximate rotational energy
+    assert "| α1 (deg) | 30, 60, 90 |" in index and "150 m/s (the table's grid speed nearest 200 m/s)" in index
+    assert "**E_Ω⁺/E_V⁻** is approximate" in index
+    # collision percentages at 90° are the table's own cell counts
+    table = read_table(small_table_path)
+    cell = table.cells["collision_counts"][table.shapes.index("prism"), 2, 1]
+    one = 100.0 * cell[0] / cell.sum()
+    assert re.search(rf"\| prism \| {one:.1f} % \|", index)
+    # α1 off the table's grid: exit 2 naming alpha1 and the grid
+    user_error(tablegen_main, ["report", "--table", str(small_table_path), "-o", str(tmp_path / "r2"),
+                               "--alpha1", "45"], capsys, "alpha1")
