@@ -5,7 +5,8 @@ import pytest
 from scipy import stats
 
 from data_schema.table import CHAIN_TO_STATE, N_CHAIN, TableResolution, slope_index
-from tablegen.build.tabulate import _regime_partition, regime_clusters, represent, resolution_for
+from tablegen.build.resolution import resolution_for
+from tablegen.build.tabulate import _regime_partition, regime_clusters, represent
 
 N = 40_000
 
