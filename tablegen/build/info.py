@@ -10,10 +10,12 @@ import numpy as np
 from data_schema.samples import STATUS_NAMES
 from data_schema.table import TABLE_VERSION, ReboundTable
 
+STEP_DECIMALS = 9       # grid steps equal to this many decimals count as one step (round-off of {start, stop, step})
+
 
 def _grid(values) -> str:
     v = np.asarray(values)
-    steps = np.unique(np.round(np.diff(v), 9)) if len(v) > 1 else []
+    steps = np.unique(np.round(np.diff(v), STEP_DECIMALS)) if len(v) > 1 else []
     step = f", step {steps[0]:g}" if len(steps) == 1 else ""
     return f"{len(v)} values, {v[0]:g} to {v[-1]:g}{step}"
 
@@ -32,6 +34,8 @@ def describe_table(table: ReboundTable, path: Path | None = None) -> str:
         f"alpha1 (deg): {_grid(table.alpha1_deg)}",
         f"speed (m/s):  {_grid(table.speed_m_s)}",
         f"shapes: {', '.join(table.shapes)} (cut_prism kappa = {table.kappa:g}); n_max = {table.n_max}",
+        f"wall law: {table.wall_law or 'not recorded'} (k = {table.restitution_k:g}, p = {table.restitution_p:g}, "
+        f"q = {table.friction_q:g})",
         f"cells: {total.size}, {table.particles_per_cell} particles each",
         "resolution: " + ", ".join(f"{f.name} {getattr(table.resolution, f.name)}"
                                    for f in dataclasses.fields(table.resolution)),

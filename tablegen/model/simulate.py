@@ -24,7 +24,7 @@ from tablegen.model.shapes import (
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 CHUNK_SIZE = 16384                  # particles drawn at a time: fixed, so a seed gives the same bits for any n
-VALID_SPEED_RANGE = (50.0, 300.0)   # m/s, range of the default restitution correlation
+VALID_SPEED_RANGE = (50.0, 300.0)   # m/s, where the default wall law was measured
 DEFAULT_N_MAX = 1000                # collisions before a particle counts as trapped
 DEFAULT_CONTACT_TOL = 1e-10         # contact distance, units of a
 DEFAULT_SET_TOL = 1e-9              # points this close to the lowest share a contact, units of a
@@ -117,7 +117,7 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     omega_in : incident angular velocity Ω⁻ a/|V⁻|, lab frame (3 numbers).
     kappa : cut-prism truncation fraction in [0, 1).
     aspect : distribution of b/a and c/b.
-    wall : wall-material law.
+    wall : wall law (restitution and friction coefficients).
     n_max : collisions allowed before a particle counts as trapped, ≥ 1.
     contact_tol : contact distance, units of a (> 0).
     set_tol : points within this of the lowest share a contact, units of a (> 0).
@@ -145,7 +145,7 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
         raise ValueError(f"The 'omega_in' parameter must be 3 finite numbers; got {omega_in!r}.")
     if not VALID_SPEED_RANGE[0] <= speed <= VALID_SPEED_RANGE[1]:
         warnings.warn(f"speed {speed} m/s is outside {VALID_SPEED_RANGE} m/s, the range of the "
-                      f"restitution correlation {wall.name!r}", stacklevel=2)
+                      f"default wall law; the law in use is {wall.name!r}", stacklevel=2)
 
     V0 = incident_velocity(alpha1, speed)
     W0 = omega_arr * speed                      # (m/s)/a

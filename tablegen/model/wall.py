@@ -1,4 +1,4 @@
-"""The wall-material law of one collision (docs/model.md §4).
+"""The wall law of one collision: restitution and friction (docs/model.md §4).
 
 Two empirical coefficients close the impulse model:
 
