@@ -10,23 +10,19 @@ imports :mod:`tablegen`, so a flow solver installs the runtime alone::
 
 From numba code, call :func:`surrogate.kernels.rebound_tuple` (or
 :func:`surrogate.kernels.rebound` on arrays) with ``table.kernel_data`` and
-``U_PER_DRAW`` uniforms per call; :func:`surrogate.rng.fill_uniforms` draws
-them fast from a caller-owned xoshiro256+ state (:func:`surrogate.rng.seed_state`).
-A solver that collects its wall hits of a time step should pass them all to
+``U_PER_DRAW`` uniforms per call; :func:`fill_uniforms` draws them fast from
+a caller-owned xoshiro256+ state (:func:`seed_state`). A solver that collects
+its wall hits of a time step should pass them all to
 :func:`surrogate.kernels.rebound_many_rng` (uniforms from a state) or
 :func:`surrogate.kernels.rebound_many` (uniforms given), which pipeline
 blocks of particles, overlap their table reads and compute their draws as
-SIMD loops (about a quarter of the per-particle cost on the default table;
-``rebound_many`` gives the per-particle results bit for bit);
-:func:`surrogate.kernels.rebound_batch_rng` does the same on all threads,
-drawing its uniforms from one xoshiro256+ state per chunk of rows
-(:func:`surrogate.rng.stream_states`; each seeds 32 SIMD lanes,
-:func:`surrogate.rng.seed_lanes`), as :func:`sample_global` does.
+SIMD loops, with the per-particle results bit for bit;
+:func:`surrogate.kernels.rebound_parallel_rng` does the same on all threads,
+as :func:`sample_global` does. :mod:`surrogate.kernels` maps where each part lives.
 """
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW
-from surrogate.rng import fill_uniforms, seed_state
+from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 

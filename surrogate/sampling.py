@@ -15,7 +15,7 @@ edge is used (and scaled by the particle's actual speed).
 Between grid points the law of a neighbouring grid point is drawn with its
 interpolation weight and, by default (``interpolation="scaled"``), moved to the
 incident state: in α1 to the interpolated means and standard deviations, in
-|V⁻| by the wall's restitution law (:func:`surrogate.kernels.draw_velocity`).
+|V⁻| by the wall's restitution law (:func:`surrogate.kernels.draw.draw_velocity`).
 Each particle gets a status: 0 rebounded, 1 trapped (rolling along or
 deposited on the wall, drawn with its tabulated probability; its V⁺ and Ω⁺
 are NaN, not a made-up rebound).
@@ -28,11 +28,12 @@ from typing import NamedTuple
 import numpy as np
 
 from data_schema.samples import SHAPE_NAMES
-from surrogate.kernels import draw_local_batch_rng, rebound_batch_rng
-from surrogate.faults import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE, FAULT_NORMAL_NOT_FINITE,
-                              FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL, FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE,
-                              FAULT_VELOCITY_NOT_FINITE, FAULT_VELOCITY_ZERO, first_faults)
-from surrogate.rng import stream_states
+from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE,
+                                      FAULT_NORMAL_NOT_FINITE, FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL,
+                                      FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
+                                      FAULT_VELOCITY_ZERO, first_faults)
+from surrogate.kernels.parallel import draw_local_parallel_rng, rebound_parallel_rng
+from surrogate.kernels.rng import chunk_states
 from surrogate.table import SurrogateTable
 
 NORMAL_TOLERANCE = 1e-6
@@ -162,10 +163,10 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
     _check_range("speed", v, table.speed_range, clamp, "m/s")
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
-    states = stream_states(check_random_state(random_state), len(a))
+    states = chunk_states(check_random_state(random_state), len(a))
     out = np.empty((len(a), 6))
     status = np.empty(len(a), dtype=np.int8)
-    draw_local_batch_rng(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), states, out,
+    draw_local_parallel_rng(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), states, out,
                          status, scaled)
     return LocalDraws(alpha2=out[:, 0], beta2=out[:, 1], speed_ratio=out[:, 2], omega=out[:, 3:], status=status)
 
@@ -185,7 +186,7 @@ def _rows(x, n):
 
 
 def _check_incident(table: SurrogateTable, V, nrm, a, clamp: bool) -> None:
-    """The checks of :func:`sample_global` in one parallel pass (:func:`surrogate.faults.first_faults`):
+    """The checks of :func:`sample_global` in one parallel pass (:func:`surrogate.kernels.checks.first_faults`):
     raise for the first check, in FAULT_* order, that a row fails, naming that check's first such row.
     ``nrm`` and ``a`` have N rows or one for all."""
     first = first_faults(V, nrm, a, NORMAL_TOLERANCE, *table.alpha1_range, *table.speed_range)
@@ -195,7 +196,7 @@ def _check_incident(table: SurrogateTable, V, nrm, a, clamp: bool) -> None:
 
 
 def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueError:
-    """The error for check ``fault`` (surrogate.faults) failing first at particle i."""
+    """The error for check ``fault`` (surrogate.kernels.checks) failing first at particle i."""
     j, k = min(i, len(nrm) - 1), min(i, len(a) - 1)      # the rows of its normal and of its half-size
     if fault == FAULT_VELOCITY_NOT_FINITE:
         return ValueError(f"The 'velocity' vector at index {i} is not finite: {V[i].tolist()}.")
@@ -259,13 +260,13 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     shape : shape name or mix (see :func:`mix_cdf`).
     random_state : int, Generator or None. The uniforms are drawn inside the
         kernel, one xoshiro256+ stream per chunk of particles seeded from it
-        (:func:`surrogate.rng.stream_states`): the same seed gives the same
+        (:func:`surrogate.kernels.rng.chunk_states`): the same seed gives the same
         draws whatever the number of threads.
     interpolation : between grid points, ``"scaled"`` (default: the law of a
         neighbouring grid point drawn with its interpolation weight, then moved
         to the incident α1 by the interpolated means and standard deviations and
         to the incident speed by the wall's restitution law) or ``"stochastic"``
-        (the neighbour's law as is); see :func:`surrogate.kernels.draw_velocity`
+        (the neighbour's law as is); see :func:`surrogate.kernels.draw.draw_velocity`
         and docs/VALIDATION.md for how they compare.
     clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
         edge instead of raising. Never beyond the physical range: here every
@@ -293,8 +294,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     _check_incident(table, V, nrm, a, clamp)
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
-    V_out, W_out, status = _outputs(out, n_particles, (V, nrm, a))
-    states = stream_states(check_random_state(random_state), n_particles)
-    rebound_batch_rng(table.kernel_data, cdf, V, _rows(nrm, n_particles), _rows(a, n_particles), states, V_out, W_out,
+    V_out, Omega_out, status = _outputs(out, n_particles, (V, nrm, a))
+    states = chunk_states(check_random_state(random_state), n_particles)
+    rebound_parallel_rng(table.kernel_data, cdf, V, _rows(nrm, n_particles), _rows(a, n_particles), states, V_out, Omega_out,
                       status, scaled)
-    return V_out, W_out, status
+    return V_out, Omega_out, status

@@ -14,7 +14,7 @@ def run_cli(main, argv, capsys):
 def user_error(main, argv, capsys, *words):
     """Assert ``main(argv)`` ends in exactly one line on stderr and exit 2, holding every word; (line, stdout)."""
     code, err, out = run_cli(main, argv, capsys)
-    assert code == 2 and len(err) == 1, err
+    assert code == 2 and len(err) == 1 and ": error: " in err[0], err
     for word in words:
         assert word in err[0], err[0]
     return err[0], out

@@ -36,7 +36,7 @@ def test_runtime_sampler_examples_run_and_draw_one_law(small_table_path):
     drawn = {"sample_global": _run(numpy_api, namespace, small_table_path)}
     drawn["rebound_many_rng"] = _run(numba_api, namespace, small_table_path)
     V, n = namespace["V"], namespace["normals"]
-    per_particle = {k: np.empty_like(namespace[k]) for k in ("V_out", "W_out", "status")}
+    per_particle = {k: np.empty_like(namespace[k]) for k in ("V_out", "Omega_out", "status")}
     namespace["bounce_hits"](namespace["data"], namespace["cdf"], V, namespace["n"], namespace["a"],
                              namespace["surrogate"].seed_state(2), *per_particle.values())
     drawn["rebound_tuple loop"] = per_particle

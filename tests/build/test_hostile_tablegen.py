@@ -2,6 +2,7 @@
 128 + the signal), before the expensive work where it can be, and nothing of the user's is replaced or left
 half-written."""
 
+import functools
 import os
 import shutil
 import signal
@@ -20,10 +21,10 @@ from data_schema.common import DataFormatError
 from data_schema.output import FOLDER_MARKER, OutputError, kind_of, remove_stale_temporaries, write_output
 from data_schema.table import TABLE_FILE_TYPE
 from tablegen.build.driver import Checkpoint, CheckpointError, build_table, model_sha256, worker_count
+from tablegen.build.config import parse_config
 from tablegen.cli import main
 
 from cli_helpers import run_cli, user_error
-from tablegen.build.config import parse_config
 
 TINY = """
 [grid]
@@ -39,14 +40,8 @@ SLOW = TINY.replace("particles_per_cell = 256", "particles_per_cell = 200000").r
     "alpha1_deg = [30.0, 80.0]", "alpha1_deg = [30.0, 40.0, 50.0, 60.0, 70.0, 80.0]")
 
 
-def _run(argv, capsys):
-    return run_cli(main, argv, capsys)
-
-
-def _user_error(argv, capsys, *words):
-    line, out = user_error(main, argv, capsys, *words)
-    assert line.startswith("tablegen ")
-    return line, out
+_run = functools.partial(run_cli, main)               # (exit status, stderr lines, stdout)
+_user_error = functools.partial(user_error, main)     # one line on stderr, exit 2: (line, stdout)
 
 
 @pytest.fixture

@@ -1,27 +1,29 @@
-"""Memory access for numba kernels: cache hints and plain loads.
-
-``prefetch(array, index)`` starts loading the cache line of ``array[index]``.
-It compiles to LLVM's ``llvm.prefetch`` (read, locality 2: ``prefetcht1`` on
-x86, which fills the level-2 cache and not the level-1), an instruction that
-neither waits for the data nor faults on any address. The sampler's
-kernels (:mod:`surrogate.kernels`) use it to have a draw's table reads, or
-those of many particles, in flight at once instead of one dependent cache
-miss after another. Into level 2 rather than level 1 because the level-2
-cache keeps more misses in flight: ``rebound_many`` requests about 15 lines
-per particle for 16 particles at once, and on the 51 MB (six-speed) default table it
-cost 157–160 ns per draw with level-1 hints (locality 3) and 141–142 ns with
-level-2 hints (interleaved runs, one process; locality 1 measured the same
-as 2, non-temporal 159 ns; the per-particle kernel did not change).
+"""Memory access for the kernels: plain loads, strided loads as tuples, and cache hints.
 
 ``load(array, index)`` reads ``array[index]`` of a 1-D array at a computed
-offset without numba's negative-index wrap-around: the kernels address the
-table's flat arrays by offsets that are ≥ 0 by construction.
+offset without numba's negative-index wrap-around (the kernels address the
+table's flat arrays by offsets that are ≥ 0 by construction).
+:func:`load3`, :func:`load6` and :func:`load15` read 3, 6 or 15 values at a
+stride as a tuple of float64 (a table row, or a particle's fields in a block
+scratch array).
+
+``prefetch(array, index)`` starts loading the cache line of ``array[index]``:
+LLVM's ``llvm.prefetch`` (read, locality 2: ``prefetcht1`` on x86, into the
+level-2 cache, which keeps more misses in flight than level 1), neither
+waiting for the data nor faulting on any address. The kernels use it to have a
+draw's table reads, or those of a block of particles, in flight at once
+instead of one dependent cache miss after another (docs/design/sampler_cost.md
+has the measurements).
 """
 
+import numba
+import numpy as np
 from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
+
+from surrogate.kernels.options import JIT
 
 
 @intrinsic
@@ -63,3 +65,21 @@ def load(typingctx, array, index):
         return context.unpack_value(builder, array_type.dtype, pointer)
 
     return array.dtype(array, index), codegen
+
+
+@numba.njit(inline="always", **JIT)
+def load3(x, at, step):
+    """x[at + j·step] for j = 0, 1, 2, as float64."""
+    return np.float64(load(x, at)), np.float64(load(x, at + step)), np.float64(load(x, at + 2 * step))
+
+
+@numba.njit(inline="always", **JIT)
+def load6(x, at, step):
+    """x[at + j·step] for j = 0 … 5, as float64."""
+    return load3(x, at, step) + load3(x, at + 3 * step, step)
+
+
+@numba.njit(inline="always", **JIT)
+def load15(x, at, step):
+    """x[at + j·step] for j = 0 … 14, as float64 (the slopes of a component row)."""
+    return load6(x, at, step) + load6(x, at + 6 * step, step) + load3(x, at + 12 * step, step)

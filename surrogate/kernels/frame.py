@@ -2,8 +2,8 @@
 
 The frame of a hit is (ex, n, ez): ex the direction of the tangential part of
 the incident velocity V⁻, n the wall's unit normal (into the gas), ez = ex × n.
-In it the local draws of :mod:`surrogate.draw` live (α1 from the wall, impact
-plane spanned by ex and n). :func:`impact_frame` builds it, :func:`_to_global`
+In it the local draws of :mod:`surrogate.kernels.draw` live (α1 from the wall, impact
+plane spanned by ex and n). :func:`impact_frame` builds it, :func:`to_global`
 turns a local draw back into V⁺ (m/s) and Ω⁺ (rad/s) in the caller's frame.
 """
 
@@ -13,12 +13,12 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED
-from surrogate.fused import fma
-from surrogate.jit import JIT
-from surrogate.trig import atan2_first_quadrant, sincos
+from surrogate.kernels.fastmath import atan2_first_quadrant, fma, sincos
+from surrogate.kernels.options import JIT
 
 
-STATUS_INVALID = -1     # returned by :func:`surrogate.kernels.rebound` for an incident state that does not hit the wall
+STATUS_INVALID = -1     # the status of an incident state that does not move into the wall
+NORMAL_IMPACT = 1e-12   # a tangential speed below this fraction of |V| is normal impact: ex drawn in the wall plane
 
 
 @numba.njit(inline="always", **JIT)
@@ -26,15 +26,15 @@ def impact_frame(V, n, u_axis):
     """Impact frame of V on a wall of unit normal n.
 
     ex is the direction of the tangential part of V (uniform in the wall plane,
-    from ``u_axis``, at normal impact: tangential part below 1e-12 |V|); the
+    from ``u_axis``, at normal impact: tangential part below NORMAL_IMPACT |V|); the
     frame is (ex, n, ez = ex × n). Returns (α1 in degrees, |V|, cos α1, sin α1,
     ex, ez) with ex and ez as 3-tuples.
     """
-    vn = _dot(V, n)
+    vn = dot(V, n)
     tx, ty, tz = fma(-vn, n[0], V[0]), fma(-vn, n[1], V[1]), fma(-vn, n[2], V[2])
     vt = math.sqrt(fma(tx, tx, fma(ty, ty, tz * tz)))
     speed = math.sqrt(fma(vn, vn, vt * vt))
-    if vt > 1e-12 * speed:
+    if vt > NORMAL_IMPACT * speed:
         inv = 1.0 / vt
         ex0, ex1, ex2 = tx * inv, ty * inv, tz * inv
     else:
@@ -55,29 +55,29 @@ def impact_frame(V, n, u_axis):
     return (math.degrees(atan2_first_quadrant(-vn, vt)), speed, vt * inv_speed, -vn * inv_speed, (ex0, ex1, ex2), ez)
 
 
-_NAN3 = (np.nan, np.nan, np.nan)     # the V⁺ and Ω⁺ of a draw that did not rebound
+NAN3 = (np.nan, np.nan, np.nan)     # the V⁺ and Ω⁺ of a draw that did not rebound
 
 
 @numba.njit(inline="always", **JIT)
-def _moves_into_wall(V, n):
+def moves_into_wall(V, n):
     """V·n < 0 and V finite."""
-    return _dot(V, n) < 0.0 and math.isfinite(V[0] + V[1] + V[2])
+    return dot(V, n) < 0.0 and math.isfinite(V[0] + V[1] + V[2])
 
 
 @numba.njit(inline="always", **JIT)
-def _dot(a, b):
+def dot(a, b):
     """a·b of two 3-vectors (tuples or arrays), the same bits wherever it is inlined."""
     return fma(a[0], b[0], fma(a[1], b[1], a[2] * b[2]))
 
 
 @numba.njit(inline="always", **JIT)
-def _to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
+def to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
     """A local draw (units |V⁻|, |V⁻|/a) as (V⁺ in m/s, Ω⁺ in rad/s) in the frame (ex, n, ez), 3-tuples;
     NaN unless rebounded."""
     if status != STATUS_REBOUNDED:
-        return _NAN3, _NAN3
+        return NAN3, NAN3
     w = speed / a
     v, o = (vx, vy, vz), (wx, wy, wz)
-    return ((speed * _dot(v, (ex[0], n[0], ez[0])), speed * _dot(v, (ex[1], n[1], ez[1])),
-             speed * _dot(v, (ex[2], n[2], ez[2]))),
-            (w * _dot(o, (ex[0], n[0], ez[0])), w * _dot(o, (ex[1], n[1], ez[1])), w * _dot(o, (ex[2], n[2], ez[2]))))
+    return ((speed * dot(v, (ex[0], n[0], ez[0])), speed * dot(v, (ex[1], n[1], ez[1])),
+             speed * dot(v, (ex[2], n[2], ez[2]))),
+            (w * dot(o, (ex[0], n[0], ez[0])), w * dot(o, (ex[1], n[1], ez[1])), w * dot(o, (ex[2], n[2], ez[2]))))

@@ -1,6 +1,6 @@
 """The sampler kernels' inlined functions against their closed forms: the fused multiply-add, sincos,
 first-quadrant atan2, the polynomial pieces of the wall's restitution factor exp(−k V^p), and the plain
-load of surrogate.memory."""
+load of surrogate.kernels.memory."""
 
 import math
 
@@ -8,10 +8,8 @@ import numba
 import numpy as np
 import pytest
 
-from surrogate.fused import fma
-from surrogate.memory import load
-from surrogate.restitution import restitution_at, restitution_pieces
-from surrogate.trig import atan2_first_quadrant, sincos
+from surrogate.kernels.fastmath import atan2_first_quadrant, fma, restitution_at, restitution_pieces, sincos
+from surrogate.kernels.memory import load
 
 ULP_ONE = np.spacing(1.0)     # 2.2e-16
 

@@ -1,27 +1,27 @@
 """A small, fast random source for numba solver loops: xoshiro256+ uniforms.
 
-Drawing the :data:`surrogate.kernels.U_PER_DRAW` uniforms of a rebound with
+Drawing the :data:`surrogate.kernels.draw.U_PER_DRAW` uniforms of a rebound with
 ``np.random.random()`` inside numba costs about as much as the rebound
 itself. xoshiro256+ (Blackman & Vigna 2018) produces a 53-bit uniform in a
 few integer operations from a state of four 64-bit words that the caller
 owns: one state per thread (or per particle stream) keeps a parallel solver
 reproducible whatever the scheduling.
 
-The block kernels (:func:`surrogate.kernels.rebound_many_rng`) draw from 32
-lanes, xoshiro256+ generators seeded from the caller's state with splitmix64
+Words: a *stream* is one xoshiro256+ state and the uniforms it gives; the
+pipeline (:func:`surrogate.kernels.pipeline.rebound_many_rng`) draws from
+BLOCK *lanes*, streams seeded from the caller's state with splitmix64
 (:func:`seed_lanes`) and stepped together as SIMD instructions
-(:func:`fill_lanes`): one stream's steps depend on each other, so 13 uniforms
-cost about 11 ns from one stream and about 3 ns from the lanes. The batch
-kernels (:func:`surrogate.kernels.rebound_batch_rng`) draw rows in chunks of
-:data:`ROWS_PER_STREAM`, chunk j from its own state (:func:`stream_states`),
-so their draws do not depend on the number of threads.
+(:func:`fill_lanes`), since one stream's steps depend on each other; the
+parallel kernels (:mod:`surrogate.kernels.parallel`) cut their rows into
+*chunks* of :data:`CHUNK_ROWS`, chunk j drawn from its own stream
+(:func:`chunk_states`), so their draws do not depend on the number of threads.
 
 Usage from a solver's ``@njit`` loop::
 
-    state = surrogate.rng.seed_state(1234)           # NumPy side, (4,) uint64
+    state = surrogate.seed_state(1234)               # NumPy side, (4,) uint64
     ...
     fill_uniforms(state, u)                          # inside numba: u[:] = next uniforms
-    status = rebound(data, mix_cdf, V, n, a, u, V_out, W_out)
+    status = rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out)
 
 :func:`seed_state` with ``n_streams`` gives independent states (rows) from
 one seed, through NumPy's ``SeedSequence``.
@@ -33,7 +33,7 @@ import numba
 import numpy as np
 
 _53_BITS = 1.0 / 9007199254740992.0      # 2**-53
-ROWS_PER_STREAM = 1024      # rows a batch kernel draws from one state (one chunk of its parallel loop)
+CHUNK_ROWS = 1024      # rows of a chunk: the unit of work of the parallel kernels, drawn from one stream
 
 
 def seed_state(seed: int, n_streams: int | None = None) -> np.ndarray:
@@ -54,15 +54,15 @@ def seed_state(seed: int, n_streams: int | None = None) -> np.ndarray:
 
 
 @numba.njit(inline="always", cache=True, nogil=True)
-def n_streams(n_rows):
-    """Chunks of ROWS_PER_STREAM rows (the last may be partial) in a batch of ``n_rows``."""
-    return (n_rows + ROWS_PER_STREAM - 1) // ROWS_PER_STREAM
+def n_chunks(n_rows):
+    """Chunks of CHUNK_ROWS rows (the last may be partial) in ``n_rows`` rows."""
+    return (n_rows + CHUNK_ROWS - 1) // CHUNK_ROWS
 
 
-def stream_states(generator: np.random.Generator, n_rows: int) -> np.ndarray:
-    """xoshiro256+ states for a batch of ``n_rows`` draws: (⌈n_rows / ROWS_PER_STREAM⌉, 4) uint64, one per
+def chunk_states(generator: np.random.Generator, n_rows: int) -> np.ndarray:
+    """xoshiro256+ states for the chunks of ``n_rows`` draws: (⌈n_rows / CHUNK_ROWS⌉, 4) uint64, one per
     chunk of rows, drawn from ``generator`` (so a seeded Generator gives the same batch every time)."""
-    state = generator.integers(0, np.iinfo(np.uint64).max, size=(n_streams(int(n_rows)), 4), dtype=np.uint64,
+    state = generator.integers(0, np.iinfo(np.uint64).max, size=(n_chunks(int(n_rows)), 4), dtype=np.uint64,
                                endpoint=True)
     state[np.all(state == 0, axis=1), 0] = 1
     return state

@@ -1,13 +1,25 @@
-"""One draw from a table in the local frame: grid look-up, table reads, the chain, the move to the incident state.
+"""The law of one draw, in three public stages: :func:`locate`, :func:`gather`, :func:`arithmetic`.
+
+1. :func:`locate` — the cell a draw reads: the shape from the mix, the grid
+   intervals of α1 and |V⁻| (:func:`grid_interval`) and the neighbour drawn
+   with its interpolation weight;
+2. :func:`gather` — every table value the draw needs (the component the alias
+   table picks, its residual quantiles and slopes, the moments and the
+   restitution factors that move it to the incident state), as a tuple;
+   :func:`hint` requests its cache lines ahead;
+3. :func:`arithmetic` — the reflected state from those values alone, with
+   every choice a select, so the block pipeline runs it as a SIMD loop
+   (:mod:`surrogate.kernels.pipeline`) and one particle
+   (:mod:`surrogate.kernels.particle`) calls the same function: the two give
+   the same bits by construction.
 
 These are plain functions over the arrays of a table (``table.kernel_data``,
-a named tuple of flat arrays and their sizes, :class:`surrogate.table.KernelData`)
-and pre-drawn uniforms. Every draw consumes exactly :data:`U_PER_DRAW`
-uniforms from [0, 1)::
+:class:`surrogate.kernels.layout.KernelData`) and pre-drawn uniforms. Every
+draw consumes exactly :data:`U_PER_DRAW` uniforms from [0, 1)::
 
     u[0] shape from the mix        u[1] α1 neighbour       u[2] speed neighbour
     u[3] trapped or not            u[4] mixture component  u[5:11] the six chain variables
-    u[11] mirror sign              u[12] in-wall axis at normal impact (:func:`surrogate.frame.impact_frame`)
+    u[11] mirror sign              u[12] in-wall axis at normal impact (:func:`surrogate.kernels.frame.impact_frame`)
 
 Between grid points the sampler uses stochastic interpolation: the cell of the
 neighbour at x_{j+1} is used with probability w = (x − x_j)/(x_{j+1} − x_j), as
@@ -19,20 +31,19 @@ state drawn from the neighbour is then moved to the incident state:
   linearly between the two neighbouring α1 (like the unit-base interpolation
   of transport codes, which stretches a neighbour's secondary law to the
   interpolated range);
-* in |V⁻|, by the wall's restitution law (:func:`_to_speed`), with a law that
+* in |V⁻|, by the wall's restitution law (:func:`to_speed`), with a law that
   depends on the drawn cluster's collision regime: the velocity change and
   the spin of a rebound of one or two collisions scale with 1 + a(V), the
   normal rebound velocity of a longer one with a(V).
 
-The hot path calls no libm function (:mod:`surrogate.trig`,
-:mod:`surrogate.restitution`) and branches only where the outcome is
-predictable (trapped, outside the grid); choices that vary from draw to draw
-(neighbour cell, alias, regime, mirror sign, quadrant) are selects.
+The hot path calls no libm function (:mod:`surrogate.kernels.fastmath`) and
+branches only where the outcome is predictable (trapped, outside the grid);
+choices that vary from draw to draw (neighbour cell, alias, regime, mirror
+sign, quadrant) are selects.
 
 Frame and units: the model's lab frame (wall y = 0, normal +Y, impact plane
 XY, α1 from the wall); angles in radians except α1 (degrees), V⁺ in units of
-|V⁻|, Ω in units of |V⁻|/a. The global-frame kernels built on these are in
-:mod:`surrogate.kernels`.
+|V⁻|, Ω in units of |V⁻|/a.
 """
 
 import math
@@ -41,24 +52,22 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from surrogate.fused import fma
-from surrogate.jit import JIT, KERNEL
-from surrogate.memory import load, prefetch
-from surrogate.restitution import restitution_at
-from surrogate.table import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD,
-                             CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE,
-                             ROW_SIZE, ROW_SLOPE)
-from surrogate.trig import sincos
+from surrogate.kernels.fastmath import fma, restitution_at, sincos
+from surrogate.kernels.layout import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED,
+                                      CELL_SD, CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE,
+                                      ROW_SHAPE, ROW_SIZE, ROW_SLOPE)
+from surrogate.kernels.memory import load, load15, prefetch
+from surrogate.kernels.options import JIT, KERNEL
 
 
 U_PER_DRAW = 13
 
 
 @numba.njit(inline="always", **JIT)
-def locate(axis, n, x):
+def grid_interval(axis, n, x):
     """(j, w): grid interval [g_j, g_{j+1}] holding x and the weight of g_{j+1} (O(1)).
 
-    ``axis`` is the record of an n-point grid (:func:`surrogate.table.axis_record`).
+    ``axis`` is the record of an n-point grid (:func:`surrogate.kernels.layout.axis_record`).
     Outside the grid, the nearest edge with weight 0 or 1; a one-point grid gives (0, 0).
     """
     if n == 1:
@@ -87,7 +96,7 @@ def _level(data, cell, k, i):
 
 
 @numba.njit(inline="always", **JIT)
-def _first_row(data, cell, u4):
+def first_row(data, cell, u4):
     """(t, c, offset of row c): the component u4 picks in cell number ``cell`` before the alias table,
     c = ⌊t⌋ with t = u4 · n_clusters."""
     t = u4 * data.n_clusters
@@ -96,31 +105,13 @@ def _first_row(data, cell, u4):
 
 
 @numba.njit(inline="always", **JIT)
-def _component(data, cell, u4):
+def component(data, cell, u4):
     """Offset in ``data.clusters`` of the mixture component u4 draws in cell number ``cell``: Walker's
     alias table (one multiply, one floor, one compare; the alias sits in the row's first cache line)."""
-    t, c, row = _first_row(data, cell, u4)
+    t, c, row = first_row(data, cell, u4)
     alias = int(load(data.clusters, row + ROW_ALIAS))
     c = alias if t - c >= load(data.clusters, row + ROW_ALIAS_PROB) else c
     return _row(data, cell, c)
-
-
-@numba.njit(inline="always", **JIT)
-def _three(x, at, step):
-    """x[at + j·step] for j = 0, 1, 2, as float64."""
-    return np.float64(load(x, at)), np.float64(load(x, at + step)), np.float64(load(x, at + 2 * step))
-
-
-@numba.njit(inline="always", **JIT)
-def _six(x, at, step):
-    """x[at + j·step] for j = 0 … 5, as float64."""
-    return _three(x, at, step) + _three(x, at + 3 * step, step)
-
-
-@numba.njit(inline="always", **JIT)
-def _fifteen(x, at, step):
-    """x[at + j·step] for j = 0 … 14, as float64 (the slopes of a component row)."""
-    return _six(x, at, step) + _six(x, at + 6 * step, step) + _three(x, at + 12 * step, step)
 
 
 @numba.njit(inline="always", **JIT)
@@ -183,21 +174,6 @@ def _folded(alpha2, beta2, s, wx, wy, wz):
 
 
 @numba.njit(inline="always", **JIT)
-def draw_folded(data, cell, u):
-    """The folded state (α2, |β2|, s, Ω_x, Ω_y, Ω_z) of cell number ``cell`` from u[4:11], and its regime.
-
-    Representation (data_schema.table): u[4] picks the mixture component with
-    the Walker alias table (:func:`_component`), u[5:11] the residual
-    quantiles (:func:`_quantiles`) of the chain (:func:`_chain`). Arrays are read by scalar indices
-    only (no views, so no reference counting on the hot path).
-    """
-    r = data.clusters
-    row = _component(data, cell, u[4])
-    state = _chain(_quantiles(data, cell, row, u), _fifteen(r, row + ROW_SLOPE, 1))
-    return state + (np.float64(load(r, row + ROW_REGIME)),)
-
-
-@numba.njit(inline="always", **JIT)
 def _alpha1_terms(data, below, wa, drawn):
     """What moves a state drawn from cell ``drawn`` to the incident α1: (ratio, m_cell, m), six-tuples in
     state order, for x' = m + (x − m_cell) · ratio (:func:`_moved`).
@@ -256,17 +232,17 @@ def _velocity(alpha2, beta2, s):
 
 
 @numba.njit(inline="always", **JIT)
-def _restitution_factors(data, jv, wv, iv):
+def restitution_factors(data, jv, wv, iv):
     """exp(−k V^p) at the incident speed V = V_jv + wv (V_jv+1 − V_jv) and at the drawn grid speed V_iv."""
     return restitution_at(data.restitution_pieces, data.n_pieces, jv, wv), np.float64(load(data.speed_restitution, iv))
 
 
 @numba.njit(inline="always", **JIT)
-def _to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, wy, wz):
+def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, wy, wz):
     """A rebound drawn at grid speed V_iv, moved to the incident speed V; returns (vx, vy, vz, wx, wy, wz).
 
     ``f_target``, ``f_grid``: exp(−k V^p) at V and at V_iv
-    (:func:`_restitution_factors`). Local frame, V⁺ in units of |V⁻|, Ω⁺ in
+    (:func:`restitution_factors`). Local frame, V⁺ in units of |V⁻|, Ω⁺ in
     units of |V⁻|/a. With a(V) = 1 − (1 − exp(−k V^p)) sin α1, the normal
     restitution of the wall law for a contact point moving like the centre
     of mass:
@@ -295,101 +271,79 @@ def _to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, 
     return vx_few if few else vx, vy_few if few else vy * f, g * vz, g * wx, g * wy, g * wz
 
 
+# -- stage 1: locate -------------------------------------------------------------
+
 @numba.njit(inline="always", **JIT)
-def _cell(data, mix_cdf, alpha1, speed, u):
+def locate(data, mix_cdf, alpha1, speed, u):
     """The cell a draw reads: (drawn, below, wa, jv, wv, iv).
 
     Shape from u[0] and the mix; grid intervals (ja, jv) with the weights of
     their upper points (wa, wv); the neighbour cell (ia, iv) drawn with those
     weights from u[1], u[2] (stochastic interpolation). ``drawn`` is the
-    number of cell (shape, ia, iv) (:class:`surrogate.table.KernelData`),
+    number of cell (shape, ia, iv) (:class:`surrogate.kernels.layout.KernelData`),
     ``below`` that of (shape, ja, iv), the lower α1 neighbour at the drawn speed.
     """
     shape = 0
     for k in range(mix_cdf.shape[0] - 1):     # the first k with u[0] < cdf[k], without data-dependent branches
         shape += u[0] >= mix_cdf[k]
-    ja, wa = locate(data.alpha1_axis, data.n_alpha1, alpha1)
-    jv, wv = locate(data.speed_axis, data.n_speed, speed)
+    ja, wa = grid_interval(data.alpha1_axis, data.n_alpha1, alpha1)
+    jv, wv = grid_interval(data.speed_axis, data.n_speed, speed)
     ia = ja + (u[1] < wa)       # integer + comparison: no branch to mispredict
     iv = jv + (u[2] < wv)
     below = (shape * data.n_alpha1 + ja) * data.n_speed + iv
     return below + (ia - ja) * data.n_speed, below, wa, jv, wv, iv
 
 
+# -- stage 2: gather --------------------------------------------------------------
+
 @numba.njit(inline="always", **JIT)
-def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
-    """One reflected state at (α1 deg, |V⁻| m/s) as local-frame vectors.
-
-    ``mix_cdf`` is the cumulative shape weights in the table's shape order
-    (last entry 1). Returns (status, V⁺_x, V⁺_y, V⁺_z, Ω_x, Ω_y, Ω_z) with
-    V⁺ in units of |V⁻| and Ω⁺ in units of |V⁻|/a; NaN for a trapped
-    particle. Outside the table's grid the law at the nearest grid edge is used.
-
-    Between grid points the cell of a neighbour is drawn with its
-    interpolation weight (stochastic interpolation). With ``scaled`` the
-    draw is then moved to the incident state: in α1 to the interpolated
-    means and standard deviations (:func:`_moved`), in |V⁻| by the wall's
-    restitution law (:func:`_to_speed`).
-    """
-    cell = _cell(data, mix_cdf, alpha1, speed, u)
-    _hint_draw(data, cell, u)
-    sin_a1, cos_a1 = sincos(math.radians(alpha1))
-    return _draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
+def is_trapped(data, drawn, u3):
+    """Whether u[3] draws the trapped outcome in cell number ``drawn``."""
+    return u3 < load(data.cells, drawn * CELL_SIZE + CELL_P_TRAPPED)
 
 
 @numba.njit(inline="always", **JIT)
-def _draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
-    """:func:`draw_velocity` once its cell (:func:`_cell`) is known; α1 given by its cosine and sine."""
+def gather_component(data, drawn, row, u):
+    """What a draw reads from its component (at offset ``row`` in cell number ``drawn``, :func:`component`):
+    (residual quantiles at u[5:11], the 15 slopes, regime, trapped flag (1.0 or 0.0), mirror uniform u[11])."""
+    r = data.clusters
+    trapped = 1.0 if is_trapped(data, drawn, u[3]) else 0.0
+    return (_quantiles(data, drawn, row, u), load15(r, row + ROW_SLOPE, 1), np.float64(load(r, row + ROW_REGIME)),
+            trapped, u[11])
+
+
+@numba.njit(inline="always", **JIT)
+def gather_cell(data, cell):
+    """What a draw reads from its cell and the grid to move it to the incident state: (wa, wv, the six α1
+    ratios, (m_cell, m) of α2, s and Ω_z (:func:`_alpha1_terms`; the other variables are centred), the
+    restitution factors at the incident and the drawn speed)."""
     drawn, below, wa, jv, wv, iv = cell
-    if u[3] < load(data.cells, drawn * CELL_SIZE + CELL_P_TRAPPED):
-        return STATUS_TRAPPED, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-    folded = draw_folded(data, drawn, u)
-    state, regime = folded[:6], folded[6]
-    if scaled and wa > 0.0:
-        state = _moved(state, _alpha1_terms(data, below, wa, drawn))
-    alpha2, beta2, s, wx, wy, wz = state
-    vx, vy, vz = _velocity(alpha2, beta2, s)
-    if scaled and wv > 0.0:
-        f_target, f_grid = _restitution_factors(data, jv, wv, iv)
-        vx, vy, vz, wx, wy, wz = _to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, wy, wz)
-    return _mirrored(u[11], vx, vy, vz, wx, wy, wz)
+    f_target, f_grid = restitution_factors(data, jv, wv, iv)
+    t = _alpha1_terms(data, below, wa, drawn)
+    return (wa, wv, (t[0][0], t[1][0], t[2][0], t[3][0], t[4][0], t[5][0]), t[0][1:] + t[2][1:] + t[5][1:],
+            f_target, f_grid)
 
 
 @numba.njit(inline="always", **JIT)
-def _mirrored(u, vx, vy, vz, wx, wy, wz):
-    """(STATUS_REBOUNDED, state) with the mirror symmetry Z → −Z applied when u < 1/2."""
-    mirror = -1.0 if u < 0.5 else 1.0
-    return STATUS_REBOUNDED, vx, vy, mirror * vz, mirror * wx, mirror * wy, wz
-
-
-@numba.njit(**KERNEL)
-def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
-    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame: (status, α2, β2, s, Ω_x, Ω_y, Ω_z).
-
-    Angles in radians, s = |V⁺|/|V⁻|, Ω in units of |V⁻|/a; the state is NaN
-    for a trapped particle. See :func:`draw_velocity` (same arguments).
-    """
-    status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
-    if status != STATUS_REBOUNDED:
-        return status, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
-    s = math.sqrt(vx * vx + vy * vy + vz * vz)
-    return status, math.atan2(vy, vx), math.asin(vz / s) if s > 0.0 else 0.0, s, wx, wy, wz
+def gather(data, cell, row, u):
+    """Every table value a draw in ``cell`` (:func:`locate`) with component ``row`` needs:
+    :func:`gather_component` + :func:`gather_cell`, the arguments of :func:`arithmetic`."""
+    return gather_component(data, cell[0], row, u) + gather_cell(data, cell)
 
 
 @numba.njit(inline="always", **JIT)
-def _hint_draw(data, cell, u):
-    """Cache hints (:func:`surrogate.memory.prefetch`) for the table reads of a draw in ``cell`` that
+def hint(data, cell, u):
+    """Cache hints (:func:`surrogate.kernels.memory.prefetch`) for the table reads of a draw in ``cell`` that
     the uniforms alone locate, so that they are all in flight at once: the component row u[4] picks
     (before its alias is resolved) and the residual-shape levels u[5:11] pick (the dictionary is
-    level-major, so these lines do not depend on the row). Without them the row and then the
-    dictionary would each wait for memory in turn. (Hints for the small arrays, the trapped
-    probabilities and the moments, measured slower: they stay cached.)"""
-    _hint_row(data, _first_row(data, cell[0], u[4])[2])
-    _hint_levels(data, cell[0], u)
+    level-major, so these lines do not depend on the row). The trapped probabilities and the moments are
+    small and stay cached."""
+    hint_row(data, first_row(data, cell[0], u[4])[2])
+    hint_levels(data, cell[0], u)
 
 
 @numba.njit(inline="always", **JIT)
-def _hint_row(data, row):
+def hint_row(data, row):
     """Cache hints for the component row at offset ``row``: its three cache lines (144 bytes, the start
     16-byte aligned)."""
     for j in range(0, ROW_SIZE, 16):
@@ -397,7 +351,7 @@ def _hint_row(data, row):
 
 
 @numba.njit(inline="always", **JIT)
-def _hint_levels(data, drawn, u):
+def hint_levels(data, drawn, u):
     """Cache hints for the residual-shape levels u[5:11] pick in cell number ``drawn`` (two per variable;
     ``u`` a row of uniforms or a tuple)."""
     _hint_level(data, drawn, 0, u[5])
@@ -415,3 +369,94 @@ def _hint_level(data, drawn, k, u):
     level = _level(data, drawn, k, min(int(u * levels), levels - 1))
     prefetch(data.dictionary, (level,))
     prefetch(data.dictionary, (level + data.n_dictionary,))
+
+
+# -- stage 3: arithmetic ----------------------------------------------------------
+
+@numba.njit(inline="always", **JIT)
+def arithmetic(gathered, cos_alpha1, sin_alpha1, scaled):
+    """The reflected state from the values :func:`gather` returns, at cos α1, sin α1:
+    (status, V⁺_x, V⁺_y, V⁺_z, Ω_x, Ω_y, Ω_z), local frame, V⁺ in units of |V⁻|, Ω in units of |V⁻|/a;
+    NaN and STATUS_TRAPPED when trapped.
+
+    The chain (:func:`_chain`), then with ``scaled`` the move to the incident α1 when wa > 0
+    (:func:`_moved`) and to the incident speed when wv > 0 (:func:`to_speed`), then the mirror sign.
+    No table read and no branch (every choice a select), so a loop of it over a block of particles runs
+    as SIMD instructions.
+    """
+    q, slopes, regime, trapped, mirror, wa, wv, ratio, shift, f_target, f_grid = gathered
+    state = _chain(q, slopes)
+    terms = ((ratio[0], shift[0], shift[1]), (ratio[1], 0.0, 0.0), (ratio[2], shift[2], shift[3]),
+             (ratio[3], 0.0, 0.0), (ratio[4], 0.0, 0.0), (ratio[5], shift[4], shift[5]))
+    state = _pick6(scaled and wa > 0.0, _moved(state, terms), state)
+    vx, vy, vz = _velocity(state[0], state[1], state[2])
+    local = (vx, vy, vz, state[3], state[4], state[5])
+    moved = to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, state[3], state[4], state[5])
+    vx, vy, vz, wx, wy, wz = _pick6(scaled and wv > 0.0, moved, local)
+    status, vx, vy, vz, wx, wy, wz = _mirrored(mirror, vx, vy, vz, wx, wy, wz)
+    out = _pick6(trapped > 0.5, _NAN6, (vx, vy, vz, wx, wy, wz))
+    return (STATUS_TRAPPED if trapped > 0.5 else status,) + out
+
+
+_NAN6 = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan)
+
+
+@numba.njit(inline="always", **JIT)
+def _pick6(c, x, y):
+    """x if c else y for two 6-tuples, element by element (selects, which vectorise)."""
+    return (x[0] if c else y[0], x[1] if c else y[1], x[2] if c else y[2], x[3] if c else y[3],
+            x[4] if c else y[4], x[5] if c else y[5])
+
+
+@numba.njit(inline="always", **JIT)
+def _mirrored(u, vx, vy, vz, wx, wy, wz):
+    """(STATUS_REBOUNDED, state) with the mirror symmetry Z → −Z applied when u < 1/2."""
+    mirror = -1.0 if u < 0.5 else 1.0
+    return STATUS_REBOUNDED, vx, vy, mirror * vz, mirror * wx, mirror * wy, wz
+
+
+# -- one draw in the local frame -----------------------------------------------------
+
+@numba.njit(inline="always", **JIT)
+def draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
+    """:func:`draw_velocity` once its cell (:func:`locate`) is known and its reads hinted; α1 given by its
+    cosine and sine. A trapped draw reads nothing more."""
+    drawn = cell[0]
+    if is_trapped(data, drawn, u[3]):
+        return (STATUS_TRAPPED,) + _NAN6
+    return arithmetic(gather(data, cell, component(data, drawn, u[4]), u), cos_alpha1, sin_alpha1, scaled)
+
+
+@numba.njit(inline="always", **JIT)
+def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
+    """One reflected state at (α1 deg, |V⁻| m/s) as local-frame vectors.
+
+    ``mix_cdf`` is the cumulative shape weights in the table's shape order
+    (last entry 1). Returns (status, V⁺_x, V⁺_y, V⁺_z, Ω_x, Ω_y, Ω_z) with
+    V⁺ in units of |V⁻| and Ω⁺ in units of |V⁻|/a; NaN for a trapped
+    particle. Outside the table's grid the law at the nearest grid edge is used.
+
+    Between grid points the cell of a neighbour is drawn with its
+    interpolation weight (stochastic interpolation). With ``scaled`` the
+    draw is then moved to the incident state: in α1 to the interpolated
+    means and standard deviations (:func:`_moved`), in |V⁻| by the wall's
+    restitution law (:func:`to_speed`).
+    """
+    cell = locate(data, mix_cdf, alpha1, speed, u)
+    hint(data, cell, u)
+    sin_a1, cos_a1 = sincos(math.radians(alpha1))
+    return draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
+
+
+@numba.njit(**KERNEL)
+def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
+    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame: (status, α2, β2, s, Ω_x, Ω_y, Ω_z).
+
+    Angles in radians, s = |V⁺|/|V⁻|, Ω in units of |V⁻|/a; the state is NaN
+    for a trapped particle. See :func:`draw_velocity` (same arguments).
+    """
+    status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
+    if status != STATUS_REBOUNDED:
+        return status, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+    s = math.sqrt(vx * vx + vy * vy + vz * vz)
+    return status, math.atan2(vy, vx), math.asin(vz / s) if s > 0.0 else 0.0, s, wx, wy, wz

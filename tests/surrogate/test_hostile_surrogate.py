@@ -1,6 +1,7 @@
 """`surrogate` command line and sampler against hostile input: every case ends in one line and exit 2, and
 nothing of the user's is replaced."""
 
+import functools
 import shutil
 import subprocess
 
@@ -18,14 +19,8 @@ from cli_helpers import run_cli, user_error
 GOOD = ["--alpha1", "45", "--speed", "150", "-n", "10", "--seed", "1"]
 
 
-def _run(argv, capsys):
-    return run_cli(main, argv, capsys)
-
-
-def _user_error(argv, capsys, *words):
-    line, out = user_error(main, argv, capsys, *words)
-    assert line.startswith("surrogate ")
-    return line, out
+_run = functools.partial(run_cli, main)               # (exit status, stderr lines, stdout)
+_user_error = functools.partial(user_error, main)     # one line on stderr, exit 2: (line, stdout)
 
 
 @pytest.fixture

@@ -1,4 +1,4 @@
-"""surrogate.rng: xoshiro256+ against an independent plain-Python implementation, uniformity, seeding."""
+"""surrogate.kernels.rng: xoshiro256+ against an independent plain-Python implementation, uniformity, seeding."""
 
 import numba
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 from scipy import stats
 
 from surrogate.kernels import BLOCK, U_PER_DRAW, rebound_uniforms
-from surrogate.rng import fill_lanes, fill_uniforms, next_uniform, seed_lanes, seed_state
+from surrogate.kernels.rng import fill_lanes, fill_uniforms, next_uniform, seed_lanes, seed_state
 
 MASK = (1 << 64) - 1
 
@@ -102,13 +102,13 @@ def test_bad_seeds_are_rejected(kwargs, message):
         seed_state(**kwargs)
 
 
-def test_stream_states_one_per_chunk_and_reproducible():
-    from surrogate.rng import ROWS_PER_STREAM, stream_states
-    for rows, streams in ((0, 0), (1, 1), (ROWS_PER_STREAM, 1), (ROWS_PER_STREAM + 1, 2)):
-        states = stream_states(np.random.default_rng(3), rows)
+def test_chunk_states_one_per_chunk_and_reproducible():
+    from surrogate.kernels.rng import CHUNK_ROWS, chunk_states
+    for rows, streams in ((0, 0), (1, 1), (CHUNK_ROWS, 1), (CHUNK_ROWS + 1, 2)):
+        states = chunk_states(np.random.default_rng(3), rows)
         assert states.shape == (streams, 4) and states.dtype == np.uint64
-    a = stream_states(np.random.default_rng(3), 10 * ROWS_PER_STREAM)
-    np.testing.assert_array_equal(a, stream_states(np.random.default_rng(3), 10 * ROWS_PER_STREAM))
+    a = chunk_states(np.random.default_rng(3), 10 * CHUNK_ROWS)
+    np.testing.assert_array_equal(a, chunk_states(np.random.default_rng(3), 10 * CHUNK_ROWS))
     assert len({tuple(row) for row in a}) == 10 and not np.any(np.all(a == 0, axis=1))
 
 

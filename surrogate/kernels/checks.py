@@ -6,7 +6,7 @@ passes over (N, 3) temporaries (norms, dot products, arctangents), as much
 as the draws themselves. :func:`first_faults` makes one pass in numba and
 returns, for every check in the order the API reports them (the FAULT_*
 constants), the first row that fails it, or −1. It computes α1 and |V⁻| as
-the sampler's kernel does (:func:`surrogate.frame.impact_frame`), so the
+the sampler's kernel does (:func:`surrogate.kernels.frame.impact_frame`), so the
 range check sees the values the draw will use.
 """
 
@@ -15,9 +15,9 @@ import math
 import numba
 import numpy as np
 
-from surrogate.frame import _dot, impact_frame
-from surrogate.jit import JIT
-from surrogate.rng import ROWS_PER_STREAM, n_streams
+from surrogate.kernels.frame import dot, impact_frame
+from surrogate.kernels.options import JIT
+from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
 
 FAULT_VELOCITY_NOT_FINITE = 0
 FAULT_NORMAL_NOT_FINITE = 1
@@ -37,17 +37,17 @@ def first_faults(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
     """First failing row of each check (FAULT_* order; −1 if none) over V (N, 3) m/s, unit normals n (N, 3)
     or (1, 3) for all rows, half-sizes a (N,) or (1,) m; ``tolerance`` on |n| − 1, the α1 range in degrees
     and the speed range in m/s."""
-    n_chunks = n_streams(V.shape[0])
-    found = np.full((n_chunks, N_FAULTS), -1, dtype=np.int64)
+    chunks = n_chunks(V.shape[0])
+    found = np.full((chunks, N_FAULTS), -1, dtype=np.int64)
     last_n, last_a = n.shape[0] - 1, a.shape[0] - 1
-    for j in numba.prange(n_chunks):
+    for j in numba.prange(chunks):
         mine = found[j]
-        for i in range(j * ROWS_PER_STREAM, min((j + 1) * ROWS_PER_STREAM, V.shape[0])):
+        for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
             k = min(i, last_n)
             _check_row((V[i, 0], V[i, 1], V[i, 2]), (n[k, 0], n[k, 1], n[k, 2]), a[min(i, last_a)], tolerance,
                        alpha1_lo, alpha1_hi, speed_lo, speed_hi, i, mine)
     first = np.full(N_FAULTS, -1, dtype=np.int64)
-    for j in range(n_chunks):          # chunks in row order: the first chunk with a fault holds its first row
+    for j in range(chunks):          # chunks in row order: the first chunk with a fault holds its first row
         for k in range(N_FAULTS):
             if first[k] < 0:
                 first[k] = found[j, k]
@@ -58,11 +58,11 @@ def first_faults(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
 def _check_row(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi, i, found):
     """Record row i in ``found`` under every check it fails, unless an earlier row of its chunk did."""
     finite = math.isfinite(V[0] + V[1] + V[2])
-    vn = _dot(V, n)
+    vn = dot(V, n)
     _record(found, FAULT_VELOCITY_NOT_FINITE, not finite, i)
     _record(found, FAULT_NORMAL_NOT_FINITE, not math.isfinite(n[0] + n[1] + n[2]), i)
-    _record(found, FAULT_NORMAL_NOT_UNIT, abs(math.sqrt(_dot(n, n)) - 1.0) > tolerance, i)
-    _record(found, FAULT_VELOCITY_ZERO, _dot(V, V) == 0.0, i)
+    _record(found, FAULT_NORMAL_NOT_UNIT, abs(math.sqrt(dot(n, n)) - 1.0) > tolerance, i)
+    _record(found, FAULT_VELOCITY_ZERO, dot(V, V) == 0.0, i)
     _record(found, FAULT_NOT_INTO_WALL, vn >= 0.0, i)
     _record(found, FAULT_HALF_SIZE, not (math.isfinite(a) and a > 0.0), i)
     if finite and vn < 0.0:

@@ -1,0 +1,40 @@
+"""The sampler's numba kernels: O(1) work per reflected state, callable from a solver's ``@njit`` code.
+
+Plain functions over the arrays of a table (``table.kernel_data``) and
+uniforms: :data:`U_PER_DRAW` per draw, given or drawn from a caller-owned
+xoshiro256+ state. Where each part lives:
+
+==============  ==============================================================
+``layout``      the table as the kernels take it (:class:`KernelData`), its record layouts
+``draw``        the law of one draw: :func:`locate`, :func:`gather`, :func:`arithmetic`; local-frame draws
+``frame``       the impact frame of a hit and the way back to the global frame
+``particle``    one particle in the global frame: :func:`rebound_tuple`, :func:`rebound`
+``pipeline``    many particles on one thread, by blocks of BLOCK: :func:`rebound_many`, :func:`rebound_many_rng`
+``parallel``    many particles on all threads, by chunks: :func:`rebound_parallel`, :func:`draw_local_parallel`
+``rng``         xoshiro256+ streams: :func:`seed_state`, :func:`fill_uniforms`, the SIMD lanes
+``fastmath``    fused multiply-add, trigonometry, the restitution factor: no libm call on the hot path
+``memory``      loads and cache hints
+``checks``      the input checks of the NumPy API in one parallel pass
+``options``     the numba options every kernel is compiled with
+==============  ==============================================================
+
+Global-frame kernels take V⁻ in m/s and return V⁺ in m/s and Ω⁺ in rad/s;
+local-frame ones use the model's lab frame (wall y = 0, normal +Y, impact
+plane XY, α1 in degrees from the wall), V⁺ in units of |V⁻| and Ω⁺ in units
+of |V⁻|/a. One particle, the pipeline and the parallel kernels give the same
+bits for the same uniforms.
+"""
+
+from surrogate.kernels.draw import U_PER_DRAW, arithmetic, draw_local, draw_velocity, gather, grid_interval, locate
+from surrogate.kernels.frame import STATUS_INVALID, impact_frame
+from surrogate.kernels.layout import KernelData
+from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel_rng, rebound_parallel,
+                                        rebound_parallel_rng)
+from surrogate.kernels.particle import rebound, rebound_tuple
+from surrogate.kernels.pipeline import BLOCK, rebound_many, rebound_many_rng, rebound_uniforms
+from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
+
+__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "STATUS_INVALID", "U_PER_DRAW", "arithmetic", "chunk_states",
+           "draw_local", "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity", "fill_uniforms", "gather",
+           "grid_interval", "impact_frame", "locate", "next_uniform", "rebound", "rebound_many", "rebound_many_rng",
+           "rebound_parallel", "rebound_parallel_rng", "rebound_tuple", "rebound_uniforms", "seed_state"]

@@ -1,0 +1,147 @@
+"""Fast math of the sampler kernels: fused multiply-add, trigonometry and the wall's restitution factor.
+
+A call to libm costs the call itself and, because every floating-point
+register is caller-saved, the spilling of the kernel's live values around
+it; ``a * b + c`` without contraction costs two roundings. So the hot path
+calls no libm function:
+
+* :func:`fma` — a·b + c rounded once: LLVM's ``llvm.fma.f64`` (one
+  instruction with FMA, the correctly rounded libm ``fma`` otherwise), the
+  same operation wherever it is compiled, so the per-particle and the block
+  kernels give the same bits (letting LLVM contract on its own would fuse
+  differently in different surrounding code);
+* :func:`sincos`, |x| ≤ 2π: Cody–Waite reduction by the nearest multiple q
+  of π/2 (π/2 split into two doubles, |r| ≤ π/4 accurate to about 1e-17),
+  Taylor polynomials of sin r to r¹⁵ and cos r to r¹⁶ (truncation below
+  5e-17), the quadrant's signs;
+* :func:`atan2_first_quadrant`, x, y ≥ 0: t = min/max, atan t = atan c +
+  atan z with c the nearest of 0, 1/4, 1/2, 3/4, 1 and z = (t − c)/(1 + c t),
+  |z| ≤ 1/8, atan z by its Taylor series to z¹⁷ (truncation below 1e-18);
+* :func:`restitution_at` — exp(−k V^p) (V in m/s) at a particle's incident
+  speed from polynomial pieces (:func:`restitution_pieces`, made when a table
+  is loaded): every interval of the speed grid cut into S equal pieces, each
+  spanning at most a factor :data:`PIECE_RATIO` in V (away from V = 0, where
+  V^p is singular), interpolated at Chebyshev points by a polynomial of degree
+  :data:`DEGREE`, exact to about 1e-14 absolute.
+
+tests/surrogate/test_kernel_math.py compares each with libm or NumPy on dense grids.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
+from numpy.polynomial import chebyshev
+
+from surrogate.kernels.memory import load
+from surrogate.kernels.options import JIT
+
+
+@intrinsic
+def fma(typingctx, a, b, c):
+    """a·b + c rounded once, as float64 (float32 or float64 arguments)."""
+    if not all(isinstance(t, types.Float) for t in (a, b, c)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        f64 = ir.DoubleType()
+        fused = builder.module.declare_intrinsic("llvm.fma", [f64], ir.FunctionType(f64, [f64, f64, f64]))
+        values = [context.cast(builder, v, t, types.float64) for v, t in zip(args, signature.args)]
+        return builder.call(fused, values)
+
+    return types.float64(a, b, c), codegen
+
+
+_HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double
+_HALF_PI_LO = 6.123233995736766e-17    # π/2 − _HALF_PI_HI
+_TWO_OVER_PI = 2.0 / math.pi
+# Taylor coefficients (−1)^k / n!: sin r = r + r³ S3 + ... + r¹⁵ S15, cos r = 1 + r² C2 + ... + r¹⁶ C16
+# (Horner steps as fused multiply-adds)
+S3, S5, S7, S9, S11, S13, S15 = ((-1.0) ** k / math.factorial(2 * k + 1) for k in range(1, 8))
+C2, C4, C6, C8, C10, C12, C14, C16 = ((-1.0) ** k / math.factorial(2 * k) for k in range(1, 9))
+
+
+@numba.njit(inline="always", **JIT)
+def sincos(x):
+    """(sin x, cos x) for |x| ≤ 2π (x in radians), to a few ulp."""
+    q = math.floor(x * _TWO_OVER_PI + 0.5)
+    r = (x - q * _HALF_PI_HI) - q * _HALF_PI_LO
+    z = r * r
+    p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, S15, S13), S11), S9), S7), S5), S3)
+    s = fma(r * z, p, r)
+    p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, C16, C14), C12), C10), C8), C6), C4), C2)
+    c = fma(z, p, 1.0)
+    quadrant = int(q) & 3       # x = r + quadrant·π/2 (mod 2π); selects, not branches
+    odd = (quadrant & 1) == 1
+    sign = 1.0 - (quadrant & 2)
+    return sign * (c if odd else s), sign * (-s if odd else c)
+
+
+_ATAN_AT_NODES = tuple(math.atan(0.25 * node) for node in range(5))
+
+
+@numba.njit(inline="always", **JIT)
+def atan2_first_quadrant(y, x):
+    """atan2(y, x) in radians for x ≥ 0, y ≥ 0, not both 0, to a few ulp."""
+    swap = y > x
+    lo, hi = (x, y) if swap else (y, x)
+    # the node c = node/4 nearest to t = lo/hi, chosen without dividing (midpoints 1/8, 3/8, 5/8, 7/8)
+    node = (lo > 0.125 * hi) + (lo > 0.375 * hi) + (lo > 0.625 * hi) + (lo > 0.875 * hi)
+    c = 0.25 * node
+    z = fma(-c, hi, lo) / fma(c, lo, hi)
+    w = z * z
+    p = fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, -1.0 / 17.0, 1.0 / 15.0), -1.0 / 13.0), 1.0 / 11.0),
+                                 -1.0 / 9.0), 1.0 / 7.0), -1.0 / 5.0), 1.0 / 3.0)
+    atan_z = fma(-z * w, p, z)
+    # atan c by selects (a tuple indexed by ``node`` would compile to a jump table, which no SIMD loop takes)
+    atan_c = _ATAN_AT_NODES[0] if node == 0 else _ATAN_AT_NODES[1] if node == 1 else _ATAN_AT_NODES[2] if node == 2 \
+        else _ATAN_AT_NODES[3] if node == 3 else _ATAN_AT_NODES[4]
+    angle = atan_c + atan_z
+    return 0.5 * math.pi - angle if swap else angle
+
+
+DEGREE = 9          # polynomial degree of a piece
+PIECE_RATIO = 1.25  # a piece [V_lo, V_hi] has V_hi ≤ PIECE_RATIO · V_lo
+
+
+def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
+    """Polynomial pieces of exp(−k V^p) over each interval of ``speed_grid`` (m/s, increasing, > 0).
+
+    Returns coefficients (max(n − 1, 1), S, DEGREE + 1): piece i of interval j
+    covers V_j + [i, i + 1]·(V_{j+1} − V_j)/S, in powers of x ∈ [−1, 1]
+    across the piece (lowest power first). A one-point grid has no interval;
+    it gets one piece of zeros that the kernels never read (their speed
+    weight is always 0 there).
+    """
+    grid = np.asarray(speed_grid, dtype=np.float64)
+    if len(grid) == 1:
+        return np.zeros((1, 1, DEGREE + 1))
+    pieces = max(1, int(np.ceil(np.max(np.diff(grid) / grid[:-1]) / (PIECE_RATIO - 1.0))))
+    coef = np.zeros((len(grid) - 1, pieces, DEGREE + 1))
+    for j in range(len(grid) - 1):
+        edges = np.linspace(grid[j], grid[j + 1], pieces + 1)
+        for i in range(pieces):
+            lo, half = edges[i], 0.5 * (edges[i + 1] - edges[i])
+            series = chebyshev.chebinterpolate(lambda x: np.exp(-k * (lo + (x + 1.0) * half) ** p), DEGREE)
+            power = chebyshev.cheb2poly(series)
+            coef[j, i, :len(power)] = power
+    return coef
+
+
+@numba.njit(inline="always", **JIT)
+def restitution_at(pieces, n_pieces, j, w):
+    """exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w ∈ [0, 1], from :func:`restitution_pieces` flattened
+    (``pieces`` 1-D, ``n_pieces`` its S: piece i of interval j starts at (j S + i)(DEGREE + 1))."""
+    t = w * n_pieces
+    i = min(int(t), n_pieces - 1)
+    x = 2.0 * (t - i) - 1.0
+    start = (j * n_pieces + i) * (DEGREE + 1)
+    value = load(pieces, start + DEGREE)
+    for d in range(DEGREE - 1, -1, -1):
+        value = fma(value, x, load(pieces, start + d))
+    return value

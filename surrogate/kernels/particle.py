@@ -1,0 +1,74 @@
+"""One particle in the global frame: :func:`rebound_tuple` (vectors as tuples, for a solver's per-hit loop)
+and :func:`rebound` (the same on (3,) arrays).
+
+The impact frame (:func:`surrogate.kernels.frame.impact_frame`), then one draw
+(:mod:`surrogate.kernels.draw`: locate, gather, arithmetic) and the way back
+to the global frame. V⁻ in m/s in, V⁺ in m/s and Ω⁺ in rad/s out.
+"""
+
+import numba
+
+from surrogate.kernels.draw import draw_in_cell, hint, locate
+from surrogate.kernels.frame import NAN3, STATUS_INVALID, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.options import JIT, KERNEL
+
+
+@numba.njit(**KERNEL)
+def rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out, scaled=True):
+    """Reflected state of one particle in the global frame; returns the status.
+
+    Parameters
+    ----------
+    data : ``table.kernel_data``.
+    mix_cdf : cumulative shape weights (table shape order).
+    V : (3,) incident velocity, m/s; must move into the wall (V·n < 0).
+    n : (3,) unit wall normal pointing into the gas (not checked here).
+    a : particle half-size (half its largest extent), m.
+    u : (U_PER_DRAW,) uniforms in [0, 1).
+    V_out, Omega_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
+    scaled : between grid points, move the draw to the incident state
+        (default; :func:`draw_velocity`); False: plain stochastic interpolation.
+
+    Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
+    move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
+    (tangential direction of V), n, ez = ex × n; the local draw is rotated back
+    into the global frame. The mirror symmetry of the model is applied with a
+    random sign (:func:`surrogate.kernels.draw.arithmetic`). An α1 or |V⁻| outside the table's
+    grid uses the law at the nearest grid edge (check ``table.alpha1_range``
+    and ``table.speed_range`` beforehand if that matters).
+    """
+    status, V_new, Omega_new = _rebound(data, mix_cdf, V, n, a, u, scaled)
+    _store(V_new, Omega_new, V_out, Omega_out)
+    return status
+
+
+@numba.njit(**KERNEL)
+def rebound_tuple(data, mix_cdf, V, n, a, u, scaled=True):
+    """:func:`rebound` returning its outputs: (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as 3-tuples.
+
+    V and n may be 3-tuples or (3,) arrays. For a solver loop over particle
+    arrays, passing ``(V[i, 0], V[i, 1], V[i, 2])`` rather than the row
+    ``V[i]`` creates no array view, so the loop does no reference counting
+    (numba's atomic counts on views cost tens of ns per call: bench_sampler.py, (b) and its variant).
+    """
+    return _rebound(data, mix_cdf, V, n, a, u, scaled)
+
+
+@numba.njit(inline="always", **JIT)
+def _rebound(data, mix_cdf, V, n, a, u, scaled):
+    """:func:`rebound_tuple`."""
+    if not moves_into_wall(V, n):
+        return STATUS_INVALID, NAN3, NAN3
+    alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
+    cell = locate(data, mix_cdf, alpha1, speed, u)
+    hint(data, cell, u)
+    status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
+    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
+    return status, V_new, Omega_new
+
+
+@numba.njit(inline="always", **JIT)
+def _store(V_new, Omega_new, V_out, Omega_out):
+    for k in range(3):
+        V_out[k] = V_new[k]
+        Omega_out[k] = Omega_new[k]
