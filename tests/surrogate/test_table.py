@@ -62,8 +62,7 @@ def test_alias_table_reproduces_the_weights(weights):
 
 
 def test_shape_missing_from_the_table(tmp_path):
-    from tablegen.build import build_table
-    from tablegen.config import parse_config
+    from tablegen import build_table, parse_config
     path = build_table(parse_config("[grid]\nalpha1_deg=[45.0]\nspeed_m_s=[100.0]\nshapes=[\"prism\"]\n"
                                     "[simulation]\nparticles_per_cell=3000\n"), tmp_path / "p.h5", workers=1)
     table = surrogate.load(path)
