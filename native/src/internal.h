@@ -1,0 +1,102 @@
+/*
+ * internal.h: the in-memory table and the layouts of its kernel arrays (surrogate/table.py, KernelData).
+ *
+ * The arrays are those of surrogate's table.kernel_data, element for element:
+ *   alpha1_axis, speed_axis  float64 axis records (AXIS_* layout, derive.c)
+ *   cells        float64 (n_cells · CELL_SIZE): P(trapped), 6 means, 6 sds, 6 inverse sds per cell
+ *   clusters     float32 (n_cells · C · ROW_SIZE): one row per mixture component (ROW_* layout)
+ *   dictionary   float32 (n_cells · 6 · n_levels · n_dictionary): residual shapes, level-major
+ *   speed_restitution   float64 (n_speed): exp(−k V^p) at the grid speeds
+ *   restitution_pieces  float64: polynomial pieces of exp(−k V^p) between them (derive.c)
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#ifndef RBS_INTERNAL_H
+#define RBS_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rebound_scatter.h"
+
+/* A component row of `clusters` (144 bytes: three cache lines when 16-byte aligned in a 64-byte block) */
+#define ROW_ALIAS_PROB 0    /* Walker alias table: keep the component if the fractional part < this */
+#define ROW_ALIAS 1         /* ... else use this component */
+#define ROW_LOC 2           /* 6 locations (chain order) */
+#define ROW_SCALE 8         /* 6 scales */
+#define ROW_SHAPE 14        /* 6 residual shape indices m */
+#define ROW_SLOPE 20        /* 15 slopes, x_k on x_j at k(k−1)/2 + j */
+#define ROW_REGIME 35       /* collision regime: 0 = at most two collisions, 1 = more */
+#define ROW_SIZE 36
+
+/* A cell record of `cells` */
+#define CELL_P_TRAPPED 0
+#define CELL_MEAN 1         /* 6 means of (α2, β2, s, Ω_x, Ω_y, Ω_z) */
+#define CELL_SD 7           /* 6 standard deviations */
+#define CELL_INV_SD 13      /* 1/sd (0 where sd = 0) */
+#define CELL_SIZE 19
+
+/* An axis record: origin and inverse step of the auxiliary uniform grid, then the n grid points, then
+ * max(n − 1, 1) inverse spacings, then the look-up indices (as float64) */
+#define AXIS_ORIGIN 0
+#define AXIS_INV_STEP 1
+#define AXIS_GRID 2
+
+#define N_CHAIN 6
+#define N_SLOPES 15
+#define RESTITUTION_DEGREE 9   /* surrogate.restitution.DEGREE */
+#define SHAPE_NAME_SIZE 32
+
+struct rbs_table {
+    char *path;
+    int n_shapes, n_alpha1, n_speed, n_clusters, n_levels, n_dictionary, n_pieces;
+    int format_major, format_minor;
+    long long particles_per_cell, n_max;
+    double restitution_k, restitution_p;
+    char shape_names[RBS_MAX_SHAPES][SHAPE_NAME_SIZE];
+    double *alpha1_deg, *speed_m_s;                 /* the grids */
+    double *alpha1_axis, *speed_axis;
+    size_t alpha1_axis_len, speed_axis_len;
+    double *cells;
+    size_t cells_len;
+    float *clusters;                                /* 64-byte aligned */
+    size_t clusters_len;
+    float *dictionary;                              /* 64-byte aligned */
+    size_t dictionary_len;
+    double *speed_restitution;
+    double *restitution_pieces;
+    size_t restitution_pieces_len;
+};
+
+/* The raw cell datasets a loader reads (derive.c turns them into the kernel arrays). */
+typedef struct rbs_raw_cells {
+    double *cluster_weight;     /* (cells, C) */
+    float *cluster_loc;         /* (cells, C, 6) */
+    float *cluster_scale;       /* (cells, C, 6) */
+    uint8_t *cluster_shape;     /* (cells, C, 6) */
+    float *cluster_slope;       /* (cells, C, 15) */
+    uint8_t *cluster_regime;    /* (cells, C) */
+    float *shape_dictionary;    /* (cells, 6, M, L + 1) */
+    int64_t *status_counts;     /* (cells, 3) */
+    double *mean;               /* (cells, 6) */
+    double *std;                /* (cells, 6) */
+} rbs_raw_cells;
+
+/* derive.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
+ * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */
+int rbs_derive(rbs_table *table, const rbs_raw_cells *raw, const char **what);
+
+/* derive.c, exposed for tests of the pieces alone */
+double *rbs_restitution_pieces(const double *grid, int n, double k, double p, int *n_pieces, size_t *len);
+
+/* error.c: printf into a caller's message buffer (NULL or size 0: nothing). */
+void rbs_message(char *message, size_t message_size, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* aligned allocation of `bytes` (rounded up to 64) on a 64-byte boundary; free with free() */
+void *rbs_aligned_alloc(size_t bytes);
+
+#endif /* RBS_INTERNAL_H */

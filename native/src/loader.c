@@ -1,0 +1,645 @@
+/*
+ * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), and the
+ * accessors of a loaded table. The kernel arrays are derived in derive.c.
+ *
+ * Every error names the file and what is wrong with it; HDF5's own error printing is switched off
+ * around each HDF5 call that may fail (H5E_BEGIN_TRY), so the library prints nothing.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <hdf5.h>
+
+#include "internal.h"
+
+#define TABLE_FILE_TYPE "rebound_table"
+
+/* what a failed step leaves: code and message (the first error wins) */
+typedef struct loader {
+    const char *path;
+    char *message;
+    size_t message_size;
+    int code;
+} loader;
+
+static int fail(loader *ld, int code, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static int fail(loader *ld, int code, const char *format, ...)
+{
+    if (ld->code != RBS_OK) return ld->code;
+    ld->code = code;
+    if (ld->message && ld->message_size > 0) {
+        char detail[512];
+        va_list args;
+        va_start(args, format);
+        vsnprintf(detail, sizeof detail, format, args);
+        va_end(args);
+        snprintf(ld->message, ld->message_size, "%s: %s", ld->path, detail);
+    }
+    return code;
+}
+
+/* ------------------------------------------------------------------------- HDF5 helpers */
+
+static int link_exists(hid_t where, const char *name)
+{
+    htri_t found = 0;
+    H5E_BEGIN_TRY { found = H5Lexists(where, name, H5P_DEFAULT); } H5E_END_TRY;
+    return found > 0;
+}
+
+static int attribute_exists(hid_t where, const char *name)
+{
+    htri_t found = 0;
+    H5E_BEGIN_TRY { found = H5Aexists(where, name); } H5E_END_TRY;
+    return found > 0;
+}
+
+/* A string attribute (variable or fixed length) into out (truncated to size); 0 on success. */
+static int read_string_attribute(hid_t where, const char *name, char *out, size_t size)
+{
+    int status = -1;
+    hid_t attr = -1, type = -1, memtype = -1, space = -1;
+    out[0] = '\0';
+    H5E_BEGIN_TRY {
+        attr = H5Aopen(where, name, H5P_DEFAULT);
+        if (attr >= 0) type = H5Aget_type(attr);
+        if (type >= 0) space = H5Aget_space(attr);
+        if (type >= 0 && space >= 0 && H5Tget_class(type) == H5T_STRING && H5Sget_simple_extent_npoints(space) == 1) {
+            if (H5Tis_variable_str(type) > 0) {
+                char *text = NULL;
+                memtype = H5Tcopy(H5T_C_S1);
+                H5Tset_size(memtype, H5T_VARIABLE);
+                H5Tset_cset(memtype, H5Tget_cset(type));
+                if (H5Aread(attr, memtype, &text) >= 0 && text) {
+                    snprintf(out, size, "%s", text);
+                    H5free_memory(text);
+                    status = 0;
+                }
+            } else {
+                size_t length = H5Tget_size(type);
+                char *text = calloc(length + 1, 1);
+                memtype = H5Tcopy(H5T_C_S1);
+                H5Tset_size(memtype, length + 1);
+                H5Tset_strpad(memtype, H5T_STR_NULLTERM);
+                if (text && H5Aread(attr, memtype, text) >= 0) {
+                    snprintf(out, size, "%s", text);
+                    status = 0;
+                }
+                free(text);
+            }
+        }
+    } H5E_END_TRY;
+    if (memtype >= 0) H5Tclose(memtype);
+    if (space >= 0) H5Sclose(space);
+    if (type >= 0) H5Tclose(type);
+    if (attr >= 0) H5Aclose(attr);
+    return status;
+}
+
+/* A numeric attribute of `count` elements (exactly) as `memtype`; 0 on success. */
+static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, void *out, hssize_t count)
+{
+    int status = -1;
+    hid_t attr = -1, type = -1, space = -1;
+    H5E_BEGIN_TRY {
+        attr = H5Aopen(where, name, H5P_DEFAULT);
+        if (attr >= 0) type = H5Aget_type(attr);
+        if (type >= 0) space = H5Aget_space(attr);
+        if (space >= 0 && H5Sget_simple_extent_npoints(space) == count
+            && (H5Tget_class(type) == H5T_INTEGER || H5Tget_class(type) == H5T_FLOAT)
+            && H5Aread(attr, memtype, out) >= 0)
+            status = 0;
+    } H5E_END_TRY;
+    if (space >= 0) H5Sclose(space);
+    if (type >= 0) H5Tclose(type);
+    if (attr >= 0) H5Aclose(attr);
+    return status;
+}
+
+static int read_double_attribute(loader *ld, hid_t where, const char *group, const char *name, double *out)
+{
+    if (!attribute_exists(where, name)) return fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
+    if (read_numeric_attribute(where, name, H5T_NATIVE_DOUBLE, out, 1) != 0)
+        return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one number", name, group);
+    return RBS_OK;
+}
+
+static int read_integer_attribute(loader *ld, hid_t where, const char *group, const char *name, long long *out)
+{
+    if (!attribute_exists(where, name)) return fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
+    if (read_numeric_attribute(where, name, H5T_NATIVE_LLONG, out, 1) != 0)
+        return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one integer", name, group);
+    return RBS_OK;
+}
+
+/* Open group `name` of the file; -1 (and the error set) if missing. */
+static hid_t open_group(loader *ld, hid_t file, const char *name)
+{
+    hid_t group = -1;
+    if (!link_exists(file, name)) {
+        fail(ld, RBS_ERR_FORMAT, "missing group '%s'", name);
+        return -1;
+    }
+    H5E_BEGIN_TRY { group = H5Gopen2(file, name, H5P_DEFAULT); } H5E_END_TRY;
+    if (group < 0) fail(ld, RBS_ERR_FORMAT, "'%s' is not a readable group (truncated or corrupt?)", name);
+    return group;
+}
+
+/* The shape of dataset `name` in `group`: its rank into *rank and dims (up to 8); 0 on success. */
+static int dataset_shape(loader *ld, hid_t group, const char *group_name, const char *name, int *rank,
+                         hsize_t dims[8])
+{
+    hid_t ds = -1, space = -1;
+    int r = -1;
+    if (!link_exists(group, name)) return fail(ld, RBS_ERR_FORMAT, "missing dataset '%s/%s'", group_name, name);
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(group, name, H5P_DEFAULT);
+        if (ds >= 0) space = H5Dget_space(ds);
+        if (space >= 0) r = H5Sget_simple_extent_ndims(space);
+        if (r >= 0 && r <= 8) H5Sget_simple_extent_dims(space, dims, NULL);
+    } H5E_END_TRY;
+    if (space >= 0) H5Sclose(space);
+    if (ds >= 0) H5Dclose(ds);
+    if (r < 0 || r > 8) return fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated or corrupt?)", group_name, name);
+    *rank = r;
+    return RBS_OK;
+}
+
+/* Read dataset `name` whole as `memtype` into a new buffer of `count` elements of `size` bytes, after
+ * checking its shape is `rank` × `dims`. */
+static void *read_dataset(loader *ld, hid_t group, const char *group_name, const char *name, hid_t memtype,
+                          size_t size, int rank, const hsize_t *dims)
+{
+    int found_rank = 0;
+    hsize_t found[8];
+    if (dataset_shape(ld, group, group_name, name, &found_rank, found) != RBS_OK) return NULL;
+    int same = found_rank == rank;
+    size_t count = 1;
+    for (int i = 0; same && i < rank; i++) {
+        same = found[i] == dims[i];
+        count *= (size_t)dims[i];
+    }
+    if (!same) {
+        char want[160] = "(", got[160] = "(";
+        for (int i = 0; i < rank; i++)
+            snprintf(want + strlen(want), sizeof want - strlen(want), "%s%llu", i ? ", " : "", (unsigned long long)dims[i]);
+        for (int i = 0; i < found_rank; i++)
+            snprintf(got + strlen(got), sizeof got - strlen(got), "%s%llu", i ? ", " : "", (unsigned long long)found[i]);
+        strcat(want, ")");
+        strcat(got, ")");
+        fail(ld, RBS_ERR_FORMAT, "dataset '%s/%s' has shape %s, expected %s", group_name, name, got, want);
+        return NULL;
+    }
+    void *buffer = malloc(count ? count * size : 1);
+    if (!buffer) {
+        fail(ld, RBS_ERR_MEMORY, "out of memory reading dataset '%s/%s' (%zu elements)", group_name, name, count);
+        return NULL;
+    }
+    herr_t status = -1;
+    hid_t ds = -1;
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(group, name, H5P_DEFAULT);
+        if (ds >= 0) status = H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer);
+    } H5E_END_TRY;
+    if (ds >= 0) H5Dclose(ds);
+    if (status < 0) {
+        free(buffer);
+        fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated, corrupt or failed checksum?)", group_name, name);
+        return NULL;
+    }
+    return buffer;
+}
+
+/* The shape names (a 1-D dataset of strings) into the table. */
+static int read_shapes(loader *ld, hid_t grid, rbs_table *t)
+{
+    int rank = 0;
+    hsize_t dims[8];
+    if (dataset_shape(ld, grid, "grid", "shapes", &rank, dims) != RBS_OK) return ld->code;
+    if (rank != 1 || dims[0] < 1 || dims[0] > RBS_MAX_SHAPES)
+        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must hold 1 to %d shape names", RBS_MAX_SHAPES);
+    int n = (int)dims[0], ok = 0;
+    hid_t ds = -1, type = -1, memtype = -1, space = -1;
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(grid, "shapes", H5P_DEFAULT);
+        if (ds >= 0) type = H5Dget_type(ds);
+        if (type >= 0 && H5Tget_class(type) == H5T_STRING) {
+            memtype = H5Tcopy(H5T_C_S1);
+            if (H5Tis_variable_str(type) > 0) {
+                char *names[RBS_MAX_SHAPES] = {NULL};
+                H5Tset_size(memtype, H5T_VARIABLE);
+                H5Tset_cset(memtype, H5Tget_cset(type));
+                if (H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, names) >= 0) {
+                    ok = 1;
+                    for (int i = 0; i < n; i++) {
+                        if (!names[i] || strlen(names[i]) >= SHAPE_NAME_SIZE) ok = 0;
+                        else snprintf(t->shape_names[i], SHAPE_NAME_SIZE, "%s", names[i]);
+                    }
+                    space = H5Dget_space(ds);
+#if H5_VERSION_GE(1, 12, 0)
+                    H5Treclaim(memtype, space, H5P_DEFAULT, names);
+#else
+                    H5Dvlen_reclaim(memtype, space, H5P_DEFAULT, names);
+#endif
+                }
+            } else {
+                size_t length = H5Tget_size(type);
+                char *text = calloc((size_t)n, length + 1);
+                H5Tset_size(memtype, length + 1);
+                H5Tset_strpad(memtype, H5T_STR_NULLTERM);
+                if (text && length < SHAPE_NAME_SIZE && H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) >= 0) {
+                    ok = 1;
+                    for (int i = 0; i < n; i++) snprintf(t->shape_names[i], SHAPE_NAME_SIZE, "%s", text + (size_t)i * (length + 1));
+                }
+                free(text);
+            }
+        }
+    } H5E_END_TRY;
+    if (space >= 0) H5Sclose(space);
+    if (memtype >= 0) H5Tclose(memtype);
+    if (type >= 0) H5Tclose(type);
+    if (ds >= 0) H5Dclose(ds);
+    if (!ok) return fail(ld, RBS_ERR_FORMAT, "cannot read the shape names of 'grid/shapes' (strings of fewer than %d bytes)", SHAPE_NAME_SIZE);
+    t->n_shapes = n;
+    return RBS_OK;
+}
+
+/* A 1-D grid dataset: finite, strictly increasing, > 0 if `positive`. */
+static double *read_grid(loader *ld, hid_t grid, const char *name, int positive, int *n)
+{
+    int rank = 0;
+    hsize_t dims[8];
+    if (dataset_shape(ld, grid, "grid", name, &rank, dims) != RBS_OK) return NULL;
+    if (rank != 1 || dims[0] < 1 || dims[0] > 100000) {
+        fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be a 1-D grid of at least one point", name);
+        return NULL;
+    }
+    double *values = read_dataset(ld, grid, "grid", name, H5T_NATIVE_DOUBLE, sizeof(double), 1, dims);
+    if (!values) return NULL;
+    for (hsize_t i = 0; i < dims[0]; i++) {
+        if (!isfinite(values[i]) || (positive && values[i] <= 0.0) || (i > 0 && !(values[i] > values[i - 1]))) {
+            fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be finite%s and strictly increasing (value %g at index %llu)",
+                 name, positive ? ", > 0" : "", values[i], (unsigned long long)i);
+            free(values);
+            return NULL;
+        }
+    }
+    *n = (int)dims[0];
+    return values;
+}
+
+/* ------------------------------------------------------------------------- the file */
+
+/* data_schema.check_file: exists, HDF5, file_type, major version. Returns the open file or -1. */
+static hid_t check_file(loader *ld, rbs_table *t)
+{
+    struct stat info;
+    if (stat(ld->path, &info) != 0) {
+        fail(ld, RBS_ERR_IO, "no such file");
+        return -1;
+    }
+    if (!S_ISREG(info.st_mode)) {
+        fail(ld, RBS_ERR_IO, "not a regular file");
+        return -1;
+    }
+    FILE *probe = fopen(ld->path, "rb");
+    if (!probe) {
+        fail(ld, RBS_ERR_IO, "cannot open the file for reading");
+        return -1;
+    }
+    fclose(probe);
+    hid_t file = -1;
+    htri_t is_hdf5 = -1;
+    H5E_BEGIN_TRY {
+        is_hdf5 = H5Fis_hdf5(ld->path);
+        if (is_hdf5 > 0) file = H5Fopen(ld->path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    } H5E_END_TRY;
+    if (file < 0) {
+        fail(ld, RBS_ERR_FORMAT, "not a readable HDF5 file (truncated or corrupt?)");
+        return -1;
+    }
+    char found[128];
+    if (!attribute_exists(file, "file_type") || read_string_attribute(file, "file_type", found, sizeof found) != 0) {
+        fail(ld, RBS_ERR_FORMAT, "file_type is missing, expected '%s'", TABLE_FILE_TYPE);
+        H5Fclose(file);
+        return -1;
+    }
+    if (strcmp(found, TABLE_FILE_TYPE) != 0) {
+        fail(ld, RBS_ERR_FORMAT, "file_type is '%s', expected '%s'", found, TABLE_FILE_TYPE);
+        H5Fclose(file);
+        return -1;
+    }
+    long long version[2] = {0, 0};
+    if (!attribute_exists(file, "format_version")
+        || read_numeric_attribute(file, "format_version", H5T_NATIVE_LLONG, version, 2) != 0) {
+        fail(ld, RBS_ERR_FORMAT, "missing or malformed 'format_version' attribute");
+        H5Fclose(file);
+        return -1;
+    }
+    if (version[0] != RBS_TABLE_MAJOR) {
+        fail(ld, RBS_ERR_VERSION, "format version %lld.%lld is not readable by this version of the library, which "
+             "reads major version %d; make the file again with a matching version of tablegen "
+             "(docs/format.md, 'Identification and versions')", version[0], version[1], RBS_TABLE_MAJOR);
+        H5Fclose(file);
+        return -1;
+    }
+    t->format_major = (int)version[0];
+    t->format_minor = (int)version[1];
+    return file;
+}
+
+static const char *const CELL_NAMES[] = {
+    "cluster_weight", "cluster_loc", "cluster_scale", "cluster_shape", "cluster_slope", "cluster_regime",
+    "shape_dictionary", "status_counts", "collision_counts", "mean", "std", "indicatrix_2d", "indicatrix_3d"};
+#define N_CELL_NAMES (sizeof CELL_NAMES / sizeof CELL_NAMES[0])
+
+/* trailing shape of cell dataset i (data_schema.table.TableResolution.cell_shapes) */
+static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dims)
+{
+    switch (i) {
+    case 0: case 5: dims[0] = C; return 1;
+    case 1: case 2: case 3: dims[0] = C; dims[1] = N_CHAIN; return 2;
+    case 4: dims[0] = C; dims[1] = N_SLOPES; return 2;
+    case 6: dims[0] = N_CHAIN; dims[1] = M; dims[2] = L + 1; return 3;
+    case 7: dims[0] = 3; return 1;
+    case 8: dims[0] = 11; return 1;
+    case 9: case 10: dims[0] = 6; return 1;
+    case 11: dims[0] = 72; return 1;
+    default: dims[0] = 72; dims[1] = 72; return 2;
+    }
+}
+
+static void free_raw(rbs_raw_cells *raw)
+{
+    free(raw->cluster_weight);
+    free(raw->cluster_loc);
+    free(raw->cluster_scale);
+    free(raw->cluster_shape);
+    free(raw->cluster_slope);
+    free(raw->cluster_regime);
+    free(raw->shape_dictionary);
+    free(raw->status_counts);
+    free(raw->mean);
+    free(raw->std);
+}
+
+static int load(loader *ld, rbs_table *t)
+{
+    hid_t file = check_file(ld, t);
+    if (file < 0) return ld->code;
+    hid_t grid = -1, resolution = -1, cells = -1;
+    rbs_raw_cells raw;
+    memset(&raw, 0, sizeof raw);
+
+    grid = open_group(ld, file, "grid");
+    if (grid >= 0) resolution = open_group(ld, file, "resolution");
+    if (resolution >= 0) cells = open_group(ld, file, "cells");
+    if (cells < 0) goto done;
+
+    /* grid: the three datasets, then every cell dataset present (the Python reader's order of checks) */
+    for (int i = 0; i < 3; i++) {
+        static const char *const names[] = {"alpha1_deg", "speed_m_s", "shapes"};
+        if (!link_exists(grid, names[i])) {
+            fail(ld, RBS_ERR_FORMAT, "missing dataset 'grid/%s'", names[i]);
+            goto done;
+        }
+    }
+    {
+        char missing[512] = "";
+        for (size_t i = 0; i < N_CELL_NAMES; i++)
+            if (!link_exists(cells, CELL_NAMES[i]))
+                snprintf(missing + strlen(missing), sizeof missing - strlen(missing), "%scells/%s",
+                         missing[0] ? ", " : "", CELL_NAMES[i]);
+        if (missing[0]) {
+            fail(ld, RBS_ERR_FORMAT, "missing dataset(s) %s", missing);
+            goto done;
+        }
+    }
+    long long C = 0, M = 0, L = 0;
+    if (read_integer_attribute(ld, resolution, "resolution", "clusters", &C) != RBS_OK
+        || read_integer_attribute(ld, resolution, "resolution", "dictionary_size", &M) != RBS_OK
+        || read_integer_attribute(ld, resolution, "resolution", "levels", &L) != RBS_OK)
+        goto done;
+    if (C < 1 || C > 1000000 || M < 1 || M > 256 || L < 1 || L > 1000000) {
+        fail(ld, RBS_ERR_FORMAT, "inconsistent table: resolution clusters %lld, dictionary_size %lld, levels %lld "
+             "(each must be >= 1, dictionary_size <= 256)", C, M, L);
+        goto done;
+    }
+    t->n_clusters = (int)C;
+    t->n_dictionary = (int)M;
+    t->n_levels = (int)L + 1;
+
+    if (read_double_attribute(ld, grid, "grid", "restitution_k", &t->restitution_k) != RBS_OK
+        || read_double_attribute(ld, grid, "grid", "restitution_p", &t->restitution_p) != RBS_OK
+        || read_integer_attribute(ld, grid, "grid", "particles_per_cell", &t->particles_per_cell) != RBS_OK
+        || read_integer_attribute(ld, grid, "grid", "n_max", &t->n_max) != RBS_OK)
+        goto done;
+    if (!(isfinite(t->restitution_k) && t->restitution_k > 0.0 && isfinite(t->restitution_p) && t->restitution_p > 0.0)) {
+        fail(ld, RBS_ERR_FORMAT, "the wall law attributes of group 'grid' must be finite and > 0: restitution_k = %g, "
+             "restitution_p = %g", t->restitution_k, t->restitution_p);
+        goto done;
+    }
+    if (read_shapes(ld, grid, t) != RBS_OK) goto done;
+    t->alpha1_deg = read_grid(ld, grid, "alpha1_deg", 0, &t->n_alpha1);
+    if (!t->alpha1_deg) goto done;
+    t->speed_m_s = read_grid(ld, grid, "speed_m_s", 1, &t->n_speed);
+    if (!t->speed_m_s) goto done;
+
+    const hsize_t lead[3] = {(hsize_t)t->n_shapes, (hsize_t)t->n_alpha1, (hsize_t)t->n_speed};
+    const size_t n_cells = (size_t)t->n_shapes * (size_t)t->n_alpha1 * (size_t)t->n_speed;
+    if ((double)n_cells * (double)C * ROW_SIZE > 4e9 || (double)n_cells * 6.0 * (double)M * (double)(L + 1) > 4e9) {
+        fail(ld, RBS_ERR_FORMAT, "inconsistent table: %zu cells of %lld components are too large", n_cells, C);
+        goto done;
+    }
+    /* every cell dataset's shape (only metadata: nothing read yet) */
+    for (size_t i = 0; i < N_CELL_NAMES; i++) {
+        hsize_t want[8], found[8];
+        int rank = 3 + cell_trailing(i, (hsize_t)C, (hsize_t)M, (hsize_t)L, want + 3), found_rank = 0;
+        memcpy(want, lead, sizeof lead);
+        if (dataset_shape(ld, cells, "cells", CELL_NAMES[i], &found_rank, found) != RBS_OK) goto done;
+        int same = found_rank == rank;
+        for (int k = 0; same && k < rank; k++) same = found[k] == want[k];
+        if (!same) {
+            read_dataset(ld, cells, "cells", CELL_NAMES[i], H5T_NATIVE_DOUBLE, sizeof(double), rank, want);
+            goto done;
+        }
+    }
+    hsize_t dims[8];
+    memcpy(dims, lead, sizeof lead);
+#define READ_CELLS(field, index, memtype, ctype)                                                              \
+    do {                                                                                                      \
+        int rank_ = 3 + cell_trailing(index, (hsize_t)C, (hsize_t)M, (hsize_t)L, dims + 3);                   \
+        raw.field = read_dataset(ld, cells, "cells", CELL_NAMES[index], memtype, sizeof(ctype), rank_, dims); \
+        if (!raw.field) goto done;                                                                            \
+    } while (0)
+    READ_CELLS(cluster_weight, 0, H5T_NATIVE_DOUBLE, double);
+    READ_CELLS(cluster_loc, 1, H5T_NATIVE_FLOAT, float);
+    READ_CELLS(cluster_scale, 2, H5T_NATIVE_FLOAT, float);
+    READ_CELLS(cluster_shape, 3, H5T_NATIVE_UINT8, uint8_t);
+    READ_CELLS(cluster_slope, 4, H5T_NATIVE_FLOAT, float);
+    READ_CELLS(cluster_regime, 5, H5T_NATIVE_UINT8, uint8_t);
+    READ_CELLS(shape_dictionary, 6, H5T_NATIVE_FLOAT, float);
+    READ_CELLS(status_counts, 7, H5T_NATIVE_INT64, int64_t);
+    READ_CELLS(mean, 9, H5T_NATIVE_DOUBLE, double);
+    READ_CELLS(std, 10, H5T_NATIVE_DOUBLE, double);
+#undef READ_CELLS
+    /* residual shape indices must name a shape of the dictionary (the kernels read there unchecked) */
+    for (size_t i = 0; i < n_cells * (size_t)C * N_CHAIN; i++) {
+        if (raw.cluster_shape[i] >= M) {
+            fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_shape' holds %u at element %zu, beyond the %lld "
+                 "shapes of the dictionary", (unsigned)raw.cluster_shape[i], i, M);
+            goto done;
+        }
+    }
+    for (size_t i = 0; i < n_cells * (size_t)C; i++) {
+        if (!(raw.cluster_weight[i] >= 0.0) || !isfinite(raw.cluster_weight[i])) {
+            fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_weight' holds %g at element %zu (weights must be finite "
+                 "and >= 0)", raw.cluster_weight[i], i);
+            goto done;
+        }
+    }
+    {
+        const char *what = NULL;
+        int code = rbs_derive(t, &raw, &what);
+        if (code == RBS_ERR_MEMORY) fail(ld, code, "out of memory deriving the kernel arrays");
+        else if (code != RBS_OK) fail(ld, code, "the derived kernel array %s is not finite (inconsistent table)", what);
+    }
+
+done:
+    free_raw(&raw);
+    if (cells >= 0) H5Gclose(cells);
+    if (resolution >= 0) H5Gclose(resolution);
+    if (grid >= 0) H5Gclose(grid);
+    H5Fclose(file);
+    return ld->code;
+}
+
+/* ------------------------------------------------------------------------- public */
+
+int rbs_table_open(const char *path, rbs_table **table, char *message, size_t message_size)
+{
+    loader ld = {path ? path : "(null)", message, message_size, RBS_OK};
+    if (message && message_size > 0) message[0] = '\0';
+    if (!table) return fail(&ld, RBS_ERR_ARGUMENT, "no place for the table (table is NULL)");
+    *table = NULL;
+    if (!path) return fail(&ld, RBS_ERR_ARGUMENT, "no path given");
+    rbs_table *t = calloc(1, sizeof *t);
+    if (!t) return fail(&ld, RBS_ERR_MEMORY, "out of memory");
+    t->path = malloc(strlen(path) + 1);
+    if (!t->path) {
+        free(t);
+        return fail(&ld, RBS_ERR_MEMORY, "out of memory");
+    }
+    strcpy(t->path, path);
+    if (load(&ld, t) != RBS_OK) {
+        rbs_table_close(t);
+        return ld.code;
+    }
+    *table = t;
+    return RBS_OK;
+}
+
+void rbs_table_close(rbs_table *t)
+{
+    if (!t) return;
+    free(t->path);
+    free(t->alpha1_deg);
+    free(t->speed_m_s);
+    free(t->alpha1_axis);
+    free(t->speed_axis);
+    free(t->cells);
+    free(t->clusters);
+    free(t->dictionary);
+    free(t->speed_restitution);
+    free(t->restitution_pieces);
+    free(t);
+}
+
+const char *rbs_table_path(const rbs_table *t) { return t ? t->path : NULL; }
+
+int rbs_table_n_shapes(const rbs_table *t) { return t ? t->n_shapes : 0; }
+
+const char *rbs_table_shape_name(const rbs_table *t, int i)
+{
+    return t && i >= 0 && i < t->n_shapes ? t->shape_names[i] : NULL;
+}
+
+void rbs_table_alpha1_range(const rbs_table *t, double *lo, double *hi)
+{
+    if (lo) *lo = t ? t->alpha1_deg[0] : NAN;
+    if (hi) *hi = t ? t->alpha1_deg[t->n_alpha1 - 1] : NAN;
+}
+
+void rbs_table_speed_range(const rbs_table *t, double *lo, double *hi)
+{
+    if (lo) *lo = t ? t->speed_m_s[0] : NAN;
+    if (hi) *hi = t ? t->speed_m_s[t->n_speed - 1] : NAN;
+}
+
+const double *rbs_table_alpha1_grid(const rbs_table *t, int *count)
+{
+    if (count) *count = t ? t->n_alpha1 : 0;
+    return t ? t->alpha1_deg : NULL;
+}
+
+const double *rbs_table_speed_grid(const rbs_table *t, int *count)
+{
+    if (count) *count = t ? t->n_speed : 0;
+    return t ? t->speed_m_s : NULL;
+}
+
+void rbs_table_info_get(const rbs_table *t, rbs_table_info *info)
+{
+    if (!info) return;
+    memset(info, 0, sizeof *info);
+    if (!t) return;
+    info->n_shapes = t->n_shapes;
+    info->n_alpha1 = t->n_alpha1;
+    info->n_speed = t->n_speed;
+    info->n_clusters = t->n_clusters;
+    info->n_levels = t->n_levels;
+    info->n_dictionary = t->n_dictionary;
+    info->n_pieces = t->n_pieces;
+    info->format_major = t->format_major;
+    info->format_minor = t->format_minor;
+    info->particles_per_cell = t->particles_per_cell;
+    info->n_max = t->n_max;
+    info->restitution_k = t->restitution_k;
+    info->restitution_p = t->restitution_p;
+    info->kernel_bytes = (t->alpha1_axis_len + t->speed_axis_len + t->cells_len + (size_t)t->n_speed
+                          + t->restitution_pieces_len) * sizeof(double)
+                         + (t->clusters_len + t->dictionary_len) * sizeof(float);
+}
+
+int rbs_table_kernel_array(const rbs_table *t, const char *name, const void **data, size_t *count, int *dtype)
+{
+    const void *p = NULL;
+    size_t n = 0;
+    int type = RBS_FLOAT64;
+    if (!t || !name) return RBS_ERR_ARGUMENT;
+    if (strcmp(name, "alpha1_axis") == 0) { p = t->alpha1_axis; n = t->alpha1_axis_len; }
+    else if (strcmp(name, "speed_axis") == 0) { p = t->speed_axis; n = t->speed_axis_len; }
+    else if (strcmp(name, "cells") == 0) { p = t->cells; n = t->cells_len; }
+    else if (strcmp(name, "clusters") == 0) { p = t->clusters; n = t->clusters_len; type = RBS_FLOAT32; }
+    else if (strcmp(name, "dictionary") == 0) { p = t->dictionary; n = t->dictionary_len; type = RBS_FLOAT32; }
+    else if (strcmp(name, "speed_restitution") == 0) { p = t->speed_restitution; n = (size_t)t->n_speed; }
+    else if (strcmp(name, "restitution_pieces") == 0) { p = t->restitution_pieces; n = t->restitution_pieces_len; }
+    else return RBS_ERR_ARGUMENT;
+    if (data) *data = p;
+    if (count) *count = n;
+    if (dtype) *dtype = type;
+    return RBS_OK;
+}

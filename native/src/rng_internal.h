@@ -1,0 +1,50 @@
+/*
+ * rng_internal.h: one xoshiro256+ step (Blackman & Vigna 2018), splitmix64, and the block lanes.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#ifndef RBS_RNG_INTERNAL_H
+#define RBS_RNG_INTERNAL_H
+
+#include <stdint.h>
+
+#include "rebound_scatter.h"
+
+#define RBS_GOLDEN 0x9E3779B97F4A7C15ull      /* splitmix64's increment */
+
+static inline uint64_t rbs_rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+/* one xoshiro256+ step: the 64-bit output, s advanced */
+static inline uint64_t rbs_next(uint64_t s[4])
+{
+    uint64_t result = s[0] + s[3];
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rbs_rotl(s[3], 45);
+    return result;
+}
+
+/* the top 53 bits times 2^-53 (surrogate.rng._step) */
+static inline double rbs_uniform_of(uint64_t x)
+{
+    return (double)(int64_t)(x >> 11) * 0x1p-53;
+}
+
+static inline uint64_t rbs_splitmix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* RBS_BLOCK lanes seeded from one step of rng (surrogate.rng.seed_lanes; word w of lane l at w·BLOCK + l) */
+void rbs_lanes_seed(rbs_rng *rng, uint64_t lanes[4 * RBS_BLOCK]);
+
+/* u[q·BLOCK + l] = the next uniform of lane l, q < RBS_U_PER_DRAW (surrogate.rng.fill_lanes) */
+void rbs_lanes_fill(uint64_t lanes[4 * RBS_BLOCK], double *u);
+
+#endif /* RBS_RNG_INTERNAL_H */

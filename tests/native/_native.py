@@ -1,0 +1,277 @@
+"""Building the native library with CMake and driving it through ctypes (the tests' side of it).
+
+:func:`build` configures and builds ``native/`` into a folder; :class:`Native` loads the shared library
+and wraps the functions the tests call, on NumPy arrays. Nothing here imports the Python packages: the
+Python side of every comparison comes through ``_python_side``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+NATIVE = REPO / "native"
+INSTALL_HINT = ("run native/install-deps.sh (as root on Debian/Ubuntu it installs gcc, g++, cmake, libhdf5-dev, "
+                "gfortran and pkg-config; elsewhere it prints what to install)")
+
+U_PER_DRAW = 13
+MAX_SHAPES = 4
+SCALED, STOCHASTIC = 0, 1
+OK, ERR_IO, ERR_FORMAT, ERR_VERSION, ERR_ARGUMENT, ERR_MEMORY = range(6)
+
+
+class BuildError(RuntimeError):
+    pass
+
+
+def missing_tools(fortran: bool = True, cxx: bool = True) -> list:
+    """The build tools not found on PATH."""
+    tools = ["cmake", "cc"] + (["c++"] if cxx else []) + (["gfortran"] if fortran else [])
+    missing = [t for t in tools if shutil.which(t) is None]
+    if "cc" in missing and shutil.which("gcc"):
+        missing.remove("cc")
+    if "c++" in missing and shutil.which("g++"):
+        missing.remove("c++")
+    return missing
+
+
+def run(command, cwd=None, env=None, timeout=600) -> subprocess.CompletedProcess:
+    return subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+
+
+def build(folder: Path, options: dict, targets=None) -> Path:
+    """Configure native/ into ``folder`` with CMake (Release, -Werror, the given -D options) and build it;
+    BuildError with CMake's output (and the install hint) on failure."""
+    folder.mkdir(parents=True, exist_ok=True)
+    configure = ["cmake", "-S", str(NATIVE), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release", "-DRBS_WERROR=ON"]
+    configure += [f"-D{k}={v}" for k, v in options.items()]
+    done = run(configure)
+    if done.returncode != 0:
+        raise BuildError(f"CMake could not configure native/ ({INSTALL_HINT}):\n{done.stdout[-3000:]}\n"
+                         f"{done.stderr[-3000:]}")
+    command = ["cmake", "--build", str(folder), "-j", "2"]
+    if targets:
+        command += ["--target", *targets]
+    done = run(command)
+    if done.returncode != 0:
+        raise BuildError(f"building native/ failed ({INSTALL_HINT}):\n{done.stdout[-5000:]}\n{done.stderr[-3000:]}")
+    return folder
+
+
+_d = ctypes.POINTER(ctypes.c_double)
+
+
+class Mix(ctypes.Structure):
+    _fields_ = [("n_shapes", ctypes.c_int), ("cdf", ctypes.c_double * MAX_SHAPES)]
+
+
+class Rng(ctypes.Structure):
+    _fields_ = [("s", ctypes.c_uint64 * 4)]
+
+
+class Info(ctypes.Structure):
+    _fields_ = [("n_shapes", ctypes.c_int), ("n_alpha1", ctypes.c_int), ("n_speed", ctypes.c_int),
+                ("n_clusters", ctypes.c_int), ("n_levels", ctypes.c_int), ("n_dictionary", ctypes.c_int),
+                ("n_pieces", ctypes.c_int), ("format_major", ctypes.c_int), ("format_minor", ctypes.c_int),
+                ("particles_per_cell", ctypes.c_longlong), ("n_max", ctypes.c_longlong),
+                ("restitution_k", ctypes.c_double), ("restitution_p", ctypes.c_double),
+                ("kernel_bytes", ctypes.c_size_t)]
+
+
+def _ptr(a: np.ndarray):
+    return a.ctypes.data_as(ctypes.c_void_p)
+
+
+class NativeTable:
+    """An open rbs_table (closed by :meth:`close` or on garbage collection)."""
+
+    def __init__(self, lib: "Native", handle):
+        self.lib, self.handle = lib, handle
+
+    def close(self):
+        if self.handle:
+            self.lib.c.rbs_table_close(self.handle)
+            self.handle = None
+
+    def __del__(self):
+        self.close()
+
+    @property
+    def shapes(self) -> tuple:
+        c = self.lib.c
+        return tuple(c.rbs_table_shape_name(self.handle, i).decode() for i in range(c.rbs_table_n_shapes(self.handle)))
+
+    def info(self) -> Info:
+        info = Info()
+        self.lib.c.rbs_table_info_get(self.handle, ctypes.byref(info))
+        return info
+
+    def kernel_array(self, name: str) -> np.ndarray:
+        data, count, dtype = ctypes.c_void_p(), ctypes.c_size_t(), ctypes.c_int()
+        code = self.lib.c.rbs_table_kernel_array(self.handle, name.encode(), ctypes.byref(data), ctypes.byref(count),
+                                                 ctypes.byref(dtype))
+        if code != OK:
+            raise KeyError(name)
+        ctype = ctypes.c_double if dtype.value == 0 else ctypes.c_float
+        array = np.ctypeslib.as_array(ctypes.cast(data, ctypes.POINTER(ctype)), shape=(count.value,))
+        return array.copy()
+
+    def ranges(self):
+        lo, hi, vlo, vhi = (ctypes.c_double() for _ in range(4))
+        self.lib.c.rbs_table_alpha1_range(self.handle, ctypes.byref(lo), ctypes.byref(hi))
+        self.lib.c.rbs_table_speed_range(self.handle, ctypes.byref(vlo), ctypes.byref(vhi))
+        return (lo.value, hi.value), (vlo.value, vhi.value)
+
+    # -- mixes
+    def mix_equal(self) -> Mix:
+        mix = Mix()
+        assert self.lib.c.rbs_mix_equal(self.handle, ctypes.byref(mix)) == OK
+        return mix
+
+    def mix_from_weights(self, weights: dict):
+        mix, message = Mix(), ctypes.create_string_buffer(1024)
+        names = (ctypes.c_char_p * max(1, len(weights)))(*[k.encode() for k in weights])
+        values = np.ascontiguousarray(list(weights.values()) or [0.0], dtype=np.float64)
+        code = self.lib.c.rbs_mix_from_weights(self.handle, len(weights), names, _ptr(values), ctypes.byref(mix),
+                                               message, len(message))
+        return code, mix, message.value.decode()
+
+    def mix_from_shape(self, name: str):
+        mix, message = Mix(), ctypes.create_string_buffer(1024)
+        code = self.lib.c.rbs_mix_from_shape(self.handle, name.encode(), ctypes.byref(mix), message, len(message))
+        return code, mix, message.value.decode()
+
+    # -- draws
+    def rebound(self, mix, V, n, a, u, interpolation=SCALED):
+        V, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, u))
+        V_out, W_out = np.empty(3), np.empty(3)
+        status = self.lib.c.rbs_rebound(self.handle, ctypes.byref(mix), _ptr(V), _ptr(n), ctypes.c_double(a), _ptr(u),
+                                        interpolation, _ptr(V_out), _ptr(W_out))
+        return status, V_out, W_out
+
+    def rebound_many(self, mix, V, n, a, u, interpolation=SCALED):
+        V, n, a, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a, u))
+        count = V.shape[0]
+        assert n.shape == (count, 3) and a.shape == (count,) and u.shape == (count, U_PER_DRAW)
+        V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
+        self.lib.c.rbs_rebound_many(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n), _ptr(a),
+                                    _ptr(u), interpolation, _ptr(V_out), _ptr(W_out), _ptr(status))
+        return status, V_out, W_out
+
+    def rebound_many_rng(self, mix, V, n, a, state: np.ndarray, interpolation=SCALED):
+        """Returns (status, V_out, W_out, advanced state)."""
+        V, n, a = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a))
+        count = V.shape[0]
+        rng = Rng(*[int(x) for x in state])
+        V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
+        self.lib.c.rbs_rebound_many_rng(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
+                                        _ptr(a), ctypes.byref(rng), interpolation, _ptr(V_out), _ptr(W_out),
+                                        _ptr(status))
+        return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
+
+    def draw_local(self, mix, alpha1, speed, u, interpolation=SCALED):
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        out = np.empty(6)
+        status = self.lib.c.rbs_draw_local(self.handle, ctypes.byref(mix), ctypes.c_double(alpha1),
+                                           ctypes.c_double(speed), _ptr(u), interpolation, _ptr(out))
+        return status, out
+
+
+class Native:
+    """The shared library of a build folder, its functions typed for ctypes."""
+
+    def __init__(self, build_dir: Path):
+        self.build_dir = Path(build_dir)
+        candidates = sorted(self.build_dir.glob("librebound_scatter.so*"))
+        if not candidates:
+            raise BuildError(f"no librebound_scatter.so in {self.build_dir}")
+        self.c = c = ctypes.CDLL(str(candidates[0]))
+        vp, sz, i, d = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, ctypes.c_double
+        c.rbs_table_open.argtypes = [ctypes.c_char_p, ctypes.POINTER(vp), ctypes.c_char_p, sz]
+        c.rbs_table_open.restype = i
+        c.rbs_table_close.argtypes = [vp]
+        c.rbs_table_close.restype = None
+        c.rbs_table_n_shapes.argtypes = [vp]
+        c.rbs_table_n_shapes.restype = i
+        c.rbs_table_shape_name.argtypes = [vp, i]
+        c.rbs_table_shape_name.restype = ctypes.c_char_p
+        c.rbs_table_path.argtypes = [vp]
+        c.rbs_table_path.restype = ctypes.c_char_p
+        c.rbs_table_alpha1_range.argtypes = [vp, _d, _d]
+        c.rbs_table_speed_range.argtypes = [vp, _d, _d]
+        c.rbs_table_info_get.argtypes = [vp, ctypes.POINTER(Info)]
+        c.rbs_table_kernel_array.argtypes = [vp, ctypes.c_char_p, ctypes.POINTER(vp), ctypes.POINTER(sz),
+                                             ctypes.POINTER(i)]
+        c.rbs_table_kernel_array.restype = i
+        c.rbs_mix_equal.argtypes = [vp, ctypes.POINTER(Mix)]
+        c.rbs_mix_equal.restype = i
+        c.rbs_mix_from_weights.argtypes = [vp, i, ctypes.POINTER(ctypes.c_char_p), vp, ctypes.POINTER(Mix),
+                                           ctypes.c_char_p, sz]
+        c.rbs_mix_from_weights.restype = i
+        c.rbs_mix_from_shape.argtypes = [vp, ctypes.c_char_p, ctypes.POINTER(Mix), ctypes.c_char_p, sz]
+        c.rbs_mix_from_shape.restype = i
+        c.rbs_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, d, vp, i, vp, vp]
+        c.rbs_rebound.restype = i
+        c.rbs_rebound_many.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, vp, i, vp, vp, vp]
+        c.rbs_rebound_many.restype = None
+        c.rbs_rebound_many_rng.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, ctypes.POINTER(Rng), i, vp, vp, vp]
+        c.rbs_rebound_many_rng.restype = None
+        c.rbs_draw_local.argtypes = [vp, ctypes.POINTER(Mix), d, d, vp, i, vp]
+        c.rbs_draw_local.restype = i
+        c.rbs_rng_seed.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64]
+        c.rbs_rng_seed_stream.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64, ctypes.c_uint64]
+        c.rbs_rng_uniform.argtypes = [ctypes.POINTER(Rng)]
+        c.rbs_rng_uniform.restype = d
+        c.rbs_rng_fill.argtypes = [ctypes.POINTER(Rng), vp, sz]
+        c.rbs_rebound_uniforms.argtypes = [ctypes.POINTER(Rng), sz, vp]
+        c.rbs_error_string.argtypes = [i]
+        c.rbs_error_string.restype = ctypes.c_char_p
+        c.rbs_version.restype = ctypes.c_char_p
+
+    def open(self, path):
+        """(code, NativeTable or None, message)."""
+        handle, message = ctypes.c_void_p(), ctypes.create_string_buffer(2048)
+        code = self.c.rbs_table_open(str(path).encode(), ctypes.byref(handle), message, len(message))
+        return code, (NativeTable(self, handle) if code == OK else None), message.value.decode()
+
+    def table(self, path) -> NativeTable:
+        code, table, message = self.open(path)
+        if code != OK:
+            raise RuntimeError(f"rbs_table_open failed ({code}): {message}")
+        return table
+
+    # -- random numbers
+    def seed(self, seed: int, stream: int | None = None) -> np.ndarray:
+        rng = Rng()
+        if stream is None:
+            self.c.rbs_rng_seed(ctypes.byref(rng), ctypes.c_uint64(seed))
+        else:
+            self.c.rbs_rng_seed_stream(ctypes.byref(rng), ctypes.c_uint64(seed), ctypes.c_uint64(stream))
+        return np.array(list(rng.s), dtype=np.uint64)
+
+    def fill(self, state: np.ndarray, count: int):
+        rng, u = Rng(*[int(x) for x in state]), np.empty(count)
+        self.c.rbs_rng_fill(ctypes.byref(rng), _ptr(u), ctypes.c_size_t(count))
+        return u, np.array(list(rng.s), dtype=np.uint64)
+
+    def uniform(self, state: np.ndarray):
+        rng = Rng(*[int(x) for x in state])
+        x = self.c.rbs_rng_uniform(ctypes.byref(rng))
+        return x, np.array(list(rng.s), dtype=np.uint64)
+
+    def rebound_uniforms(self, state: np.ndarray, count: int):
+        rng, u = Rng(*[int(x) for x in state]), np.empty((count, U_PER_DRAW))
+        self.c.rbs_rebound_uniforms(ctypes.byref(rng), ctypes.c_size_t(count), _ptr(u))
+        return u, np.array(list(rng.s), dtype=np.uint64)
+
+
+def environment_without_preload() -> dict:
+    env = dict(os.environ)
+    env.pop("LD_PRELOAD", None)
+    return env

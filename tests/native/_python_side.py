@@ -1,0 +1,42 @@
+"""Every name the native tests take from the Python packages, imported here and nowhere else.
+
+When the packages move (surrogate's kernels into ``surrogate.kernels``, tablegen into subpackages),
+only this module is re-pointed. The tests use the public API: ``surrogate.load`` and
+``table.kernel_data``, ``surrogate.mix_cdf``, ``surrogate.seed_state``, ``surrogate.fill_uniforms``,
+``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
+``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
+``draw_local``; tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
+file checks from ``data_schema``.
+"""
+
+import surrogate
+from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, load, mix_cdf, \
+    seed_state
+from surrogate.kernels import draw_local, rebound, rebound_many, rebound_many_rng, rebound_tuple, rebound_uniforms
+
+
+def build_table(config_text: str, path) -> None:
+    """Build a table from TOML configuration text into ``path`` (tablegen)."""
+    from tablegen import build_table as _build, parse_config
+    _build(parse_config(config_text), path)
+
+
+def check_table_file(path) -> None:
+    """data_schema's check of a table file (raises for a file the sampler would refuse)."""
+    from data_schema.table import read_table
+    read_table(path)
+
+
+def write_samples_file(path) -> None:
+    """A small raw-samples file (another file type) at ``path``."""
+    import numpy as np
+    from data_schema.samples import SampleSet, write_samples
+    n = 4
+    write_samples(path, SampleSet(velocity=np.ones((n, 3)), omega=np.zeros((n, 3)),
+                                  n_collisions=np.ones(n, dtype=np.int32), status=np.zeros(n, dtype=np.int8),
+                                  alpha1=45.0, speed=100.0, shape="prism", seed=1, producer="tests/native"))
+
+
+__all__ = ["STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
+           "draw_local", "fill_uniforms", "load", "mix_cdf", "rebound", "rebound_many", "rebound_many_rng",
+           "rebound_tuple", "rebound_uniforms", "seed_state", "surrogate", "write_samples_file"]
