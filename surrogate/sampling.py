@@ -28,6 +28,7 @@ from typing import NamedTuple
 import numpy as np
 
 from data_schema.samples import SHAPE_NAMES
+from data_schema.table import STATE_NAMES
 from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE,
                                       FAULT_NORMAL_NOT_FINITE, FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL,
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
@@ -36,7 +37,8 @@ from surrogate.kernels.parallel import draw_local_parallel_rng, rebound_parallel
 from surrogate.kernels.rng import chunk_states
 from surrogate.table import SurrogateTable
 
-NORMAL_TOLERANCE = 1e-6
+NORMAL_TOLERANCE = 1e-6         # |n| − 1 allowed for a wall normal
+WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
 
 
 class LocalDraws(NamedTuple):
@@ -66,7 +68,7 @@ def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
     ``shape`` is a shape name, ``"mix"`` (equal weights over the table's
     shapes), a dict {shape: weight}, or a sequence of four weights in the order
     ellipsoid, prism, cut_prism, tetrahedron. Weights must
-    be non-negative and sum to 1 (within 1e-9); a shape with positive weight
+    be non-negative and sum to 1 (within WEIGHT_SUM_TOLERANCE); a shape with positive weight
     must be in the table.
     """
     if isinstance(shape, str) and shape == "mix":
@@ -89,7 +91,7 @@ def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
         if w > 0 and name not in table.shapes:
             raise ValueError(f"shape {name!r} is not in the table {table.path} (it holds {', '.join(table.shapes)}).")
     total = sum(weights.values())
-    if abs(total - 1.0) > 1e-9:
+    if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
         raise ValueError(f"The mix weights must sum to 1; got {float(total)!r} from "
                          f"{ {k: float(v) for k, v in weights.items()} }.")
     cdf = np.cumsum([weights.get(name, 0.0) for name in table.shapes])
@@ -164,7 +166,7 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
     states = chunk_states(check_random_state(random_state), len(a))
-    out = np.empty((len(a), 6))
+    out = np.empty((len(a), len(STATE_NAMES)))
     status = np.empty(len(a), dtype=np.int8)
     draw_local_parallel_rng(table.kernel_data, cdf, np.ascontiguousarray(a), np.ascontiguousarray(v), states, out,
                          status, scaled)

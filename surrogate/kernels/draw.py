@@ -52,10 +52,11 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
+from data_schema.table import N_CHAIN
 from surrogate.kernels.fastmath import fma, restitution_at, sincos
 from surrogate.kernels.layout import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED,
-                                      CELL_SD, CELL_SIZE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC, ROW_REGIME, ROW_SCALE,
-                                      ROW_SHAPE, ROW_SIZE, ROW_SLOPE)
+                                      CELL_SD, CELL_SIZE, FLOAT32_PER_CACHE_LINE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC,
+                                      ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SIZE, ROW_SLOPE)
 from surrogate.kernels.memory import load, load15, prefetch
 from surrogate.kernels.options import JIT, KERNEL
 
@@ -92,7 +93,7 @@ def _row(data, cell, c):
 def _level(data, cell, k, i):
     """Offset in ``data.dictionary`` of level i of chain variable k's residual shapes in cell number ``cell``
     (the n_dictionary shapes follow)."""
-    return ((cell * 6 + k) * data.n_levels + i) * data.n_dictionary
+    return ((cell * N_CHAIN + k) * data.n_levels + i) * data.n_dictionary
 
 
 @numba.njit(inline="always", **JIT)
@@ -346,7 +347,7 @@ def hint(data, cell, u):
 def hint_row(data, row):
     """Cache hints for the component row at offset ``row``: its three cache lines (144 bytes, the start
     16-byte aligned)."""
-    for j in range(0, ROW_SIZE, 16):
+    for j in range(0, ROW_SIZE, FLOAT32_PER_CACHE_LINE):
         prefetch(data.clusters, (row + j,))
 
 

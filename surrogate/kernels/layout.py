@@ -22,6 +22,7 @@ from data_schema.table import N_CHAIN, N_SLOPES, ReboundTable
 from surrogate.kernels.fastmath import restitution_pieces
 
 CACHE_LINE_BYTES = 64
+FLOAT32_PER_CACHE_LINE = CACHE_LINE_BYTES // 4
 
 
 class KernelData(NamedTuple):
