@@ -213,7 +213,8 @@ def test_serial_run_hit_counts_and_rebounds_against_the_sampler(serial_case, tmp
 def test_comparison_script_command_line(serial_case, tmp_path):
     out = subprocess.run([sys.executable, str(OPENFOAM_DIR / "compare_rebounds.py"), str(serial_case),
                           "--check", "--no-classifier", "--json", str(tmp_path / "c.json")],
-                         capture_output=True, text=True)
+                         capture_output=True, text=True, cwd=REPO,
+                         env=dict(os.environ, PYTHONPATH=str(REPO)))
     assert out.returncode == 0, out.stdout + out.stderr
     assert "threshold" in out.stdout and (tmp_path / "c.json").stat().st_size > 0
 
