@@ -84,6 +84,10 @@ class Info(ctypes.Structure):
                 ("kernel_bytes", ctypes.c_size_t)]
 
 
+def _rng(state) -> Rng:
+    return Rng((ctypes.c_uint64 * 4)(*[int(x) for x in state]))
+
+
 def _ptr(a: np.ndarray):
     return a.ctypes.data_as(ctypes.c_void_p)
 
@@ -168,7 +172,7 @@ class NativeTable:
         """Returns (status, V_out, W_out, advanced state)."""
         V, n, a = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a))
         count = V.shape[0]
-        rng = Rng(*[int(x) for x in state])
+        rng = _rng(state)
         V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
         self.lib.c.rbs_rebound_many_rng(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
                                         _ptr(a), ctypes.byref(rng), interpolation, _ptr(V_out), _ptr(W_out),
@@ -256,17 +260,17 @@ class Native:
         return np.array(list(rng.s), dtype=np.uint64)
 
     def fill(self, state: np.ndarray, count: int):
-        rng, u = Rng(*[int(x) for x in state]), np.empty(count)
+        rng, u = _rng(state), np.empty(count)
         self.c.rbs_rng_fill(ctypes.byref(rng), _ptr(u), ctypes.c_size_t(count))
         return u, np.array(list(rng.s), dtype=np.uint64)
 
     def uniform(self, state: np.ndarray):
-        rng = Rng(*[int(x) for x in state])
+        rng = _rng(state)
         x = self.c.rbs_rng_uniform(ctypes.byref(rng))
         return x, np.array(list(rng.s), dtype=np.uint64)
 
     def rebound_uniforms(self, state: np.ndarray, count: int):
-        rng, u = Rng(*[int(x) for x in state]), np.empty((count, U_PER_DRAW))
+        rng, u = _rng(state), np.empty((count, U_PER_DRAW))
         self.c.rbs_rebound_uniforms(ctypes.byref(rng), ctypes.c_size_t(count), _ptr(u))
         return u, np.array(list(rng.s), dtype=np.uint64)
 

@@ -1,0 +1,157 @@
+/*
+ * rbs_bench.c: the C timing loops of benchmarks/bench_native.py.
+ *
+ *   rbs_bench TABLE.h5 STATES.bin REPEATS SEED
+ *
+ * STATES.bin: int64 count, then V (count, 3), n (count, 3), a (count) as float64 (row-major). Times, best
+ * of REPEATS, in ns per reflected state, printed as one JSON object:
+ *   c_per_particle   a solver's loop: rbs_rng_fill (13 uniforms) and rbs_rebound per particle
+ *   c_many           rbs_rebound_many_rng on all the states (uniforms from 32 xoshiro256+ lanes)
+ *   c_many_given     rbs_rebound_many on pre-drawn uniforms (their drawing not timed)
+ *   c_rng            the 13 uniforms per state alone (rbs_rng_fill)
+ *   c_grant_tabakoff the deterministic Grant–Tabakoff sphere bounce, same loop (bench_sampler.py's (d))
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "rebound_scatter.h"
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Grant & Tabakoff (1975) restitution ratios, sand on 2024 aluminium, as polynomials in β1 (rad):
+ * the bounce of benchmarks/bench_sampler.py (grant_tabakoff_bounce), written the same way. */
+static void grant_tabakoff_bounce(const double *V, const double *n, double *V_out)
+{
+    static const double GT_NORMAL[4] = {1.0, -0.4159, 0.4994, -0.292};
+    static const double GT_TANGENTIAL[4] = {1.0, -2.12, 3.0775, -1.1};
+    double vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2];
+    double tx = V[0] - vn * n[0], ty = V[1] - vn * n[1], tz = V[2] - vn * n[2];
+    double vt = sqrt(tx * tx + ty * ty + tz * tz);
+    double speed = sqrt(vn * vn + vt * vt);
+    double ex[3] = {0.0, 0.0, 0.0};
+    if (vt > 1e-12 * speed) {
+        ex[0] = tx / vt;
+        ex[1] = ty / vt;
+        ex[2] = tz / vt;
+    }
+    double ez[3] = {ex[1] * n[2] - ex[2] * n[1], ex[2] * n[0] - ex[0] * n[2], ex[0] * n[1] - ex[1] * n[0]};
+    double beta1 = atan2(-vn, vt);
+    double e_n = GT_NORMAL[0] + beta1 * (GT_NORMAL[1] + beta1 * (GT_NORMAL[2] + beta1 * GT_NORMAL[3]));
+    double e_t = GT_TANGENTIAL[0] + beta1 * (GT_TANGENTIAL[1] + beta1 * (GT_TANGENTIAL[2] + beta1 * GT_TANGENTIAL[3]));
+    double lx = e_t * vt, ly = -e_n * vn, lz = 0.0;
+    for (int k = 0; k < 3; k++) V_out[k] = lx * ex[k] + ly * n[k] + lz * ez[k];
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 5) {
+        fprintf(stderr, "usage: %s TABLE.h5 STATES.bin REPEATS SEED\n", argv[0]);
+        return 2;
+    }
+    int repeats = atoi(argv[3]);
+    unsigned long long seed = strtoull(argv[4], NULL, 10);
+    char message[1024];
+    rbs_table *table = NULL;
+    int code = rbs_table_open(argv[1], &table, message, sizeof message);
+    if (code != RBS_OK) {
+        fprintf(stderr, "%s\n", message);
+        return 1;
+    }
+    FILE *f = fopen(argv[2], "rb");
+    long long count = 0;
+    if (!f || fread(&count, sizeof count, 1, f) != 1 || count <= 0) {
+        fprintf(stderr, "%s: cannot read the states\n", argv[2]);
+        return 1;
+    }
+    size_t N = (size_t)count;
+    double *V = malloc(3 * N * sizeof *V), *n = malloc(3 * N * sizeof *n), *a = malloc(N * sizeof *a);
+    double *V_out = malloc(3 * N * sizeof *V_out), *W_out = malloc(3 * N * sizeof *W_out);
+    double *U = malloc(RBS_U_PER_DRAW * N * sizeof *U);
+    signed char *status = malloc(N);
+    if (!V || !n || !a || !V_out || !W_out || !U || !status || fread(V, sizeof *V, 3 * N, f) != 3 * N
+        || fread(n, sizeof *n, 3 * N, f) != 3 * N || fread(a, sizeof *a, N, f) != N) {
+        fprintf(stderr, "%s: cannot read the states\n", argv[2]);
+        return 1;
+    }
+    fclose(f);
+    rbs_mix mix;
+    rbs_mix_equal(table, &mix);
+    /* first touch of the outputs, and a warm-up of every loop */
+    for (size_t i = 0; i < 3 * N; i++) V_out[i] = W_out[i] = 0.0;
+    rbs_rng rng;
+    rbs_rng_seed(&rng, seed);
+    rbs_rng_fill(&rng, U, RBS_U_PER_DRAW * N);
+
+    double best[5] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+    double checksum = 0.0;
+    for (int r = 0; r < repeats + 1; r++) {         /* run 0 is the warm-up */
+        double t0, dt;
+        /* (1) per particle: uniforms and one call per hit */
+        rbs_rng_seed(&rng, seed);
+        t0 = now();
+        for (size_t i = 0; i < N; i++) {
+            double u[RBS_U_PER_DRAW];
+            rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
+            status[i] = (signed char)rbs_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED, V_out + 3 * i,
+                                                 W_out + 3 * i);
+        }
+        dt = now() - t0;
+        if (r > 0 && dt < best[0]) best[0] = dt;
+        checksum += V_out[0];
+        /* (2) many particles, uniforms from the lanes */
+        rbs_rng_seed(&rng, seed);
+        t0 = now();
+        rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_SCALED, V_out, W_out, status);
+        dt = now() - t0;
+        if (r > 0 && dt < best[1]) best[1] = dt;
+        checksum += V_out[0];
+        /* (3) many particles, uniforms given */
+        t0 = now();
+        rbs_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, W_out, status);
+        dt = now() - t0;
+        if (r > 0 && dt < best[2]) best[2] = dt;
+        checksum += V_out[0];
+        /* (4) the uniforms alone */
+        rbs_rng_seed(&rng, seed);
+        double sum = 0.0;
+        t0 = now();
+        for (size_t i = 0; i < N; i++) {
+            double u[RBS_U_PER_DRAW];
+            rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
+            for (int k = 0; k < RBS_U_PER_DRAW; k++) sum += u[k];
+        }
+        dt = now() - t0;
+        if (r > 0 && dt < best[3]) best[3] = dt;
+        checksum += sum;
+        /* (5) the Grant–Tabakoff bounce */
+        t0 = now();
+        for (size_t i = 0; i < N; i++) grant_tabakoff_bounce(V + 3 * i, n + 3 * i, V_out + 3 * i);
+        dt = now() - t0;
+        if (r > 0 && dt < best[4]) best[4] = dt;
+        checksum += V_out[0];
+    }
+    size_t trapped = 0;
+    for (size_t i = 0; i < N; i++) trapped += status[i] != RBS_REBOUNDED;
+    printf("{\"count\": %zu, \"repeats\": %d, \"c_per_particle\": %.3f, \"c_many\": %.3f, \"c_many_given\": %.3f, "
+           "\"c_rng\": %.3f, \"c_grant_tabakoff\": %.3f, \"not_rebounded\": %zu, \"checksum\": %.17g}\n",
+           N, repeats, best[0] / (double)N * 1e9, best[1] / (double)N * 1e9, best[2] / (double)N * 1e9,
+           best[3] / (double)N * 1e9, best[4] / (double)N * 1e9, trapped, checksum);
+    free(V);
+    free(n);
+    free(a);
+    free(V_out);
+    free(W_out);
+    free(U);
+    free(status);
+    rbs_table_close(table);
+    return 0;
+}

@@ -1,0 +1,62 @@
+! example.f90: load a table and draw rebounds from Fortran.
+!
+!   rbs_example_fortran TABLE.h5
+!
+! Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+program rebound_example
+  use, intrinsic :: iso_c_binding
+  use rebound_scatter
+  implicit none
+  integer, parameter :: n_many = 1000
+  type(c_ptr) :: table
+  type(rbs_mix) :: mix
+  type(rbs_rng) :: rng
+  character(len=1024) :: path, message
+  real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), W_out(3)
+  real(c_double) :: Vs(3, n_many), ns(3, n_many), a(n_many), Vs_out(3, n_many), Ws_out(3, n_many)
+  integer(c_signed_char) :: status(n_many)
+  integer(c_int) :: code, st, i
+
+  if (command_argument_count() < 1) then
+    print '(a)', "usage: rbs_example_fortran TABLE.h5"
+    stop 2
+  end if
+  call get_command_argument(1, path)
+  code = rbs_open(path, table, message)
+  if (code /= RBS_OK) then
+    print '(a, i0, 3a)', "error ", code, " (", rbs_error_string(code), "): " // trim(message)
+    stop 1
+  end if
+  code = rbs_mix_equal(table, mix)
+  call rbs_rng_seed(rng, 1_c_int64_t)
+
+  ! one particle at a time
+  V = [120.0_c_double, -80.0_c_double, 10.0_c_double]      ! m/s, into the wall
+  n = [0.0_c_double, 1.0_c_double, 0.0_c_double]           ! unit normal into the gas
+  do i = 1, 3
+    call rbs_rng_fill(rng, u, int(RBS_U_PER_DRAW, c_size_t))
+    st = rbs_rebound(table, mix, V, n, 5e-5_c_double, u, RBS_SCALED, V_out, W_out)
+    print '(a, i0, a, 3f10.3, a, 3es12.3)', "status ", st, "  V+ =", V_out, "  Omega+ =", W_out
+  end do
+
+  ! many particles in one call (the faster path)
+  do i = 1, n_many
+    Vs(:, i) = V
+    ns(:, i) = n
+  end do
+  a = 5e-5_c_double
+  call rbs_rebound_many_rng(table, mix, int(n_many, c_size_t), Vs, ns, a, rng, RBS_SCALED, Vs_out, Ws_out, status)
+  print '(a, i0, a, i0, a, i0, a)', "many: ", n_many, " particles, ", count_status(RBS_REBOUNDED), &
+      " rebounded, ", count_status(RBS_TRAPPED), " trapped"
+  if (count_status(RBS_REBOUNDED) + count_status(RBS_TRAPPED) /= n_many) stop 3
+  if (any(status == RBS_REBOUNDED .and. Vs_out(2, :) <= 0.0_c_double)) stop 4   ! rebounds leave the wall
+  call rbs_table_close(table)
+  print '(a)', "ok"
+
+contains
+
+  integer function count_status(code)
+    integer(c_int), intent(in) :: code
+    count_status = int(count(status == code))
+  end function count_status
+end program rebound_example

@@ -1,0 +1,184 @@
+"""The native library draws the same bits as surrogate's numba kernels, for the same uniforms.
+
+Over random incident states (random unit normals; α1 and |V⁻| over and beyond the table's grid; exact
+normal impact, grazing, trapped cells, invalid input), every shape alone, the equal mix and a weighted
+mix, both interpolations: V⁺, Ω⁺ and the status of rbs_rebound_many equal those of
+surrogate.kernels.rebound_many; rbs_rebound row by row equals rbs_rebound_many and rebound_tuple; the
+local draw, the derived kernel arrays and the random numbers equal surrogate's. The largest ulp
+difference is printed (run with -s to see it) and must be 0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import _python_side as py
+from _native import SCALED, STOCHASTIC
+from _states import incident_states, max_ulp, uniforms
+
+KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
+                 "restitution_pieces")
+STATES_PER_CASE = 100_000
+INTERPOLATIONS = {"scaled": SCALED, "stochastic": STOCHASTIC}
+
+
+def _mixes(table):
+    shapes = list(table.shapes)
+    weights = dict(zip(shapes, np.linspace(1.0, 2.0, len(shapes)) / np.linspace(1.0, 2.0, len(shapes)).sum()))
+    return [(s, s) for s in shapes] + [("mix", "mix"), ("weighted", weights)]
+
+
+def _native_mix(native_table, spec):
+    if isinstance(spec, dict):
+        code, mix, message = native_table.mix_from_weights(spec)
+    else:
+        code, mix, message = native_table.mix_from_shape(spec)
+    assert code == 0, message
+    return mix
+
+
+def test_derived_kernel_arrays_equal_surrogate(table_pair):
+    table, native_table = table_pair
+    data = table.kernel_data
+    for name in KERNEL_ARRAYS:
+        expected, got = np.asarray(getattr(data, name)), native_table.kernel_array(name)
+        assert got.dtype == expected.dtype and got.shape == expected.shape, name
+        assert np.array_equal(got.view(np.uint8), expected.view(np.uint8)), f"{name} differs"
+    info = native_table.info()
+    assert (info.n_shapes, info.n_alpha1, info.n_speed) == (data.n_shapes, data.n_alpha1, data.n_speed)
+    assert (info.n_clusters, info.n_levels, info.n_dictionary, info.n_pieces) == \
+        (data.n_clusters, data.n_levels, data.n_dictionary, data.n_pieces)
+    assert info.kernel_bytes == data.nbytes
+    assert native_table.shapes == tuple(table.shapes)
+    assert native_table.ranges() == (table.alpha1_range, table.speed_range)
+
+
+def test_mixes_equal_mix_cdf(table_pair):
+    table, native_table = table_pair
+    for _, spec in _mixes(table):
+        mix = _native_mix(native_table, spec)
+        expected = py.mix_cdf(table, spec)
+        assert mix.n_shapes == len(expected)
+        assert list(mix.cdf)[:len(expected)] == list(expected), spec
+
+
+@pytest.mark.parametrize("interpolation", sorted(INTERPOLATIONS))
+def test_rebound_many_bit_identical(table_pair, interpolation):
+    """1e5 random incident states per mix (six mixes), against surrogate.kernels.rebound_many."""
+    table, native_table = table_pair
+    (a_lo, a_hi), (v_lo, v_hi) = table.alpha1_range, table.speed_range
+    worst = {}
+    for k, (label, spec) in enumerate(_mixes(table)):
+        rng = np.random.default_rng(1000 + k)
+        V, n, a = incident_states(rng, STATES_PER_CASE, (0.0, 90.0), (0.2 * v_lo, 1.5 * v_hi))
+        u = uniforms(rng, STATES_PER_CASE)
+        cdf = py.mix_cdf(table, spec)
+        V_py, W_py = np.empty((STATES_PER_CASE, 3)), np.empty((STATES_PER_CASE, 3))
+        status_py = np.empty(STATES_PER_CASE, dtype=np.int8)
+        py.rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == "scaled")
+        status, V_c, W_c = native_table.rebound_many(_native_mix(native_table, spec), V, n, a, u,
+                                                     INTERPOLATIONS[interpolation])
+        assert np.array_equal(status, status_py), label
+        counts = {s: int(np.sum(status == s)) for s in (py.STATUS_REBOUNDED, py.STATUS_TRAPPED, py.STATUS_INVALID)}
+        assert counts[py.STATUS_REBOUNDED] > 0.7 * STATES_PER_CASE and counts[py.STATUS_INVALID] > 0
+        if label in ("ellipsoid", "mix"):
+            assert counts[py.STATUS_TRAPPED] > 0, "no trapped draw: the trapped cells are not exercised"
+        worst[label] = (max_ulp(V_c, V_py), max_ulp(W_c, W_py))
+    print(f"\nlargest ulp difference, {interpolation}, {STATES_PER_CASE} states per mix (V+, Omega+): {worst}")
+    assert all(v == (0.0, 0.0) for v in worst.values()), worst
+
+
+def test_single_calls_equal_many_and_rebound_tuple(table_pair):
+    """rbs_rebound row by row = rbs_rebound_many = surrogate's rebound_tuple, both interpolations."""
+    table, native_table = table_pair
+    rng = np.random.default_rng(7)
+    count = 3000
+    (v_lo, v_hi) = table.speed_range
+    V, n, a = incident_states(rng, count, (0.0, 90.0), (0.2 * v_lo, 1.5 * v_hi))
+    u = uniforms(rng, count)
+    mix = native_table.mix_equal()
+    cdf = py.mix_cdf(table, "mix")
+    for interpolation in (SCALED, STOCHASTIC):
+        status, V_many, W_many = native_table.rebound_many(mix, V, n, a, u, interpolation)
+        for i in range(count):
+            st, v, w = native_table.rebound(mix, V[i], n[i], a[i], u[i], interpolation)
+            st_py, v_py, w_py = py.rebound_tuple(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
+                                                 interpolation == SCALED)
+            assert st == status[i] == st_py, i
+            assert max_ulp(v, V_many[i]) == 0 and max_ulp(w, W_many[i]) == 0, i
+            assert max_ulp(v, np.array(v_py)) == 0 and max_ulp(w, np.array(w_py)) == 0, i
+
+
+def test_draw_local_bit_identical(table_pair):
+    table, native_table = table_pair
+    rng = np.random.default_rng(11)
+    count = 20000
+    (v_lo, v_hi) = table.speed_range
+    alpha1 = rng.uniform(0.0, 95.0, count)
+    speed = rng.uniform(0.5 * v_lo, 1.5 * v_hi, count)
+    alpha1[:50] = table.alpha1_deg[rng.integers(0, len(table.alpha1_deg), 50)]      # on the grid
+    speed[50:100] = table.speed_m_s[rng.integers(0, len(table.speed_m_s), 50)]
+    u = uniforms(rng, count)
+    worst = 0.0
+    for label, spec in _mixes(table)[-2:]:
+        mix, cdf = _native_mix(native_table, spec), py.mix_cdf(table, spec)
+        for interpolation in (SCALED, STOCHASTIC):
+            for i in range(0, count, 2 if interpolation == SCALED else 4):
+                st, out = native_table.draw_local(mix, alpha1[i], speed[i], u[i], interpolation)
+                expected = py.draw_local(table.kernel_data, cdf, alpha1[i], speed[i], u[i], interpolation == SCALED)
+                assert st == expected[0], (label, i)
+                worst = max(worst, max_ulp(out, np.array(expected[1:])))
+    print(f"\nlargest ulp difference of the local draw: {worst}")
+    assert worst == 0.0
+
+
+SEEDS = [0, 1, 2, 12345, 2**31 - 1, 2**32 - 1, 2**32, 2**32 + 1, 2**53 + 7, 2**63, 2**64 - 1]
+
+
+def test_seeds_equal_seed_state(native):
+    seeds = SEEDS + [int(s) for s in np.random.default_rng(3).integers(0, 2**63, 200, dtype=np.uint64)]
+    seeds += [int(s) for s in np.random.default_rng(4).integers(0, 2**32, 100, dtype=np.uint64)]
+    for seed in seeds:
+        assert np.array_equal(native.seed(seed), py.seed_state(seed)), seed
+        streams = py.seed_state(seed, n_streams=5)
+        for k in range(5):
+            assert np.array_equal(native.seed(seed, k), streams[k]), (seed, k)
+    for seed in SEEDS[:4]:
+        streams = py.seed_state(seed, n_streams=70)
+        for k in (0, 1, 33, 69):
+            assert np.array_equal(native.seed(seed, k), streams[k]), (seed, k)
+
+
+def test_uniforms_equal_fill_uniforms(native):
+    for seed in SEEDS:
+        state = py.seed_state(seed)
+        u_py = np.empty(1000)
+        py_state = state.copy()
+        py.fill_uniforms(py_state, u_py)
+        u_c, c_state = native.fill(state, 1000)
+        assert np.array_equal(u_c, u_py) and np.array_equal(c_state, py_state), seed
+        x, after = native.uniform(state)
+        assert x == u_py[0]
+
+
+def test_block_uniforms_and_rebound_many_rng(table_pair, native):
+    """rbs_rebound_uniforms = rebound_uniforms and rbs_rebound_many_rng = rebound_many_rng, bit for bit,
+    for row counts on and off the 32-row blocks."""
+    table, native_table = table_pair
+    mix, cdf = native_table.mix_equal(), py.mix_cdf(table, "mix")
+    rng = np.random.default_rng(5)
+    for count in (0, 1, 31, 32, 33, 1000, 20001):
+        state = py.seed_state(count + 9)
+        u_py = py.rebound_uniforms(state.copy(), count)
+        u_c, _ = native.rebound_uniforms(state, count)
+        assert np.array_equal(u_c, u_py), count
+        V, n, a = incident_states(rng, count)
+        for interpolation in (SCALED, STOCHASTIC):
+            V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
+            py_state = state.copy()
+            py.rebound_many_rng(table.kernel_data, cdf, V, n, a, py_state, V_py, W_py, status_py,
+                                interpolation == SCALED)
+            status, V_c, W_c, c_state = native_table.rebound_many_rng(mix, V, n, a, state, interpolation)
+            assert np.array_equal(status, status_py) and np.array_equal(c_state, py_state), count
+            assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0, count
