@@ -243,7 +243,13 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
                                               hits["Wout"][valid][ok_of])
     alpha1_py, speed_py, X_py = impact_states(V[ok_py], n[ok_py], a[ok_py], V_py[ok_py], W_py[ok_py])
     in_range = (speed_of >= speed_lo) & (speed_of <= speed_hi)
+    # every drawn hit (rebounded or trapped) outside the grid: the adapter's own count
+    speed_all = np.linalg.norm(V, axis=1)
+    alpha1_all = np.degrees(np.arcsin(np.clip(-np.einsum("ij,ij->i", V, n) / speed_all, -1, 1)))
+    a_lo, a_hi = float(np.min(table.alpha1_deg)), float(np.max(table.alpha1_deg))
+    outside_grid = ((speed_all < speed_lo) | (speed_all > speed_hi) | (alpha1_all < a_lo) | (alpha1_all > a_hi))
     res["incidence"] = {
+        "hits_outside_grid": int(np.sum(outside_grid)),
         "alpha1_deg_percentiles_5_50_95": np.percentile(alpha1_of, [5, 50, 95]).round(2).tolist(),
         "speed_m_s_percentiles_5_50_95": np.percentile(speed_of, [5, 50, 95]).round(1).tolist(),
         "table_speed_range_m_s": [speed_lo, speed_hi],

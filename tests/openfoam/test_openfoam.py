@@ -64,7 +64,7 @@ def _cloud_info(log: str) -> dict:
         return float(re.search(re.escape(label) + r"[^=]*=\s*([-0-9.eE+]+)", block).group(1))
     return {"hits": int(number("- wall hits")), "rebounded": int(number("- rebounded")),
             "trapped": int(number("- trapped")), "invalid": int(number("- invalid")),
-            "outside": int(number("- |V| outside")),
+            "outside": int(number("- outside the table's grid")),
             "spin_mean": float(spin.group(1)), "spin_max": float(spin.group(2))}
 
 
@@ -203,8 +203,8 @@ def test_serial_run_hit_counts_and_rebounds_against_the_sampler(serial_case, tmp
     sp = res["solver_vs_specular"]
     assert sp["ks"]["speed_ratio"] > 0.5 and sp["ks"]["beta2"] > 0.3, sp
     assert res["incidence"]["fraction_outside_speed_range"] < 0.2
-    assert info["outside"] == pytest.approx(res["incidence"]["fraction_outside_speed_range"] * info["hits"],
-                                            abs=1)
+    # the adapter's count of hits drawn at the grid's edge (rounding may move a hit at the edge itself)
+    assert info["outside"] == pytest.approx(res["incidence"]["hits_outside_grid"], abs=2)
     png = tmp_path / "rebounds.png"
     compare_rebounds.plot(res, png)
     assert png.stat().st_size > 10_000
@@ -329,5 +329,6 @@ def test_trapped_parcels_stick_or_are_removed(policy, openfoam_build, trapping_t
     res = compare_rebounds.compare(case, classifier=False)
     print(compare_rebounds.report(res))
     assert res["trapped"] == info["trapped"]
+    assert info["outside"] == pytest.approx(res["incidence"]["hits_outside_grid"], abs=2)
     assert res["trapped_fraction"]["ok"], res["trapped_fraction"]
     assert res["solver_vs_sampler"]["ks_ok"], res

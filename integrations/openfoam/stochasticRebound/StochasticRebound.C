@@ -111,6 +111,9 @@ void Foam::StochasticRebound<CloudType>::openTable(const dictionary& dict)
     table_.reset(table, rbs_table_close);
 
     double lo, hi;
+    rbs_table_alpha1_range(table, &lo, &hi);
+    alpha1Lo_ = lo;
+    alpha1Hi_ = hi;
     rbs_table_speed_range(table, &lo, &hi);
     speedLo_ = lo;
     speedHi_ = hi;
@@ -222,6 +225,8 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     removeTrapped_(false),
     seed_(0),
     interpolation_(RBS_SCALED),
+    alpha1Lo_(0),
+    alpha1Hi_(0),
     speedLo_(0),
     speedHi_(0),
     writeHits_
@@ -314,11 +319,9 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     }
 
     const rbs_table* t = table_.get();
-    double alo, ahi;
-    rbs_table_alpha1_range(t, &alo, &ahi);
     Info<< "    stochasticRebound: table " << tableFile_
-        << " (" << rbs_table_n_shapes(t) << " shapes, alpha1 " << alo
-        << "-" << ahi << " deg, |V| " << speedLo_ << "-" << speedHi_
+        << " (" << rbs_table_n_shapes(t) << " shapes, alpha1 " << alpha1Lo_
+        << "-" << alpha1Hi_ << " deg, |V| " << speedLo_ << "-" << speedHi_
         << " m/s)" << nl
         << "        shape " << mixName_.c_str() << ", a = " << halfSizeFactor_
         << "*d/2, trapped parcels " << (removeTrapped_ ? "removed" : "stick")
@@ -342,6 +345,8 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     removeTrapped_(pim.removeTrapped_),
     seed_(pim.seed_),
     interpolation_(pim.interpolation_),
+    alpha1Lo_(pim.alpha1Lo_),
+    alpha1Hi_(pim.alpha1Hi_),
     speedLo_(pim.speedLo_),
     speedHi_(pim.speedHi_),
     writeHits_(pim.writeHits_),
@@ -418,16 +423,28 @@ bool Foam::StochasticRebound<CloudType>::correct
         c.spinRatioMax = max(c.spinRatioMax, spinRatio);
     }
 
+    if (status != RBS_INVALID)
+    {
+        // Outside the table's grid the law at the nearest grid edge is drawn
+        const scalar alpha1 = radToDeg
+        (
+            std::asin(min(max(-(V[0]*n[0] + V[1]*n[1] + V[2]*n[2])/speed, -1), 1))
+        );
+        if
+        (
+            speed < speedLo_ || speed > speedHi_
+         || alpha1 < alpha1Lo_ || alpha1 > alpha1Hi_
+        )
+        {
+            ++c.outsideGrid;
+        }
+    }
+
     switch (status)
     {
         case RBS_REBOUNDED:
         {
             ++c.rebounded;
-            if (speed < speedLo_ || speed > speedHi_)
-            {
-                // Drawn from the law at the nearest grid edge
-                ++c.outsideSpeedRange;
-            }
             keepParticle = true;
             p.active(true);
             U = vector(Vout[0], Vout[1], Vout[2]) + Uwall;
@@ -480,8 +497,7 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
     label nRebounded = this->template getModelProperty<label>("nRebounded");
     label nTrapped = this->template getModelProperty<label>("nTrapped");
     label nInvalid = this->template getModelProperty<label>("nInvalid");
-    label nOutside =
-        this->template getModelProperty<label>("nOutsideSpeedRange");
+    label nOutside = this->template getModelProperty<label>("nOutsideGrid");
     scalar mTrapped = this->template getModelProperty<scalar>("massTrapped");
     label nSpin = this->template getModelProperty<label>("nSpinSamples");
     scalar spinSum = this->template getModelProperty<scalar>("spinRatioSum");
@@ -491,7 +507,7 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
     nRebounded += returnReduce(c.rebounded, sumOp<label>());
     nTrapped += returnReduce(c.trapped, sumOp<label>());
     nInvalid += returnReduce(c.invalid, sumOp<label>());
-    nOutside += returnReduce(c.outsideSpeedRange, sumOp<label>());
+    nOutside += returnReduce(c.outsideGrid, sumOp<label>());
     mTrapped += returnReduce(c.trappedMass, sumOp<scalar>());
 
     os  << "    Stochastic rebound (" << mixName_.c_str() << ')' << nl
@@ -502,7 +518,7 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
           : "      - trapped, stuck (number, mass) = ")
         << nTrapped << ", " << mTrapped << nl
         << "      - invalid (left as stock)     = " << nInvalid << nl
-        << "      - |V| outside table range     = " << nOutside << nl;
+        << "      - outside the table's grid    = " << nOutside << nl;
 
     if (stochasticReboundDetail::hasSpin<typename CloudType::parcelType>::value)
     {
@@ -525,7 +541,7 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
         this->setModelProperty("nRebounded", nRebounded);
         this->setModelProperty("nTrapped", nTrapped);
         this->setModelProperty("nInvalid", nInvalid);
-        this->setModelProperty("nOutsideSpeedRange", nOutside);
+        this->setModelProperty("nOutsideGrid", nOutside);
         this->setModelProperty("massTrapped", mTrapped);
         this->setModelProperty("nSpinSamples", nSpin);
         this->setModelProperty("spinRatioSum", spinSum);
