@@ -1,7 +1,7 @@
 /*
  * rbs_bench.c: the C timing loops of benchmarks/bench_native.py.
  *
- *   rbs_bench TABLE.h5 STATES.bin REPEATS SEED
+ *   rbs_bench TABLE.h5 STATES.bin REPEATS SEED [OUT.bin]
  *
  * STATES.bin: int64 count, then V (count, 3), n (count, 3), a (count) as float64 (row-major). Times, best
  * of REPEATS, in ns per reflected state, printed as one JSON object:
@@ -10,6 +10,9 @@
  *   c_many_given     rbs_rebound_many on pre-drawn uniforms (their drawing not timed)
  *   c_rng            the 13 uniforms per state alone (rbs_rng_fill)
  *   c_grant_tabakoff the deterministic Grant–Tabakoff sphere bounce, same loop (bench_sampler.py's (d))
+ *
+ * With OUT.bin, the results of the first rbs_rebound_many_rng call (V_out, Omega_out as float64 (count, 3),
+ * status as int8) are written there, for a comparison of the bits.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -114,6 +117,15 @@ int main(int argc, char **argv)
         dt = now() - t0;
         if (r > 0 && dt < best[1]) best[1] = dt;
         checksum += V_out[0];
+        if (r == 0 && argc > 5) {
+            FILE *out = fopen(argv[5], "wb");
+            if (!out || fwrite(V_out, sizeof *V_out, 3 * N, out) != 3 * N || fwrite(W_out, sizeof *W_out, 3 * N, out) != 3 * N
+                || fwrite(status, 1, N, out) != N) {
+                fprintf(stderr, "%s: cannot write the results\n", argv[5]);
+                return 1;
+            }
+            fclose(out);
+        }
         /* (3) many particles, uniforms given */
         t0 = now();
         rbs_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, W_out, status);

@@ -15,7 +15,7 @@
 
 /* The state (α2, β2, s, Ω_x, Ω_y, Ω_z) reflected into the range of a rebound: α2 into [0, π], β2 below
  * π/2, s into [0, 1] (surrogate.draw._folded). */
-static inline void rbs_folded(double alpha2, double beta2, double s, double wx, double wy, double wz, double state[6])
+RBS_INLINE void rbs_folded(double alpha2, double beta2, double s, double wx, double wy, double wz, double state[6])
 {
     alpha2 = fabs(alpha2);
     s = fabs(s);
@@ -29,7 +29,7 @@ static inline void rbs_folded(double alpha2, double beta2, double s, double wx, 
 
 /* The folded state of one component from its residual quantiles q and slopes b (chain order α2, |β2|,
  * s, Ω_z, Ω_x, Ω_y; surrogate.draw._chain). */
-static inline void rbs_chain(const double q[6], const double b[15], double state[6])
+RBS_INLINE void rbs_chain(const double q[6], const double b[15], double state[6])
 {
     double x0 = q[0];
     double x1 = fma(b[0], x0, q[1]);
@@ -41,20 +41,20 @@ static inline void rbs_chain(const double q[6], const double b[15], double state
 }
 
 /* m + (x − m_cell) · ratio */
-static inline double rbs_shifted(double x, rbs_term term)
+RBS_INLINE double rbs_shifted(double x, rbs_term term)
 {
     return fma(x - term.mean_cell, term.ratio, term.mean);
 }
 
 /* The folded state moved to the incident α1 (surrogate.draw._moved), then folded again. */
-static inline void rbs_moved(const double state[6], const rbs_term terms[6], double out[6])
+RBS_INLINE void rbs_moved(const double state[6], const rbs_term terms[6], double out[6])
 {
     rbs_folded(rbs_shifted(state[0], terms[0]), state[1] * terms[1].ratio, rbs_shifted(state[2], terms[2]),
                state[3] * terms[3].ratio, state[4] * terms[4].ratio, rbs_shifted(state[5], terms[5]), out);
 }
 
 /* V⁺ (local frame, units of |V⁻|) of a rebound at (α2, β2) with speed ratio s */
-static inline void rbs_velocity(double alpha2, double beta2, double s, double v[3])
+RBS_INLINE void rbs_velocity(double alpha2, double beta2, double s, double v[3])
 {
     double sb, cb, sa, ca;
     rbs_sincos(beta2, &sb, &cb);
@@ -67,7 +67,7 @@ static inline void rbs_velocity(double alpha2, double beta2, double s, double v[
 
 /* A rebound drawn at grid speed V_iv moved to the incident speed V (surrogate.draw._to_speed): x = (vx,
  * vy, vz, wx, wy, wz) in place; f_target, f_grid = exp(−k V^p) at V and V_iv. */
-static inline void rbs_to_speed(double regime, double f_target, double f_grid, double cos_alpha1, double sin_alpha1,
+RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, double cos_alpha1, double sin_alpha1,
                                 double x[6])
 {
     double a_target = 1.0 - (1.0 - f_target) * sin_alpha1;
@@ -86,7 +86,7 @@ static inline void rbs_to_speed(double regime, double f_target, double f_grid, d
 }
 
 /* the mirror symmetry Z → −Z when u < 1/2 */
-static inline void rbs_mirrored(double u, double x[6])
+RBS_INLINE void rbs_mirrored(double u, double x[6])
 {
     double mirror = u < 0.5 ? -1.0 : 1.0;
     x[2] = mirror * x[2];
@@ -96,7 +96,7 @@ static inline void rbs_mirrored(double u, double x[6])
 
 /* The whole draw in a located cell (surrogate.draw._draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
  * returns the status (NaN state when trapped). */
-static inline int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
+RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
                                    const double *u, int scaled, double x[6])
 {
     if (u[3] < t->cells[cell->drawn * CELL_SIZE + CELL_P_TRAPPED]) {

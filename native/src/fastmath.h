@@ -19,6 +19,8 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "internal.h"
+
 #define RBS_PI 0x1.921fb54442d18p+1             /* math.pi */
 #define RBS_TWO_PI 0x1.921fb54442d18p+2         /* 2.0 * math.pi */
 #define RBS_HALF_PI 0x1.921fb54442d18p+0        /* 0.5 * math.pi */
@@ -31,17 +33,17 @@
 
 /* Python's int(x) for a float, as numba compiles it (fptosi): x86-64's cvttsd2si, which gives
  * INT64_MIN for NaN and out-of-range values; written out so the C is defined everywhere. */
-static inline int64_t rbs_trunc(double x)
+RBS_INLINE int64_t rbs_trunc(double x)
 {
     return (x > -0x1p63 && x < 0x1p63) ? (int64_t)x : INT64_MIN;
 }
 
 /* numba's min(a, b) and max(a, b) of floats: b if b < a (b > a) else a */
-static inline double rbs_fmin_py(double a, double b) { return b < a ? b : a; }
-static inline double rbs_fmax_py(double a, double b) { return b > a ? b : a; }
+RBS_INLINE double rbs_fmin_py(double a, double b) { return b < a ? b : a; }
+RBS_INLINE double rbs_fmax_py(double a, double b) { return b > a ? b : a; }
 
 /* (sin x, cos x) for |x| <= 2π, to a few ulp (surrogate.trig.sincos) */
-static inline void rbs_sincos(double x, double *sin_x, double *cos_x)
+RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
 {
     const double S3 = -0x1.5555555555555p-3, S5 = 0x1.1111111111111p-7, S7 = -0x1.a01a01a01a01ap-13,
                  S9 = 0x1.71de3a556c734p-19, S11 = -0x1.ae64567f544e4p-26, S13 = 0x1.6124613a86d09p-33,
@@ -64,7 +66,7 @@ static inline void rbs_sincos(double x, double *sin_x, double *cos_x)
 }
 
 /* atan2(y, x) in radians for x >= 0, y >= 0, not both 0, to a few ulp (surrogate.trig.atan2_first_quadrant) */
-static inline double rbs_atan2_q1(double y, double x)
+RBS_INLINE double rbs_atan2_q1(double y, double x)
 {
     static const double ATAN_AT_NODES[5] = {0.0, 0x1.f5b75f92c80ddp-3, 0x1.dac670561bb4fp-2, 0x1.4978fa3269ee1p-1,
                                             0x1.921fb54442d18p-1};
@@ -85,7 +87,7 @@ static inline double rbs_atan2_q1(double y, double x)
 
 /* exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w in [0, 1], from the table's pieces (flat; n_pieces S
  * per interval, degree 9; surrogate.restitution.restitution_at) */
-static inline double rbs_restitution_at(const double *pieces, int64_t n_pieces, int64_t j, double w)
+RBS_INLINE double rbs_restitution_at(const double *pieces, int64_t n_pieces, int64_t j, double w)
 {
     double t = w * (double)n_pieces;
     int64_t i = rbs_trunc(t);

@@ -14,13 +14,13 @@
 #include "internal.h"
 
 /* a·b of two 3-vectors, the same bits wherever it is inlined (surrogate.frame._dot) */
-static inline double rbs_dot(double a0, double a1, double a2, double b0, double b1, double b2)
+RBS_INLINE double rbs_dot(double a0, double a1, double a2, double b0, double b1, double b2)
 {
     return fma(a0, b0, fma(a1, b1, a2 * b2));
 }
 
 /* V·n < 0 and V finite */
-static inline int rbs_moves_into_wall(const double *V, const double *n)
+RBS_INLINE int rbs_moves_into_wall(const double *V, const double *n)
 {
     return rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]) < 0.0 && isfinite(V[0] + V[1] + V[2]);
 }
@@ -34,7 +34,7 @@ typedef struct rbs_frame {
 
 /* The impact frame of V on a wall of unit normal n (surrogate.frame.impact_frame); at normal impact
  * (tangential part <= 1e-12 |V|) ex is uniform in the wall plane, from u_axis. */
-static inline void rbs_impact_frame(const double *V, const double *n, double u_axis, rbs_frame *f)
+RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis, rbs_frame *f)
 {
     double vn = rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]);
     double tx = fma(-vn, n[0], V[0]), ty = fma(-vn, n[1], V[1]), tz = fma(-vn, n[2], V[2]);
@@ -82,7 +82,7 @@ static inline void rbs_impact_frame(const double *V, const double *n, double u_a
 
 /* A local draw x = (vx, vy, vz, wx, wy, wz) (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the
  * frame (ex, n, ez); NaN unless rebounded (surrogate.frame._to_global). */
-static inline void rbs_to_global(int status, const double x[6], double speed, double a, const double *ex,
+RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, double a, const double *ex,
                                  const double *n, const double *ez, double *V_out, double *W_out)
 {
     if (status != RBS_REBOUNDED) {

@@ -21,19 +21,19 @@
 #endif
 
 /* offset of component c's row in cell number `cell` */
-static inline int64_t rbs_row(const rbs_table *t, int64_t cell, int64_t c)
+RBS_INLINE int64_t rbs_row(const rbs_table *t, int64_t cell, int64_t c)
 {
     return (cell * t->n_clusters + c) * ROW_SIZE;
 }
 
 /* offset of level i of chain variable k's residual shapes in cell number `cell` */
-static inline int64_t rbs_level(const rbs_table *t, int64_t cell, int64_t k, int64_t i)
+RBS_INLINE int64_t rbs_level(const rbs_table *t, int64_t cell, int64_t k, int64_t i)
 {
     return ((cell * 6 + k) * t->n_levels + i) * t->n_dictionary;
 }
 
 /* the row u4 picks before the alias table: t = u4 · C, c = ⌊t⌋ */
-static inline int64_t rbs_first_row(const rbs_table *t, int64_t cell, double u4, double *t_out, int64_t *c_out)
+RBS_INLINE int64_t rbs_first_row(const rbs_table *t, int64_t cell, double u4, double *t_out, int64_t *c_out)
 {
     double x = u4 * (double)t->n_clusters;
     int64_t c = rbs_trunc(x);
@@ -44,7 +44,7 @@ static inline int64_t rbs_first_row(const rbs_table *t, int64_t cell, double u4,
 }
 
 /* the offset of the component row u4 draws in `cell`, through Walker's alias table */
-static inline int64_t rbs_component(const rbs_table *t, int64_t cell, double u4)
+RBS_INLINE int64_t rbs_component(const rbs_table *t, int64_t cell, double u4)
 {
     double x;
     int64_t c;
@@ -55,7 +55,7 @@ static inline int64_t rbs_component(const rbs_table *t, int64_t cell, double u4)
 }
 
 /* loc + scale · S(u) of chain variable k in the component at `row` (linear between levels i, i + 1) */
-static inline double rbs_quantile(const rbs_table *t, int64_t cell, int64_t row, int k, double u)
+RBS_INLINE double rbs_quantile(const rbs_table *t, int64_t cell, int64_t row, int k, double u)
 {
     const float *r = t->clusters;
     int64_t levels = t->n_levels - 1;
@@ -68,7 +68,7 @@ static inline double rbs_quantile(const rbs_table *t, int64_t cell, int64_t row,
 }
 
 /* the six residual quantiles of a draw (u[5..10]) */
-static inline void rbs_quantiles(const rbs_table *t, int64_t cell, int64_t row, const double *u, double q[6])
+RBS_INLINE void rbs_quantiles(const rbs_table *t, int64_t cell, int64_t row, const double *u, double q[6])
 {
     for (int k = 0; k < 6; k++) q[k] = rbs_quantile(t, cell, row, k, u[5 + k]);
 }
@@ -81,7 +81,7 @@ typedef struct rbs_term {
 /* The terms that move a state drawn from cell `drawn` to the incident α1 (surrogate.draw._alpha1_terms):
  * m and σ linear in α1 (weight wa) between cell `below` and the next α1 up; with wa = 0 the cell above
  * is not read. */
-static inline void rbs_alpha1_terms(const rbs_table *t, int64_t below, double wa, int64_t drawn, rbs_term terms[6])
+RBS_INLINE void rbs_alpha1_terms(const rbs_table *t, int64_t below, double wa, int64_t drawn, rbs_term terms[6])
 {
     const double *cells = t->cells;
     int64_t lo = below * CELL_SIZE, here = drawn * CELL_SIZE;
@@ -97,7 +97,7 @@ static inline void rbs_alpha1_terms(const rbs_table *t, int64_t below, double wa
 }
 
 /* exp(−k V^p) at the incident speed (interval jv, weight wv) and at the drawn grid speed iv */
-static inline void rbs_restitution_factors(const rbs_table *t, int64_t jv, double wv, int64_t iv, double *f_target,
+RBS_INLINE void rbs_restitution_factors(const rbs_table *t, int64_t jv, double wv, int64_t iv, double *f_target,
                                            double *f_grid)
 {
     *f_target = rbs_restitution_at(t->restitution_pieces, t->n_pieces, jv, wv);
@@ -105,13 +105,13 @@ static inline void rbs_restitution_factors(const rbs_table *t, int64_t jv, doubl
 }
 
 /* cache hints for a component row: its three cache lines */
-static inline void rbs_hint_row(const rbs_table *t, int64_t row)
+RBS_INLINE void rbs_hint_row(const rbs_table *t, int64_t row)
 {
     for (int j = 0; j < ROW_SIZE; j += 16) RBS_PREFETCH(t->clusters + row + j);
 }
 
 /* cache hints for the two residual-shape levels of each chain variable that u[5..10] pick */
-static inline void rbs_hint_levels(const rbs_table *t, int64_t drawn, const double *u)
+RBS_INLINE void rbs_hint_levels(const rbs_table *t, int64_t drawn, const double *u)
 {
     int64_t levels = t->n_levels - 1;
     for (int k = 0; k < 6; k++) {
@@ -124,7 +124,7 @@ static inline void rbs_hint_levels(const rbs_table *t, int64_t drawn, const doub
 }
 
 /* the hints of a draw in `drawn`: the row u[4] picks (before its alias) and the levels */
-static inline void rbs_hint_draw(const rbs_table *t, int64_t drawn, const double *u)
+RBS_INLINE void rbs_hint_draw(const rbs_table *t, int64_t drawn, const double *u)
 {
     double x;
     int64_t c;

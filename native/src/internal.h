@@ -19,6 +19,21 @@
 
 #include "rebound_scatter.h"
 
+/* The entry points of the hot path are compiled twice on x86-64 with GCC (function multi-versioning,
+ * chosen once at load time): for x86-64-v3 (AVX2 and FMA, so fma() is one instruction, as in numba's code
+ * on such CPUs) and for the baseline (fma() is then the C library's, correctly rounded: the same bits).
+ * Define RBS_NO_CLONES to build the baseline only. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__ELF__) && !defined(RBS_NO_CLONES)
+#define RBS_HOT __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define RBS_HOT
+#endif
+#if defined(__GNUC__)
+#define RBS_INLINE static inline __attribute__((always_inline))
+#else
+#define RBS_INLINE static inline
+#endif
+
 /* A component row of `clusters` (144 bytes: three cache lines when 16-byte aligned in a 64-byte block) */
 #define ROW_ALIAS_PROB 0    /* Walker alias table: keep the component if the fractional part < this */
 #define ROW_ALIAS 1         /* ... else use this component */

@@ -14,7 +14,7 @@
 
 /* (j, w): the grid interval [g_j, g_{j+1}] holding x and the weight of g_{j+1}. Outside the grid, the
  * nearest edge with weight 0 or 1; a one-point grid gives (0, 0). */
-static inline void rbs_locate(const double *axis, int64_t axis_len, int64_t n, double x, int64_t *j_out,
+RBS_INLINE void rbs_locate(const double *axis, int64_t axis_len, int64_t n, double x, int64_t *j_out,
                               double *w_out)
 {
     if (n == 1) {
@@ -44,7 +44,7 @@ typedef struct rbs_cell {
     double wa, wv;      /* weights of the upper α1 and speed neighbours */
 } rbs_cell;
 
-static inline rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_shapes, double alpha1, double speed,
+RBS_INLINE rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_shapes, double alpha1, double speed,
                                    const double *u)
 {
     rbs_cell c;

@@ -37,7 +37,7 @@ typedef struct block {
 } block;
 
 /* stage 1: frames, cells, hints for the rows the uniforms pick */
-static void locate_block(const rbs_table *t, const rbs_mix *mix, const double *V, const double *n, block *blk)
+RBS_INLINE void locate_block(const rbs_table *t, const rbs_mix *mix, const double *V, const double *n, block *blk)
 {
     for (size_t b = 0; b < blk->m; b++) {
         size_t i = blk->start + b;
@@ -55,7 +55,7 @@ static void locate_block(const rbs_table *t, const rbs_mix *mix, const double *V
 }
 
 /* stage 2: the components through the alias tables, hints for their rows and levels */
-static void resolve_block(const rbs_table *t, block *blk)
+RBS_INLINE void resolve_block(const rbs_table *t, block *blk)
 {
     for (size_t b = 0; b < blk->m; b++) {
         located *p = &blk->p[b];
@@ -69,7 +69,7 @@ static void resolve_block(const rbs_table *t, block *blk)
 }
 
 /* stage 3: the draws and their outputs */
-static void draw_block(const rbs_table *t, const double *n, const double *a, int scaled, block *blk, double *V_out,
+RBS_INLINE void draw_block(const rbs_table *t, const double *n, const double *a, int scaled, block *blk, double *V_out,
                        double *W_out, signed char *status)
 {
     for (size_t b = 0; b < blk->m; b++) {
@@ -88,7 +88,7 @@ static void draw_block(const rbs_table *t, const double *n, const double *a, int
     }
 }
 
-static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
+RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
                        const double *a, const double *u, rbs_rng *rng, int interpolation, double *V_out,
                        double *W_out, signed char *status)
 {

@@ -11,7 +11,7 @@
 #include "locate.h"
 #include "rebound_internal.h"
 
-int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
+RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
                 const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
 {
     const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
@@ -29,7 +29,7 @@ int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const
     return status;
 }
 
-int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
+RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                    const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE])
 {
     if (!rbs_arguments_ok(t, mix, interpolation)) {

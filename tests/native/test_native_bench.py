@@ -1,0 +1,26 @@
+"""benchmarks/bench_native.py runs end to end (--quick) on the session's table and reports every figure.
+
+A smoke test: the figures are machine-dependent and are not asserted; the bits of the C many-particle
+call against numba's on the bench states are.
+"""
+
+import json
+import sys
+
+from _native import REPO
+
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+
+def test_bench_native_quick(native_build, small_table_path, tmp_path, capsys):
+    import bench_native
+    out = tmp_path / "native.json"
+    assert bench_native.main(["--quick", "--table", str(small_table_path), "-n", "20000", "--build-dir",
+                              str(native_build), "--json", str(out)]) == 0
+    figures = json.loads(out.read_text())
+    for key in ("c_per_particle", "c_many", "c_many_given", "c_rng", "numba_per_particle", "numba_block",
+                "c_grant_tabakoff", "numba_grant_tabakoff"):
+        assert figures["ns_per_state"][key] > 0, key
+    assert figures["same_bits"] is True
+    printed = capsys.readouterr().out
+    assert "(C-many)/(C-GT)" in printed and "target" in printed
