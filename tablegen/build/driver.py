@@ -25,6 +25,8 @@ import os
 import shutil
 import signal
 import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -220,22 +222,34 @@ def _run_local(config, tasks, checkpoint, workers, bar) -> None:
     workers = worker_count(workers, len(tasks))
     threads = max(1, (os.cpu_count() or 1) // workers)
     # spawn, not fork: forking a process whose numba kernels already ran on OpenMP threads is unsafe
-    pool = multiprocessing.get_context("spawn").Pool(workers, initializer=_worker_init, initargs=(threads,))
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_init, initargs=(threads,))
     try:
-        for task, cell in pool.imap_unordered(_compute_task, [(config, task) for task in tasks]):
+        futures = {pool.submit(compute_cell, config, *task): task for task in tasks}
+        for future in as_completed(futures):
+            task = futures[future]
+            try:
+                cell = future.result()
+            except BrokenProcessPool as exc:
+                raise BuildError(f"a worker process died before computing {cell_label(config, *task)} ({exc}); "
+                                 f"a script calling build_table with workers must guard its main code with "
+                                 f"`if __name__ == \"__main__\":`") from None
+            except Exception as exc:
+                raise BuildError(f"{cell_label(config, *task)} failed: {type(exc).__name__}: {exc}") from exc
             _store(checkpoint, task, cell, bar)
     finally:
-        pool.terminate()
-        pool.join()
+        _stop(pool)
 
 
-def _compute_task(item):
-    """compute_cell on a (config, task) pair, in a worker: (task, cell), or BuildError naming the cell."""
-    config, task = item
-    try:
-        return task, compute_cell(config, *task)
-    except Exception as exc:
-        raise BuildError(f"{cell_label(config, *task)}: {type(exc).__name__}: {exc}") from None
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Stop ``pool`` now: pending cells cancelled, running workers terminated (after a signal or a failed
+    cell nothing of theirs is wanted; their finished cells are already checkpointed)."""
+    processes = list((pool._processes or {}).values())     # the executor has no public way to terminate them
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join()
 
 
 def _connect(scheduler: str):

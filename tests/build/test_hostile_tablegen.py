@@ -197,8 +197,9 @@ def test_an_immutable_table_is_refused_before_building(tiny_config, small_table_
 # -- interrupted and concurrent builds -------------------------------------------
 
 def _start(command):
+    # SIGINT restored to its default in the child: a shell starts background jobs with it ignored
     return subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            text=True)
+                            text=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _wait_for_cells(partial, count, proc, timeout=180):
