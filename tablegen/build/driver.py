@@ -36,6 +36,7 @@ from data_schema.output import check_free_space, check_memory, check_output, rem
 from data_schema.table import CELL_DATASETS, TABLE_FILE_TYPE, TABLE_VERSION, CellTable, ReboundTable, write_table
 from tablegen.build.cells import cell_label, compute_cell
 from tablegen.build.config import BuildConfig
+from tablegen.progress import progress_bar
 
 
 class BuildError(RuntimeError):
@@ -192,7 +193,7 @@ def build_table(config: BuildConfig, out, workers: int | None = None, scheduler:
                 log(f"building {len(tasks)} of {config.n_cells} cells x {config.particles_per_cell} particles "
                     f"into {out}" + (f" ({config.n_cells - len(tasks)} from {checkpoint.path})"
                                      if len(tasks) < config.n_cells else ""))
-            bar = _progress_bar(config.n_cells, config.n_cells - len(tasks), progress)
+            bar = progress_bar(progress, config.n_cells, "cell", "table cells", initial=config.n_cells - len(tasks))
             try:
                 if client is not None:
                     _run_dask(config, tasks, checkpoint, client, bar)
@@ -305,10 +306,3 @@ def _assemble(config: BuildConfig, checkpoint: Checkpoint) -> ReboundTable:
         config_sha256=config.sha256(), master_seed=config.seed,
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         package_version=package_version(), model_sha256=model_sha256())
-
-
-def _progress_bar(total: int, done: int, enabled: bool):
-    if not enabled:
-        return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, initial=done, unit="cell", desc="table cells")

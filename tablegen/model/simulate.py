@@ -22,6 +22,7 @@ from tablegen.model.shapes import (
     DEFAULT_KAPPA, MIX, SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
 )
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from tablegen.progress import progress_bar
 
 CHUNK_SIZE = 16384                  # particles drawn at a time: fixed, so a seed gives the same bits for any n
 VALID_SPEED_RANGE = (50.0, 300.0)   # m/s, where the default wall law was measured
@@ -163,7 +164,7 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     hands = np.empty(n, dtype=np.int8)
     ratios = np.empty((n, 2))
 
-    bar = _progress_bar(n, progress)
+    bar = progress_bar(progress, n, "particle", "rebounds")
     for k, start in enumerate(range(0, n, CHUNK_SIZE)):
         stop = min(start + CHUNK_SIZE, n)
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
@@ -192,10 +193,3 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
                     "aspect_low": aspect.low, "aspect_high": aspect.high,
                     "wall_law": wall.name, "wall_k": wall.k, "wall_p": wall.p, "wall_q": wall.q,
                     "chunk_size": CHUNK_SIZE, "package_version": package_version()})
-
-
-def _progress_bar(total: int, enabled: bool):
-    if not enabled:
-        return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, unit="particle", unit_scale=True, desc="rebounds")

@@ -32,6 +32,7 @@ from data_schema.common import package_version
 from data_schema.output import atomic_folder
 from data_schema.samples import STATUS_REBOUNDED
 from tablegen.model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_factor
+from tablegen.progress import progress_bar
 from tablegen.study.figures import require_matplotlib, write_figures
 from tablegen.study.statistics import (
     COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, from_sample_set, nearest_alpha1,
@@ -125,7 +126,7 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
 
     alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
     mix_of = _constituents(shapes, SHAPES)
-    bar = _progress_bar(len(mix_of) * len(alpha1) * n, progress)
+    bar = progress_bar(progress, len(mix_of) * len(alpha1) * n, "particle", "report runs")
     parts = {}
     for shape in mix_of:
         for a in alpha1:
@@ -212,13 +213,6 @@ def _aspect_law(config_text: str) -> AspectRatioLaw:
     """The aspect-ratio law recorded in a table's build configuration (default law if absent)."""
     raw = tomllib.loads(config_text).get("simulation", {}).get("aspect_ratio")
     return AspectRatioLaw(**{k: float(v) for k, v in raw.items()}) if raw else AspectRatioLaw()
-
-
-def _progress_bar(total: int, enabled: bool):
-    if not enabled:
-        return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, unit="particle", unit_scale=True, desc="report runs")
 
 
 # -- output -----------------------------------------------------------------
