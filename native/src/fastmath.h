@@ -65,6 +65,31 @@ RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
     *cos_x = sign * (odd ? -s : c);
 }
 
+/* rbs_sincos written for SIMD loops: the quadrant q mod 4 taken in floating point (q − 4⌊q/4⌋, exact for
+ * every finite q, as int(q) & 3 is) instead of an integer conversion AVX2 lacks; the same bits as
+ * rbs_sincos for every finite x (and NaN where rbs_sincos gives NaN). */
+RBS_INLINE void rbs_sincos_simd(double x, double *sin_x, double *cos_x)
+{
+    const double S3 = -0x1.5555555555555p-3, S5 = 0x1.1111111111111p-7, S7 = -0x1.a01a01a01a01ap-13,
+                 S9 = 0x1.71de3a556c734p-19, S11 = -0x1.ae64567f544e4p-26, S13 = 0x1.6124613a86d09p-33,
+                 S15 = -0x1.ae7f3e733b81fp-41;
+    const double C2 = -0x1p-1, C4 = 0x1.5555555555555p-5, C6 = -0x1.6c16c16c16c17p-10, C8 = 0x1.a01a01a01a01ap-16,
+                 C10 = -0x1.27e4fb7789f5cp-22, C12 = 0x1.1eed8eff8d898p-29, C14 = -0x1.93974a8c07c9dp-37,
+                 C16 = 0x1.ae7f3e733b81fp-45;
+    double q = floor(x * RBS_TWO_OVER_PI + 0.5);
+    double r = (x - q * RBS_HALF_PI_HI) - q * RBS_HALF_PI_LO;
+    double z = r * r;
+    double p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, S15, S13), S11), S9), S7), S5), S3);
+    double s = fma(r * z, p, r);
+    p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, C16, C14), C12), C10), C8), C6), C4), C2);
+    double c = fma(z, p, 1.0);
+    double quadrant = q - 4.0 * floor(q * 0.25);
+    int odd = (quadrant == 1.0) | (quadrant == 3.0);
+    double sign = quadrant >= 2.0 ? -1.0 : 1.0;
+    *sin_x = sign * (odd ? c : s);
+    *cos_x = sign * (odd ? -s : c);
+}
+
 /* atan2(y, x) in radians for x >= 0, y >= 0, not both 0, to a few ulp (surrogate.trig.atan2_first_quadrant) */
 RBS_INLINE double rbs_atan2_q1(double y, double x)
 {
@@ -82,6 +107,27 @@ RBS_INLINE double rbs_atan2_q1(double y, double x)
                   0x1.5555555555555p-2);
     double atan_z = fma(-z * w, p, z);
     double angle = ATAN_AT_NODES[node] + atan_z;
+    return swap ? RBS_HALF_PI - angle : angle;
+}
+
+/* rbs_atan2_q1 written for SIMD loops (the node's atan by selects, not a table read): the same bits */
+RBS_INLINE double rbs_atan2_q1_simd(double y, double x)
+{
+    int swap = y > x;
+    double lo = swap ? x : y, hi = swap ? y : x;
+    double node = (lo > 0.125 * hi ? 1.0 : 0.0) + (lo > 0.375 * hi ? 1.0 : 0.0) + (lo > 0.625 * hi ? 1.0 : 0.0)
+                  + (lo > 0.875 * hi ? 1.0 : 0.0);
+    double c = 0.25 * node;
+    double z = fma(-c, hi, lo) / fma(c, lo, hi);
+    double w = z * z;
+    double p = fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, -0x1.e1e1e1e1e1e1ep-5, 0x1.1111111111111p-4),
+                                                          -0x1.3b13b13b13b14p-4), 0x1.745d1745d1746p-4),
+                                     -0x1.c71c71c71c71cp-4), 0x1.2492492492492p-3), -0x1.999999999999ap-3),
+                  0x1.5555555555555p-2);
+    double atan_z = fma(-z * w, p, z);
+    double atan_c = node == 0.0 ? 0.0 : node == 1.0 ? 0x1.f5b75f92c80ddp-3 : node == 2.0 ? 0x1.dac670561bb4fp-2
+                  : node == 3.0 ? 0x1.4978fa3269ee1p-1 : 0x1.921fb54442d18p-1;
+    double angle = atan_c + atan_z;
     return swap ? RBS_HALF_PI - angle : angle;
 }
 

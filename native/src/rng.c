@@ -10,6 +10,7 @@
  */
 #include <string.h>
 
+#include "internal.h"
 #include "rng_internal.h"
 
 /* ------------------------------------------------------------------------- SeedSequence */
@@ -107,7 +108,7 @@ void rbs_lanes_seed(rbs_rng *rng, uint64_t lanes[4 * RBS_BLOCK])
     for (uint64_t j = 0; j < 4 * RBS_BLOCK; j++) lanes[j] = rbs_splitmix64(x + (j + 1) * RBS_GOLDEN);
 }
 
-void rbs_lanes_fill(uint64_t lanes[4 * RBS_BLOCK], double *u)
+RBS_HOT void rbs_lanes_fill(uint64_t lanes[4 * RBS_BLOCK], double *u)
 {
     for (int l = 0; l < RBS_BLOCK; l++) {
         uint64_t s[4] = {lanes[l], lanes[RBS_BLOCK + l], lanes[2 * RBS_BLOCK + l], lanes[3 * RBS_BLOCK + l]};
