@@ -125,8 +125,9 @@ RBS_INLINE double rbs_atan2_q1_simd(double y, double x)
                                      -0x1.c71c71c71c71cp-4), 0x1.2492492492492p-3), -0x1.999999999999ap-3),
                   0x1.5555555555555p-2);
     double atan_z = fma(-z * w, p, z);
-    double atan_c = node == 0.0 ? 0.0 : node == 1.0 ? 0x1.f5b75f92c80ddp-3 : node == 2.0 ? 0x1.dac670561bb4fp-2
-                  : node == 3.0 ? 0x1.4978fa3269ee1p-1 : 0x1.921fb54442d18p-1;
+    /* atan c by selects; one term is non-zero, so the sum is exact */
+    double atan_c = ((node == 1.0 ? 0x1.f5b75f92c80ddp-3 : 0.0) + (node == 2.0 ? 0x1.dac670561bb4fp-2 : 0.0))
+                  + ((node == 3.0 ? 0x1.4978fa3269ee1p-1 : 0.0) + (node == 4.0 ? 0x1.921fb54442d18p-1 : 0.0));
     double angle = atan_c + atan_z;
     return swap ? RBS_HALF_PI - angle : angle;
 }

@@ -33,12 +33,12 @@ typedef struct block {
     size_t start, m;
     double u[RBS_U_PER_DRAW][B];
     /* frame (step 1) */
-    double Vin[3][B], valid[B], alpha1[B], speed[B], cos_a1[B], sin_a1[B], a[B], ex[3][B], ez[3][B], n[3][B];
+    double Vin[3][B], valid[B], normal[B], alpha1[B], speed[B], cos_a1[B], sin_a1[B], a[B], ex[3][B], ez[3][B], n[3][B];
     /* cell (steps 1, 2) */
     int64_t drawn[B], below[B], jv[B], iv[B], row[B];
     double wa[B], wv[B];
     /* gathered (step 3) */
-    double trapped[B], regime[B], f_target[B], f_grid[B], q[6][B], slope[15][B], ratio[6][B], mean_cell[6][B],
+    double trapped[B], regime[B], piece[10][B], piece_x[B], f_grid[B], q[6][B], slope[15][B], ratio[6][B], mean_cell[6][B],
         mean[6][B];
     /* results */
     double status[B], V[3][B], W[3][B];
@@ -57,7 +57,7 @@ RBS_INLINE void frames(const double *V, const double *n, const double *a, block 
         }
         k->a[b] = here ? a[i] : 1.0;
     }
-    for (size_t b = 0; b < B; b++) {
+    for (size_t b = 0; b < B; b++) {       /* branch-free: SIMD across the block */
         double V0 = k->Vin[0][b], V1 = k->Vin[1][b], V2 = k->Vin[2][b];
         double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
         double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
@@ -66,31 +66,32 @@ RBS_INLINE void frames(const double *V, const double *n, const double *a, block 
         double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
         double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));
         double speed = sqrt(fma(vn, vn, vt * vt));
-        double ex0, ex1, ex2;
-        if (vt > 1e-12 * speed) {
-            double inv = 1.0 / vt;
-            ex0 = tx * inv;
-            ex1 = ty * inv;
-            ex2 = tz * inv;
-        } else {        /* normal impact (rare): the in-wall direction from u[12], as rbs_impact_frame */
-            rbs_frame f;
-            const double Vi[3] = {V0, V1, V2}, ni[3] = {n0, n1, n2};
-            rbs_impact_frame(Vi, ni, k->u[12][b], &f);
-            ex0 = f.ex[0];
-            ex1 = f.ex[1];
-            ex2 = f.ex[2];
-        }
-        k->ex[0][b] = ex0;
-        k->ex[1][b] = ex1;
-        k->ex[2][b] = ex2;
-        k->ez[0][b] = ex1 * n2 - ex2 * n1;
-        k->ez[1][b] = ex2 * n0 - ex0 * n2;
-        k->ez[2][b] = ex0 * n1 - ex1 * n0;
+        double inv = 1.0 / vt;
+        k->ex[0][b] = tx * inv;
+        k->ex[1][b] = ty * inv;
+        k->ex[2][b] = tz * inv;
+        k->normal[b] = vt > 1e-12 * speed ? 0.0 : 1.0;
         double inv_speed = 1.0 / speed;
         k->alpha1[b] = rbs_atan2_q1_simd(-vn, vt) * RBS_RAD_TO_DEG;
         k->speed[b] = speed;
         k->cos_a1[b] = vt * inv_speed;
         k->sin_a1[b] = -vn * inv_speed;
+    }
+    for (size_t b = 0; b < B; b++) {       /* normal impact (rare): the in-wall direction from u[12] */
+        if (k->normal[b] != 0.0) {
+            rbs_frame f;
+            const double Vi[3] = {k->Vin[0][b], k->Vin[1][b], k->Vin[2][b]};
+            const double ni[3] = {k->n[0][b], k->n[1][b], k->n[2][b]};
+            rbs_impact_frame(Vi, ni, k->u[12][b], &f);
+            for (int j = 0; j < 3; j++) k->ex[j][b] = f.ex[j];
+        }
+    }
+    for (size_t b = 0; b < B; b++) {
+        double ex0 = k->ex[0][b], ex1 = k->ex[1][b], ex2 = k->ex[2][b];
+        double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
+        k->ez[0][b] = ex1 * n2 - ex2 * n1;
+        k->ez[1][b] = ex2 * n0 - ex0 * n2;
+        k->ez[2][b] = ex0 * n1 - ex1 * n0;
     }
 }
 
@@ -158,7 +159,14 @@ RBS_INLINE void gather(const rbs_table *t, block *k)
             k->mean_cell[j][b] = terms[j].mean_cell;
             k->mean[j][b] = terms[j].mean;
         }
-        rbs_restitution_factors(t, k->jv[b], k->wv[b], k->iv[b], &k->f_target[b], &k->f_grid[b]);
+        /* the restitution piece at the incident speed (evaluated in the SIMD loop) and the grid speed's factor */
+        double x = k->wv[b] * (double)t->n_pieces;
+        int64_t i = rbs_trunc(x);
+        i = (t->n_pieces - 1) < i ? (t->n_pieces - 1) : i;
+        k->piece_x[b] = 2.0 * (x - (double)i) - 1.0;
+        const double *piece = t->restitution_pieces + (k->jv[b] * t->n_pieces + i) * 10;
+        for (int d = 0; d < 10; d++) k->piece[d][b] = piece[d];
+        k->f_grid[b] = t->speed_restitution[k->iv[b]];
     }
 }
 
@@ -185,7 +193,17 @@ RBS_INLINE void arithmetic(block *k, int scaled)
         double scb = state[2] * cb;
         double local[6] = {scb * ca, scb * sa, state[2] * sb, state[3], state[4], state[5]};
         for (int j = 0; j < 6; j++) x[j] = local[j];
-        rbs_to_speed(k->regime[b], k->f_target[b], k->f_grid[b], k->cos_a1[b], k->sin_a1[b], x);
+        double px = k->piece_x[b];             /* rbs_restitution_at's Horner steps, unrolled */
+        double f_target = fma(k->piece[9][b], px, k->piece[8][b]);
+        f_target = fma(f_target, px, k->piece[7][b]);
+        f_target = fma(f_target, px, k->piece[6][b]);
+        f_target = fma(f_target, px, k->piece[5][b]);
+        f_target = fma(f_target, px, k->piece[4][b]);
+        f_target = fma(f_target, px, k->piece[3][b]);
+        f_target = fma(f_target, px, k->piece[2][b]);
+        f_target = fma(f_target, px, k->piece[1][b]);
+        f_target = fma(f_target, px, k->piece[0][b]);
+        rbs_to_speed(k->regime[b], f_target, k->f_grid[b], k->cos_a1[b], k->sin_a1[b], x);
         int move_speed = scaled & (k->wv[b] > 0.0);
         for (int j = 0; j < 6; j++) x[j] = move_speed ? x[j] : local[j];
         rbs_mirrored(k->u[11][b], x);
