@@ -149,10 +149,22 @@ void Foam::StochasticRebound<CloudType>::openTable(const dictionary& dict)
     else
     {
         const word shape(dict.getOrDefault<word>("shape", "mix"));
-        const int e = rbs_mix_from_shape
-        (
-            table, shape.c_str(), &mix_, message, sizeof(message)
-        );
+        int e = RBS_OK;
+        if (shape == "mix")
+        {
+            e = rbs_mix_equal(table, &mix_);
+            std::snprintf(message, sizeof(message), "no equal mix");
+        }
+        else
+        {
+            // One shape: the weight 1 on it
+            const char* names[1] = {shape.c_str()};
+            const double weights[1] = {1.0};
+            e = rbs_mix_from_weights
+            (
+                table, 1, names, weights, &mix_, message, sizeof(message)
+            );
+        }
         if (e != RBS_OK)
         {
             FatalIOErrorInFunction(dict)
