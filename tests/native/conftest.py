@@ -6,9 +6,14 @@ fails every test that needs it, with a message saying to run native/install-deps
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import pytest
 
-from _native import INSTALL_HINT, BuildError, Native, build, missing_tools
+sys.path.insert(0, str(Path(__file__).resolve().parent))     # the helper modules, whatever pytest's import mode
+
+from _native import INSTALL_HINT, BuildError, Native, build, missing_tools  # noqa: E402
 
 
 def _require_tools(fortran=True, cxx=True):
