@@ -72,7 +72,8 @@ EOF
             as_root apt-get update -q
         fi
         # only the tarballs: the tree is unpacked below, in part
-        (cd "$download" && apt-get source --download-only -q openfoam 2>&1 | grep -v "unsandboxed as root" || true)
+        (cd "$download" && apt-get source --download-only -q openfoam > apt-get-source.log 2>&1) || {
+            cat "$download/apt-get-source.log" >&2; echo "apt-get source openfoam failed" >&2; exit 1; }
     fi
     orig=$(ls "$download"/openfoam_*.orig.tar.* | head -n 1)
     [ -f "$orig" ] || { echo "no OpenFOAM source tarball in $download" >&2; exit 1; }
