@@ -47,6 +47,17 @@ def native_sanitized(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def native_baseline(tmp_path_factory):
+    """The shared library built for the x86-64 baseline only (no multi-versioning: fma() from the C library)."""
+    _require_tools(fortran=False, cxx=False)
+    folder = tmp_path_factory.mktemp("native_baseline")
+    try:
+        return Native(build(folder, {"CMAKE_C_FLAGS": "-DRBS_NO_CLONES", "RBS_BUILD_STATIC": "OFF"}))
+    except BuildError as exc:
+        pytest.fail(str(exc), pytrace=False)
+
+
+@pytest.fixture(scope="session")
 def native(native_build):
     """The shared library, through ctypes."""
     return Native(native_build)

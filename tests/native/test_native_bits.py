@@ -182,3 +182,24 @@ def test_block_uniforms_and_rebound_many_rng(table_pair, native):
             status, V_c, W_c, c_state = native_table.rebound_many_rng(mix, V, n, a, state, interpolation)
             assert np.array_equal(status, status_py) and np.array_equal(c_state, py_state), count
             assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0, count
+
+
+def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_table_path):
+    """Built without the x86-64-v3 versions (fma() from the C library instead of the instruction), the
+    library still gives numba's bits."""
+    table, _ = table_pair
+    baseline = native_baseline.table(small_table_path)
+    rng = np.random.default_rng(21)
+    count = 50_000
+    V, n, a = incident_states(rng, count)
+    u = uniforms(rng, count)
+    cdf = py.mix_cdf(table, "mix")
+    for interpolation in (SCALED, STOCHASTIC):
+        V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
+        py.rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == SCALED)
+        status, V_c, W_c = baseline.rebound_many(baseline.mix_equal(), V, n, a, u, interpolation)
+        assert np.array_equal(status, status_py)
+        assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0
+        for i in range(0, count, 500):
+            st, v, w = baseline.rebound(baseline.mix_equal(), V[i], n[i], a[i], u[i], interpolation)
+            assert st == status_py[i] and max_ulp(v, V_py[i]) == 0 and max_ulp(w, W_py[i]) == 0
