@@ -120,6 +120,9 @@ def main(argv=None) -> int:
         V, nrm, a = st["V"], st["normal"], st["half_size"]
         print(f"  states                 N = {count} (bench_sampler.incident_states, seed {bench_sampler.SEED}); "
               f"best of {repeats}", flush=True)
+        latency = bench_sampler.dependent_load_ns(data.nbytes)
+        print(f"  memory latency         {latency:.1f} ns per dependent read at random over {data.nbytes / 1e6:.1f} MB "
+              f"(the table's size)", flush=True)
         states = tmp / "states.bin"
         write_states(states, V, nrm, a)
         done = subprocess.run([str(program), str(path), str(states), str(repeats), str(bench_sampler.SEED)],
@@ -190,6 +193,7 @@ def main(argv=None) -> int:
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"machine": machine_info(), "states": count, "repeats": repeats, "table": str(path),
+                       "memory_latency_ns": latency,
                        "ns_per_state": {"c_per_particle": c["c_per_particle"], "c_many": c["c_many"],
                                         "c_many_given": c["c_many_given"], "c_rng": c["c_rng"],
                                         "numba_per_particle": n1, "numba_block": nb,

@@ -199,20 +199,24 @@ int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], c
 /* rbs_rebound for `count` particles, one thread: V, n, V_out, Omega_out row-major (count, 3), a (count,),
  * u (count, RBS_U_PER_DRAW), status (count,). The same bits as rbs_rebound row by row (and as
  * surrogate.kernels.rebound_many); faster, because the table reads of RBS_BLOCK rows are in flight
- * together. */
+ * together and the arithmetic runs as SIMD loops over them. The outputs must not overlap the inputs. A NULL
+ * table or mix, a mix of another table's shape count or an unknown interpolation gives every row
+ * RBS_INVALID and NaN. */
 void rbs_rebound_many(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V, const double *n,
                       const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
                       signed char *status);
 
 /* rbs_rebound_many drawing the uniforms from `rng`, as surrogate.kernels.rebound_many_rng does, bit for
  * bit: rng is advanced one step to seed RBS_BLOCK xoshiro256+ lanes (splitmix64), and row b of every
- * block of RBS_BLOCK rows takes its 13 uniforms from lane b. rbs_rebound_uniforms gives those uniforms. */
+ * block of RBS_BLOCK rows takes its 13 uniforms from lane b. rbs_rebound_uniforms gives those uniforms.
+ * A NULL rng (or the cases of rbs_rebound_many) gives every row RBS_INVALID, and rng is not advanced. */
 void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V,
                           const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
                           double *Omega_out, signed char *status);
 
 /* One reflected state at (α1 deg, |V⁻| m/s) in the local frame (surrogate.kernels.draw_local):
- * out = (α2 rad, β2 rad, s = |V⁺|/|V⁻|, Ω_x, Ω_y, Ω_z in units of |V⁻|/a), NaN unless rebounded.
+ * out = (α2 rad, β2 rad, s = |V⁺|/|V⁻|, Ω_x, Ω_y, Ω_z in units of |V⁻|/a): RBS_LOCAL_SIZE = 6 numbers
+ * (Ω⁺a/|V⁻| is a vector), NaN unless rebounded.
  * Returns RBS_REBOUNDED or RBS_TRAPPED (RBS_INVALID for a NULL table or mix, a mix of another table's
  * shape count, an unknown interpolation). Outside the grid, the law at the nearest grid edge. */
 int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
