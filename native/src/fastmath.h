@@ -21,6 +21,10 @@
 
 #include "internal.h"
 
+#if defined(__x86_64__) && defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #define RBS_PI 0x1.921fb54442d18p+1             /* math.pi */
 #define RBS_TWO_PI 0x1.921fb54442d18p+2         /* 2.0 * math.pi */
 #define RBS_HALF_PI 0x1.921fb54442d18p+0        /* 0.5 * math.pi */
@@ -35,7 +39,11 @@
  * INT64_MIN for NaN and out-of-range values; written out so the C is defined everywhere. */
 RBS_INLINE int64_t rbs_trunc(double x)
 {
+#if defined(__x86_64__) && defined(__SSE2__)
+    return _mm_cvttsd_si64(_mm_set_sd(x));      /* the instruction itself */
+#else
     return (x > -0x1p63 && x < 0x1p63) ? (int64_t)x : INT64_MIN;
+#endif
 }
 
 /* numba's min(a, b) and max(a, b) of floats: b if b < a (b > a) else a */
