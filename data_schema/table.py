@@ -228,7 +228,9 @@ class ReboundTable:
             res.attrs[field.name] = getattr(self.resolution, field.name)
         cells = f.create_group("cells")
         for name, (dtype, units, meaning) in CELL_DATASETS.items():
-            ds = cells.create_dataset(name, data=np.asarray(self.cells[name], dtype=dtype), fletcher32=True)
+            values = np.asarray(self.cells[name], dtype=dtype)
+            # one chunk per cell: whole chunks only (automatic chunk shapes padded the table by a fifth)
+            ds = cells.create_dataset(name, data=values, fletcher32=True, chunks=(1, 1, 1) + values.shape[3:])
             ds.attrs["units"] = units
             ds.attrs["meaning"] = meaning
 
