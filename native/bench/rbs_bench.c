@@ -94,10 +94,10 @@ int main(int argc, char **argv)
     }
     size_t N = (size_t)count;
     double *V = malloc(3 * N * sizeof *V), *n = malloc(3 * N * sizeof *n), *a = malloc(N * sizeof *a);
-    double *V_out = malloc(3 * N * sizeof *V_out), *W_out = malloc(3 * N * sizeof *W_out);
+    double *V_out = malloc(3 * N * sizeof *V_out), *Omega_out = malloc(3 * N * sizeof *Omega_out);
     double *U = malloc(RBS_U_PER_DRAW * N * sizeof *U);
     signed char *status = malloc(N);
-    if (!V || !n || !a || !V_out || !W_out || !U || !status || fread(V, sizeof *V, 3 * N, f) != 3 * N
+    if (!V || !n || !a || !V_out || !Omega_out || !U || !status || fread(V, sizeof *V, 3 * N, f) != 3 * N
         || fread(n, sizeof *n, 3 * N, f) != 3 * N || fread(a, sizeof *a, N, f) != N) {
         fprintf(stderr, "%s: cannot read the states\n", argv[2]);
         return 1;
@@ -106,7 +106,7 @@ int main(int argc, char **argv)
     rbs_mix mix;
     rbs_mix_equal(table, &mix);
     /* first touch of the outputs, and a warm-up of every loop */
-    for (size_t i = 0; i < 3 * N; i++) V_out[i] = W_out[i] = 0.0;
+    for (size_t i = 0; i < 3 * N; i++) V_out[i] = Omega_out[i] = 0.0;
     rbs_rng rng;
     rbs_rng_seed(&rng, seed);
     rbs_rng_fill(&rng, U, RBS_U_PER_DRAW * N);
@@ -123,7 +123,7 @@ int main(int argc, char **argv)
             double u[RBS_U_PER_DRAW];
             rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
             status[i] = (signed char)rbs_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED, V_out + 3 * i,
-                                                 W_out + 3 * i);
+                                                 Omega_out + 3 * i);
         }
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[0], &cpu[0]);
@@ -132,13 +132,13 @@ int main(int argc, char **argv)
         rbs_rng_seed(&rng, seed);
         t0 = now();
         c0 = cpu_now();
-        rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_SCALED, V_out, W_out, status);
+        rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[1], &cpu[1]);
         checksum += V_out[0];
         if (r == 0 && argc > 5) {
             FILE *out = fopen(argv[5], "wb");
-            if (!out || fwrite(V_out, sizeof *V_out, 3 * N, out) != 3 * N || fwrite(W_out, sizeof *W_out, 3 * N, out) != 3 * N
+            if (!out || fwrite(V_out, sizeof *V_out, 3 * N, out) != 3 * N || fwrite(Omega_out, sizeof *Omega_out, 3 * N, out) != 3 * N
                 || fwrite(status, 1, N, out) != N) {
                 fprintf(stderr, "%s: cannot write the results\n", argv[5]);
                 return 1;
@@ -148,7 +148,7 @@ int main(int argc, char **argv)
         /* (3) many particles, uniforms given */
         t0 = now();
         c0 = cpu_now();
-        rbs_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, W_out, status);
+        rbs_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, Omega_out, status);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[2], &cpu[2]);
         checksum += V_out[0];
@@ -186,7 +186,7 @@ int main(int argc, char **argv)
     free(n);
     free(a);
     free(V_out);
-    free(W_out);
+    free(Omega_out);
     free(U);
     free(status);
     rbs_table_close(table);

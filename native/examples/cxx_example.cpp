@@ -28,7 +28,7 @@ int main(int argc, char **argv)
     rbs_rng rng;
     rbs_rng_seed_stream(&rng, 1, 0);
     const std::size_t count = 100;
-    std::vector<double> V(3 * count), n(3 * count, 0.0), a(count, 1e-4), V_out(3 * count), W_out(3 * count);
+    std::vector<double> V(3 * count), n(3 * count, 0.0), a(count, 1e-4), V_out(3 * count), Omega_out(3 * count);
     std::vector<signed char> status(count);
     for (std::size_t i = 0; i < count; i++) {
         V[3 * i] = 100.0;
@@ -36,7 +36,7 @@ int main(int argc, char **argv)
         n[3 * i + 1] = 1.0;
     }
     rbs_rebound_many_rng(table.get(), &mix, count, V.data(), n.data(), a.data(), &rng, RBS_SCALED, V_out.data(),
-                         W_out.data(), status.data());
+                         Omega_out.data(), status.data());
     std::array<double, RBS_U_PER_DRAW> u{};
     rbs_rng_fill(&rng, u.data(), u.size());
     double one[3], spin[3];

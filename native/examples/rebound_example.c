@@ -34,11 +34,11 @@ int main(int argc, char **argv)
     const double a = 5e-5;                      /* m, half-size */
     int rebounded = 0;
     for (int i = 0; i < count; i++) {
-        double u[RBS_U_PER_DRAW], V_out[3], W_out[3];
+        double u[RBS_U_PER_DRAW], V_out[3], Omega_out[3];
         rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
-        int status = rbs_rebound(table, &mix, V, n, a, u, RBS_SCALED, V_out, W_out);
+        int status = rbs_rebound(table, &mix, V, n, a, u, RBS_SCALED, V_out, Omega_out);
         printf("%d status %2d  V+ = (%9.3f, %9.3f, %9.3f) m/s  Omega+ = (%11.1f, %11.1f, %11.1f) rad/s\n", i,
-               status, V_out[0], V_out[1], V_out[2], W_out[0], W_out[1], W_out[2]);
+               status, V_out[0], V_out[1], V_out[2], Omega_out[0], Omega_out[1], Omega_out[2]);
         rebounded += status == RBS_REBOUNDED;
     }
     printf("%d of %d rebounded\n", rebounded, count);

@@ -12,7 +12,7 @@ program rebound_example
   type(rbs_mix) :: mix
   type(rbs_rng) :: rng
   character(len=1024) :: path, message
-  real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), W_out(3)
+  real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), Omega_out(3)
   real(c_double) :: Vs(3, n_many), ns(3, n_many), a(n_many), Vs_out(3, n_many), Ws_out(3, n_many)
   integer(c_signed_char) :: status(n_many)
   integer(c_int) :: code, st, i
@@ -35,8 +35,8 @@ program rebound_example
   n = [0.0_c_double, 1.0_c_double, 0.0_c_double]           ! unit normal into the gas
   do i = 1, 3
     call rbs_rng_fill(rng, u, int(RBS_U_PER_DRAW, c_size_t))
-    st = rbs_rebound(table, mix, V, n, 5e-5_c_double, u, RBS_SCALED, V_out, W_out)
-    print '(a, i0, a, 3f10.3, a, 3es12.3)', "status ", st, "  V+ =", V_out, "  Omega+ =", W_out
+    st = rbs_rebound(table, mix, V, n, 5e-5_c_double, u, RBS_SCALED, V_out, Omega_out)
+    print '(a, i0, a, 3f10.3, a, 3es12.3)', "status ", st, "  V+ =", V_out, "  Omega+ =", Omega_out
   end do
 
   ! many particles in one call (the faster path)

@@ -83,10 +83,10 @@ RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis
 /* A local draw x = (vx, vy, vz, wx, wy, wz) (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the
  * frame (ex, n, ez); NaN unless rebounded (surrogate.frame._to_global). */
 RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, double a, const double *ex,
-                                 const double *n, const double *ez, double *V_out, double *W_out)
+                                 const double *n, const double *ez, double *V_out, double *Omega_out)
 {
     if (status != RBS_REBOUNDED) {
-        for (int k = 0; k < 3; k++) V_out[k] = W_out[k] = NAN;
+        for (int k = 0; k < 3; k++) V_out[k] = Omega_out[k] = NAN;
         return;
     }
     double w = speed / a;
@@ -94,7 +94,7 @@ RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, doubl
         V_out[k] = speed * rbs_dot(x[0], x[1], x[2], ex[k], n[k], ez[k]);
     }
     for (int k = 0; k < 3; k++) {
-        W_out[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
+        Omega_out[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
     }
 }
 

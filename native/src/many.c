@@ -220,7 +220,7 @@ RBS_INLINE void arithmetic(block *k, int scaled)
 }
 
 /* step 3c: the outputs */
-RBS_INLINE void store(const block *k, double *V_out, double *W_out, signed char *status)
+RBS_INLINE void store(const block *k, double *V_out, double *Omega_out, signed char *status)
 {
     for (size_t b = 0; b < k->m; b++) {
         size_t i = k->start + b;
@@ -228,14 +228,14 @@ RBS_INLINE void store(const block *k, double *V_out, double *W_out, signed char 
         status[i] = valid ? (signed char)k->status[b] : (signed char)RBS_INVALID;
         for (int j = 0; j < 3; j++) {
             V_out[3 * i + j] = valid ? k->V[j][b] : NAN;
-            W_out[3 * i + j] = valid ? k->W[j][b] : NAN;
+            Omega_out[3 * i + j] = valid ? k->W[j][b] : NAN;
         }
     }
 }
 
 RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
                                const double *a, const double *u, rbs_rng *rng, int scaled, double *V_out,
-                               double *W_out, signed char *status)
+                               double *Omega_out, signed char *status)
 {
     block blocks[STAGES];
     uint64_t lanes[4 * RBS_BLOCK];
@@ -261,17 +261,17 @@ RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t co
             block *k = &blocks[(j - 2) % STAGES];
             gather(t, k);
             arithmetic(k, scaled);
-            store(k, V_out, W_out, status);
+            store(k, V_out, Omega_out, status);
         }
     }
 }
 
 static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, double *V_out,
-                     double *W_out, signed char *status)
+                     double *Omega_out, signed char *status)
 {
     if (rbs_arguments_ok(t, mix, interpolation)) return 1;
     for (size_t i = 0; i < count; i++) {
-        for (int k = 0; k < 3; k++) V_out[3 * i + k] = W_out[3 * i + k] = NAN;
+        for (int k = 0; k < 3; k++) V_out[3 * i + k] = Omega_out[3 * i + k] = NAN;
         status[i] = RBS_INVALID;
     }
     return 0;

@@ -91,7 +91,7 @@ static void draw_from(const char *path)
     enum { N = 5000 };
     double *V = malloc(3 * N * sizeof *V), *n = malloc(3 * N * sizeof *n), *a = malloc(N * sizeof *a);
     double *u = malloc(RBS_U_PER_DRAW * N * sizeof *u);
-    double *V_out = malloc(3 * N * sizeof *V_out), *W_out = malloc(3 * N * sizeof *W_out);
+    double *V_out = malloc(3 * N * sizeof *V_out), *Omega_out = malloc(3 * N * sizeof *Omega_out);
     double *V_one = malloc(3 * N * sizeof *V_one), *W_one = malloc(3 * N * sizeof *W_one);
     signed char *status = malloc(N);
     rbs_rng rng;
@@ -123,14 +123,14 @@ static void draw_from(const char *path)
         rebounded += st == RBS_REBOUNDED;
     }
     CHECK(rebounded > N / 2, "%d rebounded of %d", rebounded, N);
-    rbs_rebound_many(table, &mix, N, V, n, a, u, RBS_SCALED, V_out, W_out, status);
+    rbs_rebound_many(table, &mix, N, V, n, a, u, RBS_SCALED, V_out, Omega_out, status);
     for (int i = 0; i < N; i += 2)
         CHECK(memcmp(V_out + 3 * i, V_one + 3 * i, 3 * sizeof(double)) == 0 || isnan(V_out[3 * i]),
               "many differs from one at %d", i);
-    rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_STOCHASTIC, V_out, W_out, status);
-    rbs_rebound_many_rng(table, &mix, 0, V, n, a, &rng, RBS_SCALED, V_out, W_out, status);
-    rbs_rebound_many_rng(table, &mix, 31, V, n, a, &rng, RBS_SCALED, V_out, W_out, status);
-    rbs_rebound_many(table, &mix, 33, V, n, a, u, 7, V_out, W_out, status);
+    rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_STOCHASTIC, V_out, Omega_out, status);
+    rbs_rebound_many_rng(table, &mix, 0, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+    rbs_rebound_many_rng(table, &mix, 31, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+    rbs_rebound_many(table, &mix, 33, V, n, a, u, 7, V_out, Omega_out, status);
     CHECK(status[0] == RBS_INVALID && isnan(V_out[0]), "unknown interpolation gives invalid");
     for (int i = 0; i < 2000; i++) {
         double out[RBS_LOCAL_SIZE];
@@ -144,13 +144,13 @@ static void draw_from(const char *path)
     CHECK(rbs_draw_local(table, NULL, 45.0, 100.0, u, RBS_SCALED, out) == RBS_INVALID, "NULL mix");
     rbs_mix wrong = mix;
     wrong.n_shapes = n_shapes + 1;
-    CHECK(rbs_rebound(table, &wrong, V, n, a[0], u, RBS_SCALED, V_out, W_out) == RBS_INVALID, "mix of another table");
+    CHECK(rbs_rebound(table, &wrong, V, n, a[0], u, RBS_SCALED, V_out, Omega_out) == RBS_INVALID, "mix of another table");
     free(V);
     free(n);
     free(a);
     free(u);
     free(V_out);
-    free(W_out);
+    free(Omega_out);
     free(V_one);
     free(W_one);
     free(status);

@@ -25,7 +25,7 @@ typedef struct work {
     pthread_barrier_t *start;
     uint64_t stream;
     size_t rows;
-    double *V_out, *W_out;      /* (2 rows, 3): per-particle results, then the many-particle ones */
+    double *V_out, *Omega_out;      /* (2 rows, 3): per-particle results, then the many-particle ones */
     signed char *status;        /* (2 rows) */
 } work;
 
@@ -52,9 +52,9 @@ static void *draw(void *argument)
         double u[RBS_U_PER_DRAW];
         rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
         w->status[i] = (signed char)rbs_rebound(w->table, w->mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
-                                                w->V_out + 3 * i, w->W_out + 3 * i);
+                                                w->V_out + 3 * i, w->Omega_out + 3 * i);
     }
-    rbs_rebound_many_rng(w->table, w->mix, N, V, n, a, &rng, RBS_SCALED, w->V_out + 3 * N, w->W_out + 3 * N,
+    rbs_rebound_many_rng(w->table, w->mix, N, V, n, a, &rng, RBS_SCALED, w->V_out + 3 * N, w->Omega_out + 3 * N,
                          w->status + N);
     free(V);
     free(n);
@@ -72,7 +72,7 @@ static work make_work(const rbs_table *table, const rbs_mix *mix, uint64_t strea
 static void free_work(work *w)
 {
     free(w->V_out);
-    free(w->W_out);
+    free(w->Omega_out);
     free(w->status);
 }
 
@@ -109,7 +109,7 @@ int main(int argc, char **argv)
         work alone = make_work(table, &mix, (uint64_t)t, rows);
         draw(&alone);
         if (memcmp(alone.V_out, jobs[t].V_out, 6 * rows * sizeof(double)) != 0
-            || memcmp(alone.W_out, jobs[t].W_out, 6 * rows * sizeof(double)) != 0
+            || memcmp(alone.Omega_out, jobs[t].Omega_out, 6 * rows * sizeof(double)) != 0
             || memcmp(alone.status, jobs[t].status, 2 * rows) != 0) {
             fprintf(stderr, "stream %d: the threaded draws differ from the draws of one thread\n", t);
             differ++;
