@@ -231,7 +231,7 @@ void rbs_rng_seed(rbs_rng *rng, uint64_t seed);
  * (SeedSequence(seed) child k). Use k = thread number or MPI rank. */
 void rbs_rng_seed_stream(rbs_rng *rng, uint64_t seed, uint64_t k);
 
-/* The next uniform in [0, 1) (53 bits; surrogate.rng.next_uniform). */
+/* The next uniform in [0, 1) (53 bits; surrogate.kernels.rng.next_uniform). */
 double rbs_rng_uniform(rbs_rng *rng);
 
 /* u[0..count) = the next count uniforms (surrogate.fill_uniforms). */

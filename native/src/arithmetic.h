@@ -1,5 +1,5 @@
 /*
- * arithmetic.h: the arithmetic of a draw once its table values are read (surrogate.draw: _chain,
+ * arithmetic.h: the arithmetic of a draw once its table values are read (surrogate.kernels.draw: _chain,
  * _folded, _moved, _velocity, _to_speed, _mirrored): the conditional chain of the six state variables,
  * the fold into the physical ranges, the move to the incident α1 and |V⁻|, the mirror sign. Local frame,
  * V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. Same operations, same order, fma() where numba fuses.
@@ -14,7 +14,7 @@
 #include "locate.h"
 
 /* The state (α2, β2, s, Ω_x, Ω_y, Ω_z) reflected into the range of a rebound: α2 into [0, π], β2 below
- * π/2, s into [0, 1] (surrogate.draw._folded). */
+ * π/2, s into [0, 1] (surrogate.kernels.draw._folded). */
 RBS_INLINE void rbs_folded(double alpha2, double beta2, double s, double wx, double wy, double wz, double state[6])
 {
     alpha2 = fabs(alpha2);
@@ -28,7 +28,7 @@ RBS_INLINE void rbs_folded(double alpha2, double beta2, double s, double wx, dou
 }
 
 /* The folded state of one component from its residual quantiles q and slopes b (chain order α2, |β2|,
- * s, Ω_z, Ω_x, Ω_y; surrogate.draw._chain). */
+ * s, Ω_z, Ω_x, Ω_y; surrogate.kernels.draw._chain). */
 RBS_INLINE void rbs_chain(const double q[6], const double b[15], double state[6])
 {
     double x0 = q[0];
@@ -46,7 +46,7 @@ RBS_INLINE double rbs_shifted(double x, rbs_term term)
     return fma(x - term.mean_cell, term.ratio, term.mean);
 }
 
-/* The folded state moved to the incident α1 (surrogate.draw._moved), then folded again. */
+/* The folded state moved to the incident α1 (surrogate.kernels.draw._moved), then folded again. */
 RBS_INLINE void rbs_moved(const double state[6], const rbs_term terms[6], double out[6])
 {
     rbs_folded(rbs_shifted(state[0], terms[0]), state[1] * terms[1].ratio, rbs_shifted(state[2], terms[2]),
@@ -65,7 +65,7 @@ RBS_INLINE void rbs_velocity(double alpha2, double beta2, double s, double v[3])
     v[2] = s * sb;
 }
 
-/* A rebound drawn at grid speed V_iv moved to the incident speed V (surrogate.draw._to_speed): x = (vx,
+/* A rebound drawn at grid speed V_iv moved to the incident speed V (surrogate.kernels.draw.to_speed): x = (vx,
  * vy, vz, wx, wy, wz) in place; f_target, f_grid = exp(−k V^p) at V and V_iv. */
 RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, double cos_alpha1, double sin_alpha1,
                                 double x[6])
@@ -94,7 +94,7 @@ RBS_INLINE void rbs_mirrored(double u, double x[6])
     x[4] = mirror * x[4];
 }
 
-/* The whole draw in a located cell (surrogate.draw._draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
+/* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
  * returns the status (NaN state when trapped). */
 RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
                                    const double *u, int scaled, double x[6])

@@ -2,10 +2,10 @@
  * derive.c: the kernel arrays a table derives from its cell datasets, as surrogate/table.py and
  * surrogate/restitution.py derive them, with the same operations in the same order (so the same bits):
  *
- *   axis records       surrogate.table.axis_record / interval_lookup
- *   component rows     surrogate.table.kernel_rows, with Walker's alias tables (alias_table)
- *   cell records       surrogate.table.cell_records
- *   restitution        exp(−k V^p) at the grid speeds, and surrogate.restitution.restitution_pieces
+ *   axis records       surrogate.kernels.layout.axis_record / interval_lookup
+ *   component rows     surrogate.kernels.layout.kernel_rows, with Walker's alias tables (alias_table)
+ *   cell records       surrogate.kernels.layout.cell_records
+ *   restitution        exp(−k V^p) at the grid speeds, and surrogate.kernels.fastmath.restitution_pieces
  *
  * The restitution pieces are Chebyshev interpolants computed by numpy (chebinterpolate, cheb2poly);
  * rbs_restitution_pieces repeats numpy's arithmetic step by step, including the order in which the
@@ -41,7 +41,7 @@ static long count_le(const double *grid, int n, double x)
     return lo;
 }
 
-/* surrogate.table.axis_record(grid): [origin, 1/step, grid, inverse spacings, look-up indices] */
+/* surrogate.kernels.layout.axis_record(grid): [origin, 1/step, grid, inverse spacings, look-up indices] */
 static double *axis_record(const double *grid, int n, size_t *len)
 {
     if (n == 1) {
@@ -104,7 +104,7 @@ static double pairwise_sum(const double *a, size_t n)
     return pairwise_sum(a, n2) + pairwise_sum(a + n2, n - n2);
 }
 
-/* surrogate.table.alias_table(weights): keep (float64) and alias; `stack` scratch of 2n ints */
+/* surrogate.kernels.layout.alias_table(weights): keep (float64) and alias; `stack` scratch of 2n ints */
 static void alias_table(const double *weights, int n, double *keep, int *alias, int *stack)
 {
     double factor = (double)n / pairwise_sum(weights, (size_t)n);

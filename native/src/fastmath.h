@@ -50,8 +50,9 @@ RBS_INLINE int64_t rbs_trunc(double x)
 RBS_INLINE double rbs_fmin_py(double a, double b) { return b < a ? b : a; }
 RBS_INLINE double rbs_fmax_py(double a, double b) { return b > a ? b : a; }
 
-/* (sin x, cos x) for |x| <= 2π, to a few ulp (surrogate.trig.sincos) */
-RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
+/* The reduced angle's sine s and cosine c and the multiple q of π/2 with x = r + q·π/2, |r| <= π/4
+ * (Cody–Waite reduction, Taylor polynomials; surrogate.kernels.fastmath.sincos) */
+RBS_INLINE double rbs_sincos_reduced(double x, double *s, double *c)
 {
     const double S3 = -0x1.5555555555555p-3, S5 = 0x1.1111111111111p-7, S7 = -0x1.a01a01a01a01ap-13,
                  S9 = 0x1.71de3a556c734p-19, S11 = -0x1.ae64567f544e4p-26, S13 = 0x1.6124613a86d09p-33,
@@ -63,10 +64,17 @@ RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
     double r = (x - q * RBS_HALF_PI_HI) - q * RBS_HALF_PI_LO;
     double z = r * r;
     double p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, S15, S13), S11), S9), S7), S5), S3);
-    double s = fma(r * z, p, r);
+    *s = fma(r * z, p, r);
     p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, C16, C14), C12), C10), C8), C6), C4), C2);
-    double c = fma(z, p, 1.0);
-    int64_t quadrant = rbs_trunc(q) & 3;
+    *c = fma(z, p, 1.0);
+    return q;
+}
+
+/* (sin x, cos x) for |x| <= 2π, to a few ulp (surrogate.kernels.fastmath.sincos) */
+RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
+{
+    double s, c;
+    int64_t quadrant = rbs_trunc(rbs_sincos_reduced(x, &s, &c)) & 3;
     int odd = (quadrant & 1) == 1;
     double sign = 1.0 - (double)(quadrant & 2);
     *sin_x = sign * (odd ? c : s);
@@ -78,19 +86,8 @@ RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
  * rbs_sincos for every finite x (and NaN where rbs_sincos gives NaN). */
 RBS_INLINE void rbs_sincos_simd(double x, double *sin_x, double *cos_x)
 {
-    const double S3 = -0x1.5555555555555p-3, S5 = 0x1.1111111111111p-7, S7 = -0x1.a01a01a01a01ap-13,
-                 S9 = 0x1.71de3a556c734p-19, S11 = -0x1.ae64567f544e4p-26, S13 = 0x1.6124613a86d09p-33,
-                 S15 = -0x1.ae7f3e733b81fp-41;
-    const double C2 = -0x1p-1, C4 = 0x1.5555555555555p-5, C6 = -0x1.6c16c16c16c17p-10, C8 = 0x1.a01a01a01a01ap-16,
-                 C10 = -0x1.27e4fb7789f5cp-22, C12 = 0x1.1eed8eff8d898p-29, C14 = -0x1.93974a8c07c9dp-37,
-                 C16 = 0x1.ae7f3e733b81fp-45;
-    double q = floor(x * RBS_TWO_OVER_PI + 0.5);
-    double r = (x - q * RBS_HALF_PI_HI) - q * RBS_HALF_PI_LO;
-    double z = r * r;
-    double p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, S15, S13), S11), S9), S7), S5), S3);
-    double s = fma(r * z, p, r);
-    p = fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, fma(z, C16, C14), C12), C10), C8), C6), C4), C2);
-    double c = fma(z, p, 1.0);
+    double s, c;
+    double q = rbs_sincos_reduced(x, &s, &c);
     double quadrant = q - 4.0 * floor(q * 0.25);
     int odd = (quadrant == 1.0) | (quadrant == 3.0);
     double sign = quadrant >= 2.0 ? -1.0 : 1.0;
@@ -98,7 +95,7 @@ RBS_INLINE void rbs_sincos_simd(double x, double *sin_x, double *cos_x)
     *cos_x = sign * (odd ? -s : c);
 }
 
-/* atan2(y, x) in radians for x >= 0, y >= 0, not both 0, to a few ulp (surrogate.trig.atan2_first_quadrant) */
+/* atan2(y, x) in radians for x >= 0, y >= 0, not both 0, to a few ulp (surrogate.kernels.fastmath.atan2_first_quadrant) */
 RBS_INLINE double rbs_atan2_q1(double y, double x)
 {
     static const double ATAN_AT_NODES[5] = {0.0, 0x1.f5b75f92c80ddp-3, 0x1.dac670561bb4fp-2, 0x1.4978fa3269ee1p-1,
@@ -141,7 +138,7 @@ RBS_INLINE double rbs_atan2_q1_simd(double y, double x)
 }
 
 /* exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w in [0, 1], from the table's pieces (flat; n_pieces S
- * per interval, degree 9; surrogate.restitution.restitution_at) */
+ * per interval, degree 9; surrogate.kernels.fastmath.restitution_at) */
 RBS_INLINE double rbs_restitution_at(const double *pieces, int64_t n_pieces, int64_t j, double w)
 {
     double t = w * (double)n_pieces;

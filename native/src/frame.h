@@ -13,7 +13,7 @@
 #include "fastmath.h"
 #include "internal.h"
 
-/* a·b of two 3-vectors, the same bits wherever it is inlined (surrogate.frame._dot) */
+/* a·b of two 3-vectors, the same bits wherever it is inlined (surrogate.kernels.frame._dot) */
 RBS_INLINE double rbs_dot(double a0, double a1, double a2, double b0, double b1, double b2)
 {
     return fma(a0, b0, fma(a1, b1, a2 * b2));
@@ -32,7 +32,7 @@ typedef struct rbs_frame {
     double ex[3], ez[3];
 } rbs_frame;
 
-/* The impact frame of V on a wall of unit normal n (surrogate.frame.impact_frame); at normal impact
+/* The impact frame of V on a wall of unit normal n (surrogate.kernels.frame.impact_frame); at normal impact
  * (tangential part <= 1e-12 |V|) ex is uniform in the wall plane, from u_axis. */
 RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis, rbs_frame *f)
 {
@@ -81,7 +81,7 @@ RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis
 }
 
 /* A local draw x = (vx, vy, vz, wx, wy, wz) (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the
- * frame (ex, n, ez); NaN unless rebounded (surrogate.frame._to_global). */
+ * frame (ex, n, ez); NaN unless rebounded (surrogate.kernels.frame.to_global). */
 RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, double a, const double *ex,
                                  const double *n, const double *ez, double *V_out, double *Omega_out)
 {

@@ -1,5 +1,5 @@
 /*
- * gather.h: the table reads of a draw (surrogate.draw: _component, _quantile, _alpha1_terms,
+ * gather.h: the table reads of a draw (surrogate.kernels.draw: _component, _quantile, _alpha1_terms,
  * _restitution_factors) and the cache hints that put them in flight together (_hint_draw).
  *
  * A draw reads a component row (Walker's alias table picks it), six pairs of residual-shape levels,
@@ -13,7 +13,7 @@
 #include "fastmath.h"
 #include "internal.h"
 
-/* read hint, level-2 cache (prefetcht1), as surrogate.memory.prefetch */
+/* read hint, level-2 cache (prefetcht1), as surrogate.kernels.memory.prefetch */
 #if defined(__GNUC__)
 #define RBS_PREFETCH(address) __builtin_prefetch((const void *)(address), 0, 2)
 #else
@@ -73,12 +73,12 @@ RBS_INLINE void rbs_quantiles(const rbs_table *t, int64_t cell, int64_t row, con
     for (int k = 0; k < 6; k++) q[k] = rbs_quantile(t, cell, row, k, u[5 + k]);
 }
 
-/* (ratio, m_cell, m) of state variable k for the α1 move (surrogate.draw._term) */
+/* (ratio, m_cell, m) of state variable k for the α1 move (surrogate.kernels.draw._term) */
 typedef struct rbs_term {
     double ratio, mean_cell, mean;
 } rbs_term;
 
-/* The terms that move a state drawn from cell `drawn` to the incident α1 (surrogate.draw._alpha1_terms):
+/* The terms that move a state drawn from cell `drawn` to the incident α1 (surrogate.kernels.draw._alpha1_terms):
  * m and σ linear in α1 (weight wa) between cell `below` and the next α1 up; with wa = 0 the cell above
  * is not read. */
 RBS_INLINE void rbs_alpha1_terms(const rbs_table *t, int64_t below, double wa, int64_t drawn, rbs_term terms[6])

@@ -59,7 +59,7 @@
 
 #define N_CHAIN 6
 #define N_SLOPES 15
-#define RESTITUTION_DEGREE 9   /* surrogate.restitution.DEGREE */
+#define RESTITUTION_DEGREE 9   /* surrogate.kernels.fastmath.DEGREE */
 #define SHAPE_NAME_SIZE 32
 
 struct rbs_table {

@@ -1,5 +1,5 @@
 /*
- * locate.h: the grid look-up of a draw (surrogate.draw.locate and the cell choice of surrogate.draw._cell).
+ * locate.h: the grid look-up of a draw (surrogate.kernels.draw.locate and the cell choice of surrogate.kernels.draw.locate).
  *
  * An axis record (derive.c) holds a uniform auxiliary grid whose points store the index of the grid
  * interval holding them; a query reads that index and corrects it by at most one step: O(1), no search.
@@ -35,7 +35,7 @@ RBS_INLINE void rbs_locate(const double *axis, int64_t axis_len, int64_t n, doub
     *w_out = rbs_fmin_py(rbs_fmax_py(w, 0.0), 1.0);
 }
 
-/* The cell a draw reads (surrogate.draw._cell): shape from u[0] and the mix, grid intervals and weights,
+/* The cell a draw reads (surrogate.kernels.draw.locate): shape from u[0] and the mix, grid intervals and weights,
  * the neighbour (ia, iv) drawn with those weights from u[1], u[2] (stochastic interpolation). */
 typedef struct rbs_cell {
     int64_t drawn;      /* number of cell (shape, ia, iv) */

@@ -1,5 +1,5 @@
 /*
- * many.c: many particles on one thread (surrogate.blocks: rebound_many, rebound_many_rng).
+ * many.c: many particles on one thread (surrogate.kernels.pipeline: rebound_many, rebound_many_rng).
  *
  * Rows go through a pipeline of blocks of RBS_BLOCK particles, so that one block's table reads are in
  * flight while the blocks before it are computed (as surrogate/blocks.py does):
@@ -12,7 +12,7 @@
  *      outputs.
  * Every step does the operations of the per-particle code in the same order, so rbs_rebound_many gives
  * rbs_rebound's bits row by row. rbs_rebound_many_rng draws each block's uniforms from RBS_BLOCK
- * xoshiro256+ lanes as it enters (surrogate.rng.fill_lanes).
+ * xoshiro256+ lanes as it enters (surrogate.kernels.rng.fill_lanes).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */

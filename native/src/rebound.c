@@ -1,5 +1,5 @@
 /*
- * rebound.c: one particle (surrogate.kernels.rebound_tuple, surrogate.draw.draw_local): validity, impact
+ * rebound.c: one particle (surrogate.kernels.rebound_tuple, surrogate.kernels.draw.draw_local): validity, impact
  * frame, grid look-up, cache hints, the draw in its cell, back to the global frame.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.

@@ -4,7 +4,7 @@
  * rbs_rng_seed / rbs_rng_seed_stream repeat numpy's SeedSequence (numpy/random/bit_generator.pyx): the
  * seed's 32-bit words (and, for stream k, the spawn key (k,)) hashed into a pool of four 32-bit words,
  * from which generate_state(4, uint64) draws the state, as surrogate.seed_state does. The block
- * kernels' lanes are seeded with splitmix64 from one step of the caller's state (surrogate.rng.seed_lanes).
+ * kernels' lanes are seeded with splitmix64 from one step of the caller's state (surrogate.kernels.rng.seed_lanes).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */

@@ -28,7 +28,7 @@ static inline uint64_t rbs_next(uint64_t s[4])
     return result;
 }
 
-/* the top 53 bits times 2^-53 (surrogate.rng._step) */
+/* the top 53 bits times 2^-53 (surrogate.kernels.rng._step) */
 static inline double rbs_uniform_of(uint64_t x)
 {
     return (double)(int64_t)(x >> 11) * 0x1p-53;
@@ -41,10 +41,10 @@ static inline uint64_t rbs_splitmix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-/* RBS_BLOCK lanes seeded from one step of rng (surrogate.rng.seed_lanes; word w of lane l at w·BLOCK + l) */
+/* RBS_BLOCK lanes seeded from one step of rng (surrogate.kernels.rng.seed_lanes; word w of lane l at w·BLOCK + l) */
 void rbs_lanes_seed(rbs_rng *rng, uint64_t lanes[4 * RBS_BLOCK]);
 
-/* u[q·BLOCK + l] = the next uniform of lane l, q < RBS_U_PER_DRAW (surrogate.rng.fill_lanes) */
+/* u[q·BLOCK + l] = the next uniform of lane l, q < RBS_U_PER_DRAW (surrogate.kernels.rng.fill_lanes) */
 void rbs_lanes_fill(uint64_t lanes[4 * RBS_BLOCK], double *u);
 
 #endif /* RBS_RNG_INTERNAL_H */
