@@ -110,13 +110,16 @@ void rbs_lanes_seed(rbs_rng *rng, uint64_t lanes[4 * RBS_BLOCK])
 
 RBS_HOT void rbs_lanes_fill(uint64_t lanes[4 * RBS_BLOCK], double *u)
 {
-    for (int l = 0; l < RBS_BLOCK; l++) {
-        uint64_t s[4] = {lanes[l], lanes[RBS_BLOCK + l], lanes[2 * RBS_BLOCK + l], lanes[3 * RBS_BLOCK + l]};
-        for (int q = 0; q < RBS_U_PER_DRAW; q++) u[q * RBS_BLOCK + l] = rbs_uniform_of(rbs_next(s));
-        lanes[l] = s[0];
-        lanes[RBS_BLOCK + l] = s[1];
-        lanes[2 * RBS_BLOCK + l] = s[2];
-        lanes[3 * RBS_BLOCK + l] = s[3];
+    uint64_t *w0 = lanes, *w1 = lanes + RBS_BLOCK, *w2 = lanes + 2 * RBS_BLOCK, *w3 = lanes + 3 * RBS_BLOCK;
+    for (int q = 0; q < RBS_U_PER_DRAW; q++) {
+        for (int l = 0; l < RBS_BLOCK; l++) {        /* one step of every lane: independent, so a SIMD loop */
+            uint64_t s[4] = {w0[l], w1[l], w2[l], w3[l]};
+            u[q * RBS_BLOCK + l] = rbs_uniform_of(rbs_next(s));
+            w0[l] = s[0];
+            w1[l] = s[1];
+            w2[l] = s[2];
+            w3[l] = s[3];
+        }
     }
 }
 
