@@ -95,41 +95,42 @@ RBS_INLINE void rbs_sincos_simd(double x, double *sin_x, double *cos_x)
     *cos_x = sign * (odd ? -s : c);
 }
 
-/* atan2(y, x) in radians for x >= 0, y >= 0, not both 0, to a few ulp (surrogate.kernels.fastmath.atan2_first_quadrant) */
-RBS_INLINE double rbs_atan2_q1(double y, double x)
+/* atan z of the reduced argument of atan2(y, x), x, y >= 0: t = min/max, c = node/4 the nearest of 0, 1/4, …, 1
+ * (node returned, as a double), z = (t − c)/(1 + c t), and whether y > x (surrogate.kernels.fastmath) */
+RBS_INLINE double rbs_atan2_q1_reduced(double y, double x, int *swap, double *node)
 {
-    static const double ATAN_AT_NODES[5] = {0.0, 0x1.f5b75f92c80ddp-3, 0x1.dac670561bb4fp-2, 0x1.4978fa3269ee1p-1,
-                                            0x1.921fb54442d18p-1};
-    int swap = y > x;
-    double lo = swap ? x : y, hi = swap ? y : x;
-    int node = (lo > 0.125 * hi) + (lo > 0.375 * hi) + (lo > 0.625 * hi) + (lo > 0.875 * hi);
-    double c = 0.25 * (double)node;
+    *swap = y > x;
+    double lo = *swap ? x : y, hi = *swap ? y : x;
+    *node = (lo > 0.125 * hi ? 1.0 : 0.0) + (lo > 0.375 * hi ? 1.0 : 0.0) + (lo > 0.625 * hi ? 1.0 : 0.0)
+            + (lo > 0.875 * hi ? 1.0 : 0.0);
+    double c = 0.25 * *node;
     double z = fma(-c, hi, lo) / fma(c, lo, hi);
     double w = z * z;
     double p = fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, -0x1.e1e1e1e1e1e1ep-5, 0x1.1111111111111p-4),
                                                           -0x1.3b13b13b13b14p-4), 0x1.745d1745d1746p-4),
                                      -0x1.c71c71c71c71cp-4), 0x1.2492492492492p-3), -0x1.999999999999ap-3),
                   0x1.5555555555555p-2);
-    double atan_z = fma(-z * w, p, z);
-    double angle = ATAN_AT_NODES[node] + atan_z;
+    return fma(-z * w, p, z);
+}
+
+/* atan2(y, x) in radians for x >= 0, y >= 0, not both 0, to a few ulp (surrogate.kernels.fastmath.atan2_first_quadrant) */
+RBS_INLINE double rbs_atan2_q1(double y, double x)
+{
+    static const double ATAN_AT_NODES[5] = {0.0, 0x1.f5b75f92c80ddp-3, 0x1.dac670561bb4fp-2, 0x1.4978fa3269ee1p-1,
+                                            0x1.921fb54442d18p-1};
+    int swap;
+    double node;
+    double atan_z = rbs_atan2_q1_reduced(y, x, &swap, &node);
+    double angle = ATAN_AT_NODES[(int)node] + atan_z;
     return swap ? RBS_HALF_PI - angle : angle;
 }
 
 /* rbs_atan2_q1 written for SIMD loops (the node's atan by selects, not a table read): the same bits */
 RBS_INLINE double rbs_atan2_q1_simd(double y, double x)
 {
-    int swap = y > x;
-    double lo = swap ? x : y, hi = swap ? y : x;
-    double node = (lo > 0.125 * hi ? 1.0 : 0.0) + (lo > 0.375 * hi ? 1.0 : 0.0) + (lo > 0.625 * hi ? 1.0 : 0.0)
-                  + (lo > 0.875 * hi ? 1.0 : 0.0);
-    double c = 0.25 * node;
-    double z = fma(-c, hi, lo) / fma(c, lo, hi);
-    double w = z * z;
-    double p = fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, fma(w, -0x1.e1e1e1e1e1e1ep-5, 0x1.1111111111111p-4),
-                                                          -0x1.3b13b13b13b14p-4), 0x1.745d1745d1746p-4),
-                                     -0x1.c71c71c71c71cp-4), 0x1.2492492492492p-3), -0x1.999999999999ap-3),
-                  0x1.5555555555555p-2);
-    double atan_z = fma(-z * w, p, z);
+    int swap;
+    double node;
+    double atan_z = rbs_atan2_q1_reduced(y, x, &swap, &node);
     /* atan c by selects; one term is non-zero, so the sum is exact */
     double atan_c = ((node == 1.0 ? 0x1.f5b75f92c80ddp-3 : 0.0) + (node == 2.0 ? 0x1.dac670561bb4fp-2 : 0.0))
                   + ((node == 3.0 ? 0x1.4978fa3269ee1p-1 : 0.0) + (node == 4.0 ? 0x1.921fb54442d18p-1 : 0.0));

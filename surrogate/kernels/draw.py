@@ -161,8 +161,8 @@ def _folded(alpha2, beta2, s, wx, wy, wz):
     """The state (state order) reflected into the range of a rebound: α2 into [0, π], β2 below π/2, s into [0, 1].
 
     The linear shifts of the chain and of the α1 move can step outside by a
-    hair (up to 4e-3 of the draws at a point between the grid points of a
-    coarse 3 × 3 table, 1.5e-4 on the default table). Reflected at the edge, such a draw stays a rebound that
+    hair for a rare draw (docs/format.md, "The stored law of a cell").
+    Reflected at the edge, such a draw stays a rebound that
     leaves the wall (V⁺·n = s sin α2 cos β2 > 0) and gains no kinetic energy
     (s ≤ 1: tables are built with Ω⁻ = 0, so |V⁺| ≤ |V⁻|); a cap would put it
     on the edge, where s = 0 or β2 = π/2 gives V⁺·n = 0 and s = 1 an elastic
@@ -255,11 +255,10 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     * regime 1 (more collisions): the normal rebound velocity is multiplied
       by a(V)/a(V_iv), the rest kept (the last, slow contacts set it).
 
-    Measured against the direct model between grid speeds 25–50 m/s apart
-    (docs/design/table_representation.md): either law alone fails near
-    normal impact for some shape (classifier accuracy up to 0.79), the pair
-    by regime stays ≤ 0.54. A normal velocity the shift would reverse is
-    reflected (the rebound must leave the wall).
+    One law per regime because neither alone follows the direct model near
+    normal impact for every shape (docs/design/table_representation.md). A
+    normal velocity the shift would reverse is reflected (the rebound must
+    leave the wall).
     """
     a_target = 1.0 - (1.0 - f_target) * sin_alpha1
     a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1

@@ -10,6 +10,6 @@ raising, so the hot path carries no such check.
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 # The per-particle kernels allocate nothing, so they are compiled without numba's reference
 # counting (_nrt=False): with it, every array taken from the table tuple or sliced from a row
-# costs an atomic increment and decrement that numba cannot prune across branches (measured:
-# the cell look-up alone 83 ns with, 15 ns without). Callers keep their own reference counting.
+# costs an atomic increment and decrement that numba cannot prune across branches
+# (docs/design/sampler_cost.md). Callers keep their own reference counting.
 KERNEL = dict(JIT, _nrt=False)

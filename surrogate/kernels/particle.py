@@ -49,7 +49,7 @@ def rebound_tuple(data, mix_cdf, V, n, a, u, scaled=True):
     V and n may be 3-tuples or (3,) arrays. For a solver loop over particle
     arrays, passing ``(V[i, 0], V[i, 1], V[i, 2])`` rather than the row
     ``V[i]`` creates no array view, so the loop does no reference counting
-    (numba's atomic counts on views cost tens of ns per call: bench_sampler.py, (b) and its variant).
+    (numba's atomic counts on views: docs/design/sampler_cost.md).
     """
     return _rebound(data, mix_cdf, V, n, a, u, scaled)
 
