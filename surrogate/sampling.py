@@ -94,7 +94,10 @@ def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
     if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
         raise ValueError(f"The mix weights must sum to 1; got {float(total)!r} from "
                          f"{ {k: float(v) for k, v in weights.items()} }.")
-    cdf = np.cumsum([weights.get(name, 0.0) for name in table.shapes])
+    cdf, total = np.empty(len(table.shapes)), 0.0
+    for k, name in enumerate(table.shapes):       # running sum in table order, as rbs_mix_from_weights adds
+        total += float(weights.get(name, 0.0))
+        cdf[k] = total
     cdf[-1] = 1.0
     return cdf
 

@@ -1,17 +1,16 @@
 /*
- * derive.c: the kernel arrays a table derives from its cell datasets, as surrogate/table.py and
- * surrogate/restitution.py derive them, with the same operations in the same order (so the same bits):
+ * derive.c: the kernel arrays a table derives from its cell datasets, as surrogate.kernels.layout
+ * derives them, with the same operations in the same order (so the same bits):
  *
  *   axis records       surrogate.kernels.layout.axis_record / interval_lookup
  *   component rows     surrogate.kernels.layout.kernel_rows, with Walker's alias tables (alias_table)
  *   cell records       surrogate.kernels.layout.cell_records
- *   restitution        exp(−k V^p) at the grid speeds, and surrogate.kernels.fastmath.restitution_pieces
+ *   restitution        surrogate.kernels.fastmath.restitution_factor at the grid speeds, and
+ *                      surrogate.kernels.fastmath.restitution_pieces between them
  *
- * The restitution pieces are Chebyshev interpolants computed by numpy (chebinterpolate, cheb2poly);
- * rbs_restitution_pieces repeats numpy's arithmetic step by step, including the order in which the
- * matrix-vector product of chebinterpolate sums its terms (numpy's BLAS, OpenBLAS's dgemv kernels for
- * x86-64 AVX2: docs/native.md, "Bit identity"). The libm calls (sin, exp, pow, sqrt) are those numpy
- * makes on x86-64 without AVX-512, where numpy calls the C library.
+ * Every sum is a plain loop in index order and the only libm calls are exp and pow on one value at
+ * a time, as the Python side makes them: no step depends on which SIMD kernels numpy or its BLAS pick
+ * on a given CPU (docs/native.md, "Bit identity").
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -81,33 +80,12 @@ static double *axis_record(const double *grid, int n, size_t *len)
 
 /* ------------------------------------------------------------------------- alias tables */
 
-/* numpy's pairwise summation of a float64 array (np.sum of a contiguous array) */
-static double pairwise_sum(const double *a, size_t n)
-{
-    if (n < 8) {
-        double res = 0.0;
-        for (size_t i = 0; i < n; i++) res += a[i];
-        return res;
-    }
-    if (n <= 128) {
-        double r[8];
-        size_t i;
-        for (int j = 0; j < 8; j++) r[j] = a[j];
-        for (i = 8; i < n - (n % 8); i += 8)
-            for (int j = 0; j < 8; j++) r[j] += a[i + j];
-        double res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
-        for (; i < n; i++) res += a[i];
-        return res;
-    }
-    size_t n2 = n / 2;
-    n2 -= n2 % 8;
-    return pairwise_sum(a, n2) + pairwise_sum(a + n2, n - n2);
-}
-
 /* surrogate.kernels.layout.alias_table(weights): keep (float64) and alias; `stack` scratch of 2n ints */
 static void alias_table(const double *weights, int n, double *keep, int *alias, int *stack)
 {
-    double factor = (double)n / pairwise_sum(weights, (size_t)n);
+    double total = 0.0;
+    for (int i = 0; i < n; i++) total += weights[i];
+    double factor = (double)n / total;
     int *small = stack, *large = stack + n;
     int n_small = 0, n_large = 0;
     for (int i = 0; i < n; i++) {
@@ -130,178 +108,74 @@ static void alias_table(const double *weights, int n, double *keep, int *alias, 
 
 /* ------------------------------------------------------------------------- restitution pieces */
 
-/* A numpy polynomial series (numpy.polynomial.polyutils semantics: trailing zeros trimmed) */
-typedef struct series {
-    int len;
-    double c[RESTITUTION_DEGREE + 3];
-} series;
+#define N_NODES (RESTITUTION_DEGREE + 1)   /* surrogate.kernels.fastmath.N_NODES */
 
-static series trimseq(series s)
+/* surrogate.kernels.fastmath.restitution_factor: exp(−k V^p), V in m/s */
+double rbs_restitution_factor(double V, double k, double p)
 {
-    if (s.len == 0 || s.c[s.len - 1] != 0.0) return s;
-    int i;
-    for (i = s.len - 1; i >= 0; i--)
-        if (s.c[i] != 0.0) break;
-    if (i < 0) i = 0;
-    s.len = i + 1;
-    return s;
+    return exp(-k * pow(V, p));
 }
 
-static series scalar_series(double x)
-{
-    series s;
-    s.len = 1;
-    s.c[0] = x;
-    return s;
-}
-
-/* polyutils._add */
-static series poly_add(series a, series b)
-{
-    a = trimseq(a);
-    b = trimseq(b);
-    if (a.len > b.len) {
-        for (int i = 0; i < b.len; i++) a.c[i] += b.c[i];
-        return trimseq(a);
-    }
-    for (int i = 0; i < a.len; i++) b.c[i] += a.c[i];
-    return trimseq(b);
-}
-
-/* polyutils._sub */
-static series poly_sub(series a, series b)
-{
-    a = trimseq(a);
-    b = trimseq(b);
-    if (a.len > b.len) {
-        for (int i = 0; i < b.len; i++) a.c[i] -= b.c[i];
-        return trimseq(a);
-    }
-    for (int i = 0; i < b.len; i++) b.c[i] = -b.c[i];
-    for (int i = 0; i < a.len; i++) b.c[i] += a.c[i];
-    return trimseq(b);
-}
-
-/* polynomial.polymulx, times `factor` element by element (1 = none) */
-static series poly_mulx(series s, double factor, int scale)
-{
-    s = trimseq(s);
-    if (s.len == 1 && s.c[0] == 0.0) {
-        if (scale) s.c[0] = s.c[0] * factor;
-        return s;
-    }
-    series r;
-    r.len = s.len + 1;
-    r.c[0] = s.c[0] * 0.0;
-    for (int i = 0; i < s.len; i++) r.c[i + 1] = s.c[i];
-    if (scale)
-        for (int i = 0; i < r.len; i++) r.c[i] = r.c[i] * factor;
-    return r;
-}
-
-/* chebyshev.cheb2poly */
-static series cheb2poly(series c)
-{
-    c = trimseq(c);
-    int n = c.len;
-    if (n < 3) return c;
-    series c0 = scalar_series(c.c[n - 2]), c1 = scalar_series(c.c[n - 1]);
-    for (int i = n - 1; i > 1; i--) {
-        series tmp = c0;
-        c0 = poly_sub(scalar_series(c.c[i - 2]), c1);
-        c1 = poly_add(tmp, poly_mulx(c1, 2.0, 1));
-    }
-    return poly_add(c0, poly_mulx(c1, 1.0, 0));
-}
-
-#define N_CHEB (RESTITUTION_DEGREE + 1)
-
-/* The product v · y of chebinterpolate (np.dot of the 10 × 10 Chebyshev matrix, C-contiguous, and a
- * vector) in the order numpy's BLAS sums it (OpenBLAS dgemv_t for AVX2: rows by fours with four
- * fused-multiply-add lanes over the first eight terms, the last two rows by two-lane SSE sums, then
- * the two remaining terms of every row added) */
-static void chebyshev_product(const double v[N_CHEB][N_CHEB], const double *y, double *out)
-{
-    for (int i = 0; i < 8; i++) {
-        double lane[4];
-        for (int l = 0; l < 4; l++) lane[l] = fma(v[i][l + 4], y[l + 4], fma(v[i][l], y[l], 0.0));
-        double sum = (lane[0] + lane[2]) + (lane[1] + lane[3]);
-        out[i] = 0.0 + sum * 1.0;
-    }
-    for (int i = 8; i < N_CHEB; i++) {
-        double even = 0.0, odd = 0.0;
-        for (int k = 0; k < 8; k += 2) {
-            even += v[i][k] * y[k];
-            odd += v[i][k + 1] * y[k + 1];
-        }
-        out[i] = 0.0 + (even + odd) * 1.0;
-    }
-    double x8 = y[8] * 1.0, x9 = y[9] * 1.0;
-    for (int i = 0; i < N_CHEB; i++) out[i] += fma(v[i][8], x8, v[i][9] * x9);
-}
-
-/* V^p as numpy's array ** float computes it (exponent 0.5: sqrt) */
-static double power(double V, double p)
-{
-    return p == 0.5 ? sqrt(V) : pow(V, p);
-}
-
+/* surrogate.kernels.fastmath.restitution_pieces, loop for loop */
 double *rbs_restitution_pieces(const double *grid, int n, double k, double p, int *n_pieces, size_t *len)
 {
     if (n == 1) {
-        double *zeros = calloc(N_CHEB, sizeof *zeros);
+        double *zeros = calloc(N_NODES, sizeof *zeros);
         *n_pieces = 1;
-        *len = N_CHEB;
+        *len = N_NODES;
         return zeros;
     }
-    double ratio = (grid[1] - grid[0]) / grid[0];
-    for (int j = 1; j < n - 1; j++) {
+    double widest = 0.0;
+    for (int j = 0; j < n - 1; j++) {
         double r = (grid[j + 1] - grid[j]) / grid[j];
-        if (r > ratio || r != r) ratio = r;
+        if (r > widest) widest = r;
     }
-    double count = ceil(ratio / 0.25);
+    double count = ceil(widest / (RESTITUTION_PIECE_RATIO - 1.0));
     if (!(count < 1e6)) return NULL;
     int pieces = count < 1.0 ? 1 : (int)count;
-    /* chebpts1(10) and chebvander(x, 9) */
-    double x[N_CHEB], v[N_CHEB][N_CHEB];
-    double half_pi_over = 0.5 * 3.141592653589793 / N_CHEB;
-    for (int i = 0; i < N_CHEB; i++) x[i] = sin(half_pi_over * (double)(2 * i - (N_CHEB - 1))) + 0.0;
-    for (int q = 0; q < N_CHEB; q++) {
-        v[0][q] = x[q] * 0.0 + 1.0;
-        v[1][q] = x[q];
-    }
-    for (int i = 2; i < N_CHEB; i++)
-        for (int q = 0; q < N_CHEB; q++) v[i][q] = v[i - 1][q] * (2.0 * x[q]) - v[i - 2][q];
 
-    size_t total = (size_t)(n - 1) * (size_t)pieces * N_CHEB;
-    double *coef = calloc(total, sizeof *coef);
-    double *edges = malloc(((size_t)pieces + 1) * sizeof *edges);
-    if (!coef || !edges) {
-        free(coef);
-        free(edges);
-        return NULL;
+    /* CHEBYSHEV_NODES, CHEBYSHEV_POWERS and the basis T_j(x_q) at [j][q] */
+    double basis[N_NODES][N_NODES], powers[N_NODES][N_NODES];
+    static const double x[N_NODES] = {0x1.f9b24942fe45cp-1,  0x1.c83201d3d2c6dp-1,  0x1.6a09e667f3bcdp-1,
+                                      0x1.d0e2e2b44de01p-2,  0x1.4060b67a85375p-3,  -0x1.4060b67a85375p-3,
+                                      -0x1.d0e2e2b44de01p-2, -0x1.6a09e667f3bcdp-1, -0x1.c83201d3d2c6dp-1,
+                                      -0x1.f9b24942fe45cp-1};
+    memset(powers, 0, sizeof powers);
+    powers[0][0] = 1.0;
+    powers[1][1] = 1.0;
+    for (int j = 2; j < N_NODES; j++)
+        for (int i = 0; i < N_NODES; i++)
+            powers[j][i] = 2.0 * (i > 0 ? powers[j - 1][i - 1] : 0.0) - powers[j - 2][i];
+    for (int q = 0; q < N_NODES; q++) {
+        basis[0][q] = 1.0;
+        basis[1][q] = x[q];
     }
+    for (int j = 2; j < N_NODES; j++)
+        for (int q = 0; q < N_NODES; q++) basis[j][q] = 2.0 * x[q] * basis[j - 1][q] - basis[j - 2][q];
+
+    size_t total = (size_t)(n - 1) * (size_t)pieces * N_NODES;
+    double *coef = calloc(total, sizeof *coef);
+    if (!coef) return NULL;
     for (int j = 0; j < n - 1; j++) {
-        /* np.linspace(grid[j], grid[j + 1], pieces + 1) */
-        double start = grid[j], stop = grid[j + 1];
-        double step = (stop - start) / (double)pieces;
-        for (int i = 0; i <= pieces; i++) edges[i] = (double)i * step + start;
-        edges[pieces] = stop;
+        double width = grid[j + 1] - grid[j];
+        double half = 0.5 * width / (double)pieces;
         for (int i = 0; i < pieces; i++) {
-            double lo = edges[i], half = 0.5 * (edges[i + 1] - edges[i]);
-            double y[N_CHEB], c[N_CHEB];
-            for (int q = 0; q < N_CHEB; q++) y[q] = exp(-k * power(lo + (x[q] + 1.0) * half, p));
-            chebyshev_product((const double(*)[N_CHEB])v, y, c);
-            series s;
-            s.len = N_CHEB;
-            s.c[0] = c[0] / (double)N_CHEB;
-            for (int q = 1; q < N_CHEB; q++) s.c[q] = c[q] / (0.5 * N_CHEB);
-            series power_series = cheb2poly(s);
-            double *out = coef + ((size_t)j * (size_t)pieces + (size_t)i) * N_CHEB;
-            for (int q = 0; q < power_series.len && q < N_CHEB; q++) out[q] = power_series.c[q];
+            double start = grid[j] + width * (double)i / (double)pieces;
+            double f[N_NODES], series[N_NODES];
+            for (int q = 0; q < N_NODES; q++) f[q] = rbs_restitution_factor(start + (x[q] + 1.0) * half, k, p);
+            for (int d = 0; d < N_NODES; d++) {
+                double sum = 0.0;
+                for (int q = 0; q < N_NODES; q++) sum += f[q] * basis[d][q];
+                series[d] = d == 0 ? sum / (double)N_NODES : sum * 2.0 / (double)N_NODES;
+            }
+            double *out = coef + ((size_t)j * (size_t)pieces + (size_t)i) * N_NODES;
+            for (int e = 0; e < N_NODES; e++) {
+                double sum = 0.0;
+                for (int d = 0; d < N_NODES; d++) sum += series[d] * powers[d][e];
+                out[e] = sum;
+            }
         }
     }
-    free(edges);
     *n_pieces = pieces;
     *len = total;
     return coef;
@@ -393,7 +267,7 @@ int rbs_derive(rbs_table *t, const rbs_raw_cells *raw, const char **what)
     t->speed_restitution = malloc((size_t)t->n_speed * sizeof *t->speed_restitution);
     if (!t->speed_restitution) return RBS_ERR_MEMORY;
     for (int j = 0; j < t->n_speed; j++)
-        t->speed_restitution[j] = exp(-t->restitution_k * power(t->speed_m_s[j], t->restitution_p));
+        t->speed_restitution[j] = rbs_restitution_factor(t->speed_m_s[j], t->restitution_k, t->restitution_p);
     t->restitution_pieces = rbs_restitution_pieces(t->speed_m_s, t->n_speed, t->restitution_k, t->restitution_p,
                                                    &t->n_pieces, &t->restitution_pieces_len);
     if (!t->restitution_pieces) return RBS_ERR_MEMORY;

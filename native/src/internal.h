@@ -60,6 +60,7 @@
 #define N_CHAIN 6
 #define N_SLOPES 15
 #define RESTITUTION_DEGREE 9   /* surrogate.kernels.fastmath.DEGREE */
+#define RESTITUTION_PIECE_RATIO 1.25   /* surrogate.kernels.fastmath.PIECE_RATIO */
 #define SHAPE_NAME_SIZE 32
 
 struct rbs_table {
@@ -103,6 +104,7 @@ int rbs_derive(rbs_table *table, const rbs_raw_cells *raw, const char **what);
 
 /* derive.c, exposed for tests of the pieces alone */
 double *rbs_restitution_pieces(const double *grid, int n, double k, double p, int *n_pieces, size_t *len);
+double rbs_restitution_factor(double V, double k, double p);
 
 /* error.c: printf into a caller's message buffer (NULL or size 0: nothing). */
 void rbs_message(char *message, size_t message_size, const char *format, ...)

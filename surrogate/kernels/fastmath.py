@@ -36,7 +36,6 @@ import numpy as np
 from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
-from numpy.polynomial import chebyshev
 
 from surrogate.kernels.memory import load
 from surrogate.kernels.options import JIT
@@ -109,6 +108,34 @@ DEGREE = 9          # polynomial degree of a piece
 PIECE_RATIO = 1.25  # a piece [V_lo, V_hi] has V_hi ≤ PIECE_RATIO · V_lo
 
 
+def restitution_factor(speed: float, k: float, p: float) -> float:
+    """The wall's restitution factor exp(−k V^p) at V = ``speed`` (m/s), from the C library's exp and pow,
+    called one value at a time as native/src/derive.c calls them (no array function whose SIMD kernel
+    depends on the CPU)."""
+    return math.exp(-k * math.pow(speed, p))
+
+
+N_NODES = DEGREE + 1
+# Chebyshev nodes of the first kind on [−1, 1], x_q = cos(π (2q + 1) / (2 N)) correctly rounded, as
+# literals (a cos call could be folded at compile time in C and rounded otherwise than libm at run time)
+CHEBYSHEV_NODES = tuple(float.fromhex(h) for h in (
+    "0x1.f9b24942fe45cp-1", "0x1.c83201d3d2c6dp-1", "0x1.6a09e667f3bcdp-1", "0x1.d0e2e2b44de01p-2",
+    "0x1.4060b67a85375p-3", "-0x1.4060b67a85375p-3", "-0x1.d0e2e2b44de01p-2", "-0x1.6a09e667f3bcdp-1",
+    "-0x1.c83201d3d2c6dp-1", "-0x1.f9b24942fe45cp-1"))
+
+
+def _chebyshev_power_coefficients() -> tuple:
+    """The integer coefficients of T_0 … T_DEGREE in powers of x (T_{j+1} = 2x T_j − T_{j−1}), exact in float64:
+    [T_j]_i at [j][i]."""
+    rows = [[1] + [0] * DEGREE, [0, 1] + [0] * (DEGREE - 1)]
+    for j in range(2, N_NODES):
+        rows.append([2 * (rows[j - 1][i - 1] if i > 0 else 0) - rows[j - 2][i] for i in range(N_NODES)])
+    return tuple(tuple(float(c) for c in row) for row in rows)
+
+
+CHEBYSHEV_POWERS = _chebyshev_power_coefficients()
+
+
 def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
     """Polynomial pieces of exp(−k V^p) over each interval of ``speed_grid`` (m/s, increasing, > 0).
 
@@ -117,19 +144,42 @@ def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
     across the piece (lowest power first). A one-point grid has no interval;
     it gets one piece of zeros that the kernels never read (their speed
     weight is always 0 there).
+
+    Each piece interpolates at the Chebyshev nodes: c_j = (2 − δ_j0)/N Σ_q f(x_q) T_j(x_q), then
+    power_i = Σ_j c_j [T_j]_i. Every sum is a plain loop in index order over scalars, the only library
+    calls are exp and pow on one value at a time, so the bits are the same whichever SIMD kernels numpy
+    and its BLAS pick on this CPU; native/src/derive.c (rbs_restitution_pieces) repeats the same
+    operations in the same order.
     """
-    grid = np.asarray(speed_grid, dtype=np.float64)
+    grid = [float(v) for v in np.asarray(speed_grid, dtype=np.float64).ravel()]
     if len(grid) == 1:
-        return np.zeros((1, 1, DEGREE + 1))
-    pieces = max(1, int(np.ceil(np.max(np.diff(grid) / grid[:-1]) / (PIECE_RATIO - 1.0))))
-    coef = np.zeros((len(grid) - 1, pieces, DEGREE + 1))
+        return np.zeros((1, 1, N_NODES))
+    widest = 0.0
     for j in range(len(grid) - 1):
-        edges = np.linspace(grid[j], grid[j + 1], pieces + 1)
+        widest = max(widest, (grid[j + 1] - grid[j]) / grid[j])
+    pieces = max(1, math.ceil(widest / (PIECE_RATIO - 1.0)))
+    # T_j(x_q) at [j][q], by the recurrence
+    basis = [[1.0] * N_NODES, list(CHEBYSHEV_NODES)]
+    for j in range(2, N_NODES):
+        basis.append([2.0 * x * t1 - t0 for x, t1, t0 in zip(CHEBYSHEV_NODES, basis[j - 1], basis[j - 2])])
+    coef = np.zeros((len(grid) - 1, pieces, N_NODES))
+    for j in range(len(grid) - 1):
+        width = grid[j + 1] - grid[j]
+        half = 0.5 * width / pieces
         for i in range(pieces):
-            lo, half = edges[i], 0.5 * (edges[i + 1] - edges[i])
-            series = chebyshev.chebinterpolate(lambda x: np.exp(-k * (lo + (x + 1.0) * half) ** p), DEGREE)
-            power = chebyshev.cheb2poly(series)
-            coef[j, i, :len(power)] = power
+            start = grid[j] + width * i / pieces
+            f = [restitution_factor(start + (x + 1.0) * half, k, p) for x in CHEBYSHEV_NODES]
+            series = []
+            for d in range(N_NODES):
+                total = 0.0
+                for q in range(N_NODES):
+                    total += f[q] * basis[d][q]
+                series.append(total / N_NODES if d == 0 else total * 2.0 / N_NODES)
+            for e in range(N_NODES):
+                total = 0.0
+                for d in range(N_NODES):
+                    total += series[d] * CHEBYSHEV_POWERS[d][e]
+                coef[j, i, e] = total
     return coef
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from data_schema.common import DataFormatError
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import N_CHAIN, N_SLOPES, ReboundTable
-from surrogate.kernels.fastmath import restitution_pieces
+from surrogate.kernels.fastmath import restitution_factor, restitution_pieces
 
 CACHE_LINE_BYTES = 64
 FLOAT32_PER_CACHE_LINE = CACHE_LINE_BYTES // 4
@@ -131,7 +131,10 @@ def alias_table(weights: np.ndarray):
     rounding). Zero-weight components have keep = 0 and are never drawn.
     """
     n = len(weights)
-    keep = np.asarray(weights, dtype=np.float64) * (n / np.sum(weights))
+    total = 0.0
+    for w in np.asarray(weights, dtype=np.float64).tolist():    # in index order: np.sum's order is numpy's choice
+        total += w
+    keep = np.asarray(weights, dtype=np.float64) * (n / total)
     alias = np.arange(n)
     small = [i for i in range(n) if keep[i] < 1.0]
     large = [i for i in range(n) if keep[i] >= 1.0]
@@ -207,7 +210,8 @@ def kernel_data(table: ReboundTable) -> KernelData:
         alpha1_axis=frozen(axis_record(table.alpha1_deg)), speed_axis=frozen(axis_record(speed)),
         cells=frozen(cell_records(counts[..., STATUS_TRAPPED] / landed, table.cells["mean"], table.cells["std"])),
         clusters=frozen(rows), dictionary=frozen(dictionary),
-        speed_restitution=frozen(np.exp(-table.restitution_k * speed ** table.restitution_p)),
+        speed_restitution=frozen(np.array([restitution_factor(v, table.restitution_k, table.restitution_p)
+                                           for v in speed.tolist()])),
         restitution_pieces=frozen(pieces.ravel()),
         n_shapes=lead[0], n_alpha1=lead[1], n_speed=lead[2], n_clusters=table.cells["cluster_weight"].shape[3],
         n_levels=dic_shape[-1], n_dictionary=dic_shape[-2], n_pieces=pieces.shape[1])

@@ -110,3 +110,18 @@ def test_restitution_pieces_match_the_closed_form(grid):
             _restitution_all(pieces.ravel(), pieces.shape[1], np.full(w.size, j), w, got)
             exact = np.exp(-k * (grid[j] + w * (grid[j + 1] - grid[j])) ** p)
             assert np.max(np.abs(got - exact)) <= 1e-12, (grid, k, p, j)
+
+
+def test_chebyshev_nodes_are_correctly_rounded():
+    """The node literals are cos(π (2q + 1) / (2N)) rounded to the nearest double (checked at 200 bits), and the
+    power-basis rows are numpy's T_0 … T_DEGREE (integers, exact)."""
+    import mpmath
+    from surrogate.kernels.fastmath import CHEBYSHEV_NODES, CHEBYSHEV_POWERS, N_NODES
+    with mpmath.workprec(200):
+        exact = [mpmath.cos(mpmath.pi * (2 * q + 1) / (2 * N_NODES)) for q in range(N_NODES)]
+        assert list(CHEBYSHEV_NODES) == [float(x) for x in exact]
+    for j, row in enumerate(CHEBYSHEV_POWERS):
+        expected = np.zeros(N_NODES)
+        power = np.polynomial.chebyshev.cheb2poly(np.eye(N_NODES)[j])
+        expected[:len(power)] = power
+        assert list(row) == expected.tolist(), j

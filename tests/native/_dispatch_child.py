@@ -1,0 +1,62 @@
+"""Run in a subprocess by test_native_dispatch.py, under one setting of numpy's, OpenBLAS's and numba's
+CPU dispatch: load a table, derive its kernel arrays and draw, and save everything to an .npz file.
+
+    python _dispatch_child.py TABLE.h5 INPUT.npz OUTPUT.npz
+
+INPUT holds V, n, a (incident states) and u (uniforms); OUTPUT the derived arrays (``array_<name>``),
+the mix CDFs, rebound_many's draws for both interpolations, sample_global's and sample_local's draws for
+a fixed seed, and which code paths this process took (``paths``: numpy's enabled dispatch targets,
+OpenBLAS's core type, numba's target CPU).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+import _python_side as py
+
+KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
+                 "restitution_pieces")
+WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
+
+
+def code_paths() -> dict:
+    """The SIMD code paths this process runs: numpy's dispatch targets in use, OpenBLAS's core, numba's CPU."""
+    import numba
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    except ImportError:      # numpy 1.x
+        from numpy.core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    from threadpoolctl import threadpool_info
+    blas = [i.get("architecture") for i in threadpool_info() if i.get("internal_api") == "openblas"]
+    return {"numpy": [f for f in __cpu_dispatch__ if __cpu_features__.get(f)], "openblas": blas,
+            "numba": numba.config.CPU_NAME or "host"}
+
+
+def main(table_path: str, input_path: str, output_path: str) -> None:
+    table = py.load(table_path)
+    data = table.kernel_data
+    given = np.load(input_path)
+    V, n, a, u = given["V"], given["n"], given["a"], given["u"]
+    out = {f"array_{name}": np.asarray(getattr(data, name)) for name in KERNEL_ARRAYS}
+    out["cdf_mix"], out["cdf_weighted"] = py.mix_cdf(table, "mix"), py.mix_cdf(table, WEIGHTS)
+    for label, scaled in (("scaled", True), ("stochastic", False)):
+        V_out, W_out, status = np.empty_like(V), np.empty_like(V), np.empty(len(V), dtype=np.int8)
+        py.rebound_many(data, out["cdf_weighted"], V, n, a, u, V_out, W_out, status, scaled)
+        out[f"many_{label}"] = np.column_stack([V_out, W_out, status])
+    valid = status != py.STATUS_INVALID        # sample_global refuses invalid particles
+    V_g, W_g, status_g = py.surrogate.sample_global(table, V[valid], n[valid], a[valid], shape=WEIGHTS,
+                                                    random_state=5, clamp=True)
+    out["global"] = np.column_stack([V_g, W_g, status_g])
+    local = py.surrogate.sample_local(table, np.full(5000, 45.0), np.linspace(60.0, 240.0, 5000), "mix",
+                                      random_state=6)
+    out["local"] = np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega, local.status])
+    out["paths"] = np.array(json.dumps(code_paths()))
+    np.savez(output_path, **out)
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:4])

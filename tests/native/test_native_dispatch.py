@@ -1,0 +1,118 @@
+"""The same bits whichever SIMD kernels numpy, OpenBLAS and numba pick on this CPU.
+
+numpy and OpenBLAS choose their kernels when they load (AVX-512, AVX2 or baseline SSE), and a sum or a
+product can come out in another order, so in other last bits, on another CPU. The runtime must not
+depend on that: every array the kernels derive from a table, every mix and every draw must be the
+same on an AVX-512 and an AVX2 machine, and equal to the C library's. Each case below runs
+_dispatch_child.py in a subprocess with numpy's dispatch targets, OpenBLAS's core type and numba's
+target CPU forced down to another level, checks that the process really took other code paths, and
+compares its output bit for bit with the C library's and with the default process's.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from _native import SCALED, STOCHASTIC, environment_without_preload
+from _states import incident_states, max_ulp, uniforms
+
+HERE = Path(__file__).resolve().parent
+STATES = 20_000
+WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
+CASES = ("default", "no AVX-512", "baseline")
+
+
+def _dispatched_targets(avx512_only: bool) -> list:
+    """numpy's dispatch targets that this CPU has (those NPY_DISABLE_CPU_FEATURES may switch off)."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    except ImportError:      # numpy 1.x
+        from numpy.core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    have = [f for f in __cpu_dispatch__ if __cpu_features__.get(f)]
+    return [f for f in have if "512" in f or f == "X86_V4"] if avx512_only else have
+
+
+def _environment(case: str) -> dict:
+    env = environment_without_preload()
+    env.pop("NPY_DISABLE_CPU_FEATURES", None)
+    if case == "no AVX-512":
+        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(_dispatched_targets(avx512_only=True))
+        env["OPENBLAS_CORETYPE"] = "Haswell"
+    elif case == "baseline":
+        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(_dispatched_targets(avx512_only=False))
+        env["OPENBLAS_CORETYPE"] = "Prescott"
+        env["NUMBA_CPU_NAME"] = "generic"      # no FMA, AVX or AVX-512 instructions in the kernels
+    return env
+
+
+@pytest.fixture(scope="module")
+def dispatch_runs(small_table_path, tmp_path_factory):
+    """{case: the child's output} for the three cases, on one set of incident states and uniforms."""
+    folder = tmp_path_factory.mktemp("dispatch")
+    rng = np.random.default_rng(2024)
+    V, n, a = incident_states(rng, STATES, (0.0, 90.0), (10.0, 375.0))
+    given = folder / "input.npz"
+    np.savez(given, V=V, n=n, a=a, u=uniforms(rng, STATES))
+    runs = {}
+    for case in CASES:
+        output = folder / f"{case.replace(' ', '_')}.npz"
+        done = subprocess.run([sys.executable, str(HERE / "_dispatch_child.py"), str(small_table_path), str(given),
+                               str(output)], env=_environment(case), capture_output=True, text=True, timeout=900)
+        assert done.returncode == 0, f"{case}: {done.stderr[-3000:]}"
+        with np.load(output) as saved:
+            runs[case] = {k: saved[k] for k in saved.files}
+        runs[case]["paths"] = json.loads(str(runs[case]["paths"]))
+    return np.load(given), runs
+
+
+def test_cases_take_other_code_paths(dispatch_runs):
+    """Without this, the comparisons below would prove nothing: each forced case runs other kernels."""
+    _, runs = dispatch_runs
+    paths = {case: runs[case]["paths"] for case in CASES}
+    print(f"\ncode paths: {paths}")
+    assert paths["baseline"]["numpy"] == [], paths
+    assert paths["baseline"]["numba"] == "generic"
+    assert paths["no AVX-512"]["openblas"] != paths["baseline"]["openblas"], paths
+    assert paths["default"] != paths["baseline"]
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_derived_arrays_equal_the_c_library(dispatch_runs, table_pair, case):
+    _, runs = dispatch_runs
+    _, native_table = table_pair
+    for name in ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
+                 "restitution_pieces"):
+        got, expected = runs[case][f"array_{name}"], native_table.kernel_array(name)
+        assert got.dtype == expected.dtype and got.shape == expected.shape, (case, name)
+        assert np.array_equal(got.view(np.uint8), expected.view(np.uint8)), f"{case}: {name} differs from C"
+    mix, weighted = native_table.mix_equal(), native_table.mix_from_weights(WEIGHTS)[1]
+    assert runs[case]["cdf_mix"].tolist() == list(mix.cdf)[:mix.n_shapes], case
+    assert runs[case]["cdf_weighted"].tolist() == list(weighted.cdf)[:weighted.n_shapes], case
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_draws_equal_the_c_library(dispatch_runs, table_pair, case):
+    """rebound_many's draws under each case equal rbs_rebound_many's for the same uniforms, 0 ulp."""
+    given, runs = dispatch_runs
+    _, native_table = table_pair
+    code, mix, message = native_table.mix_from_weights(WEIGHTS)
+    assert code == 0, message
+    for label, interpolation in (("scaled", SCALED), ("stochastic", STOCHASTIC)):
+        status, V_c, W_c = native_table.rebound_many(mix, given["V"], given["n"], given["a"], given["u"], interpolation)
+        got = runs[case][f"many_{label}"]
+        assert np.array_equal(got[:, 6].astype(np.int8), status), (case, label)
+        assert max_ulp(got[:, :3], V_c) == 0 and max_ulp(got[:, 3:6], W_c) == 0, (case, label)
+
+
+@pytest.mark.parametrize("case", CASES[1:])
+def test_seeded_draws_equal_the_default_process(dispatch_runs, case):
+    """sample_global and sample_local with a fixed seed: the same bits under every case."""
+    _, runs = dispatch_runs
+    for name in ("global", "local"):
+        assert max_ulp(runs[case][name], runs["default"][name]) == 0, (case, name)
