@@ -21,9 +21,11 @@ velocity and spin hold the state at the last collision and are not a rebound.
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import h5py
+import numba
 import numpy as np
 
 from data_schema.common import DataFormatError, check_file, write_header
@@ -65,6 +67,48 @@ OPTIONAL_DATASETS = {
     "failure_reason": ("int8", "0 none, 1 collision solver, 2 search budget, 3 not approaching"),
 }
 REQUIRED_ATTRS = ("alpha1_deg", "speed_m_s", "shape", "seed", "producer")
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _angles(velocity, alpha2, beta2, norm):
+    for i in range(velocity.shape[0]):
+        u, v, w = velocity[i, 0], velocity[i, 1], velocity[i, 2]
+        norm[i] = math.sqrt(u * u + v * v + w * w)
+        alpha2[i] = math.atan2(v, u)
+        sine = w / norm[i]
+        beta2[i] = math.asin(1.0 if sine > 1.0 else -1.0 if sine < -1.0 else sine)
+
+
+def rebound_angles(velocity: np.ndarray) -> tuple:
+    """(α2, β2, |V⁺|) of reflected velocities (n, 3) in the lab frame: radians, radians, the velocity's units.
+
+    One particle at a time with the C library's atan2 and asin (numba calls them), not numpy's array
+    functions, whose SIMD kernels round differently on AVX2 and AVX-512 CPUs: the tables built from these
+    angles are then the same on any x86-64 CPU.
+    """
+    velocity = np.ascontiguousarray(velocity, dtype=np.float64).reshape(-1, 3)
+    alpha2, beta2, norm = (np.empty(len(velocity)) for _ in range(3))
+    _angles(velocity, alpha2, beta2, norm)
+    return alpha2, beta2, norm
+
+
+@numba.njit(cache=True, nogil=True)
+def _velocities(alpha2, beta2, speed, velocity):
+    for i in range(alpha2.shape[0]):
+        cb = math.cos(beta2[i])
+        velocity[i, 0] = speed[i] * (cb * math.cos(alpha2[i]))
+        velocity[i, 1] = speed[i] * (cb * math.sin(alpha2[i]))
+        velocity[i, 2] = speed[i] * math.sin(beta2[i])
+
+
+def angles_to_velocity(alpha2, beta2, speed) -> np.ndarray:
+    """The reflected velocities (n, 3) with angles α2, β2 (radians) and magnitudes ``speed``, lab frame: the
+    inverse of :func:`rebound_angles`, one particle at a time with the C library's cos and sin."""
+    alpha2, beta2, speed = (np.ascontiguousarray(x, dtype=np.float64).ravel()
+                            for x in np.broadcast_arrays(alpha2, beta2, speed))
+    velocity = np.empty((len(alpha2), 3))
+    _velocities(alpha2, beta2, speed, velocity)
+    return velocity
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -122,18 +166,17 @@ class SampleSet:
     @property
     def speed_ratio(self) -> np.ndarray:
         """s = |V⁺|/|V⁻|."""
-        return np.linalg.norm(self.velocity, axis=1) / self.speed
+        return rebound_angles(self.velocity)[2] / self.speed
 
     @property
     def alpha2(self) -> np.ndarray:
         """In-plane rebound angle α2 = atan2(v⁺, u⁺) ∈ [0, π], radians from +X."""
-        return np.arctan2(self.velocity[:, 1], self.velocity[:, 0])
+        return rebound_angles(self.velocity)[0]
 
     @property
     def beta2(self) -> np.ndarray:
         """Out-of-plane rebound angle β2 = asin(w⁺/|V⁺|) ∈ [−π/2, π/2], radians."""
-        norm = np.linalg.norm(self.velocity, axis=1)
-        return np.arcsin(np.clip(self.velocity[:, 2] / norm, -1.0, 1.0))
+        return rebound_angles(self.velocity)[1]
 
     @property
     def e_trans_ratio(self) -> np.ndarray:

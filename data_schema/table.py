@@ -2,7 +2,7 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (3, 1),
+    /                      attrs: file_type = "rebound_table", format_version = (3, 2),
                            created (ISO 8601 UTC), package_version, model_sha256, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
@@ -52,7 +52,7 @@ from data_schema.common import DataFormatError, check_file, write_header
 from data_schema.output import hdf5_bytes, write_output
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (3, 1)
+TABLE_VERSION = (3, 2)
 
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
 FEW_COLLISIONS = 2                  # regime 0 of a cluster: rebounds of at most this many collisions

@@ -17,7 +17,7 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.common import DataFormatError
 from data_schema.output import check_memory, check_output, kind_of
 from data_schema.samples import (
-    SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_NAMES, SampleSet, read_samples, write_samples,
+    SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_NAMES, SampleSet, angles_to_velocity, read_samples, write_samples,
 )
 from data_schema.table import TABLE_FILE_TYPE
 
@@ -48,9 +48,7 @@ def _sample(args) -> int:
     draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), args.speed, shape,
                                    random_state=args.seed, clamp=args.clamp)
     speed = args.speed
-    cb = np.cos(draws.beta2)
-    velocity = speed * draws.speed_ratio[:, None] * np.column_stack(
-        [cb * np.cos(draws.alpha2), cb * np.sin(draws.alpha2), np.sin(draws.beta2)])
+    velocity = angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio)
     samples = SampleSet(velocity=velocity, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
                         status=draws.status, alpha1=args.alpha1, speed=speed, shape=label, seed=args.seed,
                         producer="surrogate sample",

@@ -48,22 +48,23 @@ class CheckpointError(ValueError):
 
 
 SCHEDULER_TIMEOUT_S = 10       # how long to try to reach a Dask scheduler before giving up
-PACKAGE = Path(__file__).resolve().parents[1]       # tablegen/
+SOURCE_ROOT = Path(__file__).resolve().parents[2]       # the folder holding tablegen/ and data_schema/
 # the source that decides a cell's content (not this driver): hashed into checkpoints and tables
-MODEL_SOURCES = ("model/*.py", "build/resolution.py", "build/tabulate.py", "build/cells.py")
+MODEL_SOURCES = ("tablegen/model/*.py", "tablegen/build/resolution.py", "tablegen/build/tabulate.py",
+                 "tablegen/build/cells.py", "data_schema/samples.py")
 
 
 def model_files() -> list:
-    """The files of :data:`MODEL_SOURCES`, sorted by their path under ``tablegen/``."""
-    return sorted({path for pattern in MODEL_SOURCES for path in PACKAGE.glob(pattern)},
-                  key=lambda path: path.relative_to(PACKAGE).as_posix())
+    """The files of :data:`MODEL_SOURCES`, sorted by their path under :data:`SOURCE_ROOT`."""
+    return sorted({path for pattern in MODEL_SOURCES for path in SOURCE_ROOT.glob(pattern)},
+                  key=lambda path: path.relative_to(SOURCE_ROOT).as_posix())
 
 
 def model_sha256() -> str:
     """SHA-256 of the source of :data:`MODEL_SOURCES`: identifies the model that computed a cell."""
     digest = hashlib.sha256()
     for path in model_files():
-        digest.update(path.relative_to(PACKAGE).as_posix().encode() + b"\0")
+        digest.update(path.relative_to(SOURCE_ROOT).as_posix().encode() + b"\0")
         digest.update(path.read_bytes())
     return digest.hexdigest()
 

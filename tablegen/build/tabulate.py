@@ -24,11 +24,12 @@ of a symmetric law.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from sklearn.cluster import KMeans, MiniBatchKMeans
 from threadpoolctl import threadpool_limits
 
-from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet
+from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet, rebound_angles
 from data_schema.table import (
     CHAIN_TO_STATE, FEW_COLLISIONS, INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_CHAIN, N_COLLISION_CLASSES,
     N_SLOPES,
@@ -44,13 +45,27 @@ KMEANS_EPOCHS = 5             # random centres and a few epochs suffice (docs/de
 SPREAD_TOL = 1e-9             # relative to the variable's scale: below it a cluster has no shape
 
 
-def folded_state(samples: SampleSet) -> np.ndarray:
-    """(α2, |β2|, s, Ω_x, Ω_y, Ω_z) of the rebounded particles, Ω_x and Ω_y times sign β2."""
+def rebound_states(samples: SampleSet) -> np.ndarray:
+    """(α2, β2, s, Ω_x, Ω_y, Ω_z) of the rebounded particles (radians, |V⁺|/|V⁻|, Ω⁺a/|V⁻|), lab frame."""
     ok = samples.rebounded
-    beta2 = samples.beta2[ok]
-    sign = np.where(beta2 < 0.0, -1.0, 1.0)
-    return np.column_stack([samples.alpha2[ok], np.abs(beta2), samples.speed_ratio[ok],
-                            samples.omega[ok, 0] * sign, samples.omega[ok, 1] * sign, samples.omega[ok, 2]])
+    alpha2, beta2, norm = rebound_angles(samples.velocity[ok])
+    return np.column_stack([alpha2, beta2, norm / samples.speed, samples.omega[ok]])
+
+
+def folded_state(state: np.ndarray) -> np.ndarray:
+    """:func:`rebound_states` with β2 → |β2| and Ω_x, Ω_y times sign β2."""
+    sign = np.where(state[:, 1] < 0.0, -1.0, 1.0)
+    return np.column_stack([state[:, 0], np.abs(state[:, 1]), state[:, 2], state[:, 3] * sign, state[:, 4] * sign,
+                            state[:, 5]])
+
+
+@numba.njit(cache=True, nogil=True)
+def _add_moments(state, sums, squares):
+    """Running sums of each column and of its squares, row by row (an order no SIMD kernel choice changes)."""
+    for i in range(state.shape[0]):
+        for k in range(state.shape[1]):
+            sums[k] += state[i, k]
+            squares[k] += state[i, k] * state[i, k]
 
 
 def collision_regime(samples: SampleSet) -> np.ndarray:
@@ -84,15 +99,14 @@ class CellAccumulator:
         self.status_counts += np.bincount(samples.status, minlength=len(STATUS_NAMES))[:len(STATUS_NAMES)]
         ncoll = np.minimum(samples.n_collisions[ok], N_COLLISION_CLASSES)
         self.collision_counts += np.bincount(ncoll - 1, minlength=N_COLLISION_CLASSES)
-        state = np.column_stack([samples.alpha2[ok], samples.beta2[ok], samples.speed_ratio[ok], samples.omega[ok]])
-        self.sums += state.sum(axis=0)
-        self.squares += (state ** 2).sum(axis=0)
+        state = rebound_states(samples)
+        _add_moments(state, self.sums, self.squares)
         self.hist2 += np.histogram(state[:, 0], bins=INDICATRIX_ALPHA2_EDGES)[0]
         self.hist3 += np.histogram2d(state[:, 0], state[:, 1],
                                      bins=[INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES])[0]
         keep = min(self.max_states - self.n_states, int(ok.sum()))
         if keep > 0:
-            self.states.append(folded_state(samples)[:keep])
+            self.states.append(folded_state(state[:keep]))
             self.regimes.append(collision_regime(samples)[:keep])
             self.n_states += keep
 

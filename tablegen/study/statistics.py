@@ -19,7 +19,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from data_schema.samples import FAILURE_NAMES, STATUS_FAILED, STATUS_NAMES, STATUS_TRAPPED, SampleSet
+from data_schema.samples import (
+    FAILURE_NAMES, STATUS_FAILED, STATUS_NAMES, STATUS_TRAPPED, SampleSet, angles_to_velocity,
+)
 
 COLLISION_CLASSES = ("1", "2", "3", "4", "5", ">5")
 NORMAL_IMPACT = 90.0                                   # deg
@@ -68,9 +70,7 @@ class PointSamples:
 
 def lab_velocity(alpha2, beta2, speed_ratio) -> np.ndarray:
     """(m, 3) V⁺/|V⁻| = s (cos β2 cos α2, cos β2 sin α2, sin β2), lab frame; angles in rad."""
-    cb = np.cos(beta2)
-    return np.asarray(speed_ratio)[:, None] * np.column_stack([cb * np.cos(alpha2), cb * np.sin(alpha2),
-                                                               np.sin(beta2)])
+    return angles_to_velocity(alpha2, beta2, speed_ratio)
 
 
 def derived(p: PointSamples) -> dict:

@@ -5,13 +5,11 @@ CPU dispatch: load a table, derive its kernel arrays and draw, and save everythi
 
 INPUT holds V, n, a (incident states) and u (uniforms); OUTPUT the derived arrays (``array_<name>``),
 the mix CDFs, rebound_many's draws for both interpolations, sample_global's and sample_local's draws for
-a fixed seed, and which code paths this process took (``paths``: numpy's enabled dispatch targets,
-OpenBLAS's core type, numba's target CPU).
+a fixed seed (the latter also as the velocities `surrogate sample` writes).
 """
 
 from __future__ import annotations
 
-import json
 import sys
 
 import numpy as np
@@ -21,19 +19,6 @@ import _python_side as py
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
                  "restitution_pieces")
 WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
-
-
-def code_paths() -> dict:
-    """The SIMD code paths this process runs: numpy's dispatch targets in use, OpenBLAS's core, numba's CPU."""
-    import numba
-    try:
-        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-    except ImportError:      # numpy 1.x
-        from numpy.core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-    from threadpoolctl import threadpool_info
-    blas = [i.get("architecture") for i in threadpool_info() if i.get("internal_api") == "openblas"]
-    return {"numpy": [f for f in __cpu_dispatch__ if __cpu_features__.get(f)], "openblas": blas,
-            "numba": numba.config.CPU_NAME or "host"}
 
 
 def main(table_path: str, input_path: str, output_path: str) -> None:
@@ -53,8 +38,8 @@ def main(table_path: str, input_path: str, output_path: str) -> None:
     out["global"] = np.column_stack([V_g, W_g, status_g])
     local = py.surrogate.sample_local(table, np.full(5000, 45.0), np.linspace(60.0, 240.0, 5000), "mix",
                                       random_state=6)
-    out["local"] = np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega, local.status])
-    out["paths"] = np.array(json.dumps(code_paths()))
+    velocity = py.angles_to_velocity(local.alpha2, local.beta2, 120.0 * local.speed_ratio)   # surrogate sample's
+    out["local"] = np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega, local.status, velocity])
     np.savez(output_path, **out)
 
 

@@ -6,10 +6,11 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
 ``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
 ``draw_local``; tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
-file checks from ``data_schema``.
+file checks and the samples' angle conversion from ``data_schema``.
 """
 
 import surrogate
+from data_schema.samples import angles_to_velocity
 from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, load, mix_cdf, \
     seed_state
 from surrogate.kernels import draw_local, rebound, rebound_many, rebound_many_rng, rebound_tuple, rebound_uniforms
@@ -37,6 +38,6 @@ def write_samples_file(path) -> None:
                                   alpha1=45.0, speed=100.0, shape="prism", seed=1, producer="tests/native"))
 
 
-__all__ = ["STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
+__all__ = ["angles_to_velocity", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
            "draw_local", "fill_uniforms", "load", "mix_cdf", "rebound", "rebound_many", "rebound_many_rng",
            "rebound_tuple", "rebound_uniforms", "seed_state", "surrogate", "write_samples_file"]

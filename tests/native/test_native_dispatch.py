@@ -5,13 +5,13 @@ product can come out in another order, so in other last bits, on another CPU. Th
 depend on that: every array the kernels derive from a table, every mix and every draw must be the
 same on an AVX-512 and an AVX2 machine, and equal to the C library's. Each case below runs
 _dispatch_child.py in a subprocess with numpy's dispatch targets, OpenBLAS's core type and numba's
-target CPU forced down to another level, checks that the process really took other code paths, and
-compares its output bit for bit with the C library's and with the default process's.
+target CPU forced down to another level (tests/cpu_dispatch.py), checks that the process really took
+other code paths, and compares its output bit for bit with the C library's and with the default
+process's.
 """
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
 from pathlib import Path
@@ -19,36 +19,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from _native import SCALED, STOCHASTIC, environment_without_preload
+from _native import SCALED, STOCHASTIC
 from _states import incident_states, max_ulp, uniforms
+from cpu_dispatch import CASES, code_paths, environment
 
 HERE = Path(__file__).resolve().parent
 STATES = 20_000
 WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
-CASES = ("default", "no AVX-512", "baseline")
-
-
-def _dispatched_targets(avx512_only: bool) -> list:
-    """numpy's dispatch targets that this CPU has (those NPY_DISABLE_CPU_FEATURES may switch off)."""
-    try:
-        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-    except ImportError:      # numpy 1.x
-        from numpy.core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-    have = [f for f in __cpu_dispatch__ if __cpu_features__.get(f)]
-    return [f for f in have if "512" in f or f == "X86_V4"] if avx512_only else have
-
-
-def _environment(case: str) -> dict:
-    env = environment_without_preload()
-    env.pop("NPY_DISABLE_CPU_FEATURES", None)
-    if case == "no AVX-512":
-        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(_dispatched_targets(avx512_only=True))
-        env["OPENBLAS_CORETYPE"] = "Haswell"
-    elif case == "baseline":
-        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(_dispatched_targets(avx512_only=False))
-        env["OPENBLAS_CORETYPE"] = "Prescott"
-        env["NUMBA_CPU_NAME"] = "generic"      # no FMA, AVX or AVX-512 instructions in the kernels
-    return env
 
 
 @pytest.fixture(scope="module")
@@ -63,11 +40,11 @@ def dispatch_runs(small_table_path, tmp_path_factory):
     for case in CASES:
         output = folder / f"{case.replace(' ', '_')}.npz"
         done = subprocess.run([sys.executable, str(HERE / "_dispatch_child.py"), str(small_table_path), str(given),
-                               str(output)], env=_environment(case), capture_output=True, text=True, timeout=900)
+                               str(output)], env=environment(case), capture_output=True, text=True, timeout=900)
         assert done.returncode == 0, f"{case}: {done.stderr[-3000:]}"
         with np.load(output) as saved:
             runs[case] = {k: saved[k] for k in saved.files}
-        runs[case]["paths"] = json.loads(str(runs[case]["paths"]))
+        runs[case]["paths"] = code_paths(environment(case))
     return np.load(given), runs
 
 

@@ -1,0 +1,50 @@
+"""A table built from a seed has the same bits whichever SIMD kernels numpy picks.
+
+The session's small table (built in this process, numpy's default kernels for this CPU) is built
+again by ``tablegen build`` in a subprocess with numpy's dispatch targets switched off
+(tests/cpu_dispatch.py): every dataset of the two files must be equal byte for byte. OpenBLAS keeps
+its kernels: scikit-learn's k-means computes distances through it, and its partition still depends on
+them (docs/format.md, table minor version 3.2). numba keeps the host CPU here (a generic-CPU compile of
+the direct model would take minutes); tests/native/test_native_dispatch.py covers numba's kernels on
+a generic CPU.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+from conftest import SMALL_TABLE_CONFIG
+from cpu_dispatch import code_paths, environment
+
+
+def _datasets(path) -> dict:
+    found = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, node: found.__setitem__(name, node[()]) if isinstance(node, h5py.Dataset) else None)
+    return found
+
+
+def _bytes(values) -> bytes:
+    values = np.asarray(values)
+    return repr(values.tolist()).encode() if values.dtype.kind in "OSU" else np.ascontiguousarray(values).tobytes()
+
+
+def test_table_bits_do_not_depend_on_numpy_kernels(small_table_path, tmp_path):
+    env = environment("baseline", generic_numba=False)
+    env.pop("OPENBLAS_CORETYPE")
+    paths, default = code_paths(env), code_paths(environment("default"))
+    assert paths["numpy"] == [] and default["numpy"] != [], (paths, default)
+    config = tmp_path / "small.toml"
+    config.write_text(SMALL_TABLE_CONFIG)
+    rebuilt = tmp_path / "rebuilt.h5"
+    done = subprocess.run([sys.executable, "-m", "tablegen.cli", "build", "--config", str(config), "-o", str(rebuilt)],
+                          env=env, capture_output=True, text=True, timeout=1200)
+    assert done.returncode == 0, done.stderr[-3000:]
+    expected, got = _datasets(small_table_path), _datasets(rebuilt)
+    assert sorted(got) == sorted(expected)
+    differ = [name for name in expected if _bytes(got[name]) != _bytes(expected[name])]
+    assert differ == [], f"datasets that differ with numpy's baseline kernels: {differ}"
