@@ -3,7 +3,7 @@
 Subpackages, one per job:
 
 * :mod:`tablegen.model` — the direct model (shapes, wall law, collision, rotation, flight, :func:`simulate`);
-* :mod:`tablegen.build` — the table build (configuration, presets, cells, tabulation, :func:`build_table`);
+* :mod:`tablegen.tabulation` — the table build (configuration, presets, cells, tabulation, :func:`build_table`);
 * :mod:`tablegen.study` — statistics, the paper's study (``tablegen report``) and the validation matrix.
 
 The public API is importable from here::
@@ -21,11 +21,11 @@ _API = {
     "AspectRatioLaw": "tablegen.model.shapes",
     "WallMaterial": "tablegen.model.wall",
     "CORUNDUM_ON_STEEL": "tablegen.model.wall",
-    "BuildConfig": "tablegen.build.config",
-    "ConfigError": "tablegen.build.config",
-    "load_config": "tablegen.build.config",
-    "parse_config": "tablegen.build.config",
-    "build_table": "tablegen.build.driver",
+    "BuildConfig": "tablegen.tabulation.config",
+    "ConfigError": "tablegen.tabulation.config",
+    "load_config": "tablegen.tabulation.config",
+    "parse_config": "tablegen.tabulation.config",
+    "build_table": "tablegen.tabulation.driver",
     "summarize": "tablegen.study.statistics",
 }
 __all__ = sorted(_API)

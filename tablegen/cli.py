@@ -16,7 +16,7 @@ from pathlib import Path
 from data_schema.command_line import CommandParser, count_argument, run, seed_argument
 from data_schema.output import check_memory, check_output
 from data_schema.samples import SAMPLES_FILE_TYPE, write_samples
-from tablegen.build.config import PRESETS
+from tablegen.tabulation.config import PRESETS
 from tablegen.model.shapes import DEFAULT_KAPPA, MIX, SHAPES
 from tablegen.model.simulate import DEFAULT_N_MAX
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
@@ -149,8 +149,8 @@ def _wall(args) -> WallMaterial:
 
 
 def _build(args) -> int:
-    from tablegen.build.driver import BuildError, build_table
-    from tablegen.build.config import load_config
+    from tablegen.tabulation.driver import BuildError, build_table
+    from tablegen.tabulation.config import load_config
 
     config = load_config(args.config, args.preset)
     if args.print_config:
@@ -182,7 +182,7 @@ def _build_interrupted(args) -> str | None:
 
 def _info(args) -> int:
     from data_schema.table import read_table
-    from tablegen.build.info import describe_table
+    from tablegen.tabulation.info import describe_table
 
     print(describe_table(read_table(args.table), Path(args.table)))
     return 0

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from data_schema import samples, table
-from tablegen.build.config import CONFIG_KEYS
+from tablegen.tabulation.config import CONFIG_KEYS
 
 FORMAT_DOC = (Path(__file__).resolve().parents[1] / "docs" / "format.md").read_text()
 NAMES = ([samples.SAMPLES_FILE_TYPE, "file_type", "format_version", "samples"]

@@ -13,8 +13,8 @@ import pytest
 from data_schema.common import DataFormatError
 from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table
 from data_schema.output import OutputError
-from tablegen.build.driver import BuildError, Checkpoint, CheckpointError, build_table
-from tablegen.build.config import parse_config
+from tablegen.tabulation.driver import BuildError, Checkpoint, CheckpointError, build_table
+from tablegen.tabulation.config import parse_config
 from tablegen.model.wall import CORUNDUM_ON_STEEL
 
 TINY = """

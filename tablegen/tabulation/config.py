@@ -40,7 +40,7 @@ import tomllib
 from importlib import resources
 
 from data_schema.table import TableResolution
-from tablegen.build.resolution import MIN_PARTICLES_PER_CELL, resolution_for
+from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from tablegen.model.shapes import SHAPES, AspectRatioLaw, check_kappa
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
@@ -122,7 +122,7 @@ def preset_text(name: str) -> str:
     """The TOML text of an embedded preset."""
     if name not in PRESETS:
         raise ConfigError(f"unknown preset {name!r}; presets: {', '.join(PRESETS)}")
-    return resources.files("tablegen.build.presets").joinpath(f"{name}.toml").read_text()
+    return resources.files("tablegen.tabulation.presets").joinpath(f"{name}.toml").read_text()
 
 
 def load_config(path=None, preset: str = "default") -> BuildConfig:
