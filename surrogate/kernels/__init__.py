@@ -14,7 +14,7 @@ xoshiro256+ state. Where each part lives:
 ``rng``         xoshiro256+ streams: :func:`seed_state`, :func:`fill_uniforms`, the SIMD lanes
 ``fastmath``    fused multiply-add, trigonometry, the restitution factor: no libm call on the hot path
 ``memory``      loads and cache hints
-``checks``      the input checks of the NumPy API in one parallel pass
+``checks``      input checks: the NumPy API's in one parallel pass, the array shapes of the many-particle kernels
 ``options``     the numba options every kernel is compiled with
 ==============  ==============================================================
 
@@ -26,7 +26,8 @@ bits for the same uniforms.
 """
 
 from surrogate.kernels.draw import U_PER_DRAW, arithmetic, draw_local, draw_velocity, gather, grid_interval, locate
-from surrogate.kernels.frame import STATUS_INVALID, impact_frame
+from data_schema.samples import STATUS_INVALID
+from surrogate.kernels.frame import impact_frame
 from surrogate.kernels.layout import KernelData
 from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel_rng, rebound_parallel,
                                         rebound_parallel_rng)

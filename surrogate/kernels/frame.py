@@ -17,7 +17,6 @@ from surrogate.kernels.fastmath import atan2_first_quadrant, fma, sincos
 from surrogate.kernels.options import JIT
 
 
-STATUS_INVALID = -1     # the status of an incident state that does not move into the wall
 NORMAL_IMPACT = 1e-12   # a tangential speed below this fraction of |V| is normal impact: ex drawn in the wall plane
 
 

@@ -9,7 +9,8 @@ to the global frame. V⁻ in m/s in, V⁺ in m/s and Ω⁺ in rad/s out.
 import numba
 
 from surrogate.kernels.draw import draw_in_cell, hint, locate
-from surrogate.kernels.frame import NAN3, STATUS_INVALID, impact_frame, moves_into_wall, to_global
+from data_schema.samples import STATUS_INVALID
+from surrogate.kernels.frame import NAN3, impact_frame, moves_into_wall, to_global
 from surrogate.kernels.options import JIT, KERNEL
 
 

@@ -19,15 +19,17 @@ before it are computed:
 
 The block scratch arrays are field-major (field f of particle b at
 f · BLOCK + b): a compile-time stride, which the SIMD loops need. Input
-shapes are checked before any work (ValueError naming the array).
+shapes are checked before any work (:mod:`surrogate.kernels.checks`).
 """
 
 import numba
 import numpy as np
 
+from surrogate.kernels.checks import check_rows, check_state, check_uniforms
 from surrogate.kernels.draw import (U_PER_DRAW, arithmetic, component, first_row, gather_cell, gather_component,
                                     hint_levels, hint_row, locate)
-from surrogate.kernels.frame import STATUS_INVALID, impact_frame, moves_into_wall, to_global
+from data_schema.samples import STATUS_INVALID
+from surrogate.kernels.frame import impact_frame, moves_into_wall, to_global
 from surrogate.kernels.memory import load, load3, load6, load15
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import fill_lanes, seed_lanes
@@ -109,8 +111,7 @@ def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, status, sc
     (a block's uniforms are drawn when it enters the pipeline). Seeding the
     lanes costs about 0.1 µs per call, so call it on many rows at once.
     """
-    if state.shape[0] != 4:
-        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.seed_state gives")
+    check_state(state)
     check_rows(V, n, a, V_out, Omega_out, status)
     run_blocks(data, mix_cdf, V, n, a, no_uniforms(), state, V_out, Omega_out, status, scaled)
 
@@ -134,36 +135,6 @@ def rebound_uniforms(state, n_rows):
 def _lanes():
     """The BLOCK xoshiro256+ lanes of :func:`rebound_many_rng` (:func:`surrogate.kernels.rng.seed_lanes` layout)."""
     return np.zeros(4 * BLOCK, dtype=np.uint64)
-
-
-@numba.njit(**JIT)
-def check_rows(V, n, a, V_out, Omega_out, status):
-    """ValueError naming the first array of a block kernel's call that has not one row per particle, with
-    its shape and the shape needed. Called before the parallel loops: a raise inside one keeps numba from
-    running it in parallel."""
-    rows = V.shape[0]
-    for name, shape in (("V", V.shape), ("n", n.shape), ("V_out", V_out.shape), ("Omega_out", Omega_out.shape)):
-        if shape[0] != rows or shape[1] != 3:
-            raise ValueError(shape_error(name, shape, "(" + str(rows) + ", 3)"))
-    for name, shape in (("a", a.shape), ("status", status.shape)):
-        if shape[0] != rows:
-            raise ValueError(shape_error(name, shape, "(" + str(rows) + ",)"))
-
-
-@numba.njit(**JIT)
-def check_uniforms(u, rows, first):
-    """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW), rows = len(first)."""
-    if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
-        raise ValueError(shape_error("u", u.shape, "(" + str(rows) + ", " + str(U_PER_DRAW) + ")", first))
-
-
-@numba.njit(**JIT)
-def shape_error(name, shape, needed, first="V"):
-    """The message of a shape error of the kernels over many particles: one row per particle, as many as
-    the array ``first`` has."""
-    text = ", ".join([str(x) for x in shape]) + ("," if len(shape) == 1 else "")
-    return ("'" + name + "' has shape (" + text + "); needed " + needed
-            + ": one row per particle, as many as " + first + " has")
 
 
 @numba.njit(inline="always", **JIT)
