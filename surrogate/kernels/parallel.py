@@ -10,8 +10,8 @@ parallel loop (:mod:`surrogate.kernels.checks`).
 
 import numba
 
-from surrogate.kernels.draw import draw_local
 from surrogate.kernels.options import JIT
+from surrogate.kernels.particle import draw_local
 from surrogate.kernels.checks import check_local_rows, check_rows, check_states, check_uniforms
 from surrogate.kernels.pipeline import no_state, no_uniforms, rebound_uniforms, run_blocks
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
