@@ -1,6 +1,6 @@
 /*
- * derive.c: the kernel arrays a table derives from its cell datasets, as surrogate/table.py and
- * surrogate/restitution.py derive them, with the same operations in the same order (so the same bits):
+ * derive.c: the kernel arrays a table derives from its cell datasets, as surrogate.kernels.layout
+ * derives them, with the same operations in the same order (so the same bits):
  *
  *   axis records       surrogate.kernels.layout.axis_record / interval_lookup
  *   component rows     surrogate.kernels.layout.kernel_rows, with Walker's alias tables (alias_table)
