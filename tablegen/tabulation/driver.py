@@ -50,7 +50,7 @@ class CheckpointError(ValueError):
 SCHEDULER_TIMEOUT_S = 10       # how long to try to reach a Dask scheduler before giving up
 PACKAGE = Path(__file__).resolve().parents[1]       # tablegen/
 # the source that decides a cell's content (not this driver): hashed into checkpoints and tables
-MODEL_SOURCES = ("model/*.py", "build/resolution.py", "build/tabulate.py", "build/cells.py")
+MODEL_SOURCES = ("model/*.py", "tabulation/resolution.py", "tabulation/tabulate.py", "tabulation/cells.py")
 
 
 def model_files() -> list:

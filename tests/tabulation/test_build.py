@@ -195,3 +195,15 @@ def test_reader_rejects_version_missing_dataset_and_truncation(tiny_table, tmp_p
     bad.write_bytes(data[: len(data) // 3])
     with pytest.raises(DataFormatError, match="v.h5"):
         read_table(bad)
+
+
+def test_every_model_source_is_hashed():
+    """A pattern of MODEL_SOURCES that matches no file (a folder renamed, say) would leave that source out of
+    model_sha256 unnoticed."""
+    from tablegen.tabulation.driver import MODEL_SOURCES, PACKAGE, model_files
+
+    hashed = set(model_files())
+    for pattern in MODEL_SOURCES:
+        matched = set(PACKAGE.glob(pattern))
+        assert matched and matched <= hashed, pattern
+    assert {"cells.py", "resolution.py", "tabulate.py", "rebound.py"} <= {path.name for path in hashed}
