@@ -63,7 +63,8 @@ def _folded(alpha2, beta2, s, wx, wy, wz):
 
 @numba.njit(inline="always", **JIT)
 def _moved(state, terms):
-    """The folded ``state`` of a draw moved to the incident α1 with the :func:`_alpha1_terms` ``terms``,
+    """The folded ``state`` of a draw moved to the incident α1 with the ``terms`` of
+    :func:`surrogate.kernels.gather._alpha1_terms`,
     variable by variable, like the unit-base interpolation of transport codes, then folded again. The
     centred variables (β2, Ω_x, Ω_y: mean 0 by the mirror symmetry) are only scaled."""
     return _folded(_shifted(state[0], terms[0]), state[1] * terms[1][0], _shifted(state[2], terms[2]),
@@ -91,7 +92,7 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     """A rebound drawn at grid speed V_iv, moved to the incident speed V; returns (vx, vy, vz, wx, wy, wz).
 
     ``f_target``, ``f_grid``: exp(−k V^p) at V and at V_iv
-    (:func:`restitution_factors`). Local frame, V⁺ in units of |V⁻|, Ω⁺ in
+    (:func:`surrogate.kernels.gather.restitution_factors`). Local frame, V⁺ in units of |V⁻|, Ω⁺ in
     units of |V⁻|/a. With a(V) = 1 − (1 − exp(−k V^p)) sin α1, the normal
     restitution of the wall law for a contact point moving like the centre
     of mass:
@@ -121,7 +122,7 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
 
 @numba.njit(inline="always", **JIT)
 def arithmetic(gathered, cos_alpha1, sin_alpha1, scaled):
-    """The reflected state from the values :func:`gather` returns, at cos α1, sin α1:
+    """The reflected state from the values :func:`surrogate.kernels.gather.gather` returns, at cos α1, sin α1:
     (status, V⁺_x, V⁺_y, V⁺_z, Ω_x, Ω_y, Ω_z), local frame, V⁺ in units of |V⁻|, Ω in units of |V⁻|/a;
     NaN and STATUS_TRAPPED when trapped.
 

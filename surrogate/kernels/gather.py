@@ -46,7 +46,7 @@ def _quantiles(data, cell, row, u):
 @numba.njit(inline="always", **JIT)
 def _alpha1_terms(data, below, wa, drawn):
     """What moves a state drawn from cell ``drawn`` to the incident α1: (ratio, m_cell, m), six-tuples in
-    state order, for x' = m + (x − m_cell) · ratio (:func:`_moved`).
+    state order, for x' = m + (x − m_cell) · ratio (:func:`surrogate.kernels.arithmetic._moved`).
 
     m and σ are interpolated linearly in α1 (weight wa of the upper
     neighbour) between cell ``below`` and the next α1 up, at the drawn speed;
@@ -90,7 +90,8 @@ def is_trapped(data, drawn, u3):
 
 @numba.njit(inline="always", **JIT)
 def gather_component(data, drawn, row, u):
-    """What a draw reads from its component (at offset ``row`` in cell number ``drawn``, :func:`component`):
+    """What a draw reads from its component (at offset ``row`` in cell number ``drawn``,
+    :func:`surrogate.kernels.locate.component`):
     (residual quantiles at u[5:11], the 15 slopes, regime, trapped flag (1.0 or 0.0), mirror uniform u[11])."""
     r = data.clusters
     trapped = 1.0 if is_trapped(data, drawn, u[3]) else 0.0
@@ -112,8 +113,8 @@ def gather_cell(data, cell):
 
 @numba.njit(inline="always", **JIT)
 def gather(data, cell, row, u):
-    """Every table value a draw in ``cell`` (:func:`locate`) with component ``row`` needs:
-    :func:`gather_component` + :func:`gather_cell`, the arguments of :func:`arithmetic`."""
+    """Every table value a draw in ``cell`` (:func:`surrogate.kernels.locate.locate`) with component ``row`` needs:
+    :func:`gather_component` + :func:`gather_cell`, the arguments of :func:`surrogate.kernels.arithmetic.arithmetic`."""
     return gather_component(data, cell[0], row, u) + gather_cell(data, cell)
 
 

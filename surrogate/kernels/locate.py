@@ -125,7 +125,8 @@ def hint_levels(data, drawn, u):
 
 @numba.njit(inline="always", **JIT)
 def _hint_level(data, drawn, k, u):
-    """Cache hints for the two residual-shape levels of chain variable k that u picks (:func:`_quantile`)."""
+    """Cache hints for the two residual-shape levels of chain variable k that u picks
+    (:func:`surrogate.kernels.gather._quantile`)."""
     levels = data.n_levels - 1
     level = level_offset(data, drawn, k, min(int(u * levels), levels - 1))
     prefetch(data.dictionary, (level,))

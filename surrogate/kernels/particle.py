@@ -38,7 +38,7 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out, scaled=True):
     move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
     (tangential direction of V), n, ez = ex × n; the local draw is rotated back
     into the global frame. The mirror symmetry of the model is applied with a
-    random sign (:func:`surrogate.kernels.draw.arithmetic`). An α1 or |V⁻| outside the table's
+    random sign (:func:`surrogate.kernels.arithmetic.arithmetic`). An α1 or |V⁻| outside the table's
     grid uses the law at the nearest grid edge (check ``table.alpha1_range``
     and ``table.speed_range`` beforehand if that matters).
     """
