@@ -4,7 +4,7 @@ Every import of the project's packages by integrations/openfoam and
 tests/openfoam goes through this module, so a refactoring of the packages
 re-points these few lines only. Public API only: ``surrogate.load``,
 ``surrogate.sample_global``, ``surrogate.STATUS_*`` and, to build a table,
-``tablegen.tabulation_table(tablegen.parse_config(text), path)``.
+``tablegen.build_table(tablegen.parse_config(text), path)``.
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 (see LICENSE in this folder).

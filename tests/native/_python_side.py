@@ -5,7 +5,7 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``table.kernel_data``, ``surrogate.mix_cdf``, ``surrogate.seed_state``, ``surrogate.fill_uniforms``,
 ``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
 ``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
-``draw_local``; tables come from ``tablegen.tabulation_table`` and ``tablegen.parse_config``;
+``draw_local``; tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks from ``data_schema``.
 """
 
