@@ -30,7 +30,7 @@ import numba
 import numpy as np
 
 from tablegen import build_table, load_config, parse_config
-from tablegen.build.cells import compute_cell
+from tablegen.tabulation.cells import compute_cell
 
 SUBSET_ALPHA1 = (2.0, 30.0, 60.0, 90.0)
 SUBSET_SPEED = (50.0, 175.0, 300.0)

@@ -41,6 +41,17 @@ STATUS_REBOUNDED = 0   # left the wall for good
 STATUS_TRAPPED = 1     # still colliding after n_max collisions (rolling/deposited)
 STATUS_FAILED = 2      # numerical failure (collision solver or contact search)
 STATUS_NAMES = {STATUS_REBOUNDED: "rebounded", STATUS_TRAPPED: "trapped", STATUS_FAILED: "failed"}
+STATUS_INVALID = -1    # runtime sampler only, never in a file: the incident state does not move into the wall
+
+# the physical incidence angle α1 from the wall, deg: (low, high], high = normal impact
+ALPHA1_RANGE_DEG = (0.0, 90.0)
+ALPHA1_RANGE_TEXT = f"({ALPHA1_RANGE_DEG[0]:g}, {ALPHA1_RANGE_DEG[1]:g}]"
+
+
+def alpha1_is_physical(alpha1):
+    """Whether α1 (deg; a number or an array, element by element) is in the physical range ALPHA1_RANGE_DEG."""
+    low, high = ALPHA1_RANGE_DEG
+    return (alpha1 > low) & (alpha1 <= high)
 
 # why a particle has STATUS_FAILED (optional dataset ``failure_reason``; 0 for the others)
 FAILURE_NONE = 0

@@ -21,8 +21,8 @@ SIMD loops, with the per-particle results bit for bit;
 as :func:`sample_global` does. :mod:`surrogate.kernels` maps where each part lives.
 """
 
-from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from surrogate.kernels import STATUS_INVALID, U_PER_DRAW, fill_uniforms, seed_state
+from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from surrogate.kernels import U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 

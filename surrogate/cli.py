@@ -17,7 +17,8 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.common import DataFormatError
 from data_schema.output import check_memory, check_output, kind_of
 from data_schema.samples import (
-    SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_NAMES, SampleSet, angles_to_velocity, read_samples, write_samples,
+    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_NAMES, SampleSet, angles_to_velocity, read_samples,
+    write_samples,
 )
 from data_schema.table import TABLE_FILE_TYPE
 
@@ -107,7 +108,7 @@ def main(argv=None) -> int:
                                         "(n_collisions = -1: tables do not carry it per draw).")
     sample.add_argument("--table", required=True, metavar="TABLE.h5")
     sample.add_argument("--alpha1", type=float, required=True, metavar="DEG",
-                        help="incidence angle from the wall, in the table's range (with --clamp: (0, 90])")
+                        help=f"incidence angle from the wall, in the table's range (with --clamp: {ALPHA1_RANGE_TEXT})")
     sample.add_argument("--speed", type=float, required=True, metavar="M_PER_S",
                         help="incident speed |V-| in m/s, in the table's range (with --clamp: > 0)")
     group = sample.add_mutually_exclusive_group()

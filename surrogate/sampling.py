@@ -9,7 +9,8 @@ Two entry points:
   normals in any global frame in, V⁺ (m/s) and Ω⁺ (rad/s) out.
 
 Both accept a shape name or a mix of shapes, ``random_state`` (int, Generator
-or None) and ``clamp``: by default an incident state outside the table's grid
+or None; not ``seed`` as in :mod:`tablegen`, because a Generator is accepted too, as under that name in
+NumPy's and scikit-learn's APIs) and ``clamp``: by default an incident state outside the table's grid
 is an error; with ``clamp=True`` the dimensionless law at the nearest grid
 edge is used (and scaled by the particle's actual speed).
 Between grid points the law of a neighbouring grid point is drawn with its
@@ -27,7 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from data_schema.samples import SHAPE_NAMES
+from data_schema.samples import ALPHA1_RANGE_DEG, SHAPE_NAMES
 from data_schema.table import STATE_NAMES
 from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE,
                                       FAULT_NORMAL_NOT_FINITE, FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL,
@@ -113,7 +114,7 @@ def _scaled(interpolation: str) -> bool:
 
 
 # physical range of the incident state: (low, high, high included); clamp=True never reaches beyond it
-PHYSICAL_RANGE = {"alpha1": (0.0, 90.0, True), "speed": (0.0, np.inf, False)}
+PHYSICAL_RANGE = {"alpha1": (*ALPHA1_RANGE_DEG, True), "speed": (0.0, np.inf, False)}
 
 
 def _check_range(name, values, bounds, clamp, units) -> None:

@@ -3,15 +3,34 @@
 Subpackages, one per job:
 
 * :mod:`tablegen.model` — the direct model (shapes, wall law, collision, rotation, flight, :func:`simulate`);
-* :mod:`tablegen.build` — the table build (configuration, presets, cells, tabulation, :func:`build_table`);
+* :mod:`tablegen.tabulation` — the table build (configuration, presets, cells, tabulation, :func:`build_table`);
 * :mod:`tablegen.study` — statistics, the paper's study (``tablegen report``) and the validation matrix.
 
 The public API is importable from here::
 
     from tablegen import simulate, build_table, load_config, parse_config, WallMaterial
+
+It needs the ``build`` extra (``pip install "rebound-scatter[build]"``); the
+plain install is the runtime sampler alone (:mod:`surrogate`).
 """
 
 from importlib import import_module
+from importlib.util import find_spec
+
+# the distributions of the build extra (pyproject.toml), by the module each installs
+BUILD_EXTRA = {"scipy": "scipy", "sklearn": "scikit-learn", "threadpoolctl": "threadpoolctl", "tqdm": "tqdm"}
+
+
+def _require_build_extra() -> None:
+    """ImportError naming what to install when a distribution of the build extra is missing."""
+    missing = [name for module, name in BUILD_EXTRA.items() if find_spec(module) is None]
+    if missing:
+        raise ImportError(f"tablegen needs {', '.join(missing)}, which the plain install of rebound-scatter leaves "
+                          f"out (it is the runtime sampler alone); install them with: "
+                          f'pip install "rebound-scatter[build]"')
+
+
+_require_build_extra()
 
 # name: module defining it; imported on first use, so `import tablegen` stays light (no numba, no scikit-learn)
 _API = {
@@ -21,11 +40,11 @@ _API = {
     "AspectRatioLaw": "tablegen.model.shapes",
     "WallMaterial": "tablegen.model.wall",
     "CORUNDUM_ON_STEEL": "tablegen.model.wall",
-    "BuildConfig": "tablegen.build.config",
-    "ConfigError": "tablegen.build.config",
-    "load_config": "tablegen.build.config",
-    "parse_config": "tablegen.build.config",
-    "build_table": "tablegen.build.driver",
+    "BuildConfig": "tablegen.tabulation.config",
+    "ConfigError": "tablegen.tabulation.config",
+    "load_config": "tablegen.tabulation.config",
+    "parse_config": "tablegen.tabulation.config",
+    "build_table": "tablegen.tabulation.driver",
     "summarize": "tablegen.study.statistics",
 }
 __all__ = sorted(_API)

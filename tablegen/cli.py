@@ -15,8 +15,8 @@ from pathlib import Path
 
 from data_schema.command_line import CommandParser, count_argument, run, seed_argument
 from data_schema.output import check_memory, check_output
-from data_schema.samples import SAMPLES_FILE_TYPE, write_samples
-from tablegen.build.config import PRESETS
+from data_schema.samples import ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, write_samples
+from tablegen.tabulation.config import PRESETS
 from tablegen.model.shapes import DEFAULT_KAPPA, MIX, SHAPES
 from tablegen.model.simulate import DEFAULT_N_MAX
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
@@ -35,7 +35,7 @@ def _build_parser() -> argparse.ArgumentParser:
                          description="Simulate n rebounds at one incident state (lab frame: wall y = 0, "
                                      "V- = |V-|(cos a1, -sin a1, 0)) and print a summary.")
     sim.add_argument("--shape", required=True, choices=SHAPES + (MIX,), help="particle shape or the equal-weight mix")
-    sim.add_argument("--alpha1", type=float, required=True, metavar="DEG", help="incidence angle from the wall, (0, 90]")
+    sim.add_argument("--alpha1", type=float, required=True, metavar="DEG", help=f"incidence angle from the wall, {ALPHA1_RANGE_TEXT}")
     sim.add_argument("--speed", type=float, required=True, metavar="M_PER_S", help="incident speed |V-| in m/s, > 0")
     sim.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of particles, >= 1")
     sim.add_argument("--seed", type=seed_argument, default=None,
@@ -98,7 +98,7 @@ def _build_parser() -> argparse.ArgumentParser:
     report.add_argument("--seed", type=seed_argument, default=None,
                         help="random seed in [0, 2**63) (default: fresh, recorded)")
     report.add_argument("--alpha1", type=_alpha1_list, metavar="LIST",
-                        help="comma-separated incidence angles in (0, 90] deg (default: 5,10,...,90 with "
+                        help=f"comma-separated incidence angles in {ALPHA1_RANGE_TEXT} deg (default: 5,10,...,90 with "
                              "--direct; the table's grid with --table, of which LIST must be a subset)")
     report.add_argument("--overwrite", action="store_true",
                         help="replace an existing output folder if it is a report this command wrote")
@@ -107,13 +107,13 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 def _alpha1_list(text: str) -> tuple:
-    """Comma-separated angles in (0, 90] degrees, as a tuple (argparse type)."""
+    """Comma-separated angles in the physical range (ALPHA1_RANGE_TEXT) in degrees, as a tuple (argparse type)."""
     from tablegen.model.simulate import check_alpha1
 
     try:
         return tuple(check_alpha1(v) for v in text.split(","))
     except ValueError as exc:
-        raise argparse.ArgumentTypeError(f"comma-separated angles in (0, 90] deg; {exc}") from None
+        raise argparse.ArgumentTypeError(f"comma-separated angles in {ALPHA1_RANGE_TEXT} deg; {exc}") from None
 
 
 def _progress(args) -> bool:
@@ -149,8 +149,8 @@ def _wall(args) -> WallMaterial:
 
 
 def _build(args) -> int:
-    from tablegen.build.driver import BuildError, build_table
-    from tablegen.build.config import load_config
+    from tablegen.tabulation.driver import BuildError, build_table
+    from tablegen.tabulation.config import load_config
 
     config = load_config(args.config, args.preset)
     if args.print_config:
@@ -182,7 +182,7 @@ def _build_interrupted(args) -> str | None:
 
 def _info(args) -> int:
     from data_schema.table import read_table
-    from tablegen.build.info import describe_table
+    from tablegen.tabulation.info import describe_table
 
     print(describe_table(read_table(args.table), Path(args.table)))
     return 0

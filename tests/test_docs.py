@@ -1,12 +1,13 @@
 """The prose format description stays in step with data_schema."""
 
 import dataclasses
+import re
 from pathlib import Path
 
 import pytest
 
 from data_schema import samples, table
-from tablegen.build.config import CONFIG_KEYS
+from tablegen.tabulation.config import CONFIG_KEYS
 
 FORMAT_DOC = (Path(__file__).resolve().parents[1] / "docs" / "format.md").read_text()
 NAMES = ([samples.SAMPLES_FILE_TYPE, "file_type", "format_version", "samples"]
@@ -32,3 +33,15 @@ def test_config_keys_are_documented():
     for section, keys in CONFIG_KEYS.items():
         for key in keys:
             assert f"`{section}.{key}`" in FORMAT_DOC, f"{section}.{key}"
+
+
+DOCS = sorted([Path(__file__).resolve().parents[1] / "README.md", Path(__file__).resolve().parents[1] / "examples"
+               / "README.md"] + list((Path(__file__).resolve().parents[1] / "docs").rglob("*.md")))
+
+
+@pytest.mark.parametrize("path", DOCS, ids=lambda p: p.name)
+def test_docs_carry_no_dates_or_local_paths(path):
+    """Docs are records, not a notebook: no day of a run, no path of one machine."""
+    text = path.read_text()
+    assert not re.findall(r"\b20\d\d-[01]\d-[0-3]\d\b", text), "a date"
+    assert not re.findall(r"(?<![\w.])/(?:tmp|home|work|root|Users)/", text), "a local path"

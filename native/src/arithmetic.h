@@ -1,8 +1,9 @@
 /*
- * arithmetic.h: the arithmetic of a draw once its table values are read (surrogate.kernels.draw: _chain,
- * _folded, _moved, _velocity, _to_speed, _mirrored): the conditional chain of the six state variables,
- * the fold into the physical ranges, the move to the incident α1 and |V⁻|, the mirror sign. Local frame,
- * V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. Same operations, same order, fma() where numba fuses.
+ * arithmetic.h: stage 3 of a draw, its arithmetic once its table values are read (surrogate.kernels.arithmetic:
+ * _chain, _folded, _moved, _velocity, to_speed, _mirrored): the conditional chain of the six state
+ * variables, the fold into the physical ranges, the move to the incident α1 and |V⁻|, the mirror sign; and
+ * its block form (rbs_arithmetic_block). Local frame, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. Same
+ * operations, same order, fma() where numba fuses.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -10,11 +11,11 @@
 #define RBS_ARITHMETIC_H
 
 #include "fastmath.h"
+#include "frame.h"
 #include "gather.h"
-#include "locate.h"
 
 /* The state (α2, β2, s, Ω_x, Ω_y, Ω_z) reflected into the range of a rebound: α2 into [0, π], β2 below
- * π/2, s into [0, 1] (surrogate.kernels.draw._folded). */
+ * π/2, s into [0, 1] (surrogate.kernels.arithmetic._folded). */
 RBS_INLINE void rbs_folded(double alpha2, double beta2, double s, double wx, double wy, double wz, double state[6])
 {
     alpha2 = fabs(alpha2);
@@ -28,7 +29,7 @@ RBS_INLINE void rbs_folded(double alpha2, double beta2, double s, double wx, dou
 }
 
 /* The folded state of one component from its residual quantiles q and slopes b (chain order α2, |β2|,
- * s, Ω_z, Ω_x, Ω_y; surrogate.kernels.draw._chain). */
+ * s, Ω_z, Ω_x, Ω_y; surrogate.kernels.arithmetic._chain). */
 RBS_INLINE void rbs_chain(const double q[6], const double b[15], double state[6])
 {
     double x0 = q[0];
@@ -46,7 +47,7 @@ RBS_INLINE double rbs_shifted(double x, rbs_term term)
     return fma(x - term.mean_cell, term.ratio, term.mean);
 }
 
-/* The folded state moved to the incident α1 (surrogate.kernels.draw._moved), then folded again. */
+/* The folded state moved to the incident α1 (surrogate.kernels.arithmetic._moved), then folded again. */
 RBS_INLINE void rbs_moved(const double state[6], const rbs_term terms[6], double out[6])
 {
     rbs_folded(rbs_shifted(state[0], terms[0]), state[1] * terms[1].ratio, rbs_shifted(state[2], terms[2]),
@@ -65,7 +66,7 @@ RBS_INLINE void rbs_velocity(double alpha2, double beta2, double s, double v[3])
     v[2] = s * sb;
 }
 
-/* A rebound drawn at grid speed V_iv moved to the incident speed V (surrogate.kernels.draw.to_speed): x = (vx,
+/* A rebound drawn at grid speed V_iv moved to the incident speed V (surrogate.kernels.arithmetic.to_speed): x = (vx,
  * vy, vz, wx, wy, wz) in place; f_target, f_grid = exp(−k V^p) at V and V_iv. */
 RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, double cos_alpha1, double sin_alpha1,
                                 double x[6])
@@ -94,40 +95,71 @@ RBS_INLINE void rbs_mirrored(double u, double x[6])
     x[4] = mirror * x[4];
 }
 
-/* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
- * returns the status (NaN state when trapped). */
-RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
-                                   const double *u, int scaled, double x[6])
+/* The results of a block of RBS_BLOCK particles (pipeline.c), field-major: status, V⁺ (m/s), Ω⁺ (rad/s) */
+typedef struct rbs_results {
+    double status[RBS_BLOCK], V[3][RBS_BLOCK], W[3][RBS_BLOCK];
+} rbs_results;
+
+/* Stage 3 for a gathered block (surrogate.kernels.arithmetic.arithmetic_block): the arithmetic of every
+ * draw, branch-free (rbs_draw_in_cell and rbs_to_global with selects), then the outputs of its m rows from
+ * `start`; u11 the mirror uniforms u[11] */
+RBS_INLINE void rbs_arithmetic_block(const rbs_gathered *k, const rbs_frames *f, const rbs_cells *c,
+                                     const double u11[RBS_BLOCK], int scaled, rbs_results *r, size_t start, size_t m,
+                                     double *V_out, double *Omega_out, signed char *status)
 {
-    if (u[3] < t->cells[cell->drawn * CELL_SIZE + CELL_P_TRAPPED]) {
-        for (int k = 0; k < 6; k++) x[k] = NAN;
-        return RBS_TRAPPED;
-    }
-    const float *r = t->clusters;
-    int64_t row = rbs_component(t, cell->drawn, u[4]);
-    double q[6], b[15], state[6];
-    rbs_quantiles(t, cell->drawn, row, u, q);
-    for (int k = 0; k < 15; k++) b[k] = (double)r[row + ROW_SLOPE + k];
-    rbs_chain(q, b, state);
-    double regime = (double)r[row + ROW_REGIME];
-    if (scaled && cell->wa > 0.0) {
+    for (size_t b = 0; b < RBS_BLOCK; b++) {
+        double q[6], slope[15], state[6], moved[6], x[6];
         rbs_term terms[6];
-        double moved[6];
-        rbs_alpha1_terms(t, cell->below, cell->wa, cell->drawn, terms);
+        for (int j = 0; j < 6; j++) q[j] = k->q[j][b];
+        for (int j = 0; j < 15; j++) slope[j] = k->slope[j][b];
+        rbs_chain(q, slope, state);
+        for (int j = 0; j < 6; j++) {
+            terms[j].ratio = k->ratio[j][b];
+            terms[j].mean_cell = k->mean_cell[j][b];
+            terms[j].mean = k->mean[j][b];
+        }
         rbs_moved(state, terms, moved);
-        for (int k = 0; k < 6; k++) state[k] = moved[k];
+        int move_alpha1 = scaled & (c->wa[b] > 0.0);
+        for (int j = 0; j < 6; j++) state[j] = move_alpha1 ? moved[j] : state[j];
+        double sb, cb, sa, ca;
+        rbs_sincos_simd(state[1], &sb, &cb);
+        rbs_sincos_simd(state[0], &sa, &ca);
+        double scb = state[2] * cb;
+        double local[6] = {scb * ca, scb * sa, state[2] * sb, state[3], state[4], state[5]};
+        for (int j = 0; j < 6; j++) x[j] = local[j];
+        double px = k->piece_x[b];             /* rbs_restitution_at's Horner steps, unrolled */
+        double f_target = fma(k->piece[9][b], px, k->piece[8][b]);
+        f_target = fma(f_target, px, k->piece[7][b]);
+        f_target = fma(f_target, px, k->piece[6][b]);
+        f_target = fma(f_target, px, k->piece[5][b]);
+        f_target = fma(f_target, px, k->piece[4][b]);
+        f_target = fma(f_target, px, k->piece[3][b]);
+        f_target = fma(f_target, px, k->piece[2][b]);
+        f_target = fma(f_target, px, k->piece[1][b]);
+        f_target = fma(f_target, px, k->piece[0][b]);
+        rbs_to_speed(k->regime[b], f_target, k->f_grid[b], f->cos_a1[b], f->sin_a1[b], x);
+        int move_speed = scaled & (c->wv[b] > 0.0);
+        for (int j = 0; j < 6; j++) x[j] = move_speed ? x[j] : local[j];
+        rbs_mirrored(u11[b], x);
+        int rebounded = k->trapped[b] <= 0.5;
+        r->status[b] = rebounded ? (double)RBS_REBOUNDED : (double)RBS_TRAPPED;
+        double speed = f->speed[b], w = speed / f->a[b];
+        for (int j = 0; j < 3; j++) {
+            double v = speed * rbs_dot(x[0], x[1], x[2], f->ex[j][b], f->n[j][b], f->ez[j][b]);
+            double o = w * rbs_dot(x[3], x[4], x[5], f->ex[j][b], f->n[j][b], f->ez[j][b]);
+            r->V[j][b] = rebounded ? v : NAN;
+            r->W[j][b] = rebounded ? o : NAN;
+        }
     }
-    rbs_velocity(state[0], state[1], state[2], x);
-    x[3] = state[3];
-    x[4] = state[4];
-    x[5] = state[5];
-    if (scaled && cell->wv > 0.0) {
-        double f_target, f_grid;
-        rbs_restitution_factors(t, cell->jv, cell->wv, cell->iv, &f_target, &f_grid);
-        rbs_to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, x);
+    for (size_t b = 0; b < m; b++) {
+        size_t i = start + b;
+        int valid = f->valid[b] != 0.0;
+        status[i] = valid ? (signed char)r->status[b] : (signed char)RBS_INVALID;
+        for (int j = 0; j < 3; j++) {
+            V_out[3 * i + j] = valid ? r->V[j][b] : NAN;
+            Omega_out[3 * i + j] = valid ? r->W[j][b] : NAN;
+        }
     }
-    rbs_mirrored(u[11], x);
-    return RBS_REBOUNDED;
 }
 
 #endif /* RBS_ARITHMETIC_H */

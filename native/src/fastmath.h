@@ -1,7 +1,7 @@
 /*
- * fastmath.h: the inlined arithmetic of a draw that would otherwise call libm (surrogate/trig.py,
- * surrogate/restitution.py), with the same operations in the same order and fma() wherever numba uses
- * its fused multiply-add intrinsic, so the same bits:
+ * fastmath.h: the inlined arithmetic of a draw that would otherwise call libm (surrogate.kernels.fastmath),
+ * with the same operations in the same order and fma() wherever numba uses its fused multiply-add
+ * intrinsic, so the same bits:
  *
  *   rbs_sincos            (sin x, cos x), |x| <= 2π: Cody–Waite reduction by π/2, Taylor polynomials
  *   rbs_atan2_q1          atan2(y, x) for x, y >= 0: nearest node atan c + Taylor series of atan z

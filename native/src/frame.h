@@ -1,5 +1,5 @@
 /*
- * frame.h: the impact frame of a hit and the way back to the global frame (surrogate/frame.py).
+ * frame.h: the impact frame of a hit and the way back to the global frame (surrogate.kernels.frame).
  *
  * The frame of a hit is (ex, n, ez): ex the direction of the tangential part of V⁻, n the wall's unit
  * normal (into the gas), ez = ex × n. Local draws live in it (α1 from the wall, impact plane spanned by
@@ -13,7 +13,7 @@
 #include "fastmath.h"
 #include "internal.h"
 
-/* a·b of two 3-vectors, the same bits wherever it is inlined (surrogate.kernels.frame._dot) */
+/* a·b of two 3-vectors, the same bits wherever it is inlined (surrogate.kernels.frame.dot) */
 RBS_INLINE double rbs_dot(double a0, double a1, double a2, double b0, double b1, double b2)
 {
     return fma(a0, b0, fma(a1, b1, a2 * b2));
@@ -95,6 +95,65 @@ RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, doubl
     }
     for (int k = 0; k < 3; k++) {
         Omega_out[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
+    }
+}
+
+/* The frame records of a block of RBS_BLOCK particles (pipeline.c), field-major: particle b at [b] */
+typedef struct rbs_frames {
+    double Vin[3][RBS_BLOCK], valid[RBS_BLOCK], normal[RBS_BLOCK], alpha1[RBS_BLOCK], speed[RBS_BLOCK],
+        cos_a1[RBS_BLOCK], sin_a1[RBS_BLOCK], a[RBS_BLOCK], ex[3][RBS_BLOCK], ez[3][RBS_BLOCK], n[3][RBS_BLOCK];
+} rbs_frames;
+
+/* The frame records of the m rows from `start` (surrogate.kernels.frame.frame_block): validity and impact
+ * frame of every row (rbs_impact_frame, the same operations), on the rows copied field-major (rows past the
+ * end: V = 0, n = e_y, a = 1, invalid); u12 their uniforms u[12] */
+RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *a, size_t start, size_t m,
+                                const double u12[RBS_BLOCK], rbs_frames *k)
+{
+    for (size_t b = 0; b < RBS_BLOCK; b++) {
+        size_t i = start + b;
+        int here = b < m;
+        for (int j = 0; j < 3; j++) {
+            k->Vin[j][b] = here ? V[3 * i + j] : 0.0;
+            k->n[j][b] = here ? n[3 * i + j] : (j == 1 ? 1.0 : 0.0);
+        }
+        k->a[b] = here ? a[i] : 1.0;
+    }
+    for (size_t b = 0; b < RBS_BLOCK; b++) {       /* branch-free: SIMD across the block */
+        double V0 = k->Vin[0][b], V1 = k->Vin[1][b], V2 = k->Vin[2][b];
+        double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
+        double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
+        double finite = V0 + V1 + V2;
+        k->valid[b] = (vn < 0.0) & (finite - finite == 0.0) ? 1.0 : 0.0;
+        double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
+        double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));
+        double speed = sqrt(fma(vn, vn, vt * vt));
+        double inv = 1.0 / vt;
+        k->ex[0][b] = tx * inv;
+        k->ex[1][b] = ty * inv;
+        k->ex[2][b] = tz * inv;
+        k->normal[b] = vt > 1e-12 * speed ? 0.0 : 1.0;
+        double inv_speed = 1.0 / speed;
+        k->alpha1[b] = rbs_atan2_q1_simd(-vn, vt) * RBS_RAD_TO_DEG;
+        k->speed[b] = speed;
+        k->cos_a1[b] = vt * inv_speed;
+        k->sin_a1[b] = -vn * inv_speed;
+    }
+    for (size_t b = 0; b < RBS_BLOCK; b++) {       /* normal impact (rare): the in-wall direction from u[12] */
+        if (k->normal[b] != 0.0) {
+            rbs_frame f;
+            const double Vi[3] = {k->Vin[0][b], k->Vin[1][b], k->Vin[2][b]};
+            const double ni[3] = {k->n[0][b], k->n[1][b], k->n[2][b]};
+            rbs_impact_frame(Vi, ni, u12[b], &f);
+            for (int j = 0; j < 3; j++) k->ex[j][b] = f.ex[j];
+        }
+    }
+    for (size_t b = 0; b < RBS_BLOCK; b++) {
+        double ex0 = k->ex[0][b], ex1 = k->ex[1][b], ex2 = k->ex[2][b];
+        double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
+        k->ez[0][b] = ex1 * n2 - ex2 * n1;
+        k->ez[1][b] = ex2 * n0 - ex0 * n2;
+        k->ez[2][b] = ex0 * n1 - ex1 * n0;
     }
 }
 

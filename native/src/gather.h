@@ -1,9 +1,9 @@
 /*
- * gather.h: the table reads of a draw (surrogate.kernels.draw: _component, _quantile, _alpha1_terms,
- * _restitution_factors) and the cache hints that put them in flight together (_hint_draw).
+ * gather.h: stage 2 of a draw, the table values it reads once located (surrogate.kernels.gather: _quantile,
+ * _alpha1_terms, restitution_factors), and its block form (rbs_gather_block).
  *
- * A draw reads a component row (Walker's alias table picks it), six pairs of residual-shape levels,
- * the cell records of the drawn cell and of its α1 neighbours, and the restitution pieces.
+ * A draw reads its component row (located by locate.h), six pairs of residual-shape levels, the cell
+ * records of the drawn cell and of its α1 neighbours, and the restitution pieces.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -12,47 +12,7 @@
 
 #include "fastmath.h"
 #include "internal.h"
-
-/* read hint, level-2 cache (prefetcht1), as surrogate.kernels.memory.prefetch */
-#if defined(__GNUC__)
-#define RBS_PREFETCH(address) __builtin_prefetch((const void *)(address), 0, 2)
-#else
-#define RBS_PREFETCH(address) ((void)(address))
-#endif
-
-/* offset of component c's row in cell number `cell` */
-RBS_INLINE int64_t rbs_row(const rbs_table *t, int64_t cell, int64_t c)
-{
-    return (cell * t->n_clusters + c) * ROW_SIZE;
-}
-
-/* offset of level i of chain variable k's residual shapes in cell number `cell` */
-RBS_INLINE int64_t rbs_level(const rbs_table *t, int64_t cell, int64_t k, int64_t i)
-{
-    return ((cell * 6 + k) * t->n_levels + i) * t->n_dictionary;
-}
-
-/* the row u4 picks before the alias table: t = u4 · C, c = ⌊t⌋ */
-RBS_INLINE int64_t rbs_first_row(const rbs_table *t, int64_t cell, double u4, double *t_out, int64_t *c_out)
-{
-    double x = u4 * (double)t->n_clusters;
-    int64_t c = rbs_trunc(x);
-    c = (t->n_clusters - 1) < c ? (t->n_clusters - 1) : c;
-    *t_out = x;
-    *c_out = c;
-    return rbs_row(t, cell, c);
-}
-
-/* the offset of the component row u4 draws in `cell`, through Walker's alias table */
-RBS_INLINE int64_t rbs_component(const rbs_table *t, int64_t cell, double u4)
-{
-    double x;
-    int64_t c;
-    int64_t row = rbs_first_row(t, cell, u4, &x, &c);
-    int64_t alias = (int64_t)t->clusters[row + ROW_ALIAS];
-    c = x - (double)c >= (double)t->clusters[row + ROW_ALIAS_PROB] ? alias : c;
-    return rbs_row(t, cell, c);
-}
+#include "locate.h"
 
 /* loc + scale · S(u) of chain variable k in the component at `row` (linear between levels i, i + 1) */
 RBS_INLINE double rbs_quantile(const rbs_table *t, int64_t cell, int64_t row, int k, double u)
@@ -73,12 +33,12 @@ RBS_INLINE void rbs_quantiles(const rbs_table *t, int64_t cell, int64_t row, con
     for (int k = 0; k < 6; k++) q[k] = rbs_quantile(t, cell, row, k, u[5 + k]);
 }
 
-/* (ratio, m_cell, m) of state variable k for the α1 move (surrogate.kernels.draw._term) */
+/* (ratio, m_cell, m) of state variable k for the α1 move (surrogate.kernels.gather._term) */
 typedef struct rbs_term {
     double ratio, mean_cell, mean;
 } rbs_term;
 
-/* The terms that move a state drawn from cell `drawn` to the incident α1 (surrogate.kernels.draw._alpha1_terms):
+/* The terms that move a state drawn from cell `drawn` to the incident α1 (surrogate.kernels.gather._alpha1_terms):
  * m and σ linear in α1 (weight wa) between cell `below` and the next α1 up; with wa = 0 the cell above
  * is not read. */
 RBS_INLINE void rbs_alpha1_terms(const rbs_table *t, int64_t below, double wa, int64_t drawn, rbs_term terms[6])
@@ -104,32 +64,43 @@ RBS_INLINE void rbs_restitution_factors(const rbs_table *t, int64_t jv, double w
     *f_grid = t->speed_restitution[iv];
 }
 
-/* cache hints for a component row: its three cache lines */
-RBS_INLINE void rbs_hint_row(const rbs_table *t, int64_t row)
-{
-    for (int j = 0; j < ROW_SIZE; j += 16) RBS_PREFETCH(t->clusters + row + j);
-}
+/* The gathered records of a block of RBS_BLOCK particles (pipeline.c), field-major: particle b at [b]; the
+ * restitution piece at the incident speed (its 10 coefficients and the point) is evaluated by the arithmetic */
+typedef struct rbs_gathered {
+    double trapped[RBS_BLOCK], regime[RBS_BLOCK], piece[10][RBS_BLOCK], piece_x[RBS_BLOCK], f_grid[RBS_BLOCK],
+        q[6][RBS_BLOCK], slope[15][RBS_BLOCK], ratio[6][RBS_BLOCK], mean_cell[6][RBS_BLOCK], mean[6][RBS_BLOCK];
+} rbs_gathered;
 
-/* cache hints for the two residual-shape levels of each chain variable that u[5..10] pick */
-RBS_INLINE void rbs_hint_levels(const rbs_table *t, int64_t drawn, const double *u)
+/* Stage 2 for the m particles of a located block (surrogate.kernels.gather.gather_block): the table values of
+ * every draw */
+RBS_INLINE void rbs_gather_block(const rbs_table *t, const double u[RBS_U_PER_DRAW][RBS_BLOCK], size_t m,
+                                 const rbs_frames *f, const rbs_cells *c, rbs_gathered *k)
 {
-    int64_t levels = t->n_levels - 1;
-    for (int k = 0; k < 6; k++) {
-        int64_t i = rbs_trunc(u[5 + k] * (double)levels);
-        i = (levels - 1) < i ? (levels - 1) : i;
-        int64_t level = rbs_level(t, drawn, k, i);
-        RBS_PREFETCH(t->dictionary + level);
-        RBS_PREFETCH(t->dictionary + level + t->n_dictionary);
+    const float *r = t->clusters;
+    for (size_t b = 0; b < m; b++) {
+        int64_t drawn = c->drawn[b], row = c->row[b];
+        if (f->valid[b] != 0.0) {
+            k->trapped[b] = u[3][b] < t->cells[drawn * CELL_SIZE + CELL_P_TRAPPED] ? 1.0 : 0.0;
+            k->regime[b] = (double)r[row + ROW_REGIME];
+            for (int j = 0; j < 6; j++) k->q[j][b] = rbs_quantile(t, drawn, row, j, u[5 + j][b]);
+            for (int j = 0; j < 15; j++) k->slope[j][b] = (double)r[row + ROW_SLOPE + j];
+        }
+        rbs_term terms[6];
+        rbs_alpha1_terms(t, c->below[b], c->wa[b], drawn, terms);
+        for (int j = 0; j < 6; j++) {
+            k->ratio[j][b] = terms[j].ratio;
+            k->mean_cell[j][b] = terms[j].mean_cell;
+            k->mean[j][b] = terms[j].mean;
+        }
+        /* the restitution piece at the incident speed (evaluated in the SIMD loop) and the grid speed's factor */
+        double x = c->wv[b] * (double)t->n_pieces;
+        int64_t i = rbs_trunc(x);
+        i = (t->n_pieces - 1) < i ? (t->n_pieces - 1) : i;
+        k->piece_x[b] = 2.0 * (x - (double)i) - 1.0;
+        const double *piece = t->restitution_pieces + (c->jv[b] * t->n_pieces + i) * 10;
+        for (int d = 0; d < 10; d++) k->piece[d][b] = piece[d];
+        k->f_grid[b] = t->speed_restitution[c->iv[b]];
     }
-}
-
-/* the hints of a draw in `drawn`: the row u[4] picks (before its alias) and the levels */
-RBS_INLINE void rbs_hint_draw(const rbs_table *t, int64_t drawn, const double *u)
-{
-    double x;
-    int64_t c;
-    rbs_hint_row(t, rbs_first_row(t, drawn, u[4], &x, &c));
-    rbs_hint_levels(t, drawn, u);
 }
 
 #endif /* RBS_GATHER_H */

@@ -1,13 +1,13 @@
 /*
- * internal.h: the in-memory table and the layouts of its kernel arrays (surrogate/table.py, KernelData).
+ * internal.h: the in-memory table and the layouts of its kernel arrays (surrogate.kernels.layout.KernelData).
  *
  * The arrays are those of surrogate's table.kernel_data, element for element:
- *   alpha1_axis, speed_axis  float64 axis records (AXIS_* layout, derive.c)
+ *   alpha1_axis, speed_axis  float64 axis records (AXIS_* layout, layout.c)
  *   cells        float64 (n_cells · CELL_SIZE): P(trapped), 6 means, 6 sds, 6 inverse sds per cell
  *   clusters     float32 (n_cells · C · ROW_SIZE): one row per mixture component (ROW_* layout)
  *   dictionary   float32 (n_cells · 6 · n_levels · n_dictionary): residual shapes, level-major
  *   speed_restitution   float64 (n_speed): exp(−k V^p) at the grid speeds
- *   restitution_pieces  float64: polynomial pieces of exp(−k V^p) between them (derive.c)
+ *   restitution_pieces  float64: polynomial pieces of exp(−k V^p) between them (layout.c)
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -84,7 +84,7 @@ struct rbs_table {
     size_t restitution_pieces_len;
 };
 
-/* The raw cell datasets a loader reads (derive.c turns them into the kernel arrays). */
+/* The raw cell datasets a loader reads (layout.c turns them into the kernel arrays). */
 typedef struct rbs_raw_cells {
     double *cluster_weight;     /* (cells, C) */
     float *cluster_loc;         /* (cells, C, 6) */
@@ -98,7 +98,7 @@ typedef struct rbs_raw_cells {
     double *std;                /* (cells, 6) */
 } rbs_raw_cells;
 
-/* derive.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
+/* layout.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
  * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */
 int rbs_derive(rbs_table *table, const rbs_raw_cells *raw, const char **what);
 

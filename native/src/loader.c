@@ -1,6 +1,6 @@
 /*
  * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), and the
- * accessors of a loaded table. The kernel arrays are derived in derive.c.
+ * accessors of a loaded table. The kernel arrays are derived in layout.c.
  *
  * Every error names the file and what is wrong with it; HDF5's own error printing is switched off
  * around each HDF5 call that may fail (H5E_BEGIN_TRY), so the library prints nothing.

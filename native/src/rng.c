@@ -1,5 +1,5 @@
 /*
- * rng.c: xoshiro256+ uniforms (surrogate/rng.py) and their seeding.
+ * rng.c: xoshiro256+ uniforms (surrogate.kernels.rng) and their seeding.
  *
  * rbs_rng_seed / rbs_rng_seed_stream repeat numpy's SeedSequence (numpy/random/bit_generator.pyx): the
  * seed's 32-bit words (and, for stream k, the spawn key (k,)) hashed into a pool of four 32-bit words,

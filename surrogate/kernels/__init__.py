@@ -6,15 +6,20 @@ xoshiro256+ state. Where each part lives:
 
 ==============  ==============================================================
 ``layout``      the table as the kernels take it (:class:`KernelData`), its record layouts
-``draw``        the law of one draw: :func:`locate`, :func:`gather`, :func:`arithmetic`; local-frame draws
+``draw``        the law of one draw in the local frame, its three stages composed: :func:`draw_velocity`
+``locate``      stage 1: where a draw reads (:func:`locate`: the cell; the component; cache hints)
+``gather``      stage 2: the table values a draw needs (:func:`gather`)
+``arithmetic``  stage 3: the reflected state from those values (:func:`arithmetic`)
 ``frame``       the impact frame of a hit and the way back to the global frame
-``particle``    one particle in the global frame: :func:`rebound_tuple`, :func:`rebound`
-``pipeline``    many particles on one thread, by blocks of BLOCK: :func:`rebound_many`, :func:`rebound_many_rng`
+``particle``    one particle: :func:`rebound_tuple`, :func:`rebound` (global frame), :func:`draw_local`
+``block``       the block form of the stages' records, field-major over BLOCK particles
+``pipeline``    many particles on one thread, the stages' block forms scheduled: :func:`rebound_many`,
+                :func:`rebound_many_rng`
 ``parallel``    many particles on all threads, by chunks: :func:`rebound_parallel`, :func:`draw_local_parallel`
 ``rng``         xoshiro256+ streams: :func:`seed_state`, :func:`fill_uniforms`, the SIMD lanes
 ``fastmath``    fused multiply-add, trigonometry, the restitution factor: no libm call on the hot path
 ``memory``      loads and cache hints
-``checks``      the input checks of the NumPy API in one parallel pass
+``checks``      input checks: the NumPy API's in one parallel pass, the array shapes of the many-particle kernels
 ``options``     the numba options every kernel is compiled with
 ==============  ==============================================================
 
@@ -25,13 +30,18 @@ of |V⁻|/a. One particle, the pipeline and the parallel kernels give the same
 bits for the same uniforms.
 """
 
-from surrogate.kernels.draw import U_PER_DRAW, arithmetic, draw_local, draw_velocity, gather, grid_interval, locate
-from surrogate.kernels.frame import STATUS_INVALID, impact_frame
+from data_schema.samples import STATUS_INVALID
+from surrogate.kernels.arithmetic import arithmetic
+from surrogate.kernels.block import BLOCK
+from surrogate.kernels.draw import U_PER_DRAW, draw_velocity
+from surrogate.kernels.frame import impact_frame
+from surrogate.kernels.gather import gather
 from surrogate.kernels.layout import KernelData
+from surrogate.kernels.locate import grid_interval, locate
 from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel_rng, rebound_parallel,
                                         rebound_parallel_rng)
-from surrogate.kernels.particle import rebound, rebound_tuple
-from surrogate.kernels.pipeline import BLOCK, rebound_many, rebound_many_rng, rebound_uniforms
+from surrogate.kernels.particle import draw_local, rebound, rebound_tuple
+from surrogate.kernels.pipeline import rebound_many, rebound_many_rng, rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
 
 __all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "STATUS_INVALID", "U_PER_DRAW", "arithmetic", "chunk_states",

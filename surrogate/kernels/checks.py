@@ -1,4 +1,7 @@
-"""One parallel pass over the incident states of :func:`surrogate.sample_global`: where each check first fails.
+"""The input checks of the kernels: where each check of :func:`surrogate.sample_global` first fails, in one
+parallel pass (:func:`first_faults`), and the shapes of the arrays of the kernels over many particles
+(:func:`check_rows` and the others: a ValueError naming the array, raised before any parallel loop, where a
+raise would keep numba from running it in parallel).
 
 The NumPy API must name the first offending value of each kind of bad input
 (README, "Runtime sampler"). Done with NumPy, those checks cost several
@@ -15,6 +18,7 @@ import math
 import numba
 import numpy as np
 
+from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.frame import dot, impact_frame
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
@@ -77,3 +81,61 @@ def _check_row(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi, i, 
 def _record(found, k, fails, i):
     if fails and found[k] < 0:
         found[k] = i
+
+
+# -- the shapes of the arrays of the kernels over many particles ---------------------------------------
+
+@numba.njit(**JIT)
+def check_rows(V, n, a, V_out, Omega_out, status):
+    """ValueError naming the first array of a block kernel's call that has not one row per particle, with
+    its shape and the shape needed. Called before the parallel loops: a raise inside one keeps numba from
+    running it in parallel."""
+    rows = V.shape[0]
+    for name, shape in (("V", V.shape), ("n", n.shape), ("V_out", V_out.shape), ("Omega_out", Omega_out.shape)):
+        if shape[0] != rows or shape[1] != 3:
+            raise ValueError(shape_error(name, shape, "(" + str(rows) + ", 3)"))
+    for name, shape in (("a", a.shape), ("status", status.shape)):
+        if shape[0] != rows:
+            raise ValueError(shape_error(name, shape, "(" + str(rows) + ",)"))
+
+
+@numba.njit(**JIT)
+def check_uniforms(u, rows, first):
+    """ValueError unless the uniforms ``u`` have shape (rows, U_PER_DRAW), rows = len(first)."""
+    if u.shape[0] != rows or u.shape[1] != U_PER_DRAW:
+        raise ValueError(shape_error("u", u.shape, "(" + str(rows) + ", " + str(U_PER_DRAW) + ")", first))
+
+
+@numba.njit(**JIT)
+def shape_error(name, shape, needed, first="V"):
+    """The message of a shape error of the kernels over many particles: one row per particle, as many as
+    the array ``first`` has."""
+    text = ", ".join([str(x) for x in shape]) + ("," if len(shape) == 1 else "")
+    return ("'" + name + "' has shape (" + text + "); needed " + needed
+            + ": one row per particle, as many as " + first + " has")
+
+
+@numba.njit(**JIT)
+def check_state(state):
+    """ValueError unless ``state`` is one xoshiro256+ state (the one-thread kernels that draw their uniforms)."""
+    if state.shape[0] != 4:
+        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.seed_state gives")
+
+
+@numba.njit(**JIT)
+def check_states(states, n_rows):
+    """ValueError unless ``states`` holds one xoshiro256+ state per chunk of n_rows rows (the parallel kernels)."""
+    if states.shape[0] != n_chunks(n_rows) or states.shape[1] != 4:
+        raise ValueError("'states' must hold one xoshiro256+ state (4 words) per CHUNK_ROWS rows, as "
+                         "surrogate.kernels.rng.chunk_states(generator, n_rows) gives")
+
+
+@numba.njit(**JIT)
+def check_local_rows(alpha1, speed, out, status):
+    """ValueError naming the first array of a local-frame call that has not one row per incident state."""
+    rows = alpha1.shape[0]
+    for name, shape in (("speed", speed.shape), ("status", status.shape)):
+        if shape[0] != rows:
+            raise ValueError(shape_error(name, shape, "(" + str(rows) + ",)", "alpha1"))
+    if out.shape[0] != rows or out.shape[1] != 6:
+        raise ValueError(shape_error("out", out.shape, "(" + str(rows) + ", 6)", "alpha1"))

@@ -5,6 +5,8 @@ the incident velocity V⁻, n the wall's unit normal (into the gas), ez = ex × 
 In it the local draws of :mod:`surrogate.kernels.draw` live (α1 from the wall, impact
 plane spanned by ex and n). :func:`impact_frame` builds it, :func:`to_global`
 turns a local draw back into V⁺ (m/s) and Ω⁺ (rad/s) in the caller's frame.
+:func:`frame_block` builds the frames of a block of particles (the frame record,
+FRAME_* fields, :mod:`surrogate.kernels.block`).
 """
 
 import math
@@ -13,11 +15,11 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED
+from surrogate.kernels.block import BLOCK, field, fields3, put3
 from surrogate.kernels.fastmath import atan2_first_quadrant, fma, sincos
 from surrogate.kernels.options import JIT
 
 
-STATUS_INVALID = -1     # the status of an incident state that does not move into the wall
 NORMAL_IMPACT = 1e-12   # a tangential speed below this fraction of |V| is normal impact: ex drawn in the wall plane
 
 
@@ -81,3 +83,39 @@ def to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
     return ((speed * dot(v, (ex[0], n[0], ez[0])), speed * dot(v, (ex[1], n[1], ez[1])),
              speed * dot(v, (ex[2], n[2], ez[2]))),
             (w * dot(o, (ex[0], n[0], ez[0])), w * dot(o, (ex[1], n[1], ez[1])), w * dot(o, (ex[2], n[2], ez[2]))))
+
+
+# -- the frame record of a block ----------------------------------------------------------------------
+
+FRAME_VALID, FRAME_ALPHA1, FRAME_SPEED, FRAME_COS, FRAME_SIN, FRAME_A, FRAME_EX, FRAME_EZ, FRAME_N = (
+    0, 1, 2, 3, 4, 5, 6, 9, 12)    # valid (1.0 or 0.0), α1 deg, |V⁻| m/s, cos α1, sin α1, a m, ex, ez, n
+FRAME_FIELDS = 15
+
+
+@numba.njit(inline="always", **JIT)
+def frame_block(V, n, a, ub, start, m, fr):
+    """The frame records ``fr`` of the m rows from ``start`` (their uniforms ``ub``), computed for rows that
+    do not move into the wall too (valid 0). V and n flat, row after row: a compile-time stride, which keeps
+    the SIMD loop free of run-time stride checks."""
+    for b in range(m):      # no branch and no table read: SIMD across the block
+        i = start + b
+        Vi, ni = (V[3 * i], V[3 * i + 1], V[3 * i + 2]), (n[3 * i], n[3 * i + 1], n[3 * i + 2])
+        alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[12 * BLOCK + b])
+        put3(fr, FRAME_VALID, b, (1.0 if moves_into_wall(Vi, ni) else 0.0, alpha1, speed))
+        put3(fr, FRAME_COS, b, (cos_a1, sin_a1, a[i]))
+        put3(fr, FRAME_EX, b, ex)
+        put3(fr, FRAME_EZ, b, ez)
+        put3(fr, FRAME_N, b, ni)
+
+
+@numba.njit(inline="always", **JIT)
+def is_valid(fr, b):
+    """Whether particle b of a block moves into its wall (it gets a draw)."""
+    return field(fr, FRAME_VALID, b) != 0.0
+
+
+@numba.njit(inline="always", **JIT)
+def frame_at(fr, b):
+    """Particle b's frame record: (α1 deg, |V⁻| m/s, cos α1, sin α1, a m, ex, ez, n), vectors as 3-tuples."""
+    return (field(fr, FRAME_ALPHA1, b), field(fr, FRAME_SPEED, b), field(fr, FRAME_COS, b), field(fr, FRAME_SIN, b),
+            field(fr, FRAME_A, b), fields3(fr, FRAME_EX, b), fields3(fr, FRAME_EZ, b), fields3(fr, FRAME_N, b))

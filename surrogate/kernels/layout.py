@@ -156,7 +156,7 @@ def kernel_rows(cells: dict) -> tuple:
     shapes' values at one level are contiguous (one cache line for M = 16),
     so the lines a draw reads are located by its uniforms alone, before the
     component row that names m arrives, and can be requested together with
-    that row (:func:`surrogate.kernels.draw.hint_row`). Both arrays start on a
+    that row (:func:`surrogate.kernels.locate.hint_row`). Both arrays start on a
     64-byte cache line, so a 144-byte row spans exactly three lines.
     """
     weight = cells["cluster_weight"]

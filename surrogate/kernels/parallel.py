@@ -5,16 +5,15 @@ The rows are cut into chunks of CHUNK_ROWS (:mod:`surrogate.kernels.rng`); the
 ``*_rng`` kernels draw chunk j's uniforms from the xoshiro256+ state
 ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the draws are the
 same whatever the number of threads. Input shapes are checked before the
-parallel loop (ValueError naming the array): a raise inside a prange loop
-would keep numba from running it in parallel.
+parallel loop (:mod:`surrogate.kernels.checks`).
 """
 
 import numba
 
-from surrogate.kernels.draw import draw_local
 from surrogate.kernels.options import JIT
-from surrogate.kernels.pipeline import (check_rows, check_uniforms, no_state, no_uniforms, rebound_uniforms, run_blocks,
-                                        shape_error)
+from surrogate.kernels.particle import draw_local
+from surrogate.kernels.checks import check_local_rows, check_rows, check_states, check_uniforms
+from surrogate.kernels.pipeline import no_state, no_uniforms, rebound_uniforms, run_blocks
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
 
 
@@ -37,28 +36,10 @@ def rebound_parallel_rng(data, mix_cdf, V, n, a, states, V_out, Omega_out, statu
     The draws are the same whatever the number of threads, and no (N, U_PER_DRAW) array of uniforms is
     held. ``states`` must have one row per chunk (ValueError)."""
     check_rows(V, n, a, V_out, Omega_out, status)
-    _check_states(states, V.shape[0])
+    check_states(states, V.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, V.shape[0])
         _rebound_chunk(data, mix_cdf, V, n, a, no_uniforms(), states[j].copy(), V_out, Omega_out, status, scaled, lo, hi)
-
-
-@numba.njit(**JIT)
-def _check_states(states, n_rows):
-    if states.shape[0] != n_chunks(n_rows) or states.shape[1] != 4:
-        raise ValueError("'states' must hold one xoshiro256+ state (4 words) per CHUNK_ROWS rows, as "
-                         "surrogate.kernels.rng.chunk_states(generator, n_rows) gives")
-
-
-@numba.njit(**JIT)
-def _check_local_rows(alpha1, speed, out, status):
-    """ValueError naming the first array of a local-frame call that has not one row per incident state."""
-    rows = alpha1.shape[0]
-    for name, shape in (("speed", speed.shape), ("status", status.shape)):
-        if shape[0] != rows:
-            raise ValueError(shape_error(name, shape, "(" + str(rows) + ",)", "alpha1"))
-    if out.shape[0] != rows or out.shape[1] != 6:
-        raise ValueError(shape_error("out", out.shape, "(" + str(rows) + ", 6)", "alpha1"))
 
 
 @numba.njit(inline="always", **JIT)
@@ -79,7 +60,7 @@ def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, s
 def draw_local_parallel(data, mix_cdf, alpha1, speed, u, out, status, scaled=True):
     """:func:`draw_local` for every row (parallel): alpha1 and speed (N,), u (N, U_PER_DRAW), out (N, 6)
     (α2, β2, s, Ω_x, Ω_y, Ω_z), status (N,); a ValueError names an array of another shape."""
-    _check_local_rows(alpha1, speed, out, status)
+    check_local_rows(alpha1, speed, out, status)
     check_uniforms(u, alpha1.shape[0], "alpha1")
     for j in numba.prange(n_chunks(alpha1.shape[0])):
         lo, hi = _chunk(j, alpha1.shape[0])
@@ -90,8 +71,8 @@ def draw_local_parallel(data, mix_cdf, alpha1, speed, u, out, status, scaled=Tru
 def draw_local_parallel_rng(data, mix_cdf, alpha1, speed, states, out, status, scaled=True):
     """:func:`draw_local_parallel` drawing its own uniforms, chunk by chunk as :func:`rebound_parallel_rng`
     (chunk j's are ``rebound_uniforms(states[j].copy(), rows)``)."""
-    _check_local_rows(alpha1, speed, out, status)
-    _check_states(states, alpha1.shape[0])
+    check_local_rows(alpha1, speed, out, status)
+    check_states(states, alpha1.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, alpha1.shape[0])
         _draw_local_chunk(data, mix_cdf, alpha1, speed, rebound_uniforms(states[j].copy(), hi - lo), out, status,

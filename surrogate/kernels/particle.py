@@ -1,15 +1,20 @@
-"""One particle in the global frame: :func:`rebound_tuple` (vectors as tuples, for a solver's per-hit loop)
-and :func:`rebound` (the same on (3,) arrays).
+"""One particle: in the global frame :func:`rebound_tuple` (vectors as tuples, for a solver's per-hit loop)
+and :func:`rebound` (the same on (3,) arrays); in the local frame :func:`draw_local`.
 
 The impact frame (:func:`surrogate.kernels.frame.impact_frame`), then one draw
 (:mod:`surrogate.kernels.draw`: locate, gather, arithmetic) and the way back
 to the global frame. V⁻ in m/s in, V⁺ in m/s and Ω⁺ in rad/s out.
 """
 
-import numba
+import math
 
-from surrogate.kernels.draw import draw_in_cell, hint, locate
-from surrogate.kernels.frame import NAN3, STATUS_INVALID, impact_frame, moves_into_wall, to_global
+import numba
+import numpy as np
+
+from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
+from surrogate.kernels.draw import draw_in_cell, draw_velocity
+from surrogate.kernels.frame import NAN3, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.locate import hint, locate
 from surrogate.kernels.options import JIT, KERNEL
 
 
@@ -33,7 +38,7 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out, scaled=True):
     move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
     (tangential direction of V), n, ez = ex × n; the local draw is rotated back
     into the global frame. The mirror symmetry of the model is applied with a
-    random sign (:func:`surrogate.kernels.draw.arithmetic`). An α1 or |V⁻| outside the table's
+    random sign (:func:`surrogate.kernels.arithmetic.arithmetic`). An α1 or |V⁻| outside the table's
     grid uses the law at the nearest grid edge (check ``table.alpha1_range``
     and ``table.speed_range`` beforehand if that matters).
     """
@@ -72,3 +77,17 @@ def _store(V_new, Omega_new, V_out, Omega_out):
     for k in range(3):
         V_out[k] = V_new[k]
         Omega_out[k] = Omega_new[k]
+
+
+@numba.njit(**KERNEL)
+def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
+    """One reflected state at (α1 deg, |V⁻| m/s) in the local frame: (status, α2, β2, s, Ω_x, Ω_y, Ω_z).
+
+    Angles in radians, s = |V⁺|/|V⁻|, Ω in units of |V⁻|/a; the state is NaN
+    for a trapped particle. See :func:`surrogate.kernels.draw.draw_velocity` (same arguments).
+    """
+    status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
+    if status != STATUS_REBOUNDED:
+        return status, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
+    s = math.sqrt(vx * vx + vy * vy + vz * vz)
+    return status, math.atan2(vy, vx), math.asin(vz / s) if s > 0.0 else 0.0, s, wx, wy, wz

@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 
 from data_schema.common import package_version
-from data_schema.samples import SampleSet
+from data_schema.samples import ALPHA1_RANGE_TEXT, SampleSet, alpha1_is_physical
 from tablegen.model.rebound import rebound_batch
 from tablegen.model.shapes import (
     DEFAULT_KAPPA, MIX, SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
@@ -33,13 +33,14 @@ DEFAULT_MAX_STEPS = 100_000         # contact-search steps per flight before a p
 
 
 def check_alpha1(alpha1) -> float:
-    """Incidence angle in degrees from the wall, in (0, 90]."""
+    """Incidence angle in degrees from the wall, in the physical range (0, 90] (ALPHA1_RANGE_DEG)."""
     try:
         value = float(alpha1)
     except (TypeError, ValueError):
-        raise ValueError(f"The 'alpha1' parameter must be a number in (0, 90] degrees; got {alpha1!r}.") from None
-    if not (0.0 < value <= 90.0):
-        raise ValueError(f"The 'alpha1' parameter must be in (0, 90] degrees; got {value!r}.")
+        raise ValueError(f"The 'alpha1' parameter must be a number in {ALPHA1_RANGE_TEXT} degrees; "
+                         f"got {alpha1!r}.") from None
+    if not alpha1_is_physical(value):
+        raise ValueError(f"The 'alpha1' parameter must be in {ALPHA1_RANGE_TEXT} degrees; got {value!r}.")
     return value
 
 

@@ -15,13 +15,11 @@ import numpy as np
 
 from tablegen.model.shapes import MIX
 from tablegen.study.statistics import (
-    NORMAL_IMPACT, QUANTITIES, derived, indicatrix_2d, indicatrix_3d, nearest_alpha1,
+    NORMAL_IMPACT, QUANTITIES, ReportData, derived, indicatrix_2d, indicatrix_3d, nearest_alpha1,
 )
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
-
-    from tablegen.study.report import ReportData
 
 INSTALL_HINT = 'pip install "rebound-scatter[plots]"'
 DPI = 110

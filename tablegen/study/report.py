@@ -35,7 +35,7 @@ from tablegen.model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_fac
 from tablegen.progress import progress_bar
 from tablegen.study.figures import require_matplotlib, write_figures
 from tablegen.study.statistics import (
-    COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, from_sample_set, nearest_alpha1,
+    COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, ReportData, from_sample_set, nearest_alpha1,
     point_statistics,
 )
 
@@ -44,33 +44,6 @@ DEFAULT_ALPHA1 = tuple(float(a) for a in range(5, 91, 5))   # deg
 DEFAULT_N = 20_000
 REPORT_SHAPES = SHAPES + (MIX,)
 INERTIA_QUADRATURE_POINTS = 4096                       # midpoint rule of ⟨r²⟩ over the aspect-ratio law
-
-
-@dataclasses.dataclass(frozen=True, eq=False)
-class ReportData:
-    """Everything the report shows, before statistics.
-
-    source : markdown line naming where the samples come from.
-    speed : incident speed |V⁻|, m/s.
-    alpha1 : incidence angles, deg, ascending.
-    shapes : reported shapes, in :data:`REPORT_SHAPES` order (may hold ``"mix"``).
-    mix_of : the shapes pooled with equal weight into ``"mix"``.
-    n : particles (direct model) or draws (table) per (shape, α1).
-    seed : the seed of every run.
-    counts_note, e_rot_method : markdown sentences on the collision counts and on E_Ω⁺/E_V⁻.
-    points : {(shape, α1): PointSamples}.
-    """
-
-    source: str
-    speed: float
-    alpha1: tuple
-    shapes: tuple
-    mix_of: tuple
-    n: int
-    seed: int
-    counts_note: str
-    e_rot_method: str
-    points: dict
 
 
 # -- derived quantities -------------------------------------------------------

@@ -1,4 +1,5 @@
-"""Statistics of rebounds: the one definition used by ``tablegen simulate`` and ``tablegen report``.
+"""Statistics of rebounds and the records they are taken from (:class:`PointSamples`, :class:`ReportData`): the one
+definition used by ``tablegen simulate`` and ``tablegen report``.
 
 Statistics are over the particles that rebounded; trapped and failed ones are
 counted, not averaged (docs/model.md §6). The "most probable" value of a
@@ -66,6 +67,34 @@ class PointSamples:
     e_rot_ratio: np.ndarray
     status_counts: np.ndarray
     collision_counts: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class ReportData:
+    """Everything ``tablegen report`` shows, before statistics: what :mod:`tablegen.study.report` gathers
+    and :mod:`tablegen.study.figures` draws.
+
+    source : markdown line naming where the samples come from.
+    speed : incident speed |V⁻|, m/s.
+    alpha1 : incidence angles, deg, ascending.
+    shapes : reported shapes, in :data:`tablegen.study.report.REPORT_SHAPES` order (may hold ``"mix"``).
+    mix_of : the shapes pooled with equal weight into ``"mix"``.
+    n : particles (direct model) or draws (table) per (shape, α1).
+    seed : the seed of every run.
+    counts_note, e_rot_method : markdown sentences on the collision counts and on E_Ω⁺/E_V⁻.
+    points : {(shape, α1): PointSamples}.
+    """
+
+    source: str
+    speed: float
+    alpha1: tuple
+    shapes: tuple
+    mix_of: tuple
+    n: int
+    seed: int
+    counts_note: str
+    e_rot_method: str
+    points: dict
 
 
 def lab_velocity(alpha2, beta2, speed_ratio) -> np.ndarray:

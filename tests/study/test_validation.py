@@ -10,18 +10,19 @@ validation plan, 0.03, leaves 0.006 for the representation itself.
 """
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 from scipy.stats import ks_2samp
 
-from data_schema.table import read_table
+from data_schema.table import STATE_NAMES, read_table
 from surrogate.kernels.layout import ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 from tablegen.study.validation import (
     SPEED_TARGETS, classifier_accuracy, compare, direct_states, grid_points, matrix_points, midpoints,
     table_states,
 )
-from tablegen.study.validation_report import precision
+from tablegen.study.validation_report import document, precision
 
 from conftest import NEAR_NORMAL_POINT
 
@@ -193,3 +194,13 @@ def test_stated_ks_precision_matches_simulation():
     rng = np.random.default_rng(0)
     stats_ = [ks_2samp(rng.standard_normal(n), rng.standard_normal(n)).statistic for _ in range(400)]
     assert abs(np.quantile(stats_, 0.95) / precision(n, 10 ** 12)["ks95_two_samples"] - 1) < 0.15
+
+
+def test_validation_document_names_tables_without_local_paths_or_dates(small_table_path):
+    row = {"table": "small", "where": "on grid", "shape": "prism", "alpha1": 30.0, "speed": 50.0,
+           "classifier_accuracy": 0.51, "ks": {name: 0.01 for name in STATE_NAMES}, "mean_error_se": 1.0,
+           "corr_error": 0.01}
+    text = document([row], {"small": str(small_table_path)}, 20_000, "python -m tablegen.study.validation_report")
+    assert f"`{small_table_path.name}`: α1 grid 3 values" in text
+    assert str(small_table_path.parent) not in text
+    assert not re.search(r"\b20\d\d-\d\d-\d\d\b", text), "a date in a generated document"

@@ -22,8 +22,8 @@ import os
 
 import pytest
 
-from tablegen.build.driver import build_table
-from tablegen.build.config import load_config
+from tablegen.tabulation.driver import build_table
+from tablegen.tabulation.config import load_config
 from tablegen.study.validation_report import TARGETS, run_matrix
 
 pytestmark = pytest.mark.slow

@@ -84,7 +84,7 @@ def test_every_rebound_leaves_the_wall_without_gaining_energy(request, fixture, 
     gains no kinetic energy (tables are built with Ω⁻ = 0 and the direct model never gains energy).
 
     The chain's linear shifts step outside these ranges at the tails; before the fold
-    (surrogate.kernels.draw._folded) reflected them, the 3 × 3 table gave s = 0 exactly (V⁺ = 0) in up to
+    (surrogate.kernels.arithmetic._folded) reflected them, the 3 × 3 table gave s = 0 exactly (V⁺ = 0) in up to
     4e-3 of the draws between grid points, and the default table s up to 1.01 near grazing.
     2·10⁴ draws per point and shape (at that rate, ~80 per point would fail), 2.9·10⁶ and 2.2·10⁶ in all.
     """
@@ -193,7 +193,8 @@ def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
     Regime 0: V⁺ − V⁻ and Ω⁺ times (1 + a(V))/(1 + a(V_j)), V⁻ = (cos α1, −sin α1, 0);
     regime 1: v⁺_n times a(V)/a(V_j), the rest kept; at V = V_j nothing moves.
     """
-    from surrogate.kernels.draw import restitution_factors, to_speed
+    from surrogate.kernels.arithmetic import to_speed
+    from surrogate.kernels.gather import restitution_factors
     data = small_table.kernel_data
     k, p = 0.1, 0.61       # the wall law the table was built with (tablegen's default)
     assert (small_table.restitution_k, small_table.restitution_p) == (k, p)

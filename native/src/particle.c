@@ -1,12 +1,12 @@
 /*
- * rebound.c: one particle (surrogate.kernels.rebound_tuple, surrogate.kernels.draw.draw_local): validity, impact
- * frame, grid look-up, cache hints, the draw in its cell, back to the global frame.
+ * particle.c: one particle (surrogate.kernels.particle: rebound_tuple, draw_local): validity, impact frame,
+ * grid look-up, cache hints, the draw in its cell, back to the global frame.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
 
-#include "arithmetic.h"
+#include "draw.h"
 #include "frame.h"
 #include "locate.h"
 #include "rebound_internal.h"

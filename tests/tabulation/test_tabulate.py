@@ -1,12 +1,12 @@
-"""The stored representation of a cell (tablegen.build.tabulate.represent) on laws with known answers."""
+"""The stored representation of a cell (tablegen.tabulation.tabulate.represent) on laws with known answers."""
 
 import numpy as np
 import pytest
 from scipy import stats
 
 from data_schema.table import CHAIN_TO_STATE, N_CHAIN, TableResolution, slope_index
-from tablegen.build.resolution import resolution_for
-from tablegen.build.tabulate import _regime_partition, regime_clusters, represent
+from tablegen.tabulation.resolution import resolution_for
+from tablegen.tabulation.tabulate import _regime_partition, regime_clusters, represent
 
 N = 40_000
 

@@ -1,6 +1,6 @@
 """The table build driver: every cell of a configuration, on local workers or a Dask cluster, into one HDF5 table.
 
-Cells are computed by :func:`tablegen.build.cells.compute_cell` (seeded per
+Cells are computed by :func:`tablegen.tabulation.cells.compute_cell` (seeded per
 cell, so the table does not depend on the workers or the order in which cells
 finish). Checkpoints: next to the output ``table.h5`` the build keeps a folder
 ``table.h5.partial/`` holding what produced it (table format version, package
@@ -34,8 +34,8 @@ import numpy as np
 from data_schema.common import package_version
 from data_schema.output import check_free_space, check_memory, check_output, remove_stale_temporaries, replace_file
 from data_schema.table import CELL_DATASETS, TABLE_FILE_TYPE, TABLE_VERSION, CellTable, ReboundTable, write_table
-from tablegen.build.cells import cell_label, compute_cell
-from tablegen.build.config import BuildConfig
+from tablegen.tabulation.cells import cell_label, compute_cell
+from tablegen.tabulation.config import BuildConfig
 from tablegen.progress import progress_bar
 
 
@@ -50,8 +50,8 @@ class CheckpointError(ValueError):
 SCHEDULER_TIMEOUT_S = 10       # how long to try to reach a Dask scheduler before giving up
 SOURCE_ROOT = Path(__file__).resolve().parents[2]       # the folder holding tablegen/ and data_schema/
 # the source that decides a cell's content (not this driver): hashed into checkpoints and tables
-MODEL_SOURCES = ("tablegen/model/*.py", "tablegen/build/resolution.py", "tablegen/build/tabulate.py",
-                 "tablegen/build/cells.py", "data_schema/samples.py")
+MODEL_SOURCES = ("tablegen/model/*.py", "tablegen/tabulation/resolution.py", "tablegen/tabulation/tabulate.py",
+                 "tablegen/tabulation/cells.py", "data_schema/samples.py")
 
 
 def model_files() -> list:

@@ -5,7 +5,7 @@ import pytest
 from cli_helpers import user_error
 
 from tablegen.cli import main as tablegen_main
-from tablegen.build.config import PRESETS, ConfigError, load_config, parse_config
+from tablegen.tabulation.config import PRESETS, ConfigError, load_config, parse_config
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 

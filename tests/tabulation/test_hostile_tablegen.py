@@ -20,8 +20,8 @@ import surrogate.cli
 from data_schema.common import DataFormatError
 from data_schema.output import FOLDER_MARKER, OutputError, kind_of, remove_stale_temporaries, write_output
 from data_schema.table import TABLE_FILE_TYPE
-from tablegen.build.driver import Checkpoint, CheckpointError, build_table, model_sha256, worker_count
-from tablegen.build.config import parse_config
+from tablegen.tabulation.driver import Checkpoint, CheckpointError, build_table, model_sha256, worker_count
+from tablegen.tabulation.config import parse_config
 from tablegen.cli import main
 
 from cli_helpers import run_cli, user_error

@@ -35,7 +35,7 @@ from data_schema.table import (
     N_SLOPES,
     CellTable, TableResolution, slope_index,
 )
-from tablegen.build.resolution import SAMPLES_PER_CLUSTER
+from tablegen.tabulation.resolution import SAMPLES_PER_CLUSTER
 
 KMEANS_FIT_SAMPLES = 50_000   # cluster centres are fitted on at most this many samples, then all are assigned
 RIDGE = 2.0                   # slope shrinkage: regressor sums of squares × (1 + RIDGE / cluster size)

@@ -39,8 +39,9 @@ import math
 import tomllib
 from importlib import resources
 
+from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
 from data_schema.table import TableResolution
-from tablegen.build.resolution import MIN_PARTICLES_PER_CELL, resolution_for
+from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from tablegen.model.shapes import SHAPES, AspectRatioLaw, check_kappa
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
@@ -122,7 +123,7 @@ def preset_text(name: str) -> str:
     """The TOML text of an embedded preset."""
     if name not in PRESETS:
         raise ConfigError(f"unknown preset {name!r}; presets: {', '.join(PRESETS)}")
-    return resources.files("tablegen.build.presets").joinpath(f"{name}.toml").read_text()
+    return resources.files("tablegen.tabulation.presets").joinpath(f"{name}.toml").read_text()
 
 
 def load_config(path=None, preset: str = "default") -> BuildConfig:
@@ -152,9 +153,9 @@ def parse_config(text: str, source: str = "<config>") -> BuildConfig:
     grid, sim, table, wall = merged["grid"], merged["simulation"], merged["table"], merged["wall"]
 
     alpha1 = _grid_values(grid.get("alpha1_deg"), "grid.alpha1_deg", source)
-    bad = [a for a in alpha1 if not 0.0 < a <= 90.0]
+    bad = [a for a in alpha1 if not alpha1_is_physical(a)]
     if bad:
-        raise ConfigError(f"{source}: 'grid.alpha1_deg' values must be in (0, 90] degrees; got {bad[0]!r}")
+        raise ConfigError(f"{source}: 'grid.alpha1_deg' values must be in {ALPHA1_RANGE_TEXT} degrees; got {bad[0]!r}")
     speeds = _grid_values(grid.get("speed_m_s"), "grid.speed_m_s", source)
     bad = [v for v in speeds if not (math.isfinite(v) and v > 0.0)]
     if bad:

@@ -16,7 +16,7 @@ def resolution_for(particles_per_cell: int) -> TableResolution:
     """The default resolution: C = clip(particles_per_cell // 25, 16, 500) clusters, M = 16, L = 24.
 
     Cells with fewer rebounds than particles use fewer clusters
-    (:func:`tablegen.build.tabulate.represent`).
+    (:func:`tablegen.tabulation.tabulate.represent`).
     """
     if particles_per_cell < MIN_PARTICLES_PER_CELL:
         raise ValueError(f"The 'particles_per_cell' parameter must be >= {MIN_PARTICLES_PER_CELL} to build a "

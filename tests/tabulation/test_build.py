@@ -13,8 +13,8 @@ import pytest
 from data_schema.common import DataFormatError
 from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table
 from data_schema.output import OutputError
-from tablegen.build.driver import BuildError, Checkpoint, CheckpointError, build_table
-from tablegen.build.config import parse_config
+from tablegen.tabulation.driver import BuildError, Checkpoint, CheckpointError, build_table
+from tablegen.tabulation.config import parse_config
 from tablegen.model.wall import CORUNDUM_ON_STEEL
 
 TINY = """
@@ -195,3 +195,15 @@ def test_reader_rejects_version_missing_dataset_and_truncation(tiny_table, tmp_p
     bad.write_bytes(data[: len(data) // 3])
     with pytest.raises(DataFormatError, match="v.h5"):
         read_table(bad)
+
+
+def test_every_model_source_is_hashed():
+    """A pattern of MODEL_SOURCES that matches no file (a folder renamed, say) would leave that source out of
+    model_sha256 unnoticed."""
+    from tablegen.tabulation.driver import MODEL_SOURCES, SOURCE_ROOT, model_files
+
+    hashed = set(model_files())
+    for pattern in MODEL_SOURCES:
+        matched = set(SOURCE_ROOT.glob(pattern))
+        assert matched and matched <= hashed, pattern
+    assert {"cells.py", "resolution.py", "tabulate.py", "rebound.py"} <= {path.name for path in hashed}

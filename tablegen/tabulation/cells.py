@@ -3,8 +3,8 @@
 Each cell is an independent task whose seed derives from (master seed, shape,
 α1 index, speed index) (:func:`cell_seed`), so a table is bit-identical
 whatever the number of workers, the scheduler or the order in which cells
-finish. This module and :mod:`tablegen.build.tabulate` decide a cell's content
-with the direct model (:data:`tablegen.build.driver.MODEL_SOURCES`).
+finish. This module and :mod:`tablegen.tabulation.tabulate` decide a cell's content
+with the direct model (:data:`tablegen.tabulation.driver.MODEL_SOURCES`).
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from data_schema.table import CellTable
-from tablegen.build.config import BuildConfig
-from tablegen.build.tabulate import CellAccumulator
+from tablegen.tabulation.config import BuildConfig
+from tablegen.tabulation.tabulate import CellAccumulator
 from tablegen.model.shapes import SHAPES
 from tablegen.model.simulate import simulate
 

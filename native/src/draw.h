@@ -1,0 +1,51 @@
+/*
+ * draw.h: one draw in a located cell (surrogate.kernels.draw.draw_in_cell): the table reads of gather.h and
+ * the arithmetic of arithmetic.h in turn, for one particle (particle.c). Local frame, V⁺ in units of |V⁻|,
+ * Ω⁺ in units of |V⁻|/a.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#ifndef RBS_DRAW_H
+#define RBS_DRAW_H
+
+#include "arithmetic.h"
+#include "gather.h"
+#include "locate.h"
+
+/* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
+ * returns the status (NaN state when trapped). */
+RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
+                                   const double *u, int scaled, double x[6])
+{
+    if (u[3] < t->cells[cell->drawn * CELL_SIZE + CELL_P_TRAPPED]) {
+        for (int k = 0; k < 6; k++) x[k] = NAN;
+        return RBS_TRAPPED;
+    }
+    const float *r = t->clusters;
+    int64_t row = rbs_component(t, cell->drawn, u[4]);
+    double q[6], b[15], state[6];
+    rbs_quantiles(t, cell->drawn, row, u, q);
+    for (int k = 0; k < 15; k++) b[k] = (double)r[row + ROW_SLOPE + k];
+    rbs_chain(q, b, state);
+    double regime = (double)r[row + ROW_REGIME];
+    if (scaled && cell->wa > 0.0) {
+        rbs_term terms[6];
+        double moved[6];
+        rbs_alpha1_terms(t, cell->below, cell->wa, cell->drawn, terms);
+        rbs_moved(state, terms, moved);
+        for (int k = 0; k < 6; k++) state[k] = moved[k];
+    }
+    rbs_velocity(state[0], state[1], state[2], x);
+    x[3] = state[3];
+    x[4] = state[4];
+    x[5] = state[5];
+    if (scaled && cell->wv > 0.0) {
+        double f_target, f_grid;
+        rbs_restitution_factors(t, cell->jv, cell->wv, cell->iv, &f_target, &f_grid);
+        rbs_to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, x);
+    }
+    rbs_mirrored(u[11], x);
+    return RBS_REBOUNDED;
+}
+
+#endif /* RBS_DRAW_H */

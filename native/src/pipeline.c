@@ -1,0 +1,94 @@
+/*
+ * pipeline.c: many particles on one thread (surrogate.kernels.pipeline: rebound_many, rebound_many_rng).
+ *
+ * Rows go through a pipeline of blocks of RBS_BLOCK particles, so that one block's table reads are in
+ * flight while the blocks before it are computed. This file only schedules: while block k is located
+ * (rbs_locate_block, locate.h), block k - 1 has its components resolved (rbs_resolve_block) and block
+ * k - 2 is gathered (rbs_gather_block, gather.h) and drawn (rbs_arithmetic_block, arithmetic.h). Each
+ * stage's block form does the operations of the per-particle code in the same order, so
+ * rbs_rebound_many gives rbs_rebound's bits row by row. rbs_rebound_many_rng draws each block's uniforms
+ * from RBS_BLOCK xoshiro256+ lanes as it enters (surrogate.kernels.rng.fill_lanes).
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "arithmetic.h"
+#include "rebound_internal.h"
+#include "rng_internal.h"
+
+#define STAGES 3
+#define B RBS_BLOCK
+
+/* One block: its rows, uniforms (uniform q of particle b at [q][b]) and the records of its stages */
+typedef struct block {
+    size_t start, m;
+    double u[RBS_U_PER_DRAW][B];
+    rbs_frames frames;
+    rbs_cells cells;
+    rbs_gathered gathered;
+    rbs_results results;
+} block;
+
+RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
+                               const double *a, const double *u, rbs_rng *rng, int scaled, double *V_out,
+                               double *Omega_out, signed char *status)
+{
+    block blocks[STAGES];
+    uint64_t lanes[4 * RBS_BLOCK];
+    memset(blocks, 0, sizeof blocks);
+    if (rng) rbs_lanes_seed(rng, lanes);
+    size_t n_blocks = (count + B - 1) / B;
+    for (size_t j = 0; j < n_blocks + STAGES - 1; j++) {
+        if (j < n_blocks) {
+            block *k = &blocks[j % STAGES];
+            k->start = j * B;
+            k->m = count - k->start < B ? count - k->start : B;
+            if (rng) {
+                rbs_lanes_fill(lanes, &k->u[0][0]);
+            } else {
+                for (int q = 0; q < RBS_U_PER_DRAW; q++)
+                    for (size_t b = 0; b < k->m; b++) k->u[q][b] = u[(k->start + b) * RBS_U_PER_DRAW + q];
+            }
+            rbs_locate_block(t, mix, V, n, a, k->start, k->m, k->u, &k->frames, &k->cells);
+        }
+        if (j >= 1 && j <= n_blocks) {
+            block *k = &blocks[(j - 1) % STAGES];
+            rbs_resolve_block(t, k->u, k->m, &k->frames, &k->cells);
+        }
+        if (j >= 2) {
+            block *k = &blocks[(j - 2) % STAGES];
+            rbs_gather_block(t, k->u, k->m, &k->frames, &k->cells, &k->gathered);
+            rbs_arithmetic_block(&k->gathered, &k->frames, &k->cells, k->u[11], scaled, &k->results, k->start, k->m,
+                                 V_out, Omega_out, status);
+        }
+    }
+}
+
+static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, double *V_out,
+                     double *Omega_out, signed char *status)
+{
+    if (rbs_arguments_ok(t, mix, interpolation)) return 1;
+    for (size_t i = 0; i < count; i++) {
+        for (int k = 0; k < 3; k++) V_out[3 * i + k] = Omega_out[3 * i + k] = NAN;
+        status[i] = RBS_INVALID;
+    }
+    return 0;
+}
+
+void rbs_rebound_many(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
+                      const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
+                      signed char *status)
+{
+    if (arguments(t, mix, interpolation, count, V_out, Omega_out, status))
+        run_blocks(t, mix, count, V, n, a, u, NULL, interpolation == RBS_SCALED, V_out, Omega_out, status);
+}
+
+void rbs_rebound_many_rng(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
+                          const double *a, rbs_rng *rng, int interpolation, double *V_out, double *Omega_out,
+                          signed char *status)
+{
+    if (arguments(t, rng ? mix : NULL, interpolation, count, V_out, Omega_out, status))
+        run_blocks(t, mix, count, V, n, a, NULL, rng, interpolation == RBS_SCALED, V_out, Omega_out, status);
+}
