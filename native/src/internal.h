@@ -102,7 +102,7 @@ typedef struct rbs_raw_cells {
  * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */
 int rbs_derive(rbs_table *table, const rbs_raw_cells *raw, const char **what);
 
-/* derive.c, exposed for tests of the pieces alone */
+/* layout.c, exposed for tests of the pieces alone */
 double *rbs_restitution_pieces(const double *grid, int n, double k, double p, int *n_pieces, size_t *len);
 double rbs_restitution_factor(double V, double k, double p);
 

@@ -1,5 +1,5 @@
 /*
- * derive.c: the kernel arrays a table derives from its cell datasets, as surrogate.kernels.layout
+ * layout.c: the kernel arrays a table derives from its cell datasets, as surrogate.kernels.layout
  * derives them, with the same operations in the same order (so the same bits):
  *
  *   axis records       surrogate.kernels.layout.axis_record / interval_lookup

@@ -110,7 +110,7 @@ PIECE_RATIO = 1.25  # a piece [V_lo, V_hi] has V_hi ≤ PIECE_RATIO · V_lo
 
 def restitution_factor(speed: float, k: float, p: float) -> float:
     """The wall's restitution factor exp(−k V^p) at V = ``speed`` (m/s), from the C library's exp and pow,
-    called one value at a time as native/src/derive.c calls them (no array function whose SIMD kernel
+    called one value at a time as native/src/layout.c calls them (no array function whose SIMD kernel
     depends on the CPU)."""
     return math.exp(-k * math.pow(speed, p))
 
@@ -148,7 +148,7 @@ def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
     Each piece interpolates at the Chebyshev nodes: c_j = (2 − δ_j0)/N Σ_q f(x_q) T_j(x_q), then
     power_i = Σ_j c_j [T_j]_i. Every sum is a plain loop in index order over scalars, the only library
     calls are exp and pow on one value at a time, so the bits are the same whichever SIMD kernels numpy
-    and its BLAS pick on this CPU; native/src/derive.c (rbs_restitution_pieces) repeats the same
+    and its BLAS pick on this CPU; native/src/layout.c (rbs_restitution_pieces) repeats the same
     operations in the same order.
     """
     grid = [float(v) for v in np.asarray(speed_grid, dtype=np.float64).ravel()]
