@@ -46,6 +46,13 @@ RBS_INLINE int64_t rbs_trunc(double x)
 #endif
 }
 
+/* an index i clamped into [0, last] at both ends (surrogate.kernels.fastmath.clamp_index): min(max(i, 0), last) */
+RBS_INLINE int64_t rbs_clamp_index(int64_t i, int64_t last)
+{
+    i = i < 0 ? 0 : i;
+    return last < i ? last : i;
+}
+
 /* numba's min(a, b) and max(a, b) of floats: b if b < a (b > a) else a */
 RBS_INLINE double rbs_fmin_py(double a, double b) { return b < a ? b : a; }
 RBS_INLINE double rbs_fmax_py(double a, double b) { return b > a ? b : a; }
@@ -143,8 +150,7 @@ RBS_INLINE double rbs_atan2_q1_simd(double y, double x)
 RBS_INLINE double rbs_restitution_at(const double *pieces, int64_t n_pieces, int64_t j, double w)
 {
     double t = w * (double)n_pieces;
-    int64_t i = rbs_trunc(t);
-    i = (n_pieces - 1) < i ? (n_pieces - 1) : i;
+    int64_t i = rbs_clamp_index(rbs_trunc(t), n_pieces - 1);
     double x = 2.0 * (t - (double)i) - 1.0;
     const double *piece = pieces + (j * n_pieces + i) * 10;
     double value = piece[9];

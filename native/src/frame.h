@@ -19,10 +19,47 @@ RBS_INLINE double rbs_dot(double a0, double a1, double a2, double b0, double b1,
     return fma(a0, b0, fma(a1, b1, a2 * b2));
 }
 
-/* V·n < 0 and V finite */
-RBS_INLINE int rbs_moves_into_wall(const double *V, const double *n)
+/* x finite: x − x is 0 only for finite x (a compare, which SIMD loops take, where isfinite is a call) */
+RBS_INLINE int rbs_finite(double x)
 {
-    return rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]) < 0.0 && isfinite(V[0] + V[1] + V[2]);
+    return x - x == 0.0;
+}
+
+/* V·n < 0 and V finite: a particle that hits the wall (else RBS_INVALID at once) */
+RBS_INLINE int rbs_moves_into_wall(double V0, double V1, double V2, double n0, double n1, double n2)
+{
+    return (rbs_dot(V0, V1, V2, n0, n1, n2) < 0.0) & rbs_finite(V0 + V1 + V2);
+}
+
+/* (1 ∓ RBS_NORMAL_TOLERANCE)²: the bounds of n·n, so the unit check needs no square root */
+#define RBS_NORMAL_MIN2 ((1.0 - RBS_NORMAL_TOLERANCE) * (1.0 - RBS_NORMAL_TOLERANCE))
+#define RBS_NORMAL_MAX2 ((1.0 + RBS_NORMAL_TOLERANCE) * (1.0 + RBS_NORMAL_TOLERANCE))
+
+/* The rest of what a draw needs of its particle (surrogate.kernels.frame.particle_ok): | |n| − 1 | <=
+ * RBS_NORMAL_TOLERANCE (as (1 ∓ tolerance)² bounds on n·n) and a finite and > 0. Checked with the result
+ * (rbs_to_global), not before the draw: the table reads stay in range whatever the particle. */
+RBS_INLINE int rbs_particle_ok(double n0, double n1, double n2, double a)
+{
+    double nn = rbs_dot(n0, n1, n2, n0, n1, n2);
+    return (nn >= RBS_NORMAL_MIN2) & (nn <= RBS_NORMAL_MAX2) & (a > 0.0) & rbs_finite(a);
+}
+
+/* The RBS_U_PER_DRAW uniforms u[0], u[stride], ... all in [0, 1) (NaN is not; surrogate.kernels.frame.uniforms_ok).
+ * Checked with the result: the table indices are clamped into the drawn cell, so the draw reads in range
+ * whatever the uniforms, and what it draws from bad ones is discarded. */
+RBS_INLINE int rbs_uniforms_ok(const double *u, size_t stride)
+{
+    int ok = 1;
+    for (int k = 0; k < RBS_U_PER_DRAW; k++) ok &= (u[k * stride] >= 0.0) & (u[k * stride] < 1.0);
+    return ok;
+}
+
+/* V⁺ (m/s) and Ω⁺ (rad/s) that may be reported as a rebound (surrogate.kernels.frame.rebound_ok): all
+ * finite, and V⁺ leaving the wall (V⁺·n > 0); what overflows or underflows on extreme inputs is not. */
+RBS_INLINE int rbs_rebound_ok(const double *V, const double *W, const double *n)
+{
+    return rbs_finite(V[0]) & rbs_finite(V[1]) & rbs_finite(V[2]) & rbs_finite(W[0]) & rbs_finite(W[1])
+           & rbs_finite(W[2]) & (rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]) > 0.0);
 }
 
 typedef struct rbs_frame {
@@ -81,21 +118,22 @@ RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis
 }
 
 /* A local draw x = (vx, vy, vz, wx, wy, wz) (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the
- * frame (ex, n, ez); NaN unless rebounded (surrogate.kernels.frame.to_global). */
-RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, double a, const double *ex,
-                                 const double *n, const double *ez, double *V_out, double *Omega_out)
+ * frame (ex, n, ez); returns the status: RBS_INVALID unless `ok` (the particle's and the uniforms' checks)
+ * and, for a rebound, rbs_rebound_ok. NaN unless rebounded (surrogate.kernels.frame.to_global). */
+RBS_INLINE int rbs_to_global(int status, int ok, const double x[6], double speed, double a, const double *ex,
+                                const double *n, const double *ez, double *V_out, double *Omega_out)
 {
-    if (status != RBS_REBOUNDED) {
-        for (int k = 0; k < 3; k++) V_out[k] = Omega_out[k] = NAN;
-        return;
-    }
+    double V[3], W[3];
     double w = speed / a;
+    for (int k = 0; k < 3; k++) V[k] = speed * rbs_dot(x[0], x[1], x[2], ex[k], n[k], ez[k]);
+    for (int k = 0; k < 3; k++) W[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
+    ok &= status != RBS_REBOUNDED || rbs_rebound_ok(V, W, n);
+    status = ok ? status : RBS_INVALID;
     for (int k = 0; k < 3; k++) {
-        V_out[k] = speed * rbs_dot(x[0], x[1], x[2], ex[k], n[k], ez[k]);
+        V_out[k] = status == RBS_REBOUNDED ? V[k] : NAN;
+        Omega_out[k] = status == RBS_REBOUNDED ? W[k] : NAN;
     }
-    for (int k = 0; k < 3; k++) {
-        Omega_out[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
-    }
+    return status;
 }
 
 #endif /* RBS_FRAME_H */

@@ -36,8 +36,7 @@ RBS_INLINE int64_t rbs_level(const rbs_table *t, int64_t cell, int64_t k, int64_
 RBS_INLINE int64_t rbs_first_row(const rbs_table *t, int64_t cell, double u4, double *t_out, int64_t *c_out)
 {
     double x = u4 * (double)t->n_clusters;
-    int64_t c = rbs_trunc(x);
-    c = (t->n_clusters - 1) < c ? (t->n_clusters - 1) : c;
+    int64_t c = rbs_clamp_index(rbs_trunc(x), t->n_clusters - 1);
     *t_out = x;
     *c_out = c;
     return rbs_row(t, cell, c);
@@ -60,8 +59,7 @@ RBS_INLINE double rbs_quantile(const rbs_table *t, int64_t cell, int64_t row, in
     const float *r = t->clusters;
     int64_t levels = t->n_levels - 1;
     double x = u * (double)levels;
-    int64_t i = rbs_trunc(x);
-    i = (levels - 1) < i ? (levels - 1) : i;
+    int64_t i = rbs_clamp_index(rbs_trunc(x), levels - 1);
     int64_t at = rbs_level(t, cell, k, i) + (int64_t)r[row + ROW_SHAPE + k];
     double lo = (double)t->dictionary[at], hi = (double)t->dictionary[at + t->n_dictionary];
     return fma((double)r[row + ROW_SCALE + k], fma(x - (double)i, hi - lo, lo), (double)r[row + ROW_LOC + k]);
@@ -115,8 +113,7 @@ RBS_INLINE void rbs_hint_levels(const rbs_table *t, int64_t drawn, const double 
 {
     int64_t levels = t->n_levels - 1;
     for (int k = 0; k < 6; k++) {
-        int64_t i = rbs_trunc(u[5 + k] * (double)levels);
-        i = (levels - 1) < i ? (levels - 1) : i;
+        int64_t i = rbs_clamp_index(rbs_trunc(u[5 + k] * (double)levels), levels - 1);
         int64_t level = rbs_level(t, drawn, k, i);
         RBS_PREFETCH(t->dictionary + level);
         RBS_PREFETCH(t->dictionary + level + t->n_dictionary);

@@ -33,7 +33,7 @@ typedef struct block {
     size_t start, m;
     double u[RBS_U_PER_DRAW][B];
     /* frame (step 1) */
-    double Vin[3][B], valid[B], normal[B], alpha1[B], speed[B], cos_a1[B], sin_a1[B], a[B], ex[3][B], ez[3][B], n[3][B];
+    double Vin[3][B], valid[B], ok[B], normal[B], alpha1[B], speed[B], cos_a1[B], sin_a1[B], a[B], ex[3][B], ez[3][B], n[3][B];
     /* cell (steps 1, 2) */
     int64_t drawn[B], below[B], jv[B], iv[B], row[B];
     double wa[B], wv[B];
@@ -44,8 +44,8 @@ typedef struct block {
     double status[B], V[3][B], W[3][B];
 } block;
 
-/* step 1a: validity and impact frame of every row (rbs_impact_frame, the same operations), on the block's
- * rows copied field-major (rows past the end: V = 0, n = e_y, a = 1, invalid) */
+/* step 1a: validity (rbs_moves_into_wall; `ok`: rbs_particle_ok and the uniforms' check) and impact frame of every row (rbs_impact_frame, the same
+ * operations), on the block's rows copied field-major (rows past the end: V = 0, n = e_y, a = 1, invalid) */
 RBS_INLINE void frames(const double *V, const double *n, const double *a, block *k)
 {
     for (size_t b = 0; b < B; b++) {
@@ -61,8 +61,8 @@ RBS_INLINE void frames(const double *V, const double *n, const double *a, block 
         double V0 = k->Vin[0][b], V1 = k->Vin[1][b], V2 = k->Vin[2][b];
         double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
         double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
-        double finite = V0 + V1 + V2;
-        k->valid[b] = (vn < 0.0) & (finite - finite == 0.0) ? 1.0 : 0.0;
+        k->valid[b] = rbs_moves_into_wall(V0, V1, V2, n0, n1, n2) ? 1.0 : 0.0;
+        k->ok[b] = rbs_particle_ok(n0, n1, n2, k->a[b]) & (k->ok[b] != 0.0) ? 1.0 : 0.0;
         double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
         double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));
         double speed = sqrt(fma(vn, vn, vt * vt));
@@ -130,8 +130,7 @@ RBS_INLINE void resolve(const rbs_table *t, block *k)
         rbs_hint_row(t, k->row[b]);
         int64_t levels = t->n_levels - 1;
         for (int j = 0; j < 6; j++) {
-            int64_t i = rbs_trunc(k->u[5 + j][b] * (double)levels);
-            i = (levels - 1) < i ? (levels - 1) : i;
+            int64_t i = rbs_clamp_index(rbs_trunc(k->u[5 + j][b] * (double)levels), levels - 1);
             int64_t level = rbs_level(t, drawn, j, i);
             RBS_PREFETCH(t->dictionary + level);
             RBS_PREFETCH(t->dictionary + level + t->n_dictionary);
@@ -161,8 +160,7 @@ RBS_INLINE void gather(const rbs_table *t, block *k)
         }
         /* the restitution piece at the incident speed (evaluated in the SIMD loop) and the grid speed's factor */
         double x = k->wv[b] * (double)t->n_pieces;
-        int64_t i = rbs_trunc(x);
-        i = (t->n_pieces - 1) < i ? (t->n_pieces - 1) : i;
+        int64_t i = rbs_clamp_index(rbs_trunc(x), t->n_pieces - 1);
         k->piece_x[b] = 2.0 * (x - (double)i) - 1.0;
         const double *piece = t->restitution_pieces + (k->jv[b] * t->n_pieces + i) * 10;
         for (int d = 0; d < 10; d++) k->piece[d][b] = piece[d];
@@ -207,14 +205,19 @@ RBS_INLINE void arithmetic(block *k, int scaled)
         int move_speed = scaled & (k->wv[b] > 0.0);
         for (int j = 0; j < 6; j++) x[j] = move_speed ? x[j] : local[j];
         rbs_mirrored(k->u[11][b], x);
-        int rebounded = k->trapped[b] <= 0.5;
-        k->status[b] = rebounded ? (double)RBS_REBOUNDED : (double)RBS_TRAPPED;
-        double speed = k->speed[b], w = speed / k->a[b];
+        double speed = k->speed[b], w = speed / k->a[b], v[3], o[3], n[3];
         for (int j = 0; j < 3; j++) {
-            double v = speed * rbs_dot(x[0], x[1], x[2], k->ex[j][b], k->n[j][b], k->ez[j][b]);
-            double o = w * rbs_dot(x[3], x[4], x[5], k->ex[j][b], k->n[j][b], k->ez[j][b]);
-            k->V[j][b] = rebounded ? v : NAN;
-            k->W[j][b] = rebounded ? o : NAN;
+            n[j] = k->n[j][b];
+            v[j] = speed * rbs_dot(x[0], x[1], x[2], k->ex[j][b], n[j], k->ez[j][b]);
+            o[j] = w * rbs_dot(x[3], x[4], x[5], k->ex[j][b], n[j], k->ez[j][b]);
+        }
+        /* rbs_to_global's status */
+        int ok = k->ok[b] != 0.0, trapped = k->trapped[b] > 0.5;
+        int rebounded = ok & (trapped == 0) & rbs_rebound_ok(v, o, n);
+        k->status[b] = rebounded ? (double)RBS_REBOUNDED : ok & trapped ? (double)RBS_TRAPPED : (double)RBS_INVALID;
+        for (int j = 0; j < 3; j++) {
+            k->V[j][b] = rebounded ? v[j] : NAN;
+            k->W[j][b] = rebounded ? o[j] : NAN;
         }
     }
 }
@@ -249,9 +252,11 @@ RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t co
             k->m = count - k->start < B ? count - k->start : B;
             if (rng) {
                 rbs_lanes_fill(lanes, &k->u[0][0]);
+                for (size_t b = 0; b < B; b++) k->ok[b] = 1.0;    /* a lane's uniforms are in [0, 1) */
             } else {
                 for (int q = 0; q < RBS_U_PER_DRAW; q++)
                     for (size_t b = 0; b < k->m; b++) k->u[q][b] = u[(k->start + b) * RBS_U_PER_DRAW + q];
+                for (size_t b = 0; b < B; b++) k->ok[b] = rbs_uniforms_ok(&k->u[0][b], B) ? 1.0 : 0.0;
             }
             frames(V, n, a, k);
             cells(t, mix, k);
@@ -266,14 +271,26 @@ RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t co
     }
 }
 
-static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, double *V_out,
-                     double *Omega_out, signed char *status)
+/* NaN and RBS_INVALID into the outputs a caller gave (any may be NULL) */
+static void all_invalid(size_t count, double *V_out, double *Omega_out, signed char *status)
 {
-    if (rbs_arguments_ok(t, mix, interpolation)) return 1;
     for (size_t i = 0; i < count; i++) {
-        for (int k = 0; k < 3; k++) V_out[3 * i + k] = Omega_out[3 * i + k] = NAN;
-        status[i] = RBS_INVALID;
+        for (int k = 0; k < 3; k++) {
+            if (V_out) V_out[3 * i + k] = NAN;
+            if (Omega_out) Omega_out[3 * i + k] = NAN;
+        }
+        if (status) status[i] = RBS_INVALID;
     }
+}
+
+/* a table, a mix of its shape count, a known interpolation, no NULL array (with count > 0); else every row invalid */
+static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, const double *V,
+                     const double *n, const double *a, const void *uniforms, double *V_out, double *Omega_out,
+                     signed char *status)
+{
+    int arrays = count == 0 || (V && n && a && uniforms && V_out && Omega_out && status);
+    if (arrays && rbs_arguments_ok(t, mix, interpolation)) return 1;
+    all_invalid(count, V_out, Omega_out, status);
     return 0;
 }
 
@@ -281,7 +298,7 @@ void rbs_rebound_many(const rbs_table *t, const rbs_mix *mix, size_t count, cons
                       const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
                       signed char *status)
 {
-    if (arguments(t, mix, interpolation, count, V_out, Omega_out, status))
+    if (arguments(t, mix, interpolation, count, V, n, a, u, V_out, Omega_out, status))
         run_blocks(t, mix, count, V, n, a, u, NULL, interpolation == RBS_SCALED, V_out, Omega_out, status);
 }
 
@@ -289,6 +306,6 @@ void rbs_rebound_many_rng(const rbs_table *t, const rbs_mix *mix, size_t count, 
                           const double *a, rbs_rng *rng, int interpolation, double *V_out, double *Omega_out,
                           signed char *status)
 {
-    if (arguments(t, rng ? mix : NULL, interpolation, count, V_out, Omega_out, status))
+    if (arguments(t, rbs_rng_ok(rng) ? mix : NULL, interpolation, count, V, n, a, rng, V_out, Omega_out, status))
         run_blocks(t, mix, count, V, n, a, NULL, rng, interpolation == RBS_SCALED, V_out, Omega_out, status);
 }

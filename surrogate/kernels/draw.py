@@ -53,7 +53,8 @@ import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import N_CHAIN
-from surrogate.kernels.fastmath import fma, restitution_at, sincos
+from surrogate.kernels.fastmath import clamp_index, fma, restitution_at, sincos
+from surrogate.kernels.frame import STATUS_INVALID, rebound_ok, uniforms_ok
 from surrogate.kernels.layout import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED,
                                       CELL_SD, CELL_SIZE, FLOAT32_PER_CACHE_LINE, ROW_ALIAS, ROW_ALIAS_PROB, ROW_LOC,
                                       ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SIZE, ROW_SLOPE)
@@ -75,8 +76,9 @@ def grid_interval(axis, n, x):
         return 0, 0.0
     inverse = AXIS_GRID + n     # where the inverse spacings start
     lookup = inverse + n - 1    # where the look-up indices start
-    k = int((x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP))
-    k = min(max(k, 0), axis.shape[0] - 1 - lookup)
+    last = axis.shape[0] - 1 - lookup
+    # clamped before the conversion: a huge x would overflow it to INT64_MIN, an interior point
+    k = clamp_index(int(min(max((x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP), 0.0), last)), last)
     j = int(load(axis, lookup + k))
     j += (x >= load(axis, AXIS_GRID + j + 1)) & (j < n - 2)     # one-step correction, no branch to mispredict
     w = (x - load(axis, AXIS_GRID + j)) * load(axis, inverse + j)
@@ -101,7 +103,7 @@ def first_row(data, cell, u4):
     """(t, c, offset of row c): the component u4 picks in cell number ``cell`` before the alias table,
     c = ⌊t⌋ with t = u4 · n_clusters."""
     t = u4 * data.n_clusters
-    c = min(int(t), data.n_clusters - 1)
+    c = clamp_index(int(t), data.n_clusters - 1)
     return t, c, _row(data, cell, c)
 
 
@@ -123,7 +125,7 @@ def _quantile(data, cell, row, k, u):
     r = data.clusters
     levels = data.n_levels - 1
     t = u * levels
-    i = min(int(t), levels - 1)
+    i = clamp_index(int(t), levels - 1)
     at = _level(data, cell, k, i) + int(load(r, row + ROW_SHAPE + k))
     lo, hi = np.float64(load(data.dictionary, at)), np.float64(load(data.dictionary, at + data.n_dictionary))
     return fma(np.float64(load(r, row + ROW_SCALE + k)), fma(t - i, hi - lo, lo), np.float64(load(r, row + ROW_LOC + k)))
@@ -366,7 +368,7 @@ def hint_levels(data, drawn, u):
 def _hint_level(data, drawn, k, u):
     """Cache hints for the two residual-shape levels of chain variable k that u picks (:func:`_quantile`)."""
     levels = data.n_levels - 1
-    level = _level(data, drawn, k, min(int(u * levels), levels - 1))
+    level = _level(data, drawn, k, clamp_index(int(u * levels), levels - 1))
     prefetch(data.dictionary, (level,))
     prefetch(data.dictionary, (level + data.n_dictionary,))
 
@@ -448,14 +450,27 @@ def draw_velocity(data, mix_cdf, alpha1, speed, u, scaled=True):
     return draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
 
 
+@numba.njit(inline="always", **JIT)
+def local_ok(alpha1, speed):
+    """A local incident state a draw takes: α1 in (0, 90] deg, |V⁻| finite and > 0 m/s."""
+    return alpha1 > 0.0 and alpha1 <= 90.0 and speed > 0.0 and math.isfinite(speed)
+
+
 @numba.njit(**KERNEL)
 def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
     """One reflected state at (α1 deg, |V⁻| m/s) in the local frame: (status, α2, β2, s, Ω_x, Ω_y, Ω_z).
 
     Angles in radians, s = |V⁺|/|V⁻|, Ω in units of |V⁻|/a; the state is NaN
     for a trapped particle. See :func:`draw_velocity` (same arguments).
+    STATUS_INVALID (and NaN) for α1 outside (0, 90] or NaN, |V⁻| not finite
+    and > 0, a uniform outside [0, 1), or a draw that is not a finite rebound
+    leaving the wall (as rbs_draw_local).
     """
+    if not local_ok(alpha1, speed):
+        return STATUS_INVALID, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
+    ok = uniforms_ok(u) & ((status != STATUS_REBOUNDED) | rebound_ok((vx, vy, vz), (wx, wy, wz), (0.0, 1.0, 0.0)))
+    status = status if ok else STATUS_INVALID
     if status != STATUS_REBOUNDED:
         return status, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     s = math.sqrt(vx * vx + vy * vy + vz * vz)

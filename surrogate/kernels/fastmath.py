@@ -57,6 +57,13 @@ def fma(typingctx, a, b, c):
     return types.float64(a, b, c), codegen
 
 
+@numba.njit(inline="always", **JIT)
+def clamp_index(i, last):
+    """An index i clamped into [0, last] at both ends (rbs_clamp_index): a uniform outside [0, 1), or NaN
+    (int(NaN) is INT64_MIN on x86-64), reads in range."""
+    return min(max(i, 0), last)
+
+
 _HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double
 _HALF_PI_LO = 6.123233995736766e-17    # π/2 − _HALF_PI_HI
 _TWO_OVER_PI = 2.0 / math.pi
@@ -138,7 +145,7 @@ def restitution_at(pieces, n_pieces, j, w):
     """exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w ∈ [0, 1], from :func:`restitution_pieces` flattened
     (``pieces`` 1-D, ``n_pieces`` its S: piece i of interval j starts at (j S + i)(DEGREE + 1))."""
     t = w * n_pieces
-    i = min(int(t), n_pieces - 1)
+    i = clamp_index(int(t), n_pieces - 1)
     x = 2.0 * (t - i) - 1.0
     start = (j * n_pieces + i) * (DEGREE + 1)
     value = load(pieces, start + DEGREE)

@@ -17,8 +17,12 @@ from surrogate.kernels.fastmath import atan2_first_quadrant, fma, sincos
 from surrogate.kernels.options import JIT
 
 
-STATUS_INVALID = -1     # the status of an incident state that does not move into the wall
+STATUS_INVALID = -1     # the status of a draw whose inputs or result are not those of a rebound (see to_global)
 NORMAL_IMPACT = 1e-12   # a tangential speed below this fraction of |V| is normal impact: ex drawn in the wall plane
+NORMAL_TOLERANCE = 1e-6     # | |n| − 1 | allowed for a wall normal (RBS_NORMAL_TOLERANCE)
+# (1 ∓ NORMAL_TOLERANCE)²: the bounds of n·n, so the kernels' unit check needs no square root
+NORMAL_MIN2 = (1.0 - NORMAL_TOLERANCE) * (1.0 - NORMAL_TOLERANCE)
+NORMAL_MAX2 = (1.0 + NORMAL_TOLERANCE) * (1.0 + NORMAL_TOLERANCE)
 
 
 @numba.njit(inline="always", **JIT)
@@ -60,8 +64,45 @@ NAN3 = (np.nan, np.nan, np.nan)     # the V⁺ and Ω⁺ of a draw that did not 
 
 @numba.njit(inline="always", **JIT)
 def moves_into_wall(V, n):
-    """V·n < 0 and V finite."""
+    """V·n < 0 and V finite: a particle that hits the wall (else STATUS_INVALID at once)."""
     return dot(V, n) < 0.0 and math.isfinite(V[0] + V[1] + V[2])
+
+
+@numba.njit(inline="always", **JIT)
+def unit_normal(n):
+    """| |n| − 1 | ≤ NORMAL_TOLERANCE, as bounds on n·n (no square root)."""
+    nn = dot(n, n)
+    return (nn >= NORMAL_MIN2) & (nn <= NORMAL_MAX2)
+
+
+@numba.njit(inline="always", **JIT)
+def particle_ok(n, a):
+    """The rest of what a draw needs of its particle: a unit normal (:func:`unit_normal`) and a (m) finite
+    and > 0. Checked with the result (:func:`to_global`), not before the draw: the table reads stay in
+    range whatever the particle."""
+    return unit_normal(n) & (a > 0.0) & math.isfinite(a)
+
+
+@numba.njit(inline="always", **JIT)
+def uniforms_ok(u):
+    """The U_PER_DRAW = 13 uniforms of a draw (an array or a tuple) all in [0, 1); NaN is not. Checked with
+    the result: the table indices are clamped into the drawn cell, so bad uniforms read in range and what
+    they draw is discarded."""
+    return (_unit(u[0]) & _unit(u[1]) & _unit(u[2]) & _unit(u[3]) & _unit(u[4]) & _unit(u[5]) & _unit(u[6])
+            & _unit(u[7]) & _unit(u[8]) & _unit(u[9]) & _unit(u[10]) & _unit(u[11]) & _unit(u[12]))
+
+
+@numba.njit(inline="always", **JIT)
+def _unit(x):
+    return (x >= 0.0) & (x < 1.0)
+
+
+@numba.njit(inline="always", **JIT)
+def rebound_ok(V, W, n):
+    """V⁺ and Ω⁺ (3-tuples) that may be reported as a rebound: all finite, and V⁺ leaving the wall
+    (V⁺·n > 0); what overflows or underflows at extreme |V⁻| or a is not."""
+    return (math.isfinite(V[0]) & math.isfinite(V[1]) & math.isfinite(V[2]) & math.isfinite(W[0])
+            & math.isfinite(W[1]) & math.isfinite(W[2]) & (dot(V, n) > 0.0))
 
 
 @numba.njit(inline="always", **JIT)
@@ -71,13 +112,16 @@ def dot(a, b):
 
 
 @numba.njit(inline="always", **JIT)
-def to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
-    """A local draw (units |V⁻|, |V⁻|/a) as (V⁺ in m/s, Ω⁺ in rad/s) in the frame (ex, n, ez), 3-tuples;
-    NaN unless rebounded."""
-    if status != STATUS_REBOUNDED:
-        return NAN3, NAN3
+def to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez):
+    """A local draw (units |V⁻|, |V⁻|/a) as (status, V⁺ in m/s, Ω⁺ in rad/s) in the frame (ex, n, ez),
+    3-tuples; the status is STATUS_INVALID unless ``ok`` (:func:`particle_ok`, :func:`uniforms_ok`) and,
+    for a rebound, :func:`rebound_ok`. NaN unless rebounded."""
     w = speed / a
     v, o = (vx, vy, vz), (wx, wy, wz)
-    return ((speed * dot(v, (ex[0], n[0], ez[0])), speed * dot(v, (ex[1], n[1], ez[1])),
-             speed * dot(v, (ex[2], n[2], ez[2]))),
-            (w * dot(o, (ex[0], n[0], ez[0])), w * dot(o, (ex[1], n[1], ez[1])), w * dot(o, (ex[2], n[2], ez[2]))))
+    V = (speed * dot(v, (ex[0], n[0], ez[0])), speed * dot(v, (ex[1], n[1], ez[1])),
+         speed * dot(v, (ex[2], n[2], ez[2])))
+    W = (w * dot(o, (ex[0], n[0], ez[0])), w * dot(o, (ex[1], n[1], ez[1])), w * dot(o, (ex[2], n[2], ez[2])))
+    ok = ok & ((status != STATUS_REBOUNDED) | rebound_ok(V, W, n))
+    status = status if ok else STATUS_INVALID
+    rebounded = status == STATUS_REBOUNDED
+    return status, V if rebounded else NAN3, W if rebounded else NAN3

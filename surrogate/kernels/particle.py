@@ -9,7 +9,8 @@ to the global frame. V⁻ in m/s in, V⁺ in m/s and Ω⁺ in rad/s out.
 import numba
 
 from surrogate.kernels.draw import draw_in_cell, hint, locate
-from surrogate.kernels.frame import NAN3, STATUS_INVALID, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.frame import (NAN3, STATUS_INVALID, impact_frame, moves_into_wall, particle_ok, to_global,
+                                     uniforms_ok)
 from surrogate.kernels.options import JIT, KERNEL
 
 
@@ -22,15 +23,17 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out, scaled=True):
     data : ``table.kernel_data``.
     mix_cdf : cumulative shape weights (table shape order).
     V : (3,) incident velocity, m/s; must move into the wall (V·n < 0).
-    n : (3,) unit wall normal pointing into the gas (not checked here).
-    a : particle half-size (half its largest extent), m.
+    n : (3,) unit wall normal pointing into the gas (| |n| − 1 | ≤ NORMAL_TOLERANCE).
+    a : particle half-size (half its largest extent), m, finite and > 0.
     u : (U_PER_DRAW,) uniforms in [0, 1).
     V_out, Omega_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
     scaled : between grid points, move the draw to the incident state
         (default; :func:`draw_velocity`); False: plain stochastic interpolation.
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
-    move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
+    move into the wall (V·n ≥ 0, zero or non-finite), n is not a unit vector,
+    a is not finite and > 0, a uniform is outside [0, 1), or the result would
+    not be finite or would not leave the wall (as rbs_rebound). The impact frame is ex
     (tangential direction of V), n, ez = ex × n; the local draw is rotated back
     into the global frame. The mirror symmetry of the model is applied with a
     random sign (:func:`surrogate.kernels.draw.arithmetic`). An α1 or |V⁻| outside the table's
@@ -63,8 +66,8 @@ def _rebound(data, mix_cdf, V, n, a, u, scaled):
     cell = locate(data, mix_cdf, alpha1, speed, u)
     hint(data, cell, u)
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
-    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
-    return status, V_new, Omega_new
+    ok = particle_ok(n, a) & uniforms_ok(u)
+    return to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
 
 
 @numba.njit(inline="always", **JIT)

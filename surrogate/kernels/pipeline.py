@@ -27,7 +27,7 @@ import numpy as np
 
 from surrogate.kernels.draw import (U_PER_DRAW, arithmetic, component, first_row, gather_cell, gather_component,
                                     hint_levels, hint_row, locate)
-from surrogate.kernels.frame import STATUS_INVALID, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.frame import STATUS_INVALID, impact_frame, moves_into_wall, particle_ok, to_global, uniforms_ok
 from surrogate.kernels.memory import load, load3, load6, load15
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import fill_lanes, seed_lanes
@@ -57,7 +57,10 @@ G_Q, G_SLOPE = 22, 28          # draw.gather_component: residual quantiles (6) a
 G_RATIO, G_SHIFT = 43, 49       # draw.gather_cell: 6 ratios; (m_cell, m) of α2, s, Ω_z (the others are centred)
 
 
-G_FIELDS = 55
+G_OK = 55                       # particle_ok and uniforms_ok, applied with the result (frame.to_global)
+
+
+G_FIELDS = 56
 
 
 OUT_STATUS, OUT_V, OUT_OMEGA, OUT_FIELDS = 0, 1, 4, 7                           # the draws' results, same layout
@@ -109,10 +112,18 @@ def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, status, sc
     (a block's uniforms are drawn when it enters the pipeline). Seeding the
     lanes costs about 0.1 µs per call, so call it on many rows at once.
     """
-    if state.shape[0] != 4:
-        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.seed_state gives")
+    check_state(state)
     check_rows(V, n, a, V_out, Omega_out, status)
     run_blocks(data, mix_cdf, V, n, a, no_uniforms(), state, V_out, Omega_out, status, scaled)
+
+
+@numba.njit(**JIT)
+def check_state(state):
+    """ValueError unless ``state`` is one xoshiro256+ state: (4,) uint64, not all zero (the generator's
+    fixed point; rbs_rebound_many_rng gives every row RBS_INVALID for it)."""
+    if state.shape[0] != 4 or (state[0] | state[1] | state[2] | state[3]) == 0:
+        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64 not all zero, as surrogate.seed_state "
+                         "gives")
 
 
 @numba.njit(**JIT)
@@ -318,6 +329,7 @@ def _frame(V, n, a, ub, i, g, b):
     Vi, ni = (V[3 * i], V[3 * i + 1], V[3 * i + 2]), (n[3 * i], n[3 * i + 1], n[3 * i + 2])
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[12 * BLOCK + b])
     _put3(g, G_VALID, b, (1.0 if moves_into_wall(Vi, ni) else 0.0, alpha1, speed))
+    g[G_OK * BLOCK + b] = 1.0 if particle_ok(ni, a[i]) & uniforms_ok(_uniforms(ub, b)) else 0.0
     _put3(g, G_COS, b, (cos_a1, sin_a1, a[i]))
     _put3(g, G_EX, b, ex)
     _put3(g, G_EZ, b, ez)
@@ -387,7 +399,8 @@ def _arithmetic(g, out, b, scaled):
                 _fields6(g, G_RATIO, b), _fields6(g, G_SHIFT, b), _field(g, G_F_TARGET, b), _field(g, G_F_GRID, b))
     status, vx, vy, vz, wx, wy, wz = arithmetic(gathered, _field(g, G_COS, b), _field(g, G_SIN, b), scaled)
     ex, n, ez = load3(g, G_EX * BLOCK + b, BLOCK), load3(g, G_N * BLOCK + b, BLOCK), load3(g, G_EZ * BLOCK + b, BLOCK)
-    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, _field(g, G_SPEED, b), _field(g, G_A, b), ex, n, ez)
+    status, V_new, Omega_new = to_global(status, _field(g, G_OK, b) != 0.0, vx, vy, vz, wx, wy, wz,
+                                         _field(g, G_SPEED, b), _field(g, G_A, b), ex, n, ez)
     out[OUT_STATUS * BLOCK + b] = status
     _put3(out, OUT_V, b, V_new)
     _put3(out, OUT_OMEGA, b, Omega_new)
