@@ -136,10 +136,11 @@ typedef struct rbs_table_info {
 /* ---------------------------------------------------------------- tables */
 
 /* Open and check a table file, derive the kernel arrays; *table = NULL on error.
- * Checks as data_schema.table.check_file / read_table: the file exists and is HDF5, file_type
- * "rebound_table", format_version (3, any minor), the groups grid, resolution, cells, every cell
- * dataset with its shape, the grids (increasing, finite), the wall law attributes restitution_k,
- * restitution_p (finite, > 0); then the derived arrays are checked finite.
+ * Checks what data_schema.table.read_table checks, the whole of docs/format.md "What makes a table
+ * valid": the file is a regular HDF5 file, file_type "rebound_table", format_version (3, any minor), the
+ * groups, datasets (every one read, so every checksum verified) and attributes with their shapes, the
+ * grids and shape names, the wall law (and its checksummed copy since 3.2), the cell values; then the
+ * derived arrays are checked finite.
  * Returns RBS_OK, RBS_ERR_IO, RBS_ERR_FORMAT, RBS_ERR_VERSION, RBS_ERR_MEMORY or RBS_ERR_ARGUMENT. */
 int rbs_table_open(const char *path, rbs_table **table, char *message, size_t message_size);
 
