@@ -93,6 +93,7 @@ def check_output(path, kind: str, overwrite: bool = False, inputs=(), folder: bo
         raise OutputError(f"{path}: the folder {parent} does not exist; create it first")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise OutputError(f"{path}: the folder {parent} is not writable")
+    _probe(path)
     if not (path.exists() or path.is_symlink()):
         return path
     for item in inputs:
@@ -112,6 +113,17 @@ def check_output(path, kind: str, overwrite: bool = False, inputs=(), folder: bo
         except OSError as exc:
             raise OutputError(f"{path}: cannot be replaced: {exc.strerror}") from None
     return path
+
+
+def _probe(path: Path) -> None:
+    """OutputError unless a file can be made next to ``path`` (os.access says yes to root in /proc, where the
+    write then fails after the work, naming the temporary file)."""
+    probe = _temporary_name(path)
+    try:
+        os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write in the folder {path.parent}: {exc.strerror}") from None
+    os.remove(probe)
 
 
 def _temporary_name(path: Path) -> Path:

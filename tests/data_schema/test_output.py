@@ -63,3 +63,9 @@ def test_a_failed_write_names_the_target_not_the_temporary_file(tmp_path, monkey
         write_output(tmp_path / "p.h5", b"x", KIND)
     assert info.value.filename == str(tmp_path / "p.h5") and ".tmp" not in str(info.value)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_folder_where_nothing_can_be_made_is_refused_before_the_work():
+    """/proc: os.access says writable to root, the write failed after the work naming the temporary file."""
+    with pytest.raises(OutputError, match="(cannot write in the folder|the folder) /proc"):
+        output.check_output("/proc/x.h5", KIND)
