@@ -18,6 +18,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "internal.h"
 
@@ -46,11 +47,20 @@ RBS_INLINE int64_t rbs_trunc(double x)
 #endif
 }
 
-/* an index i clamped into [0, last] at both ends (surrogate.kernels.fastmath.clamp_index): min(max(i, 0), last) */
+/* an index i (last >= 0) kept in [0, last]: i if it is there, else last (a negative i, INT64_MIN from
+ * a NaN or out-of-range conversion included, is beyond last as unsigned: one compare, as the upper clamp
+ * alone; surrogate.kernels.fastmath.clamp_index) */
 RBS_INLINE int64_t rbs_clamp_index(int64_t i, int64_t last)
 {
-    i = i < 0 ? 0 : i;
-    return last < i ? last : i;
+    return (uint64_t)i <= (uint64_t)last ? i : last;
+}
+
+/* the bits of a double (surrogate.kernels.fastmath.bits) */
+RBS_INLINE uint64_t rbs_bits(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
 }
 
 /* numba's min(a, b) and max(a, b) of floats: b if b < a (b > a) else a */

@@ -25,9 +25,12 @@ RBS_INLINE void rbs_locate(const double *axis, int64_t axis_len, int64_t n, doub
     const int64_t inverse = AXIS_GRID + n;      /* where the inverse spacings start */
     const int64_t lookup = inverse + n - 1;     /* where the look-up indices start */
     const int64_t last = axis_len - 1 - lookup;
-    /* clamped before the conversion: a huge x would overflow it to INT64_MIN, an interior point */
-    double t = rbs_fmin_py(rbs_fmax_py((x - axis[AXIS_ORIGIN]) * axis[AXIS_INV_STEP], 0.0), (double)last);
-    int64_t k = rbs_clamp_index(rbs_trunc(t), last);
+    /* capped before the conversion: a huge x (or NaN) would convert to INT64_MIN, which the lower clamp
+     * sends to the first point, an interior cell for x above the grid */
+    double t = (x - axis[AXIS_ORIGIN]) * axis[AXIS_INV_STEP];
+    t = t < (double)last ? t : (double)last;
+    int64_t k = rbs_trunc(t);
+    k = k < 0 ? 0 : k;
     int64_t j = (int64_t)axis[lookup + k];
     j += (int64_t)((x >= axis[AXIS_GRID + j + 1]) & (j < n - 2));   /* one-step correction */
     double w = (x - axis[AXIS_GRID + j]) * axis[inverse + j];

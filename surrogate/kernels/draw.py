@@ -77,8 +77,10 @@ def grid_interval(axis, n, x):
     inverse = AXIS_GRID + n     # where the inverse spacings start
     lookup = inverse + n - 1    # where the look-up indices start
     last = axis.shape[0] - 1 - lookup
-    # clamped before the conversion: a huge x would overflow it to INT64_MIN, an interior point
-    k = clamp_index(int(min(max((x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP), 0.0), last)), last)
+    # capped before the conversion: a huge x (or NaN) would convert to INT64_MIN, which the lower clamp sends
+    # to the first point, an interior cell for x above the grid
+    t = (x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP)
+    k = max(int(t if t < last else np.float64(last)), 0)
     j = int(load(axis, lookup + k))
     j += (x >= load(axis, AXIS_GRID + j + 1)) & (j < n - 2)     # one-step correction, no branch to mispredict
     w = (x - load(axis, AXIS_GRID + j)) * load(axis, inverse + j)

@@ -59,9 +59,22 @@ def fma(typingctx, a, b, c):
 
 @numba.njit(inline="always", **JIT)
 def clamp_index(i, last):
-    """An index i clamped into [0, last] at both ends (rbs_clamp_index): a uniform outside [0, 1), or NaN
-    (int(NaN) is INT64_MIN on x86-64), reads in range."""
-    return min(max(i, 0), last)
+    """An index i (last ≥ 0) kept in [0, last]: i if it is there, else last (rbs_clamp_index). A negative i,
+    INT64_MIN from int(NaN) or an out-of-range float included, is beyond last as unsigned: one compare, as
+    the upper clamp alone, and a uniform outside [0, 1) still reads in range."""
+    return i if np.uint64(i) <= np.uint64(last) else last
+
+
+@intrinsic
+def bits(typingctx, x):
+    """The bits of a float64 as a uint64 (rbs_bits)."""
+    if not isinstance(x, types.Float) or x.bitwidth != 64:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return types.uint64(x), codegen
 
 
 _HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double

@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_REBOUNDED
-from surrogate.kernels.fastmath import atan2_first_quadrant, fma, sincos
+from surrogate.kernels.fastmath import atan2_first_quadrant, bits, fma, sincos
 from surrogate.kernels.options import JIT
 
 
@@ -83,18 +83,26 @@ def particle_ok(n, a):
     return unit_normal(n) & (a > 0.0) & math.isfinite(a)
 
 
+_ONE_BITS_MINUS_1 = np.uint64(0x3FF0000000000000 - 1)    # the bits of 1.0, minus 1
+
+
 @numba.njit(inline="always", **JIT)
 def uniforms_ok(u):
-    """The U_PER_DRAW = 13 uniforms of a draw (an array or a tuple) all in [0, 1); NaN is not. Checked with
+    """The U_PER_DRAW = 13 uniforms of a draw (an array or a tuple) all in [+0, 1); NaN and −0 are not
+    (rbs_uniforms_ok: on the bits b, b | (bits(1) − 1 − b) has its top bit clear exactly then). Checked with
     the result: the table indices are clamped into the drawn cell, so bad uniforms read in range and what
     they draw is discarded."""
-    return (_unit(u[0]) & _unit(u[1]) & _unit(u[2]) & _unit(u[3]) & _unit(u[4]) & _unit(u[5]) & _unit(u[6])
-            & _unit(u[7]) & _unit(u[8]) & _unit(u[9]) & _unit(u[10]) & _unit(u[11]) & _unit(u[12]))
+    bad = (_outside(u[0]) | _outside(u[1]) | _outside(u[2]) | _outside(u[3]) | _outside(u[4]) | _outside(u[5])
+           | _outside(u[6]) | _outside(u[7]) | _outside(u[8]) | _outside(u[9]) | _outside(u[10]) | _outside(u[11])
+           | _outside(u[12]))
+    return (bad >> np.uint64(63)) == np.uint64(0)
 
 
 @numba.njit(inline="always", **JIT)
-def _unit(x):
-    return (x >= 0.0) & (x < 1.0)
+def _outside(x):
+    """Top bit set unless x is in [+0, 1) (:func:`uniforms_ok`)."""
+    b = bits(np.float64(x))
+    return b | (_ONE_BITS_MINUS_1 - b)
 
 
 @numba.njit(inline="always", **JIT)
