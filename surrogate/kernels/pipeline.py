@@ -227,7 +227,7 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, 
         if k < n_blocks:
             j = k % STAGES
             _block_uniforms(u, state, lanes, k * BLOCK, min(BLOCK, V.shape[0] - k * BLOCK), us[j])
-            _locate_block(data, mix_cdf, V_flat, n_flat, a, us[j], k * BLOCK, index[j], g[j])
+            _locate_block(data, mix_cdf, V_flat, n_flat, a, us[j], state.shape[0] != 4, k * BLOCK, index[j], g[j])
         if 1 <= k <= n_blocks:
             j = (k - 1) % STAGES
             _resolve_block(data, us[j], (k - 1) * BLOCK, V.shape[0], index[j], g[j])
@@ -256,13 +256,13 @@ def _uniforms(ub, b):
 
 
 @numba.njit(inline="always", **JIT)
-def _locate_block(data, mix_cdf, V, n, a, ub, start, index, g):
-    """Steps 1 and 2 on the block of rows from ``start`` (their uniforms ``ub``): impact frames (SIMD),
-    cells and cache hints. V and n flat, row after row: a compile-time stride, which keeps the SIMD loop
+def _locate_block(data, mix_cdf, V, n, a, ub, given, start, index, g):
+    """Steps 1 and 2 on the block of rows from ``start`` (their uniforms ``ub``, checked if ``given``):
+    impact frames (SIMD), cells and cache hints. V and n flat, row after row: a compile-time stride, which keeps the SIMD loop
     free of run-time stride checks."""
     m = min(BLOCK, a.shape[0] - start)
     for b in range(m):      # no branch and no table read: SIMD across the block
-        _frame(V, n, a, ub, start + b, g, b)
+        _frame(V, n, a, ub, given, start + b, g, b)
     for b in range(m):
         if _field(g, G_VALID, b) != 0.0:
             _cell_and_hints(data, mix_cdf, _uniforms(ub, b), index, g, b)
@@ -323,13 +323,14 @@ def _put6(g, field, b, values):
 
 
 @numba.njit(inline="always", **JIT)
-def _frame(V, n, a, ub, i, g, b):
+def _frame(V, n, a, ub, given, i, g, b):
     """Block step 1, row i as particle b (uniforms ``ub``, :func:`_block_uniforms`): validity and impact
     frame (computed for invalid rows too)."""
     Vi, ni = (V[3 * i], V[3 * i + 1], V[3 * i + 2]), (n[3 * i], n[3 * i + 1], n[3 * i + 2])
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[12 * BLOCK + b])
     _put3(g, G_VALID, b, (1.0 if moves_into_wall(Vi, ni) else 0.0, alpha1, speed))
-    g[G_OK * BLOCK + b] = 1.0 if particle_ok(ni, a[i]) & uniforms_ok(_uniforms(ub, b)) else 0.0
+    # uniforms drawn from the lanes are in [0, 1): checked only when ``given`` (rebound_many), as many.c
+    g[G_OK * BLOCK + b] = 1.0 if particle_ok(ni, a[i]) & (not given or uniforms_ok(_uniforms(ub, b))) else 0.0
     _put3(g, G_COS, b, (cos_a1, sin_a1, a[i]))
     _put3(g, G_EX, b, ex)
     _put3(g, G_EZ, b, ez)
