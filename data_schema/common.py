@@ -20,14 +20,16 @@ def check_file(path, file_type: str, major: int) -> None:
     FileNotFoundError
         The file does not exist.
     DataFormatError
-        The file is not HDF5, is truncated or corrupt, has another file type,
+        The path is a folder or not a regular file (a FIFO, a device), the file is not HDF5, is truncated or corrupt, has another file type,
         or another major format version.
     """
     path = Path(path)
     if path.is_dir():
         raise DataFormatError(f"{path}: is a folder; give a {file_type} file")
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"{path}: no such file")
+    if not path.is_file():      # a FIFO or a device would block or never end: refused without opening it
+        raise DataFormatError(f"{path}: is not a regular file (a FIFO, a device or a socket); give a {file_type} file")
     try:
         with h5py.File(path, "r") as f:
             found_type = f.attrs.get("file_type")

@@ -8,9 +8,13 @@ existing output of the kind being written (:func:`check_output`), and never a
 file the command reads. Anything else is refused with :class:`OutputError`
 naming the path and why, before any expensive work.
 
-Writes go to a temporary name next to the target and are renamed into place
+Writes go to a temporary name next to the target and are moved into place
 when complete (:func:`write_output`, :func:`atomic_folder`), so a target is
-either untouched or whole. Temporary names carry the writer's process id;
+either untouched or whole. Without ``overwrite`` the last step never replaces
+anything: a file is published by a hard link (which fails if the name
+exists), a folder by a rename that refuses to replace (``renameat2`` with
+``RENAME_NOREPLACE``), so a file that appeared at the target while the work
+ran is kept and the command fails naming it. Temporary names carry the writer's process id;
 a later write to the same folder removes those of processes that no longer
 run (left by a killed run). Content is made in memory and written with
 ordinary file writes, so a full disk is an ``OSError``, not a crash of a
@@ -20,6 +24,8 @@ library mid-write.
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import errno
 import os
 import re
 import secrets
@@ -87,6 +93,7 @@ def check_output(path, kind: str, overwrite: bool = False, inputs=(), folder: bo
         raise OutputError(f"{path}: the folder {parent} does not exist; create it first")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise OutputError(f"{path}: the folder {parent} is not writable")
+    _probe(path)
     if not (path.exists() or path.is_symlink()):
         return path
     for item in inputs:
@@ -106,6 +113,17 @@ def check_output(path, kind: str, overwrite: bool = False, inputs=(), folder: bo
         except OSError as exc:
             raise OutputError(f"{path}: cannot be replaced: {exc.strerror}") from None
     return path
+
+
+def _probe(path: Path) -> None:
+    """OutputError unless a file can be made next to ``path`` (os.access says yes to root in /proc, where the
+    write then fails after the work, naming the temporary file)."""
+    probe = _temporary_name(path)
+    try:
+        os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write in the folder {path.parent}: {exc.strerror}") from None
+    os.remove(probe)
 
 
 def _temporary_name(path: Path) -> Path:
@@ -146,14 +164,60 @@ def _mode(bits: int) -> int:
 
 
 def write_output(path, data: bytes, kind: str, overwrite: bool = False, inputs=()) -> Path:
-    """Write ``data`` to ``path`` as an output of ``kind``: checked (:func:`check_output`), whole or not at all."""
+    """Write ``data`` to ``path`` as an output of ``kind``: checked (:func:`check_output`), whole or not at all;
+    without ``overwrite``, never over a file that appeared at ``path`` meanwhile (:func:`replace_file`)."""
     path = check_output(path, kind, overwrite, inputs)
-    replace_file(path, data)
+    replace_file(path, data, overwrite)
     return path
 
 
-def replace_file(path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path``, flush it to disk and rename it onto ``path``.
+def _taken(path) -> OutputError:
+    return OutputError(f"{path}: appeared while this command ran and was kept; nothing was written (pass "
+                       f"--overwrite (overwrite=True) to replace an output of this package)")
+
+
+def _link_new(tmp: Path, path: Path) -> None:
+    """Publish the file ``tmp`` as ``path`` only if ``path`` does not exist (a hard link, then ``tmp``
+    removed); :class:`OutputError` if it does. Where the file system has no hard links, a rename that
+    refuses to replace (:func:`_rename_new`)."""
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise _taken(path) from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EMLINK):
+            raise
+        _rename_new(tmp, path)
+        return
+    os.remove(tmp)
+
+
+_RENAME_NOREPLACE = 1       # <linux/fs.h>
+_AT_FDCWD = -100
+
+
+def _rename_new(tmp: Path, path: Path) -> None:
+    """Rename ``tmp`` to ``path`` only if ``path`` does not exist (Linux ``renameat2`` with RENAME_NOREPLACE;
+    elsewhere, or where the file system lacks it, a check then a rename: a race window remains there);
+    :class:`OutputError` if it exists."""
+    renameat2 = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", None)
+    if renameat2 is not None:
+        if renameat2(_AT_FDCWD, os.fsencode(tmp), _AT_FDCWD, os.fsencode(path), _RENAME_NOREPLACE) == 0:
+            return
+        code = ctypes.get_errno()
+        if code == errno.EEXIST:
+            raise _taken(path)
+        if code not in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):
+            raise OSError(code, os.strerror(code), str(path))
+    if path.exists() or path.is_symlink():
+        raise _taken(path)
+    os.rename(tmp, path)
+
+
+def replace_file(path, data: bytes, overwrite: bool = True) -> None:
+    """Write ``data`` to a temporary file next to ``path``, flush it to disk and move it onto ``path``:
+    renamed over it with ``overwrite``, else published only if ``path`` does not exist (:func:`_link_new`:
+    :class:`OutputError` if it appeared meanwhile).
 
     No check of what ``path`` holds: for files inside a folder of ours (checkpoints) and after
     :func:`check_output`. On any error the temporary file is removed and ``path`` is untouched.
@@ -167,10 +231,15 @@ def replace_file(path, data: bytes) -> None:
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
+        if overwrite:
+            os.replace(tmp, path)
+        else:
+            _link_new(tmp, path)
+    except BaseException as exc:
         with contextlib.suppress(FileNotFoundError):
             os.remove(tmp)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError) and exc.errno:
+            raise OSError(exc.errno, exc.strerror, str(path)) from None     # the user's path, not the temporary name
         raise
 
 
@@ -189,13 +258,13 @@ def atomic_folder(path, kind: str, overwrite: bool = False):
     try:
         yield tmp
         (tmp / FOLDER_MARKER).write_text(kind + "\n", encoding="utf-8")
-        if path.exists():
+        if overwrite and path.exists():
             old = _temporary_name(path)
             os.replace(path, old)
             os.replace(tmp, path)
             shutil.rmtree(old)
         else:
-            os.replace(tmp, path)
+            _rename_new(tmp, path)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

@@ -8,12 +8,16 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
                            attrs: kappa, n_max, particles_per_cell,
                            restitution_k, restitution_p (the wall's normal-restitution law),
-                           friction_q, wall_law (its friction exponent and name; since 3.1, optional)
+                           friction_q, wall_law (its friction exponent and name; since 3.1, optional);
+                           law (restitution_k, restitution_p) and shape_codes, checksummed copies of the
+                           attributes and names the law depends on (since 3.2)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
 Every numeric dataset carries HDF5's Fletcher-32 checksum (since 3.1), so a
-corrupted file fails to load with an error naming the dataset.
+corrupted file fails to load with an error naming the dataset. What makes a
+table valid (docs/format.md, "What makes a table valid") is checked by
+:func:`check_contract` here and by the C library's loader, alike.
 
 Representation of one cell (docs/format.md): the reflected state of the
 rebounded particles, folded by the mirror symmetry Z → −Z to β2 ≥ 0 (Ω_x, Ω_y
@@ -49,11 +53,18 @@ import h5py
 import numpy as np
 
 from data_schema.common import DataFormatError, check_file, write_header
+from data_schema.samples import SHAPE_NAMES
 from data_schema.output import hdf5_bytes, write_output
 
 TABLE_FILE_TYPE = "rebound_table"
 TABLE_VERSION = (3, 2)
 
+# grid speeds a table may hold, m/s (docs/format.md, "What makes a table valid"): the direct model's arithmetic
+# fails far outside (1e-100 m/s gives no rebound), and the runtime moves draws between consecutive grid speeds
+# by polynomial pieces spanning 25 % of speed each, so their ratio sets the pieces per interval (16: 60)
+SPEED_GRID_RANGE = (1e-3, 1e4)
+MAX_SPEED_RATIO = 16.0
+WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ cluster_weight − 1| allowed per cell
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
 FEW_COLLISIONS = 2                  # regime 0 of a cluster: rebounds of at most this many collisions
 STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
@@ -116,6 +127,9 @@ class TableResolution:
             "indicatrix_3d": (len(INDICATRIX_ALPHA2_EDGES) - 1, len(INDICATRIX_BETA2_EDGES) - 1),
         }
 
+
+# the checksummed copies of the law's attributes and shape names in group grid (since 3.2)
+LAW_DATASETS = ("law", "shape_codes")
 
 # name: (dtype, units, meaning) of the per-cell datasets
 CELL_DATASETS = {
@@ -194,7 +208,7 @@ class ReboundTable:
             raise ValueError(f"ReboundTable is missing cell datasets {sorted(missing)}")
         for name, shape in expected.items():
             if self.cells[name].shape != lead + shape:
-                raise ValueError(f"cell dataset {name!r} has shape {self.cells[name].shape}, "
+                raise ValueError(f"dataset 'cells/{name}' has shape {self.cells[name].shape}, "
                                  f"expected {lead + shape}")
 
     def cell(self, shape: str, i_alpha: int, i_speed: int) -> CellTable:
@@ -216,6 +230,11 @@ class ReboundTable:
             values = np.asarray(getattr(self, name), dtype=np.float64)
             grid.create_dataset(name, data=values, fletcher32=True).attrs["units"] = units
         grid.create_dataset("shapes", data=np.array(self.shapes, dtype=h5py.string_dtype()))
+        # checksummed copies of what the law depends on beyond the cell datasets (3.2): a flipped bit of an
+        # attribute or a swapped shape name fails to load
+        grid.create_dataset("law", data=np.array([self.restitution_k, self.restitution_p]), fletcher32=True)
+        grid.create_dataset("shape_codes", data=np.array([SHAPE_NAMES.index(s) for s in self.shapes], dtype=np.uint8),
+                            fletcher32=True)
         grid.attrs["kappa"] = self.kappa
         grid.attrs["n_max"] = self.n_max
         grid.attrs["particles_per_cell"] = self.particles_per_cell
@@ -250,9 +269,14 @@ class ReboundTable:
         grid = f["grid"]
         alpha1_deg, speed_m_s = (_read(grid, name) for name in ("alpha1_deg", "speed_m_s"))
         cells = {name: _read(f["cells"], name) for name in CELL_DATASETS}
+        law = {name: _read(grid, name) for name in LAW_DATASETS if name in grid}
+        missing = [name for name in LAW_DATASETS if name not in law]
+        if _minor(f) >= 2 and missing:
+            raise DataFormatError(f"{where}: missing dataset(s) {', '.join('grid/' + n for n in missing)} (table "
+                                  f"format 3.2)")
         try:
             resolution = TableResolution(**{k: int(v) for k, v in f["resolution"].attrs.items()})
-            return cls(
+            table = cls(
                 alpha1_deg=alpha1_deg, speed_m_s=speed_m_s,
                 shapes=tuple(s.decode() if isinstance(s, bytes) else str(s) for s in grid["shapes"][()]),
                 resolution=resolution, cells=cells, kappa=float(grid.attrs["kappa"]),
@@ -268,6 +292,71 @@ class ReboundTable:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:
             raise DataFormatError(f"{where}: inconsistent table: {exc}") from exc
+        check_contract(table, where, law)
+        return table
+
+
+def _minor(f: h5py.File) -> int:
+    """The minor format version of an open table (checked a pair by check_file)."""
+    return int(f.attrs["format_version"][1])
+
+
+def check_contract(table: ReboundTable, where: str, law: dict) -> None:
+    """DataFormatError naming the file and the value unless ``table`` obeys what makes a table valid beyond its
+    layout (docs/format.md, "What makes a table valid"; the C loader checks the same). ``law`` holds the
+    datasets of :data:`LAW_DATASETS` the file has (3.2), which must equal the attributes and names."""
+    def refuse(text):
+        raise DataFormatError(f"{where}: {text}")
+
+    if not all(name in SHAPE_NAMES for name in table.shapes) or len(set(table.shapes)) != len(table.shapes):
+        refuse(f"dataset 'grid/shapes' must name distinct shapes among {', '.join(SHAPE_NAMES)}; got "
+               f"{list(table.shapes)}")
+    alpha1, speed = np.asarray(table.alpha1_deg, dtype=np.float64), np.asarray(table.speed_m_s, dtype=np.float64)
+    if not (np.all((alpha1 > 0.0) & (alpha1 <= 90.0)) and np.all(np.diff(alpha1) > 0.0)):
+        refuse(f"dataset 'grid/alpha1_deg' must be strictly increasing in (0, 90] deg; got {alpha1.tolist()}")
+    low, high = SPEED_GRID_RANGE
+    if not (np.all((speed >= low) & (speed <= high)) and np.all(np.diff(speed) > 0.0)):
+        refuse(f"dataset 'grid/speed_m_s' must be strictly increasing in [{low:g}, {high:g}] m/s; got {speed.tolist()}")
+    if np.any(speed[1:] > MAX_SPEED_RATIO * speed[:-1]):
+        refuse(f"dataset 'grid/speed_m_s' has consecutive speeds more than a factor {MAX_SPEED_RATIO:g} apart; got "
+               f"{speed.tolist()}")
+    for name in ("restitution_k", "restitution_p"):
+        value = getattr(table, name)
+        if not (np.isfinite(value) and value > 0.0):
+            refuse(f"the attribute '{name}' of group 'grid' must be finite and > 0; got {value!r}")
+    if "law" in law and not np.array_equal(np.asarray(law["law"]).view(np.uint8),
+                                          np.array([table.restitution_k, table.restitution_p]).view(np.uint8)):
+        refuse(f"the attributes restitution_k, restitution_p of group 'grid' ({table.restitution_k!r}, "
+               f"{table.restitution_p!r}) differ from their checksummed copy 'grid/law' {np.asarray(law['law']).tolist()}")
+    if "shape_codes" in law and [int(c) for c in np.ravel(law["shape_codes"])] != [SHAPE_NAMES.index(s) for s in table.shapes]:
+        refuse(f"dataset 'grid/shapes' {list(table.shapes)} differs from its checksummed copy 'grid/shape_codes' "
+               f"{np.ravel(law['shape_codes']).tolist()}")
+    cells, m = table.cells, table.resolution.dictionary_size
+    rules = (("cluster_weight", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("cluster_scale", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("cluster_shape", lambda x: x < m, f"below the dictionary size {m}"),
+             ("cluster_regime", lambda x: x <= 1, "0 or 1"),
+             ("status_counts", lambda x: x >= 0, ">= 0"),
+             ("collision_counts", lambda x: x >= 0, ">= 0"),
+             ("mean", np.isfinite, "finite"),
+             ("std", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("indicatrix_2d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("indicatrix_3d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"))
+    for name, ok, wanted in rules:
+        values = np.asarray(cells[name])
+        bad = np.flatnonzero(~ok(values).ravel())
+        if bad.size:
+            refuse(f"dataset 'cells/{name}' holds {values.ravel()[bad[0]]!r} at element {bad[0]}; its values must be "
+                   f"{wanted}")
+    weight_sum = np.asarray(cells["cluster_weight"]).sum(axis=-1).ravel()
+    bad = np.flatnonzero(np.abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE)
+    if bad.size:
+        refuse(f"dataset 'cells/cluster_weight' of cell {bad[0]} sums to {weight_sum[bad[0]]!r}; each cell's weights "
+               f"must sum to 1 within {WEIGHT_SUM_TOLERANCE:g}")
+    drawn = np.asarray(cells["status_counts"])[..., :2].sum(axis=-1).ravel()
+    if np.any(drawn <= 0):
+        refuse(f"dataset 'cells/status_counts' of cell {np.flatnonzero(drawn <= 0)[0]} has no rebounded or trapped "
+               f"particle")
 
 
 def _read(group: h5py.Group, name: str) -> np.ndarray:

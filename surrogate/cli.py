@@ -73,8 +73,11 @@ def _info(args) -> int:
     path = Path(args.file)
     if path.is_dir():
         raise DataFormatError(f"{path}: is a folder; give a table or a samples file")
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"{path}: no such file")
+    if not path.is_file():      # a FIFO or a device would block or never end
+        raise DataFormatError(f"{path}: is not a regular file (a FIFO, a device or a socket); give a table or a "
+                              f"samples file")
     file_type = kind_of(path)
     if file_type == TABLE_FILE_TYPE:
         import surrogate

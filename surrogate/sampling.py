@@ -24,6 +24,7 @@ are NaN, not a made-up rebound).
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -33,12 +34,12 @@ from data_schema.table import STATE_NAMES
 from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE,
                                       FAULT_NORMAL_NOT_FINITE, FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL,
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
-                                      FAULT_VELOCITY_ZERO, first_faults)
+                                      FAULT_VELOCITY_ZERO, SPEED_MAX, SPEED_MIN, SPIN_SCALE_MAX, first_faults)
+from surrogate.kernels.frame import NORMAL_TOLERANCE
 from surrogate.kernels.parallel import draw_local_parallel_rng, rebound_parallel_rng
 from surrogate.kernels.rng import chunk_states
 from surrogate.table import SurrogateTable
 
-NORMAL_TOLERANCE = 1e-6         # |n| − 1 allowed for a wall normal
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
 
 
@@ -103,6 +104,37 @@ def mix_cdf(table: SurrogateTable, shape) -> np.ndarray:
     return cdf
 
 
+def _check_shape(shape) -> None:
+    """ValueError unless ``shape`` has a form :func:`mix_cdf` takes: a name, a dict {name: weight} or a
+    sequence of weights, the weights real numbers (a string or None would otherwise be a TypeError)."""
+    if isinstance(shape, str):
+        return
+    if isinstance(shape, dict):
+        names, weights = list(shape), list(shape.values())
+    elif isinstance(shape, (list, tuple, np.ndarray)):
+        names, weights = [], list(np.asarray(shape, dtype=object).ravel())
+    else:
+        raise ValueError(f"The 'shape' parameter must be a shape name, 'mix', a dict {{name: weight}} or "
+                         f"{len(SHAPE_NAMES)} weights; got {shape!r}.")
+    for name in names:
+        if not isinstance(name, str):
+            raise ValueError(f"The 'shape' mix must name shapes by strings ({', '.join(SHAPE_NAMES)}); got {name!r}.")
+    for w in weights:
+        if isinstance(w, (bool, np.bool_)) or not isinstance(w, (int, float, np.integer, np.floating)):
+            raise ValueError(f"The mix weights must be real numbers; got {w!r}.")
+
+
+def _real(name: str, value) -> np.ndarray:
+    """``value`` as float64, refusing complex numbers (NumPy would silently drop their imaginary part)."""
+    arr = np.asarray(value)
+    if np.iscomplexobj(arr):
+        raise ValueError(f"The '{name}' parameter must be real; got complex values (dtype {arr.dtype}).")
+    try:
+        return np.asarray(arr, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"The '{name}' parameter must be real numbers; got {value!r}.") from None
+
+
 INTERPOLATIONS = ("stochastic", "scaled")
 
 
@@ -113,8 +145,9 @@ def _scaled(interpolation: str) -> bool:
     return interpolation == "scaled"
 
 
-# physical range of the incident state: (low, high, high included); clamp=True never reaches beyond it
-PHYSICAL_RANGE = {"alpha1": (*ALPHA1_RANGE_DEG, True), "speed": (0.0, np.inf, False)}
+# physical range of the incident state: (low, high, high included); clamp=True never reaches beyond it. For
+# |V⁻|, the range the kernels' arithmetic carries (surrogate.kernels.checks.SPEED_MIN, SPEED_MAX)
+PHYSICAL_RANGE = {"alpha1": (*ALPHA1_RANGE_DEG, True), "speed": (SPEED_MIN, SPEED_MAX, True)}
 
 
 def _check_range(name, values, bounds, clamp, units) -> None:
@@ -160,13 +193,14 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
     flattened to n draws. ``interpolation``: ``"scaled"`` (default) or
     ``"stochastic"`` (see :func:`sample_global`). ``clamp``: an α1 or |V⁻|
     outside the table's range uses the law at the nearest grid edge instead of
-    raising; α1 outside (0, 90] deg or |V⁻| ≤ 0 m/s is non-physical and always
-    raises.
+    raising; α1 outside (0, 90] deg or |V⁻| outside (1e-150, 1e150] m/s (what
+    the arithmetic carries) always raises.
     """
-    a, v = np.broadcast_arrays(np.asarray(alpha1, dtype=np.float64), np.asarray(speed, dtype=np.float64))
+    a, v = np.broadcast_arrays(_real("alpha1", alpha1), _real("speed", speed))
     a, v = a.ravel(), v.ravel()
     _check_range("alpha1", a, table.alpha1_range, clamp, "deg")
     _check_range("speed", v, table.speed_range, clamp, "m/s")
+    _check_shape(shape)
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
     states = chunk_states(check_random_state(random_state), len(a))
@@ -178,7 +212,7 @@ def sample_local(table: SurrogateTable, alpha1, speed, shape="ellipsoid", random
 
 
 def _vectors(name, value, n=None):
-    arr = np.asarray(value, dtype=np.float64)
+    arr = _real(name, value)
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 3 or (n is not None and arr.shape[0] not in (1, n)):
@@ -195,7 +229,7 @@ def _check_incident(table: SurrogateTable, V, nrm, a, clamp: bool) -> None:
     """The checks of :func:`sample_global` in one parallel pass (:func:`surrogate.kernels.checks.first_faults`):
     raise for the first check, in FAULT_* order, that a row fails, naming that check's first such row.
     ``nrm`` and ``a`` have N rows or one for all."""
-    first = first_faults(V, nrm, a, NORMAL_TOLERANCE, *table.alpha1_range, *table.speed_range)
+    first = first_faults(V, nrm, a, *table.alpha1_range, *table.speed_range)
     for fault in np.flatnonzero(first >= 0):
         if not (clamp and fault in (FAULT_ALPHA1_OUTSIDE, FAULT_SPEED_OUTSIDE)):
             raise _fault_error(int(fault), int(first[fault]), table, V, nrm, a)
@@ -213,18 +247,22 @@ def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueE
                           f"must be unit vectors (|n| - 1 within {NORMAL_TOLERANCE}).")
     if fault == FAULT_VELOCITY_ZERO:
         return ValueError(f"The 'velocity' at index {i} is zero; a particle must move into the wall.")
-    vn, speed = float(np.dot(V[i], nrm[j])), float(np.linalg.norm(V[i]))
+    # hypot, not the sum of squares: no overflow for the huge velocities these messages are about
+    vn, speed = float(np.dot(V[i], nrm[j])), math.hypot(*V[i])
     if fault == FAULT_NOT_INTO_WALL:
         return ValueError(f"The 'velocity' at index {i} does not move into the wall: V.n = {vn!r} m/s must be < 0.")
     if fault == FAULT_HALF_SIZE:
-        return ValueError(f"The 'half_size' at index {k} must be finite and > 0 m; got {float(a[k])!r}.")
-    alpha1 = float(np.degrees(np.arctan2(-vn, np.sqrt(max(speed ** 2 - vn ** 2, 0.0)))))
+        return ValueError(f"The 'half_size' at index {k} must be finite and > 0 m, with |V-|/a <= "
+                          f"{SPIN_SCALE_MAX:g} 1/s (the unit of the spin); got {float(a[k])!r} m for "
+                          f"|V-| = {speed!r} m/s.")
+    alpha1 = math.degrees(math.atan2(-vn, math.hypot(*(V[i] - vn * nrm[j]))))
     if fault == FAULT_ALPHA1_NOT_FINITE:
         return _not_finite("alpha1", i, alpha1)
     if fault == FAULT_ALPHA1_OUTSIDE:
         return _outside("alpha1", i, alpha1, table.alpha1_range, "deg")
     if fault == FAULT_SPEED_NOT_FINITE:
-        return _not_finite("speed", i, speed)
+        return ValueError(f"The 'speed' |V-| = {speed!r} m/s at index {i} is outside [{SPEED_MIN:g}, {SPEED_MAX:g}] "
+                          f"m/s, the range the sampler's arithmetic carries.")
     return _outside("speed", i, speed, table.speed_range, "m/s")
 
 
@@ -276,7 +314,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         and docs/VALIDATION.md for how they compare.
     clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
         edge instead of raising. Never beyond the physical range: here every
-        state that moves into its wall is physical (α1 in (0, 90], |V⁻| > 0).
+        state that moves into its wall is physical (α1 in (0, 90]), with |V⁻| in
+        [1e-150, 1e150] m/s (what the arithmetic carries).
     out : None (default: new arrays) or a tuple (V_out, Omega_out, status) of
         arrays to write the results into and return: C-contiguous, writeable,
         float64 (N, 3), float64 (N, 3) and int8 (N,), sharing no memory with
@@ -292,12 +331,13 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     V = np.ascontiguousarray(_vectors("velocity", velocity))
     n_particles = V.shape[0]
     nrm = np.ascontiguousarray(_vectors("normal", normal, n_particles))
-    a = np.asarray(half_size, dtype=np.float64)
+    a = _real("half_size", half_size)
     if a.ndim > 1 or a.size not in (1, n_particles):
         raise ValueError(f"The 'half_size' parameter must be a scalar or have shape ({n_particles},); "
                          f"got {a.shape}.")
     a = np.ascontiguousarray(a.reshape(-1))
     _check_incident(table, V, nrm, a, clamp)
+    _check_shape(shape)
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
     V_out, Omega_out, status = _outputs(out, n_particles, (V, nrm, a))

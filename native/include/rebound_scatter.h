@@ -11,9 +11,9 @@
  * ----------------
  * Global frame: any right-handed Cartesian frame of the caller. V⁻ (incident
  * velocity) and V⁺ (reflected) in m/s, Ω⁺ (reflected angular velocity) in
- * rad/s, n the unit wall normal pointing into the gas (|n| = 1 within ~1e-6;
- * not normalised, not checked by the draw functions), a the particle's
- * half-size (half its largest extent) in m, > 0.
+ * rad/s, n the unit wall normal pointing into the gas (| |n| − 1 | <=
+ * RBS_NORMAL_TOLERANCE; not normalised), a the particle's half-size (half its
+ * largest extent) in m, finite and > 0.
  * Impact frame of a hit: ex the direction of the tangential part of V⁻ (at
  * normal impact, |V⁻_t| <= 1e-12 |V⁻|, a direction in the wall plane drawn
  * from u[12]), n, ez = ex × n. α1 = angle of V⁻ from the wall, degrees in
@@ -25,7 +25,8 @@
  *
  * Uniforms
  * --------
- * A draw consumes RBS_U_PER_DRAW = 13 uniforms in [0, 1):
+ * A draw consumes RBS_U_PER_DRAW = 13 uniforms in [0, 1) (a draw given one
+ * outside, or NaN, returns RBS_INVALID):
  *   u[0] shape from the mix       u[1] α1 neighbour        u[2] speed neighbour
  *   u[3] trapped or not           u[4] mixture component   u[5..10] the six chain variables
  *   u[11] mirror sign             u[12] in-wall axis at normal impact
@@ -46,10 +47,15 @@
  * Functions that can fail return an RBS_ERR_* code (RBS_OK = 0) and, when
  * `message` is not NULL, write a NUL-terminated message of at most
  * message_size bytes naming the file and what is wrong. The draw functions
- * never fail: a particle that does not move into the wall (V·n >= 0, zero or
- * non-finite V) gets status RBS_INVALID and NaN outputs; an α1 or |V⁻|
- * outside the table's grid uses the law at the nearest grid edge (check
- * rbs_table_alpha1_range / rbs_table_speed_range beforehand if that matters).
+ * never fail, whatever their arguments: a NULL pointer, a uniform outside
+ * [0, 1) or NaN, a particle that does not move into the wall (V·n >= 0, zero
+ * or non-finite V), a normal that is not a unit vector, a half-size that is
+ * not finite and > 0, or a result that is not a finite rebound leaving the
+ * wall (V⁺·n > 0; what overflows or underflows at extreme |V⁻| or a) gets
+ * status RBS_INVALID and NaN outputs (a NULL output gets nothing). An α1 or
+ * |V⁻| outside the table's grid, however far, uses the law at the nearest grid
+ * edge (check rbs_table_alpha1_range / rbs_table_speed_range beforehand if that
+ * matters).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -72,6 +78,7 @@ extern "C" {
 #define RBS_TABLE_MAJOR 3       /* the table format major version read (any minor) */
 #define RBS_BLOCK 32            /* rows per block of rbs_rebound_many*, lanes of rbs_rebound_many_rng */
 #define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */
+#define RBS_NORMAL_TOLERANCE 1e-6   /* | |n| − 1 | allowed for a wall normal (surrogate.kernels.frame.NORMAL_TOLERANCE) */
 
 /* Status of a draw: the codes of surrogate (STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_INVALID). */
 enum { RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_INVALID = -1 };
@@ -129,10 +136,11 @@ typedef struct rbs_table_info {
 /* ---------------------------------------------------------------- tables */
 
 /* Open and check a table file, derive the kernel arrays; *table = NULL on error.
- * Checks as data_schema.table.check_file / read_table: the file exists and is HDF5, file_type
- * "rebound_table", format_version (3, any minor), the groups grid, resolution, cells, every cell
- * dataset with its shape, the grids (increasing, finite), the wall law attributes restitution_k,
- * restitution_p (finite, > 0); then the derived arrays are checked finite.
+ * Checks what data_schema.table.read_table checks, the whole of docs/format.md "What makes a table
+ * valid": the file is a regular HDF5 file, file_type "rebound_table", format_version (3, any minor), the
+ * groups, datasets (every one read, so every checksum verified) and attributes with their shapes, the
+ * grids and shape names, the wall law (and its checksummed copy since 3.2), the cell values; then the
+ * derived arrays are checked finite.
  * Returns RBS_OK, RBS_ERR_IO, RBS_ERR_FORMAT, RBS_ERR_VERSION, RBS_ERR_MEMORY or RBS_ERR_ARGUMENT. */
 int rbs_table_open(const char *path, rbs_table **table, char *message, size_t message_size);
 
@@ -184,15 +192,17 @@ int rbs_mix_equal(const rbs_table *table, rbs_mix *mix);
 /* ---------------------------------------------------------------- draws */
 
 /* The reflected state of one particle, global frame (surrogate.kernels.rebound_tuple).
- *   V        incident velocity V⁻, m/s (must move into the wall: V·n < 0)
- *   n        unit wall normal into the gas
- *   a        half-size, m (> 0)
+ *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
+ *   n        unit wall normal into the gas (| |n| − 1 | <= RBS_NORMAL_TOLERANCE)
+ *   a        half-size, m (finite, > 0)
  *   u        RBS_U_PER_DRAW uniforms in [0, 1)
  *   interpolation  RBS_SCALED or RBS_STOCHASTIC
  *   V_out    V⁺, m/s;  Omega_out  Ω⁺, rad/s  (NaN unless rebounded)
  * Returns RBS_REBOUNDED, RBS_TRAPPED (rolling along or deposited; drawn with the cell's tabulated
- * probability) or RBS_INVALID (V does not move into the wall, or a NULL table or mix, a mix of
- * another table's shape count, an unknown interpolation). */
+ * probability) or RBS_INVALID (V does not move into the wall, n is not a unit vector, a is not finite
+ * and > 0, a uniform is outside [0, 1), the result would not be finite or would not leave the wall; a
+ * NULL pointer, a mix of another table's shape count, an unknown interpolation). A rebound's V⁺ and Ω⁺
+ * are finite and V⁺·n > 0. */
 int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
                 const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
 
@@ -200,8 +210,8 @@ int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], c
  * u (count, RBS_U_PER_DRAW), status (count,). The same bits as rbs_rebound row by row (and as
  * surrogate.kernels.rebound_many); faster, because the table reads of RBS_BLOCK rows are in flight
  * together and the arithmetic runs as SIMD loops over them. The outputs must not overlap the inputs. A NULL
- * table or mix, a mix of another table's shape count or an unknown interpolation gives every row
- * RBS_INVALID and NaN. */
+ * table, mix or array (count > 0), a mix of another table's shape count or an unknown interpolation gives
+ * every row RBS_INVALID and NaN (in the outputs that are not NULL). */
 void rbs_rebound_many(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V, const double *n,
                       const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
                       signed char *status);
@@ -209,7 +219,8 @@ void rbs_rebound_many(const rbs_table *table, const rbs_mix *mix, size_t count, 
 /* rbs_rebound_many drawing the uniforms from `rng`, as surrogate.kernels.rebound_many_rng does, bit for
  * bit: rng is advanced one step to seed RBS_BLOCK xoshiro256+ lanes (splitmix64), and row b of every
  * block of RBS_BLOCK rows takes its 13 uniforms from lane b. rbs_rebound_uniforms gives those uniforms.
- * A NULL rng (or the cases of rbs_rebound_many) gives every row RBS_INVALID, and rng is not advanced. */
+ * A NULL or all-zero rng (or the cases of rbs_rebound_many) gives every row RBS_INVALID, and rng is not
+ * advanced. */
 void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V,
                           const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
                           double *Omega_out, signed char *status);
@@ -217,28 +228,31 @@ void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t cou
 /* One reflected state at (α1 deg, |V⁻| m/s) in the local frame (surrogate.kernels.draw_local):
  * out = (α2 rad, β2 rad, s = |V⁺|/|V⁻|, Ω_x, Ω_y, Ω_z in units of |V⁻|/a): RBS_LOCAL_SIZE = 6 numbers
  * (Ω⁺a/|V⁻| is a vector), NaN unless rebounded.
- * Returns RBS_REBOUNDED or RBS_TRAPPED (RBS_INVALID for a NULL table or mix, a mix of another table's
- * shape count, an unknown interpolation). Outside the grid, the law at the nearest grid edge. */
+ * Returns RBS_REBOUNDED or RBS_TRAPPED; RBS_INVALID for α1 outside (0, 90] or NaN, |V⁻| not finite and
+ * > 0, a uniform outside [0, 1), a NULL pointer, a mix of another table's shape count, an unknown
+ * interpolation. Outside the grid (however far), the law at the nearest grid edge. */
 int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                    const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE]);
 
 /* ---------------------------------------------------------------- random numbers */
 
-/* The state surrogate.seed_state(seed) gives (numpy's SeedSequence(seed).spawn(1)[0], 4 uint64 words). */
+/* The state surrogate.seed_state(seed) gives (numpy's SeedSequence(seed).spawn(1)[0], 4 uint64 words, never
+ * all zero). A NULL rng: nothing. */
 void rbs_rng_seed(rbs_rng *rng, uint64_t seed);
 
 /* The state surrogate.seed_state(seed, n_streams=n)[k] gives, for any n > k: stream k of a seed
  * (SeedSequence(seed) child k). Use k = thread number or MPI rank. */
 void rbs_rng_seed_stream(rbs_rng *rng, uint64_t seed, uint64_t k);
 
-/* The next uniform in [0, 1) (53 bits; surrogate.kernels.rng.next_uniform). */
+/* The next uniform in [0, 1) (53 bits; surrogate.kernels.rng.next_uniform); NaN for a NULL or all-zero
+ * state (not a xoshiro256+ state: it would give 0 forever), which every draw refuses. */
 double rbs_rng_uniform(rbs_rng *rng);
 
-/* u[0..count) = the next count uniforms (surrogate.fill_uniforms). */
+/* u[0..count) = the next count uniforms (surrogate.fill_uniforms); NaN for a NULL or all-zero state. */
 void rbs_rng_fill(rbs_rng *rng, double *u, size_t count);
 
 /* The (count, RBS_U_PER_DRAW) uniforms rbs_rebound_many_rng draws for count rows from rng, advancing
- * rng as it does (surrogate.kernels.rebound_uniforms). */
+ * rng as it does (surrogate.kernels.rebound_uniforms); NaN for a NULL or all-zero state. */
 void rbs_rebound_uniforms(rbs_rng *rng, size_t count, double *u);
 
 /* ---------------------------------------------------------------- misc */

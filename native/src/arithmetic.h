@@ -141,14 +141,19 @@ RBS_INLINE void rbs_arithmetic_block(const rbs_gathered *k, const rbs_frames *f,
         int move_speed = scaled & (c->wv[b] > 0.0);
         for (int j = 0; j < 6; j++) x[j] = move_speed ? x[j] : local[j];
         rbs_mirrored(u11[b], x);
-        int rebounded = k->trapped[b] <= 0.5;
-        r->status[b] = rebounded ? (double)RBS_REBOUNDED : (double)RBS_TRAPPED;
-        double speed = f->speed[b], w = speed / f->a[b];
+        double speed = f->speed[b], w = speed / f->a[b], v[3], o[3], n[3];
         for (int j = 0; j < 3; j++) {
-            double v = speed * rbs_dot(x[0], x[1], x[2], f->ex[j][b], f->n[j][b], f->ez[j][b]);
-            double o = w * rbs_dot(x[3], x[4], x[5], f->ex[j][b], f->n[j][b], f->ez[j][b]);
-            r->V[j][b] = rebounded ? v : NAN;
-            r->W[j][b] = rebounded ? o : NAN;
+            n[j] = f->n[j][b];
+            v[j] = speed * rbs_dot(x[0], x[1], x[2], f->ex[j][b], n[j], f->ez[j][b]);
+            o[j] = w * rbs_dot(x[3], x[4], x[5], f->ex[j][b], n[j], f->ez[j][b]);
+        }
+        /* rbs_to_global's status */
+        int ok = f->ok[b] != 0.0, trapped = k->trapped[b] > 0.5;
+        int rebounded = ok & (trapped == 0) & rbs_rebound_ok(v, o, n);
+        r->status[b] = rebounded ? (double)RBS_REBOUNDED : ok & trapped ? (double)RBS_TRAPPED : (double)RBS_INVALID;
+        for (int j = 0; j < 3; j++) {
+            r->V[j][b] = rebounded ? v[j] : NAN;
+            r->W[j][b] = rebounded ? o[j] : NAN;
         }
     }
     for (size_t b = 0; b < m; b++) {

@@ -18,6 +18,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "internal.h"
 
@@ -44,6 +45,22 @@ RBS_INLINE int64_t rbs_trunc(double x)
 #else
     return (x > -0x1p63 && x < 0x1p63) ? (int64_t)x : INT64_MIN;
 #endif
+}
+
+/* an index i (last >= 0) kept in [0, last]: i if it is there, else last (a negative i, INT64_MIN from
+ * a NaN or out-of-range conversion included, is beyond last as unsigned: one compare, as the upper clamp
+ * alone; surrogate.kernels.fastmath.clamp_index) */
+RBS_INLINE int64_t rbs_clamp_index(int64_t i, int64_t last)
+{
+    return (uint64_t)i <= (uint64_t)last ? i : last;
+}
+
+/* the bits of a double (surrogate.kernels.fastmath.bits) */
+RBS_INLINE uint64_t rbs_bits(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
 }
 
 /* numba's min(a, b) and max(a, b) of floats: b if b < a (b > a) else a */
@@ -143,8 +160,7 @@ RBS_INLINE double rbs_atan2_q1_simd(double y, double x)
 RBS_INLINE double rbs_restitution_at(const double *pieces, int64_t n_pieces, int64_t j, double w)
 {
     double t = w * (double)n_pieces;
-    int64_t i = rbs_trunc(t);
-    i = (n_pieces - 1) < i ? (n_pieces - 1) : i;
+    int64_t i = rbs_clamp_index(rbs_trunc(t), n_pieces - 1);
     double x = 2.0 * (t - (double)i) - 1.0;
     const double *piece = pieces + (j * n_pieces + i) * 10;
     double value = piece[9];

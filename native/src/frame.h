@@ -19,10 +19,54 @@ RBS_INLINE double rbs_dot(double a0, double a1, double a2, double b0, double b1,
     return fma(a0, b0, fma(a1, b1, a2 * b2));
 }
 
-/* V·n < 0 and V finite */
-RBS_INLINE int rbs_moves_into_wall(const double *V, const double *n)
+/* x finite: x − x is 0 only for finite x (a compare, which SIMD loops take, where isfinite is a call) */
+RBS_INLINE int rbs_finite(double x)
 {
-    return rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]) < 0.0 && isfinite(V[0] + V[1] + V[2]);
+    return x - x == 0.0;
+}
+
+/* V·n < 0 and V finite: a particle that hits the wall (else RBS_INVALID at once) */
+RBS_INLINE int rbs_moves_into_wall(double V0, double V1, double V2, double n0, double n1, double n2)
+{
+    return (rbs_dot(V0, V1, V2, n0, n1, n2) < 0.0) & rbs_finite(V0 + V1 + V2);
+}
+
+/* (1 ∓ RBS_NORMAL_TOLERANCE)²: the bounds of n·n, so the unit check needs no square root */
+#define RBS_NORMAL_MIN2 ((1.0 - RBS_NORMAL_TOLERANCE) * (1.0 - RBS_NORMAL_TOLERANCE))
+#define RBS_NORMAL_MAX2 ((1.0 + RBS_NORMAL_TOLERANCE) * (1.0 + RBS_NORMAL_TOLERANCE))
+
+/* The rest of what a draw needs of its particle (surrogate.kernels.frame.particle_ok): | |n| − 1 | <=
+ * RBS_NORMAL_TOLERANCE (as (1 ∓ tolerance)² bounds on n·n) and a finite and > 0. Checked with the result
+ * (rbs_to_global), not before the draw: the table reads stay in range whatever the particle. */
+RBS_INLINE int rbs_particle_ok(double n0, double n1, double n2, double a)
+{
+    double nn = rbs_dot(n0, n1, n2, n0, n1, n2);
+    return (nn >= RBS_NORMAL_MIN2) & (nn <= RBS_NORMAL_MAX2) & (a > 0.0) & rbs_finite(a);
+}
+
+#define RBS_ONE_BITS 0x3ff0000000000000ull     /* the bits of 1.0 */
+
+/* The RBS_U_PER_DRAW uniforms u[0], u[stride], ... all in [+0, 1) (NaN and −0 are not;
+ * surrogate.kernels.frame.uniforms_ok): on the bits, b | (bits(1) − 1 − b) has its top bit clear exactly
+ * then, so the test is an OR over the uniforms (SIMD), not two compares each. Checked with the result: the
+ * table indices are clamped into the drawn cell, so the draw reads in range whatever the uniforms, and
+ * what it draws from bad ones is discarded. */
+RBS_INLINE int rbs_uniforms_ok(const double *u, size_t stride)
+{
+    uint64_t bad = 0;
+    for (int k = 0; k < RBS_U_PER_DRAW; k++) {
+        uint64_t b = rbs_bits(u[k * stride]);
+        bad |= b | (RBS_ONE_BITS - 1 - b);
+    }
+    return (bad >> 63) == 0;
+}
+
+/* V⁺ (m/s) and Ω⁺ (rad/s) that may be reported as a rebound (surrogate.kernels.frame.rebound_ok): all
+ * finite, and V⁺ leaving the wall (V⁺·n > 0); what overflows or underflows on extreme inputs is not. */
+RBS_INLINE int rbs_rebound_ok(const double *V, const double *W, const double *n)
+{
+    return rbs_finite(V[0]) & rbs_finite(V[1]) & rbs_finite(V[2]) & rbs_finite(W[0]) & rbs_finite(W[1])
+           & rbs_finite(W[2]) & (rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]) > 0.0);
 }
 
 typedef struct rbs_frame {
@@ -81,34 +125,36 @@ RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis
 }
 
 /* A local draw x = (vx, vy, vz, wx, wy, wz) (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the
- * frame (ex, n, ez); NaN unless rebounded (surrogate.kernels.frame.to_global). */
-RBS_INLINE void rbs_to_global(int status, const double x[6], double speed, double a, const double *ex,
-                                 const double *n, const double *ez, double *V_out, double *Omega_out)
+ * frame (ex, n, ez); returns the status: RBS_INVALID unless `ok` (the particle's and the uniforms' checks)
+ * and, for a rebound, rbs_rebound_ok. NaN unless rebounded (surrogate.kernels.frame.to_global). */
+RBS_INLINE int rbs_to_global(int status, int ok, const double x[6], double speed, double a, const double *ex,
+                                const double *n, const double *ez, double *V_out, double *Omega_out)
 {
-    if (status != RBS_REBOUNDED) {
-        for (int k = 0; k < 3; k++) V_out[k] = Omega_out[k] = NAN;
-        return;
-    }
+    double V[3], W[3];
     double w = speed / a;
+    for (int k = 0; k < 3; k++) V[k] = speed * rbs_dot(x[0], x[1], x[2], ex[k], n[k], ez[k]);
+    for (int k = 0; k < 3; k++) W[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
+    ok &= status != RBS_REBOUNDED || rbs_rebound_ok(V, W, n);
+    status = ok ? status : RBS_INVALID;
     for (int k = 0; k < 3; k++) {
-        V_out[k] = speed * rbs_dot(x[0], x[1], x[2], ex[k], n[k], ez[k]);
+        V_out[k] = status == RBS_REBOUNDED ? V[k] : NAN;
+        Omega_out[k] = status == RBS_REBOUNDED ? W[k] : NAN;
     }
-    for (int k = 0; k < 3; k++) {
-        Omega_out[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
-    }
+    return status;
 }
 
 /* The frame records of a block of RBS_BLOCK particles (pipeline.c), field-major: particle b at [b] */
 typedef struct rbs_frames {
-    double Vin[3][RBS_BLOCK], valid[RBS_BLOCK], normal[RBS_BLOCK], alpha1[RBS_BLOCK], speed[RBS_BLOCK],
+    double Vin[3][RBS_BLOCK], valid[RBS_BLOCK], ok[RBS_BLOCK], normal[RBS_BLOCK], alpha1[RBS_BLOCK], speed[RBS_BLOCK],
         cos_a1[RBS_BLOCK], sin_a1[RBS_BLOCK], a[RBS_BLOCK], ex[3][RBS_BLOCK], ez[3][RBS_BLOCK], n[3][RBS_BLOCK];
 } rbs_frames;
 
-/* The frame records of the m rows from `start` (surrogate.kernels.frame.frame_block): validity and impact
- * frame of every row (rbs_impact_frame, the same operations), on the rows copied field-major (rows past the
- * end: V = 0, n = e_y, a = 1, invalid); u12 their uniforms u[12] */
+/* The frame records of the m rows from `start` (surrogate.kernels.frame.frame_block): validity
+ * (rbs_moves_into_wall; `ok`: rbs_particle_ok and, if `given`, rbs_uniforms_ok) and impact frame of every row
+ * (rbs_impact_frame, the same operations), on the rows copied field-major (rows past the end: V = 0,
+ * n = e_y, a = 1, invalid); u their uniforms */
 RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *a, size_t start, size_t m,
-                                const double u12[RBS_BLOCK], rbs_frames *k)
+                                const double u[RBS_U_PER_DRAW][RBS_BLOCK], int given, rbs_frames *k)
 {
     for (size_t b = 0; b < RBS_BLOCK; b++) {
         size_t i = start + b;
@@ -123,8 +169,9 @@ RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *
         double V0 = k->Vin[0][b], V1 = k->Vin[1][b], V2 = k->Vin[2][b];
         double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
         double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
-        double finite = V0 + V1 + V2;
-        k->valid[b] = (vn < 0.0) & (finite - finite == 0.0) ? 1.0 : 0.0;
+        k->valid[b] = rbs_moves_into_wall(V0, V1, V2, n0, n1, n2) ? 1.0 : 0.0;
+        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_rebound_many) */
+        k->ok[b] = rbs_particle_ok(n0, n1, n2, k->a[b]) & (!given || rbs_uniforms_ok(&u[0][b], RBS_BLOCK)) ? 1.0 : 0.0;
         double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
         double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));
         double speed = sqrt(fma(vn, vn, vt * vt));
@@ -144,7 +191,7 @@ RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *
             rbs_frame f;
             const double Vi[3] = {k->Vin[0][b], k->Vin[1][b], k->Vin[2][b]};
             const double ni[3] = {k->n[0][b], k->n[1][b], k->n[2][b]};
-            rbs_impact_frame(Vi, ni, u12[b], &f);
+            rbs_impact_frame(Vi, ni, u[12][b], &f);
             for (int j = 0; j < 3; j++) k->ex[j][b] = f.ex[j];
         }
     }

@@ -20,8 +20,7 @@ RBS_INLINE double rbs_quantile(const rbs_table *t, int64_t cell, int64_t row, in
     const float *r = t->clusters;
     int64_t levels = t->n_levels - 1;
     double x = u * (double)levels;
-    int64_t i = rbs_trunc(x);
-    i = (levels - 1) < i ? (levels - 1) : i;
+    int64_t i = rbs_clamp_index(rbs_trunc(x), levels - 1);
     int64_t at = rbs_level(t, cell, k, i) + (int64_t)r[row + ROW_SHAPE + k];
     double lo = (double)t->dictionary[at], hi = (double)t->dictionary[at + t->n_dictionary];
     return fma((double)r[row + ROW_SCALE + k], fma(x - (double)i, hi - lo, lo), (double)r[row + ROW_LOC + k]);
@@ -94,8 +93,7 @@ RBS_INLINE void rbs_gather_block(const rbs_table *t, const double u[RBS_U_PER_DR
         }
         /* the restitution piece at the incident speed (evaluated in the SIMD loop) and the grid speed's factor */
         double x = c->wv[b] * (double)t->n_pieces;
-        int64_t i = rbs_trunc(x);
-        i = (t->n_pieces - 1) < i ? (t->n_pieces - 1) : i;
+        int64_t i = rbs_clamp_index(rbs_trunc(x), t->n_pieces - 1);
         k->piece_x[b] = 2.0 * (x - (double)i) - 1.0;
         const double *piece = t->restitution_pieces + (c->jv[b] * t->n_pieces + i) * 10;
         for (int d = 0; d < 10; d++) k->piece[d][b] = piece[d];

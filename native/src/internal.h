@@ -63,6 +63,13 @@
 #define RESTITUTION_PIECE_RATIO 1.25   /* surrogate.kernels.fastmath.PIECE_RATIO */
 #define SHAPE_NAME_SIZE 32
 
+/* what makes a table valid (docs/format.md; data_schema.table.SPEED_GRID_RANGE, MAX_SPEED_RATIO,
+ * WEIGHT_SUM_TOLERANCE) */
+#define SPEED_GRID_MIN 1e-3         /* m/s */
+#define SPEED_GRID_MAX 1e4          /* m/s */
+#define MAX_SPEED_RATIO 16.0        /* between consecutive grid speeds */
+#define WEIGHT_SUM_TOLERANCE 1e-9   /* |Σ cluster_weight − 1| per cell */
+
 struct rbs_table {
     char *path;
     int n_shapes, n_alpha1, n_speed, n_clusters, n_levels, n_dictionary, n_pieces;
@@ -96,6 +103,9 @@ typedef struct rbs_raw_cells {
     int64_t *status_counts;     /* (cells, 3) */
     double *mean;               /* (cells, 6) */
     double *std;                /* (cells, 6) */
+    int64_t *collision_counts;  /* (cells, 11): read to check them and their checksums, then freed */
+    float *indicatrix_2d;       /* (cells, 72): likewise */
+    float *indicatrix_3d;       /* (cells, 72, 72): likewise */
 } rbs_raw_cells;
 
 /* layout.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.

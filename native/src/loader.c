@@ -277,8 +277,10 @@ static int read_shapes(loader *ld, hid_t grid, rbs_table *t)
     return RBS_OK;
 }
 
-/* A 1-D grid dataset: finite, strictly increasing, > 0 if `positive`. */
-static double *read_grid(loader *ld, hid_t grid, const char *name, int positive, int *n)
+/* A 1-D grid dataset: strictly increasing in [lo, hi] (lo excluded if `open_low`), consecutive values at
+ * most a factor `ratio` apart (0: no limit). */
+static double *read_grid(loader *ld, hid_t grid, const char *name, double lo, int open_low, double hi, double ratio,
+                         const char *units, int *n)
 {
     int rank = 0;
     hsize_t dims[8];
@@ -290,9 +292,16 @@ static double *read_grid(loader *ld, hid_t grid, const char *name, int positive,
     double *values = read_dataset(ld, grid, "grid", name, H5T_NATIVE_DOUBLE, sizeof(double), 1, dims);
     if (!values) return NULL;
     for (hsize_t i = 0; i < dims[0]; i++) {
-        if (!isfinite(values[i]) || (positive && values[i] <= 0.0) || (i > 0 && !(values[i] > values[i - 1]))) {
-            fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be finite%s and strictly increasing (value %g at index %llu)",
-                 name, positive ? ", > 0" : "", values[i], (unsigned long long)i);
+        double x = values[i];
+        if (!(open_low ? x > lo : x >= lo) || !(x <= hi) || (i > 0 && !(x > values[i - 1]))) {
+            fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be strictly increasing in %c%g, %g] %s (value %g at index "
+                 "%llu)", name, open_low ? '(' : '[', lo, hi, units, x, (unsigned long long)i);
+            free(values);
+            return NULL;
+        }
+        if (ratio > 0.0 && i > 0 && x > ratio * values[i - 1]) {
+            fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' has consecutive speeds more than a factor %g apart (%g and %g "
+                 "%s)", name, ratio, values[i - 1], x, units);
             free(values);
             return NULL;
         }
@@ -382,6 +391,95 @@ static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dim
     }
 }
 
+/* The shape names: distinct, among the four (data_schema.table.check_contract). */
+static int check_shape_names(loader *ld, const rbs_table *t)
+{
+    static const char *const known[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
+    for (int i = 0; i < t->n_shapes; i++) {
+        int found = 0;
+        for (int k = 0; k < RBS_MAX_SHAPES; k++) found |= strcmp(t->shape_names[i], known[k]) == 0;
+        for (int j = 0; j < i; j++) found &= strcmp(t->shape_names[i], t->shape_names[j]) != 0;
+        if (!found)
+            return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must name distinct shapes among ellipsoid, prism, "
+                        "cut_prism, tetrahedron; got '%s' at index %d", t->shape_names[i], i);
+    }
+    return RBS_OK;
+}
+
+/* Since 3.2: the checksummed copies grid/law (restitution_k, restitution_p) and grid/shape_codes equal the
+ * attributes and the names, bit for bit (data_schema.table.LAW_DATASETS). */
+static int check_law_copies(loader *ld, hid_t grid, const rbs_table *t)
+{
+    static const char *const known[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
+    if (t->format_minor < 2) return RBS_OK;
+    const hsize_t two = 2, shapes = (hsize_t)t->n_shapes;
+    double *law = read_dataset(ld, grid, "grid", "law", H5T_NATIVE_DOUBLE, sizeof(double), 1, &two);
+    if (!law) return ld->code;
+    const double attributes[2] = {t->restitution_k, t->restitution_p};
+    int same = memcmp(law, attributes, sizeof attributes) == 0;
+    if (!same)
+        fail(ld, RBS_ERR_FORMAT, "the attributes restitution_k, restitution_p of group 'grid' (%.17g, %.17g) differ "
+             "from their checksummed copy 'grid/law' (%.17g, %.17g)", t->restitution_k, t->restitution_p, law[0], law[1]);
+    free(law);
+    if (!same) return ld->code;
+    uint8_t *codes = read_dataset(ld, grid, "grid", "shape_codes", H5T_NATIVE_UINT8, 1, 1, &shapes);
+    if (!codes) return ld->code;
+    for (int i = 0; same && i < t->n_shapes; i++)
+        same = codes[i] < RBS_MAX_SHAPES && strcmp(known[codes[i]], t->shape_names[i]) == 0;
+    free(codes);
+    if (!same)
+        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' differs from its checksummed copy 'grid/shape_codes'");
+    return RBS_OK;
+}
+
+/* index of the first element of x[0..n) that fails `ok`, or n */
+#define FIRST_BAD(x, n, ok, out)                                \
+    do {                                                        \
+        (out) = (n);                                            \
+        for (size_t i_ = 0; i_ < (n); i_++) {                   \
+            double v = (double)(x)[i_];                         \
+            if (!(ok)) {                                        \
+                (out) = i_;                                     \
+                break;                                          \
+            }                                                   \
+        }                                                       \
+    } while (0)
+
+/* The values of the cell datasets (data_schema.table.check_contract, the same rules in the same order). */
+static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cells, size_t C, long long M)
+{
+    size_t bad;
+#define RULE(field, n, ok, wanted)                                                                                 \
+    do {                                                                                                           \
+        FIRST_BAD(raw->field, n, ok, bad);                                                                         \
+        if (bad < (n))                                                                                             \
+            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/%s' holds %g at element %zu; its values must be %s", \
+                        #field, (double)raw->field[bad], bad, wanted);                                             \
+    } while (0)
+    RULE(cluster_weight, n_cells * C, isfinite(v) && v >= 0.0, "finite and >= 0");
+    RULE(cluster_scale, n_cells * C * N_CHAIN, isfinite(v) && v >= 0.0, "finite and >= 0");
+    RULE(cluster_shape, n_cells * C * N_CHAIN, v < (double)M, "below the dictionary size");
+    RULE(cluster_regime, n_cells * C, v <= 1.0, "0 or 1");
+    RULE(status_counts, n_cells * 3, v >= 0.0, ">= 0");
+    RULE(collision_counts, n_cells * 11, v >= 0.0, ">= 0");
+    RULE(mean, n_cells * 6, isfinite(v), "finite");
+    RULE(std, n_cells * 6, isfinite(v) && v >= 0.0, "finite and >= 0");
+    RULE(indicatrix_2d, n_cells * 72, isfinite(v) && v >= 0.0, "finite and >= 0");
+    RULE(indicatrix_3d, n_cells * 72 * 72, isfinite(v) && v >= 0.0, "finite and >= 0");
+#undef RULE
+    for (size_t cell = 0; cell < n_cells; cell++) {
+        double sum = 0.0;
+        for (size_t c = 0; c < C; c++) sum += raw->cluster_weight[cell * C + c];
+        if (!(fabs(sum - 1.0) <= WEIGHT_SUM_TOLERANCE))
+            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_weight' of cell %zu sums to %.17g; each cell's "
+                        "weights must sum to 1 within %g", cell, sum, WEIGHT_SUM_TOLERANCE);
+        if (raw->status_counts[3 * cell] + raw->status_counts[3 * cell + 1] <= 0)
+            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/status_counts' of cell %zu has no rebounded or trapped "
+                        "particle", cell);
+    }
+    return RBS_OK;
+}
+
 static void free_raw(rbs_raw_cells *raw)
 {
     free(raw->cluster_weight);
@@ -394,6 +492,9 @@ static void free_raw(rbs_raw_cells *raw)
     free(raw->status_counts);
     free(raw->mean);
     free(raw->std);
+    free(raw->collision_counts);
+    free(raw->indicatrix_2d);
+    free(raw->indicatrix_3d);
 }
 
 static int load(loader *ld, rbs_table *t)
@@ -442,7 +543,17 @@ static int load(loader *ld, rbs_table *t)
     t->n_dictionary = (int)M;
     t->n_levels = (int)L + 1;
 
-    if (read_double_attribute(ld, grid, "grid", "restitution_k", &t->restitution_k) != RBS_OK
+    /* attributes data_schema reads (provenance: present, not used here) */
+    for (int i = 0; i < 5; i++) {
+        static const char *const names[] = {"created", "package_version", "config", "config_sha256", "master_seed"};
+        if (!attribute_exists(file, names[i])) {
+            fail(ld, RBS_ERR_FORMAT, "missing root attribute '%s'", names[i]);
+            goto done;
+        }
+    }
+    double kappa;
+    if (read_double_attribute(ld, grid, "grid", "kappa", &kappa) != RBS_OK
+        || read_double_attribute(ld, grid, "grid", "restitution_k", &t->restitution_k) != RBS_OK
         || read_double_attribute(ld, grid, "grid", "restitution_p", &t->restitution_p) != RBS_OK
         || read_integer_attribute(ld, grid, "grid", "particles_per_cell", &t->particles_per_cell) != RBS_OK
         || read_integer_attribute(ld, grid, "grid", "n_max", &t->n_max) != RBS_OK)
@@ -453,10 +564,13 @@ static int load(loader *ld, rbs_table *t)
         goto done;
     }
     if (read_shapes(ld, grid, t) != RBS_OK) goto done;
-    t->alpha1_deg = read_grid(ld, grid, "alpha1_deg", 0, &t->n_alpha1);
+    if (check_shape_names(ld, t) != RBS_OK) goto done;
+    t->alpha1_deg = read_grid(ld, grid, "alpha1_deg", 0.0, 1, 90.0, 0.0, "deg", &t->n_alpha1);
     if (!t->alpha1_deg) goto done;
-    t->speed_m_s = read_grid(ld, grid, "speed_m_s", 1, &t->n_speed);
+    t->speed_m_s = read_grid(ld, grid, "speed_m_s", SPEED_GRID_MIN, 0, SPEED_GRID_MAX, MAX_SPEED_RATIO, "m/s",
+                             &t->n_speed);
     if (!t->speed_m_s) goto done;
+    if (check_law_copies(ld, grid, t) != RBS_OK) goto done;
 
     const hsize_t lead[3] = {(hsize_t)t->n_shapes, (hsize_t)t->n_alpha1, (hsize_t)t->n_speed};
     const size_t n_cells = (size_t)t->n_shapes * (size_t)t->n_alpha1 * (size_t)t->n_speed;
@@ -495,22 +609,11 @@ static int load(loader *ld, rbs_table *t)
     READ_CELLS(status_counts, 7, H5T_NATIVE_INT64, int64_t);
     READ_CELLS(mean, 9, H5T_NATIVE_DOUBLE, double);
     READ_CELLS(std, 10, H5T_NATIVE_DOUBLE, double);
+    READ_CELLS(collision_counts, 8, H5T_NATIVE_INT64, int64_t);
+    READ_CELLS(indicatrix_2d, 11, H5T_NATIVE_FLOAT, float);
+    READ_CELLS(indicatrix_3d, 12, H5T_NATIVE_FLOAT, float);
 #undef READ_CELLS
-    /* residual shape indices must name a shape of the dictionary (the kernels read there unchecked) */
-    for (size_t i = 0; i < n_cells * (size_t)C * N_CHAIN; i++) {
-        if (raw.cluster_shape[i] >= M) {
-            fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_shape' holds %u at element %zu, beyond the %lld "
-                 "shapes of the dictionary", (unsigned)raw.cluster_shape[i], i, M);
-            goto done;
-        }
-    }
-    for (size_t i = 0; i < n_cells * (size_t)C; i++) {
-        if (!(raw.cluster_weight[i] >= 0.0) || !isfinite(raw.cluster_weight[i])) {
-            fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_weight' holds %g at element %zu (weights must be finite "
-                 "and >= 0)", raw.cluster_weight[i], i);
-            goto done;
-        }
-    }
+    if (check_cell_values(ld, &raw, n_cells, (size_t)C, M) != RBS_OK) goto done;
     {
         const char *what = NULL;
         int code = rbs_derive(t, &raw, &what);

@@ -35,10 +35,13 @@ RBS_INLINE void rbs_locate(const double *axis, int64_t axis_len, int64_t n, doub
     }
     const int64_t inverse = AXIS_GRID + n;      /* where the inverse spacings start */
     const int64_t lookup = inverse + n - 1;     /* where the look-up indices start */
-    int64_t k = rbs_trunc((x - axis[AXIS_ORIGIN]) * axis[AXIS_INV_STEP]);
     const int64_t last = axis_len - 1 - lookup;
+    /* capped before the conversion: a huge x (or NaN) would convert to INT64_MIN, which the lower clamp
+     * sends to the first point, an interior cell for x above the grid */
+    double t = (x - axis[AXIS_ORIGIN]) * axis[AXIS_INV_STEP];
+    t = t < (double)last ? t : (double)last;
+    int64_t k = rbs_trunc(t);
     k = k < 0 ? 0 : k;
-    k = last < k ? last : k;
     int64_t j = (int64_t)axis[lookup + k];
     j += (int64_t)((x >= axis[AXIS_GRID + j + 1]) & (j < n - 2));   /* one-step correction */
     double w = (x - axis[AXIS_GRID + j]) * axis[inverse + j];
@@ -86,8 +89,7 @@ RBS_INLINE int64_t rbs_level(const rbs_table *t, int64_t cell, int64_t k, int64_
 RBS_INLINE int64_t rbs_first_row(const rbs_table *t, int64_t cell, double u4, double *t_out, int64_t *c_out)
 {
     double x = u4 * (double)t->n_clusters;
-    int64_t c = rbs_trunc(x);
-    c = (t->n_clusters - 1) < c ? (t->n_clusters - 1) : c;
+    int64_t c = rbs_clamp_index(rbs_trunc(x), t->n_clusters - 1);
     *t_out = x;
     *c_out = c;
     return rbs_row(t, cell, c);
@@ -115,8 +117,7 @@ RBS_INLINE void rbs_hint_levels(const rbs_table *t, int64_t drawn, const double 
 {
     int64_t levels = t->n_levels - 1;
     for (int k = 0; k < 6; k++) {
-        int64_t i = rbs_trunc(u[5 + k] * (double)levels);
-        i = (levels - 1) < i ? (levels - 1) : i;
+        int64_t i = rbs_clamp_index(rbs_trunc(u[5 + k] * (double)levels), levels - 1);
         int64_t level = rbs_level(t, drawn, k, i);
         RBS_PREFETCH(t->dictionary + level);
         RBS_PREFETCH(t->dictionary + level + t->n_dictionary);
@@ -139,14 +140,15 @@ typedef struct rbs_cells {
     double wa[RBS_BLOCK], wv[RBS_BLOCK];
 } rbs_cells;
 
-/* Stage 1 for the m rows from `start` (surrogate.kernels.locate.locate_block): their frame records, their cells
+/* Stage 1 for the m rows from `start` (surrogate.kernels.locate.locate_block; uniforms u, checked if `given`):
+ * their frame records, their cells
  * and the hints for the rows their uniforms u pick (invalid rows: cell 0, weights 0, so the later loops read
  * the table in range; their results are discarded) */
 RBS_INLINE void rbs_locate_block(const rbs_table *t, const rbs_mix *mix, const double *V, const double *n,
                                  const double *a, size_t start, size_t m, const double u[RBS_U_PER_DRAW][RBS_BLOCK],
-                                 rbs_frames *f, rbs_cells *k)
+                                 int given, rbs_frames *f, rbs_cells *k)
 {
-    rbs_frame_block(V, n, a, start, m, u[12], f);
+    rbs_frame_block(V, n, a, start, m, u, given, f);
     for (size_t b = 0; b < m; b++) {
         if (f->valid[b] == 0.0) {
             k->drawn[b] = k->below[b] = k->jv[b] = k->iv[b] = k->row[b] = 0;
@@ -180,8 +182,7 @@ RBS_INLINE void rbs_resolve_block(const rbs_table *t, const double u[RBS_U_PER_D
         rbs_hint_row(t, k->row[b]);
         int64_t levels = t->n_levels - 1;
         for (int j = 0; j < 6; j++) {
-            int64_t i = rbs_trunc(u[5 + j][b] * (double)levels);
-            i = (levels - 1) < i ? (levels - 1) : i;
+            int64_t i = rbs_clamp_index(rbs_trunc(u[5 + j][b] * (double)levels), levels - 1);
             int64_t level = rbs_level(t, drawn, j, i);
             RBS_PREFETCH(t->dictionary + level);
             RBS_PREFETCH(t->dictionary + level + t->n_dictionary);

@@ -11,29 +11,44 @@
 #include "locate.h"
 #include "rebound_internal.h"
 
+/* NaN into the outputs a caller gave (any may be NULL) */
+static void nan_out(double *x, int count)
+{
+    if (x)
+        for (int k = 0; k < count; k++) x[k] = NAN;
+}
+
 RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
                 const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
 {
-    const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
-    if (!rbs_arguments_ok(t, mix, interpolation) || !rbs_moves_into_wall(Vi, ni)) {
-        for (int k = 0; k < 3; k++) V_out[k] = Omega_out[k] = NAN;
+    if (!V || !n || !u || !V_out || !Omega_out || !rbs_arguments_ok(t, mix, interpolation)
+        || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])) {
+        nan_out(V_out, 3);
+        nan_out(Omega_out, 3);
         return RBS_INVALID;
     }
+    const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
     rbs_frame f;
     double x[6];
     rbs_impact_frame(Vi, ni, u[12], &f);
     rbs_cell cell = rbs_cell_of(t, mix->cdf, mix->n_shapes, f.alpha1, f.speed, u);
     rbs_hint_draw(t, cell.drawn, u);
     int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, interpolation == RBS_SCALED, x);
-    rbs_to_global(status, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
-    return status;
+    int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);
+    return rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
+}
+
+/* a local incident state a draw takes (surrogate.kernels.particle.local_ok): α1 in (0, 90] deg, |V⁻| finite and > 0 m/s */
+static inline int local_ok(double alpha1_deg, double speed_m_s)
+{
+    return alpha1_deg > 0.0 && alpha1_deg <= 90.0 && speed_m_s > 0.0 && rbs_finite(speed_m_s);
 }
 
 RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                    const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE])
 {
-    if (!rbs_arguments_ok(t, mix, interpolation)) {
-        for (int k = 0; k < RBS_LOCAL_SIZE; k++) out[k] = NAN;
+    if (!u || !out || !rbs_arguments_ok(t, mix, interpolation) || !local_ok(alpha1_deg, speed_m_s)) {
+        nan_out(out, RBS_LOCAL_SIZE);
         return RBS_INVALID;
     }
     rbs_cell cell = rbs_cell_of(t, mix->cdf, mix->n_shapes, alpha1_deg, speed_m_s, u);
@@ -41,8 +56,11 @@ RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1
     double sin_a1, cos_a1, x[6];
     rbs_sincos(alpha1_deg * RBS_DEG_TO_RAD, &sin_a1, &cos_a1);
     int status = rbs_draw_in_cell(t, &cell, cos_a1, sin_a1, u, interpolation == RBS_SCALED, x);
+    static const double wall_normal[3] = {0.0, 1.0, 0.0};
+    int ok = rbs_uniforms_ok(u, 1) & (status != RBS_REBOUNDED || rbs_rebound_ok(x, x + 3, wall_normal));
+    status = ok ? status : RBS_INVALID;
     if (status != RBS_REBOUNDED) {
-        for (int k = 0; k < RBS_LOCAL_SIZE; k++) out[k] = NAN;
+        nan_out(out, RBS_LOCAL_SIZE);
         return status;
     }
     double s = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);

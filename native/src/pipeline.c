@@ -51,7 +51,7 @@ RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t co
                 for (int q = 0; q < RBS_U_PER_DRAW; q++)
                     for (size_t b = 0; b < k->m; b++) k->u[q][b] = u[(k->start + b) * RBS_U_PER_DRAW + q];
             }
-            rbs_locate_block(t, mix, V, n, a, k->start, k->m, k->u, &k->frames, &k->cells);
+            rbs_locate_block(t, mix, V, n, a, k->start, k->m, k->u, rng == NULL, &k->frames, &k->cells);
         }
         if (j >= 1 && j <= n_blocks) {
             block *k = &blocks[(j - 1) % STAGES];
@@ -66,14 +66,26 @@ RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t co
     }
 }
 
-static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, double *V_out,
-                     double *Omega_out, signed char *status)
+/* NaN and RBS_INVALID into the outputs a caller gave (any may be NULL) */
+static void all_invalid(size_t count, double *V_out, double *Omega_out, signed char *status)
 {
-    if (rbs_arguments_ok(t, mix, interpolation)) return 1;
     for (size_t i = 0; i < count; i++) {
-        for (int k = 0; k < 3; k++) V_out[3 * i + k] = Omega_out[3 * i + k] = NAN;
-        status[i] = RBS_INVALID;
+        for (int k = 0; k < 3; k++) {
+            if (V_out) V_out[3 * i + k] = NAN;
+            if (Omega_out) Omega_out[3 * i + k] = NAN;
+        }
+        if (status) status[i] = RBS_INVALID;
     }
+}
+
+/* a table, a mix of its shape count, a known interpolation, no NULL array (with count > 0); else every row invalid */
+static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, const double *V,
+                     const double *n, const double *a, const void *uniforms, double *V_out, double *Omega_out,
+                     signed char *status)
+{
+    int arrays = count == 0 || (V && n && a && uniforms && V_out && Omega_out && status);
+    if (arrays && rbs_arguments_ok(t, mix, interpolation)) return 1;
+    all_invalid(count, V_out, Omega_out, status);
     return 0;
 }
 
@@ -81,7 +93,7 @@ void rbs_rebound_many(const rbs_table *t, const rbs_mix *mix, size_t count, cons
                       const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
                       signed char *status)
 {
-    if (arguments(t, mix, interpolation, count, V_out, Omega_out, status))
+    if (arguments(t, mix, interpolation, count, V, n, a, u, V_out, Omega_out, status))
         run_blocks(t, mix, count, V, n, a, u, NULL, interpolation == RBS_SCALED, V_out, Omega_out, status);
 }
 
@@ -89,6 +101,6 @@ void rbs_rebound_many_rng(const rbs_table *t, const rbs_mix *mix, size_t count, 
                           const double *a, rbs_rng *rng, int interpolation, double *V_out, double *Omega_out,
                           signed char *status)
 {
-    if (arguments(t, rng ? mix : NULL, interpolation, count, V_out, Omega_out, status))
+    if (arguments(t, rbs_rng_ok(rng) ? mix : NULL, interpolation, count, V, n, a, rng, V_out, Omega_out, status))
         run_blocks(t, mix, count, V, n, a, NULL, rng, interpolation == RBS_SCALED, V_out, Omega_out, status);
 }

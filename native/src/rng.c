@@ -8,6 +8,7 @@
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
+#include <math.h>
 #include <string.h>
 
 #include "internal.h"
@@ -79,6 +80,7 @@ static void seed_sequence_state(uint64_t seed, uint64_t k, uint64_t out[4])
 
 void rbs_rng_seed_stream(rbs_rng *rng, uint64_t seed, uint64_t k)
 {
+    if (!rng) return;
     seed_sequence_state(seed, k, rng->s);
     if ((rng->s[0] | rng->s[1] | rng->s[2] | rng->s[3]) == 0) rng->s[0] = 1;
 }
@@ -92,11 +94,22 @@ void rbs_rng_seed(rbs_rng *rng, uint64_t seed)
 
 double rbs_rng_uniform(rbs_rng *rng)
 {
-    return rbs_uniform_of(rbs_next(rng->s));
+    return rbs_rng_ok(rng) ? rbs_uniform_of(rbs_next(rng->s)) : NAN;
+}
+
+/* NaN into u[0..count) (u may be NULL): the uniforms of a NULL or all-zero state, which every draw refuses */
+static void nan_fill(double *u, size_t count)
+{
+    if (u)
+        for (size_t k = 0; k < count; k++) u[k] = NAN;
 }
 
 void rbs_rng_fill(rbs_rng *rng, double *u, size_t count)
 {
+    if (!u || !rbs_rng_ok(rng)) {
+        nan_fill(u, count);
+        return;
+    }
     uint64_t s[4] = {rng->s[0], rng->s[1], rng->s[2], rng->s[3]};
     for (size_t k = 0; k < count; k++) u[k] = rbs_uniform_of(rbs_next(s));
     memcpy(rng->s, s, sizeof s);
@@ -127,6 +140,10 @@ void rbs_rebound_uniforms(rbs_rng *rng, size_t count, double *u)
 {
     uint64_t lanes[4 * RBS_BLOCK];
     double ub[RBS_BLOCK * RBS_U_PER_DRAW];
+    if (!u || !rbs_rng_ok(rng)) {
+        nan_fill(u, count * RBS_U_PER_DRAW);
+        return;
+    }
     rbs_lanes_seed(rng, lanes);
     for (size_t start = 0; start < count; start += RBS_BLOCK) {
         rbs_lanes_fill(lanes, ub);

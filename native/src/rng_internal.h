@@ -41,6 +41,12 @@ static inline uint64_t rbs_splitmix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
+/* a state that is not NULL and not all zero (xoshiro256+'s fixed point: all-zero words give 0 forever) */
+static inline int rbs_rng_ok(const rbs_rng *rng)
+{
+    return rng != NULL && (rng->s[0] | rng->s[1] | rng->s[2] | rng->s[3]) != 0;
+}
+
 /* RBS_BLOCK lanes seeded from one step of rng (surrogate.kernels.rng.seed_lanes; word w of lane l at w·BLOCK + l) */
 void rbs_lanes_seed(rbs_rng *rng, uint64_t lanes[4 * RBS_BLOCK]);
 

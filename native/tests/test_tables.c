@@ -37,6 +37,148 @@ static void unit(rbs_rng *rng, double *v)
     for (int k = 0; k < 3; k++) v[k] /= norm;
 }
 
+/* every output NaN (count numbers) */
+static int all_nan(const double *x, int count)
+{
+    for (int k = 0; k < count; k++)
+        if (!isnan(x[k])) return 0;
+    return 1;
+}
+
+/* a rebound's outputs: finite, leaving the wall (V⁺·n > 0) */
+static int physical(const double *V_out, const double *W_out, const double *n)
+{
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(V_out[k]) || !isfinite(W_out[k])) return 0;
+    return V_out[0] * n[0] + V_out[1] * n[1] + V_out[2] * n[2] > 0.0;
+}
+
+/* Hostile arguments to the draw functions (issue 25): uniforms outside [0, 1) or NaN, NULL pointers, extreme
+ * speeds, half-sizes and normals, an all-zero generator, local states outside the physical range. None may
+ * crash or read outside the table (the sanitizers watch); each gives RBS_INVALID and NaN, or a finite
+ * rebound leaving the wall. */
+static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo, double vhi)
+{
+    const double V[3] = {40.0, -0.3, 0.0}, n[3] = {0.0, 1.0, 0.0};
+    double u[RBS_U_PER_DRAW], good[RBS_U_PER_DRAW], V_out[3], W_out[3], out[RBS_LOCAL_SIZE], ref[RBS_LOCAL_SIZE];
+    rbs_rng rng;
+    rbs_rng_seed(&rng, 25);
+    rbs_rng_fill(&rng, good, RBS_U_PER_DRAW);
+    const int good_status = rbs_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, V_out, W_out);
+    CHECK(good_status == RBS_REBOUNDED || good_status == RBS_TRAPPED, "good uniforms: status %d", good_status);
+    int st;
+
+    static const double bad[] = {-0.5, 1.0, 1e6, 1e300, -1e300, INFINITY, -INFINITY, NAN, -1e-300};
+    for (int k = 0; k < RBS_U_PER_DRAW; k++) {
+        for (size_t j = 0; j < sizeof bad / sizeof bad[0]; j++) {
+            memcpy(u, good, sizeof u);
+            u[k] = bad[j];
+            st = rbs_rebound(table, mix, V, n, 1e-4, u, j % 2, V_out, W_out);
+            CHECK(st == RBS_INVALID && all_nan(V_out, 3) && all_nan(W_out, 3), "u[%d] = %g: status %d", k, bad[j], st);
+            st = rbs_draw_local(table, mix, 45.0, 200.0, u, j % 2, out);
+            CHECK(st == RBS_INVALID && all_nan(out, RBS_LOCAL_SIZE), "local u[%d] = %g: status %d", k, bad[j], st);
+        }
+    }
+
+    /* NULL pointers */
+    CHECK(rbs_rebound(table, mix, NULL, n, 1e-4, good, RBS_SCALED, V_out, W_out) == RBS_INVALID && all_nan(V_out, 3),
+          "NULL V");
+    CHECK(rbs_rebound(table, mix, V, NULL, 1e-4, good, RBS_SCALED, V_out, W_out) == RBS_INVALID, "NULL n");
+    CHECK(rbs_rebound(table, mix, V, n, 1e-4, NULL, RBS_SCALED, V_out, W_out) == RBS_INVALID, "NULL u");
+    CHECK(rbs_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, NULL, W_out) == RBS_INVALID && all_nan(W_out, 3),
+          "NULL V_out");
+    CHECK(rbs_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, V_out, NULL) == RBS_INVALID, "NULL Omega_out");
+    CHECK(rbs_draw_local(table, mix, 45.0, 200.0, NULL, RBS_SCALED, out) == RBS_INVALID, "local NULL u");
+    CHECK(rbs_draw_local(table, mix, 45.0, 200.0, good, RBS_SCALED, NULL) == RBS_INVALID, "local NULL out");
+    signed char status[3];
+    double Vm[9], nm[9], am[3], um[3 * RBS_U_PER_DRAW], Vo[9], Wo[9];
+    for (int i = 0; i < 3; i++) {
+        memcpy(Vm + 3 * i, V, sizeof V);
+        memcpy(nm + 3 * i, n, sizeof n);
+        memcpy(um + RBS_U_PER_DRAW * i, good, sizeof good);
+        am[i] = 1e-4;
+    }
+    rbs_rebound_many(table, mix, 3, NULL, nm, am, um, RBS_SCALED, Vo, Wo, status);
+    CHECK(status[0] == RBS_INVALID && status[2] == RBS_INVALID && all_nan(Vo, 9), "many: NULL V");
+    rbs_rebound_many(table, mix, 3, Vm, nm, am, um, RBS_SCALED, NULL, NULL, status);
+    CHECK(status[1] == RBS_INVALID, "many: NULL outputs");
+    rbs_rebound_many(table, mix, 3, Vm, nm, am, NULL, RBS_SCALED, NULL, NULL, NULL);
+    rbs_rebound_many_rng(table, mix, 3, Vm, nm, am, NULL, RBS_SCALED, Vo, Wo, status);
+    CHECK(status[0] == RBS_INVALID, "many_rng: NULL rng");
+    um[RBS_U_PER_DRAW + 5] = -0.5;     /* row 1's u[5]: that row alone is invalid */
+    rbs_rebound_many(table, mix, 3, Vm, nm, am, um, RBS_SCALED, Vo, Wo, status);
+    CHECK(status[1] == RBS_INVALID && status[0] == good_status && status[2] == good_status, "many, one bad row: %d %d %d", status[0],
+          status[1], status[2]);
+
+    /* generators: NULL and all zero (xoshiro256+'s fixed point) give NaN, never u = 0 forever */
+    rbs_rng_seed(NULL, 1);
+    rbs_rng_seed_stream(NULL, 1, 2);
+    CHECK(isnan(rbs_rng_uniform(NULL)), "uniform of NULL");
+    rbs_rng_fill(NULL, u, RBS_U_PER_DRAW);
+    CHECK(all_nan(u, RBS_U_PER_DRAW), "fill from NULL");
+    rbs_rng_fill(&rng, NULL, 5);
+    rbs_rebound_uniforms(NULL, 3, um);
+    CHECK(all_nan(um, 3 * RBS_U_PER_DRAW), "rebound_uniforms from NULL");
+    rbs_rng zero = {{0, 0, 0, 0}};
+    CHECK(isnan(rbs_rng_uniform(&zero)), "uniform of the zero state");
+    rbs_rng_fill(&zero, u, RBS_U_PER_DRAW);
+    CHECK(all_nan(u, RBS_U_PER_DRAW), "fill from the zero state");
+    CHECK(rbs_rebound(table, mix, V, n, 1e-4, u, RBS_SCALED, V_out, W_out) == RBS_INVALID, "zero state draw");
+    rbs_rebound_many_rng(table, mix, 3, Vm, nm, am, &zero, RBS_SCALED, Vo, Wo, status);
+    CHECK(status[0] == RBS_INVALID && status[2] == RBS_INVALID, "many_rng: zero state");
+
+    /* extreme particles: |V⁻| overflowing or underflowing, bad half-sizes and normals */
+    static const double speeds[] = {1e200, 1e154, 1e-160, 1e-200, 5e-324};
+    for (size_t j = 0; j < sizeof speeds / sizeof speeds[0]; j++) {
+        const double Vs[3] = {speeds[j] * 0.8, -speeds[j] * 0.6, 0.0};
+        st = rbs_rebound(table, mix, Vs, n, 1e-4, good, RBS_SCALED, V_out, W_out);
+        CHECK(st == RBS_INVALID ? all_nan(V_out, 3) : st == RBS_TRAPPED || physical(V_out, W_out, n),
+              "|V| = %g: status %d, V+ = (%g, %g, %g)", speeds[j], st, V_out[0], V_out[1], V_out[2]);
+    }
+    static const double sizes[] = {0.0, -1e-4, NAN, INFINITY, 5e-324, -INFINITY};
+    for (size_t j = 0; j < sizeof sizes / sizeof sizes[0]; j++) {
+        st = rbs_rebound(table, mix, V, n, sizes[j], good, RBS_SCALED, V_out, W_out);
+        CHECK(st == RBS_INVALID && all_nan(W_out, 3), "a = %g: status %d", sizes[j], st);
+    }
+    static const double lengths[] = {1e200, 2.0, 0.5, 1.0 + 1e-5, 1e-200};
+    for (size_t j = 0; j < sizeof lengths / sizeof lengths[0]; j++) {
+        const double nl[3] = {0.0, lengths[j], 0.0};
+        st = rbs_rebound(table, mix, V, nl, 1e-4, good, RBS_SCALED, V_out, W_out);
+        CHECK(st == RBS_INVALID && all_nan(V_out, 3), "|n| = %g: status %d", lengths[j], st);
+    }
+
+    /* local draws: α1 outside (0, 90] or NaN, |V⁻| not finite and > 0; a huge |V⁻| is the top grid edge */
+    static const double alphas[] = {NAN, -5.0, 0.0, 90.0001, 1e30, -INFINITY, INFINITY};
+    for (size_t j = 0; j < sizeof alphas / sizeof alphas[0]; j++)
+        CHECK(rbs_draw_local(table, mix, alphas[j], 200.0, good, RBS_SCALED, out) == RBS_INVALID
+              && all_nan(out, RBS_LOCAL_SIZE), "local alpha1 = %g", alphas[j]);
+    static const double local_speeds[] = {NAN, -1.0, 0.0, INFINITY, -INFINITY};
+    for (size_t j = 0; j < sizeof local_speeds / sizeof local_speeds[0]; j++)
+        CHECK(rbs_draw_local(table, mix, 45.0, local_speeds[j], good, RBS_SCALED, out) == RBS_INVALID,
+              "local speed = %g", local_speeds[j]);
+    int top = rbs_draw_local(table, mix, 45.0, vhi, good, RBS_SCALED, ref);
+    CHECK(rbs_draw_local(table, mix, 45.0, 1e25, good, RBS_SCALED, out) == top
+          && (top != RBS_REBOUNDED || memcmp(out, ref, sizeof out) == 0), "speed 1e25 is not the top grid edge");
+    int bottom = rbs_draw_local(table, mix, 45.0, vlo, good, RBS_SCALED, ref);
+    CHECK(rbs_draw_local(table, mix, 45.0, 1e-300, good, RBS_SCALED, out) == bottom
+          && (bottom != RBS_REBOUNDED || memcmp(out, ref, sizeof out) == 0), "speed 1e-300 is not the bottom grid edge");
+
+    /* random hostile uniforms and particles: whatever comes back as a rebound is finite and leaves the wall */
+    for (int i = 0; i < 20000; i++) {
+        double Vr[3], nr[3];
+        for (int k = 0; k < RBS_U_PER_DRAW; k++) u[k] = 3.0 * rbs_rng_uniform(&rng) - 1.0;
+        for (int k = 0; k < 3; k++) {
+            Vr[k] = ldexp(2.0 * rbs_rng_uniform(&rng) - 1.0, (int)(1200.0 * rbs_rng_uniform(&rng)) - 600);
+            nr[k] = 2.0 * rbs_rng_uniform(&rng) - 1.0;
+        }
+        double a = ldexp(rbs_rng_uniform(&rng), (int)(1200.0 * rbs_rng_uniform(&rng)) - 600);
+        st = rbs_rebound(table, mix, Vr, nr, a, u, i % 2, V_out, W_out);
+        CHECK(st == RBS_INVALID || st == RBS_TRAPPED || physical(V_out, W_out, nr), "random hostile draw %d", i);
+        st = rbs_draw_local(table, mix, 100.0 * u[0], ldexp(u[1], (int)(2000.0 * u[2]) - 1000), u, i % 2, out);
+        CHECK(st == RBS_INVALID || st == RBS_TRAPPED || (isfinite(out[2]) && out[2] >= 0.0), "random local draw %d", i);
+    }
+}
+
 static void draw_from(const char *path)
 {
     char message[1024];
@@ -133,14 +275,18 @@ static void draw_from(const char *path)
     rbs_rebound_many(table, &mix, 33, V, n, a, u, 7, V_out, Omega_out, status);
     CHECK(status[0] == RBS_INVALID && isnan(V_out[0]), "unknown interpolation gives invalid");
     for (int i = 0; i < 2000; i++) {
-        double out[RBS_LOCAL_SIZE];
-        int st = rbs_draw_local(table, &mix, -5.0 + 100.0 * u[i] , 0.5 * vlo + 2.0 * vhi * u[i + 1],
-                                u + RBS_U_PER_DRAW * (i % N), i % 2, out);
-        CHECK(st == RBS_REBOUNDED || st == RBS_TRAPPED, "local status %d", st);
+        double out[RBS_LOCAL_SIZE], alpha1 = -5.0 + 100.0 * u[i];
+        int st = rbs_draw_local(table, &mix, alpha1, 0.5 * vlo + 2.0 * vhi * u[i + 1], u + RBS_U_PER_DRAW * (i % N),
+                                i % 2, out);
+        if (alpha1 > 0.0 && alpha1 <= 90.0)
+            CHECK(st == RBS_REBOUNDED || st == RBS_TRAPPED, "local status %d at alpha1 %g", st, alpha1);
+        else
+            CHECK(st == RBS_INVALID, "local status %d at alpha1 %g", st, alpha1);
         if (st == RBS_REBOUNDED) CHECK(out[2] >= 0.0 && out[2] <= 1.0, "s = %g", out[2]);
     }
     double out[RBS_LOCAL_SIZE];
-    CHECK(rbs_draw_local(table, &mix, NAN, NAN, u, RBS_SCALED, out) != 99, "NaN local draw");
+    CHECK(rbs_draw_local(table, &mix, NAN, NAN, u, RBS_SCALED, out) == RBS_INVALID, "NaN local draw");
+    hostile_draws(table, &mix, vlo, vhi);
     CHECK(rbs_draw_local(table, NULL, 45.0, 100.0, u, RBS_SCALED, out) == RBS_INVALID, "NULL mix");
     rbs_mix wrong = mix;
     wrong.n_shapes = n_shapes + 1;

@@ -17,9 +17,9 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
-from surrogate.kernels.block import BLOCK, put3
+from surrogate.kernels.block import BLOCK, field, put3
 from surrogate.kernels.fastmath import fma, sincos
-from surrogate.kernels.frame import frame_at, is_valid, to_global
+from surrogate.kernels.frame import FRAME_OK, frame_at, is_valid, to_global
 from surrogate.kernels.gather import gathered_at
 from surrogate.kernels.options import JIT
 
@@ -191,7 +191,8 @@ def _draw_global(g, fr, out, b, scaled):
     """Particle b's draw (:func:`arithmetic`), then :func:`surrogate.kernels.frame.to_global`, into ``out``."""
     _, speed, cos_a1, sin_a1, a, ex, ez, n = frame_at(fr, b)
     status, vx, vy, vz, wx, wy, wz = arithmetic(gathered_at(g, b), cos_a1, sin_a1, scaled)
-    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
+    status, V_new, Omega_new = to_global(status, field(fr, FRAME_OK, b) != 0.0, vx, vy, vz, wx, wy, wz, speed, a,
+                                         ex, n, ez)
     out[OUT_STATUS * BLOCK + b] = status
     put3(out, OUT_V, b, V_new)
     put3(out, OUT_OMEGA, b, Omega_new)

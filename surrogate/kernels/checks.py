@@ -19,28 +19,33 @@ import numba
 import numpy as np
 
 from surrogate.kernels.draw import U_PER_DRAW
-from surrogate.kernels.frame import dot, impact_frame
+from surrogate.kernels.frame import dot, impact_frame, unit_normal
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
 
 FAULT_VELOCITY_NOT_FINITE = 0
 FAULT_NORMAL_NOT_FINITE = 1
-FAULT_NORMAL_NOT_UNIT = 2       # | |n| − 1 | > tolerance
+FAULT_NORMAL_NOT_UNIT = 2       # not frame.unit_normal: | |n| − 1 | > NORMAL_TOLERANCE
 FAULT_VELOCITY_ZERO = 3
 FAULT_NOT_INTO_WALL = 4         # V·n ≥ 0
-FAULT_HALF_SIZE = 5             # not finite or ≤ 0
+FAULT_HALF_SIZE = 5             # not finite or ≤ 0, or |V⁻|/a > SPIN_SCALE_MAX
 FAULT_ALPHA1_NOT_FINITE = 6
 FAULT_ALPHA1_OUTSIDE = 7        # outside [alpha1_lo, alpha1_hi] deg
-FAULT_SPEED_NOT_FINITE = 8
+FAULT_SPEED_NOT_FINITE = 8      # or outside [SPEED_MIN, SPEED_MAX]
 FAULT_SPEED_OUTSIDE = 9         # outside [speed_lo, speed_hi] m/s
 N_FAULTS = 10
 
+# |V⁻| the kernels' arithmetic carries, m/s: the squares of the impact frame neither overflow nor lose the
+# precision of subnormal numbers
+SPEED_MIN, SPEED_MAX = 1e-150, 1e150
+SPIN_SCALE_MAX = 1e300      # |V⁻|/a at most, 1/s: Ω⁺ = (|V⁻|/a)(Ω⁺a/|V⁻|) stays finite
+
 
 @numba.njit(parallel=True, **JIT)
-def first_faults(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
+def first_faults(V, n, a, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
     """First failing row of each check (FAULT_* order; −1 if none) over V (N, 3) m/s, unit normals n (N, 3)
-    or (1, 3) for all rows, half-sizes a (N,) or (1,) m; ``tolerance`` on |n| − 1, the α1 range in degrees
-    and the speed range in m/s."""
+    or (1, 3) for all rows, half-sizes a (N,) or (1,) m; the α1 range in degrees and the speed range in
+    m/s."""
     chunks = n_chunks(V.shape[0])
     found = np.full((chunks, N_FAULTS), -1, dtype=np.int64)
     last_n, last_a = n.shape[0] - 1, a.shape[0] - 1
@@ -48,7 +53,7 @@ def first_faults(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
         mine = found[j]
         for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
             k = min(i, last_n)
-            _check_row((V[i, 0], V[i, 1], V[i, 2]), (n[k, 0], n[k, 1], n[k, 2]), a[min(i, last_a)], tolerance,
+            _check_row((V[i, 0], V[i, 1], V[i, 2]), (n[k, 0], n[k, 1], n[k, 2]), a[min(i, last_a)],
                        alpha1_lo, alpha1_hi, speed_lo, speed_hi, i, mine)
     first = np.full(N_FAULTS, -1, dtype=np.int64)
     for j in range(chunks):          # chunks in row order: the first chunk with a fault holds its first row
@@ -59,21 +64,23 @@ def first_faults(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi):
 
 
 @numba.njit(inline="always", **JIT)
-def _check_row(V, n, a, tolerance, alpha1_lo, alpha1_hi, speed_lo, speed_hi, i, found):
+def _check_row(V, n, a, alpha1_lo, alpha1_hi, speed_lo, speed_hi, i, found):
     """Record row i in ``found`` under every check it fails, unless an earlier row of its chunk did."""
     finite = math.isfinite(V[0] + V[1] + V[2])
     vn = dot(V, n)
     _record(found, FAULT_VELOCITY_NOT_FINITE, not finite, i)
     _record(found, FAULT_NORMAL_NOT_FINITE, not math.isfinite(n[0] + n[1] + n[2]), i)
-    _record(found, FAULT_NORMAL_NOT_UNIT, abs(math.sqrt(dot(n, n)) - 1.0) > tolerance, i)
+    _record(found, FAULT_NORMAL_NOT_UNIT, not unit_normal(n), i)
     _record(found, FAULT_VELOCITY_ZERO, dot(V, V) == 0.0, i)
     _record(found, FAULT_NOT_INTO_WALL, vn >= 0.0, i)
     _record(found, FAULT_HALF_SIZE, not (math.isfinite(a) and a > 0.0), i)
     if finite and vn < 0.0:
         alpha1, speed = impact_frame(V, n, 0.0)[:2]
-        _record(found, FAULT_ALPHA1_NOT_FINITE, not math.isfinite(alpha1), i)
-        _record(found, FAULT_ALPHA1_OUTSIDE, alpha1 < alpha1_lo or alpha1 > alpha1_hi, i)
-        _record(found, FAULT_SPEED_NOT_FINITE, not math.isfinite(speed), i)
+        carried = SPEED_MIN <= speed <= SPEED_MAX       # else α1 and the spin's unit are not to be trusted
+        _record(found, FAULT_HALF_SIZE, carried and not speed / a <= SPIN_SCALE_MAX, i)
+        _record(found, FAULT_ALPHA1_NOT_FINITE, carried and not math.isfinite(alpha1), i)
+        _record(found, FAULT_ALPHA1_OUTSIDE, carried and (alpha1 < alpha1_lo or alpha1 > alpha1_hi), i)
+        _record(found, FAULT_SPEED_NOT_FINITE, not carried, i)
         _record(found, FAULT_SPEED_OUTSIDE, speed < speed_lo or speed > speed_hi, i)
 
 
@@ -117,9 +124,11 @@ def shape_error(name, shape, needed, first="V"):
 
 @numba.njit(**JIT)
 def check_state(state):
-    """ValueError unless ``state`` is one xoshiro256+ state (the one-thread kernels that draw their uniforms)."""
-    if state.shape[0] != 4:
-        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64, as surrogate.seed_state gives")
+    """ValueError unless ``state`` is one xoshiro256+ state (the one-thread kernels that draw their uniforms): (4,)
+    uint64, not all zero (the generator's fixed point; rbs_rebound_many_rng gives every row RBS_INVALID for it)."""
+    if state.shape[0] != 4 or (state[0] | state[1] | state[2] | state[3]) == 0:
+        raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64 not all zero, as surrogate.seed_state "
+                         "gives")
 
 
 @numba.njit(**JIT)

@@ -56,6 +56,26 @@ def fma(typingctx, a, b, c):
     return types.float64(a, b, c), codegen
 
 
+@numba.njit(inline="always", **JIT)
+def clamp_index(i, last):
+    """An index i (last ≥ 0) kept in [0, last]: i if it is there, else last (rbs_clamp_index). A negative i,
+    INT64_MIN from int(NaN) or an out-of-range float included, is beyond last as unsigned: one compare, as
+    the upper clamp alone, and a uniform outside [0, 1) still reads in range."""
+    return i if np.uint64(i) <= np.uint64(last) else last
+
+
+@intrinsic
+def bits(typingctx, x):
+    """The bits of a float64 as a uint64 (rbs_bits)."""
+    if not isinstance(x, types.Float) or x.bitwidth != 64:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return types.uint64(x), codegen
+
+
 _HALF_PI_HI = 1.5707963267948966       # π/2 rounded to a double
 _HALF_PI_LO = 6.123233995736766e-17    # π/2 − _HALF_PI_HI
 _TWO_OVER_PI = 2.0 / math.pi
@@ -188,7 +208,7 @@ def restitution_at(pieces, n_pieces, j, w):
     """exp(−k V^p) at V = V_j + w (V_{j+1} − V_j), w ∈ [0, 1], from :func:`restitution_pieces` flattened
     (``pieces`` 1-D, ``n_pieces`` its S: piece i of interval j starts at (j S + i)(DEGREE + 1))."""
     t = w * n_pieces
-    i = min(int(t), n_pieces - 1)
+    i = clamp_index(int(t), n_pieces - 1)
     x = 2.0 * (t - i) - 1.0
     start = (j * n_pieces + i) * (DEGREE + 1)
     value = load(pieces, start + DEGREE)

@@ -12,7 +12,7 @@ import numba
 import numpy as np
 
 from surrogate.kernels.block import BLOCK, field, fields6, put3, put6, uniforms
-from surrogate.kernels.fastmath import fma, restitution_at
+from surrogate.kernels.fastmath import clamp_index, fma, restitution_at
 from surrogate.kernels.frame import is_valid
 from surrogate.kernels.layout import (CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD, CELL_SIZE, ROW_LOC, ROW_REGIME,
                                       ROW_SCALE, ROW_SHAPE, ROW_SLOPE)
@@ -29,7 +29,7 @@ def _quantile(data, cell, row, k, u):
     r = data.clusters
     levels = data.n_levels - 1
     t = u * levels
-    i = min(int(t), levels - 1)
+    i = clamp_index(int(t), levels - 1)
     at = level_offset(data, cell, k, i) + int(load(r, row + ROW_SHAPE + k))
     lo, hi = np.float64(load(data.dictionary, at)), np.float64(load(data.dictionary, at + data.n_dictionary))
     return fma(np.float64(load(r, row + ROW_SCALE + k)), fma(t - i, hi - lo, lo), np.float64(load(r, row + ROW_LOC + k)))

@@ -10,9 +10,11 @@ for a block of the pipeline (:mod:`surrogate.kernels.pipeline`).
 """
 
 import numba
+import numpy as np
 
 from data_schema.table import N_CHAIN
 from surrogate.kernels.block import BLOCK, field, uniforms
+from surrogate.kernels.fastmath import clamp_index
 from surrogate.kernels.frame import FRAME_ALPHA1, FRAME_SPEED, frame_block, is_valid
 from surrogate.kernels.layout import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, FLOAT32_PER_CACHE_LINE, ROW_ALIAS,
                                       ROW_ALIAS_PROB, ROW_SIZE)
@@ -31,8 +33,11 @@ def grid_interval(axis, n, x):
         return 0, 0.0
     inverse = AXIS_GRID + n     # where the inverse spacings start
     lookup = inverse + n - 1    # where the look-up indices start
-    k = int((x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP))
-    k = min(max(k, 0), axis.shape[0] - 1 - lookup)
+    last = axis.shape[0] - 1 - lookup
+    # capped before the conversion: a huge x (or NaN) would convert to INT64_MIN, which the lower clamp sends
+    # to the first point, an interior cell for x above the grid
+    t = (x - load(axis, AXIS_ORIGIN)) * load(axis, AXIS_INV_STEP)
+    k = max(int(t if t < last else np.float64(last)), 0)
     j = int(load(axis, lookup + k))
     j += (x >= load(axis, AXIS_GRID + j + 1)) & (j < n - 2)     # one-step correction, no branch to mispredict
     w = (x - load(axis, AXIS_GRID + j)) * load(axis, inverse + j)
@@ -78,7 +83,7 @@ def first_row(data, cell, u4):
     """(t, c, offset of row c): the component u4 picks in cell number ``cell`` before the alias table,
     c = ⌊t⌋ with t = u4 · n_clusters."""
     t = u4 * data.n_clusters
-    c = min(int(t), data.n_clusters - 1)
+    c = clamp_index(int(t), data.n_clusters - 1)
     return t, c, _row(data, cell, c)
 
 
@@ -128,7 +133,7 @@ def _hint_level(data, drawn, k, u):
     """Cache hints for the two residual-shape levels of chain variable k that u picks
     (:func:`surrogate.kernels.gather._quantile`)."""
     levels = data.n_levels - 1
-    level = level_offset(data, drawn, k, min(int(u * levels), levels - 1))
+    level = level_offset(data, drawn, k, clamp_index(int(u * levels), levels - 1))
     prefetch(data.dictionary, (level,))
     prefetch(data.dictionary, (level + data.n_dictionary,))
 
@@ -149,11 +154,11 @@ def cell_at(index, weights, b):
 
 
 @numba.njit(inline="always", **JIT)
-def locate_block(data, mix_cdf, V, n, a, ub, start, m, fr, index, weights):
-    """Stage 1 for the m rows from ``start`` (their uniforms ``ub``): the frame records ``fr``
+def locate_block(data, mix_cdf, V, n, a, ub, given, start, m, fr, index, weights):
+    """Stage 1 for the m rows from ``start`` (their uniforms ``ub``, checked if ``given``): the frame records ``fr``
     (:func:`surrogate.kernels.frame.frame_block`), the cells, and cache hints for the component rows the
     uniforms pick (before the alias table)."""
-    frame_block(V, n, a, ub, start, m, fr)
+    frame_block(V, n, a, ub, given, start, m, fr)
     for b in range(m):
         if is_valid(fr, b):
             _put_cell(data, mix_cdf, field(fr, FRAME_ALPHA1, b), field(fr, FRAME_SPEED, b), uniforms(ub, b), index,

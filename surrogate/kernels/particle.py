@@ -13,7 +13,8 @@ import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
 from surrogate.kernels.draw import draw_in_cell, draw_velocity
-from surrogate.kernels.frame import NAN3, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.frame import (NAN3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
+                                     uniforms_ok)
 from surrogate.kernels.locate import hint, locate
 from surrogate.kernels.options import JIT, KERNEL
 
@@ -27,15 +28,17 @@ def rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out, scaled=True):
     data : ``table.kernel_data``.
     mix_cdf : cumulative shape weights (table shape order).
     V : (3,) incident velocity, m/s; must move into the wall (V·n < 0).
-    n : (3,) unit wall normal pointing into the gas (not checked here).
-    a : particle half-size (half its largest extent), m.
+    n : (3,) unit wall normal pointing into the gas (| |n| − 1 | ≤ NORMAL_TOLERANCE).
+    a : particle half-size (half its largest extent), m, finite and > 0.
     u : (U_PER_DRAW,) uniforms in [0, 1).
     V_out, Omega_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
     scaled : between grid points, move the draw to the incident state
         (default; :func:`draw_velocity`); False: plain stochastic interpolation.
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
-    move into the wall (V·n ≥ 0, zero or non-finite). The impact frame is ex
+    move into the wall (V·n ≥ 0, zero or non-finite), n is not a unit vector,
+    a is not finite and > 0, a uniform is outside [0, 1), or the result would
+    not be finite or would not leave the wall (as rbs_rebound). The impact frame is ex
     (tangential direction of V), n, ez = ex × n; the local draw is rotated back
     into the global frame. The mirror symmetry of the model is applied with a
     random sign (:func:`surrogate.kernels.arithmetic.arithmetic`). An α1 or |V⁻| outside the table's
@@ -68,8 +71,8 @@ def _rebound(data, mix_cdf, V, n, a, u, scaled):
     cell = locate(data, mix_cdf, alpha1, speed, u)
     hint(data, cell, u)
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
-    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
-    return status, V_new, Omega_new
+    ok = particle_ok(n, a) & uniforms_ok(u)
+    return to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
 
 
 @numba.njit(inline="always", **JIT)
@@ -79,14 +82,27 @@ def _store(V_new, Omega_new, V_out, Omega_out):
         Omega_out[k] = Omega_new[k]
 
 
+@numba.njit(inline="always", **JIT)
+def local_ok(alpha1, speed):
+    """A local incident state a draw takes: α1 in (0, 90] deg, |V⁻| finite and > 0 m/s."""
+    return alpha1 > 0.0 and alpha1 <= 90.0 and speed > 0.0 and math.isfinite(speed)
+
+
 @numba.njit(**KERNEL)
 def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
     """One reflected state at (α1 deg, |V⁻| m/s) in the local frame: (status, α2, β2, s, Ω_x, Ω_y, Ω_z).
 
     Angles in radians, s = |V⁺|/|V⁻|, Ω in units of |V⁻|/a; the state is NaN
     for a trapped particle. See :func:`surrogate.kernels.draw.draw_velocity` (same arguments).
+    STATUS_INVALID (and NaN) for α1 outside (0, 90] or NaN, |V⁻| not finite
+    and > 0, a uniform outside [0, 1), or a draw that is not a finite rebound
+    leaving the wall (as rbs_draw_local).
     """
+    if not local_ok(alpha1, speed):
+        return STATUS_INVALID, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)
+    ok = uniforms_ok(u) & ((status != STATUS_REBOUNDED) | rebound_ok((vx, vy, vz), (wx, wy, wz), (0.0, 1.0, 0.0)))
+    status = status if ok else STATUS_INVALID
     if status != STATUS_REBOUNDED:
         return status, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     s = math.sqrt(vx * vx + vy * vy + vz * vz)

@@ -137,8 +137,8 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, 
         if k < n_blocks:
             j, start = k % STAGES, k * BLOCK
             _block_uniforms(u, state, lanes, start, min(BLOCK, rows - start), us[j])
-            locate_block(data, mix_cdf, V_flat, n_flat, a, us[j], start, min(BLOCK, rows - start), fr[j], index[j],
-                         weights[j])
+            locate_block(data, mix_cdf, V_flat, n_flat, a, us[j], state.shape[0] != 4, start, min(BLOCK, rows - start),
+                         fr[j], index[j], weights[j])
         if 1 <= k <= n_blocks:
             j, start = (k - 1) % STAGES, (k - 1) * BLOCK
             resolve_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j])

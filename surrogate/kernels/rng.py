@@ -99,7 +99,10 @@ def _step(s0, s1, s2, s3):
 
 @numba.njit(inline="always", cache=True, nogil=True)
 def next_uniform(state):
-    """The next uniform in [0, 1) (53 bits) from a xoshiro256+ ``state`` (4,) uint64, updated in place."""
+    """The next uniform in [0, 1) (53 bits) from a xoshiro256+ ``state`` (4,) uint64, updated in place; NaN
+    for an all-zero state (not a xoshiro256+ state: it would give 0 forever), which every draw refuses."""
+    if (state[0] | state[1] | state[2] | state[3]) == 0:
+        return np.nan
     x, state[0], state[1], state[2], state[3] = _step(state[0], state[1], state[2], state[3])
     return x
 
@@ -110,9 +113,13 @@ def fill_uniforms(state, u):
 
     The state words stay in registers for the whole fill and are stored once
     at the end (stepping ``state`` in place per uniform would store and reload
-    them each time: the compiler cannot tell that u and state do not overlap).
+    them each time: the compiler cannot tell that u and state do not overlap). An all-zero state gives NaN
+    (:func:`next_uniform`).
     """
     s0, s1, s2, s3 = state[0], state[1], state[2], state[3]
+    if (s0 | s1 | s2 | s3) == 0:
+        u[:] = np.nan
+        return
     for k in range(u.shape[0]):
         u[k], s0, s1, s2, s3 = _step(s0, s1, s2, s3)
     state[0], state[1], state[2], state[3] = s0, s1, s2, s3

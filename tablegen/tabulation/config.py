@@ -5,7 +5,7 @@ the ``default`` preset, and the published corundum-on-steel wall law)::
 
     [grid]
     alpha1_deg = [1, 2, 3, ...] or {start = 5, stop = 90, step = 5}    # degrees, in (0, 90]
-    speed_m_s  = [50, 100, ...]  or {start = 50, stop = 300, step = 50}  # m/s, > 0
+    speed_m_s  = [50, 100, ...]  or {start = 50, stop = 300, step = 50}  # m/s, in [1e-3, 1e4], neighbours ≤ 16× apart
     shapes     = ["ellipsoid", "prism", "cut_prism", "tetrahedron"]
 
     [simulation]
@@ -40,7 +40,7 @@ import tomllib
 from importlib import resources
 
 from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
-from data_schema.table import TableResolution
+from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from tablegen.model.shapes import SHAPES, AspectRatioLaw, check_kappa
 from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
@@ -157,9 +157,16 @@ def parse_config(text: str, source: str = "<config>") -> BuildConfig:
     if bad:
         raise ConfigError(f"{source}: 'grid.alpha1_deg' values must be in {ALPHA1_RANGE_TEXT} degrees; got {bad[0]!r}")
     speeds = _grid_values(grid.get("speed_m_s"), "grid.speed_m_s", source)
-    bad = [v for v in speeds if not (math.isfinite(v) and v > 0.0)]
+    low, high = SPEED_GRID_RANGE
+    bad = [v for v in speeds if not low <= v <= high]
     if bad:
-        raise ConfigError(f"{source}: 'grid.speed_m_s' values must be finite and > 0 m/s; got {bad[0]!r}")
+        raise ConfigError(f"{source}: 'grid.speed_m_s' values must be in [{low:g}, {high:g}] m/s (what the model "
+                          f"and the runtime serve); got {bad[0]!r}")
+    wide = [(a, b) for a, b in zip(speeds, speeds[1:]) if b > MAX_SPEED_RATIO * a]
+    if wide:
+        raise ConfigError(f"{source}: 'grid.speed_m_s' has consecutive speeds {wide[0][0]!r} and {wide[0][1]!r} m/s, a "
+                          f"factor {wide[0][1] / wide[0][0]:.3g} apart; allowed: at most {MAX_SPEED_RATIO:g} (the "
+                          f"runtime's restitution pieces between grid speeds); add speeds between them")
     shapes = grid.get("shapes")
     if not isinstance(shapes, list) or not shapes:
         raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(SHAPES)}; got {shapes!r}")

@@ -32,7 +32,10 @@ def main(table_path: str, input_path: str, output_path: str) -> None:
         V_out, W_out, status = np.empty_like(V), np.empty_like(V), np.empty(len(V), dtype=np.int8)
         py.rebound_many(data, out["cdf_weighted"], V, n, a, u, V_out, W_out, status, scaled)
         out[f"many_{label}"] = np.column_stack([V_out, W_out, status])
-    valid = status != py.STATUS_INVALID        # sample_global refuses invalid particles
+    # the rows sample_global takes: valid, not the tiny (~1e-13 m/s) or huge speeds it refuses (thresholds far from
+    # every speed drawn, so that no process's rounding moves a row across it)
+    speed = np.linalg.norm(V, axis=1)
+    valid = (status != py.STATUS_INVALID) & (speed > 1e-6) & (speed < 1e6)
     V_g, W_g, status_g = py.surrogate.sample_global(table, V[valid], n[valid], a[valid], shape=WEIGHTS,
                                                     random_state=5, clamp=True)
     out["global"] = np.column_stack([V_g, W_g, status_g])

@@ -12,7 +12,9 @@ def unit_vectors(rng, count):
 
 def incident_states(rng, count, alpha1_range=(0.0, 90.0), speed_range=(5.0, 400.0)):
     """(V, n, a): random unit normals, α1 and |V⁻| uniform over the ranges (deg, m/s), with the special
-    cases mixed in: exact normal impact, grazing, invalid (V·n ≥ 0, zero, NaN, inf), grid speeds."""
+    cases mixed in: exact normal impact, grazing, invalid (V·n ≥ 0, zero, NaN, inf), grid speeds, and the
+    hostile ones the draws refuse or guard (issue 25): normals that are not unit vectors, half-sizes not
+    finite and > 0 or so small that Ω⁺ overflows, |V⁻| that overflows or underflows."""
     n = unit_vectors(rng, count)
     t = rng.standard_normal((count, 3))
     t -= np.einsum("ij,ij->i", t, n)[:, None] * n
@@ -34,14 +36,21 @@ def incident_states(rng, count, alpha1_range=(0.0, 90.0), speed_range=(5.0, 400.
     n[kind == 9] = np.array([0.0, 1.0, 0.0])                                       # axis-aligned normals
     V[kind == 9] = -speed[kind == 9, None] * n[kind == 9]
     a = rng.uniform(1e-5, 1e-3, count)
+    n[kind == 10] *= rng.choice([1.5, 1.0 + 2e-6, 1.0 - 2e-6, 1e200], (kind == 10).sum())[:, None]
+    a[kind == 11] = rng.choice([0.0, -1e-4, np.nan, np.inf, 5e-324], (kind == 11).sum())
+    V[kind == 12] *= 1e200 / speed[kind == 12, None]                              # |V⁻| 1e200 m/s: V·V overflows
+    V[kind == 13] *= 1e-160 / speed[kind == 13, None]                             # |V⁻| 1e-160 m/s: V·V underflows
     return np.ascontiguousarray(V), np.ascontiguousarray(n), a
 
 
-def uniforms(rng, count, u_per_draw=13):
-    """Uniforms in [0, 1) with the edges mixed in (0 and the largest double below 1)."""
+def uniforms(rng, count, u_per_draw=13, hostile=0.0):
+    """Uniforms in [0, 1) with the edges mixed in (0 and the largest double below 1); with ``hostile`` > 0,
+    that fraction of the rows has one uniform outside [0, 1) or NaN (which the draws refuse)."""
     u = rng.random((count, u_per_draw))
     edge = rng.random((count, u_per_draw)) < 0.01
     u[edge] = np.where(rng.random(edge.sum()) < 0.5, 0.0, np.nextafter(1.0, 0.0))
+    rows = np.flatnonzero(rng.random(count) < hostile)
+    u[rows, rng.integers(0, u_per_draw, rows.size)] = rng.choice([-0.5, 1.0, 1e6, -1e300, np.nan, np.inf], rows.size)
     return u
 
 

@@ -72,7 +72,7 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
     for k, (label, spec) in enumerate(_mixes(table)):
         rng = np.random.default_rng(1000 + k)
         V, n, a = incident_states(rng, STATES_PER_CASE, (0.0, 90.0), (0.2 * v_lo, 1.5 * v_hi))
-        u = uniforms(rng, STATES_PER_CASE)
+        u = uniforms(rng, STATES_PER_CASE, hostile=0.01)
         cdf = py.mix_cdf(table, spec)
         V_py, W_py = np.empty((STATES_PER_CASE, 3)), np.empty((STATES_PER_CASE, 3))
         status_py = np.empty(STATES_PER_CASE, dtype=np.int8)
@@ -85,6 +85,10 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
         if label in ("ellipsoid", "mix"):
             assert counts[py.STATUS_TRAPPED] > 0, "no trapped draw: the trapped cells are not exercised"
         worst[label] = (max_ulp(V_c, V_py), max_ulp(W_c, W_py))
+        rebounded = status == py.STATUS_REBOUNDED       # finite and leaving the wall, whatever the input
+        assert np.isfinite(V_c[rebounded]).all() and np.isfinite(W_c[rebounded]).all(), label
+        assert (np.einsum("ij,ij->i", V_c[rebounded], n[rebounded]) > 0.0).all(), label
+        assert np.isnan(V_c[~rebounded]).all() and np.isnan(W_c[~rebounded]).all(), label
     print(f"\nlargest ulp difference, {interpolation}, {STATES_PER_CASE} states per mix (V+, Omega+): {worst}")
     assert all(v == (0.0, 0.0) for v in worst.values()), worst
 
@@ -96,7 +100,7 @@ def test_single_calls_equal_many_and_rebound_tuple(table_pair):
     count = 3000
     (v_lo, v_hi) = table.speed_range
     V, n, a = incident_states(rng, count, (0.0, 90.0), (0.2 * v_lo, 1.5 * v_hi))
-    u = uniforms(rng, count)
+    u = uniforms(rng, count, hostile=0.01)
     mix = native_table.mix_equal()
     cdf = py.mix_cdf(table, "mix")
     for interpolation in (SCALED, STOCHASTIC):
@@ -119,7 +123,9 @@ def test_draw_local_bit_identical(table_pair):
     speed = rng.uniform(0.5 * v_lo, 1.5 * v_hi, count)
     alpha1[:50] = table.alpha1_deg[rng.integers(0, len(table.alpha1_deg), 50)]      # on the grid
     speed[50:100] = table.speed_m_s[rng.integers(0, len(table.speed_m_s), 50)]
-    u = uniforms(rng, count)
+    hostile = np.array([np.nan, -5.0, 0.0, np.inf, 1e30, 1e-300, -np.inf, 1e25])      # refused, or the grid's edge
+    alpha1[100:200], speed[200:300] = rng.choice(hostile, 100), rng.choice(hostile, 100)
+    u = uniforms(rng, count, hostile=0.01)
     worst = 0.0
     for label, spec in _mixes(table)[-2:]:
         mix, cdf = _native_mix(native_table, spec), py.mix_cdf(table, spec)
@@ -192,7 +198,7 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     rng = np.random.default_rng(21)
     count = 50_000
     V, n, a = incident_states(rng, count)
-    u = uniforms(rng, count)
+    u = uniforms(rng, count, hostile=0.01)
     cdf = py.mix_cdf(table, "mix")
     for interpolation in (SCALED, STOCHASTIC):
         V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)

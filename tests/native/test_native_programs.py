@@ -30,7 +30,7 @@ def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tmp
     """Open the good table twice (every draw function, good and bad mixes), then every bad file: the
     expected code, a message naming the file, no sanitizer report, no leak."""
     arguments = []
-    for path, code, _, _ in bad_tables(small_table_path, tmp_path / "bad"):
+    for path, code, _ in bad_tables(small_table_path, tmp_path / "bad"):
         arguments += [path, code]
     out = _sanitized_run([native_sanitized / "rbs_test_tables", small_table_path, *arguments])
     assert "0 failure(s)" in out

@@ -363,3 +363,33 @@ def test_mppic_cloud_selects_and_runs_the_model(openfoam_build, case_table, tmp_
     assert hits > 200 and rebounded + invalid <= hits and invalid == 0, info_block[:400]
     # MPPIC parcels carry no spin: no incoming-spin line
     assert "incoming spin" not in info_block.split("Min cell volume fraction")[0]
+
+
+def _insert_coeff(case: Path, entry: str) -> None:
+    """Add ``entry`` to stochasticReboundCoeffs, after its table."""
+    props = case / "constant" / "kinematicCloudProperties"
+    text, n = re.subn(r"(\n        table\s+[^;]+;)", rf"\g<1>\n        {entry}", props.read_text(), count=1)
+    assert n == 1
+    props.write_text(text)
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda c: _insert_coeff(c, "interpolaton stochastic;"), ["unknown entry interpolaton", "interpolation"]),
+    (lambda c: _insert_coeff(c, "weights { prism 1; }"), ["shape and weights are both given"]),
+    (lambda c: _set_coeff(c, "maxHitRecords", "-1"), ["maxHitRecords must be >= 0, not -1"]),
+])
+def test_dictionary_contradictions_and_unknown_entries_are_fatal(openfoam_build, case_table, tmp_path_factory,
+                                                                 edit, words):
+    """A misspelled entry silently fell back to its default, shape was ignored under weights, and
+    maxHitRecords -1 wrote nothing: each is now a FatalIOError naming the entry, before any time step."""
+    case = tmp_path_factory.mktemp("bad_dictionary") / "hopperRebound"
+    shutil.copytree(CASE, case, ignore=shutil.ignore_patterns("log.*", "processor*", "postProcessing",
+                                                              "rebound_table.h5"))
+    edit(case)
+    env = dict(os.environ, RBS_OPENFOAM_DIR=str(OPENFOAM_DIR), RBS_TABLE=str(case_table))
+    proc = subprocess.run(["bash", "./Allrun"], cwd=case, env=env, capture_output=True, text=True, timeout=600)
+    log = (case / f"log.{SOLVER}").read_text()
+    assert proc.returncode != 0 and "FOAM FATAL IO ERROR" in log, log[-3000:]
+    assert "stochasticReboundCoeffs" in log and "Time = " not in log.split("FOAM FATAL IO ERROR")[0]
+    for word in words:
+        assert word in log, log[-3000:]

@@ -125,3 +125,129 @@ def test_a_corrupted_table_fails_to_load_naming_the_dataset(table, capsys):
     table.write_bytes(bytes(data))
     line, _ = _user_error(["sample", "--table", str(table), *GOOD], capsys, str(table), "dataset")
     assert "corrupt" in line
+
+
+# -- issue 25: the kernels never return a non-finite or unphysical rebound; the API's one-line errors -------------
+
+def _draw(table, V=(40.0, -0.3, 0.0), n=(0.0, 1.0, 0.0), a=1e-4, u=None):
+    """(status, V⁺, Ω⁺) of surrogate.kernels.rebound_tuple for one particle, seed-1 uniforms unless given."""
+    from surrogate.kernels import rebound_tuple
+    if u is None:
+        u = np.empty(surrogate.U_PER_DRAW)
+        surrogate.fill_uniforms(surrogate.seed_state(1), u)
+    cdf = surrogate.mix_cdf(table, "mix")
+    return rebound_tuple(table.kernel_data, cdf, V, n, a, np.asarray(u, dtype=np.float64), True)
+
+
+@pytest.mark.parametrize("k", range(13))
+@pytest.mark.parametrize("value", [-0.5, 1.0, 1e6, -1e300, np.nan, np.inf])
+def test_uniforms_outside_the_unit_interval_give_invalid(small_table, k, value):
+    """The numba twin of rbs_rebound: a uniform outside [0, 1) or NaN is STATUS_INVALID and NaN, never a
+    read outside the cell (u[5] = -0.5 was a heap overflow in C) or |V⁺| of 3e6 m/s from 40 m/s (u[5] = 1e6)."""
+    u = np.empty(surrogate.U_PER_DRAW)
+    surrogate.fill_uniforms(surrogate.seed_state(1), u)
+    assert _draw(small_table, u=u)[0] in (surrogate.STATUS_REBOUNDED, surrogate.STATUS_TRAPPED)
+    u[k] = value
+    status, V_out, W_out = _draw(small_table, u=u)
+    assert status == surrogate.STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
+
+
+@pytest.mark.parametrize("V, n, a", [
+    ((0.8e200, -0.6e200, 0.0), (0.0, 1.0, 0.0), 1e-4),      # |V⁻| = 1e200: V·V overflows (was V⁺ = ±inf)
+    ((40.0, -0.3, 0.0), (0.0, 1.0, 0.0), 5e-324),           # Ω⁺ = |V⁻|/a · ... overflows
+    ((40.0, -0.3, 0.0), (0.0, 1.0, 0.0), 0.0),
+    ((40.0, -0.3, 0.0), (0.0, 1.0, 0.0), -1e-4),
+    ((40.0, -0.3, 0.0), (0.0, 1.0, 0.0), np.nan),
+    ((40.0, -0.3, 0.0), (0.0, 1e200, 0.0), 1e-4),           # a normal of length 1e200 (was NaN with status 0)
+    ((40.0, -0.3, 0.0), (0.0, 2.0, 0.0), 1e-4),
+])
+def test_extreme_particles_give_invalid(small_table, V, n, a):
+    status, V_out, W_out = _draw(small_table, V, n, a)
+    assert status == surrogate.STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
+
+
+@pytest.mark.parametrize("speed", [1e-150, 1e-160, 1e-200, 1e-300, 5e-324, 1e150, 1e154])
+def test_whatever_is_rebounded_is_finite_and_leaves_the_wall(small_table, speed):
+    """Tiny |V⁻| gave V⁺ = (-0, 0, -0) with status 0: a rebound must leave the wall (V⁺·n > 0) and be finite;
+    over 200 seeds."""
+    n = np.array([0.0, 1.0, 0.0])
+    for seed in range(200):
+        u = np.empty(surrogate.U_PER_DRAW)
+        surrogate.fill_uniforms(surrogate.seed_state(seed), u)
+        status, V_out, W_out = _draw(small_table, (0.8 * speed, -0.6 * speed, 0.0), tuple(n), 1e-4, u)
+        if status == surrogate.STATUS_REBOUNDED:
+            assert np.isfinite(V_out).all() and np.isfinite(W_out).all() and np.dot(V_out, n) > 0.0
+        else:
+            assert np.isnan(V_out).all() and np.isnan(W_out).all()
+
+
+def test_an_all_zero_generator_gives_nan_not_zeros(small_table):
+    """xoshiro256+'s fixed point: all-zero words gave u = 0 forever; now NaN, which every draw refuses."""
+    from surrogate.kernels.rng import next_uniform
+    u = np.zeros(5)
+    surrogate.fill_uniforms(np.zeros(4, dtype=np.uint64), u)
+    assert np.isnan(u).all() and np.isnan(next_uniform(np.zeros(4, dtype=np.uint64)))
+    from surrogate.kernels import rebound_many_rng
+    with pytest.raises(ValueError, match="not all zero"):
+        rebound_many_rng(small_table.kernel_data, surrogate.mix_cdf(small_table, "mix"), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1), np.zeros(4, dtype=np.uint64),
+                         np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1, dtype=np.int8))
+
+
+@pytest.mark.parametrize("alpha1, speed", [(np.nan, 150.0), (-5.0, 150.0), (0.0, 150.0), (1e30, 150.0),
+                                           (45.0, np.nan), (45.0, -1.0), (45.0, 0.0), (45.0, np.inf)])
+def test_local_draws_refuse_what_is_not_physical(small_table, alpha1, speed):
+    from surrogate.kernels import draw_local
+    u = np.full(surrogate.U_PER_DRAW, 0.5)
+    out = draw_local(small_table.kernel_data, surrogate.mix_cdf(small_table, "mix"), alpha1, speed, u, True)
+    assert out[0] == surrogate.STATUS_INVALID and np.isnan(out[1:]).all()
+
+
+def test_a_huge_speed_draws_from_the_edge_cell(table, capsys):
+    """|V⁻| = 1e25 m/s with clamp: the cell of the top grid speed (the index's truncation overflowed to an
+    interior cell: mean α2 41.9° against 36.6° at the edge); the same bits as a draw at the edge speed."""
+    t = surrogate.load(table)
+    top, huge = (surrogate.sample_local(t, 45.0, v, "mix", random_state=3, clamp=True)
+                 for v in (t.speed_range[1], 1e25))
+    for got, expected in zip(huge, top):
+        assert np.array_equal(got, expected, equal_nan=True)
+    code, err, out = _run(["sample", "--table", str(table), "--alpha1", "45", "--speed", "1e25", "--clamp", "-n",
+                           "1000", "--seed", "1"], capsys)
+    assert code == 0 and err == []
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"half_size": 5e-324}, ["'half_size' at index 0", "5e-324", "1e+300"]),
+    ({"velocity": [[0.8e200, -0.6e200, 0.0]]}, ["|V-| = 1.0000000000000001e+200", "[1e-150, 1e+150]"]),
+    ({"velocity": [[40.0 + 1j, -0.3, 0.0]]}, ["'velocity'", "complex"]),
+    ({"half_size": 1e-4 + 0j}, ["'half_size'", "complex"]),
+    ({"shape": None}, ["'shape'", "None"]),
+    ({"shape": {"prism": "a"}}, ["weights", "'a'"]),
+    ({"shape": ["0.25", 0.25, 0.25, 0.25]}, ["weights", "'0.25'"]),
+])
+def test_sample_global_refuses_with_a_value_error(small_table, kwargs, words):
+    """ValueError naming the value and the allowed range, never OverflowError (the message's own arithmetic
+    overflowed for |V⁻| > 1e154), TypeError (shape=None, a string weight) or complex silently made real."""
+    args = {"velocity": [[40.0, -0.3, 0.0]], "normal": [0.0, 1.0, 0.0], "half_size": 1e-4, "shape": "mix"}
+    args.update(kwargs)
+    with pytest.raises(ValueError) as info:
+        surrogate.sample_global(small_table, args["velocity"], args["normal"], args["half_size"], args["shape"],
+                                random_state=1, clamp=True)
+    for word in words:
+        assert word in str(info.value), str(info.value)
+
+
+def test_sample_local_refuses_complex_and_unreachable_speeds(small_table):
+    with pytest.raises(ValueError, match="complex"):
+        surrogate.sample_local(small_table, 45.0 + 0j, 150.0)
+    with pytest.raises(ValueError, match="physical range"):
+        surrogate.sample_local(small_table, 45.0, 1e200, clamp=True)
+
+
+def test_a_fifo_or_a_device_as_the_table_is_one_line(tmp_path, capsys):
+    """A FIFO or /dev/zero said "no such file" (and a read would block or never end)."""
+    import os
+    fifo = tmp_path / "fifo.h5"
+    os.mkfifo(fifo)
+    for path in (fifo, "/dev/zero"):
+        _user_error(["sample", "--table", str(path), *GOOD], capsys, str(path), "not a regular file")
+        _user_error(["info", str(path)], capsys, str(path), "not a regular file")

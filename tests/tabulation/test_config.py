@@ -49,6 +49,13 @@ BAD = [
     ("[grid]\nspeed_m_s = [0.0, 100.0]", "grid.speed_m_s"),
     ("[grid]\nspeed_m_s = [-50.0]", "grid.speed_m_s"),
     ("[grid]\nspeed_m_s = [200.0, 100.0]", "grid.speed_m_s"),
+    # issue 25: grids the model or the runtime cannot serve (built in 3 s, then 10 minutes of restitution
+    # pieces in surrogate and RBS_ERR_MEMORY in C; or a 28-line traceback)
+    ("[grid]\nspeed_m_s = [0.0001, 300.0]", "grid.speed_m_s"),
+    ("[grid]\nspeed_m_s = [1e-300, 1e300]", "grid.speed_m_s"),
+    ("[grid]\nspeed_m_s = [1e-300]", "grid.speed_m_s"),
+    ("[grid]\nspeed_m_s = [20000.0]", "grid.speed_m_s"),
+    ("[grid]\nspeed_m_s = [10.0, 200.0]", "grid.speed_m_s"),
     ("[grid]\nshapes = [\"sphere\"]", "grid.shapes"),
     ("[grid]\nshapes = []", "grid.shapes"),
     ("[simulation]\nparticles_per_cell = 0", "simulation.particles_per_cell"),
@@ -84,3 +91,20 @@ def test_cli_exits_2_and_leaves_the_output_untouched(text, key, tmp_path, capsys
     assert line.startswith("tablegen build: error: ")
     assert out.read_bytes() == b"previous content"
     assert not (tmp_path / "table.h5.partial").exists()
+
+
+@pytest.mark.parametrize("speeds, words", [
+    ("[0.0001, 300.0]", ["[0.001, 10000] m/s", "0.0001"]),
+    ("[1e-300]", ["[0.001, 10000] m/s", "1e-300"]),
+    ("[10.0, 200.0]", ["10.0 and 200.0", "factor 20", "at most 16"]),
+])
+def test_speed_grids_the_runtime_cannot_serve_name_the_allowed_range(tmp_path, capsys, speeds, words):
+    """One line, exit 2, the value and the allowed range; nothing built."""
+    config = tmp_path / "c.toml"
+    config.write_text(f"[grid]\nalpha1_deg = [45.0]\nspeed_m_s = {speeds}\nshapes = [\"prism\"]\n")
+    code = tablegen_main(["build", "--config", str(config), "-o", str(tmp_path / "t.h5")])
+    err = capsys.readouterr().err.splitlines()
+    assert code == 2 and len(err) == 1, err
+    for word in words:
+        assert word in err[0], err[0]
+    assert not (tmp_path / "t.h5").exists()

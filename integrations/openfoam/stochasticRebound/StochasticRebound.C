@@ -256,6 +256,38 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
 {
     const dictionary& coeffs = this->coeffDict();
 
+    // A misspelled entry would silently fall back to its default: refuse the
+    // entries neither this model nor its base classes read
+    static const wordList known
+    ({
+        "table", "shape", "weights", "halfSizeFactor", "trapped", "seed",
+        "interpolation", "writeHits", "maxHitRecords",
+        "U", "writePrecision", "writeToFile", "useUserTime", "defaultCoeffs"
+    });
+    for (const word& key : coeffs.toc())
+    {
+        if (!known.found(key))
+        {
+            FatalIOErrorInFunction(coeffs)
+                << "unknown entry " << key << " in " << coeffs.dictName()
+                << "; the entries are " << known
+                << exit(FatalIOError);
+        }
+    }
+    if (coeffs.found("shape") && coeffs.found("weights"))
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "shape and weights are both given in " << coeffs.dictName()
+            << ": give one of them (weights would take precedence unseen)"
+            << exit(FatalIOError);
+    }
+    if (maxHitRecords_ < 0)
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "maxHitRecords must be >= 0, not " << maxHitRecords_
+            << exit(FatalIOError);
+    }
+
     if (halfSizeFactor_ <= 0)
     {
         FatalIOErrorInFunction(coeffs)
