@@ -323,7 +323,7 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
     for name in ("restitution_k", "restitution_p"):
         value = getattr(table, name)
         if not (np.isfinite(value) and value > 0.0):
-            refuse(f"the attribute '{name}' of group 'grid' must be finite and > 0; got {value!r}")
+            refuse(f"the attribute '{name}' of group 'grid' must be finite and > 0; got {float(value)!r}")
     if "law" in law and not np.array_equal(np.asarray(law["law"]).view(np.uint8),
                                           np.array([table.restitution_k, table.restitution_p]).view(np.uint8)):
         refuse(f"the attributes restitution_k, restitution_p of group 'grid' ({table.restitution_k!r}, "
@@ -346,12 +346,12 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
         values = np.asarray(cells[name])
         bad = np.flatnonzero(~ok(values).ravel())
         if bad.size:
-            refuse(f"dataset 'cells/{name}' holds {values.ravel()[bad[0]]!r} at element {bad[0]}; its values must be "
-                   f"{wanted}")
+            refuse(f"dataset 'cells/{name}' holds {values.ravel()[bad[0]].item()!r} at element {bad[0]}; its values "
+                   f"must be {wanted}")
     weight_sum = np.asarray(cells["cluster_weight"]).sum(axis=-1).ravel()
     bad = np.flatnonzero(np.abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE)
     if bad.size:
-        refuse(f"dataset 'cells/cluster_weight' of cell {bad[0]} sums to {weight_sum[bad[0]]!r}; each cell's weights "
+        refuse(f"dataset 'cells/cluster_weight' of cell {bad[0]} sums to {float(weight_sum[bad[0]])!r}; each cell's weights "
                f"must sum to 1 within {WEIGHT_SUM_TOLERANCE:g}")
     drawn = np.asarray(cells["status_counts"])[..., :2].sum(axis=-1).ravel()
     if np.any(drawn <= 0):

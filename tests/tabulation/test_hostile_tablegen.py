@@ -304,14 +304,14 @@ def test_a_table_records_the_model_that_made_it(tiny_config, tmp_path, capsys):
 
 def test_non_finite_derived_arrays_fail_to_load(small_table_path, tmp_path):
     """A table whose stored numbers are wrong but checksummed (written so) still cannot give a non-finite
-    rebound: the loader checks every array it derives."""
+    rebound: the loader's table contract refuses the value, naming the dataset, before any array is derived."""
     bad = Path(shutil.copy(small_table_path, tmp_path / "t.h5"))
     with h5py.File(bad, "a") as f:
         mean = f["cells/mean"][()]
         mean[0, 1, 1, 2] = np.nan
         f["cells/mean"][...] = mean
-    with pytest.raises(DataFormatError, match=r"non-finite values in the kernel array 'cells' derived from "
-                                              r"cells/status_counts, cells/mean"):
+    with pytest.raises(DataFormatError, match=r"dataset 'cells/mean' holds nan at element 26; its values must be "
+                                              r"finite"):
         surrogate.load(bad)
 
 
