@@ -1,4 +1,4 @@
-"""Throughput benchmark of the direct rebound model (``tablegen.model.simulate.simulate``).
+"""Throughput benchmark of the direct rebound model (``direct_model.simulate.simulate``).
 
 What is measured
 ----------------
@@ -57,7 +57,7 @@ import numpy as np
 
 from data_schema.samples import STATUS_FAILED, STATUS_TRAPPED
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from tablegen.model.simulate import simulate
+from direct_model.simulate import simulate
 
 SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
 TARGET_PER_CORE = 1e5     # rebounds/s per core
@@ -145,7 +145,7 @@ def main(argv=None) -> int:
 
     info = machine_info()
     threads = info["numba_default_threads"]
-    print("Direct rebound model throughput (tablegen.model.simulate)")
+    print("Direct rebound model throughput (direct_model.simulate)")
     for key, value in info.items():
         print(f"  {key:22s} {value}")
     print(f"  speed |V-| = {args.speed:g} m/s, omega_in = 0, seed = {SEED}, "

@@ -50,7 +50,7 @@ class CheckpointError(ValueError):
 SCHEDULER_TIMEOUT_S = 10       # how long to try to reach a Dask scheduler before giving up
 SOURCE_ROOT = Path(__file__).resolve().parents[2]       # the folder holding tablegen/ and data_schema/
 # the source that decides a cell's content (not this driver): hashed into checkpoints and tables
-MODEL_SOURCES = ("tablegen/model/*.py", "tablegen/tabulation/resolution.py", "tablegen/tabulation/tabulate.py",
+MODEL_SOURCES = ("direct_model/*.py", "tablegen/tabulation/resolution.py", "tablegen/tabulation/tabulate.py",
                  "tablegen/tabulation/cells.py", "data_schema/samples.py")
 
 
