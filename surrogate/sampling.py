@@ -33,12 +33,11 @@ from data_schema.table import STATE_NAMES
 from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE,
                                       FAULT_NORMAL_NOT_FINITE, FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL,
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
-                                      FAULT_VELOCITY_ZERO, first_faults)
+                                      FAULT_VELOCITY_ZERO, NORMAL_TOLERANCE, first_faults)
 from surrogate.kernels.parallel import draw_local_parallel_rng, rebound_parallel_rng
 from surrogate.kernels.rng import chunk_states
 from surrogate.table import SurrogateTable
 
-NORMAL_TOLERANCE = 1e-6         # |n| − 1 allowed for a wall normal
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
 
 
