@@ -138,8 +138,8 @@ def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
 
     Returns
     -------
-    (status, failure_reason, n_collisions, V⁺ as 3 floats in m/s, Ω⁺ as 3 floats in (m/s)/a), model frame;
-    status and failure_reason as in :func:`direct_model.rebound.rebound`.
+    (status, n_collisions, n_search_steps, V⁺ as 3 floats in m/s, Ω⁺ as 3 floats in (m/s)/a), model frame;
+    status as in :func:`direct_model.rebound.rebound`.
     """
     semi = scratch[_SEMI:_SEMI + 3]
     R0 = scratch[_R0:_R0 + 9].reshape((3, 3))
@@ -153,8 +153,8 @@ def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
     hand = 1.0 if shape != TETRAHEDRON or u[U_HAND] < 0.5 else -1.0
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
-    status, failure, n_coll, _, _, _ = rebound(
+    status, _, n_coll, n_steps, _, _ = rebound(
         shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params[P_WALL:P_WALL + 3],
         int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
         scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])
-    return status, failure, n_coll, V[0], V[1], V[2], W[0], W[1], W[2]
+    return status, n_coll, n_steps, V[0], V[1], V[2], W[0], W[1], W[2]
