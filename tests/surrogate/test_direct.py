@@ -95,8 +95,9 @@ def test_kernel_draws_the_law_of_tablegen_simulate(small_table, shape, alpha1, s
 @pytest.mark.parametrize("shape", SHAPES)
 def test_rotating_the_frame_rotates_the_outputs(small_table, shape):
     """The same hit in two caller's frames (the model frame and a random one): the outputs, rotated back,
-    have one law (KS per component, bound from n), and particles with the same uniforms mostly agree
-    to round-off (a multi-collision sequence amplifies a last-bit difference of the frame)."""
+    have one law (KS per component, bound from n), and particles with the same uniforms agree to 1e-9 of
+    |V⁻| but for a few (a multi-collision sequence can amplify a last-bit difference of the frame; all 4000
+    agree at these seeds)."""
     state = (shape, 55.0, 170.0, (0.2, -0.1, 0.25))
     V0, W0, s0 = _kernel_in_frame(small_table, *state, np.eye(3), seed=21)
     V1, W1, s1 = _kernel_in_frame(small_table, *state, _frame(5), seed=21)
@@ -107,7 +108,7 @@ def test_rotating_the_frame_rotates_the_outputs(small_table, shape):
         assert stats.ks_2samp(W0[ok0, k], W1[ok1, k]).statistic < bound
     both = ok0 & ok1
     same = np.all(np.abs(V0[both] - V1[both]) < 1e-9, axis=1)
-    assert same.mean() > 0.5
+    assert same.mean() > 0.99 and (s0 == s1).mean() > 0.99
 
 
 @pytest.mark.parametrize("shape", SHAPES)
