@@ -27,7 +27,7 @@ and prints the cost in ns per reflected state:
     uniforms, from 32 xoshiro256+ lanes stepped as SIMD, included), and the variant that first draws them
     into an (N, 13) array for ``rebound_many``; breakdown row: the xoshiro256+
     draws alone;
-(c) the direct model, ``tablegen.model.simulate.simulate`` with the shape mix, one
+(c) the direct model, ``direct_model.simulate.simulate`` with the shape mix, one
     thread, per particle simulated (whatever its status; NumPy input draws,
     kernel and result assembly included). The states' α1 distribution
     (uniform 10–90°) is represented by the midpoints of four equal α1 bins
@@ -350,7 +350,7 @@ def row(key, label, count, threads, wall, cpu, note="") -> dict:
 
 def direct_cost(speed_bins, min_time: float, repeats: int) -> tuple:
     """(c): mean ns per particle of simulate('mix', ...) over the α1 × speed configurations, one thread."""
-    from tablegen.model.simulate import simulate
+    from direct_model.simulate import simulate
 
     def run(alpha1, speed, n):
         return lambda: simulate("mix", alpha1, speed, n, seed=SEED)

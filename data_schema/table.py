@@ -10,7 +10,9 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
                            restitution_k, restitution_p (the wall's normal-restitution law),
                            friction_q, wall_law (its friction exponent and name; since 3.1, optional);
                            law (restitution_k, restitution_p) and shape_codes, checksummed copies of the
-                           attributes and names the law depends on (since 3.2)
+                           attributes and names the law depends on (since 3.2); aspect_ratio_{mean,sd,low,high},
+                           contact_tol, set_tol, max_steps, second_moment_factors (the rest of the direct
+                           model's parameters; optional)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
@@ -47,6 +49,7 @@ sampler moves a draw between grid speeds by a law that depends on the regime
 from __future__ import annotations
 
 import dataclasses
+import tomllib
 from pathlib import Path
 
 import h5py
@@ -72,6 +75,18 @@ STATE_UNITS = ("rad", "rad", "1", "1", "1", "1")
 # indicatrix grids: α2 ∈ [0, π], β2 ∈ [−π/2, π/2], 2.5° bins
 INDICATRIX_ALPHA2_EDGES = np.linspace(0.0, np.pi, 73)
 INDICATRIX_BETA2_EDGES = np.linspace(-np.pi / 2, np.pi / 2, 73)
+
+
+# the direct model's tolerances every build used before tables recorded them (grid attributes; the defaults
+# of direct_model.simulate, which tablegen never changed)
+BUILT_WITH_TOLERANCES = {"contact_tol": 1e-10, "set_tol": 1e-9, "max_steps": 100_000}
+# s per shape code (J/m = s (b²+c², a²+c², a²+b²)) as builds computed them at κ = 0.3, every preset's κ, before
+# tables recorded them (direct_model.shapes.second_moment_factors(0.3), bit for bit)
+BUILT_WITH_KAPPA = 0.3
+BUILT_WITH_SECOND_MOMENT_FACTORS = (0.2, 0.33333333333333337, 0.3309571404654277, 0.20000000000000004)
+# the aspect-ratio law's attributes, by their key in the configuration's aspect_ratio table
+ASPECT_RATIO_ATTRIBUTES = {"aspect_ratio_mean": "mean", "aspect_ratio_sd": "sd", "aspect_ratio_low": "low",
+                           "aspect_ratio_high": "high"}
 
 
 # chain order of the folded state inside a cluster (module doc)
@@ -199,6 +214,14 @@ class ReboundTable:
     model_sha256: str = ""               # hash of the direct model's source that computed the cells ("" before 3.1)
     friction_q: float = float("nan")     # friction factor exp(q cos γ) of the wall law (NaN if not recorded)
     wall_law: str = ""                   # name of the wall law ("" if not recorded)
+    # the rest of the direct model's parameters (docs/format.md; tables before these were recorded: see
+    # :meth:`from_hdf5`): the aspect-ratio law (mean, sd, low, high) of b/a and c/b, the contact and
+    # contact-set tolerances (units of a), the search-step budget per flight, and s per shape code
+    aspect_ratio: tuple = (float("nan"),) * 4
+    contact_tol: float = BUILT_WITH_TOLERANCES["contact_tol"]
+    set_tol: float = BUILT_WITH_TOLERANCES["set_tol"]
+    max_steps: int = BUILT_WITH_TOLERANCES["max_steps"]
+    second_moment_factors: tuple = (float("nan"),) * 4
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -242,6 +265,11 @@ class ReboundTable:
         grid.attrs["restitution_p"] = self.restitution_p
         grid.attrs["friction_q"] = self.friction_q
         grid.attrs["wall_law"] = self.wall_law
+        for name, value in zip(ASPECT_RATIO_ATTRIBUTES, self.aspect_ratio):
+            grid.attrs[name] = value
+        for name in BUILT_WITH_TOLERANCES:
+            grid.attrs[name] = getattr(self, name)
+        grid.attrs["second_moment_factors"] = np.asarray(self.second_moment_factors, dtype=np.float64)
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -287,7 +315,7 @@ class ReboundTable:
                 model_sha256=str(f.attrs.get("model_sha256", "")),
                 restitution_k=float(grid.attrs["restitution_k"]), restitution_p=float(grid.attrs["restitution_p"]),
                 friction_q=float(grid.attrs.get("friction_q", float("nan"))),
-                wall_law=str(grid.attrs.get("wall_law", "")))
+                wall_law=str(grid.attrs.get("wall_law", "")), **_direct_model_attributes(f))
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:
@@ -357,6 +385,28 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
     if np.any(drawn <= 0):
         refuse(f"dataset 'cells/status_counts' of cell {np.flatnonzero(drawn <= 0)[0]} has no rebounded or trapped "
                f"particle")
+
+
+def _direct_model_attributes(f: h5py.File) -> dict:
+    """The direct model's parameters of a table (ReboundTable fields). Tables that did not record them were built
+    with the aspect-ratio law of their configuration, the tolerances BUILT_WITH_TOLERANCES and, at κ = 0.3,
+    BUILT_WITH_SECOND_MOMENT_FACTORS (NaN at another κ: not known without the build's code)."""
+    grid = f["grid"]
+    if all(name in grid.attrs for name in ASPECT_RATIO_ATTRIBUTES):
+        aspect = tuple(float(grid.attrs[name]) for name in ASPECT_RATIO_ATTRIBUTES)
+    else:
+        law = tomllib.loads(str(f.attrs["config"])).get("simulation", {}).get("aspect_ratio", {})
+        aspect = tuple(float(law.get(key, "nan")) for key in ASPECT_RATIO_ATTRIBUTES.values())
+    if "second_moment_factors" in grid.attrs:
+        kfac = tuple(float(x) for x in np.asarray(grid.attrs["second_moment_factors"], dtype=np.float64))
+    elif float(grid.attrs["kappa"]) == BUILT_WITH_KAPPA:
+        kfac = BUILT_WITH_SECOND_MOMENT_FACTORS
+    else:
+        kfac = (float("nan"),) * len(BUILT_WITH_SECOND_MOMENT_FACTORS)
+    return dict(aspect_ratio=aspect, second_moment_factors=kfac,
+                contact_tol=float(grid.attrs.get("contact_tol", BUILT_WITH_TOLERANCES["contact_tol"])),
+                set_tol=float(grid.attrs.get("set_tol", BUILT_WITH_TOLERANCES["set_tol"])),
+                max_steps=int(grid.attrs.get("max_steps", BUILT_WITH_TOLERANCES["max_steps"])))
 
 
 def _read(group: h5py.Group, name: str) -> np.ndarray:

@@ -19,13 +19,19 @@ blocks of particles, overlap their table reads and compute their draws as
 SIMD loops, with the per-particle results bit for bit;
 :func:`surrogate.kernels.rebound_parallel_rng` does the same on all threads,
 as :func:`sample_global` does. :mod:`surrogate.kernels` maps where each part lives.
+
+Where the table does not apply (a particle spinning before it hits, say), the direct model answers:
+:func:`rebound_direct` from NumPy, :func:`surrogate.kernels.rebound_direct_tuple` from numba with
+:func:`direct_model_parameters` and ``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
 """
 
-from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from direct_model.runtime import U_PER_REBOUND
+from surrogate.direct import direct_model_parameters, rebound_direct
 from surrogate.kernels import U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 
-__all__ = ["LocalDraws", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW",
-           "check_random_state", "fill_uniforms", "load", "mix_cdf", "sample_global", "sample_local",
-           "seed_state"]
+__all__ = ["LocalDraws", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable",
+           "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "direct_model_parameters", "fill_uniforms", "load",
+           "mix_cdf", "rebound_direct", "sample_global", "sample_local", "seed_state"]

@@ -10,10 +10,15 @@ the same content as a named tuple of arrays, the form numba kernels take.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
+from data_schema.common import DataFormatError
 from data_schema.table import ReboundTable, read_table
+from direct_model.runtime import model_parameters
+from direct_model.shapes import AspectRatioLaw
+from direct_model.wall import WallMaterial
 from surrogate.kernels.layout import KernelData, check_kernel_data, frozen, kernel_data
 
 
@@ -31,6 +36,7 @@ class SurrogateTable:
     restitution_k: float       # the wall's normal restitution exp(−k V^p) the table was built with, (m/s)^(−p)
     restitution_p: float
     kernel_data: KernelData
+    direct_parameters: np.ndarray | None = None   # the direct model's parameters (:func:`direct_parameters`)
 
     @property
     def alpha1_range(self) -> tuple:
@@ -50,7 +56,24 @@ class SurrogateTable:
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=frozen(np.asarray(table.alpha1_deg, float)),
                    speed_m_s=frozen(speed), particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, restitution_k=table.restitution_k,
-                   restitution_p=table.restitution_p, kernel_data=data)
+                   restitution_p=table.restitution_p, kernel_data=data,
+                   direct_parameters=direct_parameters(table, path))
+
+
+def direct_parameters(table: ReboundTable, path: str = "<memory>") -> np.ndarray | None:
+    """The parameters of the direct model the table was built with, as the run-time kernel takes them
+    (:func:`direct_model.runtime.model_parameters`), or None if the table does not record its second-moment
+    factors (built at κ ≠ 0.3 before tables recorded them); DataFormatError naming a value out of range."""
+    if not np.all(np.isfinite(table.second_moment_factors)):
+        return None
+    # tables without friction_q (before 3.1) were built before the wall law was configurable: q = 1
+    q = table.friction_q if math.isfinite(table.friction_q) else 1.0
+    try:
+        return model_parameters(AspectRatioLaw(*table.aspect_ratio), table.kappa, table.n_max,
+                                WallMaterial(table.restitution_k, table.restitution_p, q, table.wall_law),
+                                table.contact_tol, table.set_tol, table.max_steps, table.second_moment_factors)
+    except ValueError as exc:
+        raise DataFormatError(f"{path}: the direct model's parameters are out of range: {exc}") from None
 
 
 def load(path) -> SurrogateTable:

@@ -1,14 +1,16 @@
-"""tablegen: the direct rebound model and the offline table build.
+"""tablegen: the offline table build and the study, on the direct rebound model (:mod:`direct_model`).
 
-Subpackages, one per job:
+Subpackages, one per job (the model itself is the top-level package :mod:`direct_model`, which imports
+nothing from here, so that :mod:`surrogate` can run it too):
 
-* :mod:`tablegen.model` — the direct model (shapes, wall law, collision, rotation, flight, :func:`simulate`);
 * :mod:`tablegen.tabulation` — the table build (configuration, presets, cells, tabulation, :func:`build_table`);
 * :mod:`tablegen.study` — statistics, the paper's study (``tablegen report``) and the validation matrix.
 
 The public API is importable from here::
 
     from tablegen import simulate, build_table, load_config, parse_config, WallMaterial
+
+(``simulate`` is :func:`direct_model.simulate.simulate` with a progress bar: ``progress=True``.)
 
 It needs the ``build`` extra (``pip install "rebound-scatter[build]"``); the
 plain install is the runtime sampler alone (:mod:`surrogate`).
@@ -34,12 +36,12 @@ _require_build_extra()
 
 # name: module defining it; imported on first use, so `import tablegen` stays light (no numba, no scikit-learn)
 _API = {
-    "simulate": "tablegen.model.simulate",
-    "SHAPES": "tablegen.model.shapes",
-    "MIX": "tablegen.model.shapes",
-    "AspectRatioLaw": "tablegen.model.shapes",
-    "WallMaterial": "tablegen.model.wall",
-    "CORUNDUM_ON_STEEL": "tablegen.model.wall",
+    "simulate": "tablegen.progress",
+    "SHAPES": "direct_model.shapes",
+    "MIX": "direct_model.shapes",
+    "AspectRatioLaw": "direct_model.shapes",
+    "WallMaterial": "direct_model.wall",
+    "CORUNDUM_ON_STEEL": "direct_model.wall",
     "BuildConfig": "tablegen.tabulation.config",
     "ConfigError": "tablegen.tabulation.config",
     "load_config": "tablegen.tabulation.config",

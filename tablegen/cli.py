@@ -17,9 +17,9 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.output import check_memory, check_output
 from data_schema.samples import ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, write_samples
 from tablegen.tabulation.config import PRESETS
-from tablegen.model.shapes import DEFAULT_KAPPA, MIX, SHAPES
-from tablegen.model.simulate import DEFAULT_N_MAX
-from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES
+from direct_model.simulate import DEFAULT_N_MAX
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 from tablegen.study.report import DEFAULT_N as REPORT_DEFAULT_N
 
 # memory per simulated particle: its arrays, their merge and the file made in memory
@@ -108,7 +108,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
 def _alpha1_list(text: str) -> tuple:
     """Comma-separated angles in the physical range (ALPHA1_RANGE_TEXT) in degrees, as a tuple (argparse type)."""
-    from tablegen.model.simulate import check_alpha1
+    from direct_model.simulate import check_alpha1
 
     try:
         return tuple(check_alpha1(v) for v in text.split(","))
@@ -121,7 +121,7 @@ def _progress(args) -> bool:
 
 
 def _simulate(args) -> int:
-    from tablegen.model.simulate import simulate
+    from tablegen.progress import simulate
     from tablegen.study.statistics import format_summary, summarize
 
     if args.out is not None:
@@ -189,7 +189,7 @@ def _info(args) -> int:
 
 
 def _report(args) -> int:
-    from tablegen.model.simulate import check_seed
+    from direct_model.simulate import check_seed
     from tablegen.study.figures import require_matplotlib
     from tablegen.study.report import DEFAULT_ALPHA1, REPORT_KIND, direct_data, table_data, write_report
 

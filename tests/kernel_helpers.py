@@ -3,10 +3,10 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from tablegen.model.rebound import HISTORY_COLUMNS, WORK_SIZE, rebound
-from tablegen.model.shapes import second_moment_factor, shape_code
-from tablegen.model.simulate import incident_velocity
-from tablegen.model.wall import CORUNDUM_ON_STEEL
+from direct_model.rebound import HISTORY_COLUMNS, WORK_SIZE, rebound
+from direct_model.shapes import second_moment_factor, shape_code
+from direct_model.simulate import incident_velocity
+from direct_model.wall import CORUNDUM_ON_STEEL
 
 MIRROR = np.diag([1.0, 1.0, -1.0])     # reflection Z → −Z (lab) and ζ → −ζ (body)
 

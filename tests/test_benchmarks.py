@@ -1,4 +1,4 @@
-"""benchmarks/bench_sampler.py runs end to end on a small table and reports every figure the issue asks for.
+"""benchmarks/bench_sampler.py and bench_direct.py run end to end and report every figure the issues ask for.
 
 A smoke test, so the benchmark cannot silently break when the kernels' data or signatures change; the
 figures themselves are machine-dependent and are not asserted (speed is reported, never tested).
@@ -29,3 +29,16 @@ def test_bench_sampler_reports_every_figure(small_table_path, tmp_path, capsys):
     assert figures["memory_latency"]["table_bytes"] > 0
     printed = capsys.readouterr().out
     assert "(c)/(b)" in printed and "(b)/(d)" in printed and "target" in printed
+
+
+bench_direct = pytest.importorskip("bench_direct")
+
+
+def test_bench_direct_reports_the_runtime_kernel(tmp_path, capsys):
+    out = tmp_path / "direct.json"
+    assert bench_direct.main(["--runtime", "--quick", "--states", "40", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["runtime"]
+    assert [(r["shape"], r["spin"]) for r in rows] == [(s, spin) for s in bench_direct.SHAPES for spin in ("0", "yes")]
+    for row in rows:
+        assert row["us_per_rebound"] > 0 and row["us_model_frame"] > 0 and row["collisions_per_rebound"] >= 1
+    assert "us/rebound" in capsys.readouterr().out

@@ -12,6 +12,8 @@ xoshiro256+ state. Where each part lives:
 ``arithmetic``  stage 3: the reflected state from those values (:func:`arithmetic`)
 ``frame``       the impact frame of a hit and the way back to the global frame
 ``particle``    one particle: :func:`rebound_tuple`, :func:`rebound` (global frame), :func:`draw_local`
+``direct``      the direct model instead of the table: :func:`rebound_direct_tuple` (one particle),
+                :func:`rebound_direct_parallel_rng` (many, all threads)
 ``block``       the block form of the stages' records, field-major over BLOCK particles
 ``pipeline``    many particles on one thread, the stages' block forms scheduled: :func:`rebound_many`,
                 :func:`rebound_many_rng`
@@ -31,8 +33,10 @@ bits for the same uniforms.
 """
 
 from data_schema.samples import STATUS_INVALID
+from direct_model.runtime import U_PER_REBOUND
 from surrogate.kernels.arithmetic import arithmetic
 from surrogate.kernels.block import BLOCK
+from surrogate.kernels.direct import rebound_direct_parallel_rng, rebound_direct_tuple
 from surrogate.kernels.draw import U_PER_DRAW, draw_velocity
 from surrogate.kernels.frame import impact_frame
 from surrogate.kernels.gather import gather
@@ -44,7 +48,8 @@ from surrogate.kernels.particle import draw_local, rebound, rebound_tuple
 from surrogate.kernels.pipeline import rebound_many, rebound_many_rng, rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
 
-__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "STATUS_INVALID", "U_PER_DRAW", "arithmetic", "chunk_states",
-           "draw_local", "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity", "fill_uniforms", "gather",
-           "grid_interval", "impact_frame", "locate", "next_uniform", "rebound", "rebound_many", "rebound_many_rng",
+__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND", "arithmetic",
+           "chunk_states", "draw_local", "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity",
+           "fill_uniforms", "gather", "grid_interval", "impact_frame", "locate", "next_uniform", "rebound",
+           "rebound_direct_parallel_rng", "rebound_direct_tuple", "rebound_many", "rebound_many_rng",
            "rebound_parallel", "rebound_parallel_rng", "rebound_tuple", "rebound_uniforms", "seed_state"]

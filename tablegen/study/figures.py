@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tablegen.model.shapes import MIX
+from direct_model.shapes import MIX
 from tablegen.study.statistics import (
     NORMAL_IMPACT, QUANTITIES, ReportData, derived, indicatrix_2d, indicatrix_3d, nearest_alpha1,
 )

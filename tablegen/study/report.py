@@ -31,7 +31,7 @@ import numpy as np
 from data_schema.common import package_version
 from data_schema.output import atomic_folder
 from data_schema.samples import STATUS_REBOUNDED
-from tablegen.model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_factor
+from direct_model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_factor
 from tablegen.progress import progress_bar
 from tablegen.study.figures import require_matplotlib, write_figures
 from tablegen.study.statistics import (
@@ -95,7 +95,7 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
     orientations and aspect ratios at every point). The mix pools the four
     shapes' runs; it has no run of its own.
     """
-    from tablegen.model.simulate import simulate
+    from direct_model.simulate import simulate
 
     alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
     mix_of = _constituents(shapes, SHAPES)
@@ -109,7 +109,7 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
     if bar is not None:
         bar.close()
     return ReportData(
-        source="direct model (`tablegen.model.simulate.simulate`)", speed=PAPER_SPEED, alpha1=alpha1,
+        source="direct model (`direct_model.simulate.simulate`)", speed=PAPER_SPEED, alpha1=alpha1,
         shapes=_ordered(shapes), mix_of=SHAPES, n=n, seed=seed,
         counts_note=f"Counted over the {n} simulated particles per shape.",
         e_rot_method="exact: E_Ω⁺ = ½ Ω⁺·JΩ⁺ with each particle's own inertia tensor and orientation "

@@ -1,7 +1,7 @@
 """Statistical comparison of table draws with the direct model.
 
 At one incident state (shape or mix, α1, |V⁻|) draw reflected states from a
-table (:mod:`surrogate`) and from the direct model (:func:`tablegen.model.simulate.simulate`,
+table (:mod:`surrogate`) and from the direct model (:func:`direct_model.simulate.simulate`,
 an independent seed), and compare the rebounded states
 X = (α2, β2, s, Ω_x a/|V⁻|, Ω_y a/|V⁻|, Ω_z a/|V⁻|):
 
@@ -23,7 +23,7 @@ from sklearn.model_selection import train_test_split
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED
 from data_schema.table import STATE_NAMES
-from tablegen.model.simulate import simulate
+from direct_model.simulate import simulate
 
 
 def classifier_accuracy(X: np.ndarray, Y: np.ndarray, seed: int = 0) -> float:

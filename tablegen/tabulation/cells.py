@@ -14,8 +14,8 @@ import numpy as np
 from data_schema.table import CellTable
 from tablegen.tabulation.config import BuildConfig
 from tablegen.tabulation.tabulate import CellAccumulator
-from tablegen.model.shapes import SHAPES
-from tablegen.model.simulate import simulate
+from direct_model.shapes import SHAPES
+from direct_model.simulate import simulate
 
 CHUNK_PARTICLES = 1_000_000      # particles simulated at a time within one cell: bounds a worker's memory
 REPRESENTATION_KEY = 2 ** 31     # spawn key of the k-means seed (chunks use keys 0, 1, ...)

@@ -42,8 +42,8 @@ from importlib import resources
 from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
 from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
-from tablegen.model.shapes import SHAPES, AspectRatioLaw, check_kappa
-from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 PRESETS = ("default", "production", "paper")
 MAX_GRID_POINTS = 1000      # per axis: far beyond any useful table, small enough to check before allocating

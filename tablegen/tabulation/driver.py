@@ -34,6 +34,8 @@ import numpy as np
 from data_schema.common import package_version
 from data_schema.output import check_free_space, check_memory, check_output, remove_stale_temporaries, replace_file
 from data_schema.table import CELL_DATASETS, TABLE_FILE_TYPE, TABLE_VERSION, CellTable, ReboundTable, write_table
+from direct_model.shapes import second_moment_factors
+from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL     # cells.py's simulate uses these
 from tablegen.tabulation.cells import cell_label, compute_cell
 from tablegen.tabulation.config import BuildConfig
 from tablegen.progress import progress_bar
@@ -50,7 +52,7 @@ class CheckpointError(ValueError):
 SCHEDULER_TIMEOUT_S = 10       # how long to try to reach a Dask scheduler before giving up
 SOURCE_ROOT = Path(__file__).resolve().parents[2]       # the folder holding tablegen/ and data_schema/
 # the source that decides a cell's content (not this driver): hashed into checkpoints and tables
-MODEL_SOURCES = ("tablegen/model/*.py", "tablegen/tabulation/resolution.py", "tablegen/tabulation/tabulate.py",
+MODEL_SOURCES = ("direct_model/*.py", "tablegen/tabulation/resolution.py", "tablegen/tabulation/tabulate.py",
                  "tablegen/tabulation/cells.py", "data_schema/samples.py")
 
 
@@ -303,6 +305,9 @@ def _assemble(config: BuildConfig, checkpoint: Checkpoint) -> ReboundTable:
         resolution=config.resolution, cells=cells, kappa=config.kappa, n_max=config.n_max,
         restitution_k=config.wall.k, restitution_p=config.wall.p, friction_q=config.wall.q,
         wall_law=config.wall.name,
+        aspect_ratio=(config.aspect.mean, config.aspect.sd, config.aspect.low, config.aspect.high),
+        contact_tol=DEFAULT_CONTACT_TOL, set_tol=DEFAULT_SET_TOL, max_steps=DEFAULT_MAX_STEPS,
+        second_moment_factors=tuple(second_moment_factors(config.kappa)),
         particles_per_cell=config.particles_per_cell, config_text=config.to_toml(),
         config_sha256=config.sha256(), master_seed=config.seed,
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),

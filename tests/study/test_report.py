@@ -10,8 +10,8 @@ from cli_helpers import user_error
 from data_schema.output import FOLDER_MARKER
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from tablegen.cli import main as tablegen_main
-from tablegen.model.shapes import AspectRatioLaw, second_moment_factor
-from tablegen.model.simulate import simulate
+from direct_model.shapes import AspectRatioLaw, second_moment_factor
+from direct_model.simulate import simulate
 from tablegen.study.figures import FIGURES
 from tablegen.study.report import direct_data, isotropic_inertia, pool
 from tablegen.study.statistics import (

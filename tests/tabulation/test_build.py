@@ -15,7 +15,7 @@ from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table
 from data_schema.output import OutputError
 from tablegen.tabulation.driver import BuildError, Checkpoint, CheckpointError, build_table
 from tablegen.tabulation.config import parse_config
-from tablegen.model.wall import CORUNDUM_ON_STEEL
+from direct_model.wall import CORUNDUM_ON_STEEL
 
 TINY = """
 [grid]

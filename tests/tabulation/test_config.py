@@ -6,7 +6,7 @@ from cli_helpers import user_error
 
 from tablegen.cli import main as tablegen_main
 from tablegen.tabulation.config import PRESETS, ConfigError, load_config, parse_config
-from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 
 @pytest.mark.parametrize("preset", PRESETS)

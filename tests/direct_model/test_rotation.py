@@ -1,4 +1,4 @@
-"""Tests of tablegen.model.rotation: exact (elliptic-function) torque-free rigid-body rotation.
+"""Tests of direct_model.rotation: exact (elliptic-function) torque-free rigid-body rotation.
 
 References used here, all written independently of the module under test:
 
@@ -24,9 +24,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from tablegen.model import rotation as rot
-from tablegen.model.options import JIT
-from tablegen.model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
+from direct_model import rotation as rot
+from direct_model.options import JIT
+from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
 
 
 # --------------------------------------------------------------------------------------

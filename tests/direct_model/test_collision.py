@@ -5,11 +5,11 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.spatial.transform import Rotation
 
-from tablegen.model.collision import (
+from direct_model.collision import (
     COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_NOT_APPROACHING, COLLISION_OK,
     collide, smallest_positive_root,
 )
-from tablegen.model.wall import CORUNDUM_ON_STEEL
+from direct_model.wall import CORUNDUM_ON_STEEL
 
 WALL = CORUNDUM_ON_STEEL.as_array()
 

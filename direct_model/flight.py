@@ -2,7 +2,7 @@
 
 Between collisions the particle moves by inertia alone: the centre of mass
 uniformly, the orientation by exact torque-free rotation
-(:mod:`tablegen.model.rotation`). Only the height y of the centre of mass matters for
+(:mod:`direct_model.rotation`). Only the height y of the centre of mass matters for
 contact; lengths are in units of a, velocities in m/s, times in a/(m/s).
 
 Contact search: conservative advancement with a second-order bound. Every
@@ -35,9 +35,9 @@ ellipsoid support height σ = |A Rᵀ e_y|: |σ''| ≤ 2 a_max² ω²/a_min + a_
 import numba
 import numpy as np
 
-from tablegen.model.options import JIT
-from tablegen.model.rotation import rotation_at
-from tablegen.model.shapes import ELLIPSOID
+from direct_model.options import JIT
+from direct_model.rotation import rotation_at
+from direct_model.shapes import ELLIPSOID
 
 SEARCH_CONTACT = 0      # a point touches the wall (within contact_tol) and approaches it
 SEARCH_ESCAPED = 1      # the body can never reach the wall again
@@ -145,9 +145,9 @@ def find_contact(shape, verts, nv, semi, Rb, M, params, y0, v, contact_tol, set_
 
     Parameters
     ----------
-    shape, verts, nv, semi, Rb : the body (codes and arrays of :mod:`tablegen.model.shapes`).
+    shape, verts, nv, semi, Rb : the body (codes and arrays of :mod:`direct_model.shapes`).
     M : curvature bound from :func:`curvature_bound` for this flight.
-    params : rotation parameters of this flight (:func:`tablegen.model.rotation.rotation_init`).
+    params : rotation parameters of this flight (:func:`direct_model.rotation.rotation_init`).
     y0, v : centre-of-mass height at the flight's t = 0 (units of a) and its
         vertical velocity (m/s).
     contact_tol : a point this close to the wall touches it (units of a).

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from tablegen.model.shapes import (
+from direct_model.shapes import (
     AspectRatioLaw, bounding_radius, body_vertices, polyhedron_mass_properties,
     second_moment_factor, shape_code, shape_vertices, MAX_VERTICES,
 )

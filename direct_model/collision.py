@@ -33,8 +33,8 @@ momentum about the contact point, KΩ − r_c × V_p, is unchanged.
 import numba
 import numpy as np
 
-from tablegen.model.options import JIT
-from tablegen.model.wall import friction_factor, restitution
+from direct_model.options import JIT
+from direct_model.wall import friction_factor, restitution
 
 COLLISION_OK = 0
 COLLISION_MULTIPLE_ROOTS = 1      # resolved with the smallest positive root
@@ -135,7 +135,7 @@ def collide(V, W, r, Kinv, wall, dV, dW):
     W : (3,) angular velocity before, (m/s)/a, lab frame.
     r : (3,) contact point relative to the centre of mass, units of a, lab frame.
     Kinv : (3, 3) inverse of K = J/m in the lab frame, 1/a².
-    wall : (3,) wall law coefficients, :meth:`tablegen.model.wall.WallMaterial.as_array`.
+    wall : (3,) wall law coefficients, :meth:`direct_model.wall.WallMaterial.as_array`.
     dV, dW : (3,) outputs, the changes of V and W.
 
     Returns

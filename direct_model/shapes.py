@@ -37,11 +37,9 @@ import dataclasses
 
 import numba
 import numpy as np
-from scipy.spatial import ConvexHull
-from scipy.special import ndtr, ndtri
 
 from data_schema.samples import SHAPE_NAMES
-from tablegen.model.options import JIT
+from direct_model.options import JIT
 
 ELLIPSOID, PRISM, CUT_PRISM, TETRAHEDRON = 0, 1, 2, 3
 SHAPES = SHAPE_NAMES
@@ -141,6 +139,8 @@ def polyhedron_mass_properties(vertices: np.ndarray):
     centroid : (3,) array
     inertia_per_mass : (3, 3) array, J/m about the centroid (length² units).
     """
+    from scipy.spatial import ConvexHull     # here: the run-time kernel needs numpy and numba only
+
     pts = np.unique(np.asarray(vertices, dtype=float), axis=0)
     hull = ConvexHull(pts)
     p0 = pts.mean(axis=0)
@@ -200,6 +200,8 @@ class AspectRatioLaw:
 
     def ppf(self, u: np.ndarray) -> np.ndarray:
         """Inverse CDF of the truncated normal at probabilities ``u`` ∈ [0, 1]."""
+        from scipy.special import ndtr, ndtri     # here: the run-time kernel needs numpy and numba only
+
         lo = ndtr((self.low - self.mean) / self.sd)
         hi = ndtr((self.high - self.mean) / self.sd)
         x = self.mean + self.sd * ndtri(lo + np.asarray(u) * (hi - lo))

@@ -10,9 +10,9 @@ Sequence for one particle:
 1. With Ω⁻ = 0 the body starts touching the wall (its lowest point at y = 0)
    and the first collision is at t = 0; otherwise its centre starts at the
    bounding radius and the flight in to the first contact is simulated.
-2. Search the flight for the next contact (:func:`tablegen.model.flight.find_contact`).
+2. Search the flight for the next contact (:func:`direct_model.flight.find_contact`).
    None: the particle has rebounded. A contact: apply one collision
-   (:func:`tablegen.model.collision.collide`) and start a new flight there.
+   (:func:`direct_model.collision.collide`) and start a new flight there.
 3. A particle that needs a collision beyond ``n_max`` is ``trapped``; a
    search that exhausts its step budget or a collision that fails is ``failed``.
 
@@ -28,11 +28,11 @@ from data_schema.samples import (
     FAILURE_COLLISION_SOLVER, FAILURE_NONE, FAILURE_NOT_APPROACHING, FAILURE_SEARCH_BUDGET,
     STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED,
 )
-from tablegen.model.options import JIT
-from tablegen.model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
-from tablegen.model.flight import SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, lowest_points
-from tablegen.model.rotation import ROT_PARAMS_SIZE, rotation_init
-from tablegen.model.shapes import MAX_VERTICES, body_vertices, bounding_radius
+from direct_model.options import JIT
+from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
+from direct_model.flight import SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, lowest_points
+from direct_model.rotation import ROT_PARAMS_SIZE, rotation_init
+from direct_model.shapes import MAX_VERTICES, body_vertices, bounding_radius
 
 HISTORY_COLUMNS = 17
 

@@ -120,7 +120,7 @@ import math
 
 import numba
 
-from tablegen.model.options import JIT
+from direct_model.options import JIT
 
 # --------------------------------------------------------------------------------------
 # Layout of the parameter array

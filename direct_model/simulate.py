@@ -17,12 +17,11 @@ import numpy as np
 
 from data_schema.common import package_version
 from data_schema.samples import ALPHA1_RANGE_TEXT, SampleSet, alpha1_is_physical
-from tablegen.model.rebound import rebound_batch
-from tablegen.model.shapes import (
+from direct_model.rebound import rebound_batch
+from direct_model.shapes import (
     DEFAULT_KAPPA, MIX, SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
 )
-from tablegen.model.wall import CORUNDUM_ON_STEEL, WallMaterial
-from tablegen.progress import progress_bar
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 CHUNK_SIZE = 16384                  # particles drawn at a time: fixed, so a seed gives the same bits for any n
 VALID_SPEED_RANGE = (50.0, 300.0)   # m/s, where the default wall law was measured
@@ -104,7 +103,7 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
              omega_in=(0.0, 0.0, 0.0), *, kappa: float = DEFAULT_KAPPA,
              aspect: AspectRatioLaw = AspectRatioLaw(), wall: WallMaterial = CORUNDUM_ON_STEEL,
              n_max: int = DEFAULT_N_MAX, contact_tol: float = DEFAULT_CONTACT_TOL, set_tol: float = DEFAULT_SET_TOL,
-             max_steps: int = DEFAULT_MAX_STEPS, progress: bool = False) -> SampleSet:
+             max_steps: int = DEFAULT_MAX_STEPS, progress=None) -> SampleSet:
     """Simulate the rebound of ``n`` particles at one incident state.
 
     Parameters
@@ -124,7 +123,8 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     contact_tol : contact distance, units of a (> 0).
     set_tol : points within this of the lowest share a contact, units of a (> 0).
     max_steps : contact-search steps allowed per flight before ``failed``.
-    progress : show a progress bar (tqdm) on standard error.
+    progress : None, or a callable given the number of particles finished after each chunk
+        (``tablegen.simulate`` passes its progress bar's update).
 
     Returns
     -------
@@ -165,7 +165,6 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     hands = np.empty(n, dtype=np.int8)
     ratios = np.empty((n, 2))
 
-    bar = progress_bar(progress, n, "particle", "rebounds")
     for k, start in enumerate(range(0, n, CHUNK_SIZE)):
         stop = min(start + CHUNK_SIZE, n)
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
@@ -177,10 +176,8 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
                       n_max, contact_tol, set_tol, max_steps,
                       out_V[sl], out_W[sl], out_erot[sl], out_ncoll[sl], out_status[sl],
                       out_failure[sl], out_steps[sl], out_multi[sl])
-        if bar is not None:
-            bar.update(m)
-    if bar is not None:
-        bar.close()
+        if progress is not None:
+            progress(m)
 
     return SampleSet(
         velocity=out_V, omega=out_W / speed, n_collisions=out_ncoll, status=out_status,

@@ -27,7 +27,7 @@ import dataclasses
 import numba
 import numpy as np
 
-from tablegen.model.options import JIT
+from direct_model.options import JIT
 
 
 @dataclasses.dataclass(frozen=True)

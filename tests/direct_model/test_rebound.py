@@ -5,8 +5,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from tablegen.model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
-from tablegen.model.shapes import MAX_VERTICES, body_vertices, second_moment_factor, shape_code
+from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
+from direct_model.shapes import MAX_VERTICES, body_vertices, second_moment_factor, shape_code
 
 from kernel_helpers import MIRROR, random_bodies, run_one
 

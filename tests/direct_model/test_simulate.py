@@ -10,8 +10,8 @@ import pytest
 from cli_helpers import user_error
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, read_samples
 from tablegen.cli import main as tablegen_main
-from tablegen.model.shapes import AspectRatioLaw
-from tablegen.model.simulate import simulate
+from direct_model.shapes import AspectRatioLaw
+from direct_model.simulate import simulate
 from tablegen.study.statistics import QUANTITIES, summarize
 
 
@@ -151,7 +151,7 @@ def test_cli_writes_the_documented_layout(tmp_path):
 
 def test_cli_wall_law(tmp_path):
     """--wall-k/-p/-q default to the library's law; another law is the one simulated and recorded."""
-    from tablegen.model.wall import WallMaterial
+    from direct_model.wall import WallMaterial
     out = tmp_path / "s.h5"
     assert tablegen_main(["simulate", "--shape", "prism", "--alpha1", "45", "--speed", "200", "-n", "200",
                           "--seed", "3", "--wall-k", "0.2", "--wall-q", "0.5", "--out", str(out)]) == 0

@@ -1,0 +1,160 @@
+"""The direct model at run time: one particle's whole rebound from U_PER_REBOUND uniforms (docs/model.md §10).
+
+:func:`rebound_model_frame` is :func:`direct_model.rebound.rebound` with its random inputs drawn from
+uniforms the caller passes, and with every model parameter taken from one float64 array
+(:func:`model_parameters`, layout P_*), so that a runtime reads the parameters a table was built with and
+calls the model from ``@njit`` code. It works in the model's frame (wall y = 0, normal +Y; docs/model.md
+§2); :func:`surrogate.kernels.direct.rebound_direct_tuple` puts a hit in that frame and back.
+
+The uniforms, all in [0, 1): u[0:3] the orientation (Shoemake's uniform quaternion: Haar measure, like the
+batch's normalised Gaussian quaternion), u[3:5] b/a and c/b (inverse CDF of the truncated normal law, like
+:meth:`direct_model.shapes.AspectRatioLaw.ppf`), u[5] the tetrahedron's hand (+1 below ½), u[6] the
+direction ex of the model frame at normal impact (used by the caller's frame, not here). A fixed count,
+so the caller draws them from any stream (xoshiro256+ in :mod:`surrogate`, ``rbs_rng`` in C) and the same
+uniforms give the same rebound in every implementation. Needs numpy and numba only.
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from direct_model.options import JIT
+from direct_model.rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, rebound
+from direct_model.shapes import SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa
+from direct_model.wall import WallMaterial
+
+U_PER_REBOUND = 7
+U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS = 0, 3, 5, 6
+
+# layout of the parameter array (float64)
+P_ASPECT_MEAN, P_ASPECT_SD, P_ASPECT_LOW, P_ASPECT_HIGH = 0, 1, 2, 3   # the aspect-ratio law (b/a and c/b)
+P_CDF_LOW, P_CDF_HIGH = 4, 5     # Φ((low − mean)/sd), Φ((high − mean)/sd): the law's CDF bounds
+P_KAPPA, P_N_MAX, P_WALL = 6, 7, 8                  # κ, n_max, the wall law (k, p, q) at 8, 9, 10
+P_CONTACT_TOL, P_SET_TOL, P_MAX_STEPS = 11, 12, 13  # units of a, units of a, search steps per flight
+P_KFAC = 14                                          # second-moment factor s per shape code, 14..17
+N_PARAMS = P_KFAC + len(SHAPES)
+
+# the scratch of one call: rebound's work, then semi-axes, R0, V0, W0, V, W
+_SEMI = WORK_SIZE
+_R0 = _SEMI + 3
+_V0 = _R0 + 9
+SCRATCH_SIZE = _V0 + 12
+
+
+def _normal_cdf(x: float) -> float:
+    """Φ(x), the standard normal CDF (libm's erfc: no scipy at run time)."""
+    return 0.5 * math.erfc(-x / math.sqrt(2.0))
+
+
+def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: WallMaterial, contact_tol: float,
+                     set_tol: float, max_steps: int, second_moment_factors) -> np.ndarray:
+    """The parameter array of :func:`rebound_model_frame` (P_* layout), read-only; ValueError naming a value
+    outside its range. Units: tolerances in units of a, the wall law as :class:`WallMaterial`."""
+    kappa = check_kappa(kappa)
+    for name, value in (("n_max", n_max), ("max_steps", max_steps)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value < 2 ** 53:
+            raise ValueError(f"The '{name}' parameter must be an integer in [1, 2**53); got {value!r}.")
+    for name, value in (("contact_tol", contact_tol), ("set_tol", set_tol)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"The '{name}' parameter must be finite and > 0 (units of a); got {value!r}.")
+    kfac = np.asarray(second_moment_factors, dtype=np.float64)
+    if kfac.shape != (len(SHAPES),) or not np.all((kfac > 0.0) & (kfac < 1.0)):
+        raise ValueError(f"The 'second_moment_factors' parameter must be {len(SHAPES)} numbers in (0, 1), one per "
+                         f"shape code; got {second_moment_factors!r}.")
+    p = np.empty(N_PARAMS)
+    p[P_ASPECT_MEAN:P_ASPECT_HIGH + 1] = aspect.mean, aspect.sd, aspect.low, aspect.high
+    p[P_CDF_LOW] = _normal_cdf((aspect.low - aspect.mean) / aspect.sd)
+    p[P_CDF_HIGH] = _normal_cdf((aspect.high - aspect.mean) / aspect.sd)
+    p[P_KAPPA], p[P_N_MAX] = kappa, n_max
+    p[P_WALL:P_WALL + 3] = wall.as_array()
+    p[P_CONTACT_TOL], p[P_SET_TOL], p[P_MAX_STEPS] = contact_tol, set_tol, max_steps
+    p[P_KFAC:] = kfac
+    p.flags.writeable = False
+    return p
+
+
+@numba.njit(**JIT)
+def normal_quantile(p):
+    """Φ⁻¹(p) for p in (0, 1): Wichura's AS 241 (PPND16), relative error about 1e-16; log and sqrt only."""
+    q = p - 0.5
+    if abs(q) <= 0.425:
+        r = 0.180625 - q * q
+        return q * (((((((2509.0809287301226727 * r + 33430.575583588128105) * r + 67265.770927008700853) * r
+                         + 45921.953931549871457) * r + 13731.693765509461125) * r + 1971.5909503065514427) * r
+                      + 133.14166789178437745) * r + 3.387132872796366608) / (
+            ((((((5226.495278852545925 * r + 28729.085735721942674) * r + 39307.89580009271061) * r
+                + 21213.794301586595867) * r + 5394.1960214247511077) * r + 687.1870074920579083) * r
+             + 42.313330701600911252) * r + 1.0)
+    r = math.sqrt(-math.log(p if q < 0.0 else 1.0 - p))
+    if r <= 5.0:
+        r -= 1.6
+        x = (((((((7.7454501427834140764e-4 * r + 0.0227238449892691845833) * r + 0.24178072517745061177) * r
+                 + 1.27045825245236838258) * r + 3.64784832476320460504) * r + 5.7694972214606914055) * r
+              + 4.6303378461565452959) * r + 1.42343711074968357734) / (
+            ((((((1.05075007164441684324e-9 * r + 5.475938084995344946e-4) * r + 0.0151986665636164571966) * r
+                + 0.14810397642748007459) * r + 0.68976733498510000455) * r + 1.6763848301838038494) * r
+             + 2.05319162663775882187) * r + 1.0)
+    else:
+        r -= 5.0
+        x = (((((((2.01033439929228813265e-7 * r + 2.71155556874348757815e-5) * r + 0.0012426609473880784386) * r
+                 + 0.026532189526576123093) * r + 0.29656057182850489123) * r + 1.7848265399172913358) * r
+              + 5.4637849111641143699) * r + 6.6579046435011037772) / (
+            ((((((2.04426310338993978564e-15 * r + 1.4215117583164458887e-7) * r + 1.8463183175100546818e-5) * r
+                + 7.868691311456132591e-4) * r + 0.0148753612908506148525) * r + 0.13692988092273580531) * r
+             + 0.59983220655588793769) * r + 1.0)
+    return -x if q < 0.0 else x
+
+
+@numba.njit(**JIT)
+def aspect_ratio(params, u):
+    """The aspect-ratio law's quantile at u ∈ [0, 1): mean + sd Φ⁻¹(Φ_low + u (Φ_high − Φ_low)), in [low, high]."""
+    lo, hi = params[P_CDF_LOW], params[P_CDF_HIGH]
+    x = params[P_ASPECT_MEAN] + params[P_ASPECT_SD] * normal_quantile(lo + u * (hi - lo))
+    return min(max(x, params[P_ASPECT_LOW]), params[P_ASPECT_HIGH])
+
+
+@numba.njit(**JIT)
+def uniform_quaternion(u0, u1, u2, q):
+    """q = a unit quaternion uniform on S³ (Shoemake 1992) from three uniforms: Haar-uniform rotations."""
+    s, c = math.sqrt(1.0 - u0), math.sqrt(u0)
+    q[0], q[1] = s * math.sin(2.0 * math.pi * u1), s * math.cos(2.0 * math.pi * u1)
+    q[2], q[3] = c * math.sin(2.0 * math.pi * u2), c * math.cos(2.0 * math.pi * u2)
+
+
+@numba.njit(**JIT)
+def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
+    """One particle's whole rebound (docs/model.md §5) in the model frame, its random inputs from ``u``.
+
+    Parameters
+    ----------
+    params : (N_PARAMS,) :func:`model_parameters`.
+    shape : shape code 0..3 (:data:`direct_model.shapes.SHAPES`).
+    vt, vn : incident velocity (vt, vn, 0) in m/s, model frame (vn < 0: into the wall y = 0).
+    wx, wy, wz : incident angular velocity in (m/s)/a, i.e. Ω⁻ (rad/s) times a (m), model frame; all zero:
+        the body starts touching the wall, otherwise clear of it with the flight in simulated (§5.3).
+    u : (≥ U_PER_REBOUND,) uniforms in [0, 1) (module doc).
+    scratch : (SCRATCH_SIZE,) float64 work space.
+
+    Returns
+    -------
+    (status, n_collisions, n_search_steps, V⁺ as 3 floats in m/s, Ω⁺ as 3 floats in (m/s)/a), model frame;
+    status as in :func:`direct_model.rebound.rebound`.
+    """
+    semi = scratch[_SEMI:_SEMI + 3]
+    R0 = scratch[_R0:_R0 + 9].reshape((3, 3))
+    V0, W0 = scratch[_V0:_V0 + 3], scratch[_V0 + 3:_V0 + 6]
+    V, W = scratch[_V0 + 6:_V0 + 9], scratch[_V0 + 9:_V0 + 12]
+    quat = scratch[_V0 + 6:_V0 + 10]        # V and W[0]: free until rebound starts from V0, W0
+    uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat)
+    quaternion_to_matrix(quat, R0)
+    b_over_a = aspect_ratio(params, u[U_RATIOS])
+    semi[0], semi[1], semi[2] = 1.0, b_over_a, b_over_a * aspect_ratio(params, u[U_RATIOS + 1])
+    hand = 1.0 if shape != TETRAHEDRON or u[U_HAND] < 0.5 else -1.0
+    V0[0], V0[1], V0[2] = vt, vn, 0.0
+    W0[0], W0[1], W0[2] = wx, wy, wz
+    status, _, n_coll, n_steps, _, _ = rebound(
+        shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params[P_WALL:P_WALL + 3],
+        int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
+        scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])
+    return status, n_coll, n_steps, V[0], V[1], V[2], W[0], W[1], W[2]

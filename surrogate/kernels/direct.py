@@ -1,0 +1,103 @@
+"""The direct model at run time, in the caller's frame: one particle per call (:func:`rebound_direct_tuple`),
+or many on all threads (:func:`rebound_direct_parallel_rng`); docs/model.md §10.
+
+Where the table's law does not apply (a spinning particle, say), a solver asks the model itself.
+Per hit the model frame is built as the table's draws build theirs
+(:func:`surrogate.kernels.frame.impact_frame`): ey = n, ex the direction of the tangential part of V⁻
+(uniform in the wall plane at normal impact, from u[U_AXIS]), ez = ex × ey; there
+:func:`direct_model.runtime.rebound_model_frame` runs the whole rebound, and V⁺, Ω⁺ come back in the
+caller's frame. Units: V in m/s, Ω in rad/s, a in m. The model parameters come from the table
+(``table.direct_parameters``), so a table and its direct model never disagree.
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_model_frame
+from direct_model.shapes import SHAPES
+from surrogate.kernels.checks import NORMAL_TOLERANCE
+from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.options import JIT
+from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
+
+
+@numba.njit(**JIT)
+def rebound_direct_tuple(params, V, n, a, omega, shape, u):
+    """One particle's rebound by the direct model, in the caller's frame: (status, V⁺, Ω⁺) with V⁺ in m/s
+    and Ω⁺ in rad/s as 3-tuples.
+
+    Parameters
+    ----------
+    params : ``table.direct_parameters`` (:func:`direct_model.runtime.model_parameters`).
+    V : incident velocity V⁻, m/s (3-tuple or (3,) array); must move into the wall (V·n < 0).
+    n : unit wall normal pointing into the gas (|n| − 1 within NORMAL_TOLERANCE).
+    a : half-size (half the largest extent), m, > 0.
+    omega : incident angular velocity Ω⁻, rad/s; exactly zero: the body starts touching the wall (the
+        tables' case), otherwise the flight in from a clear start is simulated (docs/model.md §5.3).
+    shape : shape code 0..3 (ellipsoid, prism, cut prism, tetrahedron).
+    u : (≥ U_PER_REBOUND,) uniforms in [0, 1) (:mod:`direct_model.runtime`), e.g. from
+        :func:`surrogate.kernels.rng.fill_uniforms`.
+
+    Returns STATUS_REBOUNDED; STATUS_TRAPPED (still colliding after n_max collisions) or STATUS_FAILED
+    (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID with NaN vectors for
+    an input outside the ranges above.
+    """
+    return _rebound_direct(params, V, n, a, omega, shape, u, np.empty(SCRATCH_SIZE))
+
+
+@numba.njit(inline="always", **JIT)
+def _valid(V, n, a, omega, shape, u):
+    """The inputs of :func:`rebound_direct_tuple` are in their ranges."""
+    ok = (moves_into_wall(V, n) and math.isfinite(n[0] + n[1] + n[2])
+          and abs(math.sqrt(dot(n, n)) - 1.0) <= NORMAL_TOLERANCE and math.isfinite(a) and a > 0.0
+          and math.isfinite(omega[0] + omega[1] + omega[2]) and 0 <= shape < len(SHAPES)
+          and u.shape[0] >= U_PER_REBOUND)
+    for k in range(U_PER_REBOUND if ok else 0):
+        ok = ok and 0.0 <= u[k] < 1.0
+    return ok
+
+
+@numba.njit(inline="always", **JIT)
+def _rebound_direct(params, V, n, a, omega, shape, u, scratch):
+    """:func:`rebound_direct_tuple` with its scratch space given."""
+    if not _valid(V, n, a, omega, shape, u):
+        return STATUS_INVALID, NAN3, NAN3
+    ex, ez = _frame_axes(V, n, u[U_AXIS])
+    # Ω⁻ in (m/s)/a, the model's unit (direct_model.rebound): rad/s times a
+    status, _, _, vx, vy, vz, wx, wy, wz = rebound_model_frame(
+        params, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez), u, scratch)
+    if status != STATUS_REBOUNDED:
+        return (STATUS_TRAPPED if status == STATUS_TRAPPED else STATUS_FAILED), NAN3, NAN3
+    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
+    return status, V_new, Omega_new
+
+
+@numba.njit(**JIT)
+def _frame_axes(V, n, u_axis):
+    """ex and ez of the impact frame (:func:`impact_frame`), as 3-tuples."""
+    _, _, _, _, ex, ez = impact_frame(V, n, u_axis)
+    return ex, ez
+
+
+@numba.njit(parallel=True, **JIT)
+def rebound_direct_parallel_rng(params, V, n, a, omega, shape, states, V_out, Omega_out, status):
+    """:func:`rebound_direct_tuple` for every row i of V, n, a, omega (N, 3 or N) and shape (N,) codes, on all
+    threads: chunk j of CHUNK_ROWS rows draws its uniforms, U_PER_REBOUND per row in row order, from a copy of
+    the xoshiro256+ state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the results do not
+    depend on the number of threads. Outputs V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,)."""
+    for j in numba.prange(states.shape[0]):
+        state = states[j].copy()
+        u = np.empty(U_PER_REBOUND)
+        scratch = np.empty(SCRATCH_SIZE)
+        for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
+            fill_uniforms(state, u)
+            st, V_new, Omega_new = _rebound_direct(params, (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2]),
+                                                   a[i], (omega[i, 0], omega[i, 1], omega[i, 2]), shape[i], u,
+                                                   scratch)
+            status[i] = st
+            for k in range(3):
+                V_out[i, k] = V_new[k]
+                Omega_out[i, k] = Omega_new[k]

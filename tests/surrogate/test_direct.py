@@ -1,0 +1,241 @@
+"""The direct model at run time (surrogate.kernels.direct, surrogate.rebound_direct): the law of
+`tablegen simulate` in any caller's frame, with the table's parameters; the model's invariants through it;
+bad inputs.
+
+KS tolerances: two samples of n and m draws of one law exceed c·√((n+m)/(nm)) with probability α, c =
+√(−ln(α/2)/2). With α = 1e-3 per comparison (c = 1.95) the ~100 comparisons here pass with probability > 0.9
+for equal laws, while a wrong frame or unit moves these statistics by far more; the seeds are fixed.
+"""
+
+import math
+import subprocess
+import sys
+
+import h5py
+import numba
+import numpy as np
+import pytest
+from scipy import stats
+from scipy.spatial.transform import Rotation
+
+import surrogate
+from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from data_schema.table import BUILT_WITH_SECOND_MOMENT_FACTORS, BUILT_WITH_TOLERANCES
+from direct_model.runtime import U_PER_REBOUND, aspect_ratio, model_parameters
+from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
+from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL, simulate
+from direct_model.wall import CORUNDUM_ON_STEEL
+from surrogate.kernels import rebound_direct_tuple
+
+KS_C = math.sqrt(-math.log(1e-3 / 2) / 2)      # c(α = 1e-3) of the two-sample KS test (module doc)
+N = 4000                                       # particles per sample
+A = 2e-4                                       # half-size, m (results do not depend on it: docs/model.md §7)
+
+
+def ks_bound(n, m):
+    return KS_C * math.sqrt((n + m) / (n * m))
+
+
+def _frame(seed):
+    """A random rotation Q (caller's axes = Q · model axes)."""
+    return Rotation.random(random_state=seed).as_matrix()
+
+
+# (shape, α1 deg, |V⁻| m/s, Ω⁻ a/|V⁻| in the model frame): |Ω⁻|a/|V⁻| ∈ {0, 0.3, 1.0} in several directions
+STATES = [
+    ("ellipsoid", 30.0, 150.0, (0.0, 0.0, 0.0)),
+    ("prism", 45.0, 200.0, (0.0, 0.0, 0.0)),
+    ("cut_prism", 70.0, 100.0, (0.0, 0.0, 0.0)),
+    ("tetrahedron", 20.0, 250.0, (0.0, 0.0, 0.0)),
+    ("ellipsoid", 60.0, 80.0, (0.0, 0.0, -0.3)),
+    ("prism", 45.0, 200.0, (0.18, 0.0, -0.24)),
+    ("cut_prism", 35.0, 280.0, (0.0, 0.3, 0.0)),
+    ("tetrahedron", 75.0, 120.0, (0.3, 0.0, 0.0)),
+    ("ellipsoid", 50.0, 220.0, (0.6, 0.0, 0.8)),
+    ("prism", 25.0, 60.0, (0.0, -1.0, 0.0)),
+    ("cut_prism", 80.0, 180.0, (-0.48, 0.6, 0.64)),
+    ("tetrahedron", 40.0, 160.0, (0.0, 0.8, -0.6)),
+]
+
+
+@pytest.fixture(scope="module")
+def params(small_table):
+    return surrogate.direct_model_parameters(small_table)
+
+
+def _kernel_in_frame(table, shape, alpha1, speed, omega_in, Q, seed, n=N):
+    """rebound_direct at one incident state given in the model frame, run in the caller's frame Q; outputs
+    rotated back to the model frame: (V⁺/|V⁻|, Ω⁺a/|V⁻|, status)."""
+    t = math.radians(alpha1)
+    V = Q @ np.array([math.cos(t), -math.sin(t), 0.0]) * speed
+    W = Q @ np.asarray(omega_in) * speed / A
+    Vo, Wo, st = surrogate.rebound_direct(table, np.tile(V, (n, 1)), Q[:, 1], A, W, shape, random_state=seed)
+    return Vo @ Q / speed, Wo @ Q * A / speed, st
+
+
+@pytest.mark.parametrize("shape, alpha1, speed, omega_in", STATES)
+def test_kernel_draws_the_law_of_tablegen_simulate(small_table, shape, alpha1, speed, omega_in):
+    """In a random caller's frame, the kernel's V⁺/|V⁻| and Ω⁺a/|V⁻| (rotated back) have the law of `tablegen
+    simulate` in the model frame: KS per component, bound from n (module doc)."""
+    Q = _frame(len(shape) + int(alpha1))
+    V, W, status = _kernel_in_frame(small_table, shape, alpha1, speed, omega_in, Q, seed=11)
+    ref = simulate(shape, alpha1, speed, N, seed=12, omega_in=omega_in)
+    mine, theirs = status == STATUS_REBOUNDED, ref.rebounded
+    assert (status >= 0).all()
+    bound = ks_bound(mine.sum(), theirs.sum())
+    for k in range(3):
+        assert stats.ks_2samp(V[mine, k], ref.velocity[theirs, k] / speed).statistic < bound, ("V", k)
+        assert stats.ks_2samp(W[mine, k], ref.omega[theirs, k]).statistic < bound, ("Omega", k)
+    # the trapped fraction: binomial, 4 standard deviations of the difference of two proportions
+    p = (np.mean(status == STATUS_TRAPPED) + np.mean(ref.status == STATUS_TRAPPED)) / 2
+    assert abs(np.mean(status == STATUS_TRAPPED) - np.mean(ref.status == STATUS_TRAPPED)) <= 4 * math.sqrt(
+        2 * p * (1 - p) / N) + 1e-12
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_rotating_the_frame_rotates_the_outputs(small_table, shape):
+    """The same hit in two caller's frames (the model frame and a random one): the outputs, rotated back,
+    have one law (KS per component, bound from n), and particles with the same uniforms agree to 1e-9 of
+    |V⁻| but for a few (a multi-collision sequence can amplify a last-bit difference of the frame; all 4000
+    agree at these seeds)."""
+    state = (shape, 55.0, 170.0, (0.2, -0.1, 0.25))
+    V0, W0, s0 = _kernel_in_frame(small_table, *state, np.eye(3), seed=21)
+    V1, W1, s1 = _kernel_in_frame(small_table, *state, _frame(5), seed=21)
+    ok0, ok1 = s0 == STATUS_REBOUNDED, s1 == STATUS_REBOUNDED
+    bound = ks_bound(ok0.sum(), ok1.sum())
+    for k in range(3):
+        assert stats.ks_2samp(V0[ok0, k], V1[ok1, k]).statistic < bound
+        assert stats.ks_2samp(W0[ok0, k], W1[ok1, k]).statistic < bound
+    both = ok0 & ok1
+    same = np.all(np.abs(V0[both] - V1[both]) < 1e-9, axis=1)
+    assert same.mean() > 0.99 and (s0 == s1).mean() > 0.99
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_a_rebound_never_adds_energy(params, shape):
+    """Through the kernel, in a random frame: ½|V⁺|² + ½ K_min |Ω⁺ a|² ≤ ½|V⁻|² + ½ K_max |Ω⁻ a|² per unit mass
+    (lengths in m), K_min, K_max the extreme principal values of J/(m a²) of the particle drawn from the same
+    uniforms: the kinetic energy ½|V|² + ½ Ω·JΩ/m lies between these bounds, and collisions never add to it."""
+    rng = np.random.default_rng(31)
+    kfac = second_moment_factors()[SHAPES.index(shape)]
+    u = np.empty(U_PER_REBOUND)
+    checked = 0
+    for i in range(400):
+        Q = _frame(100 + i)
+        V = Q @ (rng.normal(size=3) * [100.0, 0.0, 100.0] - [0.0, rng.uniform(30.0, 250.0), 0.0])
+        W = rng.normal(size=3) * 150.0 / A * (i % 3) / 2             # |Ω⁻|a/|V⁻| around 0, 1, 2
+        u[:] = rng.random(U_PER_REBOUND)
+        status, V_out, W_out = rebound_direct_tuple(params, V, Q[:, 1], A, W, SHAPES.index(shape), u)
+        if status != STATUS_REBOUNDED:
+            continue
+        b = aspect_ratio(params, u[3])
+        c = b * aspect_ratio(params, u[4])
+        K = kfac * np.array([b * b + c * c, 1.0 + c * c, 1.0 + b * b])
+        before = 0.5 * V @ V + 0.5 * K.max() * (W @ W) * A * A
+        after = 0.5 * np.dot(V_out, V_out) + 0.5 * K.min() * np.dot(W_out, W_out) * A * A
+        assert after <= before * (1 + 1e-12), i
+        checked += 1
+    assert checked > 350
+
+
+def test_near_sphere_keeps_angular_momentum_about_the_contact_point():
+    """An ellipsoid with b/a, c/b ∈ [0.999999, 1] and Ω⁻ = 0 collides once at the point −a n below its centre:
+    (2/5) a² Ω⁺ + a n × V⁺ = a n × V⁻ (per unit mass) in the caller's frame, to the sphere's asphericity."""
+    near = model_parameters(AspectRatioLaw(1.0, 1e-3, 0.999999, 1.0), 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9,
+                            100_000, second_moment_factors())
+    rng = np.random.default_rng(41)
+    for i in range(200):
+        Q = _frame(300 + i)
+        n = Q[:, 1]
+        V = Q @ (rng.normal(size=3) * [80.0, 0.0, 80.0] - [0.0, rng.uniform(40.0, 250.0), 0.0])
+        status, V_out, W_out = rebound_direct_tuple(near, V, n, A, np.zeros(3), 0, rng.random(U_PER_REBOUND))
+        assert status == STATUS_REBOUNDED
+        before = A * np.cross(n, V)
+        after = 0.4 * A * A * np.asarray(W_out) + A * np.cross(n, V_out)
+        np.testing.assert_allclose(after, before, rtol=0, atol=1e-5 * A * np.linalg.norm(V))
+
+
+def test_same_seed_same_bits_whatever_the_threads(small_table):
+    rng = np.random.default_rng(51)
+    n = 2500                                      # three chunks of CHUNK_ROWS
+    V = rng.normal(size=(n, 3)) * [60.0, 0.0, 60.0] - np.c_[np.zeros(n), rng.uniform(30.0, 250.0, n), np.zeros(n)]
+    W = rng.normal(size=(n, 3)) * 1e5
+    shapes = rng.integers(0, 4, n)
+    runs = []
+    for threads in (1, numba.config.NUMBA_NUM_THREADS):
+        numba.set_num_threads(threads)
+        runs.append(surrogate.rebound_direct(small_table, V, [0.0, 1.0, 0.0], A, W, shapes, random_state=3))
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    for one, many in zip(*runs):
+        np.testing.assert_array_equal(one, many)
+    assert set(np.unique(runs[0][2])) <= {STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED}
+
+
+def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path):
+    """A table records the model's parameters; one without them (3.0–3.2, built before) gets those its build
+    used: the configuration's aspect-ratio law, the simulate defaults, s at κ = 0.3; at another κ the runtime
+    refuses it."""
+    mine = surrogate.direct_model_parameters(small_table)
+    expected = model_parameters(AspectRatioLaw(), 0.3, 1000, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL, DEFAULT_SET_TOL,
+                                DEFAULT_MAX_STEPS, second_moment_factors(0.3))
+    np.testing.assert_array_equal(mine, expected)
+    assert BUILT_WITH_TOLERANCES == {"contact_tol": DEFAULT_CONTACT_TOL, "set_tol": DEFAULT_SET_TOL,
+                                     "max_steps": DEFAULT_MAX_STEPS}
+    np.testing.assert_array_equal(BUILT_WITH_SECOND_MOMENT_FACTORS, second_moment_factors(0.3))
+    old = tmp_path / "old.h5"
+    old.write_bytes(small_table_path.read_bytes())
+    with h5py.File(old, "r+") as f:
+        for name in ("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol",
+                     "set_tol", "max_steps", "second_moment_factors", "friction_q"):
+            del f["grid"].attrs[name]
+    np.testing.assert_array_equal(surrogate.direct_model_parameters(surrogate.load(old)), expected)
+    with h5py.File(old, "r+") as f:
+        f["grid"].attrs["kappa"] = 0.25
+    with pytest.raises(ValueError, match=r"^The table .* does not record the direct model's second-moment factors"):
+        surrogate.direct_model_parameters(surrogate.load(old))
+
+
+@pytest.mark.parametrize("change", [
+    dict(V=(100.0, 50.0, 0.0)), dict(V=(0.0, 0.0, 0.0)), dict(V=(np.nan, -100.0, 0.0)), dict(n=(0.0, 1.1, 0.0)),
+    dict(n=(0.0, np.nan, 0.0)), dict(a=0.0), dict(a=np.inf), dict(omega=(0.0, np.nan, 0.0)), dict(shape=4),
+    dict(shape=-1), dict(u=np.full(U_PER_REBOUND, 1.0)), dict(u=np.full(U_PER_REBOUND - 1, 0.5)),
+])
+def test_bad_kernel_input_is_invalid_with_nan(params, change):
+    args = dict(V=(100.0, -100.0, 0.0), n=(0.0, 1.0, 0.0), a=A, omega=(0.0, 0.0, 0.0), shape=1,
+                u=np.full(U_PER_REBOUND, 0.5))
+    assert rebound_direct_tuple(params, **args)[0] == STATUS_REBOUNDED
+    args.update(change)
+    status, V_out, W_out = rebound_direct_tuple(params, **args)
+    assert status == STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(velocity=[[100.0, 50.0, 0.0]]), "The 'velocity' at index 0 does not move into the wall: V.n = 50.0 m/s"),
+    (dict(normal=[0.0, 2.0, 0.0]), "The 'normal' at index 0 has length 2.0"),
+    (dict(half_size=-1.0), "The 'half_size' at index 0 must be finite and > 0 m; got -1.0."),
+    (dict(omega=[0.0, np.inf, 0.0]), "The 'omega' vector at index 0 is not finite: [0.0, inf, 0.0]."),
+    (dict(shape="sphere"), "The 'shape' at index 0 must be one of ellipsoid, prism, cut_prism, tetrahedron; "
+                           "got 'sphere'."),
+    (dict(shape=[1, 7]), "The 'shape' code at index 1 must be in [0, 3]; got 7."),
+    (dict(velocity=np.zeros((2, 2))), "The 'velocity' parameter must have shape (N, 3); got (2, 2)."),
+])
+def test_bad_python_input_is_a_one_line_error(small_table, change, message):
+    args = dict(velocity=[[100.0, -100.0, 0.0], [10.0, -100.0, 5.0]], normal=[0.0, 1.0, 0.0], half_size=A,
+                omega=[0.0, 0.0, 0.0], shape="prism", random_state=1)
+    args.update(change)
+    with pytest.raises(ValueError) as error:
+        surrogate.rebound_direct(small_table, **args)
+    assert str(error.value).startswith(message) and "\n" not in str(error.value)
+
+
+def test_runtime_kernel_needs_no_scipy():
+    """The run-time path imports and runs with scipy hidden (the plain install has numpy, numba and h5py)."""
+    code = ("import sys; sys.modules['scipy'] = None; import numpy as np; "
+            "from direct_model.runtime import model_parameters, U_PER_REBOUND; "
+            "from direct_model.shapes import AspectRatioLaw; from direct_model.wall import CORUNDUM_ON_STEEL; "
+            "from surrogate.kernels import rebound_direct_tuple; "
+            "p = model_parameters(AspectRatioLaw(), 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9, 100000, "
+            "(0.2, 1 / 3, 0.33, 0.2)); "
+            "s = rebound_direct_tuple(p, (100.0, -100.0, 0.0), (0.0, 1.0, 0.0), 1e-3, (0.0, 0.0, 0.0), 2, "
+            "np.full(U_PER_REBOUND, 0.5))[0]; sys.exit(s)")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == STATUS_REBOUNDED
