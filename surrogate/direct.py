@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from direct_model.shapes import SHAPES
-from surrogate.kernels.checks import NORMAL_TOLERANCE, first_faults
+from surrogate.kernels.checks import first_faults
 from surrogate.kernels.direct import rebound_direct_parallel_rng
 from surrogate.kernels.rng import chunk_states
 from surrogate.sampling import _fault_error, _outputs, _rows, _vectors, check_random_state
@@ -81,7 +81,7 @@ def rebound_direct(table: SurrogateTable, velocity, normal, half_size, omega=(0.
         raise ValueError(f"The 'half_size' parameter must be a scalar or have shape ({n},); got {a.shape}.")
     a = np.ascontiguousarray(a.reshape(-1))
     # every state moving into its wall is in the model's range: only the physical checks can fail
-    first = first_faults(V, nrm, a, NORMAL_TOLERANCE, 0.0, 90.0, 0.0, np.inf)
+    first = first_faults(V, nrm, a, 0.0, 90.0, 0.0, np.inf)
     faults = np.flatnonzero(first >= 0)
     if faults.size:
         raise _fault_error(int(faults[0]), int(first[faults[0]]), table, V, nrm, a)

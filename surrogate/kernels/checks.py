@@ -34,7 +34,6 @@ FAULT_ALPHA1_OUTSIDE = 7        # outside [alpha1_lo, alpha1_hi] deg
 FAULT_SPEED_NOT_FINITE = 8      # or outside [SPEED_MIN, SPEED_MAX]
 FAULT_SPEED_OUTSIDE = 9         # outside [speed_lo, speed_hi] m/s
 N_FAULTS = 10
-NORMAL_TOLERANCE = 1e-6         # |n| − 1 allowed for a wall normal
 
 # |V⁻| the kernels' arithmetic carries, m/s: the squares of the impact frame neither overflow nor lose the
 # precision of subnormal numbers

@@ -18,8 +18,7 @@ import numpy as np
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_model_frame
 from direct_model.shapes import SHAPES
-from surrogate.kernels.checks import NORMAL_TOLERANCE
-from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, to_global
+from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, particle_ok, to_global
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
 
@@ -33,7 +32,7 @@ def rebound_direct_tuple(params, V, n, a, omega, shape, u):
     ----------
     params : ``table.direct_parameters`` (:func:`direct_model.runtime.model_parameters`).
     V : incident velocity V⁻, m/s (3-tuple or (3,) array); must move into the wall (V·n < 0).
-    n : unit wall normal pointing into the gas (|n| − 1 within NORMAL_TOLERANCE).
+    n : unit wall normal pointing into the gas (| |n| − 1 | ≤ surrogate.kernels.frame.NORMAL_TOLERANCE).
     a : half-size (half the largest extent), m, > 0.
     omega : incident angular velocity Ω⁻, rad/s; exactly zero: the body starts touching the wall (the
         tables' case), otherwise the flight in from a clear start is simulated (docs/model.md §5.3).
@@ -51,8 +50,7 @@ def rebound_direct_tuple(params, V, n, a, omega, shape, u):
 @numba.njit(inline="always", **JIT)
 def _valid(V, n, a, omega, shape, u):
     """The inputs of :func:`rebound_direct_tuple` are in their ranges."""
-    ok = (moves_into_wall(V, n) and math.isfinite(n[0] + n[1] + n[2])
-          and abs(math.sqrt(dot(n, n)) - 1.0) <= NORMAL_TOLERANCE and math.isfinite(a) and a > 0.0
+    ok = (moves_into_wall(V, n) and particle_ok(n, a)
           and math.isfinite(omega[0] + omega[1] + omega[2]) and 0 <= shape < len(SHAPES)
           and u.shape[0] >= U_PER_REBOUND)
     for k in range(U_PER_REBOUND if ok else 0):
@@ -71,8 +69,7 @@ def _rebound_direct(params, V, n, a, omega, shape, u, scratch):
         params, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez), u, scratch)
     if status != STATUS_REBOUNDED:
         return (STATUS_TRAPPED if status == STATUS_TRAPPED else STATUS_FAILED), NAN3, NAN3
-    V_new, Omega_new = to_global(status, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
-    return status, V_new, Omega_new
+    return to_global(status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
 
 
 @numba.njit(**JIT)

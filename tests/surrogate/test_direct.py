@@ -212,7 +212,7 @@ def test_bad_kernel_input_is_invalid_with_nan(params, change):
 @pytest.mark.parametrize("change, message", [
     (dict(velocity=[[100.0, 50.0, 0.0]]), "The 'velocity' at index 0 does not move into the wall: V.n = 50.0 m/s"),
     (dict(normal=[0.0, 2.0, 0.0]), "The 'normal' at index 0 has length 2.0"),
-    (dict(half_size=-1.0), "The 'half_size' at index 0 must be finite and > 0 m; got -1.0."),
+    (dict(half_size=-1.0), "The 'half_size' at index 0 must be finite and > 0 m, with |V-|/a <= 1e+300 1/s"),
     (dict(omega=[0.0, np.inf, 0.0]), "The 'omega' vector at index 0 is not finite: [0.0, inf, 0.0]."),
     (dict(shape="sphere"), "The 'shape' at index 0 must be one of ellipsoid, prism, cut_prism, tetrahedron; "
                            "got 'sphere'."),
