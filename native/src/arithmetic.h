@@ -81,6 +81,12 @@ RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, doub
     x[0] = few ? vx_few : x[0];
     x[1] = few ? vy_few : x[1] * f;
     x[2] = g * x[2];
+    /* a speed lifted above |V⁻| is folded back, s → 2 − s (surrogate.kernels.arithmetic.to_speed) */
+    double s = sqrt(fma(x[0], x[0], fma(x[1], x[1], x[2] * x[2])));
+    double shrink = s > 1.0 ? (2.0 - s) / s : 1.0;
+    x[0] = x[0] * shrink;
+    x[1] = x[1] * shrink;
+    x[2] = x[2] * shrink;
     x[3] = g * x[3];
     x[4] = g * x[4];
     x[5] = g * x[5];

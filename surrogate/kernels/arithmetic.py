@@ -107,7 +107,9 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     One law per regime because neither alone follows the direct model near
     normal impact for every shape (docs/design/table_representation.md). A
     normal velocity the shift would reverse is reflected (the rebound must
-    leave the wall).
+    leave the wall), and so is a speed it would lift above |V⁻| (|V⁺| = s > 1
+    becomes 2 − s, as the chain's s is folded: a rebound gains no kinetic
+    energy; about one draw in 10⁶ of the default table).
     """
     a_target = 1.0 - (1.0 - f_target) * sin_alpha1
     a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1
@@ -117,7 +119,10 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     f = (1.0 + a_target) / (1.0 + a_grid) if few else a_target / a_grid
     g = f if few else 1.0       # factor of the spin and of V⁺ − V⁻ off the normal
     vx_few, vy_few = fma(f, vx - cos_alpha1, cos_alpha1), abs(fma(f, vy + sin_alpha1, -sin_alpha1))
-    return vx_few if few else vx, vy_few if few else vy * f, g * vz, g * wx, g * wy, g * wz
+    vx, vy, vz = vx_few if few else vx, vy_few if few else vy * f, g * vz
+    s = math.sqrt(fma(vx, vx, fma(vy, vy, vz * vz)))
+    shrink = (2.0 - s) / s if s > 1.0 else 1.0      # × 1.0 changes no bit of the other draws
+    return vx * shrink, vy * shrink, vz * shrink, g * wx, g * wy, g * wz
 
 
 @numba.njit(inline="always", **JIT)

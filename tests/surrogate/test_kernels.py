@@ -1,5 +1,7 @@
 """The numba kernels: one particle, the pipeline and the parallel kernels give the same bits, whatever the thread count; called from a solver's loop."""
 
+import math
+
 import numba
 import numpy as np
 import pytest
@@ -210,3 +212,22 @@ def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
                      np.full(U_PER_DRAW, 0.5), V_out, Omega_out)
     assert status == STATUS_INVALID and np.all(np.isnan(V_out)) and np.all(np.isnan(Omega_out))
     np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])
+
+
+def test_speed_move_never_lifts_the_rebound_speed_above_the_incident_one():
+    """Regime 0 scales V⁺ − V⁻ by (1 + a(V))/(1 + a(V_iv)) > 1 when the incident speed restitutes more than the grid
+    speed: an elastic specular draw at α1 = 83° would come out with s = |V⁺|/|V⁻| ≈ 1.2. It is folded back to
+    2 − s, direction kept (so it still leaves the wall), as the chain's s is."""
+    from surrogate.kernels.arithmetic import to_speed
+    alpha1 = math.radians(83.0)
+    c, s = math.cos(alpha1), math.sin(alpha1)
+    f_target, f_grid = 0.95, 0.6
+    a_target, a_grid = 1.0 - (1.0 - f_target) * s, 1.0 - (1.0 - f_grid) * s
+    f = (1.0 + a_target) / (1.0 + a_grid)
+    unfolded = np.array([c, abs(f * (s + s) - s), 0.0])       # the move alone, from V⁺ = (cos α1, sin α1, 0)
+    assert np.linalg.norm(unfolded) > 1.1
+    moved = np.array(to_speed(0.0, f_target, f_grid, c, s, c, s, 0.0, 0.0, 0.0, 0.3)[:3])
+    assert np.linalg.norm(moved) == pytest.approx(2.0 - np.linalg.norm(unfolded), rel=1e-14)
+    assert np.allclose(moved / np.linalg.norm(moved), unfolded / np.linalg.norm(unfolded), rtol=0, atol=1e-15)
+    kept = np.array(to_speed(0.0, 0.6, 0.6, c, s, 0.5 * c, 0.5 * s, 0.0, 0.0, 0.0, 0.3)[:3])   # f = 1, s = 0.5
+    assert np.linalg.norm(kept) == pytest.approx(0.5, rel=1e-15)
