@@ -53,7 +53,7 @@ static int physical(const double *V_out, const double *W_out, const double *n)
     return V_out[0] * n[0] + V_out[1] * n[1] + V_out[2] * n[2] > 0.0;
 }
 
-/* Hostile arguments to the draw functions (issue 25): uniforms outside [0, 1) or NaN, NULL pointers, extreme
+/* Hostile arguments to the draw functions: uniforms outside [0, 1) or NaN, NULL pointers, extreme
  * speeds, half-sizes and normals, an all-zero generator, local states outside the physical range. None may
  * crash or read outside the table (the sanitizers watch); each gives RBS_INVALID and NaN, or a finite
  * rebound leaving the wall. */

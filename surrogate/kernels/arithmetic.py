@@ -109,7 +109,7 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     normal velocity the shift would reverse is reflected (the rebound must
     leave the wall), and so is a speed it would lift above |V⁻| (|V⁺| = s > 1
     becomes 2 − s, as the chain's s is folded: a rebound gains no kinetic
-    energy; about one draw in 10⁶ of the default table).
+    energy).
     """
     a_target = 1.0 - (1.0 - f_target) * sin_alpha1
     a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1

@@ -1,4 +1,4 @@
-"""Outputs and the race between the output check and the final step (issue 25): without overwrite, a file or
+"""Outputs and the race between the output check and the final step: without overwrite, a file or
 folder that appears at the target while the work runs is kept, and the write fails naming it."""
 
 import pytest

@@ -13,7 +13,7 @@ def unit_vectors(rng, count):
 def incident_states(rng, count, alpha1_range=(0.0, 90.0), speed_range=(5.0, 400.0)):
     """(V, n, a): random unit normals, α1 and |V⁻| uniform over the ranges (deg, m/s), with the special
     cases mixed in: exact normal impact, grazing, invalid (V·n ≥ 0, zero, NaN, inf), grid speeds, and the
-    hostile ones the draws refuse or guard (issue 25): normals that are not unit vectors, half-sizes not
+    hostile ones the draws refuse or guard: normals that are not unit vectors, half-sizes not
     finite and > 0 or so small that Ω⁺ overflows, |V⁻| that overflows or underflows."""
     n = unit_vectors(rng, count)
     t = rng.standard_normal((count, 3))

@@ -127,7 +127,7 @@ def test_a_corrupted_table_fails_to_load_naming_the_dataset(table, capsys):
     assert "corrupt" in line
 
 
-# -- issue 25: the kernels never return a non-finite or unphysical rebound; the API's one-line errors -------------
+# -- the kernels never return a non-finite or unphysical rebound; the API's one-line errors -------------
 
 def _draw(table, V=(40.0, -0.3, 0.0), n=(0.0, 1.0, 0.0), a=1e-4, u=None):
     """(status, V⁺, Ω⁺) of surrogate.kernels.rebound_tuple for one particle, seed-1 uniforms unless given."""

@@ -49,8 +49,8 @@ BAD = [
     ("[grid]\nspeed_m_s = [0.0, 100.0]", "grid.speed_m_s"),
     ("[grid]\nspeed_m_s = [-50.0]", "grid.speed_m_s"),
     ("[grid]\nspeed_m_s = [200.0, 100.0]", "grid.speed_m_s"),
-    # issue 25: grids the model or the runtime cannot serve (built in 3 s, then 10 minutes of restitution
-    # pieces in surrogate and RBS_ERR_MEMORY in C; or a 28-line traceback)
+    # grids the runtime cannot serve: speeds outside [0.001, 10⁴] m/s or neighbours too far apart for its
+    # restitution pieces
     ("[grid]\nspeed_m_s = [0.0001, 300.0]", "grid.speed_m_s"),
     ("[grid]\nspeed_m_s = [1e-300, 1e300]", "grid.speed_m_s"),
     ("[grid]\nspeed_m_s = [1e-300]", "grid.speed_m_s"),
