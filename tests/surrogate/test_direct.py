@@ -1,13 +1,10 @@
-"""The direct model at run time (surrogate.kernels.direct, surrogate.rebound_direct): the law of
-`tablegen simulate` in any caller's frame, with the table's parameters; the model's invariants through it;
-bad inputs.
+"""The direct model at run time (surrogate.kernels.direct, surrogate.rebound_direct): one law in any caller's
+frame, with the table's parameters; the model's invariants through it; bad inputs.
 
-KS tolerances: two samples of n and m draws of one law exceed c·√((n+m)/(nm)) with probability α, c =
-√(−ln(α/2)/2). With α = 1e-3 per comparison (c = 1.95) the ~100 comparisons here pass with probability > 0.9
-for equal laws, while a wrong frame or unit moves these statistics by far more; the seeds are fixed.
+The law against `tablegen simulate` at 16 incident states: test_direct_law.py. KS bounds here: those of
+tests/direct_law.py (Bonferroni over the module's comparisons, FAMILY_ALPHA = 1e-3), fixed seeds.
 """
 
-import math
 import subprocess
 import sys
 
@@ -16,80 +13,24 @@ import numba
 import numpy as np
 import pytest
 from scipy import stats
-from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import BUILT_WITH_SECOND_MOMENT_FACTORS, BUILT_WITH_TOLERANCES
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, model_parameters
 from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
-from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL, simulate
+from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL
 from direct_model.wall import CORUNDUM_ON_STEEL
 from surrogate.kernels import rebound_direct_tuple
 
-KS_C = math.sqrt(-math.log(1e-3 / 2) / 2)      # c(α = 1e-3) of the two-sample KS test (module doc)
-N = 4000                                       # particles per sample
-A = 2e-4                                       # half-size, m (results do not depend on it: docs/model.md §7)
+from direct_law import A, kernel_in_frame, ks_bound, random_frame
 
-
-def ks_bound(n, m):
-    return KS_C * math.sqrt((n + m) / (n * m))
-
-
-def _frame(seed):
-    """A random rotation Q (caller's axes = Q · model axes)."""
-    return Rotation.random(random_state=seed).as_matrix()
-
-
-# (shape, α1 deg, |V⁻| m/s, Ω⁻ a/|V⁻| in the model frame): |Ω⁻|a/|V⁻| ∈ {0, 0.3, 1.0} in several directions
-STATES = [
-    ("ellipsoid", 30.0, 150.0, (0.0, 0.0, 0.0)),
-    ("prism", 45.0, 200.0, (0.0, 0.0, 0.0)),
-    ("cut_prism", 70.0, 100.0, (0.0, 0.0, 0.0)),
-    ("tetrahedron", 20.0, 250.0, (0.0, 0.0, 0.0)),
-    ("ellipsoid", 60.0, 80.0, (0.0, 0.0, -0.3)),
-    ("prism", 45.0, 200.0, (0.18, 0.0, -0.24)),
-    ("cut_prism", 35.0, 280.0, (0.0, 0.3, 0.0)),
-    ("tetrahedron", 75.0, 120.0, (0.3, 0.0, 0.0)),
-    ("ellipsoid", 50.0, 220.0, (0.6, 0.0, 0.8)),
-    ("prism", 25.0, 60.0, (0.0, -1.0, 0.0)),
-    ("cut_prism", 80.0, 180.0, (-0.48, 0.6, 0.64)),
-    ("tetrahedron", 40.0, 160.0, (0.0, 0.8, -0.6)),
-]
+ROTATION_COMPARISONS = 6 * len(SHAPES)        # KS comparisons of test_rotating_the_frame_rotates_the_outputs
 
 
 @pytest.fixture(scope="module")
 def params(small_table):
     return surrogate.direct_model_parameters(small_table)
-
-
-def _kernel_in_frame(table, shape, alpha1, speed, omega_in, Q, seed, n=N):
-    """rebound_direct at one incident state given in the model frame, run in the caller's frame Q; outputs
-    rotated back to the model frame: (V⁺/|V⁻|, Ω⁺a/|V⁻|, status)."""
-    t = math.radians(alpha1)
-    V = Q @ np.array([math.cos(t), -math.sin(t), 0.0]) * speed
-    W = Q @ np.asarray(omega_in) * speed / A
-    Vo, Wo, st = surrogate.rebound_direct(table, np.tile(V, (n, 1)), Q[:, 1], A, W, shape, random_state=seed)
-    return Vo @ Q / speed, Wo @ Q * A / speed, st
-
-
-@pytest.mark.parametrize("shape, alpha1, speed, omega_in", STATES)
-def test_kernel_draws_the_law_of_tablegen_simulate(small_table, shape, alpha1, speed, omega_in):
-    """In a random caller's frame, the kernel's V⁺/|V⁻| and Ω⁺a/|V⁻| (rotated back) have the law of `tablegen
-    simulate` in the model frame: KS per component, bound from n (module doc)."""
-    Q = _frame(len(shape) + int(alpha1))
-    V, W, status = _kernel_in_frame(small_table, shape, alpha1, speed, omega_in, Q, seed=11)
-    ref = simulate(shape, alpha1, speed, N, seed=12, omega_in=omega_in)
-    mine, theirs = status == STATUS_REBOUNDED, ref.rebounded
-    assert (status >= 0).all()
-    bound = ks_bound(mine.sum(), theirs.sum())
-    for k in range(3):
-        assert stats.ks_2samp(V[mine, k], ref.velocity[theirs, k] / speed).statistic < bound, ("V", k)
-        assert stats.ks_2samp(W[mine, k], ref.omega[theirs, k]).statistic < bound, ("Omega", k)
-    # the trapped fraction: binomial, 4 standard deviations of the difference of two proportions
-    p = (np.mean(status == STATUS_TRAPPED) + np.mean(ref.status == STATUS_TRAPPED)) / 2
-    assert abs(np.mean(status == STATUS_TRAPPED) - np.mean(ref.status == STATUS_TRAPPED)) <= 4 * math.sqrt(
-        2 * p * (1 - p) / N) + 1e-12
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -99,10 +40,10 @@ def test_rotating_the_frame_rotates_the_outputs(small_table, shape):
     |V⁻| but for a few (a multi-collision sequence can amplify a last-bit difference of the frame; all 4000
     agree at these seeds)."""
     state = (shape, 55.0, 170.0, (0.2, -0.1, 0.25))
-    V0, W0, s0 = _kernel_in_frame(small_table, *state, np.eye(3), seed=21)
-    V1, W1, s1 = _kernel_in_frame(small_table, *state, _frame(5), seed=21)
+    V0, W0, s0 = kernel_in_frame(small_table, *state, np.eye(3), seed=21)
+    V1, W1, s1 = kernel_in_frame(small_table, *state, random_frame(5), seed=21)
     ok0, ok1 = s0 == STATUS_REBOUNDED, s1 == STATUS_REBOUNDED
-    bound = ks_bound(ok0.sum(), ok1.sum())
+    bound = ks_bound(ok0.sum(), ok1.sum(), ROTATION_COMPARISONS)
     for k in range(3):
         assert stats.ks_2samp(V0[ok0, k], V1[ok1, k]).statistic < bound
         assert stats.ks_2samp(W0[ok0, k], W1[ok1, k]).statistic < bound
@@ -121,7 +62,7 @@ def test_a_rebound_never_adds_energy(params, shape):
     u = np.empty(U_PER_REBOUND)
     checked = 0
     for i in range(400):
-        Q = _frame(100 + i)
+        Q = random_frame(100 + i)
         V = Q @ (rng.normal(size=3) * [100.0, 0.0, 100.0] - [0.0, rng.uniform(30.0, 250.0), 0.0])
         W = rng.normal(size=3) * 150.0 / A * (i % 3) / 2             # |Ω⁻|a/|V⁻| around 0, 1, 2
         u[:] = rng.random(U_PER_REBOUND)
@@ -145,7 +86,7 @@ def test_near_sphere_keeps_angular_momentum_about_the_contact_point():
                             100_000, second_moment_factors())
     rng = np.random.default_rng(41)
     for i in range(200):
-        Q = _frame(300 + i)
+        Q = random_frame(300 + i)
         n = Q[:, 1]
         V = Q @ (rng.normal(size=3) * [80.0, 0.0, 80.0] - [0.0, rng.uniform(40.0, 250.0), 0.0])
         status, V_out, W_out = rebound_direct_tuple(near, V, n, A, np.zeros(3), 0, rng.random(U_PER_REBOUND))
