@@ -1,5 +1,5 @@
 """Throughput benchmark of the direct rebound model: the batch API (``direct_model.simulate.simulate``) and
-the run-time kernel (``surrogate.kernels.rebound_direct_tuple``).
+the run-time kernels (numba's ``surrogate.kernels.rebound_direct_tuple``, C's ``rbs_rebound_direct``).
 
 What is measured: the batch
 ---------------------------
@@ -23,19 +23,33 @@ For each shape and incidence angle α1 (default: the four shapes at 45° and
 * the target, 10⁵ rebounds/s per core at α1 = 45°, and whether each shape meets
   it. This is only printed: the exit code does not depend on it.
 
-What is measured: the run-time kernel
--------------------------------------
-Microseconds per rebound of ``rebound_direct_tuple``, one particle per call in
-an ``@njit`` loop on one thread, its 7 uniforms drawn per call from a xoshiro256+
-state (``fill_uniforms``), as a solver would call it; per shape, at ``--states``
-random incident states: α1 uniform in [5°, 90°], |V⁻| uniform in 50–300 m/s, a
-random caller's frame, and Ω⁻ = 0 (the tables' case) or |Ω⁻|a/|V⁻| uniform in
-[0, 1.2] in a random direction (the flight in is simulated), reported
-separately. Where the time goes: the same states through the model-frame
-rebound alone (``direct_model.runtime.rebound_model_frame``; the rest is the
-frame, the checks and the uniforms), the same without the trapped particles
-(each runs n_max collisions), and the mean collisions and contact-search steps
-per rebound. Best of ``--repeats`` timings.
+What is measured: the run-time kernels
+--------------------------------------
+Microseconds per rebound of numba's ``rebound_direct_tuple`` and of the C library's ``rbs_rebound_direct``,
+one particle per call in a loop on one thread (an ``@njit`` loop; a C loop in native/bench/rbs_bench_direct.c),
+the 7 uniforms drawn per call from one xoshiro256+ stream of seed SEED (``fill_uniforms``, ``rbs_rng_fill``:
+the same uniforms, so the C outputs are checked against numba's bits), as a solver would call them. Per
+shape, on three sets of incident states:
+
+* 'random, 0': ``--states`` random states, α1 uniform in [5°, 90°], |V⁻| uniform in 50–300 m/s, a random
+  caller's frame, Ω⁻ = 0 (the tables' case: the body starts touching the wall);
+* 'random, spin': the same with |Ω⁻|a/|V⁻| uniform in [0, 1.2] in a random direction (the flight in is
+  simulated);
+* 'hopper': the wall hits of a hopperRebound run (benchmarks/data/hopper_hits.csv, written by
+  benchmarks/hopper_hits.py: V⁻, n, a and Ω⁻ per hit, half of them spinning), each run with the shape.
+
+The target of the issue, ≤ 5 µs per rebound on one core averaged over hopperRebound's hits, is reported
+per shape (a figure only: the exit code does not depend on it). Where the time goes: numba's rebound alone
+(``direct_model.runtime.rebound_model_frame``, the same uniforms; the rest of the call is the frame, the
+checks and the uniforms), the same without the trapped particles (each runs n_max collisions), the mean
+flights, collisions and contact-search steps per particle, and a split of the rebound's time: each piece
+timed alone on the rows' bodies (a flight's setup: K in the lab frame, rotation_init, curvature_bound; a
+search step: rotation_at, the free flight's orientation, and lowest_points; a collision: K⁻¹ in the lab
+frame and collide) times its count per rebound; the rest is the body's setup and the search's own logic.
+Times are the best of ``--repeats`` runs in this thread's CPU time (C: CLOCK_THREAD_CPUTIME_ID), which
+leaves out the time other jobs take on a shared machine. The C side builds native/ (or takes
+``--build-dir``) and reads its parameters from a table (``--table``, else a small one built with the
+defaults, the parameters numba's rows use too).
 
 How
 ---
@@ -54,7 +68,8 @@ Run from the repository root::
     PYTHONPATH=. python benchmarks/bench_direct.py            # full run (about a minute)
     PYTHONPATH=. python benchmarks/bench_direct.py --quick    # smoke run
     PYTHONPATH=. python benchmarks/bench_direct.py --json bench.json
-    PYTHONPATH=. python benchmarks/bench_direct.py --runtime  # the run-time kernel alone (about 20 s)
+    PYTHONPATH=. python benchmarks/bench_direct.py --runtime  # the run-time kernels alone (about 2 min)
+    PYTHONPATH=. python benchmarks/bench_direct.py --runtime --no-native    # numba's alone
 
 If the numbers look odd after kernel edits, delete numba's cache files
 (``*.nbi``, ``*.nbc``) and rerun.
@@ -65,25 +80,42 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
 
+import hopper_hits  # benchmarks/hopper_hits.py, next to this script: the hopperRebound hits sample
+import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
-from direct_model.runtime import SCRATCH_SIZE, U_PER_REBOUND, model_parameters, rebound_model_frame
-from direct_model.shapes import AspectRatioLaw, second_moment_factors
+from direct_model.collision import collide
+from direct_model.flight import curvature_bound, lowest_points
+from direct_model.rebound import lab_tensor, quaternion_to_matrix
+from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
+from direct_model.runtime import (P_KAPPA, P_KFAC, P_WALL, SCRATCH_SIZE, U_AXIS, U_HAND, U_ORIENTATION,
+                                  U_PER_REBOUND, U_RATIOS, aspect_ratio, model_parameters, rebound_model_frame,
+                                  uniform_quaternion)
+from direct_model.shapes import (MAX_VERTICES, TETRAHEDRON, AspectRatioLaw, body_vertices, bounding_radius,
+                                 second_moment_factors)
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_SET_TOL, simulate
 from direct_model.wall import CORUNDUM_ON_STEEL
 from machine import machine_info  # benchmarks/machine.py, next to this script
 from surrogate.kernels import fill_uniforms, impact_frame, rebound_direct_tuple, seed_state
 from surrogate.kernels.frame import dot
+from tablegen import build_table, parse_config
 
 SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
 TARGET_PER_CORE = 1e5     # rebounds/s per core
 TARGET_ALPHA1 = 45.0      # degrees
 SEED = 20240601
+NATIVE = Path(__file__).resolve().parent.parent / "native"
+# a table only for its recorded model parameters (the defaults), for the C side: 2 × 2 cells of 256
+BENCH_TABLE_CONFIG = ("[grid]\nalpha1_deg = [45.0, 90.0]\nspeed_m_s = [100.0, 200.0]\n"
+                      "[simulation]\nparticles_per_cell = 256\nseed = 1\n")
 COLUMNS = (  # (header, width, format spec, key of the result row)
     ("shape", 12, "s", "shape"), ("alpha1", 6, "g", "alpha1_deg"), ("n", 8, "d", "n"),
     ("t1 s", 5, ".2f", "time_1thread_s"), ("cpu/wall", 8, ".2f", "cpu_over_wall_1thread"),
@@ -147,22 +179,33 @@ def target_verdict(alpha1, rate_per_core) -> str:
 
 
 RUNTIME_COLUMNS = (  # (header, width, format spec, key of the result row)
-    ("shape", 12, "s", "shape"), ("spin", 5, "s", "spin"), ("n", 7, "d", "n"),
-    ("us/rebound", 10, ".2f", "us_per_rebound"), ("model frame us", 14, ".2f", "us_model_frame"),
-    ("untrapped us", 12, ".2f", "us_model_frame_untrapped"),
-    ("coll/reb", 8, ".2f", "collisions_per_rebound"), ("steps/reb", 9, ".1f", "search_steps_per_rebound"),
-    ("trapped", 7, "d", "trapped"), ("failed", 6, "d", "failed"),
+    ("shape", 12, "s", "shape"), ("states", 10, "s", "states"), ("n", 6, "d", "n"),
+    ("numba us", 8, ".2f", "us_per_rebound"), ("C us", 7, ".2f", "us_c"), ("C/numba", 7, ".2f", "c_over_numba"),
+    ("frame us", 8, ".2f", "us_model_frame"), ("untrapped", 9, ".2f", "us_model_frame_untrapped"),
+    ("flights", 7, ".2f", "flights_per_rebound"), ("coll", 6, ".2f", "collisions_per_rebound"),
+    ("steps", 6, ".1f", "search_steps_per_rebound"), ("trapped", 7, "d", "trapped"), ("failed", 6, "d", "failed"),
 )
+SPLIT_COLUMNS = (
+    ("shape", 12, "s", "shape"), ("states", 10, "s", "states"), ("setup us", 8, ".3f", "us_flight_setup"),
+    ("step us", 7, ".3f", "us_search_step"), ("coll us", 7, ".3f", "us_collision"),
+    ("flights %", 9, ".0f", "pct_flight_setup"), ("search %", 8, ".0f", "pct_search"),
+    ("coll %", 6, ".0f", "pct_collisions"), ("rest %", 6, ".0f", "pct_rest"),
+    ("trapped %", 9, ".0f", "pct_trapped"),
+)
+STATE_SETS = ("random, 0", "random, spin", "hopper")
 
 
 @numba.njit
-def _kernel_loop(params, V, n, a, omega, shape, state, status):
+def _kernel_loop(params, V, n, a, omega, shape, state, status, V_out, W_out):
     """rebound_direct_tuple on every row, uniforms from ``state``: what a solver's loop does."""
     u = np.empty(U_PER_REBOUND)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        status[i] = rebound_direct_tuple(params, (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), a,
-                                         (omega[i, 0], omega[i, 1], omega[i, 2]), shape, u)[0]
+        st, Vo, Wo = rebound_direct_tuple(params, (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i],
+                                          (omega[i, 0], omega[i, 1], omega[i, 2]), shape, u)
+        status[i] = st
+        for k in range(3):
+            V_out[i, k], W_out[i, k] = Vo[k], Wo[k]
 
 
 @numba.njit
@@ -171,23 +214,122 @@ def _model_frame_inputs(V, n, a, omega, state, u_all, model):
     for i in range(V.shape[0]):
         fill_uniforms(state, u_all[i])
         Vi, ni, Wi = (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), (omega[i, 0], omega[i, 1], omega[i, 2])
-        _, _, _, _, ex, ez = impact_frame(Vi, ni, u_all[i, 6])
+        _, _, _, _, ex, ez = impact_frame(Vi, ni, u_all[i, U_AXIS])
         model[i, 0], model[i, 1] = dot(Vi, ex), dot(Vi, ni)
-        model[i, 2], model[i, 3], model[i, 4] = a * dot(Wi, ex), a * dot(Wi, ni), a * dot(Wi, ez)
+        model[i, 2], model[i, 3], model[i, 4] = a[i] * dot(Wi, ex), a[i] * dot(Wi, ni), a[i] * dot(Wi, ez)
 
 
 @numba.njit
-def _model_frame_loop(params, model, shape, u_all, counts):
-    """rebound_model_frame alone on the rows' model-frame inputs; counts[i] = (status, collisions, steps)."""
+def _model_frame_loop(params, model, shape, u_all, counts, W_after):
+    """rebound_model_frame alone on the rows' model-frame inputs; counts[i] = (status, collisions, steps),
+    W_after[i] = Ω⁺ ((m/s)/a, model frame)."""
     scratch = np.empty(SCRATCH_SIZE)
     for i in range(model.shape[0]):
-        st, n_coll, n_steps, _, _, _, _, _, _ = rebound_model_frame(
+        st, n_coll, n_steps, _, _, _, wx, wy, wz = rebound_model_frame(
             params, shape, model[i, 0], model[i, 1], model[i, 2], model[i, 3], model[i, 4], u_all[i], scratch)
         counts[i, 0], counts[i, 1], counts[i, 2] = st, n_coll, n_steps
+        W_after[i, 0], W_after[i, 1], W_after[i, 2] = wx, wy, wz
 
 
-def random_states(m: int, spin: bool, seed: int):
-    """m incident states (module doc): V (m, 3) m/s, n (m, 3) unit normals, Ω (m, 3) rad/s for a = 1 m."""
+# ----------------------------------------------------------------------------- the pieces of a rebound
+
+@numba.njit
+def _bodies(params, shape, u_all, semi, R, verts, nv):
+    """The bodies the rows' uniforms draw (as rebound_model_frame draws them): semi-axes, orientation R,
+    vertices (untimed)."""
+    q = np.empty(4)
+    for i in range(u_all.shape[0]):
+        uniform_quaternion(u_all[i, U_ORIENTATION], u_all[i, U_ORIENTATION + 1], u_all[i, U_ORIENTATION + 2], q)
+        quaternion_to_matrix(q, R[i])
+        b = aspect_ratio(params, u_all[i, U_RATIOS])
+        semi[i, 0], semi[i, 1], semi[i, 2] = 1.0, b, b * aspect_ratio(params, u_all[i, U_RATIOS + 1])
+        hand = 1.0 if shape != TETRAHEDRON or u_all[i, U_HAND] < 0.5 else -1.0
+        nv[i] = body_vertices(shape, 1.0, semi[i, 1], semi[i, 2], params[P_KAPPA], hand, verts[i])
+
+
+@numba.njit
+def _flight_setups(params, shape, semi, R, verts, nv, W, rot):
+    """What rebound does at the start of every flight: K in the lab frame, ℓ = KΩ, rotation_init,
+    curvature_bound; rot[i] receives the rotation parameters."""
+    K, K_lab, ell = np.empty(3), np.empty((3, 3)), np.empty(3)
+    for i in range(semi.shape[0]):
+        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
+        kfac = params[P_KFAC + shape]
+        K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
+        lab_tensor(R[i], K, K_lab)
+        for j in range(3):
+            ell[j] = K_lab[j, 0] * W[i, 0] + K_lab[j, 1] * W[i, 1] + K_lab[j, 2] * W[i, 2]
+        rotation_init(K, R[i], ell, rot[i])
+        curvature_bound(shape, semi[i], bounding_radius(shape, 1.0, semi[i, 1], semi[i, 2], verts[i], nv[i]), K, ell,
+                        W[i])
+
+
+@numba.njit
+def _search_steps(shape, semi, verts, nv, rot, t):
+    """What one contact-search step costs at least: the orientation at time t[i] (rotation_at) and the
+    candidate lowest points there (lowest_points)."""
+    R, W = np.empty((3, 3)), np.empty(3)
+    h, r_all = np.empty(MAX_VERTICES), np.empty((MAX_VERTICES, 3))
+    for i in range(semi.shape[0]):
+        rotation_at(rot[i], t[i], R, W)
+        lowest_points(shape, verts[i], nv[i], semi[i], R, 1.0, h, r_all)
+
+
+@numba.njit
+def _collisions(params, shape, semi, R, verts, nv, model, out):
+    """One collision per row, the body at rest touching the wall at its lowest point, hit at V⁻ (the first
+    collision of a rebound with Ω⁻ = 0): K⁻¹ in the lab frame and collide. out[i] = collide's outcome."""
+    Kinv, Kinv_lab = np.empty(3), np.empty((3, 3))
+    h, r_all = np.empty(MAX_VERTICES), np.empty((MAX_VERTICES, 3))
+    V, W, dV, dW = np.empty(3), np.zeros(3), np.empty(3), np.empty(3)
+    wall = params[P_WALL:P_WALL + 3]
+    for i in range(semi.shape[0]):
+        m = lowest_points(shape, verts[i], nv[i], semi[i], R[i], 0.0, h, r_all)
+        low = 0
+        for j in range(m):
+            low = j if h[j] < h[low] else low
+        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
+        kfac = params[P_KFAC + shape]
+        Kinv[0], Kinv[1], Kinv[2] = 1.0 / (kfac * (b2 + c2)), 1.0 / (kfac * (a2 + c2)), 1.0 / (kfac * (a2 + b2))
+        lab_tensor(R[i], Kinv, Kinv_lab)
+        V[0], V[1], V[2] = model[i, 0], model[i, 1], 0.0
+        out[i] = collide(V, W, r_all[low], Kinv_lab, wall, dV, dW)
+
+
+def _best(fn, repeats) -> float:
+    """The best of ``repeats`` runs of fn, in seconds of this thread's CPU time: the run-time loops run on one
+    thread, and CPU time leaves out the time other jobs on a shared machine take (on an idle one it equals
+    the wall-clock time)."""
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.thread_time()
+        fn()
+        best = min(best, time.thread_time() - t0)
+    return best
+
+
+def piece_costs(params, shape_code, u_all, model, W_after, repeats) -> dict:
+    """µs per call of the pieces of a rebound (module doc), on the rows' bodies: a flight's setup with the
+    spin after the rebound, a search step 0.5 a/|V⁻| into that flight, a first collision."""
+    m = len(u_all)
+    semi, R = np.empty((m, 3)), np.empty((m, 3, 3))
+    verts, nv = np.zeros((m, MAX_VERTICES, 3)), np.empty(m, dtype=np.int64)
+    _bodies(params, shape_code, u_all, semi, R, verts, nv)
+    W = np.where(np.isfinite(W_after), W_after, 0.0)
+    rot = np.empty((m, ROT_PARAMS_SIZE))
+    t = 0.5 / np.hypot(model[:, 0], model[:, 1])
+    outcome = np.empty(m, dtype=np.int64)
+    return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(params, shape_code, semi, R, verts, nv, W, rot),
+                                             repeats) / m,
+            "us_search_step": 1e6 * _best(lambda: _search_steps(shape_code, semi, verts, nv, rot, t), repeats) / m,
+            "us_collision": 1e6 * _best(lambda: _collisions(params, shape_code, semi, R, verts, nv, model, outcome),
+                                        repeats) / m}
+
+
+# ----------------------------------------------------------------------------- incident states
+
+def random_states(m: int, spin: bool, seed: int) -> dict:
+    """m incident states (module doc): V (m, 3) m/s, n (m, 3) unit normals, a (m,) = 1 m, Ω (m, 3) rad/s."""
     rng = np.random.default_rng(seed)
     alpha1 = np.radians(rng.uniform(5.0, 90.0, m))
     speed = rng.uniform(50.0, 300.0, m)
@@ -195,64 +337,157 @@ def random_states(m: int, spin: bool, seed: int):
     local_V = np.c_[np.cos(alpha1), -np.sin(alpha1), np.zeros(m)] * speed[:, None]
     local_W = rng.normal(size=(m, 3))
     local_W *= (rng.uniform(0.0, 1.2, m) * speed / np.linalg.norm(local_W, axis=1))[:, None] * spin
-    return (np.einsum("mij,mj->mi", frames, local_V), np.ascontiguousarray(frames[:, :, 1]),
-            np.einsum("mij,mj->mi", frames, local_W))
+    return {"V": np.einsum("mij,mj->mi", frames, local_V), "n": np.ascontiguousarray(frames[:, :, 1]),
+            "a": np.ones(m), "omega": np.einsum("mij,mj->mi", frames, local_W)}
 
 
-def bench_runtime(shape_code, spin, m, repeats) -> dict:
-    """µs per rebound of the run-time kernel at m random states of one shape (module doc)."""
-    params = model_parameters(AspectRatioLaw(), 0.3, DEFAULT_N_MAX, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL,
-                              DEFAULT_SET_TOL, DEFAULT_MAX_STEPS, second_moment_factors(0.3))
-    V, n, W = random_states(m, spin, SEED + shape_code)
-    status = np.empty(m, dtype=np.int8)
-    best = math.inf
-    for _ in range(repeats):
-        state = seed_state(SEED)
-        t0 = time.perf_counter()
-        _kernel_loop(params, V, n, 1.0, W, shape_code, state, status)
-        best = min(best, time.perf_counter() - t0)
-    u_all, model, counts = np.empty((m, U_PER_REBOUND)), np.empty((m, 5)), np.empty((m, 3), dtype=np.int64)
-    _model_frame_inputs(V, n, 1.0, W, seed_state(SEED), u_all, model)
-    best_model = math.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        _model_frame_loop(params, model, shape_code, u_all, counts)
-        best_model = min(best_model, time.perf_counter() - t0)
-    ok = counts[:, 0] == STATUS_REBOUNDED
+def state_sets(m: int, hits_path: Path) -> dict:
+    """The three sets of incident states of the run-time rows (module doc)."""
+    hits = hopper_hits.read_sample(hits_path)
+    return {"random, 0": random_states(m, False, SEED), "random, spin": random_states(m, True, SEED + 1),
+            "hopper": {k: hits[k] for k in ("V", "n", "a", "omega")}}
+
+
+# ----------------------------------------------------------------------------- the C side
+
+def build_native(folder: Path) -> Path:
+    """Configure and build native/ (Release) with its bench programs into ``folder``."""
+    for command in (["cmake", "-S", str(NATIVE), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release",
+                     "-DRBS_BUILD_BENCH=ON", "-DRBS_BUILD_SHARED=OFF"],
+                    ["cmake", "--build", str(folder), "-j", "2", "--target", "rbs_bench_direct"]):
+        done = subprocess.run(command, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise SystemExit(f"{' '.join(command)} failed (native/install-deps.sh installs the tools):\n"
+                             f"{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
+    return folder
+
+
+def c_runtime(program: Path, table: Path, states: dict, shape_code: int, repeats: int, folder: Path) -> dict:
+    """µs per rebound of rbs_rebound_direct in a C loop (native/bench/rbs_bench_direct.c) on the states, and
+    its outputs for the first timed pass (the uniforms of seed SEED, as the numba loop draws them)."""
+    count = len(states["a"])
+    path, out = folder / "direct_states.bin", folder / "direct_out.bin"
+    with open(path, "wb") as f:
+        f.write(np.int64(count).tobytes())
+        for key in ("V", "omega", "n", "a"):
+            f.write(np.ascontiguousarray(states[key], dtype=np.float64).tobytes())
+    done = subprocess.run([str(program), str(table), str(path), str(shape_code), str(repeats), str(SEED), str(out)],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"rbs_bench_direct failed:\n{done.stderr}")
+    figures = json.loads(done.stdout)
+    raw = out.read_bytes()
+    figures["V_out"] = np.frombuffer(raw, np.float64, 3 * count).reshape(count, 3)
+    figures["W_out"] = np.frombuffer(raw, np.float64, 3 * count, 24 * count).reshape(count, 3)
+    figures["status"] = np.frombuffer(raw, np.int8, count, 48 * count)
+    return figures
+
+
+# ----------------------------------------------------------------------------- one row
+
+def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats: int, native=None) -> dict:
+    """µs per rebound of the run-time kernel on one set of states with one shape, the C kernel's if
+    ``native`` = (program, table, folder), counts per rebound and the time split (module doc)."""
+    V, n, a, W = states["V"], states["n"], states["a"], states["omega"]
+    m = len(a)
+    status, V_out, W_out = np.empty(m, dtype=np.int8), np.empty((m, 3)), np.empty((m, 3))
+    best = _best(lambda: _kernel_loop(params, V, n, a, W, shape_code, seed_state(SEED), status, V_out, W_out),
+                 repeats)
+    u_all, model = np.empty((m, U_PER_REBOUND)), np.empty((m, 5))
+    counts, W_after = np.empty((m, 3), dtype=np.int64), np.empty((m, 3))
+    _model_frame_inputs(V, n, a, W, seed_state(SEED), u_all, model)
+    best_model = _best(lambda: _model_frame_loop(params, model, shape_code, u_all, counts, W_after), repeats)
     rest = counts[:, 0] != STATUS_TRAPPED            # a trapped particle costs n_max collisions
-    sub_model, sub_u, sub_counts = model[rest], u_all[rest], counts[rest]
-    best_rest = math.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        _model_frame_loop(params, sub_model, shape_code, sub_u, sub_counts)
-        best_rest = min(best_rest, time.perf_counter() - t0)
-    return {"shape": SHAPES[shape_code], "spin": "yes" if spin else "0", "n": m,
-            "us_per_rebound": 1e6 * best / m, "us_model_frame": 1e6 * best_model / m,
-            "us_model_frame_untrapped": 1e6 * best_rest / max(1, int(rest.sum())),
-            "collisions_per_rebound": float(counts[ok, 1].mean()),
-            "search_steps_per_rebound": float(counts[ok, 2].mean()),
-            "trapped": int(np.sum(status == STATUS_TRAPPED)), "failed": int(np.sum(status == STATUS_FAILED))}
+    sub_model, sub_u, sub_counts, sub_W = model[rest], u_all[rest], counts[rest], W_after[rest]
+    best_rest = _best(lambda: _model_frame_loop(params, sub_model, shape_code, sub_u, sub_counts, sub_W), repeats)
+    ok = counts[:, 0] == STATUS_REBOUNDED
+    row = {"shape": SHAPES[shape_code], "states": set_name, "n": m,
+           "us_per_rebound": 1e6 * best / m, "us_model_frame": 1e6 * best_model / m,
+           "us_model_frame_untrapped": 1e6 * best_rest / max(1, int(rest.sum())),
+           "flights_per_rebound": float(np.mean(counts[:, 1] + 1)),
+           "collisions_per_rebound": float(np.mean(counts[:, 1])),
+           "search_steps_per_rebound": float(np.mean(counts[:, 2])),
+           "collisions_per_rebounded": float(counts[ok, 1].mean()),
+           "search_steps_per_rebounded": float(counts[ok, 2].mean()),
+           "trapped": int(np.sum(status == STATUS_TRAPPED)), "failed": int(np.sum(status == STATUS_FAILED)),
+           "us_c": math.nan, "c_over_numba": math.nan, "c_same_bits": None}
+    # the split: counts per rebound × µs per piece; the rest is the body's setup, the search's own logic
+    # (the contact choice, Newton and safe steps) and the frame
+    row.update(piece_costs(params, shape_code, u_all, model, W_after, repeats))
+    total = row["us_model_frame"]
+    row["pct_flight_setup"] = 100 * row["flights_per_rebound"] * row["us_flight_setup"] / total
+    row["pct_search"] = 100 * row["search_steps_per_rebound"] * row["us_search_step"] / total
+    row["pct_collisions"] = 100 * row["collisions_per_rebound"] * row["us_collision"] / total
+    row["pct_rest"] = 100 - row["pct_flight_setup"] - row["pct_search"] - row["pct_collisions"]
+    row["pct_trapped"] = 100 * (1 - best_rest / best_model) if best_model > 0 else math.nan
+    if native is not None:
+        c = c_runtime(*native[:2], states, shape_code, repeats, native[2])
+        row["us_c"], row["us_c_cpu"] = c["us_per_rebound"], c["us_per_rebound_cpu"]
+        row["c_over_numba"] = row["us_c"] / row["us_per_rebound"]
+        row["c_same_bits"] = bool(np.array_equal(c["status"], status)
+                                  and np.array_equal(c["V_out"].view(np.int64), V_out.view(np.int64))
+                                  and np.array_equal(c["W_out"].view(np.int64), W_out.view(np.int64)))
+    return row
 
 
-def main_runtime(states: int, repeats: int) -> list:
-    """Print and return the run-time kernel's figures (module doc)."""
-    for code in range(len(SHAPES)):                  # warm-up: compile the loops
-        bench_runtime(code, True, 16, 1)
-    print(f"\nRun-time kernel (surrogate.kernels.rebound_direct_tuple), one thread, {states} random states per "
-          f"row, best of {repeats}")
-    header = " ".join(f"{h:{'<' if i == 0 else '>'}{w}}" for i, (h, w, _, _) in enumerate(RUNTIME_COLUMNS))
+def _print_rows(rows, columns) -> None:
+    header = " ".join(f"{h:{'<' if i < 2 else '>'}{w}}" for i, (h, w, _, _) in enumerate(columns))
     print(header)
     print("-" * len(header))
-    rows = []
-    for code in range(len(SHAPES)):
-        for spin in (False, True):
-            rows.append(bench_runtime(code, spin, states, repeats))
-            print(" ".join(f"{rows[-1][k]:{'<' if i == 0 else '>'}{w}{spec}}"
-                           for i, (_, w, spec, k) in enumerate(RUNTIME_COLUMNS)), flush=True)
-    print("spin: Ω⁻ = 0, or |Ω⁻|a/|V⁻| uniform in [0, 1.2] (flight in simulated). model frame us: the rebound\n"
-          "alone (rebound_model_frame, the same uniforms); the rest of us/rebound is the frame, the checks and\n"
-          "the uniforms. untrapped us: the same over the particles not trapped (a trapped one runs n_max\n"
-          "collisions). Collisions and steps: means over rebounded particles.")
+    for row in rows:
+        print(" ".join(f"{row[k]:{'<' if i < 2 else '>'}{w}{spec}}" for i, (_, w, spec, k) in enumerate(columns)))
+
+
+def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | None, build_dir: Path | None,
+                 native: bool) -> list:
+    """Print and return the run-time kernels' figures (module doc)."""
+    sets = state_sets(states, hits_path)
+    with tempfile.TemporaryDirectory(prefix="bench_direct_") as tmp:
+        tmp = Path(tmp)
+        if table_path is None and native:
+            table_path = tmp / "direct.h5"
+            build_table(parse_config(BENCH_TABLE_CONFIG), table_path)
+        params = (surrogate.direct_model_parameters(surrogate.load(table_path)) if table_path is not None
+                  else model_parameters(AspectRatioLaw(), 0.3, DEFAULT_N_MAX, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL,
+                                        DEFAULT_SET_TOL, DEFAULT_MAX_STEPS, second_moment_factors(0.3)))
+        c_side = None
+        if native:
+            folder = build_dir if build_dir is not None else build_native(tmp / "build")
+            program = folder / "rbs_bench_direct"
+            if not program.is_file():
+                raise SystemExit(f"{program} not found: build native/ with -DRBS_BUILD_BENCH=ON")
+            c_side = (program, table_path, tmp)
+        warm = {k: v[:16] for k, v in random_states(16, True, SEED).items()}
+        for code in range(len(SHAPES)):                  # warm-up: compile the loops
+            bench_runtime(params, warm, "warm-up", code, 1)
+        print(f"\nRun-time kernels, one thread, best of {repeats}: numba (surrogate.kernels.rebound_direct_tuple)"
+              + (" and C (rbs_rebound_direct)" if native else "") + f"; states: {states} random per row with Ω⁻ = 0 "
+              f"('random, 0') or spinning ('random, spin'), and {len(sets['hopper']['a'])} hopperRebound hits "
+              f"({hits_path.name}, {np.mean(np.any(sets['hopper']['omega'] != 0, axis=1)):.0%} spinning) run with "
+              "each shape ('hopper')")
+        rows = [bench_runtime(params, sets[name], name, code, repeats, c_side)
+                for code in range(len(SHAPES)) for name in STATE_SETS]
+    _print_rows(rows, RUNTIME_COLUMNS)
+    print("numba us, C us: µs per rebound of the whole call (uniforms, frame, checks, rebound), the mean over all\n"
+          "the states, trapped ones included. frame us: numba's rebound alone (rebound_model_frame, the same\n"
+          "uniforms); untrapped: the same over the particles not trapped (a trapped one runs n_max collisions).\n"
+          "flights, coll, steps: means per particle (trapped included) of flights, collisions, contact-search steps.")
+    if native:
+        same = all(r["c_same_bits"] for r in rows)
+        print(f"C outputs equal numba's bits on every row: {'yes' if same else 'NO'}")
+    hopper = [r for r in rows if r["states"] == "hopper"]
+    print("\nTarget <= 5 us per rebound on one core, averaged over hopperRebound's hits, per shape: "
+          + "; ".join(f"{r['shape']} numba {r['us_per_rebound']:.1f}"
+                      + (f", C {r['us_c']:.1f}" if native else "")
+                      + f" ({'met' if min(r['us_per_rebound'], r['us_c'] if native else math.inf) <= 5.0 else 'NOT met'})"
+                      for r in hopper))
+    print("\nWhere numba's time goes (rebound alone): µs per call of each piece on the rows' bodies, times the\n"
+          "counts per rebound above, as a share of 'frame us'. setup: a flight's start (K in the lab frame, ℓ,\n"
+          "rotation_init, curvature_bound), once per flight; step: one contact-search step (rotation_at:\n"
+          "the free flight's orientation, then lowest_points); coll: one collision (K⁻¹ in the lab frame,\n"
+          "collide). rest: the body's setup and the search's own logic. trapped %: the share of the trapped\n"
+          "particles (1 − untrapped time / all).")
+    _print_rows(rows, SPLIT_COLUMNS)
     return rows
 
 
@@ -273,6 +508,12 @@ def main(argv=None) -> int:
     parser.add_argument("--runtime", action="store_true", help="the run-time kernel alone, not the batch")
     parser.add_argument("--states", type=int, default=None,
                         help="random incident states per run-time row (default 20000; --quick 500)")
+    parser.add_argument("--hits", type=Path, default=hopper_hits.DEFAULT_OUT,
+                        help="the hopperRebound hits sample (default benchmarks/data/hopper_hits.csv)")
+    parser.add_argument("--table", type=Path, help="take the model parameters from this table (default: the "
+                        "defaults; with the C side, a small table built with them)")
+    parser.add_argument("--build-dir", type=Path, help="a build of native/ holding rbs_bench_direct (else built here)")
+    parser.add_argument("--no-native", action="store_true", help="the numba kernel only, not the C one")
     args = parser.parse_args(argv)
     repeats = args.repeats or (1 if args.quick else 3)
     min_time = args.min_time or (0.1 if args.quick else 1.0)
@@ -283,7 +524,7 @@ def main(argv=None) -> int:
     print("Direct rebound model throughput (direct_model.simulate, surrogate.kernels.rebound_direct_tuple)")
     for key, value in info.items():
         print(f"  {key:22s} {value}")
-    runtime_rows = main_runtime(states, repeats)
+    runtime_rows = main_runtime(states, repeats, args.hits, args.table, args.build_dir, not args.no_native)
     if args.runtime:
         _write_json(args.json, info, {"states": states, "repeats": repeats, "seed": SEED}, [], runtime_rows)
         return 0

@@ -36,9 +36,12 @@ bench_direct = pytest.importorskip("bench_direct")
 
 def test_bench_direct_reports_the_runtime_kernel(tmp_path, capsys):
     out = tmp_path / "direct.json"
-    assert bench_direct.main(["--runtime", "--quick", "--states", "40", "--json", str(out)]) == 0
+    assert bench_direct.main(["--runtime", "--quick", "--states", "40", "--no-native", "--json", str(out)]) == 0
     rows = json.loads(out.read_text())["runtime"]
-    assert [(r["shape"], r["spin"]) for r in rows] == [(s, spin) for s in bench_direct.SHAPES for spin in ("0", "yes")]
+    assert [(r["shape"], r["states"]) for r in rows] == [(s, name) for s in bench_direct.SHAPES
+                                                         for name in bench_direct.STATE_SETS]
     for row in rows:
         assert row["us_per_rebound"] > 0 and row["us_model_frame"] > 0 and row["collisions_per_rebound"] >= 1
-    assert "us/rebound" in capsys.readouterr().out
+        assert row["us_flight_setup"] > 0 and row["us_search_step"] > 0 and row["us_collision"] > 0
+    printed = capsys.readouterr().out
+    assert "numba us" in printed and "Target <= 5 us" in printed and "search %" in printed
