@@ -419,10 +419,10 @@ def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats:
     row["pct_search"] = 100 * row["search_steps_per_rebound"] * row["us_search_step"] / total
     row["pct_collisions"] = 100 * row["collisions_per_rebound"] * row["us_collision"] / total
     row["pct_rest"] = 100 - row["pct_flight_setup"] - row["pct_search"] - row["pct_collisions"]
-    row["pct_trapped"] = 100 * (1 - best_rest / best_model) if best_model > 0 else math.nan
+    row["pct_trapped"] = 100 * (1 - best_rest / best_model) if not rest.all() else 0.0
     if native is not None:
         c = c_runtime(*native[:2], states, shape_code, repeats, native[2])
-        row["us_c"], row["us_c_cpu"] = c["us_per_rebound"], c["us_per_rebound_cpu"]
+        row["us_c"], row["us_c_wall"] = c["us_per_rebound"], c["us_per_rebound_wall"]
         row["c_over_numba"] = row["us_c"] / row["us_per_rebound"]
         row["c_same_bits"] = bool(np.array_equal(c["status"], status)
                                   and np.array_equal(c["V_out"].view(np.int64), V_out.view(np.int64))
