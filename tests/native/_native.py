@@ -179,6 +179,14 @@ class NativeTable:
                                         _ptr(status))
         return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
 
+    def rebound_direct(self, shape: int, V, Omega, n, a: float, u):
+        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_rebound_direct for one particle (shape code, 7 uniforms)."""
+        V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
+        V_out, W_out = np.empty(3), np.empty(3)
+        status = self.lib.c.rbs_rebound_direct(self.handle, shape, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a),
+                                               _ptr(u), _ptr(V_out), _ptr(W_out))
+        return status, V_out, W_out
+
     def draw_local(self, mix, alpha1, speed, u, interpolation=SCALED):
         u = np.ascontiguousarray(u, dtype=np.float64)
         out = np.empty(6)
@@ -226,6 +234,8 @@ class Native:
         c.rbs_rebound_many.restype = None
         c.rbs_rebound_many_rng.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, ctypes.POINTER(Rng), i, vp, vp, vp]
         c.rbs_rebound_many_rng.restype = None
+        c.rbs_rebound_direct.argtypes = [vp, i, vp, vp, vp, d, vp, vp, vp]
+        c.rbs_rebound_direct.restype = i
         c.rbs_draw_local.argtypes = [vp, ctypes.POINTER(Mix), d, d, vp, i, vp]
         c.rbs_draw_local.restype = i
         c.rbs_rng_seed.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64]
