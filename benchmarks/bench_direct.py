@@ -43,9 +43,10 @@ per shape (a figure only: the exit code does not depend on it). Where the time g
 (``direct_model.runtime.rebound_model_frame``, the same uniforms; the rest of the call is the frame, the
 checks and the uniforms), the same without the trapped particles (each runs n_max collisions), the mean
 flights, collisions and contact-search steps per particle, and a split of the rebound's time: each piece
-timed alone on the rows' bodies (a flight's setup: K in the lab frame, rotation_init, curvature_bound; a
-search step: rotation_at, the free flight's orientation, and lowest_points; a collision: K⁻¹ in the lab
-frame and collide) times its count per rebound; the rest is the body's setup and the search's own logic.
+timed alone on the rows' bodies, times its count per rebound: a flight's setup (K in the lab frame,
+rotation_init, curvature_bound; once per flight), the free flight's orientation at one instant
+(rotation_at) and the body's lowest points there (lowest_points; both once per search step), a collision
+(K⁻¹ in the lab frame and collide); the rest is the body's setup, the search's own logic and the frame.
 Times are the best of ``--repeats`` runs in this thread's CPU time (C: CLOCK_THREAD_CPUTIME_ID), which
 leaves out the time other jobs take on a shared machine. The C side builds native/ (or takes
 ``--build-dir``) and reads its parameters from a table (``--table``, else a small one built with the
@@ -179,18 +180,18 @@ def target_verdict(alpha1, rate_per_core) -> str:
 
 
 RUNTIME_COLUMNS = (  # (header, width, format spec, key of the result row)
-    ("shape", 12, "s", "shape"), ("states", 10, "s", "states"), ("n", 6, "d", "n"),
+    ("shape", 12, "s", "shape"), ("states", 12, "s", "states"), ("n", 6, "d", "n"),
     ("numba us", 8, ".2f", "us_per_rebound"), ("C us", 7, ".2f", "us_c"), ("C/numba", 7, ".2f", "c_over_numba"),
     ("frame us", 8, ".2f", "us_model_frame"), ("untrapped", 9, ".2f", "us_model_frame_untrapped"),
     ("flights", 7, ".2f", "flights_per_rebound"), ("coll", 6, ".2f", "collisions_per_rebound"),
     ("steps", 6, ".1f", "search_steps_per_rebound"), ("trapped", 7, "d", "trapped"), ("failed", 6, "d", "failed"),
 )
 SPLIT_COLUMNS = (
-    ("shape", 12, "s", "shape"), ("states", 10, "s", "states"), ("setup us", 8, ".3f", "us_flight_setup"),
-    ("step us", 7, ".3f", "us_search_step"), ("coll us", 7, ".3f", "us_collision"),
-    ("flights %", 9, ".0f", "pct_flight_setup"), ("search %", 8, ".0f", "pct_search"),
-    ("coll %", 6, ".0f", "pct_collisions"), ("rest %", 6, ".0f", "pct_rest"),
-    ("trapped %", 9, ".0f", "pct_trapped"),
+    ("shape", 12, "s", "shape"), ("states", 12, "s", "states"), ("setup us", 8, ".3f", "us_flight_setup"),
+    ("orient us", 9, ".3f", "us_orientation"), ("lowest us", 9, ".3f", "us_lowest_points"),
+    ("coll us", 7, ".3f", "us_collision"), ("setup %", 7, ".0f", "pct_flight_setup"),
+    ("orient %", 8, ".0f", "pct_orientation"), ("lowest %", 8, ".0f", "pct_lowest_points"),
+    ("coll %", 6, ".0f", "pct_collisions"), ("rest %", 6, ".0f", "pct_rest"), ("trapped %", 9, ".0f", "pct_trapped"),
 )
 STATE_SETS = ("random, 0", "random, spin", "hopper")
 
@@ -265,14 +266,20 @@ def _flight_setups(params, shape, semi, R, verts, nv, W, rot):
 
 
 @numba.njit
-def _search_steps(shape, semi, verts, nv, rot, t):
-    """What one contact-search step costs at least: the orientation at time t[i] (rotation_at) and the
-    candidate lowest points there (lowest_points)."""
+def _orientations(rot, t):
+    """The free flight's orientation and spin at time t[i] (rotation_at): every search step but a flight's
+    first computes it."""
     R, W = np.empty((3, 3)), np.empty(3)
+    for i in range(rot.shape[0]):
+        rotation_at(rot[i], t[i], R, W)
+
+
+@numba.njit
+def _lowest_points(shape, semi, R, verts, nv):
+    """The candidate lowest points of the body (lowest_points): what every search step computes."""
     h, r_all = np.empty(MAX_VERTICES), np.empty((MAX_VERTICES, 3))
     for i in range(semi.shape[0]):
-        rotation_at(rot[i], t[i], R, W)
-        lowest_points(shape, verts[i], nv[i], semi[i], R, 1.0, h, r_all)
+        lowest_points(shape, verts[i], nv[i], semi[i], R[i], 1.0, h, r_all)
 
 
 @numba.njit
@@ -310,7 +317,8 @@ def _best(fn, repeats) -> float:
 
 def piece_costs(params, shape_code, u_all, model, W_after, repeats) -> dict:
     """µs per call of the pieces of a rebound (module doc), on the rows' bodies: a flight's setup with the
-    spin after the rebound, a search step 0.5 a/|V⁻| into that flight, a first collision."""
+    spin after the rebound, the orientation 0.5 a/|V⁻| into that flight, the lowest points, a first
+    collision. Each piece is cheap: the best of 5 × ``repeats`` runs."""
     m = len(u_all)
     semi, R = np.empty((m, 3)), np.empty((m, 3, 3))
     verts, nv = np.zeros((m, MAX_VERTICES, 3)), np.empty(m, dtype=np.int64)
@@ -319,11 +327,13 @@ def piece_costs(params, shape_code, u_all, model, W_after, repeats) -> dict:
     rot = np.empty((m, ROT_PARAMS_SIZE))
     t = 0.5 / np.hypot(model[:, 0], model[:, 1])
     outcome = np.empty(m, dtype=np.int64)
+    runs = 5 * repeats
     return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(params, shape_code, semi, R, verts, nv, W, rot),
-                                             repeats) / m,
-            "us_search_step": 1e6 * _best(lambda: _search_steps(shape_code, semi, verts, nv, rot, t), repeats) / m,
+                                             runs) / m,
+            "us_orientation": 1e6 * _best(lambda: _orientations(rot, t), runs) / m,
+            "us_lowest_points": 1e6 * _best(lambda: _lowest_points(shape_code, semi, R, verts, nv), runs) / m,
             "us_collision": 1e6 * _best(lambda: _collisions(params, shape_code, semi, R, verts, nv, model, outcome),
-                                        repeats) / m}
+                                        runs) / m}
 
 
 # ----------------------------------------------------------------------------- incident states
@@ -416,9 +426,11 @@ def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats:
     row.update(piece_costs(params, shape_code, u_all, model, W_after, repeats))
     total = row["us_model_frame"]
     row["pct_flight_setup"] = 100 * row["flights_per_rebound"] * row["us_flight_setup"] / total
-    row["pct_search"] = 100 * row["search_steps_per_rebound"] * row["us_search_step"] / total
+    row["pct_orientation"] = 100 * row["search_steps_per_rebound"] * row["us_orientation"] / total
+    row["pct_lowest_points"] = 100 * row["search_steps_per_rebound"] * row["us_lowest_points"] / total
     row["pct_collisions"] = 100 * row["collisions_per_rebound"] * row["us_collision"] / total
-    row["pct_rest"] = 100 - row["pct_flight_setup"] - row["pct_search"] - row["pct_collisions"]
+    row["pct_rest"] = 100 - (row["pct_flight_setup"] + row["pct_orientation"] + row["pct_lowest_points"]
+                             + row["pct_collisions"])
     row["pct_trapped"] = 100 * (1 - best_rest / best_model) if not rest.all() else 0.0
     if native is not None:
         c = c_runtime(*native[:2], states, shape_code, repeats, native[2])
@@ -481,12 +493,14 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
                       + (f", C {r['us_c']:.1f}" if native else "")
                       + f" ({'met' if min(r['us_per_rebound'], r['us_c'] if native else math.inf) <= 5.0 else 'NOT met'})"
                       for r in hopper))
-    print("\nWhere numba's time goes (rebound alone): µs per call of each piece on the rows' bodies, times the\n"
-          "counts per rebound above, as a share of 'frame us'. setup: a flight's start (K in the lab frame, ℓ,\n"
-          "rotation_init, curvature_bound), once per flight; step: one contact-search step (rotation_at:\n"
-          "the free flight's orientation, then lowest_points); coll: one collision (K⁻¹ in the lab frame,\n"
-          "collide). rest: the body's setup and the search's own logic. trapped %: the share of the trapped\n"
-          "particles (1 − untrapped time / all).")
+    print("\nWhere numba's time goes (rebound alone): µs per call of each piece on the rows' bodies, times its\n"
+          "count per rebound above, as a share of 'frame us'. setup: a flight's start (K in the lab frame, ℓ,\n"
+          "rotation_init, curvature_bound), once per flight; orient: the free flight's orientation at one\n"
+          "instant (rotation_at) and lowest: the body's lowest points there (lowest_points), once per search\n"
+          "step; coll: one collision (K⁻¹ in the lab frame, collide), once per collision. rest: the body's setup,\n"
+          "the search's own logic (safe and Newton steps, the contact choice), the frame's rotations; the pieces\n"
+          "timed alone run hotter in cache than inside a rebound, so rest is uncertain by about ±10 points.\n"
+          "trapped %: the share of the time spent on trapped particles (1 − untrapped time / all).")
     _print_rows(rows, SPLIT_COLUMNS)
     return rows
 
@@ -521,7 +535,7 @@ def main(argv=None) -> int:
 
     info = machine_info()
     threads = info["numba_default_threads"]
-    print("Direct rebound model throughput (direct_model.simulate, surrogate.kernels.rebound_direct_tuple)")
+    print("Direct rebound model throughput (direct_model.simulate; the run-time kernels rebound_direct_tuple, rbs_rebound_direct)")
     for key, value in info.items():
         print(f"  {key:22s} {value}")
     runtime_rows = main_runtime(states, repeats, args.hits, args.table, args.build_dir, not args.no_native)

@@ -1,7 +1,8 @@
-"""benchmarks/bench_native.py runs end to end (--quick) on the session's table and reports every figure.
+"""benchmarks/bench_native.py and bench_direct.py --runtime run end to end (--quick) on the session's table
+and report every figure.
 
-A smoke test: the figures are machine-dependent and are not asserted; the bits of the C many-particle
-call against numba's on the bench states are.
+Smoke tests: the figures are machine-dependent and are not asserted; the bits of the C calls against
+numba's on the bench states are.
 """
 
 import json
@@ -24,3 +25,16 @@ def test_bench_native_quick(native_build, small_table_path, tmp_path, capsys):
     assert figures["same_bits"] is True
     printed = capsys.readouterr().out
     assert "(C-many)/(C-GT)" in printed and "target" in printed
+
+
+def test_bench_direct_runtime_quick(native_build, small_table_path, tmp_path, capsys):
+    """bench_direct.py --runtime times the C direct model next to numba's, and its outputs are numba's bits."""
+    import bench_direct
+    out = tmp_path / "direct.json"
+    assert bench_direct.main(["--runtime", "--quick", "--states", "40", "--table", str(small_table_path),
+                              "--build-dir", str(native_build), "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["runtime"]
+    assert len(rows) == 4 * len(bench_direct.STATE_SETS)
+    for row in rows:
+        assert row["us_c"] > 0 and row["c_same_bits"] is True, row
+    assert "C outputs equal numba's bits on every row: yes" in capsys.readouterr().out
