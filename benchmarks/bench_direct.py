@@ -47,6 +47,9 @@ timed alone on the rows' bodies, times its count per rebound: a flight's setup (
 rotation_init, curvature_bound; once per flight), the free flight's orientation at one instant
 (rotation_at) and the body's lowest points there (lowest_points; both once per search step), a collision
 (K⁻¹ in the lab frame and collide); the rest is the body's setup, the search's own logic and the frame.
+The C program times the same pieces in C (rbs_rotation_init, rbs_rotation_at, rbs_lowest_points,
+rbs_collide: the model's internal kernels) on the same inputs, and C's rebound alone
+(rbs_rebound_model_frame), for C's split at the same counts.
 Times are the best of ``--repeats`` runs in this thread's CPU time (C: CLOCK_THREAD_CPUTIME_ID), which
 leaves out the time other jobs take on a shared machine. The C side builds native/ (or takes
 ``--build-dir``) and reads its parameters from a table (``--table``, else a small one built with the
@@ -191,8 +194,11 @@ SPLIT_COLUMNS = (
     ("orient us", 9, ".3f", "us_orientation"), ("lowest us", 9, ".3f", "us_lowest_points"),
     ("coll us", 7, ".3f", "us_collision"), ("setup %", 7, ".0f", "pct_flight_setup"),
     ("orient %", 8, ".0f", "pct_orientation"), ("lowest %", 8, ".0f", "pct_lowest_points"),
-    ("coll %", 6, ".0f", "pct_collisions"), ("rest %", 6, ".0f", "pct_rest"), ("trapped %", 9, ".0f", "pct_trapped"),
+    ("coll %", 6, ".0f", "pct_collision"), ("rest %", 6, ".0f", "pct_rest"), ("trapped %", 9, ".0f", "pct_trapped"),
 )
+C_SPLIT_COLUMNS = tuple((h, w, spec, "c_" + k if k not in ("shape", "states") else k)
+                        for h, w, spec, k in SPLIT_COLUMNS if k != "pct_trapped") + (
+    ("frame us", 8, ".2f", "c_us_model_frame"),)
 STATE_SETS = ("random, 0", "random, spin", "hopper")
 
 
@@ -315,17 +321,35 @@ def _best(fn, repeats) -> float:
     return best
 
 
-def piece_costs(params, shape_code, u_all, model, W_after, repeats) -> dict:
-    """µs per call of the pieces of a rebound (module doc), on the rows' bodies: a flight's setup with the
-    spin after the rebound, the orientation 0.5 a/|V⁻| into that flight, the lowest points, a first
-    collision. Each piece is cheap: the best of 5 × ``repeats`` runs."""
+PIECES = ("flight_setup", "orientation", "lowest_points", "collision")
+
+
+def piece_inputs(params, shape_code, u_all, model, W_after) -> dict:
+    """The inputs of the pieces (module doc), from the rows' bodies: a flight's setup with the spin after the
+    rebound, the orientation 0.5 a/|V⁻| into that flight, the lowest points, a first collision."""
     m = len(u_all)
     semi, R = np.empty((m, 3)), np.empty((m, 3, 3))
     verts, nv = np.zeros((m, MAX_VERTICES, 3)), np.empty(m, dtype=np.int64)
     _bodies(params, shape_code, u_all, semi, R, verts, nv)
-    W = np.where(np.isfinite(W_after), W_after, 0.0)
+    return {"semi": semi, "R": R, "verts": verts, "nv": nv, "W": np.where(np.isfinite(W_after), W_after, 0.0),
+            "t": 0.5 / np.hypot(model[:, 0], model[:, 1]), "model": model, "u": u_all}
+
+
+def write_pieces(path: Path, pieces: dict) -> None:
+    """The pieces' inputs as rbs_bench_direct reads them (native/bench/rbs_bench_direct.c)."""
+    m = len(pieces["t"])
+    rows = np.column_stack([pieces["semi"], pieces["R"].reshape(m, 9), pieces["verts"].reshape(m, -1),
+                            pieces["nv"].astype(np.float64), pieces["W"], pieces["t"], pieces["model"], pieces["u"]])
+    with open(path, "wb") as f:
+        f.write(np.int64(m).tobytes())
+        f.write(np.ascontiguousarray(rows, dtype=np.float64).tobytes())
+
+
+def piece_costs(params, shape_code, pieces: dict, repeats) -> dict:
+    """µs per call of numba's pieces of a rebound; each is cheap: the best of 5 × ``repeats`` runs."""
+    semi, R, verts, nv, W, t, model = (pieces[k] for k in ("semi", "R", "verts", "nv", "W", "t", "model"))
+    m = len(t)
     rot = np.empty((m, ROT_PARAMS_SIZE))
-    t = 0.5 / np.hypot(model[:, 0], model[:, 1])
     outcome = np.empty(m, dtype=np.int64)
     runs = 5 * repeats
     return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(params, shape_code, semi, R, verts, nv, W, rot),
@@ -334,6 +358,15 @@ def piece_costs(params, shape_code, u_all, model, W_after, repeats) -> dict:
             "us_lowest_points": 1e6 * _best(lambda: _lowest_points(shape_code, semi, R, verts, nv), runs) / m,
             "us_collision": 1e6 * _best(lambda: _collisions(params, shape_code, semi, R, verts, nv, model, outcome),
                                         runs) / m}
+
+
+def split(row: dict, costs: dict, total_us: float) -> dict:
+    """Each piece's share (%) of total_us at the row's counts per rebound; the rest."""
+    counts = {"flight_setup": row["flights_per_rebound"], "orientation": row["search_steps_per_rebound"],
+              "lowest_points": row["search_steps_per_rebound"], "collision": row["collisions_per_rebound"]}
+    shares = {f"pct_{k}": 100 * counts[k] * costs[f"us_{k}"] / total_us for k in PIECES}
+    shares["pct_rest"] = 100 - sum(shares.values())
+    return shares
 
 
 # ----------------------------------------------------------------------------- incident states
@@ -372,17 +405,20 @@ def build_native(folder: Path) -> Path:
     return folder
 
 
-def c_runtime(program: Path, table: Path, states: dict, shape_code: int, repeats: int, folder: Path) -> dict:
-    """µs per rebound of rbs_rebound_direct in a C loop (native/bench/rbs_bench_direct.c) on the states, and
-    its outputs for the first timed pass (the uniforms of seed SEED, as the numba loop draws them)."""
+def c_runtime(program: Path, table: Path, states: dict, shape_code: int, repeats: int, folder: Path,
+              pieces: dict) -> dict:
+    """µs per rebound of rbs_rebound_direct in a C loop (native/bench/rbs_bench_direct.c) on the states, its
+    outputs for the first timed pass (the uniforms of seed SEED, as the numba loop draws them), and µs per
+    call of C's rebound alone and of its pieces on the same inputs as numba's."""
     count = len(states["a"])
-    path, out = folder / "direct_states.bin", folder / "direct_out.bin"
+    path, out, pieces_path = folder / "direct_states.bin", folder / "direct_out.bin", folder / "direct_pieces.bin"
     with open(path, "wb") as f:
         f.write(np.int64(count).tobytes())
         for key in ("V", "omega", "n", "a"):
             f.write(np.ascontiguousarray(states[key], dtype=np.float64).tobytes())
-    done = subprocess.run([str(program), str(table), str(path), str(shape_code), str(repeats), str(SEED), str(out)],
-                          capture_output=True, text=True)
+    write_pieces(pieces_path, pieces)
+    done = subprocess.run([str(program), str(table), str(path), str(shape_code), str(repeats), str(SEED), str(out),
+                           str(pieces_path)], capture_output=True, text=True)
     if done.returncode != 0:
         raise SystemExit(f"rbs_bench_direct failed:\n{done.stderr}")
     figures = json.loads(done.stdout)
@@ -423,18 +459,16 @@ def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats:
            "us_c": math.nan, "c_over_numba": math.nan, "c_same_bits": None}
     # the split: counts per rebound × µs per piece; the rest is the body's setup, the search's own logic
     # (the contact choice, Newton and safe steps) and the frame
-    row.update(piece_costs(params, shape_code, u_all, model, W_after, repeats))
-    total = row["us_model_frame"]
-    row["pct_flight_setup"] = 100 * row["flights_per_rebound"] * row["us_flight_setup"] / total
-    row["pct_orientation"] = 100 * row["search_steps_per_rebound"] * row["us_orientation"] / total
-    row["pct_lowest_points"] = 100 * row["search_steps_per_rebound"] * row["us_lowest_points"] / total
-    row["pct_collisions"] = 100 * row["collisions_per_rebound"] * row["us_collision"] / total
-    row["pct_rest"] = 100 - (row["pct_flight_setup"] + row["pct_orientation"] + row["pct_lowest_points"]
-                             + row["pct_collisions"])
+    pieces = piece_inputs(params, shape_code, u_all, model, W_after)
+    row.update(piece_costs(params, shape_code, pieces, repeats))
+    row.update(split(row, row, row["us_model_frame"]))
     row["pct_trapped"] = 100 * (1 - best_rest / best_model) if not rest.all() else 0.0
     if native is not None:
-        c = c_runtime(*native[:2], states, shape_code, repeats, native[2])
+        c = c_runtime(*native[:2], states, shape_code, repeats, native[2], pieces)
         row["us_c"], row["us_c_wall"] = c["us_per_rebound"], c["us_per_rebound_wall"]
+        c_costs = {f"us_{k}": c[f"us_{k}"] for k in PIECES}
+        row.update({f"c_{k}": v for k, v in c_costs.items()}, c_us_model_frame=c["us_model_frame"])
+        row.update({f"c_{k}": v for k, v in split(row, c_costs, c["us_model_frame"]).items()})
         row["c_over_numba"] = row["us_c"] / row["us_per_rebound"]
         row["c_same_bits"] = bool(np.array_equal(c["status"], status)
                                   and np.array_equal(c["V_out"].view(np.int64), V_out.view(np.int64))
@@ -502,6 +536,11 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
           "timed alone run hotter in cache than inside a rebound, so rest is uncertain by about ±10 points.\n"
           "trapped %: the share of the time spent on trapped particles (1 − untrapped time / all).")
     _print_rows(rows, SPLIT_COLUMNS)
+    if native:
+        print("\nWhere C's time goes: the same pieces in C (rbs_rotation_init, rbs_rotation_at, rbs_lowest_points,\n"
+              "rbs_collide, on the same inputs), times the same counts, as a share of C's rebound alone\n"
+              "(rbs_rebound_model_frame, the same uniforms: frame us).")
+        _print_rows(rows, C_SPLIT_COLUMNS)
     return rows
 
 

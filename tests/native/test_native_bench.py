@@ -37,4 +37,8 @@ def test_bench_direct_runtime_quick(native_build, small_table_path, tmp_path, ca
     assert len(rows) == 4 * len(bench_direct.STATE_SETS)
     for row in rows:
         assert row["us_c"] > 0 and row["c_same_bits"] is True, row
-    assert "C outputs equal numba's bits on every row: yes" in capsys.readouterr().out
+        for piece in ("c_us_model_frame", "c_us_flight_setup", "c_us_orientation", "c_us_lowest_points",
+                      "c_us_collision"):
+            assert row[piece] > 0, piece
+    printed = capsys.readouterr().out
+    assert "C outputs equal numba's bits on every row: yes" in printed and "Where C's time goes" in printed
