@@ -1,5 +1,5 @@
 """The C test programs under AddressSanitizer and UndefinedBehaviorSanitizer (good and bad tables, draws,
-threads), the C, C++ and Fortran examples, and the installed CMake package."""
+threads, the free flight's invariants), the C, C++ and Fortran examples, and the installed CMake package."""
 
 from __future__ import annotations
 
@@ -56,6 +56,14 @@ def test_threads_draw_as_one_thread(native_sanitized, small_table_path):
     """Four threads drawing from one table at once give the bits of one thread, stream by stream."""
     out = _sanitized_run([native_sanitized / "rbs_test_threads", small_table_path, 4, 4000])
     assert "0 stream(s) differ" in out
+
+
+def test_rotation_invariants_under_sanitizers(native_sanitized):
+    """rotation.c over 9 x 300 flights of every mode: lab angular momentum and kinetic energy kept to 1e-9,
+    R orthonormal to 1e-12, R(0) = R0; hostile arguments return; no sanitizer report."""
+    out = _sanitized_run([native_sanitized / "rbs_test_rotation", 300])
+    assert "0 failure(s)" in out and "near separatrix: 300 flights" in out
+    print("\n" + out)
 
 
 def test_c_example(native_build, small_table_path):
