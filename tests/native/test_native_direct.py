@@ -93,6 +93,29 @@ def test_the_parameter_array_is_surrogate_s(native, table_pair, small_table_path
     assert _same(expected, python.direct_parameters)
 
 
+@pytest.mark.parametrize("law", [
+    "aspect_ratio = {mean = 0.75, sd = 0.25, low = 0.4, high = 0.95}",
+    "[simulation.aspect_ratio]\nmean = 0.75\nsd = 0.25 # a comment\nlow = 0.4\nhigh = 0.95",
+])
+def test_an_old_table_takes_the_configuration_s_aspect_law(native, small_table_path, tmp_path, law):
+    """Without the aspect_ratio_* attributes the law comes from the build's configuration (TOML): the inline
+    table tablegen writes, or a [simulation.aspect_ratio] table; the same bits as surrogate."""
+    path = _old_table(small_table_path, tmp_path, "config.h5", **OLD)
+    with h5py.File(path, "r+") as f:
+        lines = str(f.attrs["config"]).split("\n")
+        inline = [k for k, line in enumerate(lines) if line.startswith("aspect_ratio")]
+        assert len(inline) == 1
+        if law.startswith("["):
+            del lines[inline[0]]
+            lines += ["", law]
+        else:
+            lines[inline[0]] = law
+        f.attrs["config"] = "\n".join(lines)
+    expected = py.load(path).direct_parameters
+    assert expected[:4].tolist() == [0.75, 0.25, 0.4, 0.95]
+    assert _same(native.table(path).kernel_array("direct_parameters"), expected)
+
+
 def test_a_table_without_the_factors_has_no_direct_model(native, small_table_path, tmp_path):
     """An old table built at κ ≠ 0.3 does not record its second-moment factors: it loads, has no
     "direct_parameters" (RBS_ERR_ARGUMENT), and rbs_rebound_direct gives RBS_INVALID with NaN."""
