@@ -39,8 +39,9 @@ def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tmp
 
 def test_direct_model_program_under_sanitizers(native_sanitized, small_table_path, tmp_path):
     """The direct model's invariants as C tests (a collision never adds energy and keeps the angular momentum
-    about the contact point, a free flight keeps energy and L to 1e-9, a rebound never adds energy) and its
-    hostile calls, on the small table and one without direct parameters: no failure, no sanitizer report."""
+    about the contact point, a free flight keeps energy and L to 1e-9, a rebound never adds energy), its
+    hostile calls on the small table and one without direct parameters, four threads on one table against one:
+    no failure, no sanitizer report."""
     import h5py
     without = tmp_path / "without_direct.h5"
     without.write_bytes(small_table_path.read_bytes())
