@@ -51,5 +51,5 @@ __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", 
            "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
            "draw_local", "fill_uniforms", "load", "mix_cdf", "rebound", "rebound_many", "rebound_many_rng",
            "rebound_tuple", "rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
-           "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius", "collide",
-           "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion"]
+           "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",
+           "collide", "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion"]

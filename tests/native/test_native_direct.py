@@ -57,7 +57,9 @@ def _direct_c(c, table, shape, V, omega, n, a, u):
 
 
 def _same(a, b):
-    return np.array_equal(np.asarray(a, dtype=np.float64).view(np.uint64), np.asarray(b, dtype=np.float64).view(np.uint64))
+    """The same float64 bits."""
+    bits = (np.asarray(x, dtype=np.float64).view(np.uint64) for x in (a, b))
+    return np.array_equal(*bits)
 
 
 def _old_table(small_table_path, tmp_path, name, **changes):
@@ -306,8 +308,9 @@ def test_null_table_and_outputs(native, table_pair):
     out = np.zeros(3)
     for outputs in ((None, out), (out, None)):
         out[:] = 0.0
-        assert c.rbs_rebound_direct(table_pair[1].handle, 1, *(x.ctypes.data for x in args), 1e-3, GOOD["u"].ctypes.data,
-                                    *(_ptr(x) for x in outputs)) == py.STATUS_INVALID
+        status = c.rbs_rebound_direct(table_pair[1].handle, 1, *(x.ctypes.data for x in args), 1e-3,
+                                      GOOD["u"].ctypes.data, *(_ptr(x) for x in outputs))
+        assert status == py.STATUS_INVALID
         assert np.isnan(out).all()
 
 
