@@ -43,7 +43,8 @@ per shape (a figure only: the exit code does not depend on it). Where the time g
 (``direct_model.runtime.rebound_model_frame``, the same uniforms; the rest of the call is the frame, the
 checks and the uniforms), the same without the trapped particles (each runs n_max collisions), the mean
 flights, collisions and contact-search steps per particle, and a split of the rebound's time: each piece
-timed alone on the rows' bodies, times its count per rebound: a flight's setup (K in the lab frame,
+timed alone on the bodies of the first PIECE_ROWS rows (inputs that stay in cache), times its count per
+rebound: a flight's setup (K in the lab frame,
 rotation_init, curvature_bound; once per flight), the free flight's orientation at one instant
 (rotation_at) and the body's lowest points there (lowest_points; both once per search step), a collision
 (K⁻¹ in the lab frame and collide); the rest is the body's setup, the search's own logic and the frame.
@@ -322,11 +323,14 @@ def _best(fn, repeats) -> float:
 
 
 PIECES = ("flight_setup", "orientation", "lowest_points", "collision")
+PIECE_ROWS = 2048     # the pieces run on the first rows only: their inputs stay in cache, as inside a rebound
 
 
 def piece_inputs(params, shape_code, u_all, model, W_after) -> dict:
     """The inputs of the pieces (module doc), from the rows' bodies: a flight's setup with the spin after the
-    rebound, the orientation 0.5 a/|V⁻| into that flight, the lowest points, a first collision."""
+    rebound, the orientation 0.5 a/|V⁻| into that flight, the lowest points, a first collision; the first
+    PIECE_ROWS rows."""
+    u_all, model, W_after = u_all[:PIECE_ROWS], model[:PIECE_ROWS], W_after[:PIECE_ROWS]
     m = len(u_all)
     semi, R = np.empty((m, 3)), np.empty((m, 3, 3))
     verts, nv = np.zeros((m, MAX_VERTICES, 3)), np.empty(m, dtype=np.int64)
