@@ -8,8 +8,9 @@ true``). Its hits files (postProcessing/lagrangian/<cloud>/stochasticRebound/hit
 the half-size a (m) and the Ω⁺ (rad/s) the stochasticRebound model set. They do not give Ω⁻: it is the
 Ω⁺ of the same parcel's previous hit (parcels keyed by origProc, origId, hits in time then file order),
 0 at its first hit. That holds because the case runs with ``collisionModel none``: in OpenFOAM v1912
-``CollidingParcel::move`` changes the angular momentum only by the torque, which only a collision model
-sets, so nothing turns a parcel between two wall hits. The script checks it against the run's own record,
+``CollidingParcel::move`` changes the angular momentum only in its half velocity steps, by ½Δt times the
+torque; the torque starts at zero and only the collision model's ``collide`` sets it (``NoCollision``'s
+does nothing), so nothing turns a parcel between two wall hits. The script checks it against the run's own record,
 the column spin_ratio = |Ω⁻|a/|V⁻|, and refuses a run where the two differ by more than 1e-7 relative
 (spin_ratio is written with 9 digits; Ω goes through the angular momentum I Ω and back).
 
