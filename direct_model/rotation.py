@@ -627,7 +627,7 @@ def _landen_agm(k, kp, eta, params):
         q *= 0.5 * num / den
         qsum += q
         landen = k >= _LANDEN_KTOL and n < _NLEV_MAX
-        if not landen and abs(q) <= 1e-17 * qsum:
+        if not landen and not abs(q) > 1e-17 * qsum:    # written so that a NaN ends the loop too
             break
         opk = 1.0 + kp
         r = 1.0 / opk

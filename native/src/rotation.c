@@ -390,8 +390,8 @@ static int rbs_is_steady(double m0, double m1, double m2, double k0, double k1, 
 }
 
 /* Store the descending Landen moduli; K(k) = pi/2 prod(1 + k_n) into *kcomp and (Pi(-eta | k) - K) / K
- * into *pik (the AGM of (1, k') with the third-kind sum of DLMF 19.8.6). The loop ends on a NaN too (numba's
- * `abs(q) <= 1e-17 * qsum` never holds then): the same bits for every other input. */
+ * into *pik (the AGM of (1, k') with the third-kind sum of DLMF 19.8.6). The exit test is written so that a
+ * NaN ends the loop too, as in numba. */
 static void rbs_landen_agm(double k, double kp, double eta, double *params, double *kcomp, double *pik)
 {
     int64_t n = 0;

@@ -218,9 +218,12 @@ def test_carlson_bit_identical(native):
 
 
 def test_rotation_init_ends_on_nan_inertia(native):
-    """A NaN principal value (numba's AGM loop never ends on it) gives NaN in C, at once."""
-    params = np.full(py.ROT_PARAMS_SIZE, PREFILL)
-    native.rotation_init(np.array([1.0, np.nan, 2.0]), np.eye(3), np.array([0.3, 0.4, 0.5]), params)
-    assert params[0] == 2.0
+    """A NaN principal value ends the AGM loop at once in both (its exit test is written so that NaN exits),
+    with NaN motion and the same parameters."""
+    K, ell = np.array([1.0, np.nan, 2.0]), np.array([0.3, 0.4, 0.5])
+    params, params_py = np.full(py.ROT_PARAMS_SIZE, PREFILL), np.full(py.ROT_PARAMS_SIZE, PREFILL)
+    native.rotation_init(K, np.eye(3), ell, params)
+    py.rotation_init(K, np.eye(3), ell, params_py)
+    assert params[0] == 2.0 and _same(params, params_py)
     R, omega = native.rotation_at(params, 1.0)
     assert np.isnan(R).any() and np.isnan(omega).any()

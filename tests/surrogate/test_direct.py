@@ -7,6 +7,7 @@ tests/direct_law.py (Bonferroni over the module's comparisons, FAMILY_ALPHA = 1e
 
 import subprocess
 import sys
+import threading
 
 import h5py
 import numba
@@ -148,6 +149,24 @@ def test_bad_kernel_input_is_invalid_with_nan(params, change):
     args.update(change)
     status, V_out, W_out = rebound_direct_tuple(params, **args)
     assert status == STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
+
+
+def test_a_state_whose_flight_underflows_ends(params):
+    """|V⁻| ~ 1e-160 m/s underflows the free flight's invariants to NaN; the kernel used to loop for ever in
+    the AGM of direct_model.rotation. It must end (here: STATUS_FAILED with NaN), as the C twin does. Run
+    in a daemon thread so that a regression fails after the timeout instead of hanging the suite."""
+    n = np.array([0.34523645, 0.41333518, 0.84259469])
+    args = (params, (-3.77668607e-161, -7.47222348e-161, -5.46831954e-161), tuple(n / np.linalg.norm(n)),
+            8.635989814806125e-4, (-1.50979875e-158, -2.14919893e-158, 1.32388636e-157), 0,
+            np.array([0.29739859, 0.48706842, 0.90535956, 0.39282742, 0.62082272, 0.55552379, 0.17284464]))
+    result = []
+    worker = threading.Thread(target=lambda: result.append(rebound_direct_tuple(*args)), daemon=True)
+    worker.start()
+    worker.join(timeout=120.0)
+    assert result, "rebound_direct_tuple did not return within 120 s"
+    status, V_out, W_out = result[0]
+    assert status in (STATUS_REBOUNDED, STATUS_FAILED)
+    assert np.isfinite(V_out).all() if status == STATUS_REBOUNDED else np.isnan(V_out).all()
 
 
 @pytest.mark.parametrize("change, message", [
