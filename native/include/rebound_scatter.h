@@ -79,9 +79,15 @@ extern "C" {
 #define RBS_BLOCK 32            /* rows per block of rbs_rebound_many*, lanes of rbs_rebound_many_rng */
 #define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */
 #define RBS_NORMAL_TOLERANCE 1e-6   /* | |n| − 1 | allowed for a wall normal (surrogate.kernels.frame.NORMAL_TOLERANCE) */
+#define RBS_U_PER_REBOUND 7     /* uniforms of one direct-model rebound (direct_model.runtime.U_PER_REBOUND) */
 
-/* Status of a draw: the codes of surrogate (STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_INVALID). */
-enum { RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_INVALID = -1 };
+/* Status of a draw: the codes of surrogate (STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED, STATUS_INVALID).
+ * RBS_FAILED comes from the direct model only (rbs_rebound_direct): a collision solve or a contact search
+ * failed; count and report it, never drop it. */
+enum { RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_FAILED = 2, RBS_INVALID = -1 };
+
+/* Shape codes of the direct model (direct_model.shapes.SHAPES order; a table's own shape order may differ). */
+enum { RBS_ELLIPSOID = 0, RBS_PRISM = 1, RBS_CUT_PRISM = 2, RBS_TETRAHEDRON = 3 };
 
 /* Error codes. */
 enum {
@@ -167,9 +173,12 @@ void rbs_table_info_get(const rbs_table *table, rbs_table_info *info);
 
 /* A derived kernel array, equal element for element to the field of surrogate's table.kernel_data of
  * the same name: "alpha1_axis", "speed_axis", "cells", "speed_restitution", "restitution_pieces"
- * (float64), "clusters", "dictionary" (float32). *data points into the table (read-only, valid until
- * rbs_table_close), *count is its number of elements, *dtype RBS_FLOAT64 or RBS_FLOAT32 (any of the
- * three output pointers may be NULL). Returns RBS_OK or RBS_ERR_ARGUMENT (unknown name). */
+ * (float64), "clusters", "dictionary" (float32); or "direct_parameters" (float64), the direct model's
+ * parameters, equal to surrogate's table.direct_parameters (direct_model.runtime.model_parameters
+ * layout). *data points into the table (read-only, valid until rbs_table_close), *count is its number of
+ * elements, *dtype RBS_FLOAT64 or RBS_FLOAT32 (any of the three output pointers may be NULL). Returns
+ * RBS_OK or RBS_ERR_ARGUMENT (unknown name, or "direct_parameters" of a table that does not record them:
+ * built at κ ≠ 0.3 before tables recorded the second-moment factors). */
 int rbs_table_kernel_array(const rbs_table *table, const char *name, const void **data, size_t *count,
                            int *dtype);
 
@@ -233,6 +242,82 @@ void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t cou
  * interpolation. Outside the grid (however far), the law at the nearest grid edge. */
 int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                    const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE]);
+
+/* ---------------------------------------------------------------- the direct model */
+
+/* One particle's rebound by the direct model, caller's frame (surrogate.kernels.rebound_direct_tuple): the
+ * impulse model itself (docs/model.md), flights and collisions simulated, where the table's law does not
+ * apply (a spinning particle, say). The same bits as the numba kernel for the same uniforms.
+ *   shape    RBS_ELLIPSOID, RBS_PRISM, RBS_CUT_PRISM or RBS_TETRAHEDRON (any of the four, whatever
+ *            shapes the table holds)
+ *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
+ *   Omega    incident angular velocity Ω⁻, rad/s (finite); exactly zero: the body starts touching the
+ *            wall (the tables' case), otherwise the flight in from a clear start is simulated
+ *   n        unit wall normal into the gas (| |n| − 1 | <= RBS_NORMAL_TOLERANCE)
+ *   a        half-size (half the largest extent), m (finite, > 0)
+ *   u        RBS_U_PER_REBOUND uniforms in [0, 1) (−0 allowed): u[0..2] the orientation (Shoemake's
+ *            uniform quaternion), u[3], u[4] the aspect ratios b/a and c/b (inverse CDF of the table's
+ *            truncated normal law), u[5] the tetrahedron's hand (+1 below ½), u[6] the direction ex of
+ *            the impact frame at normal impact (as u[12] of a draw)
+ *   V_out    V⁺, m/s;  Omega_out  Ω⁺, rad/s  (NaN unless rebounded)
+ * The model runs in the impact frame (ex, n, ez) of rbs_rebound, with Ω⁻ in units of (m/s)/a; its
+ * parameters (aspect-ratio law, κ, n_max, wall law, tolerances, second-moment factors) are the table's
+ * "direct_parameters" (rbs_table_kernel_array), so a table and its direct model never disagree.
+ * Returns RBS_REBOUNDED; RBS_TRAPPED (still colliding after n_max collisions) or RBS_FAILED (a collision
+ * solve or a contact search failed) with NaN outputs; RBS_INVALID with NaN outputs for an input outside
+ * the ranges above, a NULL pointer, a shape outside 0..3, or a table without direct parameters (a NULL
+ * output gets nothing). Thread-safe: scratch on the stack, the table read only. */
+int rbs_rebound_direct(const rbs_table *table, int shape, const double V[3], const double Omega[3],
+                       const double n[3], double a, const double u[RBS_U_PER_REBOUND],
+                       double V_out[3], double Omega_out[3]);
+
+/* ---------------------------------------------------------------- every hit: table or direct model */
+
+/* Methods of rbs_rebound_spin (surrogate's method "auto", "table", "direct"). */
+enum {
+    RBS_AUTO = 0,           /* the table where its law is valid (below), the direct model for every other hit */
+    RBS_TABLE = 1,          /* the table whatever Ω⁻ (rbs_rebound: the law at the nearest grid edge outside) */
+    RBS_DIRECT = 2          /* the direct model for every hit */
+};
+
+/* The path that answers a hit (rbs_rebound_path). */
+enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
+
+/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.SPIN_TOLERANCE). */
+#define RBS_SPIN_TOLERANCE 0.002
+
+/* The path that answers a hit under `method` (surrogate.kernels.rebound_path): a pure function of the
+ * state, so a caller learns it without another draw. Under RBS_AUTO, the table iff Ω⁻ = 0 or
+ * |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE, and α1 and |V⁻| (as rbs_rebound computes them) lie in the table's
+ * grid ranges, edges included (rbs_table_alpha1_range, rbs_table_speed_range); else the direct model.
+ *   V, n, a  as rbs_rebound;  Omega  incident angular velocity Ω⁻, rad/s (finite)
+ * Returns RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_INVALID for a NULL pointer, an unknown method, or a
+ * state rbs_rebound or rbs_rebound_direct refuses (V not moving into the wall, n not a unit vector, a
+ * not finite and > 0, Ω⁻ not finite). */
+int rbs_rebound_path(const rbs_table *table, const double V[3], const double Omega[3], const double n[3],
+                     double a, int method);
+
+/* The reflected state of one particle, spinning or not, from the table or the direct model
+ * (surrogate.kernels.rebound_spin_tuple): the path rbs_rebound_path gives, then
+ *   RBS_PATH_TABLE   rbs_rebound with the same u (Ω⁻ unused);
+ *   RBS_PATH_DIRECT  the shape drawn from the mix with u[0] as rbs_rebound draws it, then
+ *                    rbs_rebound_direct with that shape's code and u[1..RBS_U_PER_REBOUND] as its uniforms.
+ * A hit consumes RBS_U_PER_DRAW uniforms whatever the path, so streams stay aligned.
+ *   Omega    incident angular velocity Ω⁻, rad/s (finite);  method  RBS_AUTO, RBS_TABLE or RBS_DIRECT;
+ *   the other arguments as rbs_rebound.
+ * Returns RBS_REBOUNDED, RBS_TRAPPED, RBS_FAILED (direct path: a collision solve or a contact search
+ * failed; count it) or RBS_INVALID (what rbs_rebound_path refuses, a NULL pointer, a mix of another
+ * table's shape count, an unknown interpolation, a uniform outside [0, 1) or NaN); NaN outputs unless
+ * rebounded. The direct path costs microseconds, the table path a fraction of one. Thread-safe. */
+int rbs_rebound_spin_u(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
+                       double V_out[3], double Omega_out[3]);
+
+/* rbs_rebound_spin_u with its RBS_U_PER_DRAW uniforms drawn from `rng` (rbs_rng_fill), which advances by
+ * them whatever the path and whatever the result; a NULL or all-zero rng gives RBS_INVALID. */
+int rbs_rebound_spin(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                     const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
+                     double Omega_out[3]);
 
 /* ---------------------------------------------------------------- random numbers */
 
