@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "rebound_scatter.h"
+#include "runtime.h"
 
 /* The entry points of the hot path are compiled twice on x86-64 with GCC (function multi-versioning,
  * chosen once at load time): for x86-64-v3 (AVX2 and FMA, so fma() is one instruction, as in numba's code
@@ -89,6 +90,8 @@ struct rbs_table {
     double *speed_restitution;
     double *restitution_pieces;
     size_t restitution_pieces_len;
+    int has_direct;                                 /* the table records the direct model's parameters */
+    double direct_parameters[N_PARAMS];             /* surrogate.table.direct_parameters (P_* layout) */
 };
 
 /* The raw cell datasets a loader reads (layout.c turns them into the kernel arrays). */

@@ -480,6 +480,189 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
     return RBS_OK;
 }
 
+/* ------------------------------------------------------------------------- the direct model's parameters */
+
+/* the direct model's tolerances every build used before tables recorded them, and s per shape code at
+ * κ = 0.3 (data_schema.table.BUILT_WITH_TOLERANCES, BUILT_WITH_KAPPA, BUILT_WITH_SECOND_MOMENT_FACTORS) */
+#define BUILT_WITH_CONTACT_TOL 1e-10
+#define BUILT_WITH_SET_TOL 1e-9
+#define BUILT_WITH_MAX_STEPS 100000
+#define BUILT_WITH_KAPPA 0.3
+static const double BUILT_WITH_SECOND_MOMENT_FACTORS[RBS_MAX_SHAPES] = {
+    0.2, 0.33333333333333337, 0.3309571404654277, 0.20000000000000004};
+static const char *const ASPECT_KEYS[4] = {"mean", "sd", "low", "high"};
+
+/* p past spaces and tabs */
+static const char *skip_blanks(const char *p)
+{
+    while (*p == ' ' || *p == '\t') p++;
+    return p;
+}
+
+/* `key = number` pairs of the aspect-ratio law from p up to `end` (an inline table's '}' or a line's end) */
+static void parse_aspect_pairs(const char *p, const char *end, double aspect[4])
+{
+    while (p < end) {
+        p = skip_blanks(p);
+        for (int k = 0; k < 4; k++) {
+            size_t len = strlen(ASPECT_KEYS[k]);
+            const char *q = skip_blanks(p + len);
+            if (strncmp(p, ASPECT_KEYS[k], len) == 0 && *q == '=') {
+                char *after;
+                double x = strtod(q + 1, &after);
+                if (after != q + 1) aspect[k] = x;
+            }
+        }
+        while (p < end && *p != ',' && *p != '\n') p++;
+        p++;
+    }
+}
+
+/* The aspect-ratio law of the build's configuration (TOML text, as tablegen's to_toml writes it): the
+ * inline table `aspect_ratio = {mean = ..., sd = ..., low = ..., high = ...}` of [simulation], or a
+ * [simulation.aspect_ratio] table; NaN for what it does not give (data_schema.table._direct_model_attributes). */
+static void config_aspect(const char *text, double aspect[4])
+{
+    int in_simulation = 0, in_law = 0;
+    for (const char *line = text; line && *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+        const char *p = skip_blanks(line), *eol = strchr(p, '\n');
+        if (!eol) eol = p + strlen(p);
+        if (*p == '[') {
+            in_simulation = strncmp(p, "[simulation]", 12) == 0;
+            in_law = strncmp(p, "[simulation.aspect_ratio]", 25) == 0;
+        } else if (in_law) {
+            parse_aspect_pairs(p, eol, aspect);
+        } else if (in_simulation && strncmp(p, "aspect_ratio", 12) == 0) {
+            const char *q = skip_blanks(p + 12);
+            const char *close = strchr(q, '}');
+            if (*q == '=' && *(q = skip_blanks(q + 1)) == '{' && close && close < eol) parse_aspect_pairs(q + 1, close, aspect);
+        }
+    }
+}
+
+/* The attributes of the direct model (data_schema.table._direct_model_attributes, the same fallbacks for
+ * tables that did not record them) into aspect, kfac (*n_kfac of them), the tolerances and q. */
+static int direct_attributes(loader *ld, hid_t file, hid_t grid, double kappa, double aspect[4], double kfac[8],
+                             int *n_kfac, double *contact_tol, double *set_tol, long long *max_steps, double *q)
+{
+    static const char *const aspect_names[4] = {"aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low",
+                                                "aspect_ratio_high"};
+    int recorded = 1;
+    for (int k = 0; k < 4; k++) {
+        aspect[k] = NAN;
+        recorded &= attribute_exists(grid, aspect_names[k]);
+    }
+    if (recorded) {
+        for (int k = 0; k < 4; k++)
+            if (read_double_attribute(ld, grid, "grid", aspect_names[k], &aspect[k]) != RBS_OK) return ld->code;
+    } else {
+        const size_t size = 1 << 20;
+        char *config = malloc(size);
+        if (!config) return fail(ld, RBS_ERR_MEMORY, "out of memory reading the root attribute 'config'");
+        if (read_string_attribute(file, "config", config, size) == 0) config_aspect(config, aspect);
+        free(config);
+    }
+    *n_kfac = RBS_MAX_SHAPES;
+    if (attribute_exists(grid, "second_moment_factors")) {
+        hid_t attr = -1, space = -1;
+        hssize_t count = -1;
+        H5E_BEGIN_TRY {
+            attr = H5Aopen(grid, "second_moment_factors", H5P_DEFAULT);
+            if (attr >= 0) space = H5Aget_space(attr);
+            if (space >= 0) count = H5Sget_simple_extent_npoints(space);
+        } H5E_END_TRY;
+        if (space >= 0) H5Sclose(space);
+        if (attr >= 0) H5Aclose(attr);
+        if (count < 1 || count > 8
+            || read_numeric_attribute(grid, "second_moment_factors", H5T_NATIVE_DOUBLE, kfac, count) != 0)
+            return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute 'second_moment_factors' of group 'grid' as 1 to 8 "
+                        "numbers");
+        *n_kfac = (int)count;
+    } else {
+        for (int k = 0; k < RBS_MAX_SHAPES; k++) kfac[k] = kappa == BUILT_WITH_KAPPA ? BUILT_WITH_SECOND_MOMENT_FACTORS[k] : NAN;
+    }
+    *contact_tol = BUILT_WITH_CONTACT_TOL;
+    *set_tol = BUILT_WITH_SET_TOL;
+    *max_steps = BUILT_WITH_MAX_STEPS;
+    *q = NAN;
+    if ((attribute_exists(grid, "contact_tol") && read_double_attribute(ld, grid, "grid", "contact_tol", contact_tol))
+        || (attribute_exists(grid, "set_tol") && read_double_attribute(ld, grid, "grid", "set_tol", set_tol))
+        || (attribute_exists(grid, "max_steps") && read_integer_attribute(ld, grid, "grid", "max_steps", max_steps))
+        || (attribute_exists(grid, "friction_q") && read_double_attribute(ld, grid, "grid", "friction_q", q)))
+        return ld->code;
+    return RBS_OK;
+}
+
+/* Φ(x), the standard normal CDF (direct_model.runtime._normal_cdf: libm's erfc, as CPython's math.erfc) */
+static double normal_cdf(double x)
+{
+    return 0.5 * erfc(-x / sqrt(2.0));
+}
+
+#define OUT_OF_RANGE "the direct model's parameters are out of range: "
+
+/* The direct model's parameters (surrogate.table.direct_parameters): none (has_direct = 0) if the table does
+ * not record its second-moment factors, else the P_* array of direct_model.runtime.model_parameters after
+ * the same range checks in the same order (RBS_ERR_FORMAT naming the value). */
+static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table *t, double kappa)
+{
+    double aspect[4], kfac[8], contact_tol, set_tol, q;
+    long long max_steps = 0;
+    int n_kfac = 0;
+    if (direct_attributes(ld, file, grid, kappa, aspect, kfac, &n_kfac, &contact_tol, &set_tol, &max_steps, &q) != RBS_OK)
+        return ld->code;
+    for (int k = 0; k < n_kfac; k++)
+        if (!isfinite(kfac[k])) return RBS_OK;
+    /* tables without friction_q (before 3.1) were built before the wall law was configurable: q = 1 */
+    if (!isfinite(q)) q = 1.0;
+    double mean = aspect[0], sd = aspect[1], low = aspect[2], high = aspect[3];
+    if (!(0.0 < low && low < high && high <= 1.0))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio bounds must satisfy 0 < low < high <= 1; got "
+                    "low=%.17g, high=%.17g.", low, high);
+    if (!(sd > 0.0 && isfinite(sd)))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'sd' must be finite and > 0; got %.17g.", sd);
+    if (!isfinite(mean))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'mean' must be finite; got %.17g.", mean);
+    if (!(0.0 <= kappa && kappa < 1.0))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'kappa' parameter must be in [0, 1); got %.17g.", kappa);
+    const long long two53 = 9007199254740992LL;
+    if (!(t->n_max >= 1 && t->n_max < two53))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'n_max' parameter must be an integer in [1, 2**53); got %lld.",
+                    t->n_max);
+    if (!(max_steps >= 1 && max_steps < two53))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'max_steps' parameter must be an integer in [1, 2**53); got "
+                    "%lld.", max_steps);
+    if (!(isfinite(contact_tol) && contact_tol > 0.0))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'contact_tol' parameter must be finite and > 0 (units of a); "
+                    "got %.17g.", contact_tol);
+    if (!(isfinite(set_tol) && set_tol > 0.0))
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'set_tol' parameter must be finite and > 0 (units of a); got "
+                    "%.17g.", set_tol);
+    int kfac_ok = n_kfac == RBS_MAX_SHAPES;
+    for (int k = 0; kfac_ok && k < n_kfac; k++) kfac_ok = kfac[k] > 0.0 && kfac[k] < 1.0;
+    if (!kfac_ok)
+        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'second_moment_factors' parameter must be %d numbers in (0, "
+                    "1), one per shape code; got %d numbers, the first %.17g.", RBS_MAX_SHAPES, n_kfac, kfac[0]);
+    double *p = t->direct_parameters;
+    p[P_ASPECT_MEAN] = mean;
+    p[P_ASPECT_SD] = sd;
+    p[P_ASPECT_LOW] = low;
+    p[P_ASPECT_HIGH] = high;
+    p[P_CDF_LOW] = normal_cdf((low - mean) / sd);
+    p[P_CDF_HIGH] = normal_cdf((high - mean) / sd);
+    p[P_KAPPA] = kappa;
+    p[P_N_MAX] = (double)t->n_max;
+    p[P_WALL] = t->restitution_k;
+    p[P_WALL + 1] = t->restitution_p;
+    p[P_WALL + 2] = q;
+    p[P_CONTACT_TOL] = contact_tol;
+    p[P_SET_TOL] = set_tol;
+    p[P_MAX_STEPS] = (double)max_steps;
+    for (int k = 0; k < RBS_MAX_SHAPES; k++) p[P_KFAC + k] = kfac[k];
+    t->has_direct = 1;
+    return RBS_OK;
+}
+
 static void free_raw(rbs_raw_cells *raw)
 {
     free(raw->cluster_weight);
@@ -620,6 +803,7 @@ static int load(loader *ld, rbs_table *t)
         if (code == RBS_ERR_MEMORY) fail(ld, code, "out of memory deriving the kernel arrays");
         else if (code != RBS_OK) fail(ld, code, "the derived kernel array %s is not finite (inconsistent table)", what);
     }
+    if (ld->code == RBS_OK) read_direct_parameters(ld, file, grid, t, kappa);
 
 done:
     free_raw(&raw);
@@ -740,6 +924,7 @@ int rbs_table_kernel_array(const rbs_table *t, const char *name, const void **da
     else if (strcmp(name, "dictionary") == 0) { p = t->dictionary; n = t->dictionary_len; type = RBS_FLOAT32; }
     else if (strcmp(name, "speed_restitution") == 0) { p = t->speed_restitution; n = (size_t)t->n_speed; }
     else if (strcmp(name, "restitution_pieces") == 0) { p = t->restitution_pieces; n = t->restitution_pieces_len; }
+    else if (strcmp(name, "direct_parameters") == 0 && t->has_direct) { p = t->direct_parameters; n = N_PARAMS; }
     else return RBS_ERR_ARGUMENT;
     if (data) *data = p;
     if (count) *count = n;

@@ -1,0 +1,113 @@
+/*
+ * rebound.c: a whole rebound of the direct model (direct_model.rebound: rebound, quaternion_to_matrix,
+ * lab_tensor): with Ω⁻ = 0 the body starts touching the wall, otherwise with its centre at the bounding
+ * radius; then search the flight for the next contact (flight.c, rotation.c) and collide (collision.c) until
+ * the body escapes (rebounded), n_max is exceeded (trapped) or a search or collision fails (failed). The same
+ * operations in the same order as the numba kernels; the work space on the stack.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#include <math.h>
+
+#include "collision.h"
+#include "flight.h"
+#include "rebound.h"
+#include "rebound_scatter.h"
+#include "rotation.h"
+#include "shapes.h"
+
+void rbs_quaternion_to_matrix(const double q[4], double R[9])
+{
+    double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+    R[0] = 1.0 - 2.0 * (y * y + z * z);
+    R[1] = 2.0 * (x * y - w * z);
+    R[2] = 2.0 * (x * z + w * y);
+    R[3] = 2.0 * (x * y + w * z);
+    R[4] = 1.0 - 2.0 * (x * x + z * z);
+    R[5] = 2.0 * (y * z - w * x);
+    R[6] = 2.0 * (x * z - w * y);
+    R[7] = 2.0 * (y * z + w * x);
+    R[8] = 1.0 - 2.0 * (x * x + y * y);
+}
+
+/* out = R diag(diag) Rᵀ: a body-frame principal tensor in the lab frame */
+static void lab_tensor(const double *R, const double *diag, double *out)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            out[3 * i + j] = R[3 * i] * diag[0] * R[3 * j] + R[3 * i + 1] * diag[1] * R[3 * j + 1]
+                             + R[3 * i + 2] * diag[2] * R[3 * j + 2];
+}
+
+int rbs_rebound_body(int shape, const double semi[3], double kappa, double hand, double kfac, const double R0[9],
+                     const double V0[3], const double W0[3], const double wall[3], long long n_max, double contact_tol,
+                     double set_tol, long long max_steps, double V[3], double W[3], long long *n_collisions,
+                     long long *n_steps)
+{
+    /* h and r_all hold MAX_VERTICES points whatever the shape, as numba's work space (find_contact's index −1) */
+    double verts[3 * MAX_VERTICES], h[MAX_VERTICES] = {0.0}, r_all[3 * MAX_VERTICES] = {0.0};
+    double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
+    double K[3], Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
+
+    int nv = rbs_body_vertices(shape, semi[0], semi[1], semi[2], kappa, hand, verts);
+    double Rb = rbs_bounding_radius(shape, semi[0], semi[1], semi[2], verts, nv);
+    double a2 = semi[0] * semi[0], b2 = semi[1] * semi[1], c2 = semi[2] * semi[2];
+    K[0] = kfac * (b2 + c2);
+    K[1] = kfac * (a2 + c2);
+    K[2] = kfac * (a2 + b2);
+    for (int k = 0; k < 3; k++) Kinv[k] = 1.0 / K[k];
+    for (int k = 0; k < 9; k++) R[k] = R0[k];
+    for (int k = 0; k < 3; k++) {
+        V[k] = V0[k];
+        W[k] = W0[k];
+    }
+
+    double y;
+    if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
+        int n = rbs_lowest_points(shape, verts, nv, semi, R, 0.0, h, r_all);
+        /* numpy's min: the first NaN, else the smallest */
+        double lowest = h[0];
+        for (int i = 1; i < n && lowest == lowest; i++)
+            if (!(h[i] == h[i]) || h[i] < lowest) lowest = h[i];
+        y = -lowest;
+    } else {
+        y = Rb;
+    }
+    long long n_coll = 0, steps_total = 0;
+    int status = RBS_FAILED;
+    for (;;) {
+        lab_tensor(R, K, K_lab);
+        for (int i = 0; i < 3; i++) ell[i] = K_lab[3 * i] * W[0] + K_lab[3 * i + 1] * W[1] + K_lab[3 * i + 2] * W[2];
+        rbs_rotation_init(K, R, ell, params);
+        double M = rbs_curvature_bound(shape, semi, Rb, K, ell, W);
+        for (int k = 0; k < 3; k++) Wt[k] = W[k];
+        double t = 0.0;
+        long long steps = 0;
+        int code = rbs_find_contact(shape, verts, nv, semi, Rb, M, params, y, V[1], contact_tol, set_tol, max_steps,
+                                    &t, R, Wt, h, r_all, rc, &steps);
+        steps_total += steps;
+        if (code == SEARCH_ESCAPED) {
+            status = RBS_REBOUNDED;
+            break;
+        }
+        if (code == SEARCH_STALLED) break;
+        if (n_coll == n_max) {
+            status = RBS_TRAPPED;
+            break;
+        }
+        y += V[1] * t;
+        for (int k = 0; k < 3; k++) W[k] = Wt[k];
+        lab_tensor(R, Kinv, Kinv_lab);
+        int outcome = rbs_collide(V, W, rc, Kinv_lab, wall, dV, dW);
+        if (outcome != COLLISION_OK && outcome != COLLISION_MULTIPLE_ROOTS) break;
+        for (int k = 0; k < 3; k++) {
+            V[k] += dV[k];
+            W[k] += dW[k];
+        }
+        n_coll += 1;
+    }
+    *n_collisions = n_coll;
+    *n_steps = steps_total;
+    return status;
+}

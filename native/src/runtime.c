@@ -1,0 +1,80 @@
+/*
+ * runtime.c: the direct model at run time (direct_model.runtime: normal_quantile, aspect_ratio,
+ * uniform_quaternion, rebound_model_frame): the random inputs of one rebound from RBS_U_PER_REBOUND uniforms,
+ * every model parameter from the P_* array, then the rebound (rebound.c). The same operations in the same
+ * order as the numba kernels; libm's sqrt, log, sin and cos.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#include <math.h>
+
+#include "fastmath.h"
+#include "pymath.h"
+#include "rebound.h"
+#include "runtime.h"
+
+double rbs_normal_quantile(double p)
+{
+    double q = p - 0.5;
+    if (fabs(q) <= 0.425) {
+        double r = 0.180625 - q * q;
+        return q * (((((((2509.0809287301226727 * r + 33430.575583588128105) * r + 67265.770927008700853) * r
+                        + 45921.953931549871457) * r + 13731.693765509461125) * r + 1971.5909503065514427) * r
+                     + 133.14166789178437745) * r + 3.387132872796366608) / (
+            ((((((5226.495278852545925 * r + 28729.085735721942674) * r + 39307.89580009271061) * r
+               + 21213.794301586595867) * r + 5394.1960214247511077) * r + 687.1870074920579083) * r
+             + 42.313330701600911252) * r + 1.0);
+    }
+    double r = sqrt(-log(q < 0.0 ? p : 1.0 - p)), x;
+    if (r <= 5.0) {
+        r -= 1.6;
+        x = (((((((7.7454501427834140764e-4 * r + 0.0227238449892691845833) * r + 0.24178072517745061177) * r
+                + 1.27045825245236838258) * r + 3.64784832476320460504) * r + 5.7694972214606914055) * r
+              + 4.6303378461565452959) * r + 1.42343711074968357734) / (
+            ((((((1.05075007164441684324e-9 * r + 5.475938084995344946e-4) * r + 0.0151986665636164571966) * r
+               + 0.14810397642748007459) * r + 0.68976733498510000455) * r + 1.6763848301838038494) * r
+             + 2.05319162663775882187) * r + 1.0);
+    } else {
+        r -= 5.0;
+        x = (((((((2.01033439929228813265e-7 * r + 2.71155556874348757815e-5) * r + 0.0012426609473880784386) * r
+                + 0.026532189526576123093) * r + 0.29656057182850489123) * r + 1.7848265399172913358) * r
+              + 5.4637849111641143699) * r + 6.6579046435011037772) / (
+            ((((((2.04426310338993978564e-15 * r + 1.4215117583164458887e-7) * r + 1.8463183175100546818e-5) * r
+               + 7.868691311456132591e-4) * r + 0.0148753612908506148525) * r + 0.13692988092273580531) * r
+             + 0.59983220655588793769) * r + 1.0);
+    }
+    return q < 0.0 ? -x : x;
+}
+
+double rbs_aspect_ratio(const double *params, double u)
+{
+    double lo = params[P_CDF_LOW], hi = params[P_CDF_HIGH];
+    double x = params[P_ASPECT_MEAN] + params[P_ASPECT_SD] * rbs_normal_quantile(lo + u * (hi - lo));
+    return py_min(py_max(x, params[P_ASPECT_LOW]), params[P_ASPECT_HIGH]);
+}
+
+void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4])
+{
+    double s = sqrt(1.0 - u0), c = sqrt(u0);
+    q[0] = s * sin(2.0 * RBS_PI * u1);
+    q[1] = s * cos(2.0 * RBS_PI * u1);
+    q[2] = c * sin(2.0 * RBS_PI * u2);
+    q[3] = c * cos(2.0 * RBS_PI * u2);
+}
+
+int rbs_rebound_model_frame(const double *params, int shape, double vt, double vn, double wx, double wy, double wz,
+                            const double *u, double V[3], double W[3])
+{
+    double quat[4], R0[9];
+    rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat);
+    rbs_quaternion_to_matrix(quat, R0);
+    double b_over_a = rbs_aspect_ratio(params, u[U_RATIOS]);
+    const double semi[3] = {1.0, b_over_a, b_over_a * rbs_aspect_ratio(params, u[U_RATIOS + 1])};
+    double hand = shape != RBS_TETRAHEDRON || u[U_HAND] < 0.5 ? 1.0 : -1.0;
+    const double V0[3] = {vt, vn, 0.0}, W0[3] = {wx, wy, wz};
+    long long n_collisions, n_steps;
+    /* n_max and max_steps as numba's int() of the float64 parameters */
+    return rbs_rebound_body(shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params + P_WALL,
+                            rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
+                            rbs_trunc(params[P_MAX_STEPS]), V, W, &n_collisions, &n_steps);
+}

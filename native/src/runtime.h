@@ -1,0 +1,49 @@
+/*
+ * runtime.h: the direct model at run time (direct_model.runtime): one particle's whole rebound in the model's
+ * frame from RBS_U_PER_REBOUND uniforms and the parameter array P_* (direct_model.runtime.model_parameters).
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#ifndef RBS_RUNTIME_H
+#define RBS_RUNTIME_H
+
+/* layout of the parameter array (float64; direct_model.runtime: P_ASPECT_MEAN ... P_KFAC, N_PARAMS) */
+#define P_ASPECT_MEAN 0     /* the aspect-ratio law (b/a and c/b): mean, sd, low, high */
+#define P_ASPECT_SD 1
+#define P_ASPECT_LOW 2
+#define P_ASPECT_HIGH 3
+#define P_CDF_LOW 4         /* Φ((low − mean)/sd), Φ((high − mean)/sd): the law's CDF bounds */
+#define P_CDF_HIGH 5
+#define P_KAPPA 6
+#define P_N_MAX 7
+#define P_WALL 8            /* the wall law (k, p, q) at 8, 9, 10 */
+#define P_CONTACT_TOL 11    /* units of a */
+#define P_SET_TOL 12        /* units of a */
+#define P_MAX_STEPS 13      /* search steps per flight */
+#define P_KFAC 14           /* second-moment factor s per shape code, 14..17 */
+#define N_PARAMS 18
+
+/* the uniforms of one rebound (direct_model.runtime: U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS) */
+#define U_ORIENTATION 0
+#define U_RATIOS 3
+#define U_HAND 5
+#define U_AXIS 6
+
+/* Φ⁻¹(p) for p in (0, 1): Wichura's AS 241 (direct_model.runtime.normal_quantile) */
+double rbs_normal_quantile(double p);
+
+/* the aspect-ratio law's quantile at u in [0, 1), in [low, high] (direct_model.runtime.aspect_ratio) */
+double rbs_aspect_ratio(const double *params, double u);
+
+/* q = a unit quaternion (w, x, y, z) uniform on S³ from three uniforms (Shoemake;
+ * direct_model.runtime.uniform_quaternion) */
+void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4]);
+
+/* One particle's whole rebound in the model's frame (direct_model.runtime.rebound_model_frame): params the
+ * P_* array, shape code 0..3, incident velocity (vt, vn, 0) m/s (vn < 0), angular velocity (wx, wy, wz) in
+ * (m/s)/a (all zero: the body starts touching the wall), u RBS_U_PER_REBOUND uniforms. V⁺ (m/s) into V and
+ * Ω⁺ ((m/s)/a) into W; returns RBS_REBOUNDED, RBS_TRAPPED or RBS_FAILED. */
+int rbs_rebound_model_frame(const double *params, int shape, double vt, double vn, double wx, double wy, double wz,
+                            const double *u, double V[3], double W[3]);
+
+#endif /* RBS_RUNTIME_H */
