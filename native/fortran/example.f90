@@ -12,7 +12,7 @@ program rebound_example
   type(rbs_mix) :: mix
   type(rbs_rng) :: rng
   character(len=1024) :: path, message
-  real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), Omega_out(3)
+  real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), Omega_out(3), Omega(3), ud(RBS_U_PER_REBOUND)
   real(c_double) :: Vs(3, n_many), ns(3, n_many), a(n_many), Vs_out(3, n_many), Ws_out(3, n_many)
   integer(c_signed_char) :: status(n_many)
   integer(c_int) :: code, st, i
@@ -38,6 +38,13 @@ program rebound_example
     st = rbs_rebound(table, mix, V, n, 5e-5_c_double, u, RBS_SCALED, V_out, Omega_out)
     print '(a, i0, a, 3f10.3, a, 3es12.3)', "status ", st, "  V+ =", V_out, "  Omega+ =", Omega_out
   end do
+
+  ! a spinning particle by the direct model (the impulse model simulated; Omega in rad/s)
+  Omega = [0.0_c_double, 0.0_c_double, 2e5_c_double]
+  call rbs_rng_fill(rng, ud, int(RBS_U_PER_REBOUND, c_size_t))
+  st = rbs_rebound_direct(table, RBS_PRISM, V, Omega, n, 5e-5_c_double, ud, V_out, Omega_out)
+  print '(a, i0, a, 3f10.3, a, 3es12.3)', "direct: status ", st, "  V+ =", V_out, "  Omega+ =", Omega_out
+  if (st /= RBS_REBOUNDED .or. V_out(2) <= 0.0_c_double) stop 5   ! this one rebounds, leaving the wall
 
   ! many particles in one call (the faster path)
   do i = 1, n_many

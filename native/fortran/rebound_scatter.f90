@@ -12,7 +12,9 @@ module rebound_scatter
   private :: c_strlen
 
   integer(c_int), parameter :: RBS_U_PER_DRAW = 13, RBS_MAX_SHAPES = 4, RBS_LOCAL_SIZE = 6, RBS_BLOCK = 32
-  integer(c_int), parameter :: RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_INVALID = -1
+  integer(c_int), parameter :: RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_FAILED = 2, RBS_INVALID = -1
+  integer(c_int), parameter :: RBS_U_PER_REBOUND = 7
+  integer(c_int), parameter :: RBS_ELLIPSOID = 0, RBS_PRISM = 1, RBS_CUT_PRISM = 2, RBS_TETRAHEDRON = 3
   integer(c_int), parameter :: RBS_OK = 0, RBS_ERR_IO = 1, RBS_ERR_FORMAT = 2, RBS_ERR_VERSION = 3, &
                                RBS_ERR_ARGUMENT = 4, RBS_ERR_MEMORY = 5
   integer(c_int), parameter :: RBS_SCALED = 0, RBS_STOCHASTIC = 1
@@ -86,6 +88,18 @@ module rebound_scatter
       integer(c_int), value :: interpolation
       real(c_double), intent(out) :: V_out(3), Omega_out(3)
     end function rbs_rebound
+
+    ! the direct model (rbs_rebound_direct): shape a model code RBS_ELLIPSOID .. RBS_TETRAHEDRON, Omega in rad/s
+    integer(c_int) function rbs_rebound_direct(table, shape, V, Omega, n, a, u, V_out, Omega_out) &
+        bind(c, name="rbs_rebound_direct")
+      import :: c_int, c_ptr, c_double, RBS_U_PER_REBOUND
+      type(c_ptr), value :: table
+      integer(c_int), value :: shape
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      real(c_double), intent(in) :: u(RBS_U_PER_REBOUND)
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_rebound_direct
 
     subroutine rbs_rebound_many(table, mix, count, V, n, a, u, interpolation, V_out, Omega_out, status) &
         bind(c, name="rbs_rebound_many")

@@ -37,6 +37,21 @@ def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tmp
     print(f"\nsanitizers (address, undefined, leaks): no report over {len(arguments) // 2} bad files and the good one")
 
 
+def test_direct_model_program_under_sanitizers(native_sanitized, small_table_path, tmp_path):
+    """The direct model's invariants as C tests (a collision never adds energy and keeps the angular momentum
+    about the contact point, a free flight keeps energy and L to 1e-9, a rebound never adds energy) and its
+    hostile calls, on the small table and one without direct parameters: no failure, no sanitizer report."""
+    import h5py
+    without = tmp_path / "without_direct.h5"
+    without.write_bytes(small_table_path.read_bytes())
+    with h5py.File(without, "r+") as f:
+        del f["grid"].attrs["second_moment_factors"]
+        f["grid"].attrs["kappa"] = 0.25
+    out = _sanitized_run([native_sanitized / "rbs_test_direct", small_table_path, without])
+    assert "0 failure(s)" in out
+    print("\n" + out)
+
+
 def test_threads_draw_as_one_thread(native_sanitized, small_table_path):
     """Four threads drawing from one table at once give the bits of one thread, stream by stream."""
     out = _sanitized_run([native_sanitized / "rbs_test_threads", small_table_path, 4, 4000])
@@ -52,7 +67,8 @@ def test_c_example(native_build, small_table_path):
 def test_fortran_example(native_build, small_table_path):
     done = run([str(native_build / "rbs_example_fortran"), str(small_table_path)])
     assert done.returncode == 0, done.stdout + done.stderr
-    assert "many: 1000 particles" in done.stdout and done.stdout.strip().endswith("ok")
+    assert "direct: status 0" in done.stdout and "many: 1000 particles" in done.stdout
+    assert done.stdout.strip().endswith("ok")
 
 
 def test_cxx_compiles_against_the_header(native_build, small_table_path, tmp_path):
