@@ -48,15 +48,17 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rbs_api import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, sample_global  # noqa: E402
+from rbs_api import (STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, rebound_direct,  # noqa: E402
+                     sample_global)
 
 KS_C_999 = 1.949          # two-sample KS: c(α) for α = 0.001
 CLASSIFIER_SE = 4.0       # classifier threshold: 0.5 + this many standard errors
 TRAPPED_SE = 4.0          # trapped fractions: |difference| within this many standard errors
 STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
 
-HIT_COLUMNS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,nx,ny,nz,Uwx,Uwy,Uwz,status,"
+HIT_COLUMNS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,nx,ny,nz,Uwx,Uwy,Uwz,status,path,"
                "Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0").split(",")
+PATH_TABLE, PATH_DIRECT = 0, 1   # the hits file's path column (rbs_rebound_path; -1: invalid)
 
 
 # ----------------------------------------------------------------------------- reading
@@ -72,7 +74,7 @@ def hits_dir(case: Path) -> Path:
 def parse_header(line: str) -> dict:
     """The run's settings from the first line of a hits file."""
     m = re.match(r"# stochasticRebound hits: seed (\d+), stream (\d+), table (.*), mix (.*), "
-                 r"halfSizeFactor (\S+), interpolation (\w+)", line.strip())
+                 r"halfSizeFactor (\S+), interpolation (\w+), method (\w+), spin tolerance (\S+)$", line.strip())
     if not m:
         raise ValueError(f"not a stochasticRebound hits header: {line!r}")
     mix = m.group(4)
@@ -81,7 +83,8 @@ def parse_header(line: str) -> dict:
     else:
         shape = mix
     return {"seed": int(m.group(1)), "stream": int(m.group(2)), "table": m.group(3), "shape": shape,
-            "half_size_factor": float(m.group(5)), "interpolation": m.group(6)}
+            "half_size_factor": float(m.group(5)), "interpolation": m.group(6), "method": m.group(7),
+            "spin_tolerance": float(m.group(8))}
 
 
 def read_hits(case: Path) -> tuple[dict, list]:
@@ -102,11 +105,12 @@ def read_hits(case: Path) -> tuple[dict, list]:
         values = [r[j] for r in rows]
         if name == "patch":
             cols[name] = np.array(values, dtype=object)
-        elif name in ("rank", "origProc", "origId", "status"):
+        elif name in ("rank", "origProc", "origId", "status", "path"):
             cols[name] = np.array(values, dtype=np.int64)
         else:
             cols[name] = np.array(values, dtype=float)
     cols["V"] = np.column_stack([cols["Vx"], cols["Vy"], cols["Vz"]])
+    cols["Win"] = np.column_stack([cols["Winx"], cols["Winy"], cols["Winz"]])
     cols["n"] = np.column_stack([cols["nx"], cols["ny"], cols["nz"]])
     cols["Uw"] = np.column_stack([cols["Uwx"], cols["Uwy"], cols["Uwz"]])
     cols["Vout"] = np.column_stack([cols["Voutx"], cols["Vouty"], cols["Voutz"]])
@@ -210,75 +214,158 @@ def check_records(hits: dict, post: dict) -> dict:
             "max_relative_difference_of_incident_velocity": worst}
 
 
+def _shapes_of(table, shape, count: int, seed: int):
+    """The shape of each of ``count`` direct-model rebounds: the run's shape, or drawn from its mix."""
+    if isinstance(shape, str) and shape != "mix":
+        return shape
+    weights = shape if isinstance(shape, dict) else {s: 1.0 / len(table.shapes) for s in table.shapes}
+    names = list(weights)
+    p = np.array([weights[k] for k in names]) / sum(weights.values())
+    return np.array(names, dtype=object)[np.random.default_rng(seed).choice(len(names), count, p=p)]
+
+
+def _agreement(feats_a, X_a, feats_b, X_b, classifier: bool) -> dict:
+    """Two samples of reflected states at the same incident states: KS per variable and a classifier on
+    (incident features, state), with the thresholds of equal laws at these sample sizes."""
+    n1, n2 = len(X_a), len(X_b)
+    ks = {name: ks_2samp(X_a[:, j], X_b[:, j]) for j, name in enumerate(STATE_NAMES)}
+    ks_lim = ks_threshold(n1, n2)
+    if classifier:
+        acc, n_test = classifier_accuracy(np.column_stack([feats_a, X_a]), np.column_stack([feats_b, X_b]))
+    else:
+        acc, n_test = float("nan"), n1
+    acc_lim = 0.5 + CLASSIFIER_SE * math.sqrt(0.25 / n_test)
+    return {"n_solver": n1, "n_sampler": n2, "ks": ks, "ks_threshold": ks_lim,
+            "ks_ok": bool(max(ks.values()) <= ks_lim), "classifier_accuracy": acc, "classifier_n_test": n_test,
+            "classifier_threshold": acc_lim, "classifier_ok": bool(acc <= acc_lim) if classifier else True}
+
+
+def _trapped_fraction(st_solver, st_other) -> dict:
+    """Fractions not rebounded (trapped or failed) of two samples at the same incident states."""
+    p1, p2 = float(np.mean(st_solver != STATUS_REBOUNDED)), float(np.mean(st_other != STATUS_REBOUNDED))
+    pool = (p1 + p2) / 2
+    se = math.sqrt(max(pool * (1 - pool), 1e-300) * 2 / max(len(st_solver), 1))
+    return {"solver": p1, "sampler": p2, "se": se, "ok": bool(abs(p1 - p2) <= TRAPPED_SE * se or p1 == p2)}
+
+
+def _spin_features(V, n, a, W):
+    """Ω⁻a/|V⁻| along (ex, n, ez) of each hit: the incident spin as the classifier sees it."""
+    speed = np.linalg.norm(V, axis=1)
+    vn = np.einsum("ij,ij->i", V, n)
+    t = V - vn[:, None] * n
+    ex = t / np.maximum(np.linalg.norm(t, axis=1), 1e-300)[:, None]
+    ez = np.cross(ex, n)
+    return np.column_stack([np.einsum("ij,ij->i", W, e) * a / speed for e in (ex, n, ez)])
+
+
 def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifier: bool = True) -> dict:
-    """The comparisons 2 and 3 of the module docstring (``classifier=False``: KS and trapped fractions only)."""
+    """The comparisons 2 and 3 of the module docstring (``classifier=False``: KS and trapped fractions only).
+
+    Hits the table answered are compared with ``sample_global`` at their incident states, hits the direct
+    model answered with ``rebound_direct`` at theirs (Ω⁻ included); the spinning ones among the latter also
+    with the table-only rebound the adapter drew before it passed Ω⁻ (``sample_global``, clamped at the
+    grid's edge): how far off that was."""
     hits, headers = read_hits(case)
     settings = headers[0]
     table_path = Path(table_path or settings["table"])
     table = load(table_path)
-    status = hits["status"]
+    status, path = hits["status"], hits["path"]
     n_hits = len(status)
     valid = status != STATUS_INVALID
-    V, n, a = hits["V"][valid], hits["n"][valid], hits["a"][valid]
-    V_py, W_py, st_py = sample_global(table, V, n, a, shape=settings["shape"], random_state=seed,
-                                      interpolation=settings["interpolation"], clamp=True)
-    st_of = status[valid]
     speed_lo, speed_hi = float(np.min(table.speed_m_s)), float(np.max(table.speed_m_s))
+    a_lo, a_hi = float(np.min(table.alpha1_deg)), float(np.max(table.alpha1_deg))
+    tolerance = settings["spin_tolerance"]
 
     res = {"case": str(case), "table": str(table_path), "settings": settings,
            "ranks": sorted({int(h["stream"]) for h in headers}),
            "hits": n_hits, "rebounded": int(np.sum(status == STATUS_REBOUNDED)),
-           "trapped": int(np.sum(status == STATUS_TRAPPED)), "invalid": int(np.sum(~valid))}
+           "trapped": int(np.sum(status == STATUS_TRAPPED)), "failed": int(np.sum(status == STATUS_FAILED)),
+           "invalid": int(np.sum(~valid))}
 
-    # trapped fractions
-    p1, p2 = float(np.mean(st_of == STATUS_TRAPPED)), float(np.mean(st_py == STATUS_TRAPPED))
-    pool = (p1 + p2) / 2
-    se = math.sqrt(max(pool * (1 - pool), 1e-300) * 2 / len(st_of))
-    res["trapped_fraction"] = {"solver": p1, "sampler": p2, "se": se,
-                               "ok": bool(abs(p1 - p2) <= TRAPPED_SE * se or p1 == p2)}
+    # which path answered, against the rule of rbs_rebound_path (a relative margin of 1e-9 keeps the states
+    # this script's NumPy arithmetic could put on the other side of an edge out of the check)
+    speed_all = np.linalg.norm(hits["V"], axis=1)
+    alpha1_all = np.degrees(np.arcsin(np.clip(-np.einsum("ij,ij->i", hits["V"], hits["n"]) / speed_all, -1, 1)))
+    margin = 1e-9
+    inside = ((speed_all >= speed_lo * (1 + margin)) & (speed_all <= speed_hi * (1 - margin))
+              & (alpha1_all >= a_lo * (1 + margin)) & (alpha1_all <= a_hi * (1 - margin)))
+    outside = ((speed_all < speed_lo * (1 - margin)) | (speed_all > speed_hi * (1 + margin))
+               | (alpha1_all < a_lo * (1 - margin)) | (alpha1_all > a_hi * (1 + margin)))
+    spinning = hits["spin_ratio"] > tolerance * (1 + 1e-6)     # the file's 9 digits
+    still = np.all(hits["Win"] == 0.0, axis=1)
+    res["paths"] = {
+        "method": settings["method"], "spin_tolerance": tolerance,
+        "table": int(np.sum(path == PATH_TABLE)), "direct": int(np.sum(path == PATH_DIRECT)),
+        "invalid": int(np.sum(path == STATUS_INVALID)), "spinning": int(np.sum(spinning & valid)),
+        "spinning_not_direct": int(np.sum(spinning & valid & (path != PATH_DIRECT))),
+        "outside_not_direct": int(np.sum(outside & valid & (path != PATH_DIRECT))),
+        "still_inside_not_table": int(np.sum(still & inside & valid & (path != PATH_TABLE))),
+        "still_inside": int(np.sum(still & inside & valid)),
+    }
 
+    # hits the table answered, against the sampler at the same incident states
+    on_table = valid & (path == PATH_TABLE)
+    V, n, a = hits["V"][on_table], hits["n"][on_table], hits["a"][on_table]
+    st_of = status[on_table]
+    V_py, W_py, st_py = sample_global(table, V, n, a, shape=settings["shape"], random_state=seed,
+                                      interpolation=settings["interpolation"], clamp=True)
+    res["trapped_fraction"] = _trapped_fraction(st_of, st_py)
     ok_of, ok_py = st_of == STATUS_REBOUNDED, st_py == STATUS_REBOUNDED
-    Vin_of, nin_of, ain_of = V[ok_of], n[ok_of], a[ok_of]
-    alpha1_of, speed_of, X_of = impact_states(Vin_of, nin_of, ain_of, hits["Vout"][valid][ok_of],
-                                              hits["Wout"][valid][ok_of])
+    alpha1_of, speed_of, X_of = impact_states(V[ok_of], n[ok_of], a[ok_of], hits["Vout"][on_table][ok_of],
+                                              hits["Wout"][on_table][ok_of])
     alpha1_py, speed_py, X_py = impact_states(V[ok_py], n[ok_py], a[ok_py], V_py[ok_py], W_py[ok_py])
     in_range = (speed_of >= speed_lo) & (speed_of <= speed_hi)
-    # every drawn hit (rebounded or trapped) outside the grid: the adapter's own count
-    speed_all = np.linalg.norm(V, axis=1)
-    alpha1_all = np.degrees(np.arcsin(np.clip(-np.einsum("ij,ij->i", V, n) / speed_all, -1, 1)))
-    a_lo, a_hi = float(np.min(table.alpha1_deg)), float(np.max(table.alpha1_deg))
-    outside_grid = ((speed_all < speed_lo) | (speed_all > speed_hi) | (alpha1_all < a_lo) | (alpha1_all > a_hi))
     res["incidence"] = {
-        "hits_outside_grid": int(np.sum(outside_grid)),
-        "alpha1_deg_percentiles_5_50_95": np.percentile(alpha1_of, [5, 50, 95]).round(2).tolist(),
-        "speed_m_s_percentiles_5_50_95": np.percentile(speed_of, [5, 50, 95]).round(1).tolist(),
+        "hits_outside_grid": int(np.sum(valid & ((speed_all < speed_lo) | (speed_all > speed_hi)
+                                                 | (alpha1_all < a_lo) | (alpha1_all > a_hi)))),
+        "alpha1_deg_percentiles_5_50_95": np.percentile(alpha1_all[valid], [5, 50, 95]).round(2).tolist(),
+        "speed_m_s_percentiles_5_50_95": np.percentile(speed_all[valid], [5, 50, 95]).round(1).tolist(),
         "table_speed_range_m_s": [speed_lo, speed_hi],
-        "fraction_outside_speed_range": float(1 - np.mean(in_range)),
+        "fraction_outside_speed_range": float(np.mean((speed_all[valid] < speed_lo) | (speed_all[valid] > speed_hi))),
         "spin_ratio_mean_max": [float(np.mean(hits["spin_ratio"])), float(np.max(hits["spin_ratio"]))],
     }
-
-    n1, n2 = len(X_of), len(X_py)
-    ks = {name: ks_2samp(X_of[:, j], X_py[:, j]) for j, name in enumerate(STATE_NAMES)}
-    ks_lim = ks_threshold(n1, n2)
+    s = _agreement(np.column_stack([alpha1_of, speed_of]), X_of, np.column_stack([alpha1_py, speed_py]), X_py,
+                   classifier)
     in_py = (speed_py >= speed_lo) & (speed_py <= speed_hi)
-    ks_in = {name: ks_2samp(X_of[in_range, j], X_py[in_py, j]) for j, name in enumerate(STATE_NAMES)}
-    feats_of = np.column_stack([alpha1_of, speed_of, X_of])
-    feats_py = np.column_stack([alpha1_py, speed_py, X_py])
-    if classifier:
-        acc, n_test = classifier_accuracy(feats_of, feats_py)
-    else:
-        acc, n_test = float("nan"), len(feats_of)
-    acc_lim = 0.5 + CLASSIFIER_SE * math.sqrt(0.25 / n_test)
-    res["solver_vs_sampler"] = {
-        "n_solver": n1, "n_sampler": n2,
-        "ks": ks, "ks_threshold": ks_lim, "ks_ok": bool(max(ks.values()) <= ks_lim),
-        "ks_in_speed_range": ks_in,
-        "ks_in_speed_range_threshold": ks_threshold(int(in_range.sum()), int(in_py.sum())),
-        "classifier_accuracy": acc, "classifier_n_test": n_test, "classifier_threshold": acc_lim,
-        "classifier_ok": bool(acc <= acc_lim) if classifier else True,
-    }
+    s["ks_in_speed_range"] = {name: ks_2samp(X_of[in_range, j], X_py[in_py, j]) for j, name in enumerate(STATE_NAMES)}
+    s["ks_in_speed_range_threshold"] = ks_threshold(int(in_range.sum()), int(in_py.sum()))
+    res["solver_vs_sampler"] = s
+
+    # hits the direct model answered, against surrogate.rebound_direct at the same incident states (Ω⁻ too)
+    direct = valid & (path == PATH_DIRECT)
+    res["direct_hits"] = int(direct.sum())
+    if direct.sum() > 0:
+        Vd, nd, ad, Wd = hits["V"][direct], hits["n"][direct], hits["a"][direct], hits["Win"][direct]
+        st_d = status[direct]
+        Vr, Wr, st_r = rebound_direct(table, Vd, nd, ad, omega=Wd,
+                                      shape=_shapes_of(table, settings["shape"], len(Vd), seed), random_state=seed)
+        res["direct_trapped_fraction"] = _trapped_fraction(st_d, st_r)
+        ok_d, ok_r = st_d == STATUS_REBOUNDED, st_r == STATUS_REBOUNDED
+        spin_d = _spin_features(Vd, nd, ad, Wd)
+        a1_d, sp_d, X_d = impact_states(Vd[ok_d], nd[ok_d], ad[ok_d], hits["Vout"][direct][ok_d],
+                                        hits["Wout"][direct][ok_d])
+        a1_r, sp_r, X_r = impact_states(Vd[ok_r], nd[ok_r], ad[ok_r], Vr[ok_r], Wr[ok_r])
+        res["solver_vs_direct_model"] = _agreement(np.column_stack([a1_d, sp_d, spin_d[ok_d]]), X_d,
+                                                   np.column_stack([a1_r, sp_r, spin_d[ok_r]]), X_r, classifier)
+        # the spinning ones: what the table alone (the adapter before it passed Ω⁻) gave them
+        spin_sel = spinning[direct]
+        Vt, Wt, st_t = sample_global(table, Vd[spin_sel], nd[spin_sel], ad[spin_sel], shape=settings["shape"],
+                                     random_state=seed + 1, interpolation=settings["interpolation"], clamp=True)
+        ok_s = ok_d & spin_sel
+        ok_t = st_t == STATUS_REBOUNDED
+        a1_s, sp_s, X_s = impact_states(Vd[ok_s], nd[ok_s], ad[ok_s], hits["Vout"][direct][ok_s],
+                                        hits["Wout"][direct][ok_s])
+        a1_t, sp_t, X_t = impact_states(Vd[spin_sel][ok_t], nd[spin_sel][ok_t], ad[spin_sel][ok_t], Vt[ok_t], Wt[ok_t])
+        far = _agreement(np.column_stack([a1_s, sp_s, spin_d[ok_s]]), X_s,
+                         np.column_stack([a1_t, sp_t, spin_d[spin_sel][ok_t]]), X_t, classifier)
+        far["mean_speed_ratio"] = {"direct": float(np.mean(X_s[:, 2])), "table_only": float(np.mean(X_t[:, 2]))}
+        far["mean_alpha2_minus_alpha1_deg"] = {"direct": float(np.mean(np.degrees(X_s[:, 0]) - a1_s)),
+                                               "table_only": float(np.mean(np.degrees(X_t[:, 0]) - a1_t))}
+        res["spinning_direct_vs_table_only"] = far
+        res["_plot_spin"] = (a1_s, X_s, a1_r[spin_sel[ok_r]], X_r[spin_sel[ok_r]], a1_t, X_t)
 
     # the stock bounce: e = 1, mu = 0 reflects the normal component, α2 = α1, β2 = 0, s = 1
+    Vin_of, nin_of, ain_of = V[ok_of], n[ok_of], a[ok_of]
     vn = np.einsum("ij,ij->i", Vin_of, nin_of)
     V_spec = Vin_of - 2 * vn[:, None] * nin_of
     _, _, X_spec = impact_states(Vin_of, nin_of, ain_of, V_spec, np.zeros_like(V_spec))
@@ -290,19 +377,30 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
         "mean_speed_ratio": {"solver": float(np.mean(X_of[:, 2])), "specular": float(np.mean(X_spec[:, 2]))},
         "mean_abs_beta2_deg": {"solver": float(np.mean(np.degrees(np.abs(X_of[:, 1])))), "specular": 0.0},
     }
-    res["checks_passed"] = bool(res["solver_vs_sampler"]["ks_ok"] and res["solver_vs_sampler"]["classifier_ok"]
-                                and res["trapped_fraction"]["ok"])
+    checks = [s["ks_ok"], s["classifier_ok"], res["trapped_fraction"]["ok"]]
+    if "solver_vs_direct_model" in res:
+        d = res["solver_vs_direct_model"]
+        checks += [d["ks_ok"], d["classifier_ok"], res["direct_trapped_fraction"]["ok"]]
+    res["checks_passed"] = bool(all(checks))
     res["_plot"] = (alpha1_of, X_of, alpha1_py, X_py)
     return res
 
 
+def _density(ax, values, edges, color, label):
+    ax.hist(values, edges, density=True, histtype="step", color=color, lw=1.5, label=label)
+
+
 def plot(res: dict, png: Path) -> None:
+    """Top row: the hits the table answered, against the sampler and the specular bounce; bottom row (when
+    the direct model answered spinning hits): those hits against the direct model run again on their
+    incident states and against the table-only rebound."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    spin = "_plot_spin" in res and len(res["_plot_spin"][0]) > 0
     alpha1_of, X_of, alpha1_py, X_py = res["_plot"]
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
-    ax = axes[0]
+    fig, axes = plt.subplots(2 if spin else 1, 3, figsize=(15, 9.2 if spin else 4.6), squeeze=False)
+    ax = axes[0, 0]
     ax.scatter(alpha1_py, np.degrees(X_py[:, 0]), s=2, alpha=0.25, color="tab:orange",
                label="surrogate.sample_global, same incident states", rasterized=True)
     ax.scatter(alpha1_of, np.degrees(X_of[:, 0]), s=2, alpha=0.25, color="tab:blue",
@@ -313,10 +411,10 @@ def plot(res: dict, png: Path) -> None:
     ax.set_xlim(0, 90)
     ax.set_ylim(0, 180)
     ax.legend(loc="upper left", fontsize=7, markerscale=4)
-    ax.set_title("rebound direction against incidence")
+    ax.set_title("hits the table answered: rebound direction")
     bins = np.linspace(0, 90, 19)
     centres = (bins[1:] + bins[:-1]) / 2
-    ax = axes[1]
+    ax = axes[0, 1]
     for alpha1, X, color, label in ((alpha1_of, X_of, "tab:blue", "OpenFOAM + stochasticRebound"),
                                     (alpha1_py, X_py, "tab:orange", "sample_global")):
         idx = np.digitize(alpha1, bins) - 1
@@ -329,32 +427,64 @@ def plot(res: dict, png: Path) -> None:
     ax.set_ylabel("speed ratio s = |V⁺|/|V⁻|")
     ax.set_ylim(0, 1.05)
     ax.legend(fontsize=7)
-    ax.set_title("speed ratio")
-    ax = axes[2]
+    ax.set_title("hits the table answered: speed ratio")
+    ax = axes[0, 2]
     edges = np.linspace(-60, 60, 61)
-    ax.hist(np.degrees(X_of[:, 1]), edges, density=True, histtype="step", color="tab:blue", lw=1.5,
-            label="OpenFOAM + stochasticRebound")
-    ax.hist(np.degrees(X_py[:, 1]), edges, density=True, histtype="step", color="tab:orange", lw=1.5,
-            label="sample_global")
+    _density(ax, np.degrees(X_of[:, 1]), edges, "tab:blue", "OpenFOAM + stochasticRebound")
+    _density(ax, np.degrees(X_py[:, 1]), edges, "tab:orange", "sample_global")
     ax.axvline(0.0, color="k", lw=1.5, label="specular (β2 = 0)")
     ax.set_xlabel("out-of-plane angle β2 (deg)")
     ax.set_ylabel("density (1/deg)")
     ax.legend(fontsize=7)
-    ax.set_title("out-of-plane scattering")
+    ax.set_title("hits the table answered: out-of-plane scattering")
     s = res["solver_vs_sampler"]
-    fig.suptitle(f"hopperRebound ({res['hits']} wall hits, {res['settings']['shape']}): "
-                 f"solver vs sampler KS ≤ {max(s['ks'].values()):.3f} (threshold {s['ks_threshold']:.3f}), "
-                 f"classifier {s['classifier_accuracy']:.3f} (threshold {s['classifier_threshold']:.3f})",
-                 fontsize=10)
+    title = (f"hopperRebound ({res['hits']} wall hits, {res['settings']['shape']}, method "
+             f"{res['settings']['method']}): table hits vs sampler KS ≤ {max(s['ks'].values()):.3f} (threshold "
+             f"{s['ks_threshold']:.3f}), classifier {s['classifier_accuracy']:.3f} (threshold "
+             f"{s['classifier_threshold']:.3f})")
+    if spin:
+        a1_s, X_s, a1_r, X_r, a1_t, X_t = res["_plot_spin"]
+        d, far = res["solver_vs_direct_model"], res["spinning_direct_vs_table_only"]
+        curves = ((X_s, a1_s, "tab:blue", "OpenFOAM + stochasticRebound (direct model)"),
+                  (X_r, a1_r, "tab:green", "surrogate.rebound_direct, same incident states"),
+                  (X_t, a1_t, "tab:red", "table only (Ω⁻ ignored), same incident states"))
+        for X, a1, color, label in curves:
+            _density(axes[1, 0], np.degrees(X[:, 0]) - a1, np.linspace(-60, 120, 73), color, label)
+            _density(axes[1, 1], X[:, 2], np.linspace(0, 1.2, 61), color, label)
+            _density(axes[1, 2], np.linalg.norm(X[:, 3:6], axis=1), np.linspace(0, 2, 81), color, label)
+        for ax, xlabel in zip(axes[1], ("α2 − α1 (deg)", "speed ratio s = |V⁺|/|V⁻|", "|Ω⁺| a/|V⁻|")):
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel("density")
+            ax.legend(fontsize=7)
+        axes[1, 0].set_title(f"spinning hits (|Ω⁻|a/|V⁻| > {res['paths']['spin_tolerance']:g}): {len(a1_s)} rebounds")
+        axes[1, 1].set_title(f"direct hits vs rebound_direct: classifier {d['classifier_accuracy']:.3f} "
+                             f"(≤ {d['classifier_threshold']:.3f})", fontsize=9)
+        axes[1, 2].set_title(f"spinning hits vs table only: classifier {far['classifier_accuracy']:.3f}", fontsize=9)
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)
 
 
+def _agreement_line(name: str, s: dict, thresholds: bool = True) -> str:
+    verdict = (lambda ok: (": met" if ok else ": NOT met") if thresholds else "")
+    classifier = (f"classifier {s['classifier_accuracy']:.4f} (n_test {s['classifier_n_test']}, threshold "
+                  f"{s['classifier_threshold']:.4f}{verdict(s['classifier_ok'])})"
+                  if s["classifier_accuracy"] == s["classifier_accuracy"] else "classifier not run")
+    return (f"{name} ({s['n_solver']} vs {s['n_sampler']} rebounds): KS "
+            + ", ".join(f"{k} {v:.4f}" for k, v in s["ks"].items())
+            + f" (threshold {s['ks_threshold']:.4f}{verdict(s['ks_ok'])}); " + classifier)
+
+
 def report(res: dict) -> str:
-    s, sp, inc = res["solver_vs_sampler"], res["solver_vs_specular"], res["incidence"]
+    s, sp, inc, pa = res["solver_vs_sampler"], res["solver_vs_specular"], res["incidence"], res["paths"]
     lines = [f"case {res['case']}: {res['hits']} wall hits on {len(res['ranks'])} rank(s): "
-             f"{res['rebounded']} rebounded, {res['trapped']} trapped, {res['invalid']} invalid",
+             f"{res['rebounded']} rebounded, {res['trapped']} trapped, {res['failed']} failed, "
+             f"{res['invalid']} invalid",
+             f"paths (method {pa['method']}, spin tolerance {pa['spin_tolerance']:g}): table {pa['table']}, direct "
+             f"model {pa['direct']}; spinning hits {pa['spinning']} ({pa['spinning_not_direct']} not direct), "
+             f"hits outside the grid not direct {pa['outside_not_direct']}, non-spinning hits inside the grid "
+             f"{pa['still_inside']} ({pa['still_inside_not_table']} not table)",
              f"incidence: alpha1 5/50/95 % {inc['alpha1_deg_percentiles_5_50_95']} deg, |V| "
              f"{inc['speed_m_s_percentiles_5_50_95']} m/s ({100 * inc['fraction_outside_speed_range']:.1f} % "
              f"outside the table's {inc['table_speed_range_m_s']} m/s); incoming spin |Omega|a/|V| mean "
@@ -365,19 +495,26 @@ def report(res: dict) -> str:
                      f"{r['hits_per_patch_patchPostProcessing']}; parcels matched {r['parcels_matched']}, "
                      f"mismatched {r['parcels_mismatched']}, incident velocity max rel. difference "
                      f"{r['max_relative_difference_of_incident_velocity']:.2e}")
-    lines.append(f"solver vs sample_global ({s['n_solver']} vs {s['n_sampler']} rebounds): KS "
-                 + ", ".join(f"{k} {v:.4f}" for k, v in s["ks"].items())
-                 + f" (threshold {s['ks_threshold']:.4f}: {'met' if s['ks_ok'] else 'NOT met'}); "
-                 + (f"classifier {s['classifier_accuracy']:.4f} (n_test {s['classifier_n_test']}, threshold "
-                    f"{s['classifier_threshold']:.4f}: {'met' if s['classifier_ok'] else 'NOT met'})"
-                    if s["classifier_accuracy"] == s["classifier_accuracy"] else "classifier not run"))
+    lines.append(_agreement_line("table hits: solver vs sample_global", s))
     lines.append("  within the table's speed range: KS "
                  + ", ".join(f"{k} {v:.4f}" for k, v in s["ks_in_speed_range"].items())
                  + f" (threshold {s['ks_in_speed_range_threshold']:.4f})")
     t = res["trapped_fraction"]
-    lines.append(f"trapped fraction: solver {t['solver']:.4f}, sampler {t['sampler']:.4f} "
+    lines.append(f"  trapped fraction: solver {t['solver']:.4f}, sampler {t['sampler']:.4f} "
                  f"(SE {t['se']:.4f}: {'met' if t['ok'] else 'NOT met'})")
-    lines.append("solver vs stock specular bounce: KS " + ", ".join(f"{k} {v:.3f}" for k, v in sp["ks"].items())
+    if "solver_vs_direct_model" in res:
+        lines.append(_agreement_line("direct-model hits: solver vs rebound_direct", res["solver_vs_direct_model"]))
+        t = res["direct_trapped_fraction"]
+        lines.append(f"  trapped or failed fraction: solver {t['solver']:.4f}, rebound_direct {t['sampler']:.4f} "
+                     f"(SE {t['se']:.4f}: {'met' if t['ok'] else 'NOT met'})")
+        far = res["spinning_direct_vs_table_only"]
+        lines.append(_agreement_line("spinning hits: solver (direct model) vs the table alone", far, False)
+                     + f"; mean s {far['mean_speed_ratio']['direct']:.3f} vs "
+                     f"{far['mean_speed_ratio']['table_only']:.3f}, mean alpha2-alpha1 "
+                     f"{far['mean_alpha2_minus_alpha1_deg']['direct']:.1f} vs "
+                     f"{far['mean_alpha2_minus_alpha1_deg']['table_only']:.1f} deg")
+    lines.append("table hits vs stock specular bounce: KS "
+                 + ", ".join(f"{k} {v:.3f}" for k, v in sp["ks"].items())
                  + f"; mean alpha2-alpha1 {sp['mean_alpha2_minus_alpha1_deg']['solver']:.1f} deg (specular 0), "
                  f"mean s {sp['mean_speed_ratio']['solver']:.3f} (specular 1), mean |beta2| "
                  f"{sp['mean_abs_beta2_deg']['solver']:.1f} deg (specular 0)")

@@ -283,12 +283,12 @@ enum {
 /* The path that answers a hit (rbs_rebound_path). */
 enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
 
-/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.SPIN_TOLERANCE). */
+/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.kernels.spin.SPIN_TOLERANCE). */
 #define RBS_SPIN_TOLERANCE 0.002
 
-/* The path that answers a hit under `method` (surrogate.kernels.rebound_path): a pure function of the
- * state, so a caller learns it without another draw. Under RBS_AUTO, the table iff Ω⁻ = 0 or
- * |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE, and α1 and |V⁻| (as rbs_rebound computes them) lie in the table's
+/* The path that answers a hit under `method` (surrogate.kernels.spin.rebound_path): a pure function of the
+ * state, so a caller learns it without another draw. Under RBS_AUTO, the table iff |Ω⁻| a/|V⁻| <=
+ * RBS_SPIN_TOLERANCE (Ω⁻ = 0 included), and α1 and |V⁻| (as rbs_rebound computes them) lie in the table's
  * grid ranges, edges included (rbs_table_alpha1_range, rbs_table_speed_range); else the direct model.
  *   V, n, a  as rbs_rebound;  Omega  incident angular velocity Ω⁻, rad/s (finite)
  * Returns RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_INVALID for a NULL pointer, an unknown method, or a
@@ -298,7 +298,7 @@ int rbs_rebound_path(const rbs_table *table, const double V[3], const double Ome
                      double a, int method);
 
 /* The reflected state of one particle, spinning or not, from the table or the direct model
- * (surrogate.kernels.rebound_spin_tuple): the path rbs_rebound_path gives, then
+ * (surrogate.kernels.spin.rebound_spin_tuple): the path rbs_rebound_path gives, then
  *   RBS_PATH_TABLE   rbs_rebound with the same u (Ω⁻ unused);
  *   RBS_PATH_DIRECT  the shape drawn from the mix with u[0] as rbs_rebound draws it, then
  *                    rbs_rebound_direct with that shape's code and u[1..RBS_U_PER_REBOUND] as its uniforms.

@@ -26,14 +26,14 @@ static int method_known(int method)
     return method == RBS_AUTO || method == RBS_TABLE || method == RBS_DIRECT;
 }
 
-/* the table answers at (α1, |V⁻|, |Ω⁻|): no spin to speak of, inside the grid (edges included) */
+/* the table answers the hit (surrogate.kernels.spin._table_valid): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE, α1 and |V⁻|
+ * inside the grid, edges included */
 static int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
 {
-    int still = Omega[0] == 0.0 && Omega[1] == 0.0 && Omega[2] == 0.0;
-    double spin = sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) * a / speed;
-    return (still || spin <= RBS_SPIN_TOLERANCE)
-           && alpha1_deg >= t->alpha1_deg[0] && alpha1_deg <= t->alpha1_deg[t->n_alpha1 - 1]
-           && speed >= t->speed_m_s[0] && speed <= t->speed_m_s[t->n_speed - 1];
+    double spin = a * sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) / speed;
+    const double *alpha1_grid = t->alpha1_axis + AXIS_GRID, *speed_grid = t->speed_axis + AXIS_GRID;
+    return (spin <= RBS_SPIN_TOLERANCE) & (alpha1_deg >= alpha1_grid[0]) & (alpha1_deg <= alpha1_grid[t->n_alpha1 - 1])
+           & (speed >= speed_grid[0]) & (speed <= speed_grid[t->n_speed - 1]);
 }
 
 int rbs_rebound_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a,

@@ -7,7 +7,9 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
 ``draw_local``; the direct model's run-time kernel ``rebound_direct_tuple`` and the kernels it calls
 (``direct_model``: collide, body_vertices, bounding_radius, normal_quantile, aspect_ratio,
-uniform_quaternion, quaternion_to_matrix); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
+uniform_quaternion, quaternion_to_matrix); those of every hit (``surrogate.kernels.spin``:
+``rebound_spin_tuple``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_* and PATH_* codes); tables come from
+``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks and the samples' angle conversion from ``data_schema``.
 """
 
@@ -22,6 +24,8 @@ from direct_model.collision import collide
 from direct_model.rebound import quaternion_to_matrix
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, normal_quantile, uniform_quaternion
 from direct_model.shapes import MAX_VERTICES, body_vertices, bounding_radius
+from surrogate.kernels.spin import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE, SPIN_TOLERANCE,
+                                    rebound_path, rebound_spin_tuple)
 
 
 def build_table(config_text: str, path) -> None:
@@ -50,4 +54,6 @@ __all__ = ["angles_to_velocity", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_T
            "draw_local", "fill_uniforms", "load", "mix_cdf", "rebound", "rebound_many", "rebound_many_rng",
            "rebound_tuple", "rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
            "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius", "collide",
-           "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion"]
+           "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion",
+           "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE", "SPIN_TOLERANCE", "rebound_path",
+           "rebound_spin_tuple"]
