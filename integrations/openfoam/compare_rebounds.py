@@ -167,14 +167,23 @@ def ks_threshold(n: int, m: int) -> float:
     return KS_C_999 * math.sqrt((n + m) / (n * m))
 
 
-def classifier_accuracy(X, Y, seed: int = 0) -> tuple[float, int]:
-    """Held-out accuracy of a gradient-boosting classifier telling rows of X from rows of Y; n_test."""
+def classifier_accuracy(X, Y, seed: int = 0, groups=None) -> tuple[float, int]:
+    """Held-out accuracy of a gradient-boosting classifier telling rows of X from rows of Y; n_test.
+
+    ``groups`` (the hit of each row of X, then of each row of Y): the rows of one hit go to the same half.
+    Both samples share their incident features row for row; split apart, the twin of a training row is
+    recognised and given the other label, which pulls the accuracy below ½ and weakens the test."""
     from sklearn.ensemble import HistGradientBoostingClassifier
     from sklearn.model_selection import train_test_split
     Z = np.vstack([X, Y])
     labels = np.r_[np.zeros(len(X)), np.ones(len(Y))]
-    Z_train, Z_test, y_train, y_test = train_test_split(Z, labels, test_size=0.5, random_state=seed,
-                                                        stratify=labels)
+    if groups is None:
+        Z_train, Z_test, y_train, y_test = train_test_split(Z, labels, test_size=0.5, random_state=seed,
+                                                            stratify=labels)
+    else:
+        ids = np.unique(groups)
+        train = np.isin(groups, np.random.default_rng(seed).permutation(ids)[:len(ids) // 2])
+        Z_train, Z_test, y_train, y_test = Z[train], Z[~train], labels[train], labels[~train]
     model = HistGradientBoostingClassifier(max_iter=200, random_state=seed).fit(Z_train, y_train)
     return float(model.score(Z_test, y_test)), len(y_test)
 
@@ -224,14 +233,16 @@ def _shapes_of(table, shape, count: int, seed: int):
     return np.array(names, dtype=object)[np.random.default_rng(seed).choice(len(names), count, p=p)]
 
 
-def _agreement(feats_a, X_a, feats_b, X_b, classifier: bool) -> dict:
-    """Two samples of reflected states at the same incident states: KS per variable and a classifier on
-    (incident features, state), with the thresholds of equal laws at these sample sizes."""
+def _agreement(feats_a, X_a, feats_b, X_b, classifier: bool, hits_a, hits_b) -> dict:
+    """Two samples of reflected states at the same incident states (``hits_a``, ``hits_b``: the hit of each
+    row): KS per variable and a classifier on (incident features, state), with the thresholds of equal laws
+    at these sample sizes."""
     n1, n2 = len(X_a), len(X_b)
     ks = {name: ks_2samp(X_a[:, j], X_b[:, j]) for j, name in enumerate(STATE_NAMES)}
     ks_lim = ks_threshold(n1, n2)
     if classifier:
-        acc, n_test = classifier_accuracy(np.column_stack([feats_a, X_a]), np.column_stack([feats_b, X_b]))
+        acc, n_test = classifier_accuracy(np.column_stack([feats_a, X_a]), np.column_stack([feats_b, X_b]),
+                                          groups=np.r_[hits_a, hits_b])
     else:
         acc, n_test = float("nan"), n1
     acc_lim = 0.5 + CLASSIFIER_SE * math.sqrt(0.25 / n_test)
@@ -258,6 +269,48 @@ def _spin_features(V, n, a, W):
     return np.column_stack([np.einsum("ij,ij->i", W, e) * a / speed for e in (ex, n, ez)])
 
 
+def incidence(hits: dict):
+    """α1 (deg) and |V⁻| (m/s) of every hit record."""
+    speed = np.linalg.norm(hits["V"], axis=1)
+    return np.degrees(np.arcsin(np.clip(-np.einsum("ij,ij->i", hits["V"], hits["n"]) / speed, -1, 1))), speed
+
+
+def check_paths(hits: dict, settings: dict, table) -> dict:
+    """Which path answered the hits, against the rule of rbs_rebound_path under method auto: counts per path,
+    and the spinning hits, the hits outside the grid and the non-spinning hits inside it that went elsewhere.
+    A relative margin of 1e-9 keeps the states this script's NumPy arithmetic could put on the other side of
+    a grid edge, and 1e-6 those the file's 9 digits of |Ω⁻|a/|V⁻| could put on the other side of the spin
+    tolerance, out of the check."""
+    status, path = hits["status"], hits["path"]
+    valid = status != STATUS_INVALID
+    speed_lo, speed_hi = float(np.min(table.speed_m_s)), float(np.max(table.speed_m_s))
+    a_lo, a_hi = float(np.min(table.alpha1_deg)), float(np.max(table.alpha1_deg))
+    tolerance = settings["spin_tolerance"]
+    alpha1_all, speed_all = incidence(hits)
+    margin = 1e-9
+    inside = ((speed_all >= speed_lo * (1 + margin)) & (speed_all <= speed_hi * (1 - margin))
+              & (alpha1_all >= a_lo * (1 + margin)) & (alpha1_all <= a_hi * (1 - margin)))
+    outside = ((speed_all < speed_lo * (1 - margin)) | (speed_all > speed_hi * (1 + margin))
+               | (alpha1_all < a_lo * (1 - margin)) | (alpha1_all > a_hi * (1 + margin)))
+    spinning = hits["spin_ratio"] > tolerance * (1 + 1e-6)
+    still = hits["spin_ratio"] < tolerance * (1 - 1e-6)
+    return {
+        "method": settings["method"], "spin_tolerance": tolerance,
+        "table": int(np.sum(path == PATH_TABLE)), "direct": int(np.sum(path == PATH_DIRECT)),
+        "invalid": int(np.sum(path == STATUS_INVALID)), "spinning": int(np.sum(spinning & valid)),
+        "spinning_not_direct": int(np.sum(spinning & valid & (path != PATH_DIRECT))),
+        "outside_not_direct": int(np.sum(outside & valid & (path != PATH_DIRECT))),
+        "still_inside": int(np.sum(still & inside & valid)),
+        "still_inside_not_table": int(np.sum(still & inside & valid & (path != PATH_TABLE))),
+    }
+
+
+def compare_paths(case: Path, table_path: Path | None = None) -> dict:
+    """:func:`check_paths` of a run's hit records (the table from the path the run recorded)."""
+    hits, headers = read_hits(case)
+    return check_paths(hits, headers[0], load(Path(table_path or headers[0]["table"])))
+
+
 def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifier: bool = True) -> dict:
     """The comparisons 2 and 3 of the module docstring (``classifier=False``: KS and trapped fractions only).
 
@@ -282,26 +335,9 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
            "trapped": int(np.sum(status == STATUS_TRAPPED)), "failed": int(np.sum(status == STATUS_FAILED)),
            "invalid": int(np.sum(~valid))}
 
-    # which path answered, against the rule of rbs_rebound_path (a relative margin of 1e-9 keeps the states
-    # this script's NumPy arithmetic could put on the other side of an edge out of the check)
-    speed_all = np.linalg.norm(hits["V"], axis=1)
-    alpha1_all = np.degrees(np.arcsin(np.clip(-np.einsum("ij,ij->i", hits["V"], hits["n"]) / speed_all, -1, 1)))
-    margin = 1e-9
-    inside = ((speed_all >= speed_lo * (1 + margin)) & (speed_all <= speed_hi * (1 - margin))
-              & (alpha1_all >= a_lo * (1 + margin)) & (alpha1_all <= a_hi * (1 - margin)))
-    outside = ((speed_all < speed_lo * (1 - margin)) | (speed_all > speed_hi * (1 + margin))
-               | (alpha1_all < a_lo * (1 - margin)) | (alpha1_all > a_hi * (1 + margin)))
+    res["paths"] = check_paths(hits, settings, table)
+    alpha1_all, speed_all = incidence(hits)
     spinning = hits["spin_ratio"] > tolerance * (1 + 1e-6)     # the file's 9 digits
-    still = np.all(hits["Win"] == 0.0, axis=1)
-    res["paths"] = {
-        "method": settings["method"], "spin_tolerance": tolerance,
-        "table": int(np.sum(path == PATH_TABLE)), "direct": int(np.sum(path == PATH_DIRECT)),
-        "invalid": int(np.sum(path == STATUS_INVALID)), "spinning": int(np.sum(spinning & valid)),
-        "spinning_not_direct": int(np.sum(spinning & valid & (path != PATH_DIRECT))),
-        "outside_not_direct": int(np.sum(outside & valid & (path != PATH_DIRECT))),
-        "still_inside_not_table": int(np.sum(still & inside & valid & (path != PATH_TABLE))),
-        "still_inside": int(np.sum(still & inside & valid)),
-    }
 
     # hits the table answered, against the sampler at the same incident states
     on_table = valid & (path == PATH_TABLE)
@@ -324,8 +360,9 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
         "fraction_outside_speed_range": float(np.mean((speed_all[valid] < speed_lo) | (speed_all[valid] > speed_hi))),
         "spin_ratio_mean_max": [float(np.mean(hits["spin_ratio"])), float(np.max(hits["spin_ratio"]))],
     }
+    rows = np.flatnonzero(on_table)
     s = _agreement(np.column_stack([alpha1_of, speed_of]), X_of, np.column_stack([alpha1_py, speed_py]), X_py,
-                   classifier)
+                   classifier, rows[ok_of], rows[ok_py])
     in_py = (speed_py >= speed_lo) & (speed_py <= speed_hi)
     s["ks_in_speed_range"] = {name: ks_2samp(X_of[in_range, j], X_py[in_py, j]) for j, name in enumerate(STATE_NAMES)}
     s["ks_in_speed_range_threshold"] = ks_threshold(int(in_range.sum()), int(in_py.sum()))
@@ -345,8 +382,10 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
         a1_d, sp_d, X_d = impact_states(Vd[ok_d], nd[ok_d], ad[ok_d], hits["Vout"][direct][ok_d],
                                         hits["Wout"][direct][ok_d])
         a1_r, sp_r, X_r = impact_states(Vd[ok_r], nd[ok_r], ad[ok_r], Vr[ok_r], Wr[ok_r])
+        rows = np.flatnonzero(direct)
         res["solver_vs_direct_model"] = _agreement(np.column_stack([a1_d, sp_d, spin_d[ok_d]]), X_d,
-                                                   np.column_stack([a1_r, sp_r, spin_d[ok_r]]), X_r, classifier)
+                                                   np.column_stack([a1_r, sp_r, spin_d[ok_r]]), X_r, classifier,
+                                                   rows[ok_d], rows[ok_r])
         # the spinning ones: what the table alone (the adapter before it passed Ω⁻) gave them
         spin_sel = spinning[direct]
         Vt, Wt, st_t = sample_global(table, Vd[spin_sel], nd[spin_sel], ad[spin_sel], shape=settings["shape"],
@@ -357,7 +396,8 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
                                         hits["Wout"][direct][ok_s])
         a1_t, sp_t, X_t = impact_states(Vd[spin_sel][ok_t], nd[spin_sel][ok_t], ad[spin_sel][ok_t], Vt[ok_t], Wt[ok_t])
         far = _agreement(np.column_stack([a1_s, sp_s, spin_d[ok_s]]), X_s,
-                         np.column_stack([a1_t, sp_t, spin_d[spin_sel][ok_t]]), X_t, classifier)
+                         np.column_stack([a1_t, sp_t, spin_d[spin_sel][ok_t]]), X_t, classifier, rows[ok_s],
+                         rows[spin_sel][ok_t])
         far["mean_speed_ratio"] = {"direct": float(np.mean(X_s[:, 2])), "table_only": float(np.mean(X_t[:, 2]))}
         far["mean_alpha2_minus_alpha1_deg"] = {"direct": float(np.mean(np.degrees(X_s[:, 0]) - a1_s)),
                                                "table_only": float(np.mean(np.degrees(X_t[:, 0]) - a1_t))}
@@ -521,6 +561,84 @@ def report(res: dict) -> str:
     return "\n".join(lines)
 
 
+# ----------------------------------------------------------------------------- erosion
+
+def _foam_list(text: str, what: str) -> list:
+    """The entries of the first ASCII list of an OpenFOAM file: 'N (entry entry ...)', each entry a
+    parenthesised group of numbers, possibly prefixed by its length (faces: 4(a b c d))."""
+    body = text[text.index("(", re.search(r"^\d+\s*$", text, re.M).end()) + 1:]
+    entries = re.findall(r"\d*\(([^()]*)\)", body.split("\n)", 1)[0])
+    if not entries:
+        raise ValueError(f"no {what} list")
+    return [e.split() for e in entries]
+
+
+def wall_face_centres(case: Path, patch: str) -> np.ndarray:
+    """(n_faces, 3) centres (vertex means, m) of the faces of ``patch``, from the case's ASCII polyMesh."""
+    mesh = case / "constant" / "polyMesh"
+    points = np.array(_foam_list((mesh / "points").read_text(), "points"), dtype=float)
+    faces = _foam_list((mesh / "faces").read_text(), "faces")
+    block = re.search(rf"\n\s*{re.escape(patch)}\s*\{{([^}}]*)\}}", (mesh / "boundary").read_text()).group(1)
+    start = int(re.search(r"startFace\s+(\d+);", block).group(1))
+    count = int(re.search(r"nFaces\s+(\d+);", block).group(1))
+    return np.array([points[np.array(faces[f], dtype=int)].mean(axis=0) for f in range(start, start + count)])
+
+
+def read_erosion(case: Path, patch: str = "walls", cloud: str = "kinematicCloud") -> np.ndarray:
+    """The volume each face of ``patch`` lost (m³), from OpenFOAM's particleErosion field <cloud>Q at the
+    last write time of a serial run."""
+    times = [p for p in case.iterdir() if re.fullmatch(r"[0-9.e+-]+", p.name) and (p / f"{cloud}Q").is_file()]
+    if not times:
+        raise FileNotFoundError(f"{case}: no {cloud}Q field (particleErosion) in a time folder")
+    text = (max(times, key=lambda p: float(p.name)) / f"{cloud}Q").read_text()
+    block = text[re.search(rf"\n\s*{re.escape(patch)}\s*\n\s*\{{", text).end():]
+    m = re.search(r"value\s+(uniform\s+([-0-9.eE+]+)|nonuniform\s+List<scalar>\s*(\d+)\s*\(([^)]*)\))", block)
+    if m.group(2) is not None:
+        n_faces = len(wall_face_centres(case, patch))
+        return np.full(n_faces, float(m.group(2)))
+    return np.array(m.group(4).split(), dtype=float)
+
+
+def erosion_summary(case: Path, patch: str = "walls") -> dict:
+    """Faces of ``patch`` with erosion, of how many, and the total volume lost (m³)."""
+    q = read_erosion(case, patch)
+    return {"faces_eroded": int(np.sum(q > 0)), "faces": int(q.size), "total_m3": float(q.sum()),
+            "max_face_m3": float(q.max())}
+
+
+def plot_erosion(cases: dict, png: Path, patch: str = "walls") -> None:
+    """Side by side, one panel per run (``cases``: label → case folder): the hopper's wall outline in the
+    x-y plane, each point a column of faces across the depth, coloured by the volume those faces lost."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+    data = {}
+    for label, case in cases.items():
+        centres, q = wall_face_centres(case, patch), read_erosion(case, patch)
+        columns = {}
+        for c, v in zip(np.round(centres[:, :2], 7), q):
+            columns[tuple(c)] = columns.get(tuple(c), 0.0) + v
+        xy = np.array(list(columns))
+        data[label] = (xy, np.array(list(columns.values())), erosion_summary(case, patch))
+    positive = np.concatenate([v[v > 0] for _, v, _ in data.values()])
+    norm = LogNorm(vmin=positive.min(), vmax=positive.max())
+    fig, axes = plt.subplots(1, len(cases), figsize=(5.2 * len(cases), 6.2), squeeze=False)
+    for ax, (label, (xy, v, summary)) in zip(axes[0], data.items()):
+        ax.scatter(xy[v <= 0, 0], xy[v <= 0, 1], s=10, color="0.85", label="no erosion")
+        im = ax.scatter(xy[v > 0, 0], xy[v > 0, 1], c=v[v > 0], s=22, norm=norm, cmap="inferno_r")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.set_title(f"{label}\n{summary['faces_eroded']} of {summary['faces']} faces eroded, total "
+                     f"{summary['total_m3']:.2e} m³", fontsize=9)
+        ax.legend(fontsize=7, loc="lower right")
+    fig.colorbar(im, ax=axes[0].tolist(), label="volume lost per column of wall faces (m³, particleErosion)",
+                 shrink=0.8)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("case", type=Path)
@@ -530,6 +648,9 @@ def main(argv=None) -> int:
     parser.add_argument("--json", type=Path, help="write the figures here")
     parser.add_argument("--no-classifier", action="store_true", help="KS and trapped fractions only (faster)")
     parser.add_argument("--check", action="store_true", help="exit 1 if a threshold is not met")
+    parser.add_argument("--erosion-against", type=Path, metavar="CASE",
+                        help="a run of the same case with standardWallInteraction: compare the erosion of both")
+    parser.add_argument("--erosion-png", type=Path, help="write the two erosion maps side by side here")
     args = parser.parse_args(argv)
     res = compare(args.case, args.table, args.seed, classifier=not args.no_classifier)
     post = read_patch_post(args.case)
@@ -545,6 +666,15 @@ def main(argv=None) -> int:
     if args.png:
         plot(res, args.png)
         print(f"wrote {args.png}")
+    if args.erosion_against:
+        res["erosion"] = {"stochasticRebound": erosion_summary(args.case),
+                          "standardWallInteraction": erosion_summary(args.erosion_against)}
+        for label, e in res["erosion"].items():
+            print(f"erosion ({label}): {e['faces_eroded']} of {e['faces']} wall faces, total {e['total_m3']:.3e} m3")
+        if args.erosion_png:
+            plot_erosion({"standardWallInteraction (specular)": args.erosion_against,
+                          f"stochasticRebound, method {res['settings']['method']}": args.case}, args.erosion_png)
+            print(f"wrote {args.erosion_png}")
     if args.json:
         args.json.write_text(json.dumps({k: v for k, v in res.items() if not k.startswith("_")}, indent=2))
     if args.check and not res["checks_passed"]:
