@@ -5,7 +5,9 @@
  * docs/format.md) and draws reflected states of non-spherical particles hitting
  * a wall, with the same law and the same bits as the numba kernels of the
  * Python package `surrogate` (surrogate.kernels.rebound_tuple, rebound_many,
- * rebound_many_rng, draw_local), for the same uniforms. See docs/native.md.
+ * rebound_many_rng, draw_local), for the same uniforms; and runs the direct
+ * model itself where the table's law does not apply (rbs_rebound_direct, the
+ * bits of surrogate.kernels.rebound_direct_tuple). See docs/native.md.
  *
  * Frames and units
  * ----------------
@@ -146,7 +148,8 @@ typedef struct rbs_table_info {
  * valid": the file is a regular HDF5 file, file_type "rebound_table", format_version (3, any minor), the
  * groups, datasets (every one read, so every checksum verified) and attributes with their shapes, the
  * grids and shape names, the wall law (and its checksummed copy since 3.2), the cell values; then the
- * derived arrays are checked finite.
+ * derived arrays are checked finite, and the direct model's parameters in range (those of
+ * surrogate.table.direct_parameters, RBS_ERR_FORMAT "the direct model's parameters are out of range").
  * Returns RBS_OK, RBS_ERR_IO, RBS_ERR_FORMAT, RBS_ERR_VERSION, RBS_ERR_MEMORY or RBS_ERR_ARGUMENT. */
 int rbs_table_open(const char *path, rbs_table **table, char *message, size_t message_size);
 

@@ -5,7 +5,8 @@
  *   - a collision keeps the angular momentum about the contact point, KΩ − r_c × V;
  *   - a free flight keeps the energy ½ΩᵀKΩ and the angular momentum L = KΩ (lab) to 1e-9;
  *   - a whole rebound never adds energy;
- * then hostile calls of rbs_rebound_direct on a table (RBS_INVALID and NaN, never a crash).
+ * then hostile calls of rbs_rebound_direct on a table (RBS_INVALID and NaN, never a crash), and four threads
+ * calling it on one table give the bits of one thread.
  *
  *   rbs_test_direct GOOD.h5 [TABLE_WITHOUT_DIRECT_PARAMETERS.h5]
  *
@@ -14,6 +15,7 @@
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -264,6 +266,62 @@ static void hostile(const rbs_table *table, const rbs_table *without)
     printf("hostile inputs: RBS_INVALID with NaN outputs\n");
 }
 
+#define THREADED 4000   /* particles of the thread check */
+#define THREADS 4
+
+typedef struct job {
+    const rbs_table *table;
+    const double *V, *Omega, *u;
+    double *V_out, *Omega_out;
+    int *status;
+    int first, last;
+} job;
+
+static void *run_job(void *arg)
+{
+    job *j = arg;
+    const double n[3] = {0.0, 1.0, 0.0};
+    for (int i = j->first; i < j->last; i++)
+        j->status[i] = rbs_rebound_direct(j->table, i % 4, j->V + 3 * i, j->Omega + 3 * i, n, 1e-4,
+                                          j->u + RBS_U_PER_REBOUND * i, j->V_out + 3 * i, j->Omega_out + 3 * i);
+    return NULL;
+}
+
+/* THREADS threads on one table give the bits of one thread */
+static void threads(const rbs_table *table, rbs_rng *rng)
+{
+    double *V = malloc(3 * THREADED * sizeof *V), *Omega = malloc(3 * THREADED * sizeof *Omega);
+    double *u = malloc(RBS_U_PER_REBOUND * THREADED * sizeof *u), *out = malloc(4 * 3 * THREADED * sizeof *out);
+    int *status = malloc(2 * THREADED * sizeof *status);
+    if (!V || !Omega || !u || !out || !status) {
+        CHECK(0, "out of memory");
+        free(V), free(Omega), free(u), free(out), free(status);
+        return;
+    }
+    for (int i = 0; i < THREADED; i++) {
+        double angle = 0.05 + 1.5 * rbs_rng_uniform(rng);
+        V[3 * i] = 150.0 * cos(angle);
+        V[3 * i + 1] = -150.0 * sin(angle);
+        V[3 * i + 2] = 0.0;
+        for (int k = 0; k < 3; k++) Omega[3 * i + k] = i % 2 ? 0.0 : 3e5 * (2.0 * rbs_rng_uniform(rng) - 1.0);
+        rbs_rng_fill(rng, u + RBS_U_PER_REBOUND * i, RBS_U_PER_REBOUND);
+    }
+    job one = {table, V, Omega, u, out, out + 3 * THREADED, status, 0, THREADED};
+    run_job(&one);
+    pthread_t thread[THREADS];
+    job part[THREADS];
+    for (int k = 0; k < THREADS; k++) {
+        part[k] = (job){table, V, Omega, u, out + 6 * THREADED, out + 9 * THREADED, status + THREADED,
+                        k * THREADED / THREADS, (k + 1) * THREADED / THREADS};
+        CHECK(pthread_create(&thread[k], NULL, run_job, &part[k]) == 0, "thread %d", k);
+    }
+    for (int k = 0; k < THREADS; k++) pthread_join(thread[k], NULL);
+    CHECK(memcmp(status, status + THREADED, THREADED * sizeof *status) == 0, "statuses differ between threads");
+    CHECK(memcmp(out, out + 6 * THREADED, 6 * THREADED * sizeof *out) == 0, "outputs differ between threads");
+    printf("threads: %d particles on %d threads, the bits of one thread\n", THREADED, THREADS);
+    free(V), free(Omega), free(u), free(out), free(status);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2 || argc > 3) {
@@ -279,7 +337,10 @@ int main(int argc, char **argv)
     char message[1024];
     CHECK(rbs_table_open(argv[1], &table, message, sizeof message) == RBS_OK, "%s", message);
     if (argc == 3) CHECK(rbs_table_open(argv[2], &without, message, sizeof message) == RBS_OK, "%s", message);
-    if (table) hostile(table, without);
+    if (table) {
+        hostile(table, without);
+        threads(table, &rng);
+    }
     rbs_table_close(table);
     rbs_table_close(without);
     printf("%s: %d failure(s)\n", argv[0], failures);

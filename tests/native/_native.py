@@ -268,6 +268,14 @@ class Native:
         c.rbs_error_string.argtypes = [i]
         c.rbs_error_string.restype = ctypes.c_char_p
         c.rbs_version.restype = ctypes.c_char_p
+        c.rbs_rotation_init.argtypes = [vp, vp, vp, vp]
+        c.rbs_rotation_init.restype = None
+        c.rbs_rotation_at.argtypes = [vp, d, vp, vp]
+        c.rbs_rotation_at.restype = None
+        c.rbs_carlson_rf.argtypes = [d, d, d]
+        c.rbs_carlson_rf.restype = d
+        c.rbs_carlson_rj.argtypes = [d, d, d, d]
+        c.rbs_carlson_rj.restype = d
 
     def open(self, path):
         """(code, NativeTable or None, message)."""
@@ -304,6 +312,20 @@ class Native:
         rng, u = _rng(state), np.empty((count, U_PER_DRAW))
         self.c.rbs_rebound_uniforms(ctypes.byref(rng), ctypes.c_size_t(count), _ptr(u))
         return u, np.array(list(rng.s), dtype=np.uint64)
+
+    # -- torque-free flight (rotation.c, internal functions exported by the shared library)
+    def rotation_init(self, K, R0, ell, params: np.ndarray) -> None:
+        """rbs_rotation_init into ``params`` (float64, C-contiguous, written in place)."""
+        K, R0, ell = (np.ascontiguousarray(x, dtype=np.float64) for x in (K, R0, ell))
+        assert params.dtype == np.float64 and params.flags.c_contiguous
+        self.c.rbs_rotation_init(_ptr(K), _ptr(R0), _ptr(ell), _ptr(params))
+
+    def rotation_at(self, params: np.ndarray, t: float):
+        """(R (3x3, body -> lab), omega (lab)) of rbs_rotation_at."""
+        params = np.ascontiguousarray(params, dtype=np.float64)
+        R, omega = np.empty((3, 3)), np.empty(3)
+        self.c.rbs_rotation_at(_ptr(params), ctypes.c_double(t), _ptr(R), _ptr(omega))
+        return R, omega
 
 
 def environment_without_preload() -> dict:

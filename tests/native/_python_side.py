@@ -5,21 +5,21 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``table.kernel_data``, ``surrogate.mix_cdf``, ``surrogate.seed_state``, ``surrogate.fill_uniforms``,
 ``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
 ``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
-``draw_local``; the direct model's run-time kernel ``rebound_direct_tuple`` and the kernels it calls
-(``direct_model``: collide, body_vertices, bounding_radius, normal_quantile, aspect_ratio,
-uniform_quaternion, quaternion_to_matrix); those of every hit (``surrogate.kernels.spin``:
-``rebound_spin_tuple``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_* and PATH_* codes); tables come from
-``tablegen.build_table`` and ``tablegen.parse_config``;
+``draw_local``; the direct model's free flight from ``direct_model.rotation``, its run-time kernel
+``rebound_direct_tuple`` and the kernels it calls (``direct_model``: collide, body_vertices,
+bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix); those of every
+hit (``surrogate.kernels.spin``: ``rebound_spin_tuple``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
+and PATH_* codes); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks and the samples' angle conversion from ``data_schema``.
 """
 
 import surrogate
-from data_schema.samples import angles_to_velocity
+from data_schema.samples import STATUS_FAILED, angles_to_velocity
+from direct_model.rotation import ROT_PARAMS_SIZE, carlson_rf, carlson_rj, rotation_at, rotation_init
 from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, load, mix_cdf, \
     seed_state
 from surrogate.kernels import draw_local, rebound, rebound_many, rebound_many_rng, rebound_tuple, rebound_uniforms
 from surrogate.kernels.direct import rebound_direct_tuple
-from data_schema.samples import STATUS_FAILED
 from direct_model.collision import collide
 from direct_model.rebound import quaternion_to_matrix
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, normal_quantile, uniform_quaternion
@@ -50,10 +50,11 @@ def write_samples_file(path) -> None:
                                   alpha1=45.0, speed=100.0, shape="prism", seed=1, producer="tests/native"))
 
 
-__all__ = ["angles_to_velocity", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
+__all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", "rotation_at", "rotation_init",
+           "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
            "draw_local", "fill_uniforms", "load", "mix_cdf", "rebound", "rebound_many", "rebound_many_rng",
            "rebound_tuple", "rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
-           "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius", "collide",
-           "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion",
+           "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",
+           "collide", "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion",
            "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE", "SPIN_TOLERANCE", "rebound_path",
            "rebound_spin_tuple"]

@@ -57,7 +57,9 @@ def _direct_c(c, table, shape, V, omega, n, a, u):
 
 
 def _same(a, b):
-    return np.array_equal(np.asarray(a, dtype=np.float64).view(np.uint64), np.asarray(b, dtype=np.float64).view(np.uint64))
+    """The same float64 bits."""
+    bits = (np.asarray(x, dtype=np.float64).view(np.uint64) for x in (a, b))
+    return np.array_equal(*bits)
 
 
 def _old_table(small_table_path, tmp_path, name, **changes):
@@ -91,6 +93,29 @@ def test_the_parameter_array_is_surrogate_s(native, table_pair, small_table_path
     expected = py.load(old).direct_parameters
     assert _same(native.table(old).kernel_array("direct_parameters"), expected)
     assert _same(expected, python.direct_parameters)
+
+
+@pytest.mark.parametrize("law", [
+    "aspect_ratio = {mean = 0.75, sd = 0.25, low = 0.4, high = 0.95}",
+    "[simulation.aspect_ratio]\nmean = 0.75\nsd = 0.25 # a comment\nlow = 0.4\nhigh = 0.95",
+])
+def test_an_old_table_takes_the_configuration_s_aspect_law(native, small_table_path, tmp_path, law):
+    """Without the aspect_ratio_* attributes the law comes from the build's configuration (TOML): the inline
+    table tablegen writes, or a [simulation.aspect_ratio] table; the same bits as surrogate."""
+    path = _old_table(small_table_path, tmp_path, "config.h5", **OLD)
+    with h5py.File(path, "r+") as f:
+        lines = str(f.attrs["config"]).split("\n")
+        inline = [k for k, line in enumerate(lines) if line.startswith("aspect_ratio")]
+        assert len(inline) == 1
+        if law.startswith("["):
+            del lines[inline[0]]
+            lines += ["", law]
+        else:
+            lines[inline[0]] = law
+        f.attrs["config"] = "\n".join(lines)
+    expected = py.load(path).direct_parameters
+    assert expected[:4].tolist() == [0.75, 0.25, 0.4, 0.95]
+    assert _same(native.table(path).kernel_array("direct_parameters"), expected)
 
 
 def test_a_table_without_the_factors_has_no_direct_model(native, small_table_path, tmp_path):
@@ -235,6 +260,18 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
     print(f"\n|Ω⁻|a/|V⁻| = {spin}: {4 * PER_SHAPE} particles, statuses {statuses}, 0 differing")
 
 
+def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_table_path):
+    """The library built for the x86-64 baseline (the frame's fma() from the C library, not the FMA
+    instruction): the same bits as numba on 2000 spinning particles of every shape."""
+    python, _ = table_pair
+    c, table = _c(native_baseline), native_baseline.table(small_table_path)
+    rng = np.random.default_rng(11)
+    for k, (V, n, a, omega, u) in enumerate(_particles(rng, 2000, 0.3)):
+        status, V_py, W_py = py.rebound_direct_tuple(python.direct_parameters, V, n, a, omega, k % 4, u)
+        mine = _direct_c(c, table.handle, k % 4, V, omega, n, a, u)
+        assert mine[0] == status and (status != py.STATUS_REBOUNDED or (_same(mine[1], V_py) and _same(mine[2], W_py)))
+
+
 # -- hostile inputs -----------------------------------------------------------------------------------------
 
 GOOD = dict(shape=1, V=(100.0, -100.0, 0.0), omega=(0.0, 0.0, 0.0), n=(0.0, 1.0, 0.0), a=1e-3, u=np.full(7, 0.5))
@@ -271,8 +308,9 @@ def test_null_table_and_outputs(native, table_pair):
     out = np.zeros(3)
     for outputs in ((None, out), (out, None)):
         out[:] = 0.0
-        assert c.rbs_rebound_direct(table_pair[1].handle, 1, *(x.ctypes.data for x in args), 1e-3, GOOD["u"].ctypes.data,
-                                    *(_ptr(x) for x in outputs)) == py.STATUS_INVALID
+        status = c.rbs_rebound_direct(table_pair[1].handle, 1, *(x.ctypes.data for x in args), 1e-3,
+                                      GOOD["u"].ctypes.data, *(_ptr(x) for x in outputs))
+        assert status == py.STATUS_INVALID
         assert np.isnan(out).all()
 
 

@@ -1,5 +1,5 @@
 """The C test programs under AddressSanitizer and UndefinedBehaviorSanitizer (good and bad tables, draws,
-threads), the C, C++ and Fortran examples, and the installed CMake package."""
+threads, the free flight's invariants), the C, C++ and Fortran examples, and the installed CMake package."""
 
 from __future__ import annotations
 
@@ -39,8 +39,9 @@ def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tmp
 
 def test_direct_model_program_under_sanitizers(native_sanitized, small_table_path, tmp_path):
     """The direct model's invariants as C tests (a collision never adds energy and keeps the angular momentum
-    about the contact point, a free flight keeps energy and L to 1e-9, a rebound never adds energy) and its
-    hostile calls, on the small table and one without direct parameters: no failure, no sanitizer report."""
+    about the contact point, a free flight keeps energy and L to 1e-9, a rebound never adds energy), its
+    hostile calls on the small table and one without direct parameters, four threads on one table against one:
+    no failure, no sanitizer report."""
     import h5py
     without = tmp_path / "without_direct.h5"
     without.write_bytes(small_table_path.read_bytes())
@@ -56,6 +57,14 @@ def test_threads_draw_as_one_thread(native_sanitized, small_table_path):
     """Four threads drawing from one table at once give the bits of one thread, stream by stream."""
     out = _sanitized_run([native_sanitized / "rbs_test_threads", small_table_path, 4, 4000])
     assert "0 stream(s) differ" in out
+
+
+def test_rotation_invariants_under_sanitizers(native_sanitized):
+    """rotation.c over 9 x 300 flights of every mode: lab angular momentum and kinetic energy kept to 1e-9,
+    R orthonormal to 1e-12, R(0) = R0; hostile arguments return; no sanitizer report."""
+    out = _sanitized_run([native_sanitized / "rbs_test_rotation", 300])
+    assert "0 failure(s)" in out and "near separatrix: 300 flights" in out
+    print("\n" + out)
 
 
 def test_c_example(native_build, small_table_path):
