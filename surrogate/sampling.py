@@ -11,16 +11,19 @@ Two entry points:
 
 Both accept a shape name or a mix of shapes, ``random_state`` (int, Generator
 or None; not ``seed`` as in :mod:`tablegen`, because a Generator is accepted too, as under that name in
-NumPy's and scikit-learn's APIs) and ``clamp``: by default an incident state outside the table's grid
-is an error; with ``clamp=True`` the dimensionless law at the nearest grid
-edge is used (and scaled by the particle's actual speed).
+NumPy's and scikit-learn's APIs) and ``clamp``: where the table answers every draw (``sample_local``,
+``sample_global`` with ``method="table"``) an incident state outside the table's grid
+is an error by default; with ``clamp=True`` the dimensionless law at the nearest grid
+edge is used (and scaled by the particle's actual speed). ``sample_global``'s default
+``method="auto"`` sends such states, and spinning particles (``omega``), to the direct model instead
+(:mod:`surrogate.kernels.spin`).
 Between grid points the law of a neighbouring grid point is drawn with its
 interpolation weight and, by default (``interpolation="scaled"``), moved to the
 incident state: in α1 to the interpolated means and standard deviations, in
 |V⁻| by the wall's restitution law (:func:`surrogate.kernels.draw.draw_velocity`).
 Each particle gets a status: 0 rebounded, 1 trapped (rolling along or
 deposited on the wall, drawn with its tabulated probability; its V⁺ and Ω⁺
-are NaN, not a made-up rebound).
+are NaN, not a made-up rebound), 2 failed (the direct model only: NaN, never dropped).
 """
 
 from __future__ import annotations

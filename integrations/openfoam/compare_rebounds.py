@@ -221,7 +221,7 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
     valid = status != STATUS_INVALID
     V, n, a = hits["V"][valid], hits["n"][valid], hits["a"][valid]
     V_py, W_py, st_py = sample_global(table, V, n, a, shape=settings["shape"], random_state=seed,
-                                      interpolation=settings["interpolation"], clamp=True)
+                                      interpolation=settings["interpolation"], clamp=True, method="table")
     st_of = status[valid]
     speed_lo, speed_hi = float(np.min(table.speed_m_s)), float(np.max(table.speed_m_s))
 
