@@ -18,7 +18,7 @@ then:
 2. checks the path of every hit against the rule of method auto, and
    compares each path's answers with Python at the same incident states:
    the table's with `surrogate.sample_global` (same table, shape mix and
-   interpolation as the run), the direct model's with
+   interpolation as the run, method "table"), the direct model's with
    `surrogate.rebound_direct` (Ω⁻ included). The two samples of reflected
    states are compared in the impact frame, (α2, β2, s = |V⁺|/|V⁻|,
    Ω⁺a/|V⁻| along ex, n, ez): the two-sample KS statistic per variable, a
@@ -355,7 +355,7 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
     V, n, a = hits["V"][on_table], hits["n"][on_table], hits["a"][on_table]
     st_of = status[on_table]
     V_py, W_py, st_py = sample_global(table, V, n, a, shape=settings["shape"], random_state=seed,
-                                      interpolation=settings["interpolation"], clamp=True)
+                                      interpolation=settings["interpolation"], clamp=True, method="table")
     res["trapped_fraction"] = _trapped_fraction(st_of, st_py)
     ok_of, ok_py = st_of == STATUS_REBOUNDED, st_py == STATUS_REBOUNDED
     alpha1_of, speed_of, X_of = impact_states(V[ok_of], n[ok_of], a[ok_of], hits["Vout"][on_table][ok_of],
@@ -400,7 +400,7 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
         # the spinning ones: what the table alone (the adapter before it passed Ω⁻) gave them
         spin_sel = spinning[direct]
         Vt, Wt, st_t = sample_global(table, Vd[spin_sel], nd[spin_sel], ad[spin_sel], shape=settings["shape"],
-                                     random_state=seed + 1, interpolation=settings["interpolation"], clamp=True)
+                                     random_state=seed + 1, interpolation=settings["interpolation"], clamp=True, method="table")
         ok_s = ok_d & spin_sel
         ok_t = st_t == STATUS_REBOUNDED
         a1_s, sp_s, X_s = impact_states(Vd[ok_s], nd[ok_s], ad[ok_s], hits["Vout"][direct][ok_s],
