@@ -59,8 +59,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rbs_api import (STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, rebound_direct,  # noqa: E402
-                     sample_global)
+from rbs_api import (STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED,  # noqa: E402
+                     load, rebound_direct, sample_global)
 
 KS_C_999 = 1.949          # two-sample KS: c(α) for α = 0.001
 CLASSIFIER_SE = 4.0       # classifier threshold: 0.5 + this many standard errors
@@ -400,7 +400,8 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
         # the spinning ones: what the table alone (the adapter before it passed Ω⁻) gave them
         spin_sel = spinning[direct]
         Vt, Wt, st_t = sample_global(table, Vd[spin_sel], nd[spin_sel], ad[spin_sel], shape=settings["shape"],
-                                     random_state=seed + 1, interpolation=settings["interpolation"], clamp=True, method="table")
+                                     random_state=seed + 1, interpolation=settings["interpolation"], clamp=True,
+                                     method="table")
         ok_s = ok_d & spin_sel
         ok_t = st_t == STATUS_REBOUNDED
         a1_s, sp_s, X_s = impact_states(Vd[ok_s], nd[ok_s], ad[ok_s], hits["Vout"][direct][ok_s],

@@ -209,8 +209,8 @@ int main(int argc, char **argv)
     rbs_rng_seed(&rng, seed);
     double t0 = now();
     for (size_t i = 0; i < n_spin; i++)
-        status[i] = (signed char)rbs_rebound_spin(table, &mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng, RBS_AUTO,
-                                                  RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+        status[i] = (signed char)rbs_rebound_spin(table, &mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
+                                                  RBS_AUTO, RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
     double spinning_us = (now() - t0) / (double)n_spin * 1e6;
     size_t spin_failed = 0;
     for (size_t i = 0; i < n_spin; i++) spin_failed += status[i] == RBS_FAILED;

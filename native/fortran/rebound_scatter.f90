@@ -21,7 +21,7 @@ module rebound_scatter
   ! methods of rbs_rebound_spin and the paths of rbs_rebound_path
   integer(c_int), parameter :: RBS_AUTO = 0, RBS_TABLE = 1, RBS_DIRECT = 2
   integer(c_int), parameter :: RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1
-  real(c_double), parameter :: RBS_SPIN_TOLERANCE = 0.002_c_double
+  real(c_double), parameter :: RBS_SPIN_TOLERANCE = 0.001_c_double
 
   ! cumulative shape weights in the table's shape order (rbs_mix)
   type, bind(c) :: rbs_mix

@@ -286,8 +286,9 @@ enum {
 /* The path that answers a hit (rbs_rebound_path). */
 enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
 
-/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.kernels.spin.SPIN_TOLERANCE). */
-#define RBS_SPIN_TOLERANCE 0.002
+/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.SPIN_TOLERANCE): where the table's law
+ * and the direct model's with that spin stay within classifier accuracy 0.52 (docs/design/spin_tolerance.md). */
+#define RBS_SPIN_TOLERANCE 0.001
 
 /* The path that answers a hit under `method` (surrogate.kernels.spin.rebound_path): a pure function of the
  * state, so a caller learns it without another draw. Under RBS_AUTO, the table iff |Ω⁻| a/|V⁻| <=

@@ -237,7 +237,8 @@ static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, d
         double Vr[3], nr[3], Wr[3];
         unit(&rng, nr);
         unit(&rng, Wr);
-        double speed = (0.3 * vlo + 1.5 * vhi * rbs_rng_uniform(&rng)), ratio = i % 3 == 0 ? 0.0 : 2.0 * rbs_rng_uniform(&rng);
+        double speed = 0.3 * vlo + 1.5 * vhi * rbs_rng_uniform(&rng);
+        double ratio = i % 3 == 0 ? 0.0 : 2.0 * rbs_rng_uniform(&rng);
         for (int k = 0; k < 3; k++) {
             Vr[k] = speed * (2.0 * rbs_rng_uniform(&rng) - 1.0);
             Wr[k] *= ratio * speed / a;
