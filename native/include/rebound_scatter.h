@@ -7,7 +7,10 @@
  * Python package `surrogate` (surrogate.kernels.rebound_tuple, rebound_many,
  * rebound_many_rng, draw_local), for the same uniforms; and runs the direct
  * model itself where the table's law does not apply (rbs_rebound_direct, the
- * bits of surrogate.kernels.rebound_direct_tuple). See docs/native.md.
+ * bits of surrogate.kernels.rebound_direct_tuple). rbs_rebound_spin answers any
+ * hit, spinning or not: the table where its law is valid, the direct model
+ * elsewhere (the bits of surrogate.kernels.spin.rebound_spin_tuple). See
+ * docs/native.md.
  *
  * Frames and units
  * ----------------

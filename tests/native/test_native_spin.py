@@ -73,7 +73,8 @@ def spin_states(table):
     rng = np.random.default_rng(28)
     (v_lo, v_hi) = table.speed_range
     V, n, a = incident_states(rng, COUNT, (0.0, 90.0), (0.3 * v_lo, 1.5 * v_hi))
-    speed = np.linalg.norm(V, axis=1)
+    with np.errstate(over="ignore"):
+        speed = np.linalg.norm(V, axis=1)
     extreme = np.isfinite(speed) & (speed > 0.0) & ((speed < 1e-6) | (speed > 1e6))
     V[extreme] *= (v_hi / speed[extreme])[:, None]
     omega, kind = _spins(rng, V, a)
