@@ -28,7 +28,7 @@ static int method_known(int method)
 
 /* the table answers the hit (surrogate.kernels.spin._table_valid): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE, α1 and |V⁻|
  * inside the grid, edges included */
-static int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
+RBS_INLINE int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
 {
     double spin = a * sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) / speed;
     const double *alpha1_grid = t->alpha1_axis + AXIS_GRID, *speed_grid = t->speed_axis + AXIS_GRID;
@@ -36,7 +36,8 @@ static int table_valid(const rbs_table *t, double alpha1_deg, double speed, cons
            & (speed >= speed_grid[0]) & (speed <= speed_grid[t->n_speed - 1]);
 }
 
-int rbs_rebound_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a,
+/* RBS_HOT: the x86-64-v3 version has fma() as one instruction, as rbs_rebound (the same bits either way) */
+RBS_HOT int rbs_rebound_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a,
                      int method)
 {
     if (!t || !V || !Omega || !n || !method_known(method) || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])
@@ -59,7 +60,7 @@ static int shape_code(const rbs_table *t, int64_t i)
     return -1;      /* a loaded table names known shapes only: never reached */
 }
 
-int rbs_rebound_spin_u(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
+RBS_HOT int rbs_rebound_spin_u(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
                        const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
                        double V_out[3], double Omega_out[3])
 {
