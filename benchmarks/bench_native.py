@@ -12,7 +12,11 @@ uniforms included:
   (bench_sampler's (b));
 * (N-block) numba block kernel: ``rebound_many_rng`` (bench_sampler's (b-block));
 * (C-GT) the Grant–Tabakoff sphere bounce of bench_sampler.py written in C, same loop (and numba's,
-  bench_sampler's (d), for reference).
+  bench_sampler's (d), for reference);
+* (C-spin) every hit answered: (C-1)'s loop with ``rbs_rebound_spin`` (method auto) for non-spinning hits,
+  where the table answers after the path decision (its overhead: (C-spin) − (C-1)), and in µs per hit for
+  spinning ones (|Ω⁻| a/|V⁻| = 0.3 about random axes, the first 20 000 states), which the direct model
+  answers.
 
 The C loops run in a small C program (``native/bench/rbs_bench.c``) that CMake builds into a temporary
 folder (or ``--build-dir``, a build of native/ with ``-DRBS_BUILD_BENCH=ON``); this script writes the
@@ -165,7 +169,8 @@ def main(argv=None) -> int:
             ("(N-1)    numba rebound_tuple in @njit loop", n1),
             ("(N-block) numba rebound_many_rng", nb),
             ("(C-GT)   C Grant-Tabakoff sphere bounce", c["c_grant_tabakoff"]),
-            ("         numba Grant-Tabakoff bounce (bench_sampler (d))", gt)]
+            ("         numba Grant-Tabakoff bounce (bench_sampler (d))", gt),
+            ("(C-spin) C rbs_rebound_spin, auto, no spin (the table)", c["c_spin_still"])]
     print(f"\n{'case':58s} {'ns/state':>10s}")
     print("-" * 69)
     for label, ns in rows:
@@ -177,6 +182,13 @@ def main(argv=None) -> int:
     targets = {"c_per_particle_ns": c["c_per_particle"] <= TARGET_PER_PARTICLE_NS,
                "c_many_ns": c["c_many"] <= TARGET_MANY_NS,
                "c_many_over_c_bounce": ratios["c_many_over_c_bounce"] <= TARGET_MANY_OVER_BOUNCE}
+    overhead = c["c_spin_still"] - c["c_per_particle"]
+    print(f"\n(C-spin) every hit answered (rbs_rebound_spin, method auto):")
+    print(f"  no spin: {c['c_spin_still']:.1f} ns per hit against {c['c_per_particle']:.1f} for rbs_rebound: the path "
+          f"decision costs {overhead:+.1f} ns ({c['still_direct']} of {count} states off the table's grid went to "
+          f"the direct model)")
+    print(f"  spinning, |Omega-| a/|V-| = 0.3: {c['c_spin_spinning_us']:.2f} us per hit over {c['spinning']} hits "
+          f"({c['spinning_direct']} answered by the direct model, {c['spinning_failed']} failed)")
     print("\nratios and targets")
     print(f"  (C-1)/(N-1)        C / numba, per particle          {ratios['c_per_particle_over_numba']:8.3g}")
     print(f"  (C-many)/(N-block) C / numba, many particles        {ratios['c_many_over_numba_block']:8.3g}")
@@ -197,7 +209,11 @@ def main(argv=None) -> int:
                        "ns_per_state": {"c_per_particle": c["c_per_particle"], "c_many": c["c_many"],
                                         "c_many_given": c["c_many_given"], "c_rng": c["c_rng"],
                                         "numba_per_particle": n1, "numba_block": nb,
-                                        "c_grant_tabakoff": c["c_grant_tabakoff"], "numba_grant_tabakoff": gt},
+                                        "c_grant_tabakoff": c["c_grant_tabakoff"], "numba_grant_tabakoff": gt,
+                                        "c_spin_still": c["c_spin_still"]},
+                       "spin": {"decision_overhead_ns": overhead, "still_direct": c["still_direct"],
+                                "spinning_us_per_hit": c["c_spin_spinning_us"], "spinning": c["spinning"],
+                                "spinning_direct": c["spinning_direct"], "spinning_failed": c["spinning_failed"]},
                        "ratios": ratios, "targets_met": targets, "same_bits": same_bits}, f, indent=2)
         print(f"figures written to {args.json}")
     return 0

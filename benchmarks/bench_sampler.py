@@ -6,7 +6,8 @@ One run times the same N random incident states (default N = 10⁶) five ways
 and prints the cost in ns per reflected state:
 
 (a) ``surrogate.sample_global(table, V, normals, a, shape, random_state)``, the
-    vectorised NumPy API in the global frame, with numba's default thread
+    vectorised NumPy API in the global frame (its default ``method="auto"``: these
+    states do not spin and lie in the grid, so the table answers them all), with numba's default thread
     count and with one numba thread. The time covers the whole call: input
     checks, the seeding of one xoshiro256+ stream per 1024 states, the
     parallel kernel (which draws the U_PER_DRAW uniforms per state) and the
@@ -37,9 +38,17 @@ and prints the cost in ns per reflected state:
 (d) a deterministic bounce of a sphere with the Grant & Tabakoff (1975)
     restitution polynomials (:func:`grant_tabakoff_bounce`), from a user's
     ``@njit`` loop on one thread, built like our kernel's impact frame: what a
-    solver pays today for a rebound without scatter.
+    solver pays today for a rebound without scatter;
+(e) every hit answered (``method``, ``omega``): ``sample_global`` on one numba thread with
+    ``method="table"`` on the states of (a) (no spin), then the default ``"auto"`` on the same states
+    (the table answers every one of them too): the difference is the cost of the path decision; then ``"auto"`` on spinning states (the direct model answers every one: its µs per hit)
+    and on a realistic mix where half the hits spin (as in OpenFOAM's ``hopperRebound``). Spinning
+    states: the states of (a) with Ω⁻ of random direction and |Ω⁻|a/|V⁻| uniform over 0.3–1.2 (about
+    hopperRebound's spinning hits: median 0.75, 90 % below 1.16); their count is N_SPIN = min(N, 20000),
+    since each costs microseconds.
 
-Then it prints the ratios (c)/(b), (b)/(d), (c)/(b-block), (b-block)/(d)
+Then it prints the ratios (c)/(b), (b)/(d), (c)/(b-block), (b-block)/(d), (e)'s auto over table,
+spinning and the 50 % mix over table,
 and the runtime's targets, each with 'met' or 'NOT met': (b) ≤ 150 ns per
 state per core, (b-block) ≤ 100 ns and ≤ 3 × (d), a deterministic
 restitution law. The exit code does not depend on the targets.
@@ -105,8 +114,8 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import (U_PER_DRAW, chunk_states, fill_uniforms, rebound, rebound_many, rebound_many_rng,
-                               rebound_parallel_rng, rebound_tuple, seed_state)
+from surrogate.kernels import (PATH_DIRECT, U_PER_DRAW, chunk_states, fill_uniforms, rebound, rebound_many,
+                               rebound_many_rng, rebound_parallel_rng, rebound_tuple, seed_state)
 
 SEED = 20240601
 HALF_SIZE = 1e-4                    # m, particle half-size a
@@ -123,6 +132,8 @@ shapes = ["ellipsoid", "prism", "cut_prism", "tetrahedron"]
 particles_per_cell = {particles}
 """
 DIRECT_ALPHA1 = (20.0, 40.0, 60.0, 80.0)   # midpoints of four equal bins of 10–90°
+SPIN_RATIO = (0.3, 1.2)                    # |Ω⁻|a/|V⁻| of the spinning states of (e)
+N_SPIN = 20000                             # spinning states of (e) at most
 # the runtime's targets (the same as the C library's, benchmarks/bench_native.py)
 TARGET_KERNEL_NS = 150.0                   # (b) per particle at most, ns per state per core
 TARGET_BLOCK_NS = 100.0                    # (b-block) at most
@@ -320,6 +331,15 @@ def incident_states(table, count: int, seed: int, alpha1_range=ALPHA1_RANGE, spe
             "speed_bins": (v_lo + 0.25 * (v_hi - v_lo), v_lo + 0.75 * (v_hi - v_lo))}
 
 
+def spinning(states: dict, count: int, seed: int) -> np.ndarray:
+    """Ω⁻ (rad/s) of the first ``count`` states: random directions, |Ω⁻|a/|V⁻| uniform over SPIN_RATIO."""
+    rng = np.random.default_rng(seed)
+    direction = rng.standard_normal((count, 3))
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    ratio = rng.uniform(*SPIN_RATIO, count)
+    return direction * (ratio * states["speed"][:count] / states["half_size"][:count])[:, None]
+
+
 # ----------------------------------------------------------------------------- timing
 
 def best_time(fn, repeats: int, threads: int, setup=None) -> tuple:
@@ -472,9 +492,9 @@ def main(argv=None) -> int:
     print("-" * len(header))
     rows = {}
 
-    def record(key, label, thr, fn, setup=None, note=""):
+    def record(key, label, thr, fn, setup=None, note="", states=count):
         wall, cpu = best_time(fn, repeats, thr, setup)
-        rows[key] = row(key, label, count, thr, wall, cpu, note)
+        rows[key] = row(key, label, states, thr, wall, cpu, note)
         print_row(rows[key])
 
     def api():
@@ -515,6 +535,20 @@ def main(argv=None) -> int:
     record("b_rng", f"    breakdown: {U_PER_DRAW} xoshiro256+ uniforms alone", 1,
            lambda: loop_rng_only(count, seed_state(SEED), np.empty(1)))
     record("d", "(d) Grant-Tabakoff sphere bounce, @njit loop", 1, lambda: loop_bounce(V, nrm, V_out))
+    record("e_table", "(e) sample_global method='table', 1 thread", 1,
+           lambda: surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED, method="table"))
+    record("e_auto", "(e) the same, method='auto' (no spin)", 1, api)
+    m_spin = min(count, N_SPIN)
+    spin = spinning(st, m_spin, SEED + 2)
+    half = spin.copy()
+    half[::2] = 0.0
+    for key, label, omega in (("e_spin", "(e) auto, spinning states, 1 thread", spin),
+                              ("e_mix", "(e) auto, half of the states spinning, 1 thread", half)):
+        paths = surrogate.sample_global(table, V[:m_spin], nrm[:m_spin], a[:m_spin], shape=mix, random_state=SEED,
+                                        omega=omega, return_path=True)[3]
+        record(key, label, 1, lambda: surrogate.sample_global(table, V[:m_spin], nrm[:m_spin], a[:m_spin], shape=mix,
+                                                              random_state=SEED, omega=omega),
+               note=f"{np.mean(paths == PATH_DIRECT):.3f} of the hits answered by the direct model", states=m_spin)
 
     direct_ns, direct_rows = direct_cost(st["speed_bins"], min_time, repeats)
     cpu_direct = float(np.mean([r["cpu_over_wall"] for r in direct_rows]))
@@ -536,7 +570,14 @@ def main(argv=None) -> int:
               "kernel_predrawn_over_bounce": rows["b_predrawn"]["ns_per_state"] / d,
               "kernel_beam_ns": rows["b_beam"]["ns_per_state"], "block_beam_ns": rows["b_block_beam"]["ns_per_state"],
               "api_1thread_over_kernel": rows["a_1"]["ns_per_state"] / b,
-              "rng_share_of_kernel": rows["b_rng"]["ns_per_state"] / b}
+              "rng_share_of_kernel": rows["b_rng"]["ns_per_state"] / b,
+              "auto_over_table": rows["e_auto"]["ns_per_state"] / rows["e_table"]["ns_per_state"],
+              "spinning_over_table": rows["e_spin"]["ns_per_state"] / rows["e_table"]["ns_per_state"],
+              "mix_over_table": rows["e_mix"]["ns_per_state"] / rows["e_table"]["ns_per_state"],
+              "spinning_us": rows["e_spin"]["ns_per_state"] / 1e3, "mix_us": rows["e_mix"]["ns_per_state"] / 1e3,
+              "auto_over_table_cpu": rows["e_auto"]["cpu_ns_per_state"] / rows["e_table"]["cpu_ns_per_state"],
+              "spinning_cpu_us": rows["e_spin"]["cpu_ns_per_state"] / 1e3,
+              "mix_cpu_us": rows["e_mix"]["cpu_ns_per_state"] / 1e3}
     targets = {"kernel_ns": bool(b <= TARGET_KERNEL_NS), "block_ns": bool(bb <= TARGET_BLOCK_NS),
                "block_over_bounce": bool(bb / d <= TARGET_BLOCK_OVER_BOUNCE)}
     print(f"\ntrapped fraction drawn: (a) {trapped_api:.4f}, (b) {trapped_b:.4f}")
@@ -555,6 +596,12 @@ def main(argv=None) -> int:
     print(f"  (b')/(d) kernel on pre-drawn uniforms / G-T   {ratios['kernel_predrawn_over_bounce']:12.4g}")
     print(f"  (a, 1 thread)/(b) NumPy API / @njit loop      {ratios['api_1thread_over_kernel']:12.4g}")
     print(f"  RNG share of (b)                              {ratios['rng_share_of_kernel']:12.4g}")
+    print(f"  (e) auto / table, no spin (the path decision) {ratios['auto_over_table']:12.4g}   "
+          f"in CPU time {ratios['auto_over_table_cpu']:.4g}")
+    print(f"  (e) auto spinning / table, no spin            {ratios['spinning_over_table']:12.4g}   "
+          f"{ratios['spinning_us']:.3g} us per spinning hit (CPU {ratios['spinning_cpu_us']:.3g} us)")
+    print(f"  (e) auto half spinning / table, no spin       {ratios['mix_over_table']:12.4g}   "
+          f"{ratios['mix_us']:.3g} us per hit (CPU {ratios['mix_cpu_us']:.3g} us)")
     print("\nTargets are figures only: the exit code does not depend on them. Ratios and targets use the wall\n"
           "times (ns/state). cpu/wall = process CPU time / wall time of the best run: about the thread count\n"
           "on an idle machine; lower, other work took the CPU and the wall figures are pessimistic (cpu ns/st,\n"

@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""A particle beam hitting a flat wall and a cylinder: tabulated rebounds vs a specular sphere.
+"""A particle beam hitting a flat wall and a cylinder: the surrogate's rebounds vs a specular sphere.
 
 A tiny Lagrangian tracker (numba, straight-line motion, no gas) moves a beam of
-non-spherical grains and calls the runtime sampler :func:`surrogate.kernels.rebound`
-at each wall hit. The same beam is tracked again with the rebound of a sphere
+non-spherical grains and calls the runtime sampler :func:`surrogate.kernels.rebound_spin_tuple`
+at each wall hit, with the grain's incident spin Ω⁻ (``--spin``; zero by default): the table
+answers where it is valid, the direct model elsewhere (a spinning grain, a hit off the table's
+grid). The same beam is tracked again with the rebound of a sphere
 (v_n -> -e v_n with a constant restitution e, tangential velocity unchanged).
 
 Frames and units (SI throughout): global frame XYZ, lengths in m, velocities in
@@ -17,12 +19,13 @@ m/s, times in s. The beam moves in the XY plane (z = 0 at the start).
    (|y| -> R). The wall normal is the unit vector from the axis to the hit point.
 
 Particles are points for the geometry (half-size a = 50 um << R); a is used by
-the kernel only to scale the spin. Each particle hits at most once (the
+the kernel to scale the spin (Ω in rad/s, Ω a/|V| dimensionless). Each particle hits at most once (the
 rebound leaves a flat or convex wall). A trapped particle (status 1) stays at
 its hit point.
 
     python examples/particle_beam.py                       # builds a small table first (~1-2 min)
     python examples/particle_beam.py --table TABLE.h5 --n 20000 --seed 1 --out beam_output
+    python examples/particle_beam.py --spin 0.6         # grains spinning about Z, Omega- a/|V-| = 0.6
 """
 
 from __future__ import annotations
@@ -44,10 +47,10 @@ except ImportError:            # running from a source checkout without `pip ins
     sys.path.insert(0, str(REPO))
     import surrogate
 from surrogate import STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, seed_state
-from surrogate.kernels import rebound
+from surrogate.kernels import METHOD_AUTO, rebound_spin_tuple
 
 # A small table for this beam: alpha1 down to 2 deg (grazing hits on the
-# cylinder; below 2 deg the kernel uses the 2-deg law), speeds 100-200 m/s.
+# cylinder; below 2 deg the direct model answers), speeds 100-200 m/s.
 SMALL_TABLE_TOML = """\
 # Small table for examples/particle_beam.py (builds in about 1-2 minutes on 2 cores).
 [grid]
@@ -87,11 +90,14 @@ def hit_time(p, v, geometry, radius):
 
 
 @njit   # not cache=True: a cached copy would not notice later edits to surrogate.kernels
-def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size, e, rng_state):
+def track(pos, vel, omega, t_end, dt, geometry, radius, model, data, params, model_shapes, mix_cdf, half_size, e,
+          rng_state):
     """Move every particle to time t_end (in place); rebound it at its wall hit.
 
-    pos, vel : (N, 3) start positions (m) and velocities (m/s), global frame.
-    model : TABLE (surrogate kernel) or SPECULAR (sphere with restitution e).
+    pos, vel, omega : (N, 3) start positions (m), velocities (m/s) and spins (rad/s, kept in free flight),
+        global frame.
+    model : TABLE (surrogate kernel: table.kernel_data, table.direct_parameters, table.model_shapes) or
+        SPECULAR (sphere with restitution e).
     rng_state : (4,) uint64 xoshiro256+ state (surrogate.seed_state), advanced in place.
     Returns (V+ at the hit (N, 3) m/s, NaN if missed or trapped; outcome (N,) int8).
     """
@@ -101,7 +107,6 @@ def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size
     u = np.empty(U_PER_DRAW)                   # uniforms for one kernel call
     normal = np.empty(3)
     vo = np.empty(3)
-    wo = np.empty(3)                           # Omega+ in rad/s (not used here)
     n_steps = int(math.ceil(t_end / dt))
     dt = t_end / n_steps
     for i in range(n):
@@ -120,14 +125,17 @@ def track(pos, vel, t_end, dt, geometry, radius, model, data, mix_cdf, half_size
                 normal[0], normal[1], normal[2] = p[0] / r, p[1] / r, 0.0
             if model == TABLE:
                 fill_uniforms(rng_state, u)
-                status = rebound(data, mix_cdf, v, normal, half_size, u, vo, wo)
+                status, V_new, _ = rebound_spin_tuple(data, params, model_shapes, mix_cdf, (v[0], v[1], v[2]),
+                                                      (omega[i, 0], omega[i, 1], omega[i, 2]),
+                                                      (normal[0], normal[1], normal[2]), half_size, u, METHOD_AUTO)
+                vo[0], vo[1], vo[2] = V_new
             else:
                 vn = v[0] * normal[0] + v[1] * normal[1] + v[2] * normal[2]
                 for k in range(3):
                     vo[k] = v[k] - (1.0 + e) * vn * normal[k]
                 status = REBOUNDED
             outcome[i] = status
-            if status == TRAPPED:              # stays where it hit
+            if status != REBOUNDED:            # trapped (or a rare failed direct rebound): stays where it hit
                 break
             v_out[i] = vo
             v[:] = vo
@@ -155,12 +163,21 @@ def cylinder_beam(n, rng):
     return pos, vel
 
 
-def run(pos, vel, t_end, geometry, model, table, cdf, e, seed):
-    """Track a copy of the beam; returns (final positions, V+, outcome)."""
+def beam_spin(vel, spin):
+    """Ω⁻ (rad/s) of grains spinning about +Z with Ω⁻a/|V⁻| = spin."""
+    omega = np.zeros_like(vel)
+    omega[:, 2] = spin * np.linalg.norm(vel, axis=1) / HALF_SIZE
+    return omega
+
+
+def run(pos, vel, t_end, geometry, model, table, cdf, e, seed, spin=0.0):
+    """Track a copy of the beam, its grains spinning about +Z with Ω⁻a/|V⁻| = spin; returns (final positions,
+    V+, outcome)."""
     pos = pos.copy()
     dt = 0.02 * RADIUS / SPEED_RANGE[1]        # 0.2 mm per step at the top speed
-    v_out, outcome = track(pos, vel, t_end, dt, geometry, RADIUS, model, table.kernel_data, cdf,
-                           HALF_SIZE, e, seed_state(seed))
+    params = table.direct_parameters if table.direct_parameters is not None else np.zeros(0)
+    v_out, outcome = track(pos, vel, beam_spin(vel, spin), t_end, dt, geometry, RADIUS, model, table.kernel_data,
+                           params, table.model_shapes, cdf, HALF_SIZE, e, seed_state(seed))
     return pos, v_out, outcome
 
 
@@ -186,7 +203,7 @@ def get_table(path, out):
     lo, hi = table.speed_range
     if SPEED_RANGE[0] < lo or SPEED_RANGE[1] > hi:
         print(f"note: beam speeds {SPEED_RANGE} m/s exceed the table's range [{lo:g}, {hi:g}] m/s; "
-              f"the kernel uses the law at the nearest grid edge")
+              f"the direct model answers those hits")
     return table
 
 
@@ -202,7 +219,7 @@ def plot_wall(plt, res, angle_deg, e, path):
     fig = plt.figure(figsize=(12, 5))
     ax = fig.add_subplot(1, 2, 1, projection="polar")
     bins = np.radians(np.arange(0, 181, 2.0))
-    for label, color in [("table", "tab:blue"), ("specular sphere", "tab:orange")]:
+    for label, color in [("surrogate", "tab:blue"), ("specular sphere", "tab:orange")]:
         h, _ = np.histogram(np.radians(res[label]["alpha2"]), bins)
         r = np.repeat(h / h.max(), 2)                      # histogram as a closed step outline
         theta = np.column_stack([bins[:-1], bins[1:]]).ravel()
@@ -220,8 +237,8 @@ def plot_wall(plt, res, angle_deg, e, path):
     ax.legend(loc="upper left", bbox_to_anchor=(-0.1, -0.05), fontsize=8, ncol=2)
 
     ax = fig.add_subplot(1, 2, 2)
-    t = res["table"]
-    ax.scatter(t["alpha2"], t["beta2"], s=1, alpha=0.15, color="tab:blue", label="table", rasterized=True)
+    t = res["surrogate"]
+    ax.scatter(t["alpha2"], t["beta2"], s=1, alpha=0.15, color="tab:blue", label="surrogate", rasterized=True)
     s = res["specular sphere"]
     ax.scatter(s["alpha2"], s["beta2"], s=4, color="tab:orange", label="specular sphere")
     ax.set_xlim(0, 180)
@@ -279,9 +296,11 @@ def main(argv=None):
                         help="normal restitution e of the specular sphere (default %(default)s)")
     parser.add_argument("--shape", default="mix", choices=["mix", "ellipsoid", "prism", "cut_prism", "tetrahedron"],
                         help="particle shape; mix = equal weights of the table's shapes (default)")
+    parser.add_argument("--spin", type=float, default=0.0,
+                        help="the grains' incident spin about +Z, Omega- a/|V-| (default 0: no spin)")
     args = parser.parse_args(argv)
-    if args.n < 1 or args.seed < 0 or not 0.0 < args.angle < 90.0:
-        parser.error("need --n >= 1, --seed >= 0 and 0 < --angle < 90")
+    if args.n < 1 or args.seed < 0 or not 0.0 < args.angle < 90.0 or not math.isfinite(args.spin):
+        parser.error("need --n >= 1, --seed >= 0, 0 < --angle < 90 and a finite --spin")
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -296,9 +315,9 @@ def main(argv=None):
     shape = {s: 1.0 / len(table.shapes) for s in table.shapes} if args.shape == "mix" else args.shape
     cdf = surrogate.mix_cdf(table, shape)
     rng = np.random.default_rng(args.seed)
-    models = {"table": TABLE, "specular sphere": SPECULAR}
+    models = {"surrogate": TABLE, "specular sphere": SPECULAR}
     print(f"table {table.path}: shapes {', '.join(table.shapes)}, alpha1 {table.alpha1_range} deg, "
-          f"speed {table.speed_range} m/s; particles: {args.shape}")
+          f"speed {table.speed_range} m/s; particles: {args.shape}, Omega- a/|V-| = {args.spin:g} about +Z")
 
     # 1. flat wall: rebound directions
     pos, vel = wall_beam(args.n, args.angle, rng)
@@ -306,7 +325,7 @@ def main(argv=None):
     print(f"\n1. flat wall y = 0, beam at {args.angle:g} +- {SPREAD_DEG:g} deg from the wall, {args.n} particles")
     wall = {}
     for label, model in models.items():
-        _, v_out, outcome = run(pos, vel, t_end, WALL, model, table, cdf, args.restitution, args.seed)
+        _, v_out, outcome = run(pos, vel, t_end, WALL, model, table, cdf, args.restitution, args.seed, args.spin)
         ok = outcome == REBOUNDED
         a2, b2 = angles(v_out[ok])
         ratio = np.linalg.norm(v_out[ok], axis=1) / np.linalg.norm(vel[ok], axis=1)
@@ -321,7 +340,8 @@ def main(argv=None):
     print(f"\n2. cylinder R = {RADIUS * 1e3:g} mm, beam along +X over |y| < R, {args.n} particles")
     cyl = {}
     for label, model in models.items():
-        p_end, v_out, outcome = run(pos, vel, t_end, CYLINDER, model, table, cdf, args.restitution, args.seed)
+        p_end, v_out, outcome = run(pos, vel, t_end, CYLINDER, model, table, cdf, args.restitution, args.seed,
+                                    args.spin)
         v = v_out[outcome == REBOUNDED]
         deflection = np.degrees(np.arccos(v[:, 0] / np.linalg.norm(v, axis=1)))   # from +X: 0 = undeflected
         print(f"  {label:16s} {counts(v_out, outcome)} | deflection {deflection.mean():5.1f} +- "

@@ -20,18 +20,22 @@ SIMD loops, with the per-particle results bit for bit;
 :func:`surrogate.kernels.rebound_parallel_rng` does the same on all threads,
 as :func:`sample_global` does. :mod:`surrogate.kernels` maps where each part lives.
 
-Where the table does not apply (a particle spinning before it hits, say), the direct model answers:
-:func:`rebound_direct` from NumPy, :func:`surrogate.kernels.rebound_direct_tuple` from numba with
-:func:`direct_model_parameters` and ``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
+Where the table does not apply (a particle spinning before it hits, an α1 or |V⁻| off its grid), the direct
+model answers: :func:`sample_global` with its default ``method="auto"`` picks, per hit, the table where it is
+valid (|Ω⁻|a/|V⁻| ≤ :data:`SPIN_TOLERANCE`, inside the grid) and the direct model elsewhere; from numba,
+:func:`surrogate.kernels.rebound_spin_tuple` (13 uniforms per hit whatever the path) and
+:func:`surrogate.kernels.rebound_path`. The direct model alone: :func:`rebound_direct` from NumPy,
+:func:`surrogate.kernels.rebound_direct_tuple` from numba with :func:`direct_model_parameters` and
+``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
 """
 
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import U_PER_REBOUND
 from surrogate.direct import direct_model_parameters, rebound_direct
-from surrogate.kernels import U_PER_DRAW, fill_uniforms, seed_state
-from surrogate.sampling import LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
+from surrogate.kernels import SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
+from surrogate.sampling import METHODS, LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 
-__all__ = ["LocalDraws", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable",
-           "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "direct_model_parameters", "fill_uniforms", "load",
+__all__ = ["LocalDraws", "METHODS", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
+           "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "direct_model_parameters", "fill_uniforms", "load",
            "mix_cdf", "rebound_direct", "sample_global", "sample_local", "seed_state"]

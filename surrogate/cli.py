@@ -8,6 +8,7 @@ and never the table being read (:mod:`data_schema.output`).
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -17,8 +18,8 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.common import DataFormatError
 from data_schema.output import check_memory, check_output, kind_of
 from data_schema.samples import (
-    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_NAMES, SampleSet, angles_to_velocity, read_samples,
-    write_samples,
+    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_FAILED, STATUS_NAMES, SampleSet, angles_to_velocity,
+    read_samples, rebound_angles, write_samples,
 )
 from data_schema.table import TABLE_FILE_TYPE
 
@@ -38,6 +39,42 @@ def _mix(args):
     return weights, "mix:" + ",".join(f"{w:g}" for w in weights)
 
 
+def _omega(args) -> np.ndarray:
+    """--omega as an array of 3 finite numbers (Ω⁻ a/|V⁻|, lab frame)."""
+    omega = np.array(args.omega, dtype=np.float64)
+    if not np.all(np.isfinite(omega)):
+        raise ValueError(f"--omega must be 3 finite numbers (Omega- a/|V-|, lab frame); got {' '.join(map(repr, args.omega))}")
+    return omega
+
+
+def _draw(table, args, shape, omega):
+    """(draws in the local frame, V⁺ in m/s lab frame, the path of the draws) at the incident state of ``args``.
+
+    The lab frame (wall y = 0, normal +Y, V⁻ in the XY plane) is the impact frame of that state, so the local
+    draws are lab-frame vectors. The path is that of :func:`surrogate.kernels.rebound_path`, the same for
+    every draw of one incident state; the table's draws are those of ``sample_local``, the direct model's
+    those of ``sample_global``."""
+    import surrogate
+    from surrogate.kernels import PATH_DIRECT, PATH_TABLE, rebound_path
+
+    a1, speed = math.radians(args.alpha1), args.speed
+    V = (speed * math.cos(a1), -speed * math.sin(a1), 0.0)
+    half_size = 1.0        # m: any value; the draws and Omega- are given in units of |V-| and |V-|/a
+    spin = tuple(float(w) * speed / half_size for w in omega)
+    path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, surrogate.METHODS[args.method])
+            if 0.0 < args.alpha1 <= 90.0 and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
+    if path != PATH_DIRECT:
+        draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, shape, random_state=args.seed,
+                                       clamp=args.clamp)
+        return draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio), PATH_TABLE
+    V_out, Omega_out, status = surrogate.sample_global(table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size,
+                                                       shape, random_state=args.seed, omega=spin, method="direct")
+    alpha2, beta2, v = rebound_angles(V_out)
+    draws = surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
+                                 omega=Omega_out * (half_size / speed), status=status)
+    return draws, V_out, PATH_DIRECT
+
+
 def _sample(args) -> int:
     import surrogate
 
@@ -45,18 +82,21 @@ def _sample(args) -> int:
         check_output(args.out, SAMPLES_FILE_TYPE, args.overwrite, inputs=(args.table,))
     check_memory(args.n, BYTES_PER_DRAW, "-n")
     shape, label = _mix(args)
+    omega = _omega(args)
     table = surrogate.load(args.table)
-    draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), args.speed, shape,
-                                   random_state=args.seed, clamp=args.clamp)
+    draws, velocity, path = _draw(table, args, shape, omega)
     speed = args.speed
-    velocity = angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio)
     samples = SampleSet(velocity=velocity, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
                         status=draws.status, alpha1=args.alpha1, speed=speed, shape=label, seed=args.seed,
                         producer="surrogate sample",
                         provenance={"table": str(args.table), "table_config_sha256": table.config_sha256,
-                                    "clamp": bool(args.clamp)})
+                                    "clamp": bool(args.clamp), "method": args.method, "omega_in": omega,
+                                    "path": "direct model" if path else "table"})
     counts = ", ".join(f"{name} {int(np.sum(draws.status == code))}" for code, name in STATUS_NAMES.items())
-    print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s, {label}: {counts}")
+    spin = "" if not np.any(omega) else f", Omega- a/|V-| = ({', '.join(f'{w:g}' for w in omega)})"
+    print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s{spin}, {label}: {counts}")
+    print(f"  answered by the table {0 if path else args.n}, by the direct model {args.n if path else 0} "
+          f"(method {args.method}); failed {int(np.sum(draws.status == STATUS_FAILED))}")
     ok = samples.rebounded
     for name, values in (("alpha2 (deg)", np.degrees(draws.alpha2[ok])), ("beta2 (deg)", np.degrees(draws.beta2[ok])),
                          ("|V+|/|V-|", draws.speed_ratio[ok]), ("Omega_z a/|V-|", draws.omega[ok, 2])):
@@ -64,8 +104,8 @@ def _sample(args) -> int:
             q05, q50, q95 = np.percentile(values, [5, 50, 95])
             print(f"  {name:<15} mean {values.mean():8.3f}   5% {q05:8.3f}   median {q50:8.3f}   95% {q95:8.3f}")
     if args.out is not None:
-        path = write_samples(args.out, samples, overwrite=args.overwrite, inputs=(args.table,))
-        print(f"samples written to {path}")
+        written = write_samples(args.out, samples, overwrite=args.overwrite, inputs=(args.table,))
+        print(f"samples written to {written}")
     return 0
 
 
@@ -108,19 +148,30 @@ def main(argv=None) -> int:
     sample = sub.add_parser("sample", help="draw reflected states from a table at one incident state",
                             description="Draw n reflected states at one incident state and write them in "
                                         "the raw-samples layout of 'tablegen simulate --out' "
-                                        "(n_collisions = -1: tables do not carry it per draw).")
+                                        "(n_collisions = -1: neither the tables nor the run-time direct model "
+                                        "carry it per draw).")
     sample.add_argument("--table", required=True, metavar="TABLE.h5")
     sample.add_argument("--alpha1", type=float, required=True, metavar="DEG",
-                        help=f"incidence angle from the wall, in the table's range (with --clamp: {ALPHA1_RANGE_TEXT})")
+                        help=f"incidence angle from the wall, {ALPHA1_RANGE_TEXT} (with --method table: in the "
+                             f"table's range, unless --clamp)")
     sample.add_argument("--speed", type=float, required=True, metavar="M_PER_S",
-                        help="incident speed |V-| in m/s, in the table's range (with --clamp: > 0)")
+                        help="incident speed |V-| in m/s, > 0 (with --method table: in the table's range, unless "
+                             "--clamp)")
     group = sample.add_mutually_exclusive_group()
     group.add_argument("--shape", choices=SHAPE_NAMES)
     group.add_argument("--mix", metavar="W1,W2,W3,W4", help="weights of ellipsoid, prism, cut_prism, tetrahedron")
     sample.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of draws, >= 1")
     sample.add_argument("--seed", type=seed_argument, default=None, help="random seed in [0, 2**63)")
+    sample.add_argument("--omega", type=float, nargs=3, default=(0.0, 0.0, 0.0), metavar=("WX", "WY", "WZ"),
+                        help="incident angular velocity Omega- a/|V-|, lab frame (default 0 0 0), as tablegen "
+                             "simulate's")
+    sample.add_argument("--method", choices=("auto", "table", "direct"), default="auto",
+                        help="auto (default): the table where it is valid (|Omega-|a/|V-| <= the spin tolerance, "
+                             "inside the grid), the direct model elsewhere; table: always the table (Omega- "
+                             "ignored); direct: always the direct model")
     sample.add_argument("--clamp", action="store_true",
-                        help="outside the table's range (but physical), use the law at the nearest grid edge")
+                        help="with --method table: outside the table's range (but physical), use the law at the "
+                             "nearest grid edge")
     sample.add_argument("--out", metavar="FILE.h5", help="write the draws (HDF5 samples layout, docs/format.md)")
     sample.add_argument("--overwrite", action="store_true",
                         help="replace an existing --out file if it is a samples file (never the table)")

@@ -5,21 +5,25 @@ Two entry points:
 * :func:`sample_local` — for arrays of incidence angle α1 (deg) and speed |V⁻|
   (m/s), the reflected state (α2, β2, s, Ω⁺a/|V⁻|) in the local frame (wall
   y = 0, normal +Y, impact plane XY);
-* :func:`sample_global` — the solver's API: incident velocities and wall
-  normals in any global frame in, V⁺ (m/s) and Ω⁺ (rad/s) out.
+* :func:`sample_global` — the solver's API: incident velocities, spins and wall
+  normals in any global frame in, V⁺ (m/s) and Ω⁺ (rad/s) out; every hit answered,
+  by the table where it is valid and by the direct model elsewhere (``method``).
 
 Both accept a shape name or a mix of shapes, ``random_state`` (int, Generator
 or None; not ``seed`` as in :mod:`tablegen`, because a Generator is accepted too, as under that name in
-NumPy's and scikit-learn's APIs) and ``clamp``: by default an incident state outside the table's grid
-is an error; with ``clamp=True`` the dimensionless law at the nearest grid
-edge is used (and scaled by the particle's actual speed).
+NumPy's and scikit-learn's APIs) and ``clamp``: where the table answers every draw (``sample_local``,
+``sample_global`` with ``method="table"``) an incident state outside the table's grid
+is an error by default; with ``clamp=True`` the dimensionless law at the nearest grid
+edge is used (and scaled by the particle's actual speed). ``sample_global``'s default
+``method="auto"`` sends such states, and spinning particles (``omega``), to the direct model instead
+(:mod:`surrogate.kernels.spin`).
 Between grid points the law of a neighbouring grid point is drawn with its
 interpolation weight and, by default (``interpolation="scaled"``), moved to the
 incident state: in α1 to the interpolated means and standard deviations, in
 |V⁻| by the wall's restitution law (:func:`surrogate.kernels.draw.draw_velocity`).
 Each particle gets a status: 0 rebounded, 1 trapped (rolling along or
 deposited on the wall, drawn with its tabulated probability; its V⁺ and Ω⁺
-are NaN, not a made-up rebound).
+are NaN, not a made-up rebound), 2 failed (the direct model only: NaN, never dropped).
 """
 
 from __future__ import annotations
@@ -36,8 +40,9 @@ from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTS
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
                                       FAULT_VELOCITY_ZERO, SPEED_MAX, SPEED_MIN, SPIN_SCALE_MAX, first_faults)
 from surrogate.kernels.frame import NORMAL_TOLERANCE
-from surrogate.kernels.parallel import draw_local_parallel_rng, rebound_parallel_rng
+from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
+from surrogate.kernels.spin import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, rebound_spin_parallel_rng
 from surrogate.table import SurrogateTable
 
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
@@ -266,18 +271,19 @@ def _fault_error(fault: int, i: int, table: SurrogateTable, V, nrm, a) -> ValueE
     return _outside("speed", i, speed, table.speed_range, "m/s")
 
 
-OUT_NAMES = ("V_out", "Omega_out", "status")
+OUT_NAMES = ("V_out", "Omega_out", "status", "path")
 
 
-def _outputs(out, n: int, inputs) -> tuple:
-    """The (V_out, Omega_out, status) arrays of :func:`sample_global`: new ones, or the ``out`` arrays once
-    checked (ValueError naming the first that is not as documented)."""
+def _outputs(out, n: int, inputs, count: int = 3) -> tuple:
+    """The first ``count`` of the (V_out, Omega_out, status, path) arrays of :func:`sample_global`: new ones,
+    or the ``out`` arrays once checked (ValueError naming the first that is not as documented)."""
+    wanted = ((n, 3), np.float64), ((n, 3), np.float64), ((n,), np.int8), ((n,), np.int8)
     if out is None:
-        return np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int8)
-    if not isinstance(out, tuple) or len(out) != 3:
-        raise ValueError(f"The 'out' parameter must be None or a tuple of 3 arrays ({', '.join(OUT_NAMES)}); "
-                         f"got {type(out).__name__}.")
-    wanted = ((n, 3), np.float64), ((n, 3), np.float64), ((n,), np.int8)
+        return tuple(np.empty(shape, dtype=dtype) for shape, dtype in wanted[:count])
+    if not isinstance(out, tuple) or len(out) != count:
+        raise ValueError(f"The 'out' parameter must be None or a tuple of {count} arrays "
+                         f"({', '.join(OUT_NAMES[:count])}); got {type(out).__name__}"
+                         f"{f' of {len(out)}' if isinstance(out, tuple) else ''}.")
     for i, (name, arr, (shape, dtype)) in enumerate(zip(OUT_NAMES, out, wanted)):
         if not isinstance(arr, np.ndarray) or arr.shape != shape or arr.dtype != dtype:
             got = f"dtype {arr.dtype}, shape {arr.shape}" if isinstance(arr, np.ndarray) else type(arr).__name__
@@ -290,9 +296,50 @@ def _outputs(out, n: int, inputs) -> tuple:
     return out
 
 
+METHODS = {"auto": METHOD_AUTO, "table": METHOD_TABLE, "direct": METHOD_DIRECT}
+
+
+def method_code(method) -> int:
+    """The kernels' code (METHOD_*) of a method name: "auto", "table" or "direct"."""
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"The 'method' parameter must be one of {', '.join(METHODS)}; got {method!r}.")
+    return METHODS[method]
+
+
+def _omega(omega, n: int) -> np.ndarray:
+    """Ω⁻ as (N, 3) or (1, 3) float64 (None: one zero row); ValueError for another shape or a non-finite row."""
+    if omega is None:
+        return np.zeros((1, 3))
+    W = _real("omega", omega)
+    if W.ndim == 1 and W.shape == (3,):
+        W = W[None, :]
+    if W.ndim != 2 or W.shape[1] != 3 or W.shape[0] not in (1, n):
+        raise ValueError(f"The 'omega' parameter must have shape ({n}, 3) or (3,) (rad/s); got {W.shape}.")
+    bad = np.flatnonzero(~np.isfinite(W).all(axis=1))
+    if bad.size:
+        raise ValueError(f"The 'omega' vector at index {bad[0]} is not finite: {W[bad[0]].tolist()} rad/s.")
+    return np.ascontiguousarray(W)
+
+
+def _check_direct_parameters(table: SurrogateTable, path: np.ndarray, V, W, a) -> None:
+    """ValueError if a hit needs the direct model (path PATH_DIRECT) and ``table`` does not record its
+    parameters."""
+    if table.direct_parameters is not None:
+        return
+    needs = np.flatnonzero(path == PATH_DIRECT)
+    if needs.size:
+        i = int(needs[0])
+        spin = float(np.linalg.norm(W[min(i, len(W) - 1)]) * a[min(i, len(a) - 1)] / np.linalg.norm(V[i]))
+        raise ValueError(f"The hit at index {i} (|Omega-|a/|V-| = {spin!r}) needs the direct model, whose parameters "
+                         f"the table {table.path} does not record (built before tables recorded them); rebuild "
+                         f"it with this version, or pass method='table'.")
+
+
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
-                  clamp: bool = False, interpolation: str = "scaled", out=None):
-    """Reflected velocities and spins of particles hitting walls, in the global frame.
+                  clamp: bool = False, interpolation: str = "scaled", out=None, *, omega=None, method: str = "auto",
+                  return_path: bool = False):
+    """Reflected velocities and spins of particles hitting walls, in the global frame: every hit answered, by
+    the table where it is valid and by the direct model elsewhere.
 
     Parameters
     ----------
@@ -304,29 +351,42 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     shape : shape name or mix (see :func:`mix_cdf`).
     random_state : int, Generator or None. The uniforms are drawn inside the
         kernel, one xoshiro256+ stream per chunk of particles seeded from it
-        (:func:`surrogate.kernels.rng.chunk_states`): the same seed gives the same
-        draws whatever the number of threads.
+        (:func:`surrogate.kernels.rng.chunk_states`), U_PER_DRAW = 13 per hit whatever
+        path answers it: the same seed gives the same bits whatever the number of threads.
     interpolation : between grid points, ``"scaled"`` (default: the law of a
         neighbouring grid point drawn with its interpolation weight, then moved
         to the incident α1 by the interpolated means and standard deviations and
         to the incident speed by the wall's restitution law) or ``"stochastic"``
         (the neighbour's law as is); see :func:`surrogate.kernels.draw.draw_velocity`
         and docs/VALIDATION.md for how they compare.
-    clamp : outside the table's α1 or |V⁻| range, use the law at the nearest grid
-        edge instead of raising. Never beyond the physical range: here every
+    clamp : with ``method="table"``, outside the table's α1 or |V⁻| range use the law
+        at the nearest grid edge instead of raising. Never beyond the physical range: here every
         state that moves into its wall is physical (α1 in (0, 90]), with |V⁻| in
-        [1e-150, 1e150] m/s (what the arithmetic carries).
+        [1e-150, 1e150] m/s (what the arithmetic carries). The other methods send such states
+        to the direct model.
     out : None (default: new arrays) or a tuple (V_out, Omega_out, status) of
-        arrays to write the results into and return: C-contiguous, writeable,
-        float64 (N, 3), float64 (N, 3) and int8 (N,), sharing no memory with
+        arrays to write the results into and return (with ``return_path``, a fourth: path): C-contiguous,
+        writeable, float64 (N, 3), float64 (N, 3), int8 (N,) (and int8 (N,)), sharing no memory with
         the inputs. A solver calling this every time step can keep them, which
         spares it the allocation and the first touch of fresh pages.
+    omega : None (default: no spin) or (N, 3) or (3,) incident angular velocities Ω⁻, rad/s, in the frame of
+        ``velocity``.
+    method : ``"auto"`` (default): the table iff |Ω⁻|a/|V⁻| ≤ :data:`surrogate.SPIN_TOLERANCE` and α1, |V⁻|
+        lie in the table's grid ranges (inclusive), the direct model (:func:`surrogate.rebound_direct`'s,
+        microseconds per hit) for every other hit; ``"table"``: the table for every hit, Ω⁻ ignored (the
+        behaviour before spin was taken into account; ``clamp`` applies); ``"direct"``: the direct model
+        for every hit. With Ω⁻ zero and every state in the grid, ``"auto"`` gives ``"table"``'s bits.
+    return_path : also return which path answered each hit (0 the table, 1 the direct model;
+        :data:`surrogate.kernels.PATH_TABLE`, :data:`surrogate.kernels.PATH_DIRECT`).
 
     Returns
     -------
-    (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8); NaN rows for
-    trapped particles. Every check runs before anything is written: on a
-    ValueError the ``out`` arrays are unchanged.
+    (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8), and path (N,) int8 with ``return_path``.
+    Status 0 rebounded, 1 trapped, 2 failed (the direct model only: a collision solve or a contact search
+    failed; rare, never dropped: count them with ``status == surrogate.STATUS_FAILED``); NaN rows unless
+    rebounded. Every check runs before anything is written: on a ValueError the ``out`` arrays are unchanged.
+    The direct model needs ``table.direct_parameters``: with a table that lacks them, a hit the model must
+    answer is a ValueError.
     """
     V = np.ascontiguousarray(_vectors("velocity", velocity))
     n_particles = V.shape[0]
@@ -336,12 +396,25 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         raise ValueError(f"The 'half_size' parameter must be a scalar or have shape ({n_particles},); "
                          f"got {a.shape}.")
     a = np.ascontiguousarray(a.reshape(-1))
-    _check_incident(table, V, nrm, a, clamp)
+    code = method_code(method)
+    W = _omega(omega, n_particles)
+    # the grid's range is an error only where the table must answer every hit
+    _check_incident(table, V, nrm, a, clamp or code != METHOD_TABLE)
     _check_shape(shape)
     cdf = mix_cdf(table, shape)
     scaled = _scaled(interpolation)
-    V_out, Omega_out, status = _outputs(out, n_particles, (V, nrm, a))
+    outputs = _outputs(out, n_particles, (V, nrm, a, W), 4 if return_path else 3)
+    old_table = table.direct_parameters is None and code != METHOD_TABLE
+    # a table without the model's parameters: draw into fresh arrays, so that ``out`` stays unchanged if a hit
+    # needs the model
+    V_out, Omega_out, status, path = (_outputs(None, n_particles, (), 4) if old_table
+                                      else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
+    params = np.zeros(0) if table.direct_parameters is None else table.direct_parameters
     states = chunk_states(check_random_state(random_state), n_particles)
-    rebound_parallel_rng(table.kernel_data, cdf, V, _rows(nrm, n_particles), _rows(a, n_particles), states, V_out, Omega_out,
-                      status, scaled)
-    return V_out, Omega_out, status
+    rebound_spin_parallel_rng(table.kernel_data, params, table.model_shapes, cdf, V, W, _rows(nrm, n_particles),
+                              _rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
+    if old_table:
+        _check_direct_parameters(table, path, V, W, a)
+        for target, result in zip(outputs, (V_out, Omega_out, status, path)):
+            target[...] = result
+    return tuple(outputs)

@@ -10,6 +10,7 @@ the same content as a named tuple of arrays, the form numba kernels take.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -17,7 +18,7 @@ import numpy as np
 from data_schema.common import DataFormatError
 from data_schema.table import ReboundTable, read_table
 from direct_model.runtime import model_parameters
-from direct_model.shapes import AspectRatioLaw
+from direct_model.shapes import SHAPES, AspectRatioLaw
 from direct_model.wall import WallMaterial
 from surrogate.kernels.layout import KernelData, check_kernel_data, frozen, kernel_data
 
@@ -37,6 +38,12 @@ class SurrogateTable:
     restitution_p: float
     kernel_data: KernelData
     direct_parameters: np.ndarray | None = None   # the direct model's parameters (:func:`direct_parameters`)
+
+    @functools.cached_property
+    def model_shapes(self) -> np.ndarray:
+        """The direct model's shape code (:data:`direct_model.shapes.SHAPES`) of each of the table's shapes, in
+        the table's order: read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound_spin_tuple` takes it."""
+        return frozen(np.array([SHAPES.index(name) for name in self.shapes], dtype=np.int64))
 
     @property
     def alpha1_range(self) -> tuple:

@@ -20,8 +20,12 @@ def test_bench_sampler_reports_every_figure(small_table_path, tmp_path, capsys):
                                "--min-time", "0.01", "--json", str(out)]) == 0
     figures = json.loads(out.read_text())
     results = figures["results"]
-    for key in ("a_all", "a_1", "a_kernel_1", "b", "b_views", "b_predrawn", "b_block", "b_rng", "c", "d"):
+    for key in ("a_all", "a_1", "a_kernel_1", "b", "b_views", "b_predrawn", "b_block", "b_rng", "c", "d", "e_table",
+                "e_auto", "e_spin", "e_mix"):
         assert results[key]["ns_per_state"] > 0, key
+    assert figures["ratios"]["mix_over_table"] == pytest.approx(results["e_mix"]["ns_per_state"]
+                                                                / results["e_table"]["ns_per_state"])
+    assert results["e_spin"]["note"].startswith("1.000 of the hits") and results["e_mix"]["note"].startswith("0.500")
     b, c, d = (results[k]["ns_per_state"] for k in ("b", "c", "d"))
     assert figures["ratios"]["direct_over_kernel"] == pytest.approx(c / b)
     assert figures["ratios"]["kernel_over_bounce"] == pytest.approx(b / d)

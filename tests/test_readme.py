@@ -31,13 +31,17 @@ def _check_rebounds(result, V, n):
 
 
 def test_runtime_sampler_examples_run_and_draw_one_law(small_table_path):
-    numpy_api, numba_api, direct_api = _python_blocks("Runtime sampler")
+    numpy_api, numba_api = _python_blocks("Runtime sampler")
+    spin_api, direct_api = _python_blocks("Spinning particles and states beyond the table")
     namespace = {}
     drawn = {"sample_global": _run(numpy_api, namespace, small_table_path)}
-    # the direct model with spin: a law of its own (and spin can feed |V⁺|), so only that rebounds leave the wall
-    direct = _run(direct_api, namespace, small_table_path)
-    ok = direct["status"] == 0
-    assert ok.mean() > 0.9 and np.all(direct["V_out"][ok] @ namespace["normals"] > 0.0)
+    # the direct model with spin (alone, and for the spinning half under "auto"): a law of its own (and spin can
+    # feed |V⁺|), so only that rebounds leave the wall; "auto" answers the others from the table
+    for code in (direct_api, spin_api):
+        direct = _run(code, namespace, small_table_path)
+        ok = direct["status"] == 0
+        assert ok.mean() > 0.9 and np.all(direct["V_out"][ok] @ namespace["normals"] > 0.0)
+    np.testing.assert_array_equal(namespace["path"], np.resize([1, 0], 1000))
     drawn["rebound_many_rng"] = _run(numba_api, namespace, small_table_path)
     V, n = namespace["V"], namespace["normals"]
     per_particle = {k: np.empty_like(namespace[k]) for k in ("V_out", "Omega_out", "status")}

@@ -10,7 +10,10 @@
  *   c_many_given     rbs_rebound_many on pre-drawn uniforms (their drawing not timed)
  *   c_rng            the 13 uniforms per state alone (rbs_rng_fill)
  *   c_grant_tabakoff the deterministic Grant–Tabakoff sphere bounce, same loop (bench_sampler.py's (d))
- * and, under "cpu", the thread CPU time per state of each best run (steadier when other work shares the CPU).
+ *   c_spin_still     c_per_particle's loop with rbs_rebound_spin (RBS_AUTO, Ω⁻ = 0): the path decision's cost
+ * and, under "cpu", the thread CPU time per state of each best run (steadier when other work shares the CPU);
+ * then, in µs per hit, c_spin_spinning_us: rbs_rebound_spin (RBS_AUTO) on the first SPINNING states with
+ * |Ω⁻| a/|V⁻| = 0.3 about random axes (the direct model answers them), one timed run.
  *
  * With OUT.bin, the results of the first rbs_rebound_many_rng call (V_out, Omega_out as float64 (count, 3),
  * status as int8) are written there, for a comparison of the bits.
@@ -111,7 +114,8 @@ int main(int argc, char **argv)
     rbs_rng_seed(&rng, seed);
     rbs_rng_fill(&rng, U, RBS_U_PER_DRAW * N);
 
-    double best[5] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY}, cpu[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    double best[6] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY}, cpu[6] = {0.0};
+    const double still[3] = {0.0, 0.0, 0.0};
     double checksum = 0.0;
     for (int r = 0; r < repeats + 1; r++) {         /* run 0 is the warm-up */
         double t0, dt, c0;
@@ -172,16 +176,54 @@ int main(int argc, char **argv)
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[4], &cpu[4]);
         checksum += V_out[0];
+        /* (6) per particle through rbs_rebound_spin, no spin: the table answers, after the path decision */
+        rbs_rng_seed(&rng, seed);
+        t0 = now();
+        c0 = cpu_now();
+        for (size_t i = 0; i < N; i++)
+            status[i] = (signed char)rbs_rebound_spin(table, &mix, V + 3 * i, still, n + 3 * i, a[i], &rng, RBS_AUTO,
+                                                      RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+        dt = now() - t0;
+        keep(r, dt, cpu_now() - c0, &best[5], &cpu[5]);
+        checksum += V_out[0];
     }
     size_t trapped = 0;
     for (size_t i = 0; i < N; i++) trapped += status[i] != RBS_REBOUNDED;
+    size_t still_direct = 0;
+    for (size_t i = 0; i < N; i++) still_direct += rbs_rebound_path(table, V + 3 * i, still, n + 3 * i, a[i], RBS_AUTO)
+                                                   == RBS_PATH_DIRECT;
+    /* spinning hits: |Ω⁻| a/|V⁻| = 0.3 about random axes; the direct model answers */
+    enum { SPINNING = 20000 };
+    size_t n_spin = N < SPINNING ? N : SPINNING, spin_direct = 0;
+    double *Omega = malloc(3 * n_spin * sizeof *Omega);
+    rbs_rng_seed(&rng, seed + 1);
+    for (size_t i = 0; i < n_spin; i++) {
+        double w[3], ww, speed = sqrt(V[3 * i] * V[3 * i] + V[3 * i + 1] * V[3 * i + 1] + V[3 * i + 2] * V[3 * i + 2]);
+        do {
+            for (int k = 0; k < 3; k++) w[k] = 2.0 * rbs_rng_uniform(&rng) - 1.0;
+            ww = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        } while (ww > 1.0 || ww < 1e-3);
+        for (int k = 0; k < 3; k++) Omega[3 * i + k] = 0.3 * speed / a[i] * w[k] / ww;
+        spin_direct += rbs_rebound_path(table, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], RBS_AUTO) == RBS_PATH_DIRECT;
+    }
+    rbs_rng_seed(&rng, seed);
+    double t0 = now();
+    for (size_t i = 0; i < n_spin; i++)
+        status[i] = (signed char)rbs_rebound_spin(table, &mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
+                                                  RBS_AUTO, RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+    double spinning_us = (now() - t0) / (double)n_spin * 1e6;
+    size_t spin_failed = 0;
+    for (size_t i = 0; i < n_spin; i++) spin_failed += status[i] == RBS_FAILED;
+    free(Omega);
     printf("{\"count\": %zu, \"repeats\": %d, \"c_per_particle\": %.3f, \"c_many\": %.3f, \"c_many_given\": %.3f, "
            "\"c_rng\": %.3f, \"c_grant_tabakoff\": %.3f, \"cpu\": {\"c_per_particle\": %.3f, \"c_many\": %.3f, "
-           "\"c_many_given\": %.3f, \"c_rng\": %.3f, \"c_grant_tabakoff\": %.3f}, \"not_rebounded\": %zu, "
-           "\"checksum\": %.17g}\n",
+           "\"c_many_given\": %.3f, \"c_rng\": %.3f, \"c_grant_tabakoff\": %.3f, \"c_spin_still\": %.3f}, "
+           "\"not_rebounded\": %zu, \"checksum\": %.17g, \"c_spin_still\": %.3f, \"still_direct\": %zu, "
+           "\"c_spin_spinning_us\": %.4f, \"spinning\": %zu, \"spinning_direct\": %zu, \"spinning_failed\": %zu}\n",
            N, repeats, best[0] / (double)N * 1e9, best[1] / (double)N * 1e9, best[2] / (double)N * 1e9,
            best[3] / (double)N * 1e9, best[4] / (double)N * 1e9, cpu[0] / (double)N * 1e9, cpu[1] / (double)N * 1e9,
-           cpu[2] / (double)N * 1e9, cpu[3] / (double)N * 1e9, cpu[4] / (double)N * 1e9, trapped, checksum);
+           cpu[2] / (double)N * 1e9, cpu[3] / (double)N * 1e9, cpu[4] / (double)N * 1e9, cpu[5] / (double)N * 1e9,
+           trapped, checksum, best[5] / (double)N * 1e9, still_direct, spinning_us, n_spin, spin_direct, spin_failed);
     free(V);
     free(n);
     free(a);

@@ -15,7 +15,7 @@ program rebound_example
   real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), Omega_out(3), Omega(3), ud(RBS_U_PER_REBOUND)
   real(c_double) :: Vs(3, n_many), ns(3, n_many), a(n_many), Vs_out(3, n_many), Ws_out(3, n_many)
   integer(c_signed_char) :: status(n_many)
-  integer(c_int) :: code, st, i
+  integer(c_int) :: code, st, i, answered_by
 
   if (command_argument_count() < 1) then
     print '(a)', "usage: rbs_example_fortran TABLE.h5"
@@ -45,6 +45,13 @@ program rebound_example
   st = rbs_rebound_direct(table, RBS_PRISM, V, Omega, n, 5e-5_c_double, ud, V_out, Omega_out)
   print '(a, i0, a, 3f10.3, a, 3es12.3)', "direct: status ", st, "  V+ =", V_out, "  Omega+ =", Omega_out
   if (st /= RBS_REBOUNDED .or. V_out(2) <= 0.0_c_double) stop 5   ! this one rebounds, leaving the wall
+
+  ! a spinning particle, |Omega-| a/|V-| = 0.3: the direct model answers under RBS_AUTO
+  Omega = [0.0_c_double, 0.3_c_double * norm2(V) / 5e-5_c_double, 0.0_c_double]     ! rad/s
+  answered_by = rbs_rebound_path(table, V, Omega, n, 5e-5_c_double, RBS_AUTO)
+  st = rbs_rebound_spin(table, mix, V, Omega, n, 5e-5_c_double, rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out)
+  print '(a, i0, a, i0, a, 3f10.3)', "spinning: path ", answered_by, ", status ", st, "  V+ =", V_out
+  if (answered_by /= RBS_PATH_DIRECT) stop 6
 
   ! many particles in one call (the faster path)
   do i = 1, n_many

@@ -18,6 +18,10 @@ module rebound_scatter
   integer(c_int), parameter :: RBS_OK = 0, RBS_ERR_IO = 1, RBS_ERR_FORMAT = 2, RBS_ERR_VERSION = 3, &
                                RBS_ERR_ARGUMENT = 4, RBS_ERR_MEMORY = 5
   integer(c_int), parameter :: RBS_SCALED = 0, RBS_STOCHASTIC = 1
+  ! methods of rbs_rebound_spin and the paths of rbs_rebound_path
+  integer(c_int), parameter :: RBS_AUTO = 0, RBS_TABLE = 1, RBS_DIRECT = 2
+  integer(c_int), parameter :: RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1
+  real(c_double), parameter :: RBS_SPIN_TOLERANCE = 0.001_c_double
 
   ! cumulative shape weights in the table's shape order (rbs_mix)
   type, bind(c) :: rbs_mix
@@ -100,6 +104,39 @@ module rebound_scatter
       real(c_double), intent(in) :: u(RBS_U_PER_REBOUND)
       real(c_double), intent(out) :: V_out(3), Omega_out(3)
     end function rbs_rebound_direct
+
+    ! Omega: the incident angular velocity in rad/s; method RBS_AUTO, RBS_TABLE or RBS_DIRECT
+    integer(c_int) function rbs_rebound_spin(table, mix, V, Omega, n, a, rng, method, interpolation, V_out, &
+        Omega_out) bind(c, name="rbs_rebound_spin")
+      import :: c_int, c_ptr, c_double, rbs_mix, rbs_rng
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      type(rbs_rng), intent(inout) :: rng
+      integer(c_int), value :: method, interpolation
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_rebound_spin
+
+    integer(c_int) function rbs_rebound_spin_u(table, mix, V, Omega, n, a, u, method, interpolation, V_out, &
+        Omega_out) bind(c, name="rbs_rebound_spin_u")
+      import :: c_int, c_ptr, c_double, rbs_mix, RBS_U_PER_DRAW
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      real(c_double), intent(in) :: u(RBS_U_PER_DRAW)
+      integer(c_int), value :: method, interpolation
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_rebound_spin_u
+
+    integer(c_int) function rbs_rebound_path(table, V, Omega, n, a, method) bind(c, name="rbs_rebound_path")
+      import :: c_int, c_ptr, c_double
+      type(c_ptr), value :: table
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      integer(c_int), value :: method
+    end function rbs_rebound_path
 
     subroutine rbs_rebound_many(table, mix, count, V, n, a, u, interpolation, V_out, Omega_out, status) &
         bind(c, name="rbs_rebound_many")

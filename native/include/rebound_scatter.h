@@ -7,7 +7,10 @@
  * Python package `surrogate` (surrogate.kernels.rebound_tuple, rebound_many,
  * rebound_many_rng, draw_local), for the same uniforms; and runs the direct
  * model itself where the table's law does not apply (rbs_rebound_direct, the
- * bits of surrogate.kernels.rebound_direct_tuple). See docs/native.md.
+ * bits of surrogate.kernels.rebound_direct_tuple). rbs_rebound_spin answers any
+ * hit, spinning or not: the table where its law is valid, the direct model
+ * elsewhere (the bits of surrogate.kernels.spin.rebound_spin_tuple). See
+ * docs/native.md.
  *
  * Frames and units
  * ----------------
@@ -273,6 +276,55 @@ int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg
 int rbs_rebound_direct(const rbs_table *table, int shape, const double V[3], const double Omega[3],
                        const double n[3], double a, const double u[RBS_U_PER_REBOUND],
                        double V_out[3], double Omega_out[3]);
+
+/* ---------------------------------------------------------------- every hit: table or direct model */
+
+/* Methods of rbs_rebound_spin (surrogate's method "auto", "table", "direct"). */
+enum {
+    RBS_AUTO = 0,           /* the table where its law is valid (below), the direct model for every other hit */
+    RBS_TABLE = 1,          /* the table whatever Ω⁻ (rbs_rebound: the law at the nearest grid edge outside) */
+    RBS_DIRECT = 2          /* the direct model for every hit */
+};
+
+/* The path that answers a hit (rbs_rebound_path). */
+enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
+
+/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.SPIN_TOLERANCE): where the table's law
+ * and the direct model's with that spin stay within classifier accuracy 0.52 (docs/design/spin_tolerance.md). */
+#define RBS_SPIN_TOLERANCE 0.001
+
+/* The path that answers a hit under `method` (surrogate.kernels.spin.rebound_path): a pure function of the
+ * state, so a caller learns it without another draw. Under RBS_AUTO, the table iff |Ω⁻| a/|V⁻| <=
+ * RBS_SPIN_TOLERANCE (Ω⁻ = 0 included), and α1 and |V⁻| (as rbs_rebound computes them) lie in the table's
+ * grid ranges, edges included (rbs_table_alpha1_range, rbs_table_speed_range); else the direct model.
+ *   V, n, a  as rbs_rebound;  Omega  incident angular velocity Ω⁻, rad/s (finite)
+ * Returns RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_INVALID for a NULL pointer, an unknown method, or a
+ * state rbs_rebound or rbs_rebound_direct refuses (V not moving into the wall, n not a unit vector, a
+ * not finite and > 0, Ω⁻ not finite). */
+int rbs_rebound_path(const rbs_table *table, const double V[3], const double Omega[3], const double n[3],
+                     double a, int method);
+
+/* The reflected state of one particle, spinning or not, from the table or the direct model
+ * (surrogate.kernels.spin.rebound_spin_tuple): the path rbs_rebound_path gives, then
+ *   RBS_PATH_TABLE   rbs_rebound with the same u (Ω⁻ unused);
+ *   RBS_PATH_DIRECT  the shape drawn from the mix with u[0] as rbs_rebound draws it, then
+ *                    rbs_rebound_direct with that shape's code and u[1..RBS_U_PER_REBOUND] as its uniforms.
+ * A hit consumes RBS_U_PER_DRAW uniforms whatever the path, so streams stay aligned.
+ *   Omega    incident angular velocity Ω⁻, rad/s (finite);  method  RBS_AUTO, RBS_TABLE or RBS_DIRECT;
+ *   the other arguments as rbs_rebound.
+ * Returns RBS_REBOUNDED, RBS_TRAPPED, RBS_FAILED (direct path: a collision solve or a contact search
+ * failed; count it) or RBS_INVALID (what rbs_rebound_path refuses, a NULL pointer, a mix of another
+ * table's shape count, an unknown interpolation, a uniform outside [0, 1) or NaN); NaN outputs unless
+ * rebounded. The direct path costs microseconds, the table path a fraction of one. Thread-safe. */
+int rbs_rebound_spin_u(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
+                       double V_out[3], double Omega_out[3]);
+
+/* rbs_rebound_spin_u with its RBS_U_PER_DRAW uniforms drawn from `rng` (rbs_rng_fill), which advances by
+ * them whatever the path and whatever the result; a NULL or all-zero rng gives RBS_INVALID. */
+int rbs_rebound_spin(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                     const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
+                     double Omega_out[3]);
 
 /* ---------------------------------------------------------------- random numbers */
 

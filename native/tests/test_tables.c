@@ -179,6 +179,80 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
     }
 }
 
+/* every hit answered (rbs_rebound_spin, rbs_rebound_spin_u, rbs_rebound_path): spinning and hostile hits under
+ * the three methods; whatever rebounds is finite and leaves the wall, the rest is NaN */
+static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, double vhi)
+{
+    rbs_rng rng;
+    rbs_rng_seed_stream(&rng, 28, 1);
+    const double n[3] = {0.0, 1.0, 0.0}, still[3] = {0.0, 0.0, 0.0}, a = 1e-4;
+    double V[3] = {100.0, -100.0, 0.0}, V_out[3], W_out[3], u[RBS_U_PER_DRAW];
+    double spin[3] = {0.0, 0.0, 0.3 * sqrt(2e4) / a};        /* |Omega-| a/|V-| = 0.3 */
+    rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
+    CHECK(rbs_rebound_path(table, V, still, n, a, RBS_AUTO) == RBS_PATH_TABLE, "no spin at 45 deg: the table");
+    CHECK(rbs_rebound_path(table, V, spin, n, a, RBS_AUTO) == RBS_PATH_DIRECT, "spin 0.3: the direct model");
+    CHECK(rbs_rebound_path(table, V, spin, n, a, RBS_TABLE) == RBS_PATH_TABLE, "method table");
+    CHECK(rbs_rebound_path(table, V, still, n, a, RBS_DIRECT) == RBS_PATH_DIRECT, "method direct");
+    for (int method = RBS_AUTO; method <= RBS_DIRECT; method++) {
+        int st = rbs_rebound_spin_u(table, mix, V, spin, n, a, u, method, RBS_SCALED, V_out, W_out);
+        CHECK(st == RBS_REBOUNDED ? physical(V_out, W_out, n) : st != RBS_INVALID && all_nan(V_out, 3),
+              "spinning hit, method %d: status %d", method, st);
+    }
+    /* NULL pointers, bad methods, bad Omega-, a NULL or all-zero rng */
+    const double bad_spins[3] = {NAN, INFINITY, -INFINITY};
+    for (int j = 0; j < 3; j++) {
+        double W_bad[3] = {1.0, bad_spins[j], 1.0};
+        CHECK(rbs_rebound_path(table, V, W_bad, n, a, RBS_AUTO) == RBS_INVALID, "Omega %g: path", bad_spins[j]);
+        CHECK(rbs_rebound_spin_u(table, mix, V, W_bad, n, a, u, RBS_TABLE, RBS_SCALED, V_out, W_out) == RBS_INVALID
+              && all_nan(V_out, 3) && all_nan(W_out, 3), "Omega %g", bad_spins[j]);
+    }
+    CHECK(rbs_rebound_spin_u(NULL, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID
+          && all_nan(V_out, 3), "spin: NULL table");
+    CHECK(rbs_rebound_spin_u(table, NULL, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+          "spin: NULL mix");
+    CHECK(rbs_rebound_spin_u(table, mix, NULL, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+          "spin: NULL V");
+    CHECK(rbs_rebound_spin_u(table, mix, V, NULL, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+          "spin: NULL Omega");
+    CHECK(rbs_rebound_spin_u(table, mix, V, spin, NULL, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+          "spin: NULL n");
+    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, NULL, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+          "spin: NULL u");
+    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, NULL, W_out) == RBS_INVALID
+          && all_nan(W_out, 3), "spin: NULL V_out");
+    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, NULL) == RBS_INVALID,
+          "spin: NULL Omega_out");
+    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, 3, RBS_SCALED, V_out, W_out) == RBS_INVALID, "method 3");
+    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, RBS_AUTO, 9, V_out, W_out) == RBS_INVALID,
+          "spin: unknown interpolation");
+    CHECK(rbs_rebound_path(table, NULL, spin, n, a, RBS_AUTO) == RBS_INVALID, "path: NULL V");
+    CHECK(rbs_rebound_path(table, V, spin, n, a, -1) == RBS_INVALID, "path: method -1");
+    rbs_rng zero = {{0, 0, 0, 0}};
+    CHECK(rbs_rebound_spin(table, mix, V, spin, n, a, NULL, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID
+          && all_nan(V_out, 3), "spin: NULL rng");
+    CHECK(rbs_rebound_spin(table, mix, V, spin, n, a, &zero, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+          "spin: zero rng");
+    /* random hits over and beyond the grid, spins from none to 2 |V-|/a, random methods; hostile particles */
+    for (int i = 0; i < 3000; i++) {
+        double Vr[3], nr[3], Wr[3];
+        unit(&rng, nr);
+        unit(&rng, Wr);
+        double speed = 0.3 * vlo + 1.5 * vhi * rbs_rng_uniform(&rng);
+        double ratio = i % 3 == 0 ? 0.0 : 2.0 * rbs_rng_uniform(&rng);
+        for (int k = 0; k < 3; k++) {
+            Vr[k] = speed * (2.0 * rbs_rng_uniform(&rng) - 1.0);
+            Wr[k] *= ratio * speed / a;
+        }
+        if (i % 50 == 0) Vr[i % 3] = i % 100 == 0 ? NAN : 1e300;
+        if (i % 70 == 0) nr[0] *= 3.0;
+        int method = (int)(3.0 * rbs_rng_uniform(&rng)), path = rbs_rebound_path(table, Vr, Wr, nr, a, method);
+        int st = rbs_rebound_spin(table, mix, Vr, Wr, nr, a, &rng, method, i % 2, V_out, W_out);
+        CHECK(path != RBS_INVALID || st == RBS_INVALID, "random spin hit %d: path invalid, status %d", i, st);
+        CHECK(st == RBS_REBOUNDED ? physical(V_out, W_out, nr) : all_nan(V_out, 3) && all_nan(W_out, 3),
+              "random spin hit %d: status %d", i, st);
+    }
+}
+
 static void draw_from(const char *path)
 {
     char message[1024];
@@ -287,6 +361,7 @@ static void draw_from(const char *path)
     double out[RBS_LOCAL_SIZE];
     CHECK(rbs_draw_local(table, &mix, NAN, NAN, u, RBS_SCALED, out) == RBS_INVALID, "NaN local draw");
     hostile_draws(table, &mix, vlo, vhi);
+    spin_draws(table, &mix, vlo, vhi);
     CHECK(rbs_draw_local(table, NULL, 45.0, 100.0, u, RBS_SCALED, out) == RBS_INVALID, "NULL mix");
     rbs_mix wrong = mix;
     wrong.n_shapes = n_shapes + 1;

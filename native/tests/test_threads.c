@@ -5,8 +5,9 @@
  *   rbs_test_threads TABLE.h5 THREADS ROWS
  *
  * Thread t draws ROWS incident states and their rebounds from stream t of seed 7
- * (rbs_rng_seed_stream), with rbs_rebound per particle and with rbs_rebound_many_rng; then the main
- * thread redoes every stream alone and compares the bits.
+ * (rbs_rng_seed_stream), with rbs_rebound per particle, with rbs_rebound_many_rng and with rbs_rebound_spin
+ * (every other hit spinning, |Ω⁻| a/|V⁻| = 0.5: the direct model answers it); then the main thread redoes
+ * every stream alone and compares the bits.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -25,8 +26,8 @@ typedef struct work {
     pthread_barrier_t *start;
     uint64_t stream;
     size_t rows;
-    double *V_out, *Omega_out;      /* (2 rows, 3): per-particle results, then the many-particle ones */
-    signed char *status;        /* (2 rows) */
+    double *V_out, *Omega_out;      /* (3 rows, 3): per-particle results, the many-particle ones, the spin ones */
+    signed char *status;        /* (3 rows) */
 } work;
 
 static void *draw(void *argument)
@@ -56,6 +57,14 @@ static void *draw(void *argument)
     }
     rbs_rebound_many_rng(w->table, w->mix, N, V, n, a, &rng, RBS_SCALED, w->V_out + 3 * N, w->Omega_out + 3 * N,
                          w->status + N);
+    for (size_t i = 0; i < N; i++) {
+        const double *v = V + 3 * i;
+        double w_i = i % 2 ? 0.5 * sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / a[i] : 0.0;
+        const double Omega[3] = {0.6 * w_i, 0.0, 0.8 * w_i};
+        w->status[2 * N + i] = (signed char)rbs_rebound_spin(w->table, w->mix, v, Omega, n + 3 * i, a[i], &rng,
+                                                             RBS_AUTO, RBS_SCALED, w->V_out + 3 * (2 * N + i),
+                                                             w->Omega_out + 3 * (2 * N + i));
+    }
     free(V);
     free(n);
     free(a);
@@ -64,8 +73,8 @@ static void *draw(void *argument)
 
 static work make_work(const rbs_table *table, const rbs_mix *mix, uint64_t stream, size_t rows)
 {
-    work w = {table, mix, NULL, stream, rows, malloc(6 * rows * sizeof(double)), malloc(6 * rows * sizeof(double)),
-              malloc(2 * rows)};
+    work w = {table, mix, NULL, stream, rows, malloc(9 * rows * sizeof(double)), malloc(9 * rows * sizeof(double)),
+              malloc(3 * rows)};
     return w;
 }
 
@@ -108,17 +117,17 @@ int main(int argc, char **argv)
     for (int t = 0; t < threads; t++) {
         work alone = make_work(table, &mix, (uint64_t)t, rows);
         draw(&alone);
-        if (memcmp(alone.V_out, jobs[t].V_out, 6 * rows * sizeof(double)) != 0
-            || memcmp(alone.Omega_out, jobs[t].Omega_out, 6 * rows * sizeof(double)) != 0
-            || memcmp(alone.status, jobs[t].status, 2 * rows) != 0) {
+        if (memcmp(alone.V_out, jobs[t].V_out, 9 * rows * sizeof(double)) != 0
+            || memcmp(alone.Omega_out, jobs[t].Omega_out, 9 * rows * sizeof(double)) != 0
+            || memcmp(alone.status, jobs[t].status, 3 * rows) != 0) {
             fprintf(stderr, "stream %d: the threaded draws differ from the draws of one thread\n", t);
             differ++;
         }
-        for (size_t i = 0; i < 2 * rows; i++) rebounded += alone.status[i] == RBS_REBOUNDED;
+        for (size_t i = 0; i < 3 * rows; i++) rebounded += alone.status[i] == RBS_REBOUNDED;
         free_work(&alone);
         free_work(&jobs[t]);
     }
-    printf("%d threads x %zu rows (per particle and many): %zu rebounded, %d stream(s) differ\n", threads, rows,
+    printf("%d threads x %zu rows (per particle, many, spinning or not): %zu rebounded, %d stream(s) differ\n", threads, rows,
            rebounded, differ);
     free(ids);
     free(jobs);

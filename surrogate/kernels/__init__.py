@@ -14,6 +14,9 @@ xoshiro256+ state. Where each part lives:
 ``particle``    one particle: :func:`rebound_tuple`, :func:`rebound` (global frame), :func:`draw_local`
 ``direct``      the direct model instead of the table: :func:`rebound_direct_tuple` (one particle),
                 :func:`rebound_direct_parallel_rng` (many, all threads)
+``spin``        every hit answered, spinning or not: :func:`rebound_path` (which path answers a hit: the table
+                where it is valid, the direct model elsewhere), :func:`rebound_spin_tuple` (one particle),
+                :func:`rebound_spin_parallel_rng` (many, all threads); METHOD_*, PATH_*, SPIN_TOLERANCE
 ``block``       the block form of the stages' records, field-major over BLOCK particles
 ``pipeline``    many particles on one thread, the stages' block forms scheduled: :func:`rebound_many`,
                 :func:`rebound_many_rng`
@@ -47,9 +50,12 @@ from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel
 from surrogate.kernels.particle import draw_local, rebound, rebound_tuple
 from surrogate.kernels.pipeline import rebound_many, rebound_many_rng, rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
+from surrogate.kernels.spin import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE, SPIN_TOLERANCE,
+                                    rebound_path, rebound_spin_parallel_rng, rebound_spin_tuple)
 
-__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND", "arithmetic",
-           "chunk_states", "draw_local", "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity",
+__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT",
+           "PATH_TABLE", "SPIN_TOLERANCE", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND", "arithmetic", "chunk_states", "draw_local", "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity",
            "fill_uniforms", "gather", "grid_interval", "impact_frame", "locate", "next_uniform", "rebound",
            "rebound_direct_parallel_rng", "rebound_direct_tuple", "rebound_many", "rebound_many_rng",
-           "rebound_parallel", "rebound_parallel_rng", "rebound_tuple", "rebound_uniforms", "seed_state"]
+           "rebound_parallel", "rebound_parallel_rng", "rebound_path", "rebound_spin_parallel_rng",
+           "rebound_spin_tuple", "rebound_tuple", "rebound_uniforms", "seed_state"]

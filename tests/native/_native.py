@@ -23,6 +23,9 @@ INSTALL_HINT = ("run native/install-deps.sh (as root on Debian/Ubuntu it install
 U_PER_DRAW = 13
 MAX_SHAPES = 4
 SCALED, STOCHASTIC = 0, 1
+AUTO, TABLE, DIRECT = 0, 1, 2           # RBS_AUTO, RBS_TABLE, RBS_DIRECT
+PATH_TABLE, PATH_DIRECT = 0, 1          # RBS_PATH_TABLE, RBS_PATH_DIRECT
+INVALID = -1                            # RBS_INVALID
 OK, ERR_IO, ERR_FORMAT, ERR_VERSION, ERR_ARGUMENT, ERR_MEMORY = range(6)
 
 
@@ -187,6 +190,28 @@ class NativeTable:
                                                _ptr(u), _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out
 
+    def rebound_spin_u(self, mix, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
+        V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
+        V_out, W_out = np.empty(3), np.empty(3)
+        status = self.lib.c.rbs_rebound_spin_u(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
+                                               ctypes.c_double(a), _ptr(u), method, interpolation, _ptr(V_out),
+                                               _ptr(W_out))
+        return status, V_out, W_out
+
+    def rebound_spin(self, mix, V, Omega, n, a, state: np.ndarray, method=AUTO, interpolation=SCALED):
+        """Returns (status, V_out, W_out, advanced state)."""
+        V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
+        rng = _rng(state)
+        V_out, W_out = np.empty(3), np.empty(3)
+        status = self.lib.c.rbs_rebound_spin(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
+                                             ctypes.c_double(a), ctypes.byref(rng), method, interpolation,
+                                             _ptr(V_out), _ptr(W_out))
+        return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
+
+    def rebound_path(self, V, Omega, n, a, method=AUTO):
+        V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
+        return self.lib.c.rbs_rebound_path(self.handle, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a), method)
+
     def draw_local(self, mix, alpha1, speed, u, interpolation=SCALED):
         u = np.ascontiguousarray(u, dtype=np.float64)
         out = np.empty(6)
@@ -238,6 +263,12 @@ class Native:
         c.rbs_rebound_direct.restype = i
         c.rbs_draw_local.argtypes = [vp, ctypes.POINTER(Mix), d, d, vp, i, vp]
         c.rbs_draw_local.restype = i
+        c.rbs_rebound_spin_u.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, vp, i, i, vp, vp]
+        c.rbs_rebound_spin_u.restype = i
+        c.rbs_rebound_spin.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, ctypes.POINTER(Rng), i, i, vp, vp]
+        c.rbs_rebound_spin.restype = i
+        c.rbs_rebound_path.argtypes = [vp, vp, vp, vp, d, i]
+        c.rbs_rebound_path.restype = i
         c.rbs_rng_seed.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64]
         c.rbs_rng_seed_stream.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64, ctypes.c_uint64]
         c.rbs_rng_uniform.argtypes = [ctypes.POINTER(Rng)]

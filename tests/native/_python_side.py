@@ -7,9 +7,10 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
 ``draw_local``; the direct model's free flight from ``direct_model.rotation``, its run-time kernel
 ``rebound_direct_tuple`` and the kernels it calls (``direct_model``: collide, body_vertices,
-bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix); the law
-comparisons of tests/direct_law.py (its states, ``tablegen simulate`` and the statistics); tables come
-from ``tablegen.build_table`` and ``tablegen.parse_config``;
+bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix); those of every
+hit (``surrogate.kernels.spin``: ``rebound_spin_tuple``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
+and PATH_* codes); the law comparisons of tests/direct_law.py (its states, ``tablegen simulate`` and the
+statistics); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks and the samples' angle conversion from ``data_schema``.
 """
 
@@ -25,6 +26,8 @@ from direct_model.rebound import quaternion_to_matrix
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, normal_quantile, uniform_quaternion
 from direct_model.shapes import MAX_VERTICES, SHAPES, body_vertices, bounding_radius
 from direct_law import A, N, STATES, assert_one_law, frame_of, incident, one_law, simulated, state_id, to_model_frame
+from surrogate.kernels.spin import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE, SPIN_TOLERANCE,
+                                    rebound_path, rebound_spin_tuple)
 
 
 def build_table(config_text: str, path) -> None:
@@ -56,4 +59,5 @@ __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", 
            "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",
            "collide", "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion",
            "A", "N", "SHAPES", "STATES", "assert_one_law", "frame_of", "incident", "one_law", "simulated", "state_id",
-           "to_model_frame"]
+           "to_model_frame", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE",
+           "SPIN_TOLERANCE", "rebound_path", "rebound_spin_tuple"]

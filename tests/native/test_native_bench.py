@@ -20,8 +20,11 @@ def test_bench_native_quick(native_build, small_table_path, tmp_path, capsys):
                               str(native_build), "--json", str(out)]) == 0
     figures = json.loads(out.read_text())
     for key in ("c_per_particle", "c_many", "c_many_given", "c_rng", "numba_per_particle", "numba_block",
-                "c_grant_tabakoff", "numba_grant_tabakoff"):
+                "c_grant_tabakoff", "numba_grant_tabakoff", "c_spin_still"):
         assert figures["ns_per_state"][key] > 0, key
+    # the spinning hits (|Omega-| a/|V-| = 0.3, far above the spin tolerance) all went to the direct model
+    spin = figures["spin"]
+    assert spin["spinning"] == 20000 and spin["spinning_direct"] == spin["spinning"] and spin["spinning_us_per_hit"] > 0
     assert figures["same_bits"] is True
     printed = capsys.readouterr().out
     assert "(C-many)/(C-GT)" in printed and "target" in printed

@@ -25,8 +25,9 @@ BAD_GLOBAL = [
     (dict(velocity=[[np.inf, -100.0, 0.0]]), "not finite"),
     (dict(normal=[0.0, 2.0, 0.0]), "unit vectors"),
     (dict(half_size=0.0), "half_size"),
-    (dict(velocity=[[10.0, -400.0, 0.0]]), r"'speed' value .* outside the table's range \[50, 250\]"),
-    (dict(velocity=[[200.0, -10.0, 0.0]]), r"'alpha1' value .* outside the table's range \[30, 90\]"),
+    # outside the grid is an error only where the table answers every hit (method "table")
+    (dict(velocity=[[10.0, -400.0, 0.0]], method="table"), r"'speed' value .* outside the table's range \[50, 250\]"),
+    (dict(velocity=[[200.0, -10.0, 0.0]], method="table"), r"'alpha1' value .* outside the table's range \[30, 90\]"),
     (dict(shape=[0.5, 0.6, 0.0, -0.1]), "must be finite and >= 0"),
     (dict(shape=[0.5, 0.6, 0.0, 0.0]), "sum to 1"),
     (dict(shape="sphere"), "must name one of"),
@@ -106,12 +107,13 @@ def test_the_error_names_the_first_failing_check_and_its_first_row(small_table):
             surrogate.sample_global(small_table, V, n, a, "prism", random_state=0)
         fix()
     with pytest.raises(ValueError, match=r"'alpha1' value [\d.]+ deg \(index 1500\)"):
-        surrogate.sample_global(small_table, V, n, a, "prism", random_state=0)
-    V_out, _, status = surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, clamp=True)
+        surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, method="table")
+    V_out, _, status = surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, clamp=True,
+                                               method="table")
     assert np.all(np.isfinite(V_out[status == STATUS_REBOUNDED])) and status[700] in (STATUS_REBOUNDED, STATUS_TRAPPED)
     V[1500] = V[0]
     with pytest.raises(ValueError, match=r"'speed' value 400\.0 m/s \(index 700\)"):
-        surrogate.sample_global(small_table, V, n, a, "prism", random_state=0)
+        surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, method="table")
     with pytest.raises(ValueError, match=r"'half_size' parameter must be a scalar or have shape \(3000,\)"):
         surrogate.sample_global(small_table, V, n, np.full(7, 1e-4), "prism")
 
@@ -133,7 +135,8 @@ def test_cli_sample_writes_the_raw_layout(small_table_path, tmp_path):
     assert len(s) == 2000 and s.producer == "surrogate sample" and np.all(s.n_collisions == -1)
     ok = s.rebounded
     np.testing.assert_allclose(np.linalg.norm(s.velocity[ok], axis=1) / 100.0, s.speed_ratio[ok])
+    # outside the grid: an error where the table answers every hit (the default, auto, asks the direct model)
     bad = subprocess.run([sys.executable, "-m", "surrogate.cli", "sample", "--table", str(small_table_path),
-                          "--alpha1", "10", "--speed", "100", "--shape", "prism", "-n", "5"],
+                          "--alpha1", "10", "--speed", "100", "--shape", "prism", "-n", "5", "--method", "table"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "alpha1" in bad.stderr

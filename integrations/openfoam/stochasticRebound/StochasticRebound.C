@@ -29,6 +29,7 @@ License
 #include "Pstream.H"
 #include "OSspecific.H"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <type_traits>
@@ -182,10 +183,12 @@ void Foam::StochasticRebound<CloudType>::recordHit
     const typename CloudType::parcelType& p,
     const polyPatch& pp,
     const double V[3],
+    const double Omega[3],
     const double n[3],
     const vector& Uwall,
     double a,
     int status,
+    int path,
     const double Vout[3],
     const double Wout[3],
     scalar spinRatio,
@@ -203,13 +206,15 @@ void Foam::StochasticRebound<CloudType>::recordHit
     (
         line, sizeof(line),
         "%.9g,%d,%s,%d,%d,%.9g,%.9g,"
-        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g,"
-        "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.17g\n",
+        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+        "%.9g,%.9g,%.9g,"
+        "%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.17g\n",
         this->owner().mesh().time().value(),
         int(Pstream::myProcNo()), pp.name().c_str(),
         int(p.origProc()), int(p.origId()), p.d(), a,
-        V[0], V[1], V[2], n[0], n[1], n[2], Uwall.x(), Uwall.y(), Uwall.z(),
-        status, Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2],
+        V[0], V[1], V[2], Omega[0], Omega[1], Omega[2], n[0], n[1], n[2],
+        Uwall.x(), Uwall.y(), Uwall.z(),
+        status, path, Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2],
         spinRatio, u0
     );
     s.hits << line;
@@ -237,6 +242,7 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     removeTrapped_(false),
     seed_(0),
     interpolation_(RBS_SCALED),
+    method_(RBS_AUTO),
     alpha1Lo_(0),
     alpha1Hi_(0),
     speedLo_(0),
@@ -261,7 +267,7 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     static const wordList known
     ({
         "table", "shape", "weights", "halfSizeFactor", "trapped", "seed",
-        "interpolation", "writeHits", "maxHitRecords",
+        "interpolation", "method", "writeHits", "maxHitRecords",
         "U", "writePrecision", "writeToFile", "useUserTime", "defaultCoeffs"
     });
     for (const word& key : coeffs.toc())
@@ -319,6 +325,22 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
             << exit(FatalIOError);
     }
 
+    const word method(coeffs.getOrDefault<word>("method", "auto"));
+    if (method == "table")
+    {
+        method_ = RBS_TABLE;
+    }
+    else if (method == "direct")
+    {
+        method_ = RBS_DIRECT;
+    }
+    else if (method != "auto")
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "method must be auto, table or direct, not " << method
+            << exit(FatalIOError);
+    }
+
     const label seed = coeffs.getOrDefault<label>("seed", 1);
     if (seed < 0)
     {
@@ -352,14 +374,18 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
             << "# stochasticRebound hits: seed " << seed_ << ", stream "
             << stream << ", table " << tableFile_.c_str() << ", mix "
             << mixName_.c_str() << ", halfSizeFactor " << halfSizeFactor_
-            << ", interpolation " << interp.c_str() << "\n"
-            << "# V: incident velocity relative to the wall, n: unit normal"
-               " into the gas, Uw: wall velocity, Vout/Wout: rebound"
-               " velocity (relative to the wall) and angular velocity,"
-               " spin_ratio: |Omega-| a/|V| (colliding parcels), u0: first"
-               " uniform of the draw\n"
-            << "time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,nx,ny,nz,"
-               "Uwx,Uwy,Uwz,status,Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0\n";
+            << ", interpolation " << interp.c_str() << ", method "
+            << method.c_str() << ", spin tolerance " << RBS_SPIN_TOLERANCE
+            << "\n"
+            << "# V: incident velocity relative to the wall, Win: incident"
+               " angular velocity (colliding parcels, else 0), n: unit normal"
+               " into the gas, Uw: wall velocity, path: 0 table, 1 direct"
+               " model, -1 invalid, Vout/Wout: rebound velocity (relative to"
+               " the wall) and angular velocity, spin_ratio: |Win| a/|V|,"
+               " u0: first uniform of the draw\n"
+            << "time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,"
+               "nx,ny,nz,Uwx,Uwy,Uwz,status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,"
+               "spin_ratio,u0\n";
     }
 
     const rbs_table* t = table_.get();
@@ -369,7 +395,9 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
         << " m/s)" << nl
         << "        shape " << mixName_.c_str() << ", a = " << halfSizeFactor_
         << "*d/2, trapped parcels " << (removeTrapped_ ? "removed" : "stick")
-        << ", interpolation " << interp << ", seed " << seed_
+        << ", interpolation " << interp << ", method " << method
+        << " (spin tolerance " << RBS_SPIN_TOLERANCE << ")"
+        << ", seed " << seed_
         << " (rank r draws stream r)" << endl;
 }
 
@@ -389,6 +417,7 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     removeTrapped_(pim.removeTrapped_),
     seed_(pim.seed_),
     interpolation_(pim.interpolation_),
+    method_(pim.method_),
     alpha1Lo_(pim.alpha1Lo_),
     alpha1Hi_(pim.alpha1Hi_),
     speedLo_(pim.speedLo_),
@@ -425,10 +454,12 @@ bool Foam::StochasticRebound<CloudType>::correct
 
     vector& U = p.U();
     const vector Vin(U - Uwall);
+    const vector Win(stochasticReboundDetail::angularVelocity(p, 0));
     const scalar nMag = mag(nw);
     const scalar a = halfSizeFactor_*0.5*p.d();
 
     double V[3] = {Vin.x(), Vin.y(), Vin.z()};
+    double Omega[3] = {Win.x(), Win.y(), Win.z()};
     double n[3] = {0, 0, 0};
     if (nMag > 0)
     {
@@ -438,30 +469,43 @@ bool Foam::StochasticRebound<CloudType>::correct
         n[2] = -nw.z()/nMag;
     }
 
+    // 13 uniforms per hit whatever the path (the first one is recorded)
     double u[RBS_U_PER_DRAW];
     rbs_rng_fill(&s.rng, u, RBS_U_PER_DRAW);
 
+    // The path is a pure function of the state: learnt before the draw,
+    // so the clock runs around the direct model's calls only
     double Vout[3], Wout[3];
-    int status = RBS_INVALID;
-    if (nMag > 0 && a > 0)
+    const rbs_table* table = table_.get();
+    const int path = rbs_rebound_path(table, V, Omega, n, a, method_);
+    std::chrono::steady_clock::time_point t0;
+    if (path == RBS_PATH_DIRECT)
     {
-        status = rbs_rebound
+        t0 = std::chrono::steady_clock::now();
+    }
+    const int status = rbs_rebound_spin_u
+    (
+        table, &mix_, V, Omega, n, a, u, method_, interpolation_, Vout, Wout
+    );
+    if (path == RBS_PATH_DIRECT)
+    {
+        c.directSeconds += std::chrono::duration<double>
         (
-            table_.get(), &mix_, V, n, a, u, interpolation_, Vout, Wout
-        );
+            std::chrono::steady_clock::now() - t0
+        ).count();
+        ++c.directPath;
+    }
+    else if (path == RBS_PATH_TABLE)
+    {
+        ++c.tablePath;
     }
 
     ++c.hits;
 
     const scalar speed = mag(Vin);
-    scalar spinRatio = 0;
+    const scalar spinRatio = speed > 0 ? mag(Win)*a/speed : 0;
     if (stochasticReboundDetail::hasSpin<typename CloudType::parcelType>::value)
     {
-        if (speed > 0)
-        {
-            spinRatio =
-                mag(stochasticReboundDetail::angularVelocity(p, 0))*a/speed;
-        }
         ++c.spinSamples;
         c.spinRatioSum += spinRatio;
         c.spinRatioMax = max(c.spinRatioMax, spinRatio);
@@ -469,7 +513,8 @@ bool Foam::StochasticRebound<CloudType>::correct
 
     if (status != RBS_INVALID)
     {
-        // Outside the table's grid the law at the nearest grid edge is drawn
+        // Outside the table's grid: the direct model answers under auto and
+        // direct, the law at the nearest grid edge under table
         const scalar alpha1 = radToDeg
         (
             std::asin(min(max(-(V[0]*n[0] + V[1]*n[1] + V[2]*n[2])/speed, -1), 1))
@@ -499,9 +544,20 @@ bool Foam::StochasticRebound<CloudType>::correct
             break;
         }
         case RBS_TRAPPED:
+        case RBS_FAILED:
         {
-            ++c.trapped;
-            c.trappedMass += p.nParticle()*p.mass();
+            // A failed direct rebound has no answer: the trapped policy
+            // applies, counted apart
+            if (status == RBS_TRAPPED)
+            {
+                ++c.trapped;
+                c.trappedMass += p.nParticle()*p.mass();
+            }
+            else
+            {
+                ++c.failed;
+                c.failedMass += p.nParticle()*p.mass();
+            }
             // stick: kept, inactive, at rest on the wall; remove: deleted
             keepParticle = !removeTrapped_;
             p.active(false);
@@ -521,7 +577,11 @@ bool Foam::StochasticRebound<CloudType>::correct
 
     if (s.hits.is_open())
     {
-        recordHit(p, pp, V, n, Uwall, a, status, Vout, Wout, spinRatio, u[0]);
+        recordHit
+        (
+            p, pp, V, Omega, n, Uwall, a, status, path, Vout, Wout, spinRatio,
+            u[0]
+        );
     }
 
     return true;
@@ -537,30 +597,44 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
     const Counters& c = s.counters;
 
     // Totals: the values stored at the last write plus this run's since then
-    label nHits = this->template getModelProperty<label>("nHits");
-    label nRebounded = this->template getModelProperty<label>("nRebounded");
-    label nTrapped = this->template getModelProperty<label>("nTrapped");
-    label nInvalid = this->template getModelProperty<label>("nInvalid");
-    label nOutside = this->template getModelProperty<label>("nOutsideGrid");
-    scalar mTrapped = this->template getModelProperty<scalar>("massTrapped");
+    auto total = [this](const word& name, label now)
+    {
+        return this->template getModelProperty<label>(name)
+            + returnReduce(now, sumOp<label>());
+    };
+    auto totalScalar = [this](const word& name, scalar now)
+    {
+        return this->template getModelProperty<scalar>(name)
+            + returnReduce(now, sumOp<scalar>());
+    };
+    const label nHits = total("nHits", c.hits);
+    const label nTable = total("nTablePath", c.tablePath);
+    const label nDirect = total("nDirectPath", c.directPath);
+    const label nRebounded = total("nRebounded", c.rebounded);
+    const label nTrapped = total("nTrapped", c.trapped);
+    const label nFailed = total("nFailed", c.failed);
+    const label nInvalid = total("nInvalid", c.invalid);
+    const label nOutside = total("nOutsideGrid", c.outsideGrid);
+    const scalar mTrapped = totalScalar("massTrapped", c.trappedMass);
+    const scalar mFailed = totalScalar("massFailed", c.failedMass);
+    const scalar directSeconds =
+        totalScalar("directModelSeconds", c.directSeconds);
     label nSpin = this->template getModelProperty<label>("nSpinSamples");
     scalar spinSum = this->template getModelProperty<scalar>("spinRatioSum");
     scalar spinMax = this->template getModelProperty<scalar>("spinRatioMax");
 
-    nHits += returnReduce(c.hits, sumOp<label>());
-    nRebounded += returnReduce(c.rebounded, sumOp<label>());
-    nTrapped += returnReduce(c.trapped, sumOp<label>());
-    nInvalid += returnReduce(c.invalid, sumOp<label>());
-    nOutside += returnReduce(c.outsideGrid, sumOp<label>());
-    mTrapped += returnReduce(c.trappedMass, sumOp<scalar>());
-
+    const char* policy = removeTrapped_ ? "removed" : "stuck";
     os  << "    Stochastic rebound (" << mixName_.c_str() << ')' << nl
         << "      - wall hits                   = " << nHits << nl
+        << "      - answered by the table       = " << nTable << nl
+        << "      - answered by the direct model = " << nDirect
+        << " (mean cost " << (nDirect > 0 ? 1e6*directSeconds/nDirect : 0)
+        << " us per hit)" << nl
         << "      - rebounded                   = " << nRebounded << nl
-        << (removeTrapped_
-          ? "      - trapped, removed (number, mass) = "
-          : "      - trapped, stuck (number, mass) = ")
+        << "      - trapped, " << policy << " (number, mass) = "
         << nTrapped << ", " << mTrapped << nl
+        << "      - failed (direct model), " << policy << " (number, mass) = "
+        << nFailed << ", " << mFailed << nl
         << "      - invalid (left as stock)     = " << nInvalid << nl
         << "      - outside the table's grid    = " << nOutside << nl;
 
@@ -571,7 +645,8 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
         spinMax = max(spinMax, returnReduce(c.spinRatioMax, maxOp<scalar>()));
         os  << "      - incoming spin |Omega|a/|V|  = mean "
             << (nSpin > 0 ? spinSum/nSpin : 0) << ", max " << spinMax
-            << " (not used: tables are for non-spinning particles)" << nl;
+            << " (the table answers up to " << RBS_SPIN_TOLERANCE
+            << " under auto)" << nl;
     }
 
     if (s.hits.is_open())
@@ -582,11 +657,16 @@ void Foam::StochasticRebound<CloudType>::info(Ostream& os)
     if (this->writeTime())
     {
         this->setModelProperty("nHits", nHits);
+        this->setModelProperty("nTablePath", nTable);
+        this->setModelProperty("nDirectPath", nDirect);
         this->setModelProperty("nRebounded", nRebounded);
         this->setModelProperty("nTrapped", nTrapped);
+        this->setModelProperty("nFailed", nFailed);
         this->setModelProperty("nInvalid", nInvalid);
         this->setModelProperty("nOutsideGrid", nOutside);
         this->setModelProperty("massTrapped", mTrapped);
+        this->setModelProperty("massFailed", mFailed);
+        this->setModelProperty("directModelSeconds", directSeconds);
         this->setModelProperty("nSpinSamples", nSpin);
         this->setModelProperty("spinRatioSum", spinSum);
         this->setModelProperty("spinRatioMax", spinMax);

@@ -1,0 +1,88 @@
+/*
+ * spin.c: every wall hit answered, spinning or not (surrogate.kernels.spin: rebound_path, rebound_spin_tuple):
+ * the path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound along it.
+ *
+ * A hit consumes RBS_U_PER_DRAW uniforms whatever path answers it, so a stream stays aligned. The table path
+ * is rbs_rebound with those uniforms; the direct path draws the shape from the mix with u[0] as the table
+ * path does and gives the direct model u[1..RBS_U_PER_REBOUND] as its own uniforms.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "frame.h"
+#include "rebound_internal.h"
+
+/* NaN into the outputs a caller gave (any may be NULL) */
+static void nan_out(double *x)
+{
+    if (x)
+        for (int k = 0; k < 3; k++) x[k] = NAN;
+}
+
+static int method_known(int method)
+{
+    return method == RBS_AUTO || method == RBS_TABLE || method == RBS_DIRECT;
+}
+
+/* the table answers the hit (surrogate.kernels.spin._table_valid): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE, α1 and |V⁻|
+ * inside the grid, edges included */
+RBS_INLINE int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
+{
+    double spin = a * sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) / speed;
+    const double *alpha1_grid = t->alpha1_axis + AXIS_GRID, *speed_grid = t->speed_axis + AXIS_GRID;
+    return (spin <= RBS_SPIN_TOLERANCE) & (alpha1_deg >= alpha1_grid[0]) & (alpha1_deg <= alpha1_grid[t->n_alpha1 - 1])
+           & (speed >= speed_grid[0]) & (speed <= speed_grid[t->n_speed - 1]);
+}
+
+/* RBS_HOT: the x86-64-v3 version has fma() as one instruction, as rbs_rebound (the same bits either way) */
+RBS_HOT int rbs_rebound_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a,
+                     int method)
+{
+    if (!t || !V || !Omega || !n || !method_known(method) || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])
+        || !rbs_particle_ok(n[0], n[1], n[2], a) || !rbs_finite(Omega[0] + Omega[1] + Omega[2]))
+        return RBS_INVALID;
+    if (method != RBS_AUTO)
+        return method == RBS_TABLE ? RBS_PATH_TABLE : RBS_PATH_DIRECT;
+    const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
+    rbs_frame f;
+    rbs_impact_frame(Vi, ni, 0.0, &f);      /* α1 and |V⁻| do not depend on the in-wall axis */
+    return table_valid(t, f.alpha1, f.speed, Omega, a) ? RBS_PATH_TABLE : RBS_PATH_DIRECT;
+}
+
+/* the direct model's code of the table's shape i (direct_model.shapes.SHAPES order) */
+static int shape_code(const rbs_table *t, int64_t i)
+{
+    static const char *const codes[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
+    for (int k = 0; k < RBS_MAX_SHAPES; k++)
+        if (strcmp(t->shape_names[i], codes[k]) == 0) return k;
+    return -1;      /* a loaded table names known shapes only: never reached */
+}
+
+RBS_HOT int rbs_rebound_spin_u(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
+                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
+                       double V_out[3], double Omega_out[3])
+{
+    int path = rbs_rebound_path(t, V, Omega, n, a, method);
+    if (path == RBS_INVALID || !u || !V_out || !Omega_out || !rbs_arguments_ok(t, mix, interpolation)
+        || !rbs_uniforms_ok(u, 1)) {
+        nan_out(V_out);
+        nan_out(Omega_out);
+        return RBS_INVALID;
+    }
+    if (path == RBS_PATH_TABLE)
+        return rbs_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
+    int64_t shape = 0;
+    for (int k = 0; k < mix->n_shapes - 1; k++) shape += (int64_t)(u[0] >= mix->cdf[k]);     /* as rbs_cell_of */
+    return rbs_rebound_direct(t, shape_code(t, shape), V, Omega, n, a, u + 1, V_out, Omega_out);
+}
+
+int rbs_rebound_spin(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
+                     const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
+                     double Omega_out[3])
+{
+    double u[RBS_U_PER_DRAW];
+    rbs_rng_fill(rng, u, RBS_U_PER_DRAW);       /* NaN (refused) for a NULL or all-zero rng */
+    return rbs_rebound_spin_u(t, mix, V, Omega, n, a, u, method, interpolation, V_out, Omega_out);
+}

@@ -1,0 +1,168 @@
+"""Every wall hit answered, spinning or not: the table where it is valid, the direct model elsewhere.
+
+A table holds the law of particles that do not spin before they hit (Ω⁻ = 0), on its α1 and |V⁻| grid. For
+any other hit the direct model (:mod:`surrogate.kernels.direct`) answers, per particle, at run time.
+:func:`rebound_path` says which *path* answers a hit (a pure function of the state and the method);
+:func:`rebound_spin_tuple` answers one hit by that path; :func:`rebound_spin_parallel_rng` answers many on all
+threads.
+
+Methods (integer codes, as in C): METHOD_AUTO, the table iff |Ω⁻| a/|V⁻| ≤ SPIN_TOLERANCE and α1 lies in the
+table's [first, last] α1 grid range and |V⁻| in its speed range (inclusive; α1 and |V⁻| computed as the
+table path computes them, :func:`surrogate.kernels.frame.impact_frame`), otherwise the direct model;
+METHOD_TABLE, always the table (the law of the nearest grid edge outside the grid, Ω⁻ ignored);
+METHOD_DIRECT, always the direct model. Paths: PATH_TABLE, PATH_DIRECT.
+
+One hit consumes U_PER_DRAW = 13 uniforms whatever path answers it, so streams stay aligned. The table path
+is :func:`surrogate.kernels.particle.rebound_tuple` with those 13. The direct path draws the shape from the mix
+with u[0] exactly as the table path does (:func:`surrogate.kernels.locate.locate`), maps the table's shape to
+the model's shape code (``model_shapes``), and gives the model u[1..7] as its U_PER_REBOUND uniforms (u[1 + k]
+is the model's u[k]; the axis at normal impact is u[7]).
+
+Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
+gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a
+contact search failed; NaN vectors), STATUS_INVALID (NaN vectors).
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from data_schema.samples import STATUS_INVALID
+from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
+from surrogate.kernels.direct import _rebound_direct
+from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, particle_ok, uniforms_ok
+from surrogate.kernels.layout import AXIS_GRID
+from surrogate.kernels.options import JIT
+from surrogate.kernels.particle import _rebound
+from surrogate.kernels.pipeline import no_uniforms, rebound_uniforms, run_blocks
+from surrogate.kernels.rng import CHUNK_ROWS
+
+METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
+PATH_TABLE, PATH_DIRECT = 0, 1
+# largest |Ω⁻| a/|V⁻| the table answers under METHOD_AUTO: where the table's law and the direct model's with
+# that spin stay within classifier accuracy 0.52, measured (docs/design/spin_tolerance.md; 0.0015 fails)
+SPIN_TOLERANCE = 0.001
+
+
+@numba.njit(inline="always", **JIT)
+def _table_valid(data, V, omega, n, a):
+    """The table answers this hit under METHOD_AUTO (module doc); V moves into the wall."""
+    alpha1, speed, _, _, _, _ = impact_frame(V, n, 0.0)
+    spin = a * math.sqrt(dot(omega, omega)) / speed
+    alpha1_grid, speed_grid = data.alpha1_axis, data.speed_axis
+    return ((spin <= SPIN_TOLERANCE)
+            & (alpha1 >= alpha1_grid[AXIS_GRID]) & (alpha1 <= alpha1_grid[AXIS_GRID + data.n_alpha1 - 1])
+            & (speed >= speed_grid[AXIS_GRID]) & (speed <= speed_grid[AXIS_GRID + data.n_speed - 1]))
+
+
+@numba.njit(**JIT)
+def rebound_path(data, V, omega, n, a, method):
+    """Which path answers a hit: PATH_TABLE or PATH_DIRECT; STATUS_INVALID for a bad input.
+
+    Parameters
+    ----------
+    data : ``table.kernel_data``.
+    V : incident velocity V⁻, m/s, caller's frame (3-tuple or (3,) array); must move into the wall (V·n < 0).
+    omega : incident angular velocity Ω⁻, rad/s, caller's frame; finite.
+    n : unit wall normal into the gas (| |n| − 1 | ≤ NORMAL_TOLERANCE).
+    a : half-size (half the largest extent), m, finite and > 0.
+    method : METHOD_AUTO, METHOD_TABLE or METHOD_DIRECT (module doc).
+
+    A pure function of the state: a caller learns the path of a hit without drawing anything.
+    """
+    if not (moves_into_wall(V, n) and particle_ok(n, a) and math.isfinite(omega[0] + omega[1] + omega[2])
+            and METHOD_AUTO <= method <= METHOD_DIRECT):
+        return STATUS_INVALID
+    if method == METHOD_TABLE:
+        return PATH_TABLE
+    if method == METHOD_DIRECT:
+        return PATH_DIRECT
+    return PATH_TABLE if _table_valid(data, V, omega, n, a) else PATH_DIRECT
+
+
+@numba.njit(**JIT)
+def rebound_spin_tuple(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True):
+    """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
+    3-tuples in the caller's frame.
+
+    Parameters
+    ----------
+    data : ``table.kernel_data``.
+    params : ``table.direct_parameters`` (:func:`direct_model.runtime.model_parameters`); a table without
+        them: an empty array, and a hit the direct model must answer is STATUS_INVALID.
+    model_shapes : ``table.model_shapes``, (n_shapes,) int64: the direct model's shape code of each table shape.
+    mix_cdf : cumulative shape weights, table shape order (:func:`surrogate.mix_cdf`).
+    V, omega, n, a, method : as :func:`rebound_path`.
+    u : (U_PER_DRAW,) array of uniforms in [0, 1) (module doc for how each path uses them).
+    scaled : the table path's interpolation (:func:`surrogate.kernels.particle.rebound`).
+
+    Returns STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
+    a uniform outside [0, 1) whatever the path, a method not in the three); NaN vectors unless rebounded.
+    """
+    path = rebound_path(data, V, omega, n, a, method)
+    if path == PATH_TABLE:
+        return _rebound(data, mix_cdf, V, n, a, u, scaled)
+    if path == PATH_DIRECT:
+        return _rebound_spin_direct(params, model_shapes, mix_cdf, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
+    return STATUS_INVALID, NAN3, NAN3
+
+
+@numba.njit(inline="always", **JIT)
+def _rebound_spin_direct(params, model_shapes, mix_cdf, V, omega, n, a, u, scratch):
+    """The direct path of :func:`rebound_spin_tuple` with its scratch space given."""
+    if not (uniforms_ok(u) and params.shape[0] == N_PARAMS and model_shapes.shape[0] == mix_cdf.shape[0]):
+        return STATUS_INVALID, NAN3, NAN3
+    shape = 0
+    for k in range(mix_cdf.shape[0] - 1):     # the table path's shape draw (locate)
+        shape += u[0] >= mix_cdf[k]
+    return _rebound_direct(params, V, n, a, omega, model_shapes[shape], u[1:1 + U_PER_REBOUND], scratch)
+
+
+@numba.njit(parallel=True, **JIT)
+def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, states, method, V_out, Omega_out,
+                              status, path, scaled=True):
+    """:func:`rebound_spin_tuple` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
+    a (N,), on all threads; the path of each row into ``path`` (N,).
+
+    The uniforms are those :func:`surrogate.kernels.parallel.rebound_parallel_rng` draws: chunk j's rows
+    (CHUNK_ROWS rows) from a copy of ``states[j]``, U_PER_DRAW per row. Where the table answers every row
+    the results are that kernel's, bit for bit; they never depend on the number of threads. The table's
+    pipeline answers every row of a chunk that has a table row (at the table's cost; the rows of the other
+    path are answered again), then the direct model answers the direct rows with the same row's uniforms
+    (:func:`surrogate.kernels.pipeline.rebound_uniforms`). Inputs are not checked here
+    (:func:`surrogate.sample_global` checks them first); a row with a bad input gets path STATUS_INVALID and
+    status STATUS_INVALID.
+    """
+    rows = V.shape[0]
+    last_omega = omega.shape[0] - 1
+    for j in numba.prange(states.shape[0]):
+        lo, hi = j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows)
+        n_table = 0
+        for i in range(lo, hi):
+            w = min(i, last_omega)
+            p = rebound_path(data, (V[i, 0], V[i, 1], V[i, 2]), (omega[w, 0], omega[w, 1], omega[w, 2]),
+                             (n[i, 0], n[i, 1], n[i, 2]), a[i], method)
+            path[i] = p
+            n_table += p == PATH_TABLE
+        if n_table > 0:
+            run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), states[j].copy(), V_out[lo:hi],
+                       Omega_out[lo:hi], status[lo:hi], scaled)
+        if n_table < hi - lo:
+            u = rebound_uniforms(states[j].copy(), hi - lo)
+            scratch = np.empty(SCRATCH_SIZE)
+            for i in range(lo, hi):
+                if path[i] == PATH_TABLE:
+                    continue
+                w = min(i, last_omega)
+                st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
+                if path[i] == PATH_DIRECT:
+                    st, V_new, Omega_new = _rebound_spin_direct(
+                        params, model_shapes, mix_cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                        (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo],
+                        scratch)
+                status[i] = st
+                for k in range(3):
+                    V_out[i, k] = V_new[k]
+                    Omega_out[i, k] = Omega_new[k]
+
