@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "check.h"
 #include "collision.h"
 #include "rebound.h"
 #include "rebound_scatter.h"
@@ -27,18 +28,6 @@
 #include "runtime.h"
 
 #define TRIALS 20000
-
-static int failures = 0;
-
-#define CHECK(condition, ...)                           \
-    do {                                                \
-        if (!(condition)) {                             \
-            fprintf(stderr, "FAILED %s: ", #condition); \
-            fprintf(stderr, __VA_ARGS__);               \
-            fprintf(stderr, "\n");                      \
-            failures++;                                 \
-        }                                               \
-    } while (0)
 
 /* a random body: principal K (units a²) of half-extents (1, b/a, c/a) and factor s, orientation R */
 static void random_body(rbs_rng *rng, double K[3], double R[9])

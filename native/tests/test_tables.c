@@ -13,19 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "check.h"
 #include "rebound_scatter.h"
-
-static int failures = 0;
-
-#define CHECK(condition, ...)                           \
-    do {                                                \
-        if (!(condition)) {                             \
-            fprintf(stderr, "FAILED %s: ", #condition); \
-            fprintf(stderr, __VA_ARGS__);               \
-            fprintf(stderr, "\n");                      \
-            failures++;                                 \
-        }                                               \
-    } while (0)
 
 static void unit(rbs_rng *rng, double *v)
 {
