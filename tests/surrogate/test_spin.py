@@ -204,6 +204,16 @@ def test_bad_method_names_the_allowed_ones(small_table):
         surrogate.sample_global(small_table, _in_grid(3, 1), NORMAL, A, method="tabel")
 
 
+def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table):
+    from surrogate.kernels import rebound_spin_parallel_rng
+    V = np.array(_in_grid(3, 1))
+    outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
+    with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
+        rebound_spin_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
+                                  surrogate.mix_cdf(small_table, "mix"), V, np.zeros((1, 3)), np.tile(NORMAL, (3, 1)),
+                                  np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3, *outputs)
+
+
 def test_auto_sends_states_outside_the_grid_to_the_model_and_table_keeps_its_errors(small_table):
     V = np.array([_velocity(10.0, 150.0), _velocity(60.0, 400.0), _velocity(60.0, 20.0)])
     V_out, _, status, path = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=2,
