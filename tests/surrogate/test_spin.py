@@ -186,6 +186,15 @@ def test_the_path_at_the_tolerance_and_the_grid_s_edges(small_table):
         assert rebound_path(data, args["V_in"], args["W"], args["n"], args["a"], args["method"]) == STATUS_INVALID
 
 
+def test_the_path_at_both_ends_of_an_alpha1_grid_below_normal_impact(off_grid_table):
+    """A table whose α1 grid ends at 45° (1–45°, 150–200 m/s): the direct model just above its last α1 and
+    just below its first, the table just inside both."""
+    data = off_grid_table.kernel_data
+    for alpha1, want in [(45.0 - 1e-9, PATH_TABLE), (45.0 + 1e-9, PATH_DIRECT), (1.0 + 1e-9, PATH_TABLE),
+                         (1.0 - 1e-9, PATH_DIRECT)]:
+        assert rebound_path(data, _velocity(alpha1, 175.0), (0.0, 0.0, 0.0), NORMAL, A, METHOD_AUTO) == want, alpha1
+
+
 @pytest.mark.parametrize("omega, message", [
     ([[0.0, 0.0, 0.0], [np.nan, 1.0, 0.0], [0.0, 0.0, 0.0]], r"'omega' vector at index 1 is not finite: \[nan, 1\.0"),
     ([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -np.inf, 0.0]], r"'omega' vector at index 2 is not finite: \[0\.0, -inf"),
