@@ -36,10 +36,7 @@ def impact_frame(V, n, u_axis):
     frame is (ex, n, ez = ex × n). Returns (α1 in degrees, |V|, cos α1, sin α1,
     ex, ez) with ex and ez as 3-tuples.
     """
-    vn = dot(V, n)
-    tx, ty, tz = fma(-vn, n[0], V[0]), fma(-vn, n[1], V[1]), fma(-vn, n[2], V[2])
-    vt = math.sqrt(fma(tx, tx, fma(ty, ty, tz * tz)))
-    speed = math.sqrt(fma(vn, vn, vt * vt))
+    vn, tx, ty, tz, vt, speed = incidence(V, n)
     if vt > NORMAL_IMPACT * speed:
         inv = 1.0 / vt
         ex0, ex1, ex2 = tx * inv, ty * inv, tz * inv
@@ -58,7 +55,23 @@ def impact_frame(V, n, u_axis):
         ex0, ex1, ex2 = c * px + s * qx, c * py + s * qy, c * pz + s * qz
     ez = (ex1 * n[2] - ex2 * n[1], ex2 * n[0] - ex0 * n[2], ex0 * n[1] - ex1 * n[0])
     inv_speed = 1.0 / speed
-    return (math.degrees(atan2_first_quadrant(-vn, vt)), speed, vt * inv_speed, -vn * inv_speed, (ex0, ex1, ex2), ez)
+    return (incidence_angle(vn, vt), speed, vt * inv_speed, -vn * inv_speed, (ex0, ex1, ex2), ez)
+
+
+@numba.njit(inline="always", **JIT)
+def incidence(V, n):
+    """The parts of V on a wall of unit normal n that :func:`impact_frame` builds on: (V·n, the tangential
+    part's three components, its length, |V|)."""
+    vn = dot(V, n)
+    tx, ty, tz = fma(-vn, n[0], V[0]), fma(-vn, n[1], V[1]), fma(-vn, n[2], V[2])
+    vt = math.sqrt(fma(tx, tx, fma(ty, ty, tz * tz)))
+    return vn, tx, ty, tz, vt, math.sqrt(fma(vn, vn, vt * vt))
+
+
+@numba.njit(inline="always", **JIT)
+def incidence_angle(vn, vt):
+    """α1 in degrees from the wall, from V·n and the tangential speed (:func:`incidence`)."""
+    return math.degrees(atan2_first_quadrant(-vn, vt))
 
 
 NAN3 = (np.nan, np.nan, np.nan)     # the V⁺ and Ω⁺ of a draw that did not rebound

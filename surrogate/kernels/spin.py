@@ -8,7 +8,7 @@ threads.
 
 Methods (integer codes, as in C): METHOD_AUTO, the table iff |Ω⁻| a/|V⁻| ≤ SPIN_TOLERANCE and α1 lies in the
 table's [first, last] α1 grid range and |V⁻| in its speed range (inclusive; α1 and |V⁻| computed as the
-table path computes them, :func:`surrogate.kernels.frame.impact_frame`), otherwise the direct model;
+table path computes them, :func:`surrogate.kernels.frame.incidence`), otherwise the direct model;
 METHOD_TABLE, always the table (the law of the nearest grid edge outside the grid, Ω⁻ ignored);
 METHOD_DIRECT, always the direct model. Paths: PATH_TABLE, PATH_DIRECT.
 
@@ -31,7 +31,7 @@ import numpy as np
 from data_schema.samples import STATUS_INVALID
 from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
 from surrogate.kernels.direct import _rebound_direct
-from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, particle_ok, uniforms_ok
+from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.options import JIT
 from surrogate.kernels.particle import _rebound
@@ -46,14 +46,24 @@ SPIN_TOLERANCE = 0.001
 
 
 @numba.njit(inline="always", **JIT)
-def _table_valid(data, V, omega, n, a):
-    """The table answers this hit under METHOD_AUTO (module doc); V moves into the wall."""
-    alpha1, speed, _, _, _, _ = impact_frame(V, n, 0.0)
+def _grid_bounds(data):
+    """The table's grid ranges: (first α1, last α1) in degrees, (first |V⁻|, last |V⁻|) in m/s."""
+    return ((data.alpha1_axis[AXIS_GRID], data.alpha1_axis[AXIS_GRID + data.n_alpha1 - 1]),
+            (data.speed_axis[AXIS_GRID], data.speed_axis[AXIS_GRID + data.n_speed - 1]))
+
+
+@numba.njit(inline="always", **JIT)
+def _auto_path(bounds, V, omega, n, a):
+    """:func:`rebound_path` under METHOD_AUTO, ``bounds`` from :func:`_grid_bounds`."""
+    vn, _, _, _, vt, speed = incidence(V, n)
+    alpha1 = incidence_angle(vn, vt)
     spin = a * math.sqrt(dot(omega, omega)) / speed
-    alpha1_grid, speed_grid = data.alpha1_axis, data.speed_axis
-    return ((spin <= SPIN_TOLERANCE)
-            & (alpha1 >= alpha1_grid[AXIS_GRID]) & (alpha1 <= alpha1_grid[AXIS_GRID + data.n_alpha1 - 1])
-            & (speed >= speed_grid[AXIS_GRID]) & (speed <= speed_grid[AXIS_GRID + data.n_speed - 1]))
+    (alpha1_lo, alpha1_hi), (speed_lo, speed_hi) = bounds
+    table = ((spin <= SPIN_TOLERANCE) & (alpha1 >= alpha1_lo) & (alpha1 <= alpha1_hi) & (speed >= speed_lo)
+             & (speed <= speed_hi))
+    valid = ((vn < 0.0) & math.isfinite(V[0] + V[1] + V[2]) & particle_ok(n, a)
+             & math.isfinite(omega[0] + omega[1] + omega[2]))
+    return np.int8(PATH_TABLE if table else PATH_DIRECT) if valid else np.int8(STATUS_INVALID)
 
 
 @numba.njit(**JIT)
@@ -71,14 +81,12 @@ def rebound_path(data, V, omega, n, a, method):
 
     A pure function of the state: a caller learns the path of a hit without drawing anything.
     """
-    if not (moves_into_wall(V, n) and particle_ok(n, a) and math.isfinite(omega[0] + omega[1] + omega[2])
-            and METHOD_AUTO <= method <= METHOD_DIRECT):
-        return STATUS_INVALID
+    path = _auto_path(_grid_bounds(data), V, omega, n, a)
+    if path == STATUS_INVALID or method == METHOD_AUTO:
+        return path
     if method == METHOD_TABLE:
         return PATH_TABLE
-    if method == METHOD_DIRECT:
-        return PATH_DIRECT
-    return PATH_TABLE if _table_valid(data, V, omega, n, a) else PATH_DIRECT
+    return PATH_DIRECT if method == METHOD_DIRECT else STATUS_INVALID
 
 
 @numba.njit(**JIT)
@@ -119,6 +127,19 @@ def _rebound_spin_direct(params, model_shapes, mix_cdf, V, omega, n, a, u, scrat
     return _rebound_direct(params, V, n, a, omega, model_shapes[shape], u[1:1 + U_PER_REBOUND], scratch)
 
 
+@numba.njit(**JIT)
+def _auto_paths(data, V, omega, n, a, lo, hi, path):
+    """path[lo:hi] under METHOD_AUTO (:func:`_auto_path`), omega with one row per row of V or one for all.
+    Compiled on its own, not inlined into the parallel loop (numba's parallel analysis rejects the frame's
+    tuples there)."""
+    bounds = _grid_bounds(data)
+    last_omega = omega.shape[0] - 1
+    for i in range(lo, hi):
+        w = min(i, last_omega)
+        path[i] = _auto_path(bounds, (V[i, 0], V[i, 1], V[i, 2]), (omega[w, 0], omega[w, 1], omega[w, 2]),
+                             (n[i, 0], n[i, 1], n[i, 2]), a[i])
+
+
 @numba.njit(parallel=True, **JIT)
 def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, states, method, V_out, Omega_out,
                               status, path, scaled=True):
@@ -130,21 +151,24 @@ def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, 
     the results are that kernel's, bit for bit; they never depend on the number of threads. The table's
     pipeline answers every row of a chunk that has a table row (at the table's cost; the rows of the other
     path are answered again), then the direct model answers the direct rows with the same row's uniforms
-    (:func:`surrogate.kernels.pipeline.rebound_uniforms`). Inputs are not checked here
-    (:func:`surrogate.sample_global` checks them first); a row with a bad input gets path STATUS_INVALID and
-    status STATUS_INVALID.
+    (:func:`surrogate.kernels.pipeline.rebound_uniforms`). Rows are not checked here
+    (:func:`surrogate.sample_global` checks them first): a row with a bad input gets status STATUS_INVALID,
+    and path STATUS_INVALID under METHOD_AUTO, the method's path under the others. A method code outside
+    the three is a ValueError.
     """
+    if not METHOD_AUTO <= method <= METHOD_DIRECT:
+        raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
     rows = V.shape[0]
     last_omega = omega.shape[0] - 1
     for j in numba.prange(states.shape[0]):
         lo, hi = j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows)
+        if method == METHOD_AUTO:
+            _auto_paths(data, V, omega, n, a, lo, hi, path)
+        else:
+            path[lo:hi] = PATH_TABLE if method == METHOD_TABLE else PATH_DIRECT
         n_table = 0
         for i in range(lo, hi):
-            w = min(i, last_omega)
-            p = rebound_path(data, (V[i, 0], V[i, 1], V[i, 2]), (omega[w, 0], omega[w, 1], omega[w, 2]),
-                             (n[i, 0], n[i, 1], n[i, 2]), a[i], method)
-            path[i] = p
-            n_table += p == PATH_TABLE
+            n_table += path[i] == PATH_TABLE
         if n_table > 0:
             run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), states[j].copy(), V_out[lo:hi],
                        Omega_out[lo:hi], status[lo:hi], scaled)
@@ -165,4 +189,3 @@ def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, 
                 for k in range(3):
                     V_out[i, k] = V_new[k]
                     Omega_out[i, k] = Omega_new[k]
-

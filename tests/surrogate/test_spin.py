@@ -186,6 +186,15 @@ def test_the_path_at_the_tolerance_and_the_grid_s_edges(small_table):
         assert rebound_path(data, args["V_in"], args["W"], args["n"], args["a"], args["method"]) == STATUS_INVALID
 
 
+def test_the_path_at_both_ends_of_an_alpha1_grid_below_normal_impact(off_grid_table):
+    """A table whose α1 grid ends at 45° (1–45°, 150–200 m/s): the direct model just above its last α1 and
+    just below its first, the table just inside both."""
+    data = off_grid_table.kernel_data
+    for alpha1, want in [(45.0 - 1e-9, PATH_TABLE), (45.0 + 1e-9, PATH_DIRECT), (1.0 + 1e-9, PATH_TABLE),
+                         (1.0 - 1e-9, PATH_DIRECT)]:
+        assert rebound_path(data, _velocity(alpha1, 175.0), (0.0, 0.0, 0.0), NORMAL, A, METHOD_AUTO) == want, alpha1
+
+
 @pytest.mark.parametrize("omega, message", [
     ([[0.0, 0.0, 0.0], [np.nan, 1.0, 0.0], [0.0, 0.0, 0.0]], r"'omega' vector at index 1 is not finite: \[nan, 1\.0"),
     ([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, -np.inf, 0.0]], r"'omega' vector at index 2 is not finite: \[0\.0, -inf"),
@@ -202,6 +211,16 @@ def test_bad_omega_is_a_one_line_value_error(small_table, omega, message):
 def test_bad_method_names_the_allowed_ones(small_table):
     with pytest.raises(ValueError, match=r"'method' parameter must be one of auto, table, direct; got 'tabel'"):
         surrogate.sample_global(small_table, _in_grid(3, 1), NORMAL, A, method="tabel")
+
+
+def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table):
+    from surrogate.kernels import rebound_spin_parallel_rng
+    V = np.array(_in_grid(3, 1))
+    outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
+    with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
+        rebound_spin_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
+                                  surrogate.mix_cdf(small_table, "mix"), V, np.zeros((1, 3)), np.tile(NORMAL, (3, 1)),
+                                  np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3, *outputs)
 
 
 def test_auto_sends_states_outside_the_grid_to_the_model_and_table_keeps_its_errors(small_table):
