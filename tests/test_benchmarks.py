@@ -65,3 +65,14 @@ def test_the_stored_hits_sample():
     np.testing.assert_allclose(np.linalg.norm(sample["n"], axis=1), 1.0, rtol=0, atol=1e-12)
     ratio = np.linalg.norm(sample["omega"], axis=1) * sample["a"] / np.linalg.norm(sample["V"], axis=1)
     np.testing.assert_allclose(ratio, sample["spin_ratio"], rtol=1e-15, atol=0)
+
+
+def test_a_hits_sample_without_omega_in_is_refused(tmp_path):
+    """A sample written before Ω⁻ was recorded (no Wx, Wy, Wz) is refused in one line naming the columns."""
+    path = tmp_path / "old.csv"
+    path.write_text("# old\nVx,Vy,Vz,nx,ny,nz,a,spin_ratio\n3,-4,0,0,1,0,1e-4,0\n")
+    with pytest.raises(ValueError, match=r"no column Wx,Wy,Wz; the columns are 'Vx,Vy,Vz,nx,ny,nz,a,spin_ratio'"):
+        bench_direct.read_hits_sample(path)
+    path.write_text("# new\nVx,Vy,Vz,nx,ny,nz,a,Wx,Wy,Wz,spin_ratio\n3,-4,0,0,1,0,1e-4,0,0,1e4,0.2\n")
+    sample = bench_direct.read_hits_sample(path)
+    assert sample["omega"].tolist() == [[0.0, 0.0, 1e4]] and sample["n"].tolist() == [[0.0, 1.0, 0.0]]
