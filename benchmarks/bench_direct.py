@@ -36,7 +36,8 @@ shape, on three sets of incident states:
 * 'random, spin': the same with |Ω⁻|a/|V⁻| uniform in [0, 1.2] in a random direction (the flight in is
   simulated);
 * 'hopper': the wall hits of a hopperRebound run (benchmarks/data/hopper_hits.csv, written by
-  benchmarks/hopper_hits.py: V⁻, n, a and Ω⁻ per hit, half of them spinning), each run with the shape.
+  integrations/openfoam/sample_hits.py: V⁻, n, a and Ω⁻ per hit, read by ``read_hits_sample``), each run
+  with the shape.
 
 The target of the issue, ≤ 5 µs per rebound on one core averaged over hopperRebound's hits, is reported
 per shape (a figure only: the exit code does not depend on it). Where the time goes: numba's rebound alone
@@ -94,7 +95,6 @@ from pathlib import Path
 import numba
 import numpy as np
 
-import hopper_hits  # benchmarks/hopper_hits.py, next to this script: the hopperRebound hits sample
 import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.collision import collide
@@ -118,6 +118,7 @@ TARGET_PER_CORE = 1e5     # rebounds/s per core
 TARGET_ALPHA1 = 45.0      # degrees
 SEED = 20240601
 NATIVE = Path(__file__).resolve().parent.parent / "native"
+HITS_SAMPLE = Path(__file__).resolve().parent / "data" / "hopper_hits.csv"
 # a table only for its recorded model parameters (the defaults), for the C side: 2 × 2 cells of 256
 BENCH_TABLE_CONFIG = ("[grid]\nalpha1_deg = [45.0, 90.0]\nspeed_m_s = [100.0, 200.0]\n"
                       "[simulation]\nparticles_per_cell = 256\nseed = 1\n")
@@ -388,9 +389,29 @@ def random_states(m: int, spin: bool, seed: int) -> dict:
             "a": np.ones(m), "omega": np.einsum("mij,mj->mi", frames, local_W)}
 
 
+def read_hits_sample(path: Path = HITS_SAMPLE) -> dict:
+    """A sample of wall hits (integrations/openfoam/sample_hits.py writes it: '#' comment lines, then a header
+    naming the columns) as arrays: V (m, 3) m/s, n (m, 3) unit normals into the gas, a (m,) m, omega (m, 3) Ω⁻
+    rad/s, spin_ratio (m,) |Ω⁻|a/|V⁻|."""
+    with open(path) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    names = lines[0].strip().split(",")
+    data = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], dtype=np.float64)
+    data = data.reshape(-1, len(names))
+
+    def columns(*wanted):
+        missing = [c for c in wanted if c not in names]
+        if missing:
+            raise ValueError(f"{path}: no column {','.join(missing)}; the columns are {lines[0].strip()!r}")
+        return np.ascontiguousarray(data[:, [names.index(c) for c in wanted]])
+
+    return {"V": columns("Vx", "Vy", "Vz"), "n": columns("nx", "ny", "nz"), "a": columns("a")[:, 0],
+            "omega": columns("Wx", "Wy", "Wz"), "spin_ratio": columns("spin_ratio")[:, 0]}
+
+
 def state_sets(m: int, hits_path: Path) -> dict:
     """The three sets of incident states of the run-time rows (module doc)."""
-    hits = hopper_hits.read_sample(hits_path)
+    hits = read_hits_sample(hits_path)
     return {"random, 0": random_states(m, False, SEED), "random, spin": random_states(m, True, SEED + 1),
             "hopper": {k: hits[k] for k in ("V", "n", "a", "omega")}}
 
@@ -565,7 +586,7 @@ def main(argv=None) -> int:
     parser.add_argument("--runtime", action="store_true", help="the run-time kernel alone, not the batch")
     parser.add_argument("--states", type=int, default=None,
                         help="random incident states per run-time row (default 20000; --quick 500)")
-    parser.add_argument("--hits", type=Path, default=hopper_hits.DEFAULT_OUT,
+    parser.add_argument("--hits", type=Path, default=HITS_SAMPLE,
                         help="the hopperRebound hits sample (default benchmarks/data/hopper_hits.csv)")
     parser.add_argument("--table", type=Path, help="take the model parameters from this table (default: the "
                         "defaults; with the C side, a small table built with them)")

@@ -1,13 +1,15 @@
 """benchmarks/bench_sampler.py and bench_direct.py run end to end and report every figure the issues ask for.
 
 A smoke test, so the benchmark cannot silently break when the kernels' data or signatures change; the
-figures themselves are machine-dependent and are not asserted (speed is reported, never tested).
+figures themselves are machine-dependent and are not asserted (speed is reported, never tested). And the
+hopperRebound hits sample bench_direct.py reads (benchmarks/data/hopper_hits.csv) holds what its header says.
 """
 
 import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
@@ -50,3 +52,27 @@ def test_bench_direct_reports_the_runtime_kernel(tmp_path, capsys):
             assert row[piece] > 0, piece
     printed = capsys.readouterr().out
     assert "numba us" in printed and "Target <= 5 us" in printed and "orient %" in printed
+
+
+def test_the_stored_hits_sample():
+    """benchmarks/data/hopper_hits.csv holds what its header says: 2767 hits of a hopperRebound run, half of them
+    spinning; they move into their walls through unit normals, and spin_ratio is |Ω⁻|a/|V⁻| of each row."""
+    sample = bench_direct.read_hits_sample()
+    header = bench_direct.HITS_SAMPLE.read_text().splitlines()[1]
+    assert "method auto" in header and "2767 rows" in header and "49.2% spinning" in header
+    assert len(sample["a"]) == 2767 and f"{np.mean(sample['spin_ratio'] > 0):.1%}" == "49.2%"
+    assert np.all(np.einsum("ij,ij->i", sample["V"], sample["n"]) < 0)
+    np.testing.assert_allclose(np.linalg.norm(sample["n"], axis=1), 1.0, rtol=0, atol=1e-12)
+    ratio = np.linalg.norm(sample["omega"], axis=1) * sample["a"] / np.linalg.norm(sample["V"], axis=1)
+    np.testing.assert_allclose(ratio, sample["spin_ratio"], rtol=1e-15, atol=0)
+
+
+def test_a_hits_sample_without_omega_in_is_refused(tmp_path):
+    """A sample written before Ω⁻ was recorded (no Wx, Wy, Wz) is refused in one line naming the columns."""
+    path = tmp_path / "old.csv"
+    path.write_text("# old\nVx,Vy,Vz,nx,ny,nz,a,spin_ratio\n3,-4,0,0,1,0,1e-4,0\n")
+    with pytest.raises(ValueError, match=r"no column Wx,Wy,Wz; the columns are 'Vx,Vy,Vz,nx,ny,nz,a,spin_ratio'"):
+        bench_direct.read_hits_sample(path)
+    path.write_text("# new\nVx,Vy,Vz,nx,ny,nz,a,Wx,Wy,Wz,spin_ratio\n3,-4,0,0,1,0,1e-4,0,0,1e4,0.2\n")
+    sample = bench_direct.read_hits_sample(path)
+    assert sample["omega"].tolist() == [[0.0, 0.0, 1e4]] and sample["n"].tolist() == [[0.0, 1.0, 0.0]]
