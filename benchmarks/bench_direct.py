@@ -108,6 +108,7 @@ from direct_model.shapes import (MAX_VERTICES, TETRAHEDRON, AspectRatioLaw, body
                                  second_moment_factors)
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_SET_TOL, simulate
 from direct_model.wall import CORUNDUM_ON_STEEL
+from bench_native import build_native  # benchmarks/, next to this script
 from machine import machine_info  # benchmarks/machine.py, next to this script
 from surrogate.kernels import fill_uniforms, impact_frame, rebound_direct_tuple, seed_state
 from surrogate.kernels.frame import dot
@@ -117,7 +118,6 @@ SHAPES = ("ellipsoid", "prism", "cut_prism", "tetrahedron")
 TARGET_PER_CORE = 1e5     # rebounds/s per core
 TARGET_ALPHA1 = 45.0      # degrees
 SEED = 20240601
-NATIVE = Path(__file__).resolve().parent.parent / "native"
 HITS_SAMPLE = Path(__file__).resolve().parent / "data" / "hopper_hits.csv"
 # a table only for its recorded model parameters (the defaults), for the C side: 2 × 2 cells of 256
 BENCH_TABLE_CONFIG = ("[grid]\nalpha1_deg = [45.0, 90.0]\nspeed_m_s = [100.0, 200.0]\n"
@@ -418,18 +418,6 @@ def state_sets(m: int, hits_path: Path) -> dict:
 
 # ----------------------------------------------------------------------------- the C side
 
-def build_native(folder: Path) -> Path:
-    """Configure and build native/ (Release) with its bench programs into ``folder``."""
-    for command in (["cmake", "-S", str(NATIVE), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release",
-                     "-DRBS_BUILD_BENCH=ON", "-DRBS_BUILD_SHARED=OFF"],
-                    ["cmake", "--build", str(folder), "-j", "2", "--target", "rbs_bench_direct"]):
-        done = subprocess.run(command, capture_output=True, text=True)
-        if done.returncode != 0:
-            raise SystemExit(f"{' '.join(command)} failed (native/install-deps.sh installs the tools):\n"
-                             f"{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
-    return folder
-
-
 def c_runtime(program: Path, table: Path, states: dict, shape_code: int, repeats: int, folder: Path,
               pieces: dict) -> dict:
     """µs per rebound of rbs_rebound_direct in a C loop (native/bench/rbs_bench_direct.c) on the states, its
@@ -523,7 +511,7 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
                                         DEFAULT_SET_TOL, DEFAULT_MAX_STEPS, second_moment_factors(0.3)))
         c_side = None
         if native:
-            folder = build_dir if build_dir is not None else build_native(tmp / "build")
+            folder = build_dir if build_dir is not None else build_native(tmp / "build", "rbs_bench_direct")
             program = folder / "rbs_bench_direct"
             if not program.is_file():
                 raise SystemExit(f"{program} not found: build native/ with -DRBS_BUILD_BENCH=ON")

@@ -55,11 +55,11 @@ TARGET_MANY_NS = 100.0
 TARGET_MANY_OVER_BOUNCE = 3.0
 
 
-def build_native(folder: Path) -> Path:
-    """Configure and build native/ (Release) with its bench program into ``folder``."""
+def build_native(folder: Path, target: str = "rbs_bench") -> Path:
+    """Configure and build native/ (Release) with the bench program ``target`` into ``folder``."""
     for command in (["cmake", "-S", str(NATIVE), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release",
                      "-DRBS_BUILD_BENCH=ON", "-DRBS_BUILD_SHARED=OFF"],
-                    ["cmake", "--build", str(folder), "-j", "2", "--target", "rbs_bench"]):
+                    ["cmake", "--build", str(folder), "-j", "2", "--target", target]):
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:
             raise SystemExit(f"{' '.join(command)} failed (native/install-deps.sh installs the tools):\n"

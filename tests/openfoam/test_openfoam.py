@@ -11,6 +11,9 @@ beside ours, and times the runs against standardWallInteraction.
 
 These tests need OpenFOAM: they fail (they are not skipped) when it is
 missing, with a message naming integrations/openfoam/install-deps.sh.
+
+Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
+(see integrations/openfoam/LICENSE): these tests import the integration's scripts.
 """
 
 from __future__ import annotations
