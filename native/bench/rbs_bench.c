@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_io.h"
 #include "rebound_scatter.h"
 
 static double now(void)
@@ -82,20 +83,10 @@ int main(int argc, char **argv)
     }
     int repeats = atoi(argv[3]);
     unsigned long long seed = strtoull(argv[4], NULL, 10);
-    char message[1024];
-    rbs_table *table = NULL;
-    int code = rbs_table_open(argv[1], &table, message, sizeof message);
-    if (code != RBS_OK) {
-        fprintf(stderr, "%s\n", message);
-        return 1;
-    }
-    FILE *f = fopen(argv[2], "rb");
-    long long count = 0;
-    if (!f || fread(&count, sizeof count, 1, f) != 1 || count <= 0) {
-        fprintf(stderr, "%s: cannot read the states\n", argv[2]);
-        return 1;
-    }
-    size_t N = (size_t)count;
+    size_t N = 0;
+    rbs_table *table = bench_open_table(argv[1]);
+    FILE *f = table ? bench_open_states(argv[2], &N) : NULL;
+    if (!f) return 1;
     double *V = malloc(3 * N * sizeof *V), *n = malloc(3 * N * sizeof *n), *a = malloc(N * sizeof *a);
     double *V_out = malloc(3 * N * sizeof *V_out), *Omega_out = malloc(3 * N * sizeof *Omega_out);
     double *U = malloc(RBS_U_PER_DRAW * N * sizeof *U);

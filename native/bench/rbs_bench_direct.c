@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_io.h"
 #include "rebound_scatter.h"
 
 #include "collision.h"   /* the model's internal kernels, for the time split */
@@ -153,19 +154,10 @@ int main(int argc, char **argv)
     }
     int shape = atoi(argv[3]), repeats = atoi(argv[4]);
     unsigned long long seed = strtoull(argv[5], NULL, 10);
-    char message[1024];
-    rbs_table *table = NULL;
-    if (rbs_table_open(argv[1], &table, message, sizeof message) != RBS_OK) {
-        fprintf(stderr, "%s\n", message);
-        return 1;
-    }
-    FILE *f = fopen(argv[2], "rb");
-    long long count = 0;
-    if (!f || fread(&count, sizeof count, 1, f) != 1 || count <= 0) {
-        fprintf(stderr, "%s: cannot read the states\n", argv[2]);
-        return 1;
-    }
-    size_t N = (size_t)count;
+    size_t N = 0;
+    rbs_table *table = bench_open_table(argv[1]);
+    FILE *f = table ? bench_open_states(argv[2], &N) : NULL;
+    if (!f) return 1;
     double *V = malloc(3 * N * sizeof *V), *Omega = malloc(3 * N * sizeof *Omega), *n = malloc(3 * N * sizeof *n);
     double *a = malloc(N * sizeof *a), *V_out = malloc(3 * N * sizeof *V_out);
     double *Omega_out = malloc(3 * N * sizeof *Omega_out);
