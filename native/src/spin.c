@@ -26,8 +26,8 @@ static int method_known(int method)
     return method == RBS_AUTO || method == RBS_TABLE || method == RBS_DIRECT;
 }
 
-/* the table answers the hit (surrogate.kernels.spin._table_valid): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE, α1 and |V⁻|
- * inside the grid, edges included */
+/* the table answers the hit (the test of surrogate.kernels.spin._auto_path): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE,
+ * α1 and |V⁻| inside the grid, edges included */
 RBS_INLINE int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
 {
     double spin = a * sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) / speed;

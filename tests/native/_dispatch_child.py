@@ -11,10 +11,12 @@ a fixed seed (the latter also as the velocities `surrogate sample` writes).
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 
-import _python_side as py
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))    # tests/: _python_side imports direct_law
+import _python_side as py  # noqa: E402
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
                  "restitution_pieces")
