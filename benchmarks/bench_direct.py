@@ -39,7 +39,7 @@ shape, on three sets of incident states:
   integrations/openfoam/sample_hits.py: V⁻, n, a and Ω⁻ per hit, read by ``read_hits_sample``), each run
   with the shape.
 
-The target of the issue, ≤ 5 µs per rebound on one core averaged over hopperRebound's hits, is reported
+The run-time target, ≤ 5 µs per rebound on one core averaged over hopperRebound's hits, is reported
 per shape (a figure only: the exit code does not depend on it). Where the time goes: numba's rebound alone
 (``direct_model.runtime.rebound_model_frame``, the same uniforms; the rest of the call is the frame, the
 checks and the uniforms), the same without the trapped particles (each runs n_max collisions), the mean

@@ -12,7 +12,7 @@ from direct_law import STATES, assert_one_law, frame_of, kernel_in_frame, one_la
 # 0.02 (it starts clear, the flight in simulated): KS 0.19 and classifier accuracy 0.75 at N = 4000. At the
 # other 0.02 states the jump is smaller (accuracy 0.49–0.53), below what N = 4000 resolves: an accuracy of
 # 0.5 + d is seen by the bound (z = 3.84) with 97.5 % power from n_test = ((3.84 + 1.96)·0.5/d)² rows, i.e.
-# about 5300 particles per sample for d = 0.04 (the 0.54), 21 000 for d = 0.02.
+# about 5300 particles per sample for d = 0.04 (accuracy 0.54), 21 000 for d = 0.02.
 CONTROL = STATES[4]
 
 
