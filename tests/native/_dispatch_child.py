@@ -10,12 +10,23 @@ a fixed seed (the latter also as the velocities `surrogate sample` writes).
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))    # tests/: _python_side imports direct_law
+
+def _load_direct_law() -> None:
+    """tests/direct_law.py, which _python_side imports, loaded by its path: putting tests/ on sys.path would
+    let its folders (tests/surrogate, ...) shadow the packages of the same names in this process."""
+    spec = importlib.util.spec_from_file_location("direct_law", Path(__file__).resolve().parents[1] / "direct_law.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["direct_law"] = module
+    spec.loader.exec_module(module)
+
+
+_load_direct_law()
 import _python_side as py  # noqa: E402
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
