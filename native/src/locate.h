@@ -58,12 +58,19 @@ typedef struct rbs_cell {
     double wa, wv;      /* weights of the upper α1 and speed neighbours */
 } rbs_cell;
 
+/* the shape drawn from the mix: the first k with u0 < cdf[k] (surrogate.kernels.locate.mix_shape) */
+RBS_INLINE int64_t rbs_mix_shape(const double *cdf, int n_shapes, double u0)
+{
+    int64_t shape = 0;
+    for (int k = 0; k < n_shapes - 1; k++) shape += (int64_t)(u0 >= cdf[k]);
+    return shape;
+}
+
 RBS_INLINE rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_shapes, double alpha1, double speed,
                                    const double *u)
 {
     rbs_cell c;
-    int64_t shape = 0, ja;
-    for (int k = 0; k < n_shapes - 1; k++) shape += (int64_t)(u[0] >= cdf[k]);
+    int64_t shape = rbs_mix_shape(cdf, n_shapes, u[0]), ja;
     rbs_locate(t->alpha1_axis, (int64_t)t->alpha1_axis_len, t->n_alpha1, alpha1, &ja, &c.wa);
     rbs_locate(t->speed_axis, (int64_t)t->speed_axis_len, t->n_speed, speed, &c.jv, &c.wv);
     int64_t ia = ja + (int64_t)(u[1] < c.wa);

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "frame.h"
+#include "locate.h"
 #include "rebound_internal.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
@@ -73,9 +74,8 @@ RBS_HOT int rbs_rebound_spin_u(const rbs_table *t, const rbs_mix *mix, const dou
     }
     if (path == RBS_PATH_TABLE)
         return rbs_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
-    int64_t shape = 0;
-    for (int k = 0; k < mix->n_shapes - 1; k++) shape += (int64_t)(u[0] >= mix->cdf[k]);     /* as rbs_cell_of */
-    return rbs_rebound_direct(t, shape_code(t, shape), V, Omega, n, a, u + 1, V_out, Omega_out);
+    return rbs_rebound_direct(t, shape_code(t, rbs_mix_shape(mix->cdf, mix->n_shapes, u[0])), V, Omega, n, a, u + 1,
+                              V_out, Omega_out);
 }
 
 int rbs_rebound_spin(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],

@@ -45,6 +45,15 @@ def grid_interval(axis, n, x):
 
 
 @numba.njit(inline="always", **JIT)
+def mix_shape(mix_cdf, u0):
+    """The shape drawn from the mix with the uniform u0: the first k with u0 < mix_cdf[k]."""
+    shape = 0
+    for k in range(mix_cdf.shape[0] - 1):     # without data-dependent branches
+        shape += u0 >= mix_cdf[k]
+    return shape
+
+
+@numba.njit(inline="always", **JIT)
 def locate(data, mix_cdf, alpha1, speed, u):
     """The cell a draw reads: (drawn, below, wa, jv, wv, iv).
 
@@ -54,9 +63,7 @@ def locate(data, mix_cdf, alpha1, speed, u):
     number of cell (shape, ia, iv) (:class:`surrogate.kernels.layout.KernelData`),
     ``below`` that of (shape, ja, iv), the lower α1 neighbour at the drawn speed.
     """
-    shape = 0
-    for k in range(mix_cdf.shape[0] - 1):     # the first k with u[0] < cdf[k], without data-dependent branches
-        shape += u[0] >= mix_cdf[k]
+    shape = mix_shape(mix_cdf, u[0])
     ja, wa = grid_interval(data.alpha1_axis, data.n_alpha1, alpha1)
     jv, wv = grid_interval(data.speed_axis, data.n_speed, speed)
     ia = ja + (u[1] < wa)       # integer + comparison: no branch to mispredict

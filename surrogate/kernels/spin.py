@@ -33,6 +33,7 @@ from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
 from surrogate.kernels.direct import _rebound_direct
 from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
 from surrogate.kernels.layout import AXIS_GRID
+from surrogate.kernels.locate import mix_shape
 from surrogate.kernels.options import JIT
 from surrogate.kernels.particle import _rebound
 from surrogate.kernels.pipeline import no_uniforms, rebound_uniforms, run_blocks
@@ -121,9 +122,7 @@ def _rebound_spin_direct(params, model_shapes, mix_cdf, V, omega, n, a, u, scrat
     """The direct path of :func:`rebound_spin_tuple` with its scratch space given."""
     if not (uniforms_ok(u) and params.shape[0] == N_PARAMS and model_shapes.shape[0] == mix_cdf.shape[0]):
         return STATUS_INVALID, NAN3, NAN3
-    shape = 0
-    for k in range(mix_cdf.shape[0] - 1):     # the table path's shape draw (locate)
-        shape += u[0] >= mix_cdf[k]
+    shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
     return _rebound_direct(params, V, n, a, omega, model_shapes[shape], u[1:1 + U_PER_REBOUND], scratch)
 
 
