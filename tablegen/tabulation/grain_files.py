@@ -43,16 +43,18 @@ def read_mesh(path):
     if size == 0:
         raise GrainError(f"{path}: the file is empty")
     try:
-        loaded = trimesh.load(path)
-        if isinstance(loaded, trimesh.Scene):       # an OBJ or PLY of several objects: one grain of all
-            loaded = trimesh.load(path, force="mesh")
+        loaded = trimesh.load(path, process=False)     # as written: processing would drop NaN vertices silently
+        if isinstance(loaded, trimesh.Scene):           # an OBJ or PLY of several objects: one grain of all
+            loaded = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:                       # a parser of many formats: any failure means unreadable
         raise GrainError(f"{path}: cannot read the mesh: {(str(exc) or type(exc).__name__).splitlines()[0]}") from None
     points = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float).reshape(-1, 3)
     if len(points) == 0:
         raise GrainError(f"{path}: no vertices in the file (not a {path.suffix[1:].upper()} mesh, or an empty one)")
-    closed = isinstance(loaded, trimesh.Trimesh) and len(loaded.faces) > 0 and loaded.is_watertight
-    return points, abs(float(loaded.volume)) if closed else None
+    if not (isinstance(loaded, trimesh.Trimesh) and len(loaded.faces) > 0 and np.isfinite(points).all()):
+        return points, None
+    surface = trimesh.Trimesh(points, loaded.faces)     # merges the corners that STL repeats per triangle
+    return points, abs(float(surface.volume)) if surface.is_watertight else None
 
 
 def convex_hull(points, source):
