@@ -39,8 +39,9 @@ def _scan_along(vertices, directions):
     total = 0
     for i in range(directions.shape[0]):
         best, top = 0, -np.inf
+        d0, d1, d2 = directions[i, 0], directions[i, 1], directions[i, 2]
         for j in range(vertices.shape[0]):
-            h = directions[i, 0] * vertices[j, 0] + directions[i, 1] * vertices[j, 1] + directions[i, 2] * vertices[j, 2]
+            h = d0 * vertices[j, 0] + d1 * vertices[j, 1] + d2 * vertices[j, 2]
             if h > top:
                 best, top = j, h
         total += best
@@ -86,7 +87,8 @@ def main(argv=None) -> int:
         scan = _ns_per_query(_scan_along, (vertices, directions), args.queries)
         assert _climb_along(vertices, start, neighbours, directions) == _scan_along(vertices, directions)
         results[n] = {"climb_ns": climb, "scan_ns": scan, "scan_over_climb": scan / climb}
-        print(f"{n:4d} vertices: climb {climb:7.1f} ns/query, scan {scan:7.1f} ns/query, scan/climb {scan / climb:5.2f}")
+        print(f"{n:4d} vertices: climb {climb:7.1f} ns/query, scan {scan:7.1f} ns/query, "
+              f"scan/climb {scan / climb:5.2f}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"turn": args.turn, "queries": args.queries, "results": results}, f, indent=1)

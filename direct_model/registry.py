@@ -27,9 +27,9 @@ import numpy as np
 from direct_model.polyhedron import canonical_frame, mass_properties, vertex_graph
 from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, shape_vertices
 
-# The C direct path keeps a lab-frame copy of the hull and a height per vertex on the stack, with a fixed
-# capacity: 256 vertices are 8 KiB there, far inside the smallest thread stack in common use (musl, 128 KiB),
-# and a hull of 256 points resolves a grain's outline to about 1/16 of its size in each direction.
+# The C direct path keeps 56 bytes of work space per vertex on the stack (vertices, lab-frame offsets, heights):
+# 256 vertices are 14 KiB, far inside the smallest thread stack in common use (musl, 128 KiB); and a hull of 256
+# vertices resolves a grain's outline to about 1/16 of its size in each direction (docs/design/grains.md).
 MAX_HULL_VERTICES = 256
 MIN_THICKNESS = 1e-3        # thinnest half-extent, in units of a: the flight bound grows as (a / thickness)²
 NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")   # also an HDF5 dataset name and a C identifier's tail

@@ -55,7 +55,7 @@ def test_a_non_convex_mesh_warns_once_with_the_added_volume(tmp_path):
 
 
 def _l_prism():
-    """Vertices and outward triangles of an L-shaped prism: the 2 × 1 rectangle less a 0.5 × 0.5 corner, z in [0, 1]."""
+    """Vertices and outward triangles of an L-shaped prism: a 2 × 1 rectangle less a 0.5 × 0.5 corner, z in [0, 1]."""
     outline = [(-1.0, -0.5), (1.0, -0.5), (1.0, 0.0), (0.5, 0.0), (0.5, 0.5), (-1.0, 0.5)]   # counter-clockwise
     n = len(outline)
     vertices = [(x, y, 0.0) for x, y in outline] + [(x, y, 1.0) for x, y in outline]
