@@ -1,5 +1,5 @@
 """Throughput benchmark of the direct rebound model: the batch API (``direct_model.simulate.simulate``) and
-the run-time kernels (numba's ``surrogate.kernels.rebound_direct_tuple``, C's ``rbs_rebound_direct``).
+the run-time kernels (numba's ``surrogate.kernels.direct_rebound``, C's ``rbs_rebound_direct``).
 
 What is measured: the batch
 ---------------------------
@@ -25,7 +25,7 @@ For each shape and incidence angle α1 (default: the four shapes at 45° and
 
 What is measured: the run-time kernels
 --------------------------------------
-Microseconds per rebound of numba's ``rebound_direct_tuple`` and of the C library's ``rbs_rebound_direct``,
+Microseconds per rebound of numba's ``direct_rebound`` and of the C library's ``rbs_rebound_direct``,
 one particle per call in a loop on one thread (an ``@njit`` loop; a C loop in native/bench/rbs_bench_direct.c),
 the 7 uniforms drawn per call from one xoshiro256+ stream of seed SEED (``fill_uniforms``, ``rbs_rng_fill``:
 the same uniforms, so the C outputs are checked against numba's bits), as a solver would call them. Per
@@ -99,7 +99,7 @@ import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.collision import collide
 from direct_model.flight import curvature_bound, lowest_points
-from direct_model.rebound import lab_tensor, quaternion_to_matrix
+from direct_model.body_rebound import lab_tensor, quaternion_to_matrix
 from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
 from direct_model.runtime import (P_KAPPA, P_KFAC, P_WALL, SCRATCH_SIZE, U_AXIS, U_HAND, U_ORIENTATION,
                                   U_PER_REBOUND, U_RATIOS, aspect_ratio, model_parameters, rebound_model_frame,
@@ -110,7 +110,7 @@ from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAUL
 from direct_model.wall import CORUNDUM_ON_STEEL
 from bench_native import build_native  # benchmarks/, next to this script
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import fill_uniforms, impact_frame, rebound_direct_tuple, seed_state
+from surrogate.kernels import fill_uniforms, impact_frame, direct_rebound, seed_state
 from surrogate.kernels.frame import dot
 from tablegen import build_table, parse_config
 
@@ -205,13 +205,13 @@ STATE_SETS = ("random, 0", "random, spin", "hopper")
 
 
 @numba.njit
-def _kernel_loop(params, V, n, a, omega, shape, state, status, V_out, W_out):
-    """rebound_direct_tuple on every row, uniforms from ``state``: what a solver's loop does."""
+def _kernel_loop(params, shape, V, omega, n, a, state, status, V_out, W_out):
+    """direct_rebound on every row, uniforms from ``state``: what a solver's loop does."""
     u = np.empty(U_PER_REBOUND)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        st, Vo, Wo = rebound_direct_tuple(params, (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i],
-                                          (omega[i, 0], omega[i, 1], omega[i, 2]), shape, u)
+        st, Vo, Wo = direct_rebound(params, shape, (V[i, 0], V[i, 1], V[i, 2]), (omega[i, 0], omega[i, 1], omega[i, 2]),
+                                    (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
         status[i] = st
         for k in range(3):
             V_out[i, k], W_out[i, k] = Vo[k], Wo[k]
@@ -450,7 +450,7 @@ def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats:
     V, n, a, W = states["V"], states["n"], states["a"], states["omega"]
     m = len(a)
     status, V_out, W_out = np.empty(m, dtype=np.int8), np.empty((m, 3)), np.empty((m, 3))
-    best = _best(lambda: _kernel_loop(params, V, n, a, W, shape_code, seed_state(SEED), status, V_out, W_out),
+    best = _best(lambda: _kernel_loop(params, shape_code, V, W, n, a, seed_state(SEED), status, V_out, W_out),
                  repeats)
     u_all, model = np.empty((m, U_PER_REBOUND)), np.empty((m, 5))
     counts, W_after = np.empty((m, 3), dtype=np.int64), np.empty((m, 3))
@@ -519,7 +519,7 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
         warm = {k: v[:16] for k, v in random_states(16, True, SEED).items()}
         for code in range(len(SHAPES)):                  # warm-up: compile the loops
             bench_runtime(params, warm, "warm-up", code, 1)
-        print(f"\nRun-time kernels, one thread, best of {repeats}: numba (surrogate.kernels.rebound_direct_tuple)"
+        print(f"\nRun-time kernels, one thread, best of {repeats}: numba (surrogate.kernels.direct_rebound)"
               + (" and C (rbs_rebound_direct)" if native else "") + f"; states: {states} random per row with Ω⁻ = 0 "
               f"('random, 0') or spinning ('random, spin'), and {len(sets['hopper']['a'])} hopperRebound hits "
               f"({hits_path.name}, {np.mean(np.any(sets['hopper']['omega'] != 0, axis=1)):.0%} spinning) run with "
@@ -587,7 +587,7 @@ def main(argv=None) -> int:
 
     info = machine_info()
     threads = info["numba_default_threads"]
-    print("Direct rebound model throughput (direct_model.simulate; the run-time kernels rebound_direct_tuple, rbs_rebound_direct)")
+    print("Direct rebound model throughput (direct_model.simulate; the run-time kernels direct_rebound, rbs_rebound_direct)")
     for key, value in info.items():
         print(f"  {key:22s} {value}")
     runtime_rows = main_runtime(states, repeats, args.hits, args.table, args.build_dir, not args.no_native)

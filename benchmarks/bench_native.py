@@ -8,9 +8,9 @@ uniforms included:
 * (C-1) C per particle: a C loop calling ``rbs_rng_fill`` (13 uniforms) and ``rbs_rebound`` per hit;
 * (C-many) C many-particle call: ``rbs_rebound_many_rng`` on all the hits (uniforms from 32 lanes);
   breakdown: ``rbs_rebound_many`` on pre-drawn uniforms, and the 13 uniforms alone;
-* (N-1) numba per particle: ``rebound_tuple`` in an ``@njit`` loop with ``fill_uniforms``
+* (N-1) numba per particle: ``table_rebound`` in an ``@njit`` loop with ``fill_uniforms``
   (bench_sampler's (b));
-* (N-block) numba block kernel: ``rebound_many_rng`` (bench_sampler's (b-block));
+* (N-block) numba block kernel: ``table_rebound_many_rng`` (bench_sampler's (b-block));
 * (C-GT) the Grant–Tabakoff sphere bounce of bench_sampler.py written in C, same loop (and numba's,
   bench_sampler's (d), for reference);
 * (C-spin) every hit answered: (C-1)'s loop with ``rbs_rebound_spin`` (method auto) for non-spinning hits,
@@ -21,7 +21,7 @@ uniforms included:
 The C loops run in a small C program (``native/bench/rbs_bench.c``) that CMake builds into a temporary
 folder (or ``--build-dir``, a build of native/ with ``-DRBS_BUILD_BENCH=ON``); this script writes the
 states to a file for it and reads its figures back. It also checks that the C many-particle call gives
-numba's ``rebound_many_rng`` bits on these states. Targets reported: C per particle ≤ 150 ns, C many ≤
+numba's ``table_rebound_many_rng`` bits on these states. Targets reported: C per particle ≤ 150 ns, C many ≤
 100 ns and ≤ 3 × the C Grant–Tabakoff bounce. The exit code does not depend on them.
 
 Run from the repository root::
@@ -47,7 +47,7 @@ sys.path.insert(0, str(HERE))
 import bench_sampler  # noqa: E402  (benchmarks/, next to this script: its states, table and numba loops)
 import surrogate  # noqa: E402
 from machine import machine_info  # noqa: E402
-from surrogate.kernels import rebound_many_rng  # noqa: E402
+from surrogate.kernels import table_rebound_many_rng  # noqa: E402
 
 NATIVE = HERE.parent / "native"
 TARGET_PER_PARTICLE_NS = 150.0
@@ -149,7 +149,7 @@ def main(argv=None) -> int:
         # the C many-particle call gives numba's bits on these states
         m = min(count, 20000)
         V_py, W_py, s_py = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-        rebound_many_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(bench_sampler.SEED), V_py, W_py, s_py)
+        table_rebound_many_rng(data, cdf, V[:m], nrm[:m], a[:m], seed_state(bench_sampler.SEED), V_py, W_py, s_py)
         results = tmp / "results.bin"
         check = subprocess.run([str(program), str(path), str(states), "0", str(bench_sampler.SEED), str(results)],
                                capture_output=True, text=True)
@@ -166,8 +166,8 @@ def main(argv=None) -> int:
             ("(C-many) C rbs_rebound_many_rng, all hits", c["c_many"]),
             ("         breakdown: rbs_rebound_many, uniforms given", c["c_many_given"]),
             ("         breakdown: 13 xoshiro256+ uniforms alone", c["c_rng"]),
-            ("(N-1)    numba rebound_tuple in @njit loop", n1),
-            ("(N-block) numba rebound_many_rng", nb),
+            ("(N-1)    numba table_rebound in @njit loop", n1),
+            ("(N-block) numba table_rebound_many_rng", nb),
             ("(C-GT)   C Grant-Tabakoff sphere bounce", c["c_grant_tabakoff"]),
             ("         numba Grant-Tabakoff bounce (bench_sampler (d))", gt),
             ("(C-spin) C rbs_rebound_spin, auto, no spin (the table)", c["c_spin_still"])]
@@ -200,7 +200,7 @@ def main(argv=None) -> int:
     print(f"  (C-many)           C many particles, ns             {c['c_many']:8.4g}   "
           f"target <= {TARGET_MANY_NS:g}: {verdict(targets['c_many_ns'])}")
     bits = "yes" if same_bits else "NO"
-    print(f"\nC draws checked against numba's rebound_many_rng on the first {m} states: equal bits: {bits}")
+    print(f"\nC draws checked against numba's table_rebound_many_rng on the first {m} states: equal bits: {bits}")
     print("Targets are figures only: the exit code does not depend on them.")
     if args.json:
         with open(args.json, "w") as f:

@@ -13,20 +13,20 @@ and prints the cost in ns per reflected state:
     parallel kernel (which draws the U_PER_DRAW uniforms per state) and the
     outputs; variants pass ``out=`` arrays that the caller keeps (no
     allocation, no first touch of fresh pages). Two breakdown rows time that
-    kernel, ``surrogate.kernels.rebound_parallel_rng``, alone;
-(b) ``surrogate.kernels.rebound_tuple`` called from a user's ``@njit`` loop
+    kernel, ``surrogate.kernels.table_rebound_parallel_rng``, alone;
+(b) ``surrogate.kernels.table_rebound`` called from a user's ``@njit`` loop
     on one thread, as a flow solver would call it per wall hit: the particle's
     V and n passed as 3-tuples of its components and V⁺, Ω⁺ returned as
     tuples (no array views, so the loop does no reference counting); the loop
     draws the U_PER_DRAW uniforms of each state with
     ``surrogate.fill_uniforms`` (xoshiro256+, caller-owned state) and that
-    cost is included. Variants: ``surrogate.kernels.rebound`` on the rows
-    ``V[i]``, ``n[i]``, ``V_out[i]``, ``Omega_out[i]`` (array views); the uniforms
+    cost is included. Variants: ``surrogate.kernels.table_rebound`` on the rows
+    ``V[i]``, ``n[i]``, its outputs stored into ``V_out[i]``, ``Omega_out[i]`` (array views); the uniforms
     from numba's ``np.random.random()``; (b') the loop reading pre-drawn
     uniforms; (b-block) a solver that collects its wall hits and calls
-    ``surrogate.kernels.rebound_many_rng`` on them from ``@njit`` code (its
+    ``surrogate.kernels.table_rebound_many_rng`` on them from ``@njit`` code (its
     uniforms, from 32 xoshiro256+ lanes stepped as SIMD, included), and the variant that first draws them
-    into an (N, 13) array for ``rebound_many``; breakdown row: the xoshiro256+
+    into an (N, 13) array for ``table_rebound_many``; breakdown row: the xoshiro256+
     draws alone;
 (c) the direct model, ``direct_model.simulate.simulate`` with the shape mix, one
     thread, per particle simulated (whatever its status; NumPy input draws,
@@ -114,8 +114,8 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import (PATH_DIRECT, U_PER_DRAW, chunk_states, fill_uniforms, rebound, rebound_many,
-                               rebound_many_rng, rebound_parallel_rng, rebound_tuple, seed_state)
+from surrogate.kernels import (PATH_DIRECT, U_PER_DRAW, chunk_states, fill_uniforms, seed_state, table_rebound,
+                               table_rebound_many, table_rebound_many_rng, table_rebound_parallel_rng)
 
 SEED = 20240601
 HALF_SIZE = 1e-4                    # m, particle half-size a
@@ -167,7 +167,7 @@ def grant_tabakoff_bounce(V, n, V_out):
     :func:`surrogate.kernels.impact_frame`: normal and tangential parts of V,
     ex along the tangential part, ez = ex × n, β1 = atan2(−V·n, |V_t|); then
     V⁺ = e_T |V_t| ex − e_N (V·n) n + 0·ez is rotated back into the global
-    frame as :func:`surrogate.kernels.rebound` does. No spin, no scatter.
+    frame as :func:`surrogate.kernels.table_rebound` does. No spin, no scatter.
     V must move into the wall (V·n < 0). Scalars only, like the sampler kernel.
     """
     vn = V[0] * n[0] + V[1] * n[1] + V[2] * n[2]
@@ -196,11 +196,11 @@ def seed_numba_rng(seed):
 @numba.njit(**JIT)
 def loop_kernel_rng(data, cdf, V, n, a, state, V_out, Omega_out, status):
     """(b) A solver's loop: uniforms from a xoshiro256+ state (surrogate.fill_uniforms), our kernel on
-    the particle's components (rebound_tuple: no array views)."""
+    the particle's components (table_rebound: no array views)."""
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
                                                 (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
@@ -208,25 +208,29 @@ def loop_kernel_rng(data, cdf, V, n, a, state, V_out, Omega_out, status):
 
 @numba.njit(**JIT)
 def loop_kernel_views(data, cdf, V, n, a, state, V_out, Omega_out, status):
-    """(b, rows) The same loop calling rebound on the rows V[i], n[i], V_out[i], Omega_out[i] (array views)."""
+    """(b, rows) The same loop calling table_rebound on the rows V[i], n[i] and storing into V_out[i],
+    Omega_out[i] (array views)."""
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], Omega_out[i])
+        status[i], V_new, W_new = table_rebound(data, cdf, V[i], n[i], a[i], u)
+        V_row, W_row = V_out[i], Omega_out[i]
+        for k in range(3):
+            V_row[k], W_row[k] = V_new[k], W_new[k]
 
 
 @numba.njit(**JIT)
 def loop_block_rng(data, cdf, V, n, a, state, V_out, Omega_out, status):
-    """(b, block) A solver that collects its wall hits and calls rebound_many_rng on them with its state."""
-    rebound_many_rng(data, cdf, V, n, a, state, V_out, Omega_out, status)
+    """(b, block) A solver that collects its wall hits and calls table_rebound_many_rng on them with its state."""
+    table_rebound_many_rng(data, cdf, V, n, a, state, V_out, Omega_out, status)
 
 
 @numba.njit(**JIT)
 def loop_block_given(data, cdf, V, n, a, state, U, V_out, Omega_out, status):
-    """(b-block, U given) The same hits: their uniforms (xoshiro256+) into U first, then rebound_many."""
+    """(b-block, U given) The same hits: their uniforms (xoshiro256+) into U first, then table_rebound_many."""
     for i in range(V.shape[0]):
         fill_uniforms(state, U[i])
-    rebound_many(data, cdf, V, n, a, U, V_out, Omega_out, status)
+    table_rebound_many(data, cdf, V, n, a, U, V_out, Omega_out, status)
 
 
 @numba.njit(**JIT)
@@ -236,7 +240,7 @@ def loop_kernel_nprandom(data, cdf, V, n, a, V_out, Omega_out, status):
     for i in range(V.shape[0]):
         for k in range(U_PER_DRAW):
             u[k] = np.random.random()
-        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
                                                 (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
@@ -247,7 +251,7 @@ def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, Omega_out, status, scaled
     """(b') The same loop on pre-drawn uniforms U (N, U_PER_DRAW); with scaled=False, plain stochastic
     interpolation (no moment scaling, breakdown row)."""
     for i in range(V.shape[0]):
-        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
                                                 (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i], scaled)
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
@@ -465,7 +469,7 @@ def main(argv=None) -> int:
     # warm-up: compile everything timed below (a small slice; numba caches per type signature)
     m = min(count, 1000)
     surrogate.sample_global(table, V[:m], nrm[:m], a[:m], shape=mix, random_state=SEED)
-    rebound_parallel_rng(data, cdf, V[:m], nrm[:m], a[:m], chunk_states(np.random.default_rng(SEED), m),
+    table_rebound_parallel_rng(data, cdf, V[:m], nrm[:m], a[:m], chunk_states(np.random.default_rng(SEED), m),
                       V_out[:m], Omega_out[:m], status[:m])
     streams = chunk_states(np.random.default_rng(SEED), count)
     seed_numba_rng(SEED)
@@ -507,26 +511,26 @@ def main(argv=None) -> int:
     record("a_1", "(a) sample_global, 1 numba thread", 1, api)
     record("a_out_all", "    variant: with out= arrays kept, all cores", threads, api_out)
     record("a_out_1", "    variant: with out= arrays kept, 1 thread", 1, api_out)
-    record("a_kernel_all", "    breakdown: rebound_parallel_rng, all cores", threads,
-           lambda: rebound_parallel_rng(data, cdf, V, nrm, a, streams, V_out, Omega_out, status))
-    record("a_kernel_1", "    breakdown: rebound_parallel_rng, 1 thread", 1,
-           lambda: rebound_parallel_rng(data, cdf, V, nrm, a, streams, V_out, Omega_out, status))
+    record("a_kernel_all", "    breakdown: table_rebound_parallel_rng, all cores", threads,
+           lambda: table_rebound_parallel_rng(data, cdf, V, nrm, a, streams, V_out, Omega_out, status))
+    record("a_kernel_1", "    breakdown: table_rebound_parallel_rng, 1 thread", 1,
+           lambda: table_rebound_parallel_rng(data, cdf, V, nrm, a, streams, V_out, Omega_out, status))
     trapped_api = float(np.mean(api()[2] != 0))
-    record("b", "(b) rebound_tuple in @njit loop, xoshiro256+", 1,
+    record("b", "(b) table_rebound in @njit loop, xoshiro256+", 1,
            lambda: loop_kernel_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
-    record("b_views", "    variant: rebound on array rows (views)", 1,
+    record("b_views", "    variant: table_rebound on array rows (views)", 1,
            lambda: loop_kernel_views(data, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
     record("b_nprandom", "    variant: uniforms from np.random.random()", 1,
            lambda: loop_kernel_nprandom(data, cdf, V, nrm, a, V_out, Omega_out, status),
            setup=lambda: seed_numba_rng(SEED))
     trapped_b = float(np.mean(status != 0))
-    record("b_predrawn", "(b') rebound_tuple in @njit loop, pre-drawn u", 1,
+    record("b_predrawn", "(b') table_rebound in @njit loop, pre-drawn u", 1,
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, Omega_out, status, True))
     record("b_unscaled", "    breakdown: (b') without moment scaling", 1,
            lambda: loop_kernel_predrawn(data, cdf, V, nrm, a, U, V_out, Omega_out, status, False))
-    record("b_block", "(b-block) rebound_many_rng in @njit", 1,
+    record("b_block", "(b-block) table_rebound_many_rng in @njit", 1,
            lambda: loop_block_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
-    record("b_block_given", "    variant: uniforms into U, rebound_many", 1,
+    record("b_block_given", "    variant: uniforms into U, table_rebound_many", 1,
            lambda: loop_block_given(data, cdf, V, nrm, a, seed_state(SEED), U_block, V_out, Omega_out, status))
     record("b_beam", "(b) on the wall-beam states", 1,
            lambda: loop_kernel_rng(data, cdf, beam["V"], beam["normal"], a, seed_state(SEED), V_out, Omega_out, status))

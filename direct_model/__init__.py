@@ -1,7 +1,7 @@
 """The direct model: the rebound of a particle from a wall, collision by collision (docs/model.md).
 
 shapes (bodies and their random draws), wall (the wall law), collision (one impulse), rotation (exact
-torque-free rotation), flight (contact search), rebound (one particle, numba kernels), simulate (the
+torque-free rotation), flight (contact search), body_rebound (one particle, numba kernels), simulate (the
 batch API, :func:`direct_model.simulate.simulate`), options (the numba options of every kernel).
 Any convex grain (docs/model.md §9): polyhedron (a hull's mass properties and canonical frame), registry
 (the record of a shape; the four families as records), support (a hull's support point by hill climbing).

@@ -1,10 +1,10 @@
 """The direct model at run time: one particle's whole rebound from U_PER_REBOUND uniforms (docs/model.md §10).
 
-:func:`rebound_model_frame` is :func:`direct_model.rebound.rebound` with its random inputs drawn from
+:func:`rebound_model_frame` is :func:`direct_model.body_rebound.body_rebound` with its random inputs drawn from
 uniforms the caller passes, and with every model parameter taken from one float64 array
 (:func:`model_parameters`, layout P_*), so that a runtime reads the parameters a table was built with and
 calls the model from ``@njit`` code. It works in the model's frame (wall y = 0, normal +Y; docs/model.md
-§2); :func:`surrogate.kernels.direct.rebound_direct_tuple` puts a hit in that frame and back.
+§2); :func:`surrogate.kernels.direct_path.direct_rebound` puts a hit in that frame and back.
 
 The uniforms, all in [0, 1): u[0:3] the orientation (Shoemake's uniform quaternion: Haar measure, like the
 batch's normalised Gaussian quaternion), u[3:5] b/a and c/b (inverse CDF of the truncated normal law, like
@@ -20,7 +20,7 @@ import numba
 import numpy as np
 
 from direct_model.options import JIT
-from direct_model.rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, rebound
+from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, body_rebound
 from direct_model.shapes import SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa
 from direct_model.wall import WallMaterial
 
@@ -139,7 +139,7 @@ def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
     Returns
     -------
     (status, n_collisions, n_search_steps, V⁺ as 3 floats in m/s, Ω⁺ as 3 floats in (m/s)/a), model frame;
-    status as in :func:`direct_model.rebound.rebound`.
+    status as in :func:`direct_model.body_rebound.body_rebound`.
     """
     semi = scratch[_SEMI:_SEMI + 3]
     R0 = scratch[_R0:_R0 + 9].reshape((3, 3))
@@ -153,7 +153,7 @@ def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
     hand = 1.0 if shape != TETRAHEDRON or u[U_HAND] < 0.5 else -1.0
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
-    status, _, n_coll, n_steps, _, _ = rebound(
+    status, _, n_coll, n_steps, _, _ = body_rebound(
         shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params[P_WALL:P_WALL + 3],
         int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
         scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])

@@ -17,7 +17,7 @@ import numpy as np
 
 from data_schema.common import package_version
 from data_schema.samples import ALPHA1_RANGE_TEXT, SampleSet, alpha1_is_physical
-from direct_model.rebound import rebound_batch
+from direct_model.body_rebound import body_rebound_batch
 from direct_model.shapes import (
     DEFAULT_KAPPA, MIX, SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
 )
@@ -172,7 +172,7 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
         m = stop - start
         codes[start:stop], ratios[start:stop], hands[start:stop] = c[:m], r[:m], hnd[:m]
         sl = slice(start, stop)
-        rebound_batch(codes[sl], ratios[sl], hands[sl], q[:m], V0, W0, kfacs, kappa, wall_arr,
+        body_rebound_batch(codes[sl], ratios[sl], hands[sl], q[:m], V0, W0, kfacs, kappa, wall_arr,
                       n_max, contact_tol, set_tol, max_steps,
                       out_V[sl], out_W[sl], out_erot[sl], out_ncoll[sl], out_status[sl],
                       out_failure[sl], out_steps[sl], out_multi[sl])

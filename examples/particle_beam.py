@@ -2,7 +2,7 @@
 """A particle beam hitting a flat wall and a cylinder: the surrogate's rebounds vs a specular sphere.
 
 A tiny Lagrangian tracker (numba, straight-line motion, no gas) moves a beam of
-non-spherical grains and calls the runtime sampler :func:`surrogate.kernels.rebound_spin_tuple`
+non-spherical grains and calls the runtime sampler :func:`surrogate.kernels.rebound`
 at each wall hit, with the grain's incident spin Ω⁻ (``--spin``; zero by default): the table
 answers where it is valid, the direct model elsewhere (a spinning grain, a hit off the table's
 grid). The same beam is tracked again with the rebound of a sphere
@@ -47,7 +47,7 @@ except ImportError:            # running from a source checkout without `pip ins
     sys.path.insert(0, str(REPO))
     import surrogate
 from surrogate import STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, seed_state
-from surrogate.kernels import METHOD_AUTO, rebound_spin_tuple
+from surrogate.kernels import METHOD_AUTO, rebound
 
 # A small table for this beam: alpha1 down to 2 deg (grazing hits on the
 # cylinder; below 2 deg the direct model answers), speeds 100-200 m/s.
@@ -125,7 +125,7 @@ def track(pos, vel, omega, t_end, dt, geometry, radius, model, data, params, mod
                 normal[0], normal[1], normal[2] = p[0] / r, p[1] / r, 0.0
             if model == TABLE:
                 fill_uniforms(rng_state, u)
-                status, V_new, _ = rebound_spin_tuple(data, params, model_shapes, mix_cdf, (v[0], v[1], v[2]),
+                status, V_new, _ = rebound(data, params, model_shapes, mix_cdf, (v[0], v[1], v[2]),
                                                       (omega[i, 0], omega[i, 1], omega[i, 2]),
                                                       (normal[0], normal[1], normal[2]), half_size, u, METHOD_AUTO)
                 vo[0], vo[1], vo[2] = V_new

@@ -8,34 +8,34 @@ imports :mod:`tablegen`, so a flow solver installs the runtime alone::
     V_out, Omega_out, status = surrogate.sample_global(table, V, normals, half_size, shape="prism",
                                                        random_state=1)
 
-From numba code, call :func:`surrogate.kernels.rebound_tuple` (or
-:func:`surrogate.kernels.rebound` on arrays) with ``table.kernel_data`` and
-``U_PER_DRAW`` uniforms per call; :func:`fill_uniforms` draws them fast from
+From numba code, the call that answers any wall hit is :func:`surrogate.kernels.rebound` (module doc's last
+paragraph); the table path alone is :func:`surrogate.kernels.table_rebound`, called with ``table.kernel_data``
+and ``U_PER_DRAW`` uniforms per call; :func:`fill_uniforms` draws them fast from
 a caller-owned xoshiro256+ state (:func:`seed_state`). A solver that collects
 its wall hits of a time step should pass them all to
-:func:`surrogate.kernels.rebound_many_rng` (uniforms from a state) or
-:func:`surrogate.kernels.rebound_many` (uniforms given), which pipeline
+:func:`surrogate.kernels.table_rebound_many_rng` (uniforms from a state) or
+:func:`surrogate.kernels.table_rebound_many` (uniforms given), which pipeline
 blocks of particles, overlap their table reads and compute their draws as
 SIMD loops, with the per-particle results bit for bit;
-:func:`surrogate.kernels.rebound_parallel_rng` does the same on all threads,
+:func:`surrogate.kernels.table_rebound_parallel_rng` does the same on all threads,
 as :func:`sample_global` does. :mod:`surrogate.kernels` maps where each part lives.
 
 Where the table does not apply (a particle spinning before it hits, an α1 or |V⁻| off its grid), the direct
 model answers: :func:`sample_global` with its default ``method="auto"`` picks, per hit, the table where it is
 valid (|Ω⁻|a/|V⁻| ≤ :data:`SPIN_TOLERANCE`, inside the grid) and the direct model elsewhere; from numba,
-:func:`surrogate.kernels.rebound_spin_tuple` (13 uniforms per hit whatever the path) and
-:func:`surrogate.kernels.rebound_path`. The direct model alone: :func:`rebound_direct` from NumPy,
-:func:`surrogate.kernels.rebound_direct_tuple` from numba with :func:`direct_model_parameters` and
+:func:`surrogate.kernels.rebound` (13 uniforms per hit whatever the path) and
+:func:`surrogate.kernels.rebound_path`. The direct model alone: :func:`sample_direct` from NumPy,
+:func:`surrogate.kernels.direct_rebound` from numba with :func:`direct_model_parameters` and
 ``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
 """
 
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import U_PER_REBOUND
-from surrogate.direct import direct_model_parameters, rebound_direct
+from surrogate.direct import direct_model_parameters, sample_direct
 from surrogate.kernels import SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.sampling import METHODS, LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 
 __all__ = ["LocalDraws", "METHODS", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
            "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "direct_model_parameters", "fill_uniforms", "load",
-           "mix_cdf", "rebound_direct", "sample_global", "sample_local", "seed_state"]
+           "mix_cdf", "sample_direct", "sample_global", "sample_local", "seed_state"]

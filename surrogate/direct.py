@@ -8,7 +8,7 @@ import numpy as np
 
 from direct_model.shapes import SHAPES
 from surrogate.kernels.checks import first_faults
-from surrogate.kernels.direct import rebound_direct_parallel_rng
+from surrogate.kernels.direct_path import direct_rebound_parallel_rng
 from surrogate.kernels.rng import chunk_states
 from surrogate.sampling import _fault_error, _outputs, _rows, _vectors, check_random_state
 from surrogate.table import SurrogateTable
@@ -16,7 +16,7 @@ from surrogate.table import SurrogateTable
 
 def direct_model_parameters(table: SurrogateTable) -> np.ndarray:
     """The direct model's parameters of ``table`` as the run-time kernel takes them
-    (:func:`surrogate.kernels.direct.rebound_direct_tuple`): a read-only float64 array, layout P_* of
+    (:func:`surrogate.kernels.direct_path.direct_rebound`): a read-only float64 array, layout P_* of
     :mod:`direct_model.runtime`. ValueError if the table does not record them."""
     if table.direct_parameters is None:
         raise ValueError(f"The table {table.path} does not record the direct model's second-moment factors (built "
@@ -46,7 +46,7 @@ def _shape_codes(shape, n: int) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(codes, (n,)))
 
 
-def rebound_direct(table: SurrogateTable, velocity, normal, half_size, omega=(0.0, 0.0, 0.0), shape="ellipsoid",
+def sample_direct(table: SurrogateTable, velocity, normal, half_size, omega=(0.0, 0.0, 0.0), shape="ellipsoid",
                    random_state=None, out=None):
     """Reflected velocities and spins of particles hitting walls, from the direct model, in the caller's frame.
 
@@ -91,6 +91,6 @@ def rebound_direct(table: SurrogateTable, velocity, normal, half_size, omega=(0.
     codes = _shape_codes(shape, n)
     V_out, Omega_out, status = _outputs(out, n, (V, nrm, a, W))
     states = chunk_states(check_random_state(random_state), n)
-    rebound_direct_parallel_rng(params, V, _rows(nrm, n), _rows(a, n), _rows(W, n), codes, states, V_out, Omega_out,
+    direct_rebound_parallel_rng(params, V, _rows(nrm, n), _rows(a, n), _rows(W, n), codes, states, V_out, Omega_out,
                                 status)
     return V_out, Omega_out, status

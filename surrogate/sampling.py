@@ -16,7 +16,7 @@ NumPy's and scikit-learn's APIs) and ``clamp``: where the table answers every dr
 is an error by default; with ``clamp=True`` the dimensionless law at the nearest grid
 edge is used (and scaled by the particle's actual speed). ``sample_global``'s default
 ``method="auto"`` sends such states, and spinning particles (``omega``), to the direct model instead
-(:mod:`surrogate.kernels.spin`).
+(:mod:`surrogate.kernels.wall_hit`).
 Between grid points the law of a neighbouring grid point is drawn with its
 interpolation weight and, by default (``interpolation="scaled"``), moved to the
 incident state: in α1 to the interpolated means and standard deviations, in
@@ -42,7 +42,7 @@ from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTS
 from surrogate.kernels.frame import NORMAL_TOLERANCE
 from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
-from surrogate.kernels.spin import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, rebound_spin_parallel_rng
+from surrogate.kernels.wall_hit import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, rebound_parallel_rng
 from surrogate.table import SurrogateTable
 
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
@@ -372,7 +372,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     omega : None (default: no spin) or (N, 3) or (3,) incident angular velocities Ω⁻, rad/s, in the frame of
         ``velocity``.
     method : ``"auto"`` (default): the table iff |Ω⁻|a/|V⁻| ≤ :data:`surrogate.SPIN_TOLERANCE` and α1, |V⁻|
-        lie in the table's grid ranges (inclusive), the direct model (:func:`surrogate.rebound_direct`'s,
+        lie in the table's grid ranges (inclusive), the direct model (:func:`surrogate.sample_direct`'s,
         microseconds per hit) for every other hit; ``"table"``: the table for every hit, Ω⁻ ignored (the
         behaviour before spin was taken into account; ``clamp`` applies); ``"direct"``: the direct model
         for every hit. With Ω⁻ zero and every state in the grid, ``"auto"`` gives ``"table"``'s bits.
@@ -411,7 +411,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
     params = np.zeros(0) if table.direct_parameters is None else table.direct_parameters
     states = chunk_states(check_random_state(random_state), n_particles)
-    rebound_spin_parallel_rng(table.kernel_data, params, table.model_shapes, cdf, V, W, _rows(nrm, n_particles),
+    rebound_parallel_rng(table.kernel_data, params, table.model_shapes, cdf, V, W, _rows(nrm, n_particles),
                               _rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
     if old_table:
         _check_direct_parameters(table, path, V, W, a)

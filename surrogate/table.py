@@ -42,7 +42,7 @@ class SurrogateTable:
     @functools.cached_property
     def model_shapes(self) -> np.ndarray:
         """The direct model's shape code (:data:`direct_model.shapes.SHAPES`) of each of the table's shapes, in
-        the table's order: read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound_spin_tuple` takes it."""
+        the table's order: read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound` takes it."""
         return frozen(np.array([SHAPES.index(name) for name in self.shapes], dtype=np.int64))
 
     @property

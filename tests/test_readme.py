@@ -42,18 +42,18 @@ def test_runtime_sampler_examples_run_and_draw_one_law(small_table_path):
         ok = direct["status"] == 0
         assert ok.mean() > 0.9 and np.all(direct["V_out"][ok] @ namespace["normals"] > 0.0)
     np.testing.assert_array_equal(namespace["path"], np.resize([1, 0], 1000))
-    drawn["rebound_many_rng"] = _run(numba_api, namespace, small_table_path)
+    drawn["table_rebound_many_rng"] = _run(numba_api, namespace, small_table_path)
     V, n = namespace["V"], namespace["normals"]
     per_particle = {k: np.empty_like(namespace[k]) for k in ("V_out", "Omega_out", "status")}
     namespace["bounce_hits"](namespace["data"], namespace["cdf"], V, namespace["n"], namespace["a"],
                              namespace["surrogate"].seed_state(2), *per_particle.values())
-    drawn["rebound_tuple loop"] = per_particle
+    drawn["table_rebound loop"] = per_particle
     rebounds = {name: _check_rebounds(result, V, n) for name, result in drawn.items()}
     # The three are independent samples of one law at one incident state: the difference of two
     # sample means has SE sqrt(s1²/n1 + s2²/n2); 5 SE over 3 components and 2 pairs leaves a false
     # alarm rate below 1e-5, while a wrong frame or sign moves a mean by tens of SE (n ≈ 1000).
     reference = rebounds["sample_global"]
-    for name in ("rebound_many_rng", "rebound_tuple loop"):
+    for name in ("table_rebound_many_rng", "table_rebound loop"):
         other = rebounds[name]
         se = np.sqrt(reference.var(axis=0) / len(reference) + other.var(axis=0) / len(other))
         assert np.all(np.abs(reference.mean(axis=0) - other.mean(axis=0)) < 5 * se), name

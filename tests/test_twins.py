@@ -13,10 +13,12 @@ C_SOURCES = sorted(p for p in (ROOT / "native").rglob("*")
                    if p.suffix in (".c", ".h", ".cpp", ".f90") or p.name == "CMakeLists.txt")
 CITING = C_SOURCES + [NATIVE_DOC]
 
-DOTTED = re.compile(r"\b(?:surrogate|data_schema|tablegen)(?:\.[A-Za-z_]\w*)+")
-PATH = re.compile(r"\b(?:surrogate|data_schema|tablegen|benchmarks|tests)/[\w/]+\.py\b")
-# "(surrogate.kernels.draw: _chain, _folded)": names listed after a module
-LISTED = re.compile(r"\b((?:surrogate|data_schema)(?:\.\w+)+): ([\w, ]+)\)")
+# every package of the project that C may cite
+PACKAGES = "surrogate|direct_model|data_schema|tablegen"
+DOTTED = re.compile(rf"\b(?:{PACKAGES})(?:\.[A-Za-z_]\w*)+")
+PATH = re.compile(rf"\b(?:{PACKAGES}|benchmarks|tests)/[\w/]+\.py\b")
+# "(surrogate.kernels.draw: _chain, _folded)": names listed after a module (not prose after a colon)
+LISTED = re.compile(rf"\b((?:{PACKAGES})(?:\.\w+)+): (\w+(?:, \w+)*)\)")
 
 
 def _text(path: Path) -> str:
@@ -57,6 +59,7 @@ CITATIONS = sorted(set(_citations()))
 def test_the_sources_cite_python():
     assert len(CITATIONS) > 50
     assert any(name == "surrogate.kernels.arithmetic._chain" for _, name in CITATIONS)     # a listed name
+    assert any(name.startswith("direct_model.") for _, name in CITATIONS)
 
 
 @pytest.mark.parametrize("where, name", CITATIONS, ids=[f"{w}:{n}" for w, n in CITATIONS])

@@ -19,7 +19,7 @@ then:
    compares each path's answers with Python at the same incident states:
    the table's with `surrogate.sample_global` (same table, shape mix and
    interpolation as the run, method "table"), the direct model's with
-   `surrogate.rebound_direct` (Ω⁻ included). The two samples of reflected
+   `surrogate.sample_direct` (Ω⁻ included). The two samples of reflected
    states are compared in the impact frame, (α2, β2, s = |V⁺|/|V⁻|,
    Ω⁺a/|V⁻| along ex, n, ez): the two-sample KS statistic per variable, a
    classifier two-sample test on the incident and reflected states
@@ -60,7 +60,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from rbs_api import (STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED,  # noqa: E402
-                     load, rebound_direct, sample_global)
+                     load, sample_direct, sample_global)
 
 KS_C_999 = 1.949          # two-sample KS: c(α) for α = 0.001
 CLASSIFIER_SE = 4.0       # classifier threshold: 0.5 + this many standard errors
@@ -326,7 +326,7 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
     """The comparisons 2 and 3 of the module docstring (``classifier=False``: KS and trapped fractions only).
 
     Hits the table answered are compared with ``sample_global`` at their incident states, hits the direct
-    model answered with ``rebound_direct`` at theirs (Ω⁻ included); the spinning ones among the latter also
+    model answered with ``sample_direct`` at theirs (Ω⁻ included); the spinning ones among the latter also
     with the table-only rebound the adapter drew before it passed Ω⁻ (``sample_global``, clamped at the
     grid's edge): how far off that was."""
     hits, headers = read_hits(case)
@@ -379,13 +379,13 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
     s["ks_in_speed_range_threshold"] = ks_threshold(int(in_range.sum()), int(in_py.sum()))
     res["solver_vs_sampler"] = s
 
-    # hits the direct model answered, against surrogate.rebound_direct at the same incident states (Ω⁻ too)
+    # hits the direct model answered, against surrogate.sample_direct at the same incident states (Ω⁻ too)
     direct = valid & (path == PATH_DIRECT)
     res["direct_hits"] = int(direct.sum())
     if direct.sum() > 0:
         Vd, nd, ad, Wd = hits["V"][direct], hits["n"][direct], hits["a"][direct], hits["Win"][direct]
         st_d = status[direct]
-        Vr, Wr, st_r = rebound_direct(table, Vd, nd, ad, omega=Wd,
+        Vr, Wr, st_r = sample_direct(table, Vd, nd, ad, omega=Wd,
                                       shape=_shapes_of(table, settings["shape"], len(Vd), seed), random_state=seed)
         res["direct_trapped_fraction"] = _trapped_fraction(st_d, st_r)
         ok_d, ok_r = st_d == STATUS_REBOUNDED, st_r == STATUS_REBOUNDED
@@ -498,7 +498,7 @@ def plot(res: dict, png: Path) -> None:
         a1_s, X_s, a1_r, X_r, a1_t, X_t = res["_plot_spin"]
         d, far = res["solver_vs_direct_model"], res["spinning_direct_vs_table_only"]
         curves = ((X_s, a1_s, "tab:blue", "OpenFOAM + stochasticRebound (direct model)"),
-                  (X_r, a1_r, "tab:green", "surrogate.rebound_direct, same incident states"),
+                  (X_r, a1_r, "tab:green", "surrogate.sample_direct, same incident states"),
                   (X_t, a1_t, "tab:red", "table only (Ω⁻ ignored), same incident states"))
         for X, a1, color, label in curves:
             _density(axes[1, 0], np.degrees(X[:, 0]) - a1, np.linspace(-60, 120, 73), color, label)
@@ -509,7 +509,7 @@ def plot(res: dict, png: Path) -> None:
             ax.set_ylabel("density")
             ax.legend(fontsize=7)
         axes[1, 0].set_title(f"spinning hits (|Ω⁻|a/|V⁻| > {res['paths']['spin_tolerance']:g}): {len(a1_s)} rebounds")
-        axes[1, 1].set_title(f"direct hits vs rebound_direct: classifier {d['classifier_accuracy']:.3f} "
+        axes[1, 1].set_title(f"direct hits vs sample_direct: classifier {d['classifier_accuracy']:.3f} "
                              f"(≤ {d['classifier_threshold']:.3f})", fontsize=9)
         axes[1, 2].set_title(f"spinning hits vs table only: classifier {far['classifier_accuracy']:.3f}", fontsize=9)
     fig.suptitle(title, fontsize=10)
@@ -555,9 +555,9 @@ def report(res: dict) -> str:
     lines.append(f"  trapped fraction: solver {t['solver']:.4f}, sampler {t['sampler']:.4f} "
                  f"(SE {t['se']:.4f}: {'met' if t['ok'] else 'NOT met'})")
     if "solver_vs_direct_model" in res:
-        lines.append(_agreement_line("direct-model hits: solver vs rebound_direct", res["solver_vs_direct_model"]))
+        lines.append(_agreement_line("direct-model hits: solver vs sample_direct", res["solver_vs_direct_model"]))
         t = res["direct_trapped_fraction"]
-        lines.append(f"  trapped or failed fraction: solver {t['solver']:.4f}, rebound_direct {t['sampler']:.4f} "
+        lines.append(f"  trapped or failed fraction: solver {t['solver']:.4f}, sample_direct {t['sampler']:.4f} "
                      f"(SE {t['se']:.4f}: {'met' if t['ok'] else 'NOT met'})")
         far = res["spinning_direct_vs_table_only"]
         lines.append(_agreement_line("spinning hits: solver (direct model) vs the table alone", far, False)

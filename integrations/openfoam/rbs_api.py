@@ -3,18 +3,18 @@
 Every import of the project's packages by integrations/openfoam and
 tests/openfoam goes through this module, so a refactoring of the packages
 re-points these few lines only. Public API only: ``surrogate.load``,
-``surrogate.sample_global``, ``surrogate.rebound_direct``, ``surrogate.STATUS_*`` and, to build a table,
+``surrogate.sample_global``, ``surrogate.sample_direct``, ``surrogate.STATUS_*`` and, to build a table,
 ``tablegen.build_table(tablegen.parse_config(text), path)``.
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 (see LICENSE in this folder).
 """
 
-from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, rebound_direct, \
+from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, sample_direct, \
     sample_global
 
 __all__ = ["STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "build_table_from_text", "load",
-           "rebound_direct", "sample_global"]
+           "sample_direct", "sample_global"]
 
 
 def build_table_from_text(config_text: str, path, **kwargs):

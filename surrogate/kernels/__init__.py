@@ -4,29 +4,31 @@ Plain functions over the arrays of a table (``table.kernel_data``) and
 uniforms: :data:`U_PER_DRAW` per draw, given or drawn from a caller-owned
 xoshiro256+ state. Where each part lives:
 
-==============  ==============================================================
-``layout``      the table as the kernels take it (:class:`KernelData`), its record layouts
-``draw``        the law of one draw in the local frame, its three stages composed: :func:`draw_velocity`
-``locate``      stage 1: where a draw reads (:func:`locate`: the cell; the component; cache hints)
-``gather``      stage 2: the table values a draw needs (:func:`gather`)
-``arithmetic``  stage 3: the reflected state from those values (:func:`arithmetic`)
-``frame``       the impact frame of a hit and the way back to the global frame
-``particle``    one particle: :func:`rebound_tuple`, :func:`rebound` (global frame), :func:`draw_local`
-``direct``      the direct model instead of the table: :func:`rebound_direct_tuple` (one particle),
-                :func:`rebound_direct_parallel_rng` (many, all threads)
-``spin``        every hit answered, spinning or not: :func:`rebound_path` (which path answers a hit: the table
-                where it is valid, the direct model elsewhere), :func:`rebound_spin_tuple` (one particle),
-                :func:`rebound_spin_parallel_rng` (many, all threads); METHOD_*, PATH_*, SPIN_TOLERANCE
-``block``       the block form of the stages' records, field-major over BLOCK particles
-``pipeline``    many particles on one thread, the stages' block forms scheduled: :func:`rebound_many`,
-                :func:`rebound_many_rng`
-``parallel``    many particles on all threads, by chunks: :func:`rebound_parallel`, :func:`draw_local_parallel`
-``rng``         xoshiro256+ streams: :func:`seed_state`, :func:`fill_uniforms`, the SIMD lanes
-``fastmath``    fused multiply-add, trigonometry, the restitution factor: no libm call on the hot path
-``memory``      loads and cache hints
-``checks``      input checks: the NumPy API's in one parallel pass, the array shapes of the many-particle kernels
-``options``     the numba options every kernel is compiled with
-==============  ==============================================================
+===============  ==============================================================
+``layout``       the table as the kernels take it (:class:`KernelData`), its record layouts
+``draw``         the law of one draw in the local frame, its three stages composed: :func:`draw_velocity`
+``locate``       stage 1: where a draw reads (:func:`locate`: the cell; the component; cache hints)
+``gather``       stage 2: the table values a draw needs (:func:`gather`)
+``arithmetic``   stage 3: the reflected state from those values (:func:`arithmetic`)
+``frame``        the impact frame of a hit and the way back to the global frame
+``table_path``   the table path, one particle: :func:`table_rebound` (global frame), :func:`draw_local` (local frame)
+``direct_path``  the direct path, the direct model instead of the table: :func:`direct_rebound` (one particle),
+                 :func:`direct_rebound_parallel_rng` (many, all threads)
+``wall_hit``     every hit answered, spinning or not (the call a solver reaches first): :func:`rebound` (one
+                 particle), :func:`rebound_parallel_rng` (many, all threads), :func:`rebound_path` (which path
+                 answers a hit: the table where it is valid, the direct model elsewhere); METHOD_*, PATH_*,
+                 SPIN_TOLERANCE
+``block``        the block form of the stages' records, field-major over BLOCK particles
+``pipeline``     many particles on one thread, the stages' block forms scheduled: :func:`table_rebound_many`,
+                 :func:`table_rebound_many_rng`
+``parallel``     many particles on all threads, by chunks: :func:`table_rebound_parallel`,
+                 :func:`draw_local_parallel`
+``rng``          xoshiro256+ streams: :func:`seed_state`, :func:`fill_uniforms`, the SIMD lanes
+``fastmath``     fused multiply-add, trigonometry, the restitution factor: no libm call on the hot path
+``memory``       loads and cache hints
+``checks``       input checks: the NumPy API's in one parallel pass, the array shapes of the many-particle kernels
+``options``      the numba options every kernel is compiled with
+===============  ==============================================================
 
 Global-frame kernels take V⁻ in m/s and return V⁺ in m/s and Ω⁺ in rad/s;
 local-frame ones use the model's lab frame (wall y = 0, normal +Y, impact
@@ -39,23 +41,24 @@ from data_schema.samples import STATUS_INVALID
 from direct_model.runtime import U_PER_REBOUND
 from surrogate.kernels.arithmetic import arithmetic
 from surrogate.kernels.block import BLOCK
-from surrogate.kernels.direct import rebound_direct_parallel_rng, rebound_direct_tuple
+from surrogate.kernels.direct_path import direct_rebound, direct_rebound_parallel_rng
 from surrogate.kernels.draw import U_PER_DRAW, draw_velocity
 from surrogate.kernels.frame import impact_frame
 from surrogate.kernels.gather import gather
 from surrogate.kernels.layout import KernelData
 from surrogate.kernels.locate import grid_interval, locate
-from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel_rng, rebound_parallel,
-                                        rebound_parallel_rng)
-from surrogate.kernels.particle import draw_local, rebound, rebound_tuple
-from surrogate.kernels.pipeline import rebound_many, rebound_many_rng, rebound_uniforms
+from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel_rng, table_rebound_parallel,
+                                        table_rebound_parallel_rng)
+from surrogate.kernels.pipeline import table_rebound_many, table_rebound_many_rng, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
-from surrogate.kernels.spin import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE, SPIN_TOLERANCE,
-                                    rebound_path, rebound_spin_parallel_rng, rebound_spin_tuple)
+from surrogate.kernels.table_path import draw_local, table_rebound
+from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
+                                        SPIN_TOLERANCE, rebound, rebound_parallel_rng, rebound_path)
 
 __all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT",
-           "PATH_TABLE", "SPIN_TOLERANCE", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND", "arithmetic", "chunk_states", "draw_local", "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity",
-           "fill_uniforms", "gather", "grid_interval", "impact_frame", "locate", "next_uniform", "rebound",
-           "rebound_direct_parallel_rng", "rebound_direct_tuple", "rebound_many", "rebound_many_rng",
-           "rebound_parallel", "rebound_parallel_rng", "rebound_path", "rebound_spin_parallel_rng",
-           "rebound_spin_tuple", "rebound_tuple", "rebound_uniforms", "seed_state"]
+           "PATH_TABLE", "SPIN_TOLERANCE", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND", "arithmetic",
+           "chunk_states", "direct_rebound", "direct_rebound_parallel_rng", "draw_local", "draw_local_parallel",
+           "draw_local_parallel_rng", "draw_velocity", "fill_uniforms", "gather", "grid_interval", "impact_frame",
+           "locate", "next_uniform", "rebound", "rebound_parallel_rng", "rebound_path", "seed_state",
+           "table_rebound", "table_rebound_many", "table_rebound_many_rng", "table_rebound_parallel",
+           "table_rebound_parallel_rng", "table_rebound_uniforms"]

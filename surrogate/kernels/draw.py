@@ -10,7 +10,7 @@
 3. arithmetic (:mod:`surrogate.kernels.arithmetic`) — the reflected state from
    those values alone, with every choice a select.
 
-One particle (:mod:`surrogate.kernels.particle`) calls them in turn; the
+One particle (:mod:`surrogate.kernels.table_path`) calls them in turn; the
 pipeline (:mod:`surrogate.kernels.pipeline`) calls each stage's block form on
 a block of particles, so the two give the same bits by construction.
 

@@ -168,7 +168,7 @@ def frame_block(V, n, a, ub, given, start, m, fr):
         Vi, ni = (V[3 * i], V[3 * i + 1], V[3 * i + 2]), (n[3 * i], n[3 * i + 1], n[3 * i + 2])
         alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(Vi, ni, ub[12 * BLOCK + b])
         put3(fr, FRAME_VALID, b, (1.0 if moves_into_wall(Vi, ni) else 0.0, alpha1, speed))
-        # uniforms drawn from the lanes are in [0, 1): checked only when ``given`` (rebound_many), as pipeline.c
+        # uniforms drawn from the lanes are in [0, 1): checked only when ``given`` (table_rebound_many), as pipeline.c
         fr[FRAME_OK * BLOCK + b] = 1.0 if particle_ok(ni, a[i]) & (not given or uniforms_ok(uniforms(ub, b))) else 0.0
         put3(fr, FRAME_COS, b, (cos_a1, sin_a1, a[i]))
         put3(fr, FRAME_EX, b, ex)

@@ -11,16 +11,16 @@ parallel loop (:mod:`surrogate.kernels.checks`).
 import numba
 
 from surrogate.kernels.options import JIT
-from surrogate.kernels.particle import draw_local
+from surrogate.kernels.table_path import draw_local
 from surrogate.kernels.checks import check_local_rows, check_rows, check_states, check_uniforms
-from surrogate.kernels.pipeline import no_state, no_uniforms, rebound_uniforms, run_blocks
+from surrogate.kernels.pipeline import no_state, no_uniforms, table_rebound_uniforms, run_blocks
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_parallel(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled=True):
-    """:func:`surrogate.kernels.particle.rebound` for every row (parallel over chunks of
-    :func:`surrogate.kernels.pipeline.rebound_many`); u has shape (N, U_PER_DRAW)."""
+def table_rebound_parallel(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled=True):
+    """:func:`surrogate.kernels.table_path.table_rebound` for every row (parallel over chunks of
+    :func:`surrogate.kernels.pipeline.table_rebound_many`); u has shape (N, U_PER_DRAW)."""
     check_rows(V, n, a, V_out, Omega_out, status)
     check_uniforms(u, V.shape[0], "V")
     for j in numba.prange(n_chunks(V.shape[0])):
@@ -29,10 +29,10 @@ def rebound_parallel(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_parallel_rng(data, mix_cdf, V, n, a, states, V_out, Omega_out, status, scaled=True):
-    """:func:`rebound_parallel` drawing its own uniforms: the rows of chunk j (CHUNK_ROWS rows) from a
+def table_rebound_parallel_rng(data, mix_cdf, V, n, a, states, V_out, Omega_out, status, scaled=True):
+    """:func:`table_rebound_parallel` drawing its own uniforms: the rows of chunk j (CHUNK_ROWS rows) from a
     copy of the xoshiro256+ state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`; ``states`` itself is
-    not advanced), as :func:`surrogate.kernels.pipeline.rebound_many_rng` draws them (:func:`rebound_uniforms`).
+    not advanced), as :func:`surrogate.kernels.pipeline.table_rebound_many_rng` draws them (:func:`table_rebound_uniforms`).
     The draws are the same whatever the number of threads, and no (N, U_PER_DRAW) array of uniforms is
     held. ``states`` must have one row per chunk (ValueError)."""
     check_rows(V, n, a, V_out, Omega_out, status)
@@ -50,8 +50,8 @@ def _chunk(j, n_rows):
 
 @numba.njit(inline="always", **JIT)
 def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled, lo, hi):
-    """:func:`surrogate.kernels.pipeline.rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows,
-    or :func:`surrogate.kernels.pipeline.rebound_many_rng` with ``state``."""
+    """:func:`surrogate.kernels.pipeline.table_rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows,
+    or :func:`surrogate.kernels.pipeline.table_rebound_many_rng` with ``state``."""
     run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], Omega_out[lo:hi], status[lo:hi],
                 scaled)
 
@@ -69,13 +69,13 @@ def draw_local_parallel(data, mix_cdf, alpha1, speed, u, out, status, scaled=Tru
 
 @numba.njit(parallel=True, **JIT)
 def draw_local_parallel_rng(data, mix_cdf, alpha1, speed, states, out, status, scaled=True):
-    """:func:`draw_local_parallel` drawing its own uniforms, chunk by chunk as :func:`rebound_parallel_rng`
-    (chunk j's are ``rebound_uniforms(states[j].copy(), rows)``)."""
+    """:func:`draw_local_parallel` drawing its own uniforms, chunk by chunk as :func:`table_rebound_parallel_rng`
+    (chunk j's are ``table_rebound_uniforms(states[j].copy(), rows)``)."""
     check_local_rows(alpha1, speed, out, status)
     check_states(states, alpha1.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, alpha1.shape[0])
-        _draw_local_chunk(data, mix_cdf, alpha1, speed, rebound_uniforms(states[j].copy(), hi - lo), out, status,
+        _draw_local_chunk(data, mix_cdf, alpha1, speed, table_rebound_uniforms(states[j].copy(), hi - lo), out, status,
                           scaled, lo, hi)
 
 

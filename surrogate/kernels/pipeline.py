@@ -1,8 +1,8 @@
-"""Many particles on one thread: the draws of :func:`surrogate.kernels.particle.rebound` as a pipeline of blocks.
+"""Many particles on one thread: the draws of :func:`surrogate.kernels.table_path.table_rebound` as a pipeline of blocks.
 
 A per-particle draw is a chain of dependent steps (frame, cell, table reads,
-arithmetic), and a table read waits for memory. :func:`rebound_many` and
-:func:`rebound_many_rng` take BLOCK particles at a time
+arithmetic), and a table read waits for memory. :func:`table_rebound_many` and
+:func:`table_rebound_many_rng` take BLOCK particles at a time
 (:mod:`surrogate.kernels.block`) through the stages of a draw, each stage's
 block form a step of the pipeline, so that one block's table reads are in
 flight while the blocks before it are computed. This module only schedules:
@@ -31,11 +31,11 @@ STAGES = 3      # blocks in the pipeline: located, resolved, drawn
 
 
 @numba.njit(**JIT)
-def rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled=True):
-    """:func:`surrogate.kernels.particle.rebound` for every row, one thread, by blocks of BLOCK particles.
+def table_rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled=True):
+    """:func:`surrogate.kernels.table_path.table_rebound` for every row, one thread, by blocks of BLOCK particles.
 
-    Same arguments as :func:`surrogate.kernels.parallel.rebound_parallel` and the same results, bit for
-    bit, as calling :func:`surrogate.kernels.particle.rebound` row by row. Every array must have one row per
+    Same arguments as :func:`surrogate.kernels.parallel.table_rebound_parallel` and the same results, bit for
+    bit, as calling :func:`surrogate.kernels.table_path.table_rebound` row by row. Every array must have one row per
     particle (ValueError naming the first that has not); V, n and a are
     copied if they are not C-contiguous. Each stage is a loop over the
     block whose iterations do not depend on each other (so the processor
@@ -44,7 +44,7 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled=Tru
     block's worth of work to arrive in.
 
     For a flow solver that collects its wall hits: call this from its
-    ``@njit`` code on the hit arrays (or :func:`rebound_many_rng`, which
+    ``@njit`` code on the hit arrays (or :func:`table_rebound_many_rng`, which
     draws the uniforms itself).
     """
     check_rows(V, n, a, V_out, Omega_out, status)
@@ -53,15 +53,15 @@ def rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scaled=Tru
 
 
 @numba.njit(**JIT)
-def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, status, scaled=True):
-    """:func:`rebound_many` drawing the uniforms from the xoshiro256+ ``state`` ((4,) uint64,
+def table_rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, status, scaled=True):
+    """:func:`table_rebound_many` drawing the uniforms from the xoshiro256+ ``state`` ((4,) uint64,
     :func:`surrogate.kernels.rng.seed_state`), which it advances by one step.
 
     The uniforms come from BLOCK xoshiro256+ lanes seeded from ``state``
     (:func:`surrogate.kernels.rng.seed_lanes`): row b of every block of BLOCK rows
     from lane b (:func:`surrogate.kernels.rng.fill_lanes`, SIMD across the lanes).
-    The results are the same, bit for bit, as ``rebound_many`` on the array
-    :func:`rebound_uniforms` returns for the same state, without holding it
+    The results are the same, bit for bit, as ``table_rebound_many`` on the array
+    :func:`table_rebound_uniforms` returns for the same state, without holding it
     (a block's uniforms are drawn when it enters the pipeline). Seeding the
     lanes costs about 0.1 µs per call, so call it on many rows at once.
     """
@@ -71,9 +71,9 @@ def rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, status, sc
 
 
 @numba.njit(**JIT)
-def rebound_uniforms(state, n_rows):
-    """The (n_rows, U_PER_DRAW) uniforms :func:`rebound_many_rng` draws from ``state`` for n_rows rows,
-    advancing ``state`` as it does (for tests, and to replay a draw through :func:`rebound_many`)."""
+def table_rebound_uniforms(state, n_rows):
+    """The (n_rows, U_PER_DRAW) uniforms :func:`table_rebound_many_rng` draws from ``state`` for n_rows rows,
+    advancing ``state`` as it does (for tests, and to replay a draw through :func:`table_rebound_many`)."""
     lanes, u = _lanes(), np.empty((n_rows, U_PER_DRAW))
     seed_lanes(state, lanes)
     ub = np.empty(BLOCK * U_PER_DRAW)
@@ -87,13 +87,13 @@ def rebound_uniforms(state, n_rows):
 
 @numba.njit(inline="always", **JIT)
 def _lanes():
-    """The BLOCK xoshiro256+ lanes of :func:`rebound_many_rng` (:func:`surrogate.kernels.rng.seed_lanes` layout)."""
+    """The BLOCK xoshiro256+ lanes of :func:`table_rebound_many_rng` (:func:`surrogate.kernels.rng.seed_lanes` layout)."""
     return np.zeros(4 * BLOCK, dtype=np.uint64)
 
 
 @numba.njit(inline="always", **JIT)
 def run_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled):
-    """The pipeline (:func:`rebound_many` with ``u``, :func:`rebound_many_rng` with ``state``; the other
+    """The pipeline (:func:`table_rebound_many` with ``u``, :func:`table_rebound_many_rng` with ``state``; the other
     argument empty: :func:`no_state`, :func:`no_uniforms`) with its scratch, V, n, a made C-contiguous
     (copied if they are not)."""
     _rebound_blocks(data, mix_cdf, np.ascontiguousarray(V), np.ascontiguousarray(n), np.ascontiguousarray(a), u,
@@ -125,7 +125,7 @@ def _block_scratch():
 @numba.njit(**KERNEL)
 def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled, us, fr, index, weights, g, out,
                     lanes):
-    """:func:`rebound_many` (uniforms ``u``) or :func:`rebound_many_rng` (uniforms drawn from ``state``)
+    """:func:`table_rebound_many` (uniforms ``u``) or :func:`table_rebound_many_rng` (uniforms drawn from ``state``)
     with its scratch arrays (:func:`_block_scratch`): a pipeline of STAGES blocks, so that a block's table
     reads have a whole step to arrive before they are used."""
     if state.shape[0] == 4:
@@ -151,7 +151,7 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, 
 @numba.njit(inline="always", **JIT)
 def _block_uniforms(u, state, lanes, start, m, ub):
     """The uniforms of the m rows from ``start`` into ``ub``, uniform k of row start + b at k · BLOCK + b:
-    drawn from the ``lanes`` when ``state`` is a state (rebound_many_rng), else copied from ``u``."""
+    drawn from the ``lanes`` when ``state`` is a state (table_rebound_many_rng), else copied from ``u``."""
     if state.shape[0] == 4:
         fill_lanes(lanes, ub, BLOCK, U_PER_DRAW)
     else:

@@ -8,7 +8,7 @@ owns: one state per thread (or per particle stream) keeps a parallel solver
 reproducible whatever the scheduling.
 
 Words: a *stream* is one xoshiro256+ state and the uniforms it gives; the
-pipeline (:func:`surrogate.kernels.pipeline.rebound_many_rng`) draws from
+pipeline (:func:`surrogate.kernels.pipeline.table_rebound_many_rng`) draws from
 BLOCK *lanes*, streams seeded from the caller's state with splitmix64
 (:func:`seed_lanes`) and stepped together as SIMD instructions
 (:func:`fill_lanes`), since one stream's steps depend on each other; the
@@ -21,7 +21,7 @@ Usage from a solver's ``@njit`` loop::
     state = surrogate.seed_state(1234)               # NumPy side, (4,) uint64
     ...
     fill_uniforms(state, u)                          # inside numba: u[:] = next uniforms
-    status = rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out)
+    status, V_out, Omega_out = table_rebound(data, mix_cdf, V, n, a, u)
 
 :func:`seed_state` with ``n_streams`` gives independent states (rows) from
 one seed, through NumPy's ``SeedSequence``.

@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 from scipy.special import ndtri
 
-from direct_model.rebound import quaternion_to_matrix
+from direct_model.body_rebound import quaternion_to_matrix
 from direct_model.runtime import (N_PARAMS, P_CDF_HIGH, P_CDF_LOW, P_KFAC, aspect_ratio, model_parameters,
                                   normal_quantile, uniform_quaternion)
 from direct_model.shapes import AspectRatioLaw, second_moment_factors

@@ -4,7 +4,7 @@ CPU dispatch: load a table, derive its kernel arrays and draw, and save everythi
     python -m tests.helpers.dispatch_child TABLE.h5 INPUT.npz OUTPUT.npz      (from the repository's root)
 
 INPUT holds V, n, a (incident states) and u (uniforms); OUTPUT the derived arrays (``array_<name>``),
-the mix CDFs, rebound_many's draws for both interpolations, sample_global's and sample_local's draws for
+the mix CDFs, table_rebound_many's draws for both interpolations, sample_global's and sample_local's draws for
 a fixed seed (the latter also as the velocities `surrogate sample` writes).
 """
 
@@ -30,7 +30,7 @@ def main(table_path: str, input_path: str, output_path: str) -> None:
     out["cdf_mix"], out["cdf_weighted"] = py.mix_cdf(table, "mix"), py.mix_cdf(table, WEIGHTS)
     for label, scaled in (("scaled", True), ("stochastic", False)):
         V_out, W_out, status = np.empty_like(V), np.empty_like(V), np.empty(len(V), dtype=np.int8)
-        py.rebound_many(data, out["cdf_weighted"], V, n, a, u, V_out, W_out, status, scaled)
+        py.table_rebound_many(data, out["cdf_weighted"], V, n, a, u, V_out, W_out, status, scaled)
         out[f"many_{label}"] = np.column_stack([V_out, W_out, status])
     # the rows sample_global takes: valid, not the tiny (~1e-13 m/s) or huge speeds it refuses (thresholds far from
     # every speed drawn, so that no process's rounding moves a row across it)

@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from direct_model.rebound import HISTORY_COLUMNS, WORK_SIZE, rebound
+from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, body_rebound
 from direct_model.shapes import second_moment_factor, shape_code
 from direct_model.simulate import incident_velocity
 from direct_model.wall import CORUNDUM_ON_STEEL
@@ -16,7 +16,7 @@ def run_one(shape, semi, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0),
     """Rebound of one particle; returns (V⁺ m/s, Ω⁺ (m/s)/a, status, n_coll, e_rot, history)."""
     V, W = np.empty(3), np.empty(3)
     history = np.full((history_rows, HISTORY_COLUMNS), np.nan)
-    status, _, ncoll, _, _, erot = rebound(
+    status, _, ncoll, _, _, erot = body_rebound(
         shape_code(shape), np.asarray(semi, dtype=float), kappa, float(hand),
         second_moment_factor(shape, kappa), np.ascontiguousarray(R0), incident_velocity(alpha1, speed),
         np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(), n_max,

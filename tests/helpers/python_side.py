@@ -4,11 +4,11 @@ When the packages move (surrogate's kernels into ``surrogate.kernels``, tablegen
 only this module is re-pointed. The tests use the public API: ``surrogate.load`` and
 ``table.kernel_data``, ``surrogate.mix_cdf``, ``surrogate.seed_state``, ``surrogate.fill_uniforms``,
 ``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
-``rebound_tuple``, ``rebound``, ``rebound_many``, ``rebound_many_rng``, ``rebound_uniforms``,
+``table_rebound``, ``table_rebound_many``, ``table_rebound_many_rng``, ``table_rebound_uniforms``,
 ``draw_local``; the direct model's free flight from ``direct_model.rotation``, its run-time kernel
-``rebound_direct_tuple`` and the kernels it calls (``direct_model``: collide, body_vertices,
+``direct_rebound`` and the kernels it calls (``direct_model``: collide, body_vertices,
 bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix); those of every
-hit (``surrogate.kernels.spin``: ``rebound_spin_tuple``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
+hit (``surrogate.kernels.wall_hit``: ``rebound``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
 and PATH_* codes); the law comparisons of tests/helpers/direct_law.py (its states, ``tablegen simulate`` and the
 statistics); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks and the samples' angle conversion from ``data_schema``.
@@ -19,14 +19,14 @@ from data_schema.samples import STATUS_FAILED, angles_to_velocity
 from direct_model.rotation import ROT_PARAMS_SIZE, carlson_rf, carlson_rj, rotation_at, rotation_init
 from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, load, mix_cdf, \
     seed_state
-from surrogate.kernels import draw_local, rebound, rebound_many, rebound_many_rng, rebound_tuple, rebound_uniforms
-from surrogate.kernels.direct import rebound_direct_tuple
+from surrogate.kernels import draw_local, table_rebound, table_rebound_many, table_rebound_many_rng, table_rebound_uniforms
+from surrogate.kernels.direct_path import direct_rebound
 from direct_model.collision import collide
-from direct_model.rebound import quaternion_to_matrix
+from direct_model.body_rebound import quaternion_to_matrix
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, normal_quantile, uniform_quaternion
 from direct_model.shapes import MAX_VERTICES, SHAPES, body_vertices, bounding_radius
-from surrogate.kernels.spin import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE, SPIN_TOLERANCE,
-                                    rebound_path, rebound_spin_tuple)
+from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
+                                        SPIN_TOLERANCE, rebound, rebound_path)
 from tests.helpers.direct_law import (A, N, STATES, assert_one_law, frame_of, incident, one_law, simulated, state_id,
                                       to_model_frame)
 
@@ -55,10 +55,10 @@ def write_samples_file(path) -> None:
 
 __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", "rotation_at", "rotation_init",
            "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
-           "draw_local", "fill_uniforms", "load", "mix_cdf", "rebound", "rebound_many", "rebound_many_rng",
-           "rebound_tuple", "rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
+           "draw_local", "fill_uniforms", "load", "mix_cdf", "table_rebound_many", "table_rebound_many_rng",
+           "table_rebound", "table_rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
            "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",
-           "collide", "normal_quantile", "quaternion_to_matrix", "rebound_direct_tuple", "uniform_quaternion",
+           "collide", "normal_quantile", "quaternion_to_matrix", "direct_rebound", "uniform_quaternion",
            "A", "N", "SHAPES", "STATES", "assert_one_law", "frame_of", "incident", "one_law", "simulated", "state_id",
            "to_model_frame", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE",
-           "SPIN_TOLERANCE", "rebound_path", "rebound_spin_tuple"]
+           "SPIN_TOLERANCE", "rebound_path", "rebound"]

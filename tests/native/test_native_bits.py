@@ -3,7 +3,7 @@
 Over random incident states (random unit normals; α1 and |V⁻| over and beyond the table's grid; exact
 normal impact, grazing, trapped cells, invalid input), every shape alone, the equal mix and a weighted
 mix, both interpolations: V⁺, Ω⁺ and the status of rbs_rebound_many equal those of
-surrogate.kernels.rebound_many; rbs_rebound row by row equals rbs_rebound_many and rebound_tuple; the
+surrogate.kernels.table_rebound_many; rbs_rebound row by row equals rbs_rebound_many and table_rebound; the
 local draw, the derived kernel arrays and the random numbers equal surrogate's. The largest ulp
 difference is printed (run with -s to see it) and must be 0.
 """
@@ -65,7 +65,7 @@ def test_mixes_equal_mix_cdf(table_pair):
 
 @pytest.mark.parametrize("interpolation", sorted(INTERPOLATIONS))
 def test_rebound_many_bit_identical(table_pair, interpolation):
-    """1e5 random incident states per mix (six mixes), against surrogate.kernels.rebound_many."""
+    """1e5 random incident states per mix (six mixes), against surrogate.kernels.table_rebound_many."""
     table, native_table = table_pair
     (a_lo, a_hi), (v_lo, v_hi) = table.alpha1_range, table.speed_range
     worst = {}
@@ -76,7 +76,7 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
         cdf = py.mix_cdf(table, spec)
         V_py, W_py = np.empty((STATES_PER_CASE, 3)), np.empty((STATES_PER_CASE, 3))
         status_py = np.empty(STATES_PER_CASE, dtype=np.int8)
-        py.rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == "scaled")
+        py.table_rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == "scaled")
         status, V_c, W_c = native_table.rebound_many(_native_mix(native_table, spec), V, n, a, u,
                                                      INTERPOLATIONS[interpolation])
         assert np.array_equal(status, status_py), label
@@ -93,8 +93,8 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
     assert all(v == (0.0, 0.0) for v in worst.values()), worst
 
 
-def test_single_calls_equal_many_and_rebound_tuple(table_pair):
-    """rbs_rebound row by row = rbs_rebound_many = surrogate's rebound_tuple, both interpolations."""
+def test_single_calls_equal_many_and_table_rebound(table_pair):
+    """rbs_rebound row by row = rbs_rebound_many = surrogate's table_rebound, both interpolations."""
     table, native_table = table_pair
     rng = np.random.default_rng(7)
     count = 3000
@@ -107,7 +107,7 @@ def test_single_calls_equal_many_and_rebound_tuple(table_pair):
         status, V_many, W_many = native_table.rebound_many(mix, V, n, a, u, interpolation)
         for i in range(count):
             st, v, w = native_table.rebound(mix, V[i], n[i], a[i], u[i], interpolation)
-            st_py, v_py, w_py = py.rebound_tuple(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
+            st_py, v_py, w_py = py.table_rebound(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
                                                  interpolation == SCALED)
             assert st == status[i] == st_py, i
             assert max_ulp(v, V_many[i]) == 0 and max_ulp(w, W_many[i]) == 0, i
@@ -168,22 +168,22 @@ def test_uniforms_equal_fill_uniforms(native):
         assert x == u_py[0]
 
 
-def test_block_uniforms_and_rebound_many_rng(table_pair, native):
-    """rbs_rebound_uniforms = rebound_uniforms and rbs_rebound_many_rng = rebound_many_rng, bit for bit,
+def test_block_uniforms_and_table_rebound_many_rng(table_pair, native):
+    """rbs_rebound_uniforms = table_rebound_uniforms and rbs_rebound_many_rng = table_rebound_many_rng, bit for bit,
     for row counts on and off the 32-row blocks."""
     table, native_table = table_pair
     mix, cdf = native_table.mix_equal(), py.mix_cdf(table, "mix")
     rng = np.random.default_rng(5)
     for count in (0, 1, 31, 32, 33, 1000, 20001):
         state = py.seed_state(count + 9)
-        u_py = py.rebound_uniforms(state.copy(), count)
+        u_py = py.table_rebound_uniforms(state.copy(), count)
         u_c, _ = native.rebound_uniforms(state, count)
         assert np.array_equal(u_c, u_py), count
         V, n, a = incident_states(rng, count)
         for interpolation in (SCALED, STOCHASTIC):
             V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
             py_state = state.copy()
-            py.rebound_many_rng(table.kernel_data, cdf, V, n, a, py_state, V_py, W_py, status_py,
+            py.table_rebound_many_rng(table.kernel_data, cdf, V, n, a, py_state, V_py, W_py, status_py,
                                 interpolation == SCALED)
             status, V_c, W_c, c_state = native_table.rebound_many_rng(mix, V, n, a, state, interpolation)
             assert np.array_equal(status, status_py) and np.array_equal(c_state, py_state), count
@@ -202,7 +202,7 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     cdf = py.mix_cdf(table, "mix")
     for interpolation in (SCALED, STOCHASTIC):
         V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        py.rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == SCALED)
+        py.table_rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == SCALED)
         status, V_c, W_c = baseline.rebound_many(baseline.mix_equal(), V, n, a, u, interpolation)
         assert np.array_equal(status, status_py)
         assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0

@@ -238,7 +238,7 @@ def _particles(rng, count, spin):
 
 @pytest.mark.parametrize("spin", SPINS)
 def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
-    """rbs_rebound_direct against rebound_direct_tuple, PER_SHAPE particles of each shape in random caller frames,
+    """rbs_rebound_direct against direct_rebound, PER_SHAPE particles of each shape in random caller frames,
     the same uniforms: the same status, and for a rebound the same bits of V⁺ and Ω⁺ — multi-collision sequences
     included, so every operation of the port is numba's (a last-bit difference would grow through them)."""
     python, c_table = table_pair
@@ -248,7 +248,7 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
     statuses = {}
     for shape in range(4):
         for V, n, a, omega, u in _particles(rng, PER_SHAPE, spin):
-            status, V_py, W_py = py.rebound_direct_tuple(params, V, n, a, omega, shape, u)
+            status, V_py, W_py = py.direct_rebound(params, shape, V, omega, n, a, u)
             mine = _direct_c(c, c_table.handle, shape, V, omega, n, a, u)
             assert mine[0] == status
             if status == py.STATUS_REBOUNDED:
@@ -267,7 +267,7 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     c, table = _c(native_baseline), native_baseline.table(small_table_path)
     rng = np.random.default_rng(11)
     for k, (V, n, a, omega, u) in enumerate(_particles(rng, 2000, 0.3)):
-        status, V_py, W_py = py.rebound_direct_tuple(python.direct_parameters, V, n, a, omega, k % 4, u)
+        status, V_py, W_py = py.direct_rebound(python.direct_parameters, k % 4, V, omega, n, a, u)
         mine = _direct_c(c, table.handle, k % 4, V, omega, n, a, u)
         assert mine[0] == status and (status != py.STATUS_REBOUNDED or (_same(mine[1], V_py) and _same(mine[2], W_py)))
 
@@ -293,9 +293,9 @@ def test_bad_input_is_invalid_with_nan(native, table_pair, change):
                              args["u"])
     assert status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
     if all(args[k] is not None for k in ("V", "omega", "n", "u")):
-        theirs = py.rebound_direct_tuple(table_pair[0].direct_parameters, np.asarray(args["V"], float),
-                                         np.asarray(args["n"], float), args["a"], np.asarray(args["omega"], float),
-                                         args["shape"], args["u"])
+        theirs = py.direct_rebound(table_pair[0].direct_parameters, args["shape"], np.asarray(args["V"], float),
+                                   np.asarray(args["omega"], float), np.asarray(args["n"], float), args["a"],
+                                   args["u"])
         assert theirs[0] == py.STATUS_INVALID
 
 
@@ -320,6 +320,6 @@ def test_minus_zero_uniform_is_taken_as_numba_takes_it(native, table_pair):
     u = np.full(7, 0.5)
     u[3] = -0.0
     status, V, W = _direct_c(c, table_pair[1].handle, 2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
-    theirs = py.rebound_direct_tuple(table_pair[0].direct_parameters, np.asarray(GOOD["V"]), np.asarray(GOOD["n"]),
-                                     GOOD["a"], np.asarray(GOOD["omega"]), 2, u)
+    theirs = py.direct_rebound(table_pair[0].direct_parameters, 2, np.asarray(GOOD["V"]), np.asarray(GOOD["omega"]),
+                               np.asarray(GOOD["n"]), GOOD["a"], u)
     assert status == theirs[0] == py.STATUS_REBOUNDED and _same(V, theirs[1]) and _same(W, theirs[2])

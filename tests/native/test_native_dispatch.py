@@ -74,7 +74,7 @@ def test_derived_arrays_equal_the_c_library(dispatch_runs, table_pair, case):
 
 @pytest.mark.parametrize("case", CASES)
 def test_draws_equal_the_c_library(dispatch_runs, table_pair, case):
-    """rebound_many's draws under each case equal rbs_rebound_many's for the same uniforms, 0 ulp."""
+    """table_rebound_many's draws under each case equal rbs_rebound_many's for the same uniforms, 0 ulp."""
     given, runs = dispatch_runs
     _, native_table = table_pair
     code, mix, message = native_table.mix_from_weights(WEIGHTS)

@@ -1,5 +1,5 @@
 """Every wall hit answered in C: rbs_rebound_path, rbs_rebound_spin_u and rbs_rebound_spin give the paths and
-the bits of surrogate.kernels.spin (rebound_path, rebound_spin_tuple) for the same uniforms.
+the bits of surrogate.kernels.wall_hit (rebound_path, rebound) for the same uniforms.
 
 Over random incident states (over and beyond the table's grid, the hostile ones of tests.helpers.states.incident_states)
 with Ω⁻ zero, below the spin tolerance, at it, above it, large, and NaN or infinite, under the three methods:
@@ -84,7 +84,7 @@ def spin_states(table):
 
 
 def _numba(table, cdf, V, omega, n, a, u, method, scaled=True):
-    return py.rebound_spin_tuple(table.kernel_data, table.direct_parameters, table.model_shapes, cdf, tuple(V),
+    return py.rebound(table.kernel_data, table.direct_parameters, table.model_shapes, cdf, tuple(V),
                                  tuple(omega), tuple(n), a, u, method, scaled)
 
 

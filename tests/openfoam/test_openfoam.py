@@ -5,7 +5,7 @@ against Debian's OpenFOAM v1912 (integrations/openfoam/build.sh, on the
 outputs of install-deps.sh), runs the case hopperRebound serially and on 2
 MPI ranks with method auto, and checks the hit counts per path, the
 rebounds the table answered against surrogate.sample_global and those the
-direct model answered against surrogate.rebound_direct on the same incident
+direct model answered against surrogate.sample_direct on the same incident
 states, the random streams per rank, a moving wall, OpenFOAM's erosion model
 beside ours, and times the runs against standardWallInteraction.
 
@@ -227,7 +227,7 @@ def test_serial_run_hit_counts_and_rebounds_against_the_sampler(serial_case, tmp
     assert res["trapped_fraction"]["ok"], res["trapped_fraction"]
     # the hits the direct model answered (spinning, or off the grid) follow the direct model's law: KS and
     # classifier within the bounds of equal laws at these sample sizes (_agreement), against
-    # surrogate.rebound_direct run again on the same incident states, Ω⁻ included
+    # surrogate.sample_direct run again on the same incident states, Ω⁻ included
     d = res["solver_vs_direct_model"]
     assert d["n_solver"] > 1000 and d["ks_ok"] and d["classifier_ok"], d
     assert res["direct_trapped_fraction"]["ok"], res["direct_trapped_fraction"]
@@ -391,7 +391,7 @@ def test_trapped_parcels_stick_or_are_removed(policy, openfoam_build, trapping_t
     assert info["outside"] == pytest.approx(res["incidence"]["hits_outside_grid"], abs=2)
     assert res["trapped_fraction"]["ok"], res["trapped_fraction"]
     assert res["solver_vs_sampler"]["ks_ok"], res
-    # the direct model with the table's n_max = 2 traps too, as often as rebound_direct does
+    # the direct model with the table's n_max = 2 traps too, as often as sample_direct does
     assert res["direct_trapped_fraction"]["ok"], res["direct_trapped_fraction"]
 
 

@@ -1,4 +1,4 @@
-"""The direct model at run time (surrogate.kernels.direct, surrogate.rebound_direct): one law in any caller's
+"""The direct model at run time (surrogate.kernels.direct_path, surrogate.sample_direct): one law in any caller's
 frame, with the table's parameters; the model's invariants through it; bad inputs.
 
 The law against `tablegen simulate` at 16 incident states: test_direct_law.py. KS bounds here: those of
@@ -22,7 +22,7 @@ from direct_model.runtime import U_PER_REBOUND, aspect_ratio, model_parameters
 from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL
 from direct_model.wall import CORUNDUM_ON_STEEL
-from surrogate.kernels import rebound_direct_tuple
+from surrogate.kernels import direct_rebound
 
 from tests.helpers.direct_law import A, kernel_in_frame, ks_bound, random_frame
 
@@ -67,7 +67,7 @@ def test_a_rebound_never_adds_energy(params, shape):
         V = Q @ (rng.normal(size=3) * [100.0, 0.0, 100.0] - [0.0, rng.uniform(30.0, 250.0), 0.0])
         W = rng.normal(size=3) * 150.0 / A * (i % 3) / 2             # |Ω⁻|a/|V⁻| around 0, 1, 2
         u[:] = rng.random(U_PER_REBOUND)
-        status, V_out, W_out = rebound_direct_tuple(params, V, Q[:, 1], A, W, SHAPES.index(shape), u)
+        status, V_out, W_out = direct_rebound(params, SHAPES.index(shape), V, W, Q[:, 1], A, u)
         if status != STATUS_REBOUNDED:
             continue
         b = aspect_ratio(params, u[3])
@@ -90,7 +90,7 @@ def test_near_sphere_keeps_angular_momentum_about_the_contact_point():
         Q = random_frame(300 + i)
         n = Q[:, 1]
         V = Q @ (rng.normal(size=3) * [80.0, 0.0, 80.0] - [0.0, rng.uniform(40.0, 250.0), 0.0])
-        status, V_out, W_out = rebound_direct_tuple(near, V, n, A, np.zeros(3), 0, rng.random(U_PER_REBOUND))
+        status, V_out, W_out = direct_rebound(near, 0, V, np.zeros(3), n, A, rng.random(U_PER_REBOUND))
         assert status == STATUS_REBOUNDED
         before = A * np.cross(n, V)
         after = 0.4 * A * A * np.asarray(W_out) + A * np.cross(n, V_out)
@@ -106,7 +106,7 @@ def test_same_seed_same_bits_whatever_the_threads(small_table):
     runs = []
     for threads in (1, numba.config.NUMBA_NUM_THREADS):
         numba.set_num_threads(threads)
-        runs.append(surrogate.rebound_direct(small_table, V, [0.0, 1.0, 0.0], A, W, shapes, random_state=3))
+        runs.append(surrogate.sample_direct(small_table, V, [0.0, 1.0, 0.0], A, W, shapes, random_state=3))
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     for one, many in zip(*runs):
         np.testing.assert_array_equal(one, many)
@@ -145,9 +145,9 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
 def test_bad_kernel_input_is_invalid_with_nan(params, change):
     args = dict(V=(100.0, -100.0, 0.0), n=(0.0, 1.0, 0.0), a=A, omega=(0.0, 0.0, 0.0), shape=1,
                 u=np.full(U_PER_REBOUND, 0.5))
-    assert rebound_direct_tuple(params, **args)[0] == STATUS_REBOUNDED
+    assert direct_rebound(params, **args)[0] == STATUS_REBOUNDED
     args.update(change)
-    status, V_out, W_out = rebound_direct_tuple(params, **args)
+    status, V_out, W_out = direct_rebound(params, **args)
     assert status == STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
 
 
@@ -156,14 +156,14 @@ def test_a_state_whose_flight_underflows_ends(params):
     the AGM of direct_model.rotation. It must end (here: STATUS_FAILED with NaN), as the C twin does. Run
     in a daemon thread so that a regression fails after the timeout instead of hanging the suite."""
     n = np.array([0.34523645, 0.41333518, 0.84259469])
-    args = (params, (-3.77668607e-161, -7.47222348e-161, -5.46831954e-161), tuple(n / np.linalg.norm(n)),
-            8.635989814806125e-4, (-1.50979875e-158, -2.14919893e-158, 1.32388636e-157), 0,
+    args = (params, 0, (-3.77668607e-161, -7.47222348e-161, -5.46831954e-161),
+            (-1.50979875e-158, -2.14919893e-158, 1.32388636e-157), tuple(n / np.linalg.norm(n)), 8.635989814806125e-4,
             np.array([0.29739859, 0.48706842, 0.90535956, 0.39282742, 0.62082272, 0.55552379, 0.17284464]))
     result = []
-    worker = threading.Thread(target=lambda: result.append(rebound_direct_tuple(*args)), daemon=True)
+    worker = threading.Thread(target=lambda: result.append(direct_rebound(*args)), daemon=True)
     worker.start()
     worker.join(timeout=120.0)
-    assert result, "rebound_direct_tuple did not return within 120 s"
+    assert result, "direct_rebound did not return within 120 s"
     status, V_out, W_out = result[0]
     assert status in (STATUS_REBOUNDED, STATUS_FAILED)
     assert np.isfinite(V_out).all() if status == STATUS_REBOUNDED else np.isnan(V_out).all()
@@ -184,7 +184,7 @@ def test_bad_python_input_is_a_one_line_error(small_table, change, message):
                 omega=[0.0, 0.0, 0.0], shape="prism", random_state=1)
     args.update(change)
     with pytest.raises(ValueError) as error:
-        surrogate.rebound_direct(small_table, **args)
+        surrogate.sample_direct(small_table, **args)
     assert str(error.value).startswith(message) and "\n" not in str(error.value)
 
 
@@ -193,9 +193,9 @@ def test_runtime_kernel_needs_no_scipy():
     code = ("import sys; sys.modules['scipy'] = None; import numpy as np; "
             "from direct_model.runtime import model_parameters, U_PER_REBOUND; "
             "from direct_model.shapes import AspectRatioLaw; from direct_model.wall import CORUNDUM_ON_STEEL; "
-            "from surrogate.kernels import rebound_direct_tuple; "
+            "from surrogate.kernels import direct_rebound; "
             "p = model_parameters(AspectRatioLaw(), 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9, 100000, "
             "(0.2, 1 / 3, 0.33, 0.2)); "
-            "s = rebound_direct_tuple(p, (100.0, -100.0, 0.0), (0.0, 1.0, 0.0), 1e-3, (0.0, 0.0, 0.0), 2, "
+            "s = direct_rebound(p, 2, (100.0, -100.0, 0.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 1e-3, "
             "np.full(U_PER_REBOUND, 0.5))[0]; sys.exit(s)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == STATUS_REBOUNDED

@@ -1,4 +1,4 @@
-"""numba's run-time kernel (surrogate.rebound_direct, in random caller's frames) and `tablegen simulate`
+"""numba's run-time kernel (surrogate.sample_direct, in random caller's frames) and `tablegen simulate`
 (direct_model.simulate, model frame) draw one law at 16 incident states: every shape at |Ω⁻|a/|V⁻| ∈
 {0, 0.02, 0.3, 1.0}, 60–280 m/s. Statistics and their bounds: tests/helpers/direct_law.py (KS over the six
 components and a classifier two-sample test, both with bounds from n and the number of comparisons); the

@@ -130,13 +130,13 @@ def test_a_corrupted_table_fails_to_load_naming_the_dataset(table, capsys):
 # -- the kernels never return a non-finite or unphysical rebound; the API's one-line errors -------------
 
 def _draw(table, V=(40.0, -0.3, 0.0), n=(0.0, 1.0, 0.0), a=1e-4, u=None):
-    """(status, V⁺, Ω⁺) of surrogate.kernels.rebound_tuple for one particle, seed-1 uniforms unless given."""
-    from surrogate.kernels import rebound_tuple
+    """(status, V⁺, Ω⁺) of surrogate.kernels.table_rebound for one particle, seed-1 uniforms unless given."""
+    from surrogate.kernels import table_rebound
     if u is None:
         u = np.empty(surrogate.U_PER_DRAW)
         surrogate.fill_uniforms(surrogate.seed_state(1), u)
     cdf = surrogate.mix_cdf(table, "mix")
-    return rebound_tuple(table.kernel_data, cdf, V, n, a, np.asarray(u, dtype=np.float64), True)
+    return table_rebound(table.kernel_data, cdf, V, n, a, np.asarray(u, dtype=np.float64), True)
 
 
 @pytest.mark.parametrize("k", range(13))
@@ -187,9 +187,9 @@ def test_an_all_zero_generator_gives_nan_not_zeros(small_table):
     u = np.zeros(5)
     surrogate.fill_uniforms(np.zeros(4, dtype=np.uint64), u)
     assert np.isnan(u).all() and np.isnan(next_uniform(np.zeros(4, dtype=np.uint64)))
-    from surrogate.kernels import rebound_many_rng
+    from surrogate.kernels import table_rebound_many_rng
     with pytest.raises(ValueError, match="not all zero"):
-        rebound_many_rng(small_table.kernel_data, surrogate.mix_cdf(small_table, "mix"), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1), np.zeros(4, dtype=np.uint64),
+        table_rebound_many_rng(small_table.kernel_data, surrogate.mix_cdf(small_table, "mix"), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1), np.zeros(4, dtype=np.uint64),
                          np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1, dtype=np.int8))
 
 

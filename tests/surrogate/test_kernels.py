@@ -9,14 +9,14 @@ import pytest
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.kernels import (BLOCK, STATUS_INVALID, U_PER_DRAW, draw_local, draw_local_parallel,
-                               draw_local_parallel_rng, rebound, rebound_parallel, rebound_parallel_rng, rebound_many,
-                               rebound_many_rng, rebound_tuple, rebound_uniforms)
+                               draw_local_parallel_rng, table_rebound, table_rebound_many, table_rebound_many_rng,
+                               table_rebound_parallel, table_rebound_parallel_rng, table_rebound_uniforms)
 from surrogate.kernels.rng import CHUNK_ROWS, seed_state, chunk_states
 
 
 def test_api_draws_do_not_depend_on_the_thread_count(small_table):
     """sample_global and sample_local draw the rows of chunk j from the xoshiro256+ state j of
-    chunk_states: the same bits on one and on two threads, and the same as rebound_many and draw_local
+    chunk_states: the same bits on one and on two threads, and the same as table_rebound_many and draw_local
     on the uniforms those states give row after row (2 full chunks and a partial one)."""
     m = 2 * CHUNK_ROWS + 77
     rng = np.random.default_rng(4)
@@ -40,18 +40,18 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
     def uniforms(seed):
         states = chunk_states(np.random.default_rng(seed), m)
         assert states.shape == (3, 4)
-        return np.concatenate([rebound_uniforms(state.copy(), min(CHUNK_ROWS, m - j * CHUNK_ROWS))
+        return np.concatenate([table_rebound_uniforms(state.copy(), min(CHUNK_ROWS, m - j * CHUNK_ROWS))
                                for j, state in enumerate(states)])
 
     cdf = surrogate.mix_cdf(small_table, "mix")
     V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_many(small_table.kernel_data, cdf, V, n, a, uniforms(5), V3, W3, s3)
+    table_rebound_many(small_table.kernel_data, cdf, V, n, a, uniforms(5), V3, W3, s3)
     np.testing.assert_array_equal(V1, V3)
     np.testing.assert_array_equal(W1, W3)
     np.testing.assert_array_equal(s1, s3)
     for wrong in (chunk_states(np.random.default_rng(5), m - CHUNK_ROWS), np.ones((3, 3), np.uint64)):
         with pytest.raises(ValueError, match="one xoshiro256\\+ state"):
-            rebound_parallel_rng(small_table.kernel_data, cdf, V, n, a, wrong, V3, W3, s3)
+            table_rebound_parallel_rng(small_table.kernel_data, cdf, V, n, a, wrong, V3, W3, s3)
     U = uniforms(6)
     for i in (0, CHUNK_ROWS, m - 1):
         expected = draw_local(small_table.kernel_data, cdf, np.degrees(a1[i]), speed[i], U[i])
@@ -85,7 +85,9 @@ def _solver_loop(data, cdf, V, n, a, seed):
         for k in range(U_PER_DRAW):
             u[k] = np.random.random()
         U[i] = u
-        status[i] = rebound(data, cdf, V[i], n[i], a[i], u, V_out[i], Omega_out[i])
+        status[i], V_new, W_new = table_rebound(data, cdf, V[i], n[i], a[i], u)
+        for k in range(3):
+            V_out[i, k], Omega_out[i, k] = V_new[k], W_new[k]
     return V_out, Omega_out, status, U
 
 
@@ -98,7 +100,7 @@ def test_callable_from_a_numba_loop(small_table):
     cdf = surrogate.mix_cdf(small_table, [0.25] * 4)
     V1, W1, s1, U = _solver_loop(small_table.kernel_data, cdf, V, n, a, 42)
     V2, W2, s2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_parallel(small_table.kernel_data, cdf, V, n, a, U, V2, W2, s2)
+    table_rebound_parallel(small_table.kernel_data, cdf, V, n, a, U, V2, W2, s2)
     np.testing.assert_array_equal(s1, s2)
     np.testing.assert_array_equal(V1, V2)
     np.testing.assert_array_equal(W1, W2)
@@ -107,17 +109,17 @@ def test_callable_from_a_numba_loop(small_table):
 
 @numba.njit
 def _tuple_loop(data, cdf, V, n, a, U, V_out, Omega_out, status):
-    """A solver loop on scalars: rebound_tuple on 3-tuples built from the rows (no array views)."""
+    """A solver loop on scalars: table_rebound on 3-tuples built from the rows (no array views)."""
     for i in range(V.shape[0]):
-        status[i], V_new, W_new = rebound_tuple(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
                                                 (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i])
         for k in range(3):
             V_out[i, k], Omega_out[i, k] = V_new[k], W_new[k]
 
 
 def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
-    """rebound_many (table reads of 16 particles issued together) and rebound_tuple (outputs returned,
-    inputs as tuples) = rebound row by row, bit for bit.
+    """table_rebound_many (table reads of a block of particles issued together) and table_rebound in a numba
+    loop (inputs as tuples) = table_rebound called row by row on (3,) arrays, bit for bit.
 
     1001 rows (not a multiple of the block), normal impacts (trapped draws
     occur there), rows that leave the wall or are NaN (reported invalid).
@@ -136,9 +138,9 @@ def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
     data = small_table.kernel_data
     V1, W1, s1 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     for i in range(m):
-        s1[i] = rebound(data, cdf, V[i], n[i], a[i], U[i], V1[i], W1[i])
+        s1[i], V1[i], W1[i] = table_rebound(data, cdf, V[i], n[i], a[i], U[i])
     V2, W2, s2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_many(data, cdf, V, n, a, U, V2, W2, s2)
+    table_rebound_many(data, cdf, V, n, a, U, V2, W2, s2)
     V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     _tuple_loop(data, cdf, V, n, a, U, V3, W3, s3)
     for s, V_, W_ in ((s2, V2, W2), (s3, V3, W3)):
@@ -146,13 +148,11 @@ def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
         np.testing.assert_array_equal(V1, V_)
         np.testing.assert_array_equal(W1, W_)
     assert s1[5] == s1[600] == STATUS_INVALID and np.any(s1 == STATUS_TRAPPED)
-    status, V_new, W_new = rebound_tuple(data, cdf, V[7], n[7], a[7], U[7])     # (3,) arrays work as well
-    assert status == s1[7] and V_new == tuple(V1[7]) and W_new == tuple(W1[7])
 
 
 def test_block_kernel_drawing_its_uniforms_equals_the_one_given_them(small_table):
-    """rebound_many_rng(state) = rebound_uniforms(state) then rebound_many, bit for bit, and leaves the
-    state where rebound_uniforms leaves it (rows: two pipelines' worth of blocks and a partial one, an
+    """table_rebound_many_rng(state) = table_rebound_uniforms(state) then table_rebound_many, bit for bit, and leaves the
+    state where table_rebound_uniforms leaves it (rows: two pipelines' worth of blocks and a partial one, an
     invalid row); a state of the wrong size is rejected."""
     m = 7 * BLOCK + 5
     rng = np.random.default_rng(8)
@@ -162,17 +162,17 @@ def test_block_kernel_drawing_its_uniforms_equals_the_one_given_them(small_table
     n, a = np.tile([0.0, 1.0, 0.0], (m, 1)), np.full(m, 1e-4)
     data, cdf = small_table.kernel_data, surrogate.mix_cdf(small_table, "mix")
     state_given, state_drawn = seed_state(9), seed_state(9)
-    U = rebound_uniforms(state_given, m)
+    U = table_rebound_uniforms(state_given, m)
     given = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_many(data, cdf, V, n, a, U, *given)
+    table_rebound_many(data, cdf, V, n, a, U, *given)
     drawn = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_many_rng(data, cdf, V, n, a, state_drawn, *drawn)
+    table_rebound_many_rng(data, cdf, V, n, a, state_drawn, *drawn)
     for x, y in zip(given, drawn):
         np.testing.assert_array_equal(x, y)
     np.testing.assert_array_equal(state_given, state_drawn)
     assert drawn[2][3] == STATUS_INVALID and np.all(drawn[2][np.arange(m) != 3] != STATUS_INVALID)
     with pytest.raises(ValueError, match="one xoshiro256\\+ state"):
-        rebound_many_rng(data, cdf, V, n, a, np.ones(3, np.uint64), *drawn)
+        table_rebound_many_rng(data, cdf, V, n, a, np.ones(3, np.uint64), *drawn)
 
 
 def test_block_kernel_takes_strided_rows_and_rejects_short_arrays(small_table):
@@ -187,29 +187,28 @@ def test_block_kernel_takes_strided_rows_and_rejects_short_arrays(small_table):
     assert not V.flags.c_contiguous and not n.flags.c_contiguous
     data, cdf = small_table.kernel_data, surrogate.mix_cdf(small_table, "mix")
     strided = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_many_rng(data, cdf, V, n, a, seed_state(3), *strided)
+    table_rebound_many_rng(data, cdf, V, n, a, seed_state(3), *strided)
     copied = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
-    rebound_many_rng(data, cdf, V.copy(), n.copy(), a, seed_state(3), *copied)
+    table_rebound_many_rng(data, cdf, V.copy(), n.copy(), a, seed_state(3), *copied)
     for x, y in zip(strided, copied):
         np.testing.assert_array_equal(x, y)
     assert np.all(strided[2] != STATUS_INVALID)
     with pytest.raises(ValueError, match="'n' has shape \\(66, 3\\); needed \\(67, 3\\)"):
-        rebound_many_rng(data, cdf, V, n[:-1], a, seed_state(3), *copied)
+        table_rebound_many_rng(data, cdf, V, n[:-1], a, seed_state(3), *copied)
     with pytest.raises(ValueError, match="'status' has shape \\(66,\\); needed \\(67,\\)"):
-        rebound_many_rng(data, cdf, V, n, a, seed_state(3), *copied[:2], copied[2][:-1])
+        table_rebound_many_rng(data, cdf, V, n, a, seed_state(3), *copied[:2], copied[2][:-1])
     with pytest.raises(ValueError, match="'u' has shape \\(67, 12\\); needed \\(67, 13\\)"):
-        rebound_many(data, cdf, V, n, a, np.zeros((m, U_PER_DRAW - 1)), *copied)
+        table_rebound_many(data, cdf, V, n, a, np.zeros((m, U_PER_DRAW - 1)), *copied)
     # the parallel kernels check before their loop
     with pytest.raises(ValueError, match="'Omega_out' has shape \\(65, 3\\); needed \\(67, 3\\)"):
-        rebound_parallel_rng(data, cdf, V, n, a, chunk_states(np.random.default_rng(3), m), copied[0], copied[1][:-2],
+        table_rebound_parallel_rng(data, cdf, V, n, a, chunk_states(np.random.default_rng(3), m), copied[0], copied[1][:-2],
                           copied[2])
 
 
 def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
-    V_out, Omega_out = np.empty(3), np.empty(3)
     cdf = surrogate.mix_cdf(small_table, "mix")
-    status = rebound(small_table.kernel_data, cdf, np.array([10.0, 5.0, 0.0]), np.array([0.0, 1.0, 0.0]), 1e-4,
-                     np.full(U_PER_DRAW, 0.5), V_out, Omega_out)
+    status, V_out, Omega_out = table_rebound(small_table.kernel_data, cdf, np.array([10.0, 5.0, 0.0]),
+                                             np.array([0.0, 1.0, 0.0]), 1e-4, np.full(U_PER_DRAW, 0.5))
     assert status == STATUS_INVALID and np.all(np.isnan(V_out)) and np.all(np.isnan(Omega_out))
     np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])
 

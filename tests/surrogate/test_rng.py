@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from surrogate.kernels import BLOCK, U_PER_DRAW, rebound_uniforms
+from surrogate.kernels import BLOCK, U_PER_DRAW, table_rebound_uniforms
 from surrogate.kernels.rng import fill_lanes, fill_uniforms, next_uniform, seed_lanes, seed_state
 
 MASK = (1 << 64) - 1
@@ -138,10 +138,10 @@ def test_fill_lanes_runs_each_lane_as_xoshiro256plus():
 
 
 def test_rebound_uniforms_gives_row_b_of_each_block_from_lane_b():
-    """Row i of rebound_uniforms: uniforms 13·(i // BLOCK) … of lane i % BLOCK, seeded by seed_lanes."""
+    """Row i of table_rebound_uniforms: uniforms 13·(i // BLOCK) … of lane i % BLOCK, seeded by seed_lanes."""
     rows = 3 * BLOCK + 7
     state, copy = seed_state(23), seed_state(23)
-    U = rebound_uniforms(state, rows)
+    U = table_rebound_uniforms(state, rows)
     lanes = np.zeros(4 * BLOCK, dtype=np.uint64)
     _seed_lanes(copy, lanes)
     np.testing.assert_array_equal(state, copy)
@@ -157,7 +157,7 @@ def test_rebound_uniforms_are_uniform_and_lanes_uncorrelated():
     """KS against U(0, 1) on 10⁴ rows (1.3·10⁵ uniforms): p < 1e-3 would flag a defect. Neighbouring lanes
     (rows i, i + 1 of a block) and consecutive uniforms of a row: the correlation of n independent pairs has
     standard deviation 1/√n (n = 10⁴ rows), so |r| < 5/√n fails by chance with probability below 1e-6."""
-    U = rebound_uniforms(seed_state(24), 10_000)
+    U = table_rebound_uniforms(seed_state(24), 10_000)
     assert U.min() >= 0.0 and U.max() < 1.0
     assert stats.kstest(U.ravel(), "uniform").pvalue > 1e-3
     limit = 5.0 / np.sqrt(len(U))

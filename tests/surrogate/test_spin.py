@@ -1,4 +1,4 @@
-"""Every wall hit answered (surrogate.kernels.spin, sample_global's omega and method, `surrogate sample
+"""Every wall hit answered (surrogate.kernels.wall_hit, sample_global's omega and method, `surrogate sample
 --omega --method`): the path each hit takes, the three methods against the table and the direct model, bad Ω⁻,
 failed rebounds, threads.
 
@@ -20,8 +20,8 @@ import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED
 from direct_model.runtime import P_MAX_STEPS, U_PER_REBOUND
 from surrogate.kernels import (CHUNK_ROWS, METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
-                               SPIN_TOLERANCE, chunk_states, rebound_direct_tuple, rebound_path, rebound_spin_tuple,
-                               rebound_tuple, rebound_uniforms)
+                               SPIN_TOLERANCE, chunk_states, direct_rebound, rebound_path, rebound,
+                               table_rebound, table_rebound_uniforms)
 
 KS_C = math.sqrt(-math.log(1e-3 / 2) / 2)      # c(α = 1e-3) (module doc)
 A = 1e-3                                       # half-size, m
@@ -79,12 +79,12 @@ def test_table_method_ignores_spin(small_table):
 def _chunk_uniforms(seed, m):
     """The U_PER_DRAW uniforms of each of m rows as sample_global draws them (random_state=seed)."""
     states = chunk_states(np.random.default_rng(seed), m)
-    return np.vstack([rebound_uniforms(states[j].copy(), min(CHUNK_ROWS, m - j * CHUNK_ROWS))
+    return np.vstack([table_rebound_uniforms(states[j].copy(), min(CHUNK_ROWS, m - j * CHUNK_ROWS))
                       for j in range(len(states))])
 
 
 def test_direct_method_is_the_direct_model_with_the_hit_s_uniforms(small_table):
-    """method "direct": each hit is rebound_direct_tuple on the model shape drawn from the mix with u[0] and
+    """method "direct": each hit is direct_rebound on the model shape drawn from the mix with u[0] and
     the uniforms u[1..7], bit for bit (spinning and not, in and out of the grid)."""
     m = CHUNK_ROWS + 40
     V = _in_grid(m, 5, alpha1=(5.0, 90.0), speed=(20.0, 300.0))
@@ -98,15 +98,15 @@ def test_direct_method_is_the_direct_model_with_the_hit_s_uniforms(small_table):
     cdf = surrogate.mix_cdf(small_table, weights)
     for i in range(0, m, 7):
         shape = small_table.model_shapes[np.searchsorted(cdf, u[i, 0], side="right")]
-        st, v, w = rebound_direct_tuple(small_table.direct_parameters, tuple(V[i]), NORMAL, A, tuple(W[i]), shape,
-                                        u[i, 1:1 + U_PER_REBOUND])
+        st, v, w = direct_rebound(small_table.direct_parameters, shape, tuple(V[i]), tuple(W[i]), NORMAL, A,
+                                  u[i, 1:1 + U_PER_REBOUND])
         assert st == status[i]
         np.testing.assert_array_equal(np.array(v), V_out[i])
         np.testing.assert_array_equal(np.array(w), W_out[i])
 
 
-def test_rebound_spin_tuple_is_the_table_or_the_direct_kernel_by_path(small_table):
-    """Per particle: the table path is rebound_tuple's bits, the direct path rebound_direct_tuple's with
+def test_rebound_is_the_table_or_the_direct_kernel_by_path(small_table):
+    """Per particle: the table path is table_rebound's bits, the direct path direct_rebound's with
     u[1..7]; a uniform outside [0, 1) is STATUS_INVALID on either path, as a bad method."""
     data, params, shapes = small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes
     cdf = surrogate.mix_cdf(small_table, "mix")
@@ -115,26 +115,26 @@ def test_rebound_spin_tuple_is_the_table_or_the_direct_kernel_by_path(small_tabl
         u = rng.random(13)
         V = _velocity(rng.uniform(30, 90), rng.uniform(50, 250), rng.uniform(0, 6))
         W = tuple(rng.normal(size=3) * (1e4 if i % 2 else 0.0))
-        got = rebound_spin_tuple(data, params, shapes, cdf, V, W, NORMAL, A, u, METHOD_AUTO, True)
+        got = rebound(data, params, shapes, cdf, V, W, NORMAL, A, u, METHOD_AUTO, True)
         if i % 2 == 0:
-            want = rebound_tuple(data, cdf, V, NORMAL, A, u, True)
+            want = table_rebound(data, cdf, V, NORMAL, A, u, True)
         else:
             shape = shapes[np.searchsorted(cdf, u[0], side="right")]
-            want = rebound_direct_tuple(params, V, NORMAL, A, W, shape, u[1:8])
+            want = direct_rebound(params, shape, V, W, NORMAL, A, u[1:8])
         assert got[0] == want[0]
         np.testing.assert_array_equal(np.array(got[1:]), np.array(want[1:]))
         for method in (METHOD_TABLE, METHOD_DIRECT):
             bad = u.copy()
             bad[12] = 1.0
-            st, v, _ = rebound_spin_tuple(data, params, shapes, cdf, V, W, NORMAL, A, bad, method, True)
+            st, v, _ = rebound(data, params, shapes, cdf, V, W, NORMAL, A, bad, method, True)
             assert st == STATUS_INVALID and np.all(np.isnan(v))
-    st, v, _ = rebound_spin_tuple(data, params, shapes, cdf, V, W, NORMAL, A, rng.random(13), 3, True)
+    st, v, _ = rebound(data, params, shapes, cdf, V, W, NORMAL, A, rng.random(13), 3, True)
     assert st == STATUS_INVALID and np.all(np.isnan(v))
 
 
 def test_spinning_hits_follow_the_direct_model_s_law(small_table):
     """Spinning prisms (|Ω⁻|a/|V⁻| = 0.6 about the axis across V⁻, inside the grid): "auto" answers them
-    with the direct model, whose law is surrogate.rebound_direct's at the same states (independent draws;
+    with the direct model, whose law is surrogate.sample_direct's at the same states (independent draws;
     KS per component of V⁺ and Ω⁺ within the bound from n), and far from the table's (the reason for it)."""
     n = 4000
     V = np.tile(_velocity(45.0, 150.0), (n, 1))
@@ -142,7 +142,7 @@ def test_spinning_hits_follow_the_direct_model_s_law(small_table):
     V_a, W_a, st_a, path = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=11, omega=W,
                                                    return_path=True)
     assert np.all(path == PATH_DIRECT)
-    V_d, W_d, st_d = surrogate.rebound_direct(small_table, V, NORMAL, A, omega=W, shape="prism", random_state=12)
+    V_d, W_d, st_d = surrogate.sample_direct(small_table, V, NORMAL, A, omega=W, shape="prism", random_state=12)
     V_t, W_t, st_t = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=13, method="table")
     x, y, z = (np.column_stack([v, w])[s == STATUS_REBOUNDED] for v, w, s in ((V_a, W_a, st_a), (V_d, W_d, st_d),
                                                                             (V_t, W_t, st_t)))
@@ -214,11 +214,11 @@ def test_bad_method_names_the_allowed_ones(small_table):
 
 
 def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table):
-    from surrogate.kernels import rebound_spin_parallel_rng
+    from surrogate.kernels import rebound_parallel_rng
     V = np.array(_in_grid(3, 1))
     outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
     with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
-        rebound_spin_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
+        rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
                                   surrogate.mix_cdf(small_table, "mix"), V, np.zeros((1, 3)), np.tile(NORMAL, (3, 1)),
                                   np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3, *outputs)
 

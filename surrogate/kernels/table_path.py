@@ -1,5 +1,5 @@
-"""One particle: in the global frame :func:`rebound_tuple` (vectors as tuples, for a solver's per-hit loop)
-and :func:`rebound` (the same on (3,) arrays); in the local frame :func:`draw_local`.
+"""The table path, one particle: in the global frame :func:`table_rebound` (for a solver's per-hit loop); in
+the local frame :func:`draw_local`.
 
 The impact frame (:func:`surrogate.kernels.frame.impact_frame`), then one draw
 (:mod:`surrogate.kernels.draw`: locate, gather, arithmetic) and the way back
@@ -20,51 +20,42 @@ from surrogate.kernels.options import JIT, KERNEL
 
 
 @numba.njit(**KERNEL)
-def rebound(data, mix_cdf, V, n, a, u, V_out, Omega_out, scaled=True):
-    """Reflected state of one particle in the global frame; returns the status.
+def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
+    """Reflected state of one particle in the global frame, drawn from the table: (status, V⁺, Ω⁺), V⁺ in
+    m/s and Ω⁺ in rad/s as 3-tuples.
 
     Parameters
     ----------
     data : ``table.kernel_data``.
     mix_cdf : cumulative shape weights (table shape order).
-    V : (3,) incident velocity, m/s; must move into the wall (V·n < 0).
-    n : (3,) unit wall normal pointing into the gas (| |n| − 1 | ≤ NORMAL_TOLERANCE).
+    V : incident velocity, m/s (3-tuple or (3,) array); must move into the wall (V·n < 0).
+    n : unit wall normal pointing into the gas (| |n| − 1 | ≤ NORMAL_TOLERANCE; 3-tuple or (3,) array).
     a : particle half-size (half its largest extent), m, finite and > 0.
     u : (U_PER_DRAW,) uniforms in [0, 1).
-    V_out, Omega_out : (3,) outputs: V⁺ in m/s and Ω⁺ in rad/s (NaN unless rebounded).
     scaled : between grid points, move the draw to the incident state
         (default; :func:`draw_velocity`); False: plain stochastic interpolation.
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
     move into the wall (V·n ≥ 0, zero or non-finite), n is not a unit vector,
     a is not finite and > 0, a uniform is outside [0, 1), or the result would
-    not be finite or would not leave the wall (as rbs_rebound). The impact frame is ex
-    (tangential direction of V), n, ez = ex × n; the local draw is rotated back
+    not be finite or would not leave the wall (as rbs_table_rebound); NaN vectors unless rebounded. The
+    impact frame is ex (tangential direction of V), n, ez = ex × n; the local draw is rotated back
     into the global frame. The mirror symmetry of the model is applied with a
     random sign (:func:`surrogate.kernels.arithmetic.arithmetic`). An α1 or |V⁻| outside the table's
     grid uses the law at the nearest grid edge (check ``table.alpha1_range``
     and ``table.speed_range`` beforehand if that matters).
-    """
-    status, V_new, Omega_new = _rebound(data, mix_cdf, V, n, a, u, scaled)
-    _store(V_new, Omega_new, V_out, Omega_out)
-    return status
 
-
-@numba.njit(**KERNEL)
-def rebound_tuple(data, mix_cdf, V, n, a, u, scaled=True):
-    """:func:`rebound` returning its outputs: (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as 3-tuples.
-
-    V and n may be 3-tuples or (3,) arrays. For a solver loop over particle
-    arrays, passing ``(V[i, 0], V[i, 1], V[i, 2])`` rather than the row
+    For a solver loop over particle arrays, passing ``(V[i, 0], V[i, 1], V[i, 2])`` rather than the row
     ``V[i]`` creates no array view, so the loop does no reference counting
     (numba's atomic counts on views: docs/design/sampler_cost.md).
     """
-    return _rebound(data, mix_cdf, V, n, a, u, scaled)
+    return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
 
 
 @numba.njit(inline="always", **JIT)
-def _rebound(data, mix_cdf, V, n, a, u, scaled):
-    """:func:`rebound_tuple`."""
+def inline_table_rebound(data, mix_cdf, V, n, a, u, scaled):
+    """:func:`table_rebound`, inlined into its caller (the call that answers any hit,
+    :func:`surrogate.kernels.wall_hit.rebound`)."""
     if not moves_into_wall(V, n):
         return STATUS_INVALID, NAN3, NAN3
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
@@ -73,13 +64,6 @@ def _rebound(data, mix_cdf, V, n, a, u, scaled):
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
     ok = particle_ok(n, a) & uniforms_ok(u)
     return to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
-
-
-@numba.njit(inline="always", **JIT)
-def _store(V_new, Omega_new, V_out, Omega_out):
-    for k in range(3):
-        V_out[k] = V_new[k]
-        Omega_out[k] = Omega_new[k]
 
 
 @numba.njit(inline="always", **JIT)

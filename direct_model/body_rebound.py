@@ -36,7 +36,7 @@ from direct_model.shapes import MAX_VERTICES, body_vertices, bounding_radius
 
 HISTORY_COLUMNS = 17
 
-# layout of the scratch array of :func:`rebound`
+# layout of the scratch array of :func:`body_rebound`
 _VERTS = 0
 _HEIGHTS = _VERTS + 3 * MAX_VERTICES
 _OFFSETS = _HEIGHTS + MAX_VERTICES
@@ -46,7 +46,7 @@ _K_LAB = _R + 9
 _KINV_LAB = _K_LAB + 9
 _K = _KINV_LAB + 9                 # then seven 3-vectors: K, 1/K, ℓ, r_c, ΔV, ΔΩ, Ω(t)
 WORK_SIZE = _K + 21
-_BLOCKS = 1024                     # parallel work units of rebound_batch (scratch allocated per block)
+_BLOCKS = 1024                     # parallel work units of body_rebound_batch (scratch allocated per block)
 
 
 @numba.njit(**JIT)
@@ -68,7 +68,7 @@ def lab_tensor(R, diag, out):
 
 
 @numba.njit(**JIT)
-def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol, set_tol,
+def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol, set_tol,
             max_steps, V, W, history, work):
     """Simulate one particle's rebound.
 
@@ -175,10 +175,10 @@ def rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_batch(shapes, ratios, hands, quats, V0, W0, kfacs, kappa, wall, n_max,
+def body_rebound_batch(shapes, ratios, hands, quats, V0, W0, kfacs, kappa, wall, n_max,
                   contact_tol, set_tol, max_steps,
                   out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi):
-    """Run :func:`rebound` for every particle i (parallel over blocks of particles).
+    """Run :func:`body_rebound` for every particle i (parallel over blocks of particles).
 
     Inputs per particle: ``shapes[i]`` code, ``ratios[i] = (b/a, c/b)``,
     ``hands[i]`` = ±1, ``quats[i]`` orientation quaternion (any norm > 0).
@@ -196,7 +196,7 @@ def rebound_batch(shapes, ratios, hands, quats, V0, W0, kfacs, kappa, wall, n_ma
         for i in range(block * n // n_blocks, (block + 1) * n // n_blocks):
             semi[0], semi[1], semi[2] = 1.0, ratios[i, 0], ratios[i, 0] * ratios[i, 1]
             quaternion_to_matrix(quats[i], R0)
-            status, failure, ncoll, steps, multi, erot = rebound(
+            status, failure, ncoll, steps, multi, erot = body_rebound(
                 shapes[i], semi, kappa, float(hands[i]), kfacs[shapes[i]], R0, V0, W0, wall,
                 n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
             out_status[i] = status

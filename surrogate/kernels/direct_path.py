@@ -1,5 +1,5 @@
-"""The direct model at run time, in the caller's frame: one particle per call (:func:`rebound_direct_tuple`),
-or many on all threads (:func:`rebound_direct_parallel_rng`); docs/model.md §10.
+"""The direct path: the direct model at run time, in the caller's frame, one particle per call
+(:func:`direct_rebound`) or many on all threads (:func:`direct_rebound_parallel_rng`); docs/model.md §10.
 
 Where the table's law does not apply (a spinning particle, say), a solver asks the model itself.
 Per hit the model frame is built as the table's draws build theirs
@@ -24,19 +24,19 @@ from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
 
 
 @numba.njit(**JIT)
-def rebound_direct_tuple(params, V, n, a, omega, shape, u):
+def direct_rebound(params, shape, V, omega, n, a, u):
     """One particle's rebound by the direct model, in the caller's frame: (status, V⁺, Ω⁺) with V⁺ in m/s
     and Ω⁺ in rad/s as 3-tuples.
 
     Parameters
     ----------
     params : ``table.direct_parameters`` (:func:`direct_model.runtime.model_parameters`).
+    shape : shape code 0..3 (ellipsoid, prism, cut prism, tetrahedron).
     V : incident velocity V⁻, m/s (3-tuple or (3,) array); must move into the wall (V·n < 0).
-    n : unit wall normal pointing into the gas (| |n| − 1 | ≤ surrogate.kernels.frame.NORMAL_TOLERANCE).
-    a : half-size (half the largest extent), m, > 0.
     omega : incident angular velocity Ω⁻, rad/s; exactly zero: the body starts touching the wall (the
         tables' case), otherwise the flight in from a clear start is simulated (docs/model.md §5.3).
-    shape : shape code 0..3 (ellipsoid, prism, cut prism, tetrahedron).
+    n : unit wall normal pointing into the gas (| |n| − 1 | ≤ surrogate.kernels.frame.NORMAL_TOLERANCE).
+    a : half-size (half the largest extent), m, > 0.
     u : (≥ U_PER_REBOUND,) uniforms in [0, 1) (:mod:`direct_model.runtime`), e.g. from
         :func:`surrogate.kernels.rng.fill_uniforms`.
 
@@ -44,12 +44,12 @@ def rebound_direct_tuple(params, V, n, a, omega, shape, u):
     (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID with NaN vectors for
     an input outside the ranges above.
     """
-    return _rebound_direct(params, V, n, a, omega, shape, u, np.empty(SCRATCH_SIZE))
+    return inline_direct_rebound(params, shape, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
 
 
 @numba.njit(inline="always", **JIT)
-def _valid(V, n, a, omega, shape, u):
-    """The inputs of :func:`rebound_direct_tuple` are in their ranges."""
+def _valid(shape, V, omega, n, a, u):
+    """The inputs of :func:`direct_rebound` are in their ranges."""
     ok = (moves_into_wall(V, n) and particle_ok(n, a)
           and math.isfinite(omega[0] + omega[1] + omega[2]) and 0 <= shape < len(SHAPES)
           and u.shape[0] >= U_PER_REBOUND)
@@ -59,12 +59,13 @@ def _valid(V, n, a, omega, shape, u):
 
 
 @numba.njit(inline="always", **JIT)
-def _rebound_direct(params, V, n, a, omega, shape, u, scratch):
-    """:func:`rebound_direct_tuple` with its scratch space given."""
-    if not _valid(V, n, a, omega, shape, u):
+def inline_direct_rebound(params, shape, V, omega, n, a, u, scratch):
+    """:func:`direct_rebound` with its scratch space given, inlined into its caller (the parallel kernel, and
+    the call that answers any hit, :func:`surrogate.kernels.wall_hit.rebound`)."""
+    if not _valid(shape, V, omega, n, a, u):
         return STATUS_INVALID, NAN3, NAN3
     ex, ez = _frame_axes(V, n, u[U_AXIS])
-    # Ω⁻ in (m/s)/a, the model's unit (direct_model.rebound): rad/s times a
+    # Ω⁻ in (m/s)/a, the model's unit (direct_model.body_rebound): rad/s times a
     status, _, _, vx, vy, vz, wx, wy, wz = rebound_model_frame(
         params, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez), u, scratch)
     if status != STATUS_REBOUNDED:
@@ -80,8 +81,8 @@ def _frame_axes(V, n, u_axis):
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_direct_parallel_rng(params, V, n, a, omega, shape, states, V_out, Omega_out, status):
-    """:func:`rebound_direct_tuple` for every row i of V, n, a, omega (N, 3 or N) and shape (N,) codes, on all
+def direct_rebound_parallel_rng(params, shape, V, omega, n, a, states, V_out, Omega_out, status):
+    """:func:`direct_rebound` for every row i of shape (N,) codes, V, omega, n (N, 3) and a (N,), on all
     threads: chunk j of CHUNK_ROWS rows draws its uniforms, U_PER_REBOUND per row in row order, from a copy of
     the xoshiro256+ state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the results do not
     depend on the number of threads. Outputs V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,)."""
@@ -91,9 +92,9 @@ def rebound_direct_parallel_rng(params, V, n, a, omega, shape, states, V_out, Om
         scratch = np.empty(SCRATCH_SIZE)
         for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
             fill_uniforms(state, u)
-            st, V_new, Omega_new = _rebound_direct(params, (V[i, 0], V[i, 1], V[i, 2]), (n[i, 0], n[i, 1], n[i, 2]),
-                                                   a[i], (omega[i, 0], omega[i, 1], omega[i, 2]), shape[i], u,
-                                                   scratch)
+            st, V_new, Omega_new = inline_direct_rebound(params, shape[i], (V[i, 0], V[i, 1], V[i, 2]),
+                                                         (omega[i, 0], omega[i, 1], omega[i, 2]),
+                                                         (n[i, 0], n[i, 1], n[i, 2]), a[i], u, scratch)
             status[i] = st
             for k in range(3):
                 V_out[i, k] = V_new[k]

@@ -1,9 +1,9 @@
 """Every wall hit answered, spinning or not: the table where it is valid, the direct model elsewhere.
 
 A table holds the law of particles that do not spin before they hit (Ω⁻ = 0), on its α1 and |V⁻| grid. For
-any other hit the direct model (:mod:`surrogate.kernels.direct`) answers, per particle, at run time.
+any other hit the direct model (:mod:`surrogate.kernels.direct_path`) answers, per particle, at run time.
 :func:`rebound_path` says which *path* answers a hit (a pure function of the state and the method);
-:func:`rebound_spin_tuple` answers one hit by that path; :func:`rebound_spin_parallel_rng` answers many on all
+:func:`rebound` answers one hit by that path; :func:`rebound_parallel_rng` answers many on all
 threads.
 
 Methods (integer codes, as in C): METHOD_AUTO, the table iff |Ω⁻| a/|V⁻| ≤ SPIN_TOLERANCE and α1 lies in the
@@ -13,7 +13,7 @@ METHOD_TABLE, always the table (the law of the nearest grid edge outside the gri
 METHOD_DIRECT, always the direct model. Paths: PATH_TABLE, PATH_DIRECT.
 
 One hit consumes U_PER_DRAW = 13 uniforms whatever path answers it, so streams stay aligned. The table path
-is :func:`surrogate.kernels.particle.rebound_tuple` with those 13. The direct path draws the shape from the mix
+is :func:`surrogate.kernels.table_path.table_rebound` with those 13. The direct path draws the shape from the mix
 with u[0] exactly as the table path does (:func:`surrogate.kernels.locate.locate`), maps the table's shape to
 the model's shape code (``model_shapes``), and gives the model u[1..7] as its U_PER_REBOUND uniforms (u[1 + k]
 is the model's u[k]; the axis at normal impact is u[7]).
@@ -30,13 +30,13 @@ import numpy as np
 
 from data_schema.samples import STATUS_INVALID
 from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
-from surrogate.kernels.direct import _rebound_direct
+from surrogate.kernels.direct_path import inline_direct_rebound
 from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import mix_shape
 from surrogate.kernels.options import JIT
-from surrogate.kernels.particle import _rebound
-from surrogate.kernels.pipeline import no_uniforms, rebound_uniforms, run_blocks
+from surrogate.kernels.table_path import inline_table_rebound
+from surrogate.kernels.pipeline import no_uniforms, table_rebound_uniforms, run_blocks
 from surrogate.kernels.rng import CHUNK_ROWS
 
 METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
@@ -91,7 +91,7 @@ def rebound_path(data, V, omega, n, a, method):
 
 
 @numba.njit(**JIT)
-def rebound_spin_tuple(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True):
+def rebound(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True):
     """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
     3-tuples in the caller's frame.
 
@@ -104,26 +104,26 @@ def rebound_spin_tuple(data, params, model_shapes, mix_cdf, V, omega, n, a, u, m
     mix_cdf : cumulative shape weights, table shape order (:func:`surrogate.mix_cdf`).
     V, omega, n, a, method : as :func:`rebound_path`.
     u : (U_PER_DRAW,) array of uniforms in [0, 1) (module doc for how each path uses them).
-    scaled : the table path's interpolation (:func:`surrogate.kernels.particle.rebound`).
+    scaled : the table path's interpolation (:func:`surrogate.kernels.table_path.table_rebound`).
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
     a uniform outside [0, 1) whatever the path, a method not in the three); NaN vectors unless rebounded.
     """
     path = rebound_path(data, V, omega, n, a, method)
     if path == PATH_TABLE:
-        return _rebound(data, mix_cdf, V, n, a, u, scaled)
+        return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
-        return _rebound_spin_direct(params, model_shapes, mix_cdf, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
+        return _direct_path(params, model_shapes, mix_cdf, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
     return STATUS_INVALID, NAN3, NAN3
 
 
 @numba.njit(inline="always", **JIT)
-def _rebound_spin_direct(params, model_shapes, mix_cdf, V, omega, n, a, u, scratch):
-    """The direct path of :func:`rebound_spin_tuple` with its scratch space given."""
+def _direct_path(params, model_shapes, mix_cdf, V, omega, n, a, u, scratch):
+    """The direct path of :func:`rebound` with its scratch space given."""
     if not (uniforms_ok(u) and params.shape[0] == N_PARAMS and model_shapes.shape[0] == mix_cdf.shape[0]):
         return STATUS_INVALID, NAN3, NAN3
     shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
-    return _rebound_direct(params, V, n, a, omega, model_shapes[shape], u[1:1 + U_PER_REBOUND], scratch)
+    return inline_direct_rebound(params, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND], scratch)
 
 
 @numba.njit(**JIT)
@@ -140,17 +140,17 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, states, method, V_out, Omega_out,
+def rebound_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, states, method, V_out, Omega_out,
                               status, path, scaled=True):
-    """:func:`rebound_spin_tuple` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
+    """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
     a (N,), on all threads; the path of each row into ``path`` (N,).
 
-    The uniforms are those :func:`surrogate.kernels.parallel.rebound_parallel_rng` draws: chunk j's rows
+    The uniforms are those :func:`surrogate.kernels.parallel.table_rebound_parallel_rng` draws: chunk j's rows
     (CHUNK_ROWS rows) from a copy of ``states[j]``, U_PER_DRAW per row. Where the table answers every row
     the results are that kernel's, bit for bit; they never depend on the number of threads. The table's
     pipeline answers every row of a chunk that has a table row (at the table's cost; the rows of the other
     path are answered again), then the direct model answers the direct rows with the same row's uniforms
-    (:func:`surrogate.kernels.pipeline.rebound_uniforms`). Rows are not checked here
+    (:func:`surrogate.kernels.pipeline.table_rebound_uniforms`). Rows are not checked here
     (:func:`surrogate.sample_global` checks them first): a row with a bad input gets status STATUS_INVALID,
     and path STATUS_INVALID under METHOD_AUTO, the method's path under the others. A method code outside
     the three is a ValueError.
@@ -172,7 +172,7 @@ def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, 
             run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), states[j].copy(), V_out[lo:hi],
                        Omega_out[lo:hi], status[lo:hi], scaled)
         if n_table < hi - lo:
-            u = rebound_uniforms(states[j].copy(), hi - lo)
+            u = table_rebound_uniforms(states[j].copy(), hi - lo)
             scratch = np.empty(SCRATCH_SIZE)
             for i in range(lo, hi):
                 if path[i] == PATH_TABLE:
@@ -180,7 +180,7 @@ def rebound_spin_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, 
                 w = min(i, last_omega)
                 st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
                 if path[i] == PATH_DIRECT:
-                    st, V_new, Omega_new = _rebound_spin_direct(
+                    st, V_new, Omega_new = _direct_path(
                         params, model_shapes, mix_cdf, (V[i, 0], V[i, 1], V[i, 2]),
                         (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo],
                         scratch)
