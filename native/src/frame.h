@@ -170,7 +170,7 @@ RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *
         double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
         double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
         k->valid[b] = rbs_moves_into_wall(V0, V1, V2, n0, n1, n2) ? 1.0 : 0.0;
-        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_rebound_many) */
+        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_table_rebound_many) */
         k->ok[b] = rbs_particle_ok(n0, n1, n2, k->a[b]) & (!given || rbs_uniforms_ok(&u[0][b], RBS_BLOCK)) ? 1.0 : 0.0;
         double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
         double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));

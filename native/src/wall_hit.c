@@ -1,10 +1,10 @@
 /*
- * spin.c: every wall hit answered, spinning or not (surrogate.kernels.spin: rebound_path, rebound_spin_tuple):
- * the path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound along it.
+ * wall_hit.c: every wall hit answered, spinning or not (surrogate.kernels.wall_hit: rebound_path, rebound): the
+ * path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound along it.
  *
  * A hit consumes RBS_U_PER_DRAW uniforms whatever path answers it, so a stream stays aligned. The table path
- * is rbs_rebound with those uniforms; the direct path draws the shape from the mix with u[0] as the table
- * path does and gives the direct model u[1..RBS_U_PER_REBOUND] as its own uniforms.
+ * is rbs_table_rebound with those uniforms; the direct path draws the shape from the mix with u[0] as the
+ * table path does and gives the direct model u[1..RBS_U_PER_REBOUND] as its own uniforms.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -13,7 +13,7 @@
 
 #include "frame.h"
 #include "locate.h"
-#include "rebound_internal.h"
+#include "table_arguments.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
 static void nan_out(double *x)
@@ -27,7 +27,7 @@ static int method_known(int method)
     return method == RBS_AUTO || method == RBS_TABLE || method == RBS_DIRECT;
 }
 
-/* the table answers the hit (the test of surrogate.kernels.spin._auto_path): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE,
+/* the table answers the hit (the test of surrogate.kernels.wall_hit._auto_path): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE,
  * α1 and |V⁻| inside the grid, edges included */
 RBS_INLINE int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
 {
@@ -37,7 +37,7 @@ RBS_INLINE int table_valid(const rbs_table *t, double alpha1_deg, double speed, 
            & (speed >= speed_grid[0]) & (speed <= speed_grid[t->n_speed - 1]);
 }
 
-/* RBS_HOT: the x86-64-v3 version has fma() as one instruction, as rbs_rebound (the same bits either way) */
+/* RBS_HOT: the x86-64-v3 version has fma() as one instruction, as rbs_table_rebound (the same bits either way) */
 RBS_HOT int rbs_rebound_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a,
                      int method)
 {
@@ -61,28 +61,35 @@ static int shape_code(const rbs_table *t, int64_t i)
     return -1;      /* a loaded table names known shapes only: never reached */
 }
 
-RBS_HOT int rbs_rebound_spin_u(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
-                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
-                       double V_out[3], double Omega_out[3])
+RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
+                        const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
+                        double V_out[3], double Omega_out[3])
 {
     int path = rbs_rebound_path(t, V, Omega, n, a, method);
-    if (path == RBS_INVALID || !u || !V_out || !Omega_out || !rbs_arguments_ok(t, mix, interpolation)
+    if (path == RBS_INVALID || !u || !V_out || !Omega_out || !rbs_table_arguments_ok(t, mix, interpolation)
         || !rbs_uniforms_ok(u, 1)) {
         nan_out(V_out);
         nan_out(Omega_out);
         return RBS_INVALID;
     }
     if (path == RBS_PATH_TABLE)
-        return rbs_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
-    return rbs_rebound_direct(t, shape_code(t, rbs_mix_shape(mix->cdf, mix->n_shapes, u[0])), V, Omega, n, a, u + 1,
+        return rbs_table_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
+    return rbs_direct_rebound(t, shape_code(t, rbs_mix_shape(mix->cdf, mix->n_shapes, u[0])), V, Omega, n, a, u + 1,
                               V_out, Omega_out);
 }
 
+int rbs_rebound_rng(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3], const double n[3],
+                    double a, rbs_rng *rng, int method, int interpolation, double V_out[3], double Omega_out[3])
+{
+    double u[RBS_U_PER_DRAW];
+    rbs_rng_fill(rng, u, RBS_U_PER_DRAW);       /* NaN (refused) for a NULL or all-zero rng */
+    return rbs_rebound(t, mix, V, Omega, n, a, u, method, interpolation, V_out, Omega_out);
+}
+
+/* kept for programs written against 0.x (rebound_scatter.h) */
 int rbs_rebound_spin(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
                      const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
                      double Omega_out[3])
 {
-    double u[RBS_U_PER_DRAW];
-    rbs_rng_fill(rng, u, RBS_U_PER_DRAW);       /* NaN (refused) for a NULL or all-zero rng */
-    return rbs_rebound_spin_u(t, mix, V, Omega, n, a, u, method, interpolation, V_out, Omega_out);
+    return rbs_rebound_rng(t, mix, V, Omega, n, a, rng, method, interpolation, V_out, Omega_out);
 }
