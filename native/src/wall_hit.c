@@ -22,34 +22,34 @@ static void nan_out(double *x)
         for (int k = 0; k < 3; k++) x[k] = NAN;
 }
 
-static int method_known(int method)
+/* The path under RBS_AUTO, RBS_INVALID for a bad input (surrogate.kernels.wall_hit._auto_path): the table iff
+ * |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE and α1, |V⁻| lie inside the grid, edges included. α1 and |V⁻| come from
+ * the incidence alone, as the table path computes them; the rest of the impact frame is not needed. */
+RBS_INLINE int auto_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a)
 {
-    return method == RBS_AUTO || method == RBS_TABLE || method == RBS_DIRECT;
-}
-
-/* the table answers the hit (the test of surrogate.kernels.wall_hit._auto_path): |Ω⁻| a/|V⁻| <= RBS_SPIN_TOLERANCE,
- * α1 and |V⁻| inside the grid, edges included */
-RBS_INLINE int table_valid(const rbs_table *t, double alpha1_deg, double speed, const double Omega[3], double a)
-{
-    double spin = a * sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) / speed;
+    rbs_incidence_parts in = rbs_incidence(V, n);
+    double alpha1 = rbs_incidence_angle(in.vn, in.vt);
+    double spin = a * sqrt(rbs_dot(Omega[0], Omega[1], Omega[2], Omega[0], Omega[1], Omega[2])) / in.speed;
     const double *alpha1_grid = t->alpha1_axis + AXIS_GRID, *speed_grid = t->speed_axis + AXIS_GRID;
-    return (spin <= RBS_SPIN_TOLERANCE) & (alpha1_deg >= alpha1_grid[0]) & (alpha1_deg <= alpha1_grid[t->n_alpha1 - 1])
-           & (speed >= speed_grid[0]) & (speed <= speed_grid[t->n_speed - 1]);
+    int table = (spin <= RBS_SPIN_TOLERANCE) & (alpha1 >= alpha1_grid[0]) & (alpha1 <= alpha1_grid[t->n_alpha1 - 1])
+                & (in.speed >= speed_grid[0]) & (in.speed <= speed_grid[t->n_speed - 1]);
+    int valid = (in.vn < 0.0) & rbs_finite(V[0] + V[1] + V[2]) & rbs_particle_ok(n[0], n[1], n[2], a)
+                & rbs_finite(Omega[0] + Omega[1] + Omega[2]);
+    return valid ? (table ? RBS_PATH_TABLE : RBS_PATH_DIRECT) : RBS_INVALID;
 }
 
 /* RBS_HOT: the x86-64-v3 version has fma() as one instruction, as rbs_table_rebound (the same bits either way) */
 RBS_HOT int rbs_rebound_path(const rbs_table *t, const double V[3], const double Omega[3], const double n[3], double a,
-                     int method)
+                             int method)
 {
-    if (!t || !V || !Omega || !n || !method_known(method) || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])
-        || !rbs_particle_ok(n[0], n[1], n[2], a) || !rbs_finite(Omega[0] + Omega[1] + Omega[2]))
+    if (!t || !V || !Omega || !n)
         return RBS_INVALID;
-    if (method != RBS_AUTO)
-        return method == RBS_TABLE ? RBS_PATH_TABLE : RBS_PATH_DIRECT;
-    const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
-    rbs_frame f;
-    rbs_impact_frame(Vi, ni, 0.0, &f);      /* α1 and |V⁻| do not depend on the in-wall axis */
-    return table_valid(t, f.alpha1, f.speed, Omega, a) ? RBS_PATH_TABLE : RBS_PATH_DIRECT;
+    int path = auto_path(t, V, Omega, n, a);
+    if (path == RBS_INVALID || method == RBS_AUTO)
+        return path;
+    if (method == RBS_TABLE)
+        return RBS_PATH_TABLE;
+    return method == RBS_DIRECT ? RBS_PATH_DIRECT : RBS_INVALID;
 }
 
 /* the direct model's code of the table's shape i (direct_model.shapes.SHAPES order) */
