@@ -89,7 +89,7 @@ extern "C" {
 #define RBS_VERSION_PATCH 0
 
 #define RBS_U_PER_DRAW 13       /* uniforms per draw (surrogate.U_PER_DRAW) */
-#define RBS_MAX_SHAPES 4        /* ellipsoid, prism, cut_prism, tetrahedron */
+#define RBS_MAX_SHAPES 4        /* the direct model's shapes (direct_model.shapes.SHAPES), the most a table holds */
 #define RBS_TABLE_MAJOR 3       /* the table format major version read (any minor) */
 #define RBS_BLOCK 32            /* rows per block of rbs_table_rebound_many*, lanes of rbs_table_rebound_many_rng */
 #define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */

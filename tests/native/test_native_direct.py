@@ -6,13 +6,14 @@ rebounds in random caller frames, and hostile inputs (RBS_INVALID with NaN, neve
 from __future__ import annotations
 
 import ctypes
+import re
 
 import h5py
 import numpy as np
 import pytest
 
 import _python_side as py
-from _native import ERR_FORMAT
+from _native import ERR_FORMAT, NATIVE
 
 SPINS = (0.0, 0.02, 0.3, 1.0)     # |Ω⁻| a / |V⁻| of the whole-rebound comparisons
 PER_SHAPE = 2000                  # particles per shape and spin
@@ -81,6 +82,35 @@ OLD = dict.fromkeys(("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low",
 
 
 # -- the parameters -------------------------------------------------------------------------------------
+
+_DEFINE = re.compile(r"^#define (\w+) \(?(\w+(?: \+ \w+)*)\)?(?=\s|$)", flags=re.M)
+
+
+def _integer_defines(*headers) -> dict:
+    """The #defines of the headers whose value is an integer or a sum of integers and earlier such names."""
+    values = {}
+    for header in headers:
+        for name, expression in _DEFINE.findall(header.read_text()):
+            terms = expression.split(" + ")
+            if all(t.isdigit() or t in values for t in terms):
+                values[name] = sum(int(t) if t.isdigit() else values[t] for t in terms)
+    return values
+
+
+def test_the_parameter_layout_is_direct_model_s(table_pair):
+    """runtime.h's layout is direct_model.runtime's: every P_* offset, U_* index and N_PARAMS, which both sides
+    derive from the shape count (P_KFAC, then one second-moment factor per shape code); the loader's array
+    has N_PARAMS elements."""
+    c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", NATIVE / "src" / "runtime.h")
+    c["U_PER_REBOUND"] = c["RBS_U_PER_REBOUND"]
+    layout = re.compile(r"P_[A-Z_]+|U_[A-Z_]+|N_PARAMS")
+    python = {name: value for name, value in vars(py.direct_runtime).items() if layout.fullmatch(name)}
+    assert {"P_KFAC", "N_PARAMS", "U_AXIS"} <= set(python)
+    assert {name: value for name, value in c.items() if layout.fullmatch(name)} == python
+    assert c["N_PARAMS"] == c["P_KFAC"] + len(py.SHAPES) == c["P_KFAC"] + c["RBS_MAX_SHAPES"]
+    assert table_pair[1].kernel_array("direct_parameters").size == python["N_PARAMS"]
+
+
 
 def test_the_parameter_array_is_surrogate_s(native, table_pair, small_table_path, tmp_path):
     """The loader's "direct_parameters" equal surrogate's table.direct_parameters bit for bit: on a table that
