@@ -9,10 +9,10 @@
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
-#include <string.h>
 
 #include "frame.h"
 #include "locate.h"
+#include "shapes.h"
 #include "table_arguments.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
@@ -52,15 +52,6 @@ RBS_HOT int rbs_rebound_path(const rbs_table *t, const double V[3], const double
     return method == RBS_DIRECT ? RBS_PATH_DIRECT : RBS_INVALID;
 }
 
-/* the direct model's code of the table's shape i (direct_model.shapes.SHAPES order) */
-static int shape_code(const rbs_table *t, int64_t i)
-{
-    static const char *const codes[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
-    for (int k = 0; k < RBS_MAX_SHAPES; k++)
-        if (strcmp(t->shape_names[i], codes[k]) == 0) return k;
-    return -1;      /* a loaded table names known shapes only: never reached */
-}
-
 RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3],
                         const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
                         double V_out[3], double Omega_out[3])
@@ -74,8 +65,10 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3
     }
     if (path == RBS_PATH_TABLE)
         return rbs_table_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
-    return rbs_direct_rebound(t, shape_code(t, rbs_mix_shape(mix->cdf, mix->n_shapes, u[0])), V, Omega, n, a, u + 1,
-                              V_out, Omega_out);
+    /* the table's shape drawn as the table path draws it, then its model code (a loaded table names known
+     * shapes only) */
+    int64_t shape = rbs_mix_shape(mix->cdf, mix->n_shapes, u[0]);
+    return rbs_direct_rebound(t, rbs_shape_code(t->shape_names[shape]), V, Omega, n, a, u + 1, V_out, Omega_out);
 }
 
 int rbs_rebound_rng(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3], const double n[3],
