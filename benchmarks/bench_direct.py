@@ -1,5 +1,5 @@
 """Throughput benchmark of the direct rebound model: the batch API (``direct_model.simulate.simulate``) and
-the run-time kernels (numba's ``surrogate.kernels.direct_rebound``, C's ``rbs_rebound_direct``).
+the run-time kernels (numba's ``surrogate.kernels.direct_rebound``, C's ``rbs_direct_rebound``).
 
 What is measured: the batch
 ---------------------------
@@ -25,7 +25,7 @@ For each shape and incidence angle α1 (default: the four shapes at 45° and
 
 What is measured: the run-time kernels
 --------------------------------------
-Microseconds per rebound of numba's ``direct_rebound`` and of the C library's ``rbs_rebound_direct``,
+Microseconds per rebound of numba's ``direct_rebound`` and of the C library's ``rbs_direct_rebound``,
 one particle per call in a loop on one thread (an ``@njit`` loop; a C loop in native/bench/rbs_bench_direct.c),
 the 7 uniforms drawn per call from one xoshiro256+ stream of seed SEED (``fill_uniforms``, ``rbs_rng_fill``:
 the same uniforms, so the C outputs are checked against numba's bits), as a solver would call them. Per
@@ -420,7 +420,7 @@ def state_sets(m: int, hits_path: Path) -> dict:
 
 def c_runtime(program: Path, table: Path, states: dict, shape_code: int, repeats: int, folder: Path,
               pieces: dict) -> dict:
-    """µs per rebound of rbs_rebound_direct in a C loop (native/bench/rbs_bench_direct.c) on the states, its
+    """µs per rebound of rbs_direct_rebound in a C loop (native/bench/rbs_bench_direct.c) on the states, its
     outputs for the first timed pass (the uniforms of seed SEED, as the numba loop draws them), and µs per
     call of C's rebound alone and of its pieces on the same inputs as numba's."""
     count = len(states["a"])
@@ -520,7 +520,7 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
         for code in range(len(SHAPES)):                  # warm-up: compile the loops
             bench_runtime(params, warm, "warm-up", code, 1)
         print(f"\nRun-time kernels, one thread, best of {repeats}: numba (surrogate.kernels.direct_rebound)"
-              + (" and C (rbs_rebound_direct)" if native else "") + f"; states: {states} random per row with Ω⁻ = 0 "
+              + (" and C (rbs_direct_rebound)" if native else "") + f"; states: {states} random per row with Ω⁻ = 0 "
               f"('random, 0') or spinning ('random, spin'), and {len(sets['hopper']['a'])} hopperRebound hits "
               f"({hits_path.name}, {np.mean(np.any(sets['hopper']['omega'] != 0, axis=1)):.0%} spinning) run with "
               "each shape ('hopper')")
@@ -587,7 +587,7 @@ def main(argv=None) -> int:
 
     info = machine_info()
     threads = info["numba_default_threads"]
-    print("Direct rebound model throughput (direct_model.simulate; the run-time kernels direct_rebound, rbs_rebound_direct)")
+    print("Direct rebound model throughput (direct_model.simulate; the run-time kernels direct_rebound, rbs_direct_rebound)")
     for key, value in info.items():
         print(f"  {key:22s} {value}")
     runtime_rows = main_runtime(states, repeats, args.hits, args.table, args.build_dir, not args.no_native)

@@ -5,18 +5,18 @@
  *
  * STATES.bin: int64 count, then V (count, 3), n (count, 3), a (count) as float64 (row-major). Times, best
  * of REPEATS, in ns per reflected state, printed as one JSON object:
- *   c_per_particle   a solver's loop: rbs_rng_fill (13 uniforms) and rbs_rebound per particle
- *   c_many           rbs_rebound_many_rng on all the states (uniforms from 32 xoshiro256+ lanes)
- *   c_many_given     rbs_rebound_many on pre-drawn uniforms (their drawing not timed)
+ *   c_per_particle   a solver's loop: rbs_rng_fill (13 uniforms) and rbs_table_rebound per particle
+ *   c_many           rbs_table_rebound_many_rng on all the states (uniforms from 32 xoshiro256+ lanes)
+ *   c_many_given     rbs_table_rebound_many on pre-drawn uniforms (their drawing not timed)
  *   c_rng            the 13 uniforms per state alone (rbs_rng_fill)
  *   c_grant_tabakoff the deterministic Grant–Tabakoff sphere bounce, same loop (bench_sampler.py's (d))
- *   c_spin_still     c_per_particle's loop with rbs_rebound_spin (RBS_AUTO, Ω⁻ = 0): the path decision's cost
+ *   c_spin_still     c_per_particle's loop with rbs_rebound_rng (RBS_AUTO, Ω⁻ = 0): the path decision's cost
  * and, under "cpu", the thread CPU time per state of each best run (steadier when other work shares the CPU);
- * then, in µs per hit, c_spin_spinning_us: rbs_rebound_spin (RBS_AUTO) on the first SPINNING states with
+ * then, in µs per hit, c_spin_spinning_us: rbs_rebound_rng (RBS_AUTO) on the first SPINNING states with
  * |Ω⁻| a/|V⁻| = 0.3 about random axes (the direct model answers them), one timed run.
  *
- * With OUT.bin, the results of the first rbs_rebound_many_rng call (V_out, Omega_out as float64 (count, 3),
- * status as int8) are written there, for a comparison of the bits.
+ * With OUT.bin, the results of the first rbs_table_rebound_many_rng call (V_out, Omega_out as float64
+ * (count, 3), status as int8) are written there, for a comparison of the bits.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -117,8 +117,8 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < N; i++) {
             double u[RBS_U_PER_DRAW];
             rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
-            status[i] = (signed char)rbs_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED, V_out + 3 * i,
-                                                 Omega_out + 3 * i);
+            status[i] = (signed char)rbs_table_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
+                                                       V_out + 3 * i, Omega_out + 3 * i);
         }
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[0], &cpu[0]);
@@ -127,7 +127,7 @@ int main(int argc, char **argv)
         rbs_rng_seed(&rng, seed);
         t0 = now();
         c0 = cpu_now();
-        rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+        rbs_table_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[1], &cpu[1]);
         checksum += V_out[0];
@@ -143,7 +143,7 @@ int main(int argc, char **argv)
         /* (3) many particles, uniforms given */
         t0 = now();
         c0 = cpu_now();
-        rbs_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, Omega_out, status);
+        rbs_table_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, Omega_out, status);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[2], &cpu[2]);
         checksum += V_out[0];
@@ -167,13 +167,13 @@ int main(int argc, char **argv)
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[4], &cpu[4]);
         checksum += V_out[0];
-        /* (6) per particle through rbs_rebound_spin, no spin: the table answers, after the path decision */
+        /* (6) per particle through rbs_rebound_rng, no spin: the table answers, after the path decision */
         rbs_rng_seed(&rng, seed);
         t0 = now();
         c0 = cpu_now();
         for (size_t i = 0; i < N; i++)
-            status[i] = (signed char)rbs_rebound_spin(table, &mix, V + 3 * i, still, n + 3 * i, a[i], &rng, RBS_AUTO,
-                                                      RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+            status[i] = (signed char)rbs_rebound_rng(table, &mix, V + 3 * i, still, n + 3 * i, a[i], &rng, RBS_AUTO,
+                                                     RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[5], &cpu[5]);
         checksum += V_out[0];
@@ -200,8 +200,8 @@ int main(int argc, char **argv)
     rbs_rng_seed(&rng, seed);
     double t0 = now();
     for (size_t i = 0; i < n_spin; i++)
-        status[i] = (signed char)rbs_rebound_spin(table, &mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
-                                                  RBS_AUTO, RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+        status[i] = (signed char)rbs_rebound_rng(table, &mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
+                                                 RBS_AUTO, RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
     double spinning_us = (now() - t0) / (double)n_spin * 1e6;
     size_t spin_failed = 0;
     for (size_t i = 0; i < n_spin; i++) spin_failed += status[i] == RBS_FAILED;

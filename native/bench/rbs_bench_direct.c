@@ -6,7 +6,7 @@
  * STATES.bin: int64 count, then V (count, 3) m/s, Omega (count, 3) rad/s, n (count, 3), a (count) m, as
  * float64 (row-major). SHAPE: a shape code (RBS_ELLIPSOID ..). The loop a solver runs: per state,
  * rbs_rng_fill (RBS_U_PER_REBOUND uniforms from one stream of SEED, as numba's fill_uniforms draws them)
- * and rbs_rebound_direct. Printed as one JSON object, best of REPEATS: us_per_rebound (this thread's CPU
+ * and rbs_direct_rebound. Printed as one JSON object, best of REPEATS: us_per_rebound (this thread's CPU
  * time, which leaves out the time other jobs take on a shared machine), us_per_rebound_wall, and the
  * counts of each status. With OUT.bin, the outputs (V_out, Omega_out as float64 (count, 3), status as
  * int8) are written there, for a comparison of the bits with numba's.
@@ -177,7 +177,7 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < N; i++) {
             double u[RBS_U_PER_REBOUND];
             rbs_rng_fill(&rng, u, RBS_U_PER_REBOUND);
-            status[i] = (signed char)rbs_rebound_direct(table, shape, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], u,
+            status[i] = (signed char)rbs_direct_rebound(table, shape, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], u,
                                                         V_out + 3 * i, Omega_out + 3 * i);
         }
         double cpu = seconds(CLOCK_THREAD_CPUTIME_ID) - c0, wall = seconds(CLOCK_MONOTONIC) - w0;

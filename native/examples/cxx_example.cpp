@@ -35,12 +35,12 @@ int main(int argc, char **argv)
         V[3 * i + 1] = -60.0 - static_cast<double>(i);
         n[3 * i + 1] = 1.0;
     }
-    rbs_rebound_many_rng(table.get(), &mix, count, V.data(), n.data(), a.data(), &rng, RBS_SCALED, V_out.data(),
-                         Omega_out.data(), status.data());
+    rbs_table_rebound_many_rng(table.get(), &mix, count, V.data(), n.data(), a.data(), &rng, RBS_SCALED,
+                               V_out.data(), Omega_out.data(), status.data());
     std::array<double, RBS_U_PER_DRAW> u{};
     rbs_rng_fill(&rng, u.data(), u.size());
     double one[3], spin[3];
-    int st = rbs_rebound(table.get(), &mix, V.data(), n.data(), 1e-4, u.data(), RBS_STOCHASTIC, one, spin);
+    int st = rbs_table_rebound(table.get(), &mix, V.data(), n.data(), 1e-4, u.data(), RBS_STOCHASTIC, one, spin);
     std::size_t rebounded = 0;
     for (signed char s : status) rebounded += s == RBS_REBOUNDED;
     std::printf("C++: %zu of %zu rebounded; one more: status %d; library %s\n", rebounded, count, st, rbs_version());

@@ -43,7 +43,7 @@ int main(int argc, char **argv)
         double V_out[3], Omega_out[3];
         /* RBS_AUTO: the table where its law is valid, the direct model for the other hits */
         int path = rbs_rebound_path(table, V, Omega, n, a, RBS_AUTO);
-        int status = rbs_rebound_spin(table, &mix, V, Omega, n, a, &rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out);
+        int status = rbs_rebound_rng(table, &mix, V, Omega, n, a, &rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out);
         printf("%d Omega- = (%g, %g, %g) rad/s, %s: status %2d  V+ = (%9.3f, %9.3f, %9.3f) m/s  "
                "Omega+ = (%11.1f, %11.1f, %11.1f) rad/s\n", i, Omega[0], Omega[1], Omega[2],
                path == RBS_PATH_TABLE ? "table" : "direct model", status, V_out[0], V_out[1], V_out[2],

@@ -30,26 +30,27 @@ program rebound_example
   code = rbs_mix_equal(table, mix)
   call rbs_rng_seed(rng, 1_c_int64_t)
 
-  ! one particle at a time
+  ! one particle at a time, every hit answered (here no spin: the table answers)
   V = [120.0_c_double, -80.0_c_double, 10.0_c_double]      ! m/s, into the wall
   n = [0.0_c_double, 1.0_c_double, 0.0_c_double]           ! unit normal into the gas
+  Omega = 0.0_c_double                                     ! rad/s
   do i = 1, 3
     call rbs_rng_fill(rng, u, int(RBS_U_PER_DRAW, c_size_t))
-    st = rbs_rebound(table, mix, V, n, 5e-5_c_double, u, RBS_SCALED, V_out, Omega_out)
+    st = rbs_rebound(table, mix, V, Omega, n, 5e-5_c_double, u, RBS_AUTO, RBS_SCALED, V_out, Omega_out)
     print '(a, i0, a, 3f10.3, a, 3es12.3)', "status ", st, "  V+ =", V_out, "  Omega+ =", Omega_out
   end do
 
-  ! a spinning particle by the direct model (the impulse model simulated; Omega in rad/s)
+  ! a spinning particle by the direct path alone (the impulse model simulated; Omega in rad/s)
   Omega = [0.0_c_double, 0.0_c_double, 2e5_c_double]
   call rbs_rng_fill(rng, ud, int(RBS_U_PER_REBOUND, c_size_t))
-  st = rbs_rebound_direct(table, RBS_PRISM, V, Omega, n, 5e-5_c_double, ud, V_out, Omega_out)
+  st = rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 5e-5_c_double, ud, V_out, Omega_out)
   print '(a, i0, a, 3f10.3, a, 3es12.3)', "direct: status ", st, "  V+ =", V_out, "  Omega+ =", Omega_out
   if (st /= RBS_REBOUNDED .or. V_out(2) <= 0.0_c_double) stop 5   ! this one rebounds, leaving the wall
 
   ! a spinning particle, |Omega-| a/|V-| = 0.3: the direct model answers under RBS_AUTO
   Omega = [0.0_c_double, 0.3_c_double * norm2(V) / 5e-5_c_double, 0.0_c_double]     ! rad/s
   answered_by = rbs_rebound_path(table, V, Omega, n, 5e-5_c_double, RBS_AUTO)
-  st = rbs_rebound_spin(table, mix, V, Omega, n, 5e-5_c_double, rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out)
+  st = rbs_rebound_rng(table, mix, V, Omega, n, 5e-5_c_double, rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out)
   print '(a, i0, a, i0, a, 3f10.3)', "spinning: path ", answered_by, ", status ", st, "  V+ =", V_out
   if (answered_by /= RBS_PATH_DIRECT) stop 6
 
@@ -59,7 +60,7 @@ program rebound_example
     ns(:, i) = n
   end do
   a = 5e-5_c_double
-  call rbs_rebound_many_rng(table, mix, int(n_many, c_size_t), Vs, ns, a, rng, RBS_SCALED, Vs_out, Ws_out, status)
+  call rbs_table_rebound_many_rng(table, mix, int(n_many, c_size_t), Vs, ns, a, rng, RBS_SCALED, Vs_out, Ws_out, status)
   print '(a, i0, a, i0, a, i0, a)', "many: ", n_many, " particles, ", count_status(RBS_REBOUNDED), &
       " rebounded, ", count_status(RBS_TRAPPED), " trapped"
   if (count_status(RBS_REBOUNDED) + count_status(RBS_TRAPPED) /= n_many) stop 3

@@ -18,7 +18,7 @@ module rebound_scatter
   integer(c_int), parameter :: RBS_OK = 0, RBS_ERR_IO = 1, RBS_ERR_FORMAT = 2, RBS_ERR_VERSION = 3, &
                                RBS_ERR_ARGUMENT = 4, RBS_ERR_MEMORY = 5
   integer(c_int), parameter :: RBS_SCALED = 0, RBS_STOCHASTIC = 1
-  ! methods of rbs_rebound_spin and the paths of rbs_rebound_path
+  ! methods of rbs_rebound and the paths of rbs_rebound_path
   integer(c_int), parameter :: RBS_AUTO = 0, RBS_TABLE = 1, RBS_DIRECT = 2
   integer(c_int), parameter :: RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1
   real(c_double), parameter :: RBS_SPIN_TOLERANCE = 0.001_c_double
@@ -81,33 +81,23 @@ module rebound_scatter
       integer(c_size_t), value :: message_size
     end function rbs_mix_from_shape_c
 
-    integer(c_int) function rbs_rebound(table, mix, V, n, a, u, interpolation, V_out, Omega_out) &
-        bind(c, name="rbs_rebound")
+    ! Every wall hit: call this first. The table where its law is valid, the direct model elsewhere; Omega the
+    ! incident angular velocity in rad/s; method RBS_AUTO, RBS_TABLE or RBS_DIRECT; u RBS_U_PER_DRAW uniforms
+    integer(c_int) function rbs_rebound(table, mix, V, Omega, n, a, u, method, interpolation, V_out, &
+        Omega_out) bind(c, name="rbs_rebound")
       import :: c_int, c_ptr, c_double, rbs_mix, RBS_U_PER_DRAW
       type(c_ptr), value :: table
       type(rbs_mix), intent(in) :: mix
-      real(c_double), intent(in) :: V(3), n(3)
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
       real(c_double), value :: a
       real(c_double), intent(in) :: u(RBS_U_PER_DRAW)
-      integer(c_int), value :: interpolation
+      integer(c_int), value :: method, interpolation
       real(c_double), intent(out) :: V_out(3), Omega_out(3)
     end function rbs_rebound
 
-    ! the direct model (rbs_rebound_direct): shape a model code RBS_ELLIPSOID .. RBS_TETRAHEDRON, Omega in rad/s
-    integer(c_int) function rbs_rebound_direct(table, shape, V, Omega, n, a, u, V_out, Omega_out) &
-        bind(c, name="rbs_rebound_direct")
-      import :: c_int, c_ptr, c_double, RBS_U_PER_REBOUND
-      type(c_ptr), value :: table
-      integer(c_int), value :: shape
-      real(c_double), intent(in) :: V(3), Omega(3), n(3)
-      real(c_double), value :: a
-      real(c_double), intent(in) :: u(RBS_U_PER_REBOUND)
-      real(c_double), intent(out) :: V_out(3), Omega_out(3)
-    end function rbs_rebound_direct
-
-    ! Omega: the incident angular velocity in rad/s; method RBS_AUTO, RBS_TABLE or RBS_DIRECT
-    integer(c_int) function rbs_rebound_spin(table, mix, V, Omega, n, a, rng, method, interpolation, V_out, &
-        Omega_out) bind(c, name="rbs_rebound_spin")
+    ! rbs_rebound with its uniforms drawn from rng
+    integer(c_int) function rbs_rebound_rng(table, mix, V, Omega, n, a, rng, method, interpolation, V_out, &
+        Omega_out) bind(c, name="rbs_rebound_rng")
       import :: c_int, c_ptr, c_double, rbs_mix, rbs_rng
       type(c_ptr), value :: table
       type(rbs_mix), intent(in) :: mix
@@ -116,19 +106,7 @@ module rebound_scatter
       type(rbs_rng), intent(inout) :: rng
       integer(c_int), value :: method, interpolation
       real(c_double), intent(out) :: V_out(3), Omega_out(3)
-    end function rbs_rebound_spin
-
-    integer(c_int) function rbs_rebound_spin_u(table, mix, V, Omega, n, a, u, method, interpolation, V_out, &
-        Omega_out) bind(c, name="rbs_rebound_spin_u")
-      import :: c_int, c_ptr, c_double, rbs_mix, RBS_U_PER_DRAW
-      type(c_ptr), value :: table
-      type(rbs_mix), intent(in) :: mix
-      real(c_double), intent(in) :: V(3), Omega(3), n(3)
-      real(c_double), value :: a
-      real(c_double), intent(in) :: u(RBS_U_PER_DRAW)
-      integer(c_int), value :: method, interpolation
-      real(c_double), intent(out) :: V_out(3), Omega_out(3)
-    end function rbs_rebound_spin_u
+    end function rbs_rebound_rng
 
     integer(c_int) function rbs_rebound_path(table, V, Omega, n, a, method) bind(c, name="rbs_rebound_path")
       import :: c_int, c_ptr, c_double
@@ -138,8 +116,21 @@ module rebound_scatter
       integer(c_int), value :: method
     end function rbs_rebound_path
 
-    subroutine rbs_rebound_many(table, mix, count, V, n, a, u, interpolation, V_out, Omega_out, status) &
-        bind(c, name="rbs_rebound_many")
+    ! the table path alone
+    integer(c_int) function rbs_table_rebound(table, mix, V, n, a, u, interpolation, V_out, Omega_out) &
+        bind(c, name="rbs_table_rebound")
+      import :: c_int, c_ptr, c_double, rbs_mix, RBS_U_PER_DRAW
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      real(c_double), intent(in) :: V(3), n(3)
+      real(c_double), value :: a
+      real(c_double), intent(in) :: u(RBS_U_PER_DRAW)
+      integer(c_int), value :: interpolation
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_table_rebound
+
+    subroutine rbs_table_rebound_many(table, mix, count, V, n, a, u, interpolation, V_out, Omega_out, status) &
+        bind(c, name="rbs_table_rebound_many")
       import :: c_int, c_ptr, c_double, c_size_t, c_signed_char, rbs_mix
       type(c_ptr), value :: table
       type(rbs_mix), intent(in) :: mix
@@ -148,10 +139,10 @@ module rebound_scatter
       integer(c_int), value :: interpolation
       real(c_double), intent(out) :: V_out(3, *), Omega_out(3, *)
       integer(c_signed_char), intent(out) :: status(*)
-    end subroutine rbs_rebound_many
+    end subroutine rbs_table_rebound_many
 
-    subroutine rbs_rebound_many_rng(table, mix, count, V, n, a, rng, interpolation, V_out, Omega_out, status) &
-        bind(c, name="rbs_rebound_many_rng")
+    subroutine rbs_table_rebound_many_rng(table, mix, count, V, n, a, rng, interpolation, V_out, Omega_out, &
+        status) bind(c, name="rbs_table_rebound_many_rng")
       import :: c_int, c_ptr, c_double, c_size_t, c_signed_char, rbs_mix, rbs_rng
       type(c_ptr), value :: table
       type(rbs_mix), intent(in) :: mix
@@ -161,7 +152,7 @@ module rebound_scatter
       integer(c_int), value :: interpolation
       real(c_double), intent(out) :: V_out(3, *), Omega_out(3, *)
       integer(c_signed_char), intent(out) :: status(*)
-    end subroutine rbs_rebound_many_rng
+    end subroutine rbs_table_rebound_many_rng
 
     integer(c_int) function rbs_draw_local(table, mix, alpha1_deg, speed_m_s, u, interpolation, out) &
         bind(c, name="rbs_draw_local")
@@ -173,6 +164,31 @@ module rebound_scatter
       integer(c_int), value :: interpolation
       real(c_double), intent(out) :: out(RBS_LOCAL_SIZE)
     end function rbs_draw_local
+
+    ! the direct path alone (the direct model): shape a model code RBS_ELLIPSOID .. RBS_TETRAHEDRON, Omega in rad/s
+    integer(c_int) function rbs_direct_rebound(table, shape, V, Omega, n, a, u, V_out, Omega_out) &
+        bind(c, name="rbs_direct_rebound")
+      import :: c_int, c_ptr, c_double, RBS_U_PER_REBOUND
+      type(c_ptr), value :: table
+      integer(c_int), value :: shape
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      real(c_double), intent(in) :: u(RBS_U_PER_REBOUND)
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_direct_rebound
+
+    ! rbs_rebound_rng under its 0.x name, kept for programs written against 0.x
+    integer(c_int) function rbs_rebound_spin(table, mix, V, Omega, n, a, rng, method, interpolation, V_out, &
+        Omega_out) bind(c, name="rbs_rebound_spin")
+      import :: c_int, c_ptr, c_double, rbs_mix, rbs_rng
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      type(rbs_rng), intent(inout) :: rng
+      integer(c_int), value :: method, interpolation
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_rebound_spin
 
     subroutine rbs_rng_seed(rng, seed) bind(c, name="rbs_rng_seed")
       import :: c_int64_t, rbs_rng

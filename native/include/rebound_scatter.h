@@ -1,16 +1,26 @@
 /*
  * rebound_scatter.h: the native runtime of rebound-scatter.
  *
- * A C library that reads the tables `tablegen build` writes (table format 3.x,
- * docs/format.md) and draws reflected states of non-spherical particles hitting
- * a wall, with the same law and the same bits as the numba kernels of the
- * Python package `surrogate` (surrogate.kernels.rebound_tuple, rebound_many,
- * rebound_many_rng, draw_local), for the same uniforms; and runs the direct
- * model itself where the table's law does not apply (rbs_rebound_direct, the
- * bits of surrogate.kernels.rebound_direct_tuple). rbs_rebound_spin answers any
- * hit, spinning or not: the table where its law is valid, the direct model
- * elsewhere (the bits of surrogate.kernels.spin.rebound_spin_tuple). See
- * docs/native.md.
+ * A C library that answers a particle's hit on a wall with its reflected state, for non-spherical
+ * particles spinning or not, with the same law and the same bits as the numba kernels of the Python
+ * package `surrogate` for the same uniforms. See docs/native.md.
+ *
+ * Where to start
+ * --------------
+ * A solver calls rbs_rebound (uniforms given) or rbs_rebound_rng (uniforms from an rbs_rng) for every
+ * wall hit: it answers any hit, from the table where the table's law is valid (the table path), from the
+ * direct model elsewhere (the direct path), per particle (surrogate.kernels.wall_hit.rebound). Before
+ * the loop: rbs_table_open (a table `tablegen build` wrote, format 3.x, docs/format.md), a shape mix
+ * (rbs_mix_equal, rbs_mix_from_shape, rbs_mix_from_weights) and one rbs_rng per thread.
+ * Each path can also be called alone: the table path rbs_table_rebound
+ * (surrogate.kernels.table_path.table_rebound), its many-particle forms rbs_table_rebound_many and
+ * rbs_table_rebound_many_rng (surrogate.kernels.pipeline), rbs_draw_local; the direct path
+ * rbs_direct_rebound (surrogate.kernels.direct_path.direct_rebound).
+ *
+ * One naming rule: no suffix, the uniforms are given; _rng, they are drawn from an rbs_rng. One argument
+ * order: table, the mix or the shape, V, Omega, n, a, the uniforms or the rng, then options and outputs.
+ * Version 1.0 renamed the draws of 0.x; rbs_rebound_spin and rbs_rebound_path keep working with their 0.x
+ * arguments (end of this header).
  *
  * Frames and units
  * ----------------
@@ -74,20 +84,20 @@
 extern "C" {
 #endif
 
-#define RBS_VERSION_MAJOR 0
-#define RBS_VERSION_MINOR 1
+#define RBS_VERSION_MAJOR 1
+#define RBS_VERSION_MINOR 0
 #define RBS_VERSION_PATCH 0
 
 #define RBS_U_PER_DRAW 13       /* uniforms per draw (surrogate.U_PER_DRAW) */
-#define RBS_MAX_SHAPES 4        /* ellipsoid, prism, cut_prism, tetrahedron */
+#define RBS_MAX_SHAPES 4        /* the direct model's shapes (direct_model.shapes.SHAPES), the most a table holds */
 #define RBS_TABLE_MAJOR 3       /* the table format major version read (any minor) */
-#define RBS_BLOCK 32            /* rows per block of rbs_rebound_many*, lanes of rbs_rebound_many_rng */
+#define RBS_BLOCK 32            /* rows per block of rbs_table_rebound_many*, lanes of rbs_table_rebound_many_rng */
 #define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */
 #define RBS_NORMAL_TOLERANCE 1e-6   /* | |n| − 1 | allowed for a wall normal (surrogate.kernels.frame.NORMAL_TOLERANCE) */
 #define RBS_U_PER_REBOUND 7     /* uniforms of one direct-model rebound (direct_model.runtime.U_PER_REBOUND) */
 
 /* Status of a draw: the codes of surrogate (STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED, STATUS_INVALID).
- * RBS_FAILED comes from the direct model only (rbs_rebound_direct): a collision solve or a contact search
+ * RBS_FAILED comes from the direct model only (rbs_direct_rebound): a collision solve or a contact search
  * failed; count and report it, never drop it. */
 enum { RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_FAILED = 2, RBS_INVALID = -1 };
 
@@ -152,7 +162,8 @@ typedef struct rbs_table_info {
  * groups, datasets (every one read, so every checksum verified) and attributes with their shapes, the
  * grids and shape names, the wall law (and its checksummed copy since 3.2), the cell values; then the
  * derived arrays are checked finite, and the direct model's parameters in range (those of
- * surrogate.table.direct_parameters, RBS_ERR_FORMAT "the direct model's parameters are out of range").
+ * surrogate.table.SurrogateTable.direct_parameters, RBS_ERR_FORMAT "the direct model's parameters are out of
+ * range").
  * Returns RBS_OK, RBS_ERR_IO, RBS_ERR_FORMAT, RBS_ERR_VERSION, RBS_ERR_MEMORY or RBS_ERR_ARGUMENT. */
 int rbs_table_open(const char *path, rbs_table **table, char *message, size_t message_size);
 
@@ -204,9 +215,66 @@ int rbs_mix_from_shape(const rbs_table *table, const char *name, rbs_mix *mix, c
 /* The equal mix over the table's shapes (surrogate.mix_cdf(table, "mix")). RBS_OK or RBS_ERR_ARGUMENT. */
 int rbs_mix_equal(const rbs_table *table, rbs_mix *mix);
 
-/* ---------------------------------------------------------------- draws */
+/* ---------------------------------------------------------------- every wall hit: call this first */
 
-/* The reflected state of one particle, global frame (surrogate.kernels.rebound_tuple).
+/* Methods of rbs_rebound (surrogate's method "auto", "table", "direct"). */
+enum {
+    RBS_AUTO = 0,           /* the table where its law is valid (below), the direct model for every other hit */
+    RBS_TABLE = 1,          /* the table whatever Ω⁻ (rbs_table_rebound: the law at the nearest grid edge outside) */
+    RBS_DIRECT = 2          /* the direct model for every hit */
+};
+
+/* The path that answers a hit (rbs_rebound_path). */
+enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
+
+/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.SPIN_TOLERANCE): where the table's law
+ * and the direct model's with that spin stay within classifier accuracy 0.52 (docs/design/spin_tolerance.md). */
+#define RBS_SPIN_TOLERANCE 0.001
+
+/* The reflected state of one particle hitting the wall, spinning or not, global frame
+ * (surrogate.kernels.wall_hit.rebound): the path rbs_rebound_path gives, then
+ *   RBS_PATH_TABLE   rbs_table_rebound with the same u (Ω⁻ unused);
+ *   RBS_PATH_DIRECT  the shape drawn from the mix with u[0] as rbs_table_rebound draws it, then
+ *                    rbs_direct_rebound with that shape's code and u[1..RBS_U_PER_REBOUND] as its uniforms.
+ * A hit consumes RBS_U_PER_DRAW uniforms whatever the path, so streams stay aligned.
+ *   mix      the shape mix (rbs_mix_equal, rbs_mix_from_shape, rbs_mix_from_weights)
+ *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
+ *   Omega    incident angular velocity Ω⁻, rad/s (finite)
+ *   n        unit wall normal into the gas (| |n| − 1 | <= RBS_NORMAL_TOLERANCE)
+ *   a        half-size (half the largest extent), m (finite, > 0)
+ *   u        RBS_U_PER_DRAW uniforms in [0, 1)
+ *   method   RBS_AUTO (the default of surrogate), RBS_TABLE or RBS_DIRECT
+ *   interpolation  the table path's, RBS_SCALED or RBS_STOCHASTIC
+ *   V_out    V⁺, m/s;  Omega_out  Ω⁺, rad/s  (NaN unless rebounded)
+ * Returns RBS_REBOUNDED, RBS_TRAPPED, RBS_FAILED (direct path: a collision solve or a contact search
+ * failed; count it) or RBS_INVALID (what rbs_rebound_path refuses, a NULL pointer, a mix of another
+ * table's shape count, an unknown interpolation, a uniform outside [0, 1) or NaN); NaN outputs unless
+ * rebounded. The direct path costs microseconds, the table path a fraction of one. Thread-safe. */
+int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
+                double V_out[3], double Omega_out[3]);
+
+/* rbs_rebound with its RBS_U_PER_DRAW uniforms drawn from `rng` (rbs_rng_fill), which advances by them
+ * whatever the path and whatever the result; a NULL or all-zero rng gives RBS_INVALID. */
+int rbs_rebound_rng(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                    const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
+                    double Omega_out[3]);
+
+/* The path that answers a hit under `method` (surrogate.kernels.wall_hit.rebound_path): a pure function of
+ * the state, so a caller learns it without another draw. Under RBS_AUTO, the table iff |Ω⁻| a/|V⁻| <=
+ * RBS_SPIN_TOLERANCE (Ω⁻ = 0 included), and α1 and |V⁻| (as rbs_table_rebound computes them) lie in the
+ * table's grid ranges, edges included (rbs_table_alpha1_range, rbs_table_speed_range); else the direct model.
+ *   V, Omega, n, a  as rbs_rebound
+ * Returns RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_INVALID for a NULL pointer, an unknown method, or a
+ * state rbs_table_rebound or rbs_direct_rebound refuses (V not moving into the wall, n not a unit vector, a
+ * not finite and > 0, Ω⁻ not finite). */
+int rbs_rebound_path(const rbs_table *table, const double V[3], const double Omega[3], const double n[3],
+                     double a, int method);
+
+/* ---------------------------------------------------------------- the table path */
+
+/* The reflected state of one particle from the table's law, global frame
+ * (surrogate.kernels.table_path.table_rebound); Ω⁻ = 0 is assumed.
  *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
  *   n        unit wall normal into the gas (| |n| − 1 | <= RBS_NORMAL_TOLERANCE)
  *   a        half-size, m (finite, > 0)
@@ -218,29 +286,29 @@ int rbs_mix_equal(const rbs_table *table, rbs_mix *mix);
  * and > 0, a uniform is outside [0, 1), the result would not be finite or would not leave the wall; a
  * NULL pointer, a mix of another table's shape count, an unknown interpolation). A rebound's V⁺ and Ω⁺
  * are finite and V⁺·n > 0. */
-int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
-                const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
+int rbs_table_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
+                      const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
 
-/* rbs_rebound for `count` particles, one thread: V, n, V_out, Omega_out row-major (count, 3), a (count,),
- * u (count, RBS_U_PER_DRAW), status (count,). The same bits as rbs_rebound row by row (and as
- * surrogate.kernels.rebound_many); faster, because the table reads of RBS_BLOCK rows are in flight
- * together and the arithmetic runs as SIMD loops over them. The outputs must not overlap the inputs. A NULL
- * table, mix or array (count > 0), a mix of another table's shape count or an unknown interpolation gives
- * every row RBS_INVALID and NaN (in the outputs that are not NULL). */
-void rbs_rebound_many(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V, const double *n,
-                      const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
-                      signed char *status);
+/* rbs_table_rebound for `count` particles, one thread: V, n, V_out, Omega_out row-major (count, 3), a (count,),
+ * u (count, RBS_U_PER_DRAW), status (count,). The same bits as rbs_table_rebound row by row (and as
+ * surrogate.kernels.pipeline.table_rebound_many); faster, because the table reads of RBS_BLOCK rows are in
+ * flight together and the arithmetic runs as SIMD loops over them. The outputs must not overlap the inputs.
+ * A NULL table, mix or array (count > 0), a mix of another table's shape count or an unknown interpolation
+ * gives every row RBS_INVALID and NaN (in the outputs that are not NULL). */
+void rbs_table_rebound_many(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V,
+                            const double *n, const double *a, const double *u, int interpolation, double *V_out,
+                            double *Omega_out, signed char *status);
 
-/* rbs_rebound_many drawing the uniforms from `rng`, as surrogate.kernels.rebound_many_rng does, bit for
- * bit: rng is advanced one step to seed RBS_BLOCK xoshiro256+ lanes (splitmix64), and row b of every
- * block of RBS_BLOCK rows takes its 13 uniforms from lane b. rbs_rebound_uniforms gives those uniforms.
- * A NULL or all-zero rng (or the cases of rbs_rebound_many) gives every row RBS_INVALID, and rng is not
- * advanced. */
-void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V,
-                          const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
-                          double *Omega_out, signed char *status);
+/* rbs_table_rebound_many drawing the uniforms from `rng`, as surrogate.kernels.pipeline.table_rebound_many_rng
+ * does, bit for bit: rng is advanced one step to seed RBS_BLOCK xoshiro256+ lanes (splitmix64), and row b of
+ * every block of RBS_BLOCK rows takes its 13 uniforms from lane b. rbs_table_rebound_uniforms gives those
+ * uniforms. A NULL or all-zero rng (or the cases of rbs_table_rebound_many) gives every row RBS_INVALID, and
+ * rng is not advanced. */
+void rbs_table_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t count, const double *V,
+                                const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
+                                double *Omega_out, signed char *status);
 
-/* One reflected state at (α1 deg, |V⁻| m/s) in the local frame (surrogate.kernels.draw_local):
+/* One reflected state at (α1 deg, |V⁻| m/s) in the local frame (surrogate.kernels.table_path.draw_local):
  * out = (α2 rad, β2 rad, s = |V⁺|/|V⁻|, Ω_x, Ω_y, Ω_z in units of |V⁻|/a): RBS_LOCAL_SIZE = 6 numbers
  * (Ω⁺a/|V⁻| is a vector), NaN unless rebounded.
  * Returns RBS_REBOUNDED or RBS_TRAPPED; RBS_INVALID for α1 outside (0, 90] or NaN, |V⁻| not finite and
@@ -249,10 +317,10 @@ void rbs_rebound_many_rng(const rbs_table *table, const rbs_mix *mix, size_t cou
 int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                    const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE]);
 
-/* ---------------------------------------------------------------- the direct model */
+/* ---------------------------------------------------------------- the direct path */
 
-/* One particle's rebound by the direct model, caller's frame (surrogate.kernels.rebound_direct_tuple): the
- * impulse model itself (docs/model.md), flights and collisions simulated, where the table's law does not
+/* One particle's rebound by the direct model, caller's frame (surrogate.kernels.direct_path.direct_rebound):
+ * the impulse model itself (docs/model.md), flights and collisions simulated, where the table's law does not
  * apply (a spinning particle, say). The same bits as the numba kernel for the same uniforms.
  *   shape    RBS_ELLIPSOID, RBS_PRISM, RBS_CUT_PRISM or RBS_TETRAHEDRON (any of the four, whatever
  *            shapes the table holds)
@@ -266,65 +334,16 @@ int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg
  *            truncated normal law), u[5] the tetrahedron's hand (+1 below ½), u[6] the direction ex of
  *            the impact frame at normal impact (as u[12] of a draw)
  *   V_out    V⁺, m/s;  Omega_out  Ω⁺, rad/s  (NaN unless rebounded)
- * The model runs in the impact frame (ex, n, ez) of rbs_rebound, with Ω⁻ in units of (m/s)/a; its
+ * The model runs in the impact frame (ex, n, ez) of rbs_table_rebound, with Ω⁻ in units of (m/s)/a; its
  * parameters (aspect-ratio law, κ, n_max, wall law, tolerances, second-moment factors) are the table's
  * "direct_parameters" (rbs_table_kernel_array), so a table and its direct model never disagree.
  * Returns RBS_REBOUNDED; RBS_TRAPPED (still colliding after n_max collisions) or RBS_FAILED (a collision
  * solve or a contact search failed) with NaN outputs; RBS_INVALID with NaN outputs for an input outside
  * the ranges above, a NULL pointer, a shape outside 0..3, or a table without direct parameters (a NULL
  * output gets nothing). Thread-safe: scratch on the stack, the table read only. */
-int rbs_rebound_direct(const rbs_table *table, int shape, const double V[3], const double Omega[3],
+int rbs_direct_rebound(const rbs_table *table, int shape, const double V[3], const double Omega[3],
                        const double n[3], double a, const double u[RBS_U_PER_REBOUND],
                        double V_out[3], double Omega_out[3]);
-
-/* ---------------------------------------------------------------- every hit: table or direct model */
-
-/* Methods of rbs_rebound_spin (surrogate's method "auto", "table", "direct"). */
-enum {
-    RBS_AUTO = 0,           /* the table where its law is valid (below), the direct model for every other hit */
-    RBS_TABLE = 1,          /* the table whatever Ω⁻ (rbs_rebound: the law at the nearest grid edge outside) */
-    RBS_DIRECT = 2          /* the direct model for every hit */
-};
-
-/* The path that answers a hit (rbs_rebound_path). */
-enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
-
-/* The largest |Ω⁻| a/|V⁻| the table answers under RBS_AUTO (surrogate.SPIN_TOLERANCE): where the table's law
- * and the direct model's with that spin stay within classifier accuracy 0.52 (docs/design/spin_tolerance.md). */
-#define RBS_SPIN_TOLERANCE 0.001
-
-/* The path that answers a hit under `method` (surrogate.kernels.spin.rebound_path): a pure function of the
- * state, so a caller learns it without another draw. Under RBS_AUTO, the table iff |Ω⁻| a/|V⁻| <=
- * RBS_SPIN_TOLERANCE (Ω⁻ = 0 included), and α1 and |V⁻| (as rbs_rebound computes them) lie in the table's
- * grid ranges, edges included (rbs_table_alpha1_range, rbs_table_speed_range); else the direct model.
- *   V, n, a  as rbs_rebound;  Omega  incident angular velocity Ω⁻, rad/s (finite)
- * Returns RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_INVALID for a NULL pointer, an unknown method, or a
- * state rbs_rebound or rbs_rebound_direct refuses (V not moving into the wall, n not a unit vector, a
- * not finite and > 0, Ω⁻ not finite). */
-int rbs_rebound_path(const rbs_table *table, const double V[3], const double Omega[3], const double n[3],
-                     double a, int method);
-
-/* The reflected state of one particle, spinning or not, from the table or the direct model
- * (surrogate.kernels.spin.rebound_spin_tuple): the path rbs_rebound_path gives, then
- *   RBS_PATH_TABLE   rbs_rebound with the same u (Ω⁻ unused);
- *   RBS_PATH_DIRECT  the shape drawn from the mix with u[0] as rbs_rebound draws it, then
- *                    rbs_rebound_direct with that shape's code and u[1..RBS_U_PER_REBOUND] as its uniforms.
- * A hit consumes RBS_U_PER_DRAW uniforms whatever the path, so streams stay aligned.
- *   Omega    incident angular velocity Ω⁻, rad/s (finite);  method  RBS_AUTO, RBS_TABLE or RBS_DIRECT;
- *   the other arguments as rbs_rebound.
- * Returns RBS_REBOUNDED, RBS_TRAPPED, RBS_FAILED (direct path: a collision solve or a contact search
- * failed; count it) or RBS_INVALID (what rbs_rebound_path refuses, a NULL pointer, a mix of another
- * table's shape count, an unknown interpolation, a uniform outside [0, 1) or NaN); NaN outputs unless
- * rebounded. The direct path costs microseconds, the table path a fraction of one. Thread-safe. */
-int rbs_rebound_spin_u(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
-                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
-                       double V_out[3], double Omega_out[3]);
-
-/* rbs_rebound_spin_u with its RBS_U_PER_DRAW uniforms drawn from `rng` (rbs_rng_fill), which advances by
- * them whatever the path and whatever the result; a NULL or all-zero rng gives RBS_INVALID. */
-int rbs_rebound_spin(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
-                     const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
-                     double Omega_out[3]);
 
 /* ---------------------------------------------------------------- random numbers */
 
@@ -343,9 +362,21 @@ double rbs_rng_uniform(rbs_rng *rng);
 /* u[0..count) = the next count uniforms (surrogate.fill_uniforms); NaN for a NULL or all-zero state. */
 void rbs_rng_fill(rbs_rng *rng, double *u, size_t count);
 
-/* The (count, RBS_U_PER_DRAW) uniforms rbs_rebound_many_rng draws for count rows from rng, advancing
- * rng as it does (surrogate.kernels.rebound_uniforms); NaN for a NULL or all-zero state. */
-void rbs_rebound_uniforms(rbs_rng *rng, size_t count, double *u);
+/* The (count, RBS_U_PER_DRAW) uniforms rbs_table_rebound_many_rng draws for count rows from rng, advancing
+ * rng as it does (surrogate.kernels.pipeline.table_rebound_uniforms); NaN for a NULL or all-zero state. */
+void rbs_table_rebound_uniforms(rbs_rng *rng, size_t count, double *u);
+
+/* ---------------------------------------------------------------- kept from 0.x */
+
+/* rbs_rebound_rng under its 0.x name, kept for programs written against 0.x: the same arguments, the same
+ * bits. rbs_rebound_path too keeps its 0.x name and arguments. The other draws of 0.x were renamed in 1.0
+ * (a program calling one of them no longer compiles): rbs_rebound → rbs_table_rebound (the table path; the
+ * name rbs_rebound now answers any hit), rbs_rebound_many → rbs_table_rebound_many, rbs_rebound_many_rng →
+ * rbs_table_rebound_many_rng, rbs_rebound_uniforms → rbs_table_rebound_uniforms, rbs_rebound_direct →
+ * rbs_direct_rebound (same arguments), rbs_rebound_spin_u → rbs_rebound (same arguments). */
+int rbs_rebound_spin(const rbs_table *table, const rbs_mix *mix, const double V[3], const double Omega[3],
+                     const double n[3], double a, rbs_rng *rng, int method, int interpolation, double V_out[3],
+                     double Omega_out[3]);
 
 /* ---------------------------------------------------------------- misc */
 

@@ -1,6 +1,6 @@
 /*
  * draw.h: one draw in a located cell (surrogate.kernels.draw.draw_in_cell): the table reads of gather.h and
- * the arithmetic of arithmetic.h in turn, for one particle (particle.c). Local frame, V⁺ in units of |V⁻|,
+ * the arithmetic of arithmetic.h in turn, for one particle (table_path.c). Local frame, V⁺ in units of |V⁻|,
  * Ω⁺ in units of |V⁻|/a.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.

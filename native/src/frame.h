@@ -69,6 +69,36 @@ RBS_INLINE int rbs_rebound_ok(const double *V, const double *W, const double *n)
            & rbs_finite(W[2]) & (rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]) > 0.0);
 }
 
+/* a tangential speed at or below this fraction of |V| is normal impact: ex drawn in the wall plane
+ * (surrogate.kernels.frame.NORMAL_IMPACT) */
+#define RBS_NORMAL_IMPACT 1e-12
+
+/* The parts of V on a wall of unit normal n that the impact frame is built on (surrogate.kernels.frame.incidence) */
+typedef struct rbs_incidence_parts {
+    double vn;              /* V·n, m/s */
+    double t[3];            /* the tangential part V − (V·n) n, m/s */
+    double vt;              /* its length, m/s */
+    double speed;           /* |V⁻|, m/s */
+} rbs_incidence_parts;
+
+RBS_INLINE rbs_incidence_parts rbs_incidence(const double *V, const double *n)
+{
+    rbs_incidence_parts p;
+    p.vn = rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]);
+    p.t[0] = fma(-p.vn, n[0], V[0]);
+    p.t[1] = fma(-p.vn, n[1], V[1]);
+    p.t[2] = fma(-p.vn, n[2], V[2]);
+    p.vt = sqrt(fma(p.t[0], p.t[0], fma(p.t[1], p.t[1], p.t[2] * p.t[2])));
+    p.speed = sqrt(fma(p.vn, p.vn, p.vt * p.vt));
+    return p;
+}
+
+/* α1 in degrees from the wall, from V·n and the tangential speed (surrogate.kernels.frame.incidence_angle) */
+RBS_INLINE double rbs_incidence_angle(double vn, double vt)
+{
+    return rbs_atan2_q1(-vn, vt) * RBS_RAD_TO_DEG;
+}
+
 typedef struct rbs_frame {
     double alpha1;          /* deg */
     double speed;           /* |V⁻|, m/s */
@@ -77,19 +107,16 @@ typedef struct rbs_frame {
 } rbs_frame;
 
 /* The impact frame of V on a wall of unit normal n (surrogate.kernels.frame.impact_frame); at normal impact
- * (tangential part <= 1e-12 |V|) ex is uniform in the wall plane, from u_axis. */
+ * (tangential part <= RBS_NORMAL_IMPACT |V|) ex is uniform in the wall plane, from u_axis. */
 RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis, rbs_frame *f)
 {
-    double vn = rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]);
-    double tx = fma(-vn, n[0], V[0]), ty = fma(-vn, n[1], V[1]), tz = fma(-vn, n[2], V[2]);
-    double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));
-    double speed = sqrt(fma(vn, vn, vt * vt));
+    rbs_incidence_parts in = rbs_incidence(V, n);
     double ex0, ex1, ex2;
-    if (vt > 1e-12 * speed) {
-        double inv = 1.0 / vt;
-        ex0 = tx * inv;
-        ex1 = ty * inv;
-        ex2 = tz * inv;
+    if (in.vt > RBS_NORMAL_IMPACT * in.speed) {
+        double inv = 1.0 / in.vt;
+        ex0 = in.t[0] * inv;
+        ex1 = in.t[1] * inv;
+        ex2 = in.t[2] * inv;
     } else {
         /* orthonormal basis (p, q) of the wall plane: p = n × e_k with e_k the axis least aligned with n */
         double px, py, pz;
@@ -117,11 +144,11 @@ RBS_INLINE void rbs_impact_frame(const double *V, const double *n, double u_axis
     f->ez[0] = ex1 * n[2] - ex2 * n[1];
     f->ez[1] = ex2 * n[0] - ex0 * n[2];
     f->ez[2] = ex0 * n[1] - ex1 * n[0];
-    double inv_speed = 1.0 / speed;
-    f->alpha1 = rbs_atan2_q1(-vn, vt) * RBS_RAD_TO_DEG;
-    f->speed = speed;
-    f->cos_alpha1 = vt * inv_speed;
-    f->sin_alpha1 = -vn * inv_speed;
+    double inv_speed = 1.0 / in.speed;
+    f->alpha1 = rbs_incidence_angle(in.vn, in.vt);
+    f->speed = in.speed;
+    f->cos_alpha1 = in.vt * inv_speed;
+    f->sin_alpha1 = -in.vn * inv_speed;
 }
 
 /* A local draw x = (vx, vy, vz, wx, wy, wz) (units |V⁻|, |V⁻|/a) as V⁺ (m/s) and Ω⁺ (rad/s) in the
@@ -170,7 +197,7 @@ RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *
         double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
         double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
         k->valid[b] = rbs_moves_into_wall(V0, V1, V2, n0, n1, n2) ? 1.0 : 0.0;
-        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_rebound_many) */
+        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_table_rebound_many) */
         k->ok[b] = rbs_particle_ok(n0, n1, n2, k->a[b]) & (!given || rbs_uniforms_ok(&u[0][b], RBS_BLOCK)) ? 1.0 : 0.0;
         double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
         double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));
@@ -179,7 +206,7 @@ RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *
         k->ex[0][b] = tx * inv;
         k->ex[1][b] = ty * inv;
         k->ex[2][b] = tz * inv;
-        k->normal[b] = vt > 1e-12 * speed ? 0.0 : 1.0;
+        k->normal[b] = vt > RBS_NORMAL_IMPACT * speed ? 0.0 : 1.0;
         double inv_speed = 1.0 / speed;
         k->alpha1[b] = rbs_atan2_q1_simd(-vn, vt) * RBS_RAD_TO_DEG;
         k->speed[b] = speed;

@@ -91,7 +91,7 @@ struct rbs_table {
     double *restitution_pieces;
     size_t restitution_pieces_len;
     int has_direct;                                 /* the table records the direct model's parameters */
-    double direct_parameters[N_PARAMS];             /* surrogate.table.direct_parameters (P_* layout) */
+    double direct_parameters[N_PARAMS];             /* surrogate.table.SurrogateTable.direct_parameters (P_*) */
 };
 
 /* The raw cell datasets a loader reads (layout.c turns them into the kernel arrays). */

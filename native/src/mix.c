@@ -7,15 +7,7 @@
 #include <string.h>
 
 #include "internal.h"
-
-static const char *const SHAPE_NAMES[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
-
-static int known_shape(const char *name)
-{
-    for (int i = 0; i < RBS_MAX_SHAPES; i++)
-        if (strcmp(name, SHAPE_NAMES[i]) == 0) return 1;
-    return 0;
-}
+#include "shapes.h"
 
 static int table_shape(const rbs_table *t, const char *name)
 {
@@ -36,7 +28,7 @@ int rbs_mix_from_weights(const rbs_table *t, int n, const char *const names[], c
     double total = 0.0;
     for (int i = 0; i < n; i++) {
         const char *name = names[i];
-        if (!name || !known_shape(name)) {
+        if (!name || rbs_shape_code(name) < 0) {
             rbs_message(message, message_size, "The 'shape' parameter must name one of ellipsoid, prism, cut_prism, "
                         "tetrahedron; got '%s'.", name ? name : "(null)");
             return RBS_ERR_ARGUMENT;

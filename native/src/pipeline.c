@@ -1,13 +1,14 @@
 /*
- * pipeline.c: many particles on one thread (surrogate.kernels.pipeline: rebound_many, rebound_many_rng).
+ * pipeline.c: many particles on one thread, the table path (surrogate.kernels.pipeline: table_rebound_many,
+ * table_rebound_many_rng).
  *
  * Rows go through a pipeline of blocks of RBS_BLOCK particles, so that one block's table reads are in
  * flight while the blocks before it are computed. This file only schedules: while block k is located
  * (rbs_locate_block, locate.h), block k - 1 has its components resolved (rbs_resolve_block) and block
  * k - 2 is gathered (rbs_gather_block, gather.h) and drawn (rbs_arithmetic_block, arithmetic.h). Each
  * stage's block form does the operations of the per-particle code in the same order, so
- * rbs_rebound_many gives rbs_rebound's bits row by row. rbs_rebound_many_rng draws each block's uniforms
- * from RBS_BLOCK xoshiro256+ lanes as it enters (surrogate.kernels.rng.fill_lanes).
+ * rbs_table_rebound_many gives rbs_table_rebound's bits row by row. rbs_table_rebound_many_rng draws each
+ * block's uniforms from RBS_BLOCK xoshiro256+ lanes as it enters (surrogate.kernels.rng.fill_lanes).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -15,8 +16,8 @@
 #include <string.h>
 
 #include "arithmetic.h"
-#include "rebound_internal.h"
 #include "rng_internal.h"
+#include "table_arguments.h"
 
 #define STAGES 3
 #define B RBS_BLOCK
@@ -84,22 +85,22 @@ static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, 
                      signed char *status)
 {
     int arrays = count == 0 || (V && n && a && uniforms && V_out && Omega_out && status);
-    if (arrays && rbs_arguments_ok(t, mix, interpolation)) return 1;
+    if (arrays && rbs_table_arguments_ok(t, mix, interpolation)) return 1;
     all_invalid(count, V_out, Omega_out, status);
     return 0;
 }
 
-void rbs_rebound_many(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
-                      const double *a, const double *u, int interpolation, double *V_out, double *Omega_out,
-                      signed char *status)
+void rbs_table_rebound_many(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V,
+                            const double *n, const double *a, const double *u, int interpolation, double *V_out,
+                            double *Omega_out, signed char *status)
 {
     if (arguments(t, mix, interpolation, count, V, n, a, u, V_out, Omega_out, status))
         run_blocks(t, mix, count, V, n, a, u, NULL, interpolation == RBS_SCALED, V_out, Omega_out, status);
 }
 
-void rbs_rebound_many_rng(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
-                          const double *a, rbs_rng *rng, int interpolation, double *V_out, double *Omega_out,
-                          signed char *status)
+void rbs_table_rebound_many_rng(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V,
+                                const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
+                                double *Omega_out, signed char *status)
 {
     if (arguments(t, rbs_rng_ok(rng) ? mix : NULL, interpolation, count, V, n, a, rng, V_out, Omega_out, status))
         run_blocks(t, mix, count, V, n, a, NULL, rng, interpolation == RBS_SCALED, V_out, Omega_out, status);

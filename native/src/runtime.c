@@ -1,17 +1,19 @@
 /*
  * runtime.c: the direct model at run time (direct_model.runtime: normal_quantile, aspect_ratio,
  * uniform_quaternion, rebound_model_frame): the random inputs of one rebound from RBS_U_PER_REBOUND uniforms,
- * every model parameter from the P_* array, then the rebound (rebound.c). The same operations in the same
+ * every model parameter from the P_* array, then the rebound (body_rebound.c). The same operations in the same
  * order as the numba kernels; libm's sqrt, log, sin and cos.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
 
+#include "body_rebound.h"
 #include "fastmath.h"
 #include "pymath.h"
-#include "rebound.h"
 #include "runtime.h"
+
+_Static_assert(RBS_TETRAHEDRON + 1 == RBS_MAX_SHAPES, "RBS_MAX_SHAPES counts the shape codes (N_PARAMS rests on it)");
 
 double rbs_normal_quantile(double p)
 {
@@ -74,7 +76,7 @@ int rbs_rebound_model_frame(const double *params, int shape, double vt, double v
     const double V0[3] = {vt, vn, 0.0}, W0[3] = {wx, wy, wz};
     long long n_collisions, n_steps;
     /* n_max and max_steps as numba's int() of the float64 parameters */
-    return rbs_rebound_body(shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params + P_WALL,
+    return rbs_body_rebound(shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params + P_WALL,
                             rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
                             rbs_trunc(params[P_MAX_STEPS]), V, W, &n_collisions, &n_steps);
 }

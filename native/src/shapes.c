@@ -1,13 +1,23 @@
 /*
- * shapes.c: the particle shapes of the direct model (direct_model.shapes: body_vertices, bounding_radius).
+ * shapes.c: the particle shapes of the direct model (direct_model.shapes: SHAPES, body_vertices,
+ * bounding_radius).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
+#include <string.h>
 
 #include "pymath.h"
 #include "shapes.h"
-#include "rebound_scatter.h"
+
+const char *const rbs_shape_names[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
+
+int rbs_shape_code(const char *name)
+{
+    for (int k = 0; k < RBS_MAX_SHAPES; k++)
+        if (strcmp(name, rbs_shape_names[k]) == 0) return k;
+    return -1;
+}
 
 static void put(double *out, int i, double x, double y, double z)
 {

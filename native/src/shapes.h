@@ -7,7 +7,15 @@
 #ifndef RBS_SHAPES_H
 #define RBS_SHAPES_H
 
+#include "rebound_scatter.h"
+
 #define MAX_VERTICES 24     /* direct_model.shapes.MAX_VERTICES: the cut prism's */
+
+/* The shapes' names by code, RBS_ELLIPSOID .. RBS_TETRAHEDRON (direct_model.shapes.SHAPES) */
+extern const char *const rbs_shape_names[RBS_MAX_SHAPES];
+
+/* The code of a shape's name, −1 for a name that is none (direct_model.shapes.SHAPES.index) */
+int rbs_shape_code(const char *name);
 
 /* out[0..n) = the body-frame vertices (row-major n × 3) of the polyhedron `shape` with half-extents a, b, c,
  * cut fraction kappa (cut prism) and hand ±1 (tetrahedron); returns n, 0 for the ellipsoid

@@ -5,7 +5,7 @@
  *   - a collision keeps the angular momentum about the contact point, KΩ − r_c × V;
  *   - a free flight keeps the energy ½ΩᵀKΩ and the angular momentum L = KΩ (lab) to 1e-9;
  *   - a whole rebound never adds energy;
- * then hostile calls of rbs_rebound_direct on a table (RBS_INVALID and NaN, never a crash), and four threads
+ * then hostile calls of rbs_direct_rebound on a table (RBS_INVALID and NaN, never a crash), and four threads
  * calling it on one table give the bits of one thread.
  *
  *   rbs_test_direct GOOD.h5 [TABLE_WITHOUT_DIRECT_PARAMETERS.h5]
@@ -20,9 +20,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "body_rebound.h"
 #include "check.h"
 #include "collision.h"
-#include "rebound.h"
 #include "rebound_scatter.h"
 #include "rotation.h"
 #include "runtime.h"
@@ -162,7 +162,7 @@ static void rebounds(rbs_rng *rng)
         K[1] = kfac[shape] * (1.0 + c * c);
         K[2] = kfac[shape] * (1.0 + b * b);
         long long n_coll, n_steps;
-        int status = rbs_rebound_body(shape, semi, 0.3, 1.0, kfac[shape], R0, V0, W0, wall, 1000, 1e-10, 1e-9, 100000,
+        int status = rbs_body_rebound(shape, semi, 0.3, 1.0, kfac[shape], R0, V0, W0, wall, 1000, 1e-10, 1e-9, 100000,
                                       V, W, &n_coll, &n_steps);
         CHECK(status == RBS_REBOUNDED || status == RBS_TRAPPED || status == RBS_FAILED, "status %d", status);
         if (status >= 0 && status < 3) counts[status]++;
@@ -191,11 +191,11 @@ static void hostile(const rbs_table *table, const rbs_table *without)
     const double V[3] = {100.0, -100.0, 0.0}, Omega[3] = {0.0, 0.0, 0.0}, n[3] = {0.0, 1.0, 0.0};
     const double u[RBS_U_PER_REBOUND] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
     double Vo[3], Wo[3];
-    CHECK(rbs_rebound_direct(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, Wo) == RBS_REBOUNDED, "a good call");
+    CHECK(rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, Wo) == RBS_REBOUNDED, "a good call");
 #define INVALID(...)                                                                                    \
     do {                                                                                                \
         Vo[0] = Vo[1] = Vo[2] = Wo[0] = Wo[1] = Wo[2] = 0.0;                                            \
-        int status_ = rbs_rebound_direct(__VA_ARGS__);                                                  \
+        int status_ = rbs_direct_rebound(__VA_ARGS__);                                                  \
         CHECK(status_ == RBS_INVALID && all_nan(Vo) && all_nan(Wo), "%s: status %d", #__VA_ARGS__, status_); \
     } while (0)
     INVALID(NULL, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, Wo);
@@ -209,8 +209,10 @@ static void hostile(const rbs_table *table, const rbs_table *without)
     INVALID(table, RBS_PRISM, V, Omega, n, NAN, u, Vo, Wo);
     INVALID(table, RBS_PRISM, V, Omega, n, INFINITY, u, Vo, Wo);
     INVALID(table, RBS_PRISM, V, Omega, n, 0.0, u, Vo, Wo);
-    CHECK(rbs_rebound_direct(table, RBS_PRISM, V, Omega, n, 1e-3, u, NULL, Wo) == RBS_INVALID && all_nan(Wo), "NULL V_out");
-    CHECK(rbs_rebound_direct(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, NULL) == RBS_INVALID && all_nan(Vo), "NULL Omega_out");
+    CHECK(rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 1e-3, u, NULL, Wo) == RBS_INVALID && all_nan(Wo),
+          "NULL V_out");
+    CHECK(rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, NULL) == RBS_INVALID && all_nan(Vo),
+          "NULL Omega_out");
     const double bad[] = {NAN, INFINITY, -INFINITY, 1.0, -1e-300, 2.0};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         for (int k = 0; k < 3; k++) {
@@ -244,7 +246,7 @@ static void hostile(const rbs_table *table, const rbs_table *without)
             for (int shape = 0; shape < 4; shape++) {
                 const double Vx[3] = {speeds[i], -speeds[i], 0.0}, Ox[3] = {speeds[i] / sizes[j], 0.0, 0.0};
                 for (int spin = 0; spin < 2; spin++) {
-                    int status = rbs_rebound_direct(table, shape, Vx, spin ? Ox : Omega, n, sizes[j], u, Vo, Wo);
+                    int status = rbs_direct_rebound(table, shape, Vx, spin ? Ox : Omega, n, sizes[j], u, Vo, Wo);
                     int finite = isfinite(Vo[0]) && isfinite(Vo[1]) && isfinite(Vo[2]) && isfinite(Wo[0])
                                  && isfinite(Wo[1]) && isfinite(Wo[2]);
                     CHECK(status == RBS_INVALID || status == RBS_REBOUNDED || status == RBS_TRAPPED || status == RBS_FAILED,
@@ -271,7 +273,7 @@ static void *run_job(void *arg)
     job *j = arg;
     const double n[3] = {0.0, 1.0, 0.0};
     for (int i = j->first; i < j->last; i++)
-        j->status[i] = rbs_rebound_direct(j->table, i % 4, j->V + 3 * i, j->Omega + 3 * i, n, 1e-4,
+        j->status[i] = rbs_direct_rebound(j->table, i % 4, j->V + 3 * i, j->Omega + 3 * i, n, 1e-4,
                                           j->u + RBS_U_PER_REBOUND * i, j->V_out + 3 * i, j->Omega_out + 3 * i);
     return NULL;
 }

@@ -53,7 +53,7 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
     rbs_rng rng;
     rbs_rng_seed(&rng, 25);
     rbs_rng_fill(&rng, good, RBS_U_PER_DRAW);
-    const int good_status = rbs_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, V_out, W_out);
+    const int good_status = rbs_table_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, V_out, W_out);
     CHECK(good_status == RBS_REBOUNDED || good_status == RBS_TRAPPED, "good uniforms: status %d", good_status);
     int st;
 
@@ -62,7 +62,7 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
         for (size_t j = 0; j < sizeof bad / sizeof bad[0]; j++) {
             memcpy(u, good, sizeof u);
             u[k] = bad[j];
-            st = rbs_rebound(table, mix, V, n, 1e-4, u, j % 2, V_out, W_out);
+            st = rbs_table_rebound(table, mix, V, n, 1e-4, u, j % 2, V_out, W_out);
             CHECK(st == RBS_INVALID && all_nan(V_out, 3) && all_nan(W_out, 3), "u[%d] = %g: status %d", k, bad[j], st);
             st = rbs_draw_local(table, mix, 45.0, 200.0, u, j % 2, out);
             CHECK(st == RBS_INVALID && all_nan(out, RBS_LOCAL_SIZE), "local u[%d] = %g: status %d", k, bad[j], st);
@@ -70,13 +70,13 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
     }
 
     /* NULL pointers */
-    CHECK(rbs_rebound(table, mix, NULL, n, 1e-4, good, RBS_SCALED, V_out, W_out) == RBS_INVALID && all_nan(V_out, 3),
-          "NULL V");
-    CHECK(rbs_rebound(table, mix, V, NULL, 1e-4, good, RBS_SCALED, V_out, W_out) == RBS_INVALID, "NULL n");
-    CHECK(rbs_rebound(table, mix, V, n, 1e-4, NULL, RBS_SCALED, V_out, W_out) == RBS_INVALID, "NULL u");
-    CHECK(rbs_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, NULL, W_out) == RBS_INVALID && all_nan(W_out, 3),
+    CHECK(rbs_table_rebound(table, mix, NULL, n, 1e-4, good, RBS_SCALED, V_out, W_out) == RBS_INVALID
+          && all_nan(V_out, 3), "NULL V");
+    CHECK(rbs_table_rebound(table, mix, V, NULL, 1e-4, good, RBS_SCALED, V_out, W_out) == RBS_INVALID, "NULL n");
+    CHECK(rbs_table_rebound(table, mix, V, n, 1e-4, NULL, RBS_SCALED, V_out, W_out) == RBS_INVALID, "NULL u");
+    CHECK(rbs_table_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, NULL, W_out) == RBS_INVALID && all_nan(W_out, 3),
           "NULL V_out");
-    CHECK(rbs_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, V_out, NULL) == RBS_INVALID, "NULL Omega_out");
+    CHECK(rbs_table_rebound(table, mix, V, n, 1e-4, good, RBS_SCALED, V_out, NULL) == RBS_INVALID, "NULL Omega_out");
     CHECK(rbs_draw_local(table, mix, 45.0, 200.0, NULL, RBS_SCALED, out) == RBS_INVALID, "local NULL u");
     CHECK(rbs_draw_local(table, mix, 45.0, 200.0, good, RBS_SCALED, NULL) == RBS_INVALID, "local NULL out");
     signed char status[3];
@@ -87,15 +87,15 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
         memcpy(um + RBS_U_PER_DRAW * i, good, sizeof good);
         am[i] = 1e-4;
     }
-    rbs_rebound_many(table, mix, 3, NULL, nm, am, um, RBS_SCALED, Vo, Wo, status);
+    rbs_table_rebound_many(table, mix, 3, NULL, nm, am, um, RBS_SCALED, Vo, Wo, status);
     CHECK(status[0] == RBS_INVALID && status[2] == RBS_INVALID && all_nan(Vo, 9), "many: NULL V");
-    rbs_rebound_many(table, mix, 3, Vm, nm, am, um, RBS_SCALED, NULL, NULL, status);
+    rbs_table_rebound_many(table, mix, 3, Vm, nm, am, um, RBS_SCALED, NULL, NULL, status);
     CHECK(status[1] == RBS_INVALID, "many: NULL outputs");
-    rbs_rebound_many(table, mix, 3, Vm, nm, am, NULL, RBS_SCALED, NULL, NULL, NULL);
-    rbs_rebound_many_rng(table, mix, 3, Vm, nm, am, NULL, RBS_SCALED, Vo, Wo, status);
+    rbs_table_rebound_many(table, mix, 3, Vm, nm, am, NULL, RBS_SCALED, NULL, NULL, NULL);
+    rbs_table_rebound_many_rng(table, mix, 3, Vm, nm, am, NULL, RBS_SCALED, Vo, Wo, status);
     CHECK(status[0] == RBS_INVALID, "many_rng: NULL rng");
     um[RBS_U_PER_DRAW + 5] = -0.5;     /* row 1's u[5]: that row alone is invalid */
-    rbs_rebound_many(table, mix, 3, Vm, nm, am, um, RBS_SCALED, Vo, Wo, status);
+    rbs_table_rebound_many(table, mix, 3, Vm, nm, am, um, RBS_SCALED, Vo, Wo, status);
     CHECK(status[1] == RBS_INVALID && status[0] == good_status && status[2] == good_status, "many, one bad row: %d %d %d", status[0],
           status[1], status[2]);
 
@@ -106,33 +106,33 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
     rbs_rng_fill(NULL, u, RBS_U_PER_DRAW);
     CHECK(all_nan(u, RBS_U_PER_DRAW), "fill from NULL");
     rbs_rng_fill(&rng, NULL, 5);
-    rbs_rebound_uniforms(NULL, 3, um);
+    rbs_table_rebound_uniforms(NULL, 3, um);
     CHECK(all_nan(um, 3 * RBS_U_PER_DRAW), "rebound_uniforms from NULL");
     rbs_rng zero = {{0, 0, 0, 0}};
     CHECK(isnan(rbs_rng_uniform(&zero)), "uniform of the zero state");
     rbs_rng_fill(&zero, u, RBS_U_PER_DRAW);
     CHECK(all_nan(u, RBS_U_PER_DRAW), "fill from the zero state");
-    CHECK(rbs_rebound(table, mix, V, n, 1e-4, u, RBS_SCALED, V_out, W_out) == RBS_INVALID, "zero state draw");
-    rbs_rebound_many_rng(table, mix, 3, Vm, nm, am, &zero, RBS_SCALED, Vo, Wo, status);
+    CHECK(rbs_table_rebound(table, mix, V, n, 1e-4, u, RBS_SCALED, V_out, W_out) == RBS_INVALID, "zero state draw");
+    rbs_table_rebound_many_rng(table, mix, 3, Vm, nm, am, &zero, RBS_SCALED, Vo, Wo, status);
     CHECK(status[0] == RBS_INVALID && status[2] == RBS_INVALID, "many_rng: zero state");
 
     /* extreme particles: |V⁻| overflowing or underflowing, bad half-sizes and normals */
     static const double speeds[] = {1e200, 1e154, 1e-160, 1e-200, 5e-324};
     for (size_t j = 0; j < sizeof speeds / sizeof speeds[0]; j++) {
         const double Vs[3] = {speeds[j] * 0.8, -speeds[j] * 0.6, 0.0};
-        st = rbs_rebound(table, mix, Vs, n, 1e-4, good, RBS_SCALED, V_out, W_out);
+        st = rbs_table_rebound(table, mix, Vs, n, 1e-4, good, RBS_SCALED, V_out, W_out);
         CHECK(st == RBS_INVALID ? all_nan(V_out, 3) : st == RBS_TRAPPED || physical(V_out, W_out, n),
               "|V| = %g: status %d, V+ = (%g, %g, %g)", speeds[j], st, V_out[0], V_out[1], V_out[2]);
     }
     static const double sizes[] = {0.0, -1e-4, NAN, INFINITY, 5e-324, -INFINITY};
     for (size_t j = 0; j < sizeof sizes / sizeof sizes[0]; j++) {
-        st = rbs_rebound(table, mix, V, n, sizes[j], good, RBS_SCALED, V_out, W_out);
+        st = rbs_table_rebound(table, mix, V, n, sizes[j], good, RBS_SCALED, V_out, W_out);
         CHECK(st == RBS_INVALID && all_nan(W_out, 3), "a = %g: status %d", sizes[j], st);
     }
     static const double lengths[] = {1e200, 2.0, 0.5, 1.0 + 1e-5, 1e-200};
     for (size_t j = 0; j < sizeof lengths / sizeof lengths[0]; j++) {
         const double nl[3] = {0.0, lengths[j], 0.0};
-        st = rbs_rebound(table, mix, V, nl, 1e-4, good, RBS_SCALED, V_out, W_out);
+        st = rbs_table_rebound(table, mix, V, nl, 1e-4, good, RBS_SCALED, V_out, W_out);
         CHECK(st == RBS_INVALID && all_nan(V_out, 3), "|n| = %g: status %d", lengths[j], st);
     }
 
@@ -161,14 +161,14 @@ static void hostile_draws(const rbs_table *table, const rbs_mix *mix, double vlo
             nr[k] = 2.0 * rbs_rng_uniform(&rng) - 1.0;
         }
         double a = ldexp(rbs_rng_uniform(&rng), (int)(1200.0 * rbs_rng_uniform(&rng)) - 600);
-        st = rbs_rebound(table, mix, Vr, nr, a, u, i % 2, V_out, W_out);
+        st = rbs_table_rebound(table, mix, Vr, nr, a, u, i % 2, V_out, W_out);
         CHECK(st == RBS_INVALID || st == RBS_TRAPPED || physical(V_out, W_out, nr), "random hostile draw %d", i);
         st = rbs_draw_local(table, mix, 100.0 * u[0], ldexp(u[1], (int)(2000.0 * u[2]) - 1000), u, i % 2, out);
         CHECK(st == RBS_INVALID || st == RBS_TRAPPED || (isfinite(out[2]) && out[2] >= 0.0), "random local draw %d", i);
     }
 }
 
-/* every hit answered (rbs_rebound_spin, rbs_rebound_spin_u, rbs_rebound_path): spinning and hostile hits under
+/* every hit answered (rbs_rebound_rng, rbs_rebound, rbs_rebound_path): spinning and hostile hits under
  * the three methods; whatever rebounds is finite and leaves the wall, the rest is NaN */
 static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, double vhi)
 {
@@ -183,7 +183,7 @@ static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, d
     CHECK(rbs_rebound_path(table, V, spin, n, a, RBS_TABLE) == RBS_PATH_TABLE, "method table");
     CHECK(rbs_rebound_path(table, V, still, n, a, RBS_DIRECT) == RBS_PATH_DIRECT, "method direct");
     for (int method = RBS_AUTO; method <= RBS_DIRECT; method++) {
-        int st = rbs_rebound_spin_u(table, mix, V, spin, n, a, u, method, RBS_SCALED, V_out, W_out);
+        int st = rbs_rebound(table, mix, V, spin, n, a, u, method, RBS_SCALED, V_out, W_out);
         CHECK(st == RBS_REBOUNDED ? physical(V_out, W_out, n) : st != RBS_INVALID && all_nan(V_out, 3),
               "spinning hit, method %d: status %d", method, st);
     }
@@ -192,34 +192,34 @@ static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, d
     for (int j = 0; j < 3; j++) {
         double W_bad[3] = {1.0, bad_spins[j], 1.0};
         CHECK(rbs_rebound_path(table, V, W_bad, n, a, RBS_AUTO) == RBS_INVALID, "Omega %g: path", bad_spins[j]);
-        CHECK(rbs_rebound_spin_u(table, mix, V, W_bad, n, a, u, RBS_TABLE, RBS_SCALED, V_out, W_out) == RBS_INVALID
+        CHECK(rbs_rebound(table, mix, V, W_bad, n, a, u, RBS_TABLE, RBS_SCALED, V_out, W_out) == RBS_INVALID
               && all_nan(V_out, 3) && all_nan(W_out, 3), "Omega %g", bad_spins[j]);
     }
-    CHECK(rbs_rebound_spin_u(NULL, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID
+    CHECK(rbs_rebound(NULL, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID
           && all_nan(V_out, 3), "spin: NULL table");
-    CHECK(rbs_rebound_spin_u(table, NULL, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound(table, NULL, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
           "spin: NULL mix");
-    CHECK(rbs_rebound_spin_u(table, mix, NULL, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound(table, mix, NULL, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
           "spin: NULL V");
-    CHECK(rbs_rebound_spin_u(table, mix, V, NULL, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound(table, mix, V, NULL, n, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
           "spin: NULL Omega");
-    CHECK(rbs_rebound_spin_u(table, mix, V, spin, NULL, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound(table, mix, V, spin, NULL, a, u, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
           "spin: NULL n");
-    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, NULL, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound(table, mix, V, spin, n, a, NULL, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
           "spin: NULL u");
-    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, NULL, W_out) == RBS_INVALID
+    CHECK(rbs_rebound(table, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, NULL, W_out) == RBS_INVALID
           && all_nan(W_out, 3), "spin: NULL V_out");
-    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, NULL) == RBS_INVALID,
+    CHECK(rbs_rebound(table, mix, V, spin, n, a, u, RBS_AUTO, RBS_SCALED, V_out, NULL) == RBS_INVALID,
           "spin: NULL Omega_out");
-    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, 3, RBS_SCALED, V_out, W_out) == RBS_INVALID, "method 3");
-    CHECK(rbs_rebound_spin_u(table, mix, V, spin, n, a, u, RBS_AUTO, 9, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound(table, mix, V, spin, n, a, u, 3, RBS_SCALED, V_out, W_out) == RBS_INVALID, "method 3");
+    CHECK(rbs_rebound(table, mix, V, spin, n, a, u, RBS_AUTO, 9, V_out, W_out) == RBS_INVALID,
           "spin: unknown interpolation");
     CHECK(rbs_rebound_path(table, NULL, spin, n, a, RBS_AUTO) == RBS_INVALID, "path: NULL V");
     CHECK(rbs_rebound_path(table, V, spin, n, a, -1) == RBS_INVALID, "path: method -1");
     rbs_rng zero = {{0, 0, 0, 0}};
-    CHECK(rbs_rebound_spin(table, mix, V, spin, n, a, NULL, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID
+    CHECK(rbs_rebound_rng(table, mix, V, spin, n, a, NULL, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID
           && all_nan(V_out, 3), "spin: NULL rng");
-    CHECK(rbs_rebound_spin(table, mix, V, spin, n, a, &zero, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
+    CHECK(rbs_rebound_rng(table, mix, V, spin, n, a, &zero, RBS_AUTO, RBS_SCALED, V_out, W_out) == RBS_INVALID,
           "spin: zero rng");
     /* random hits over and beyond the grid, spins from none to 2 |V-|/a, random methods; hostile particles */
     for (int i = 0; i < 3000; i++) {
@@ -235,10 +235,22 @@ static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, d
         if (i % 50 == 0) Vr[i % 3] = i % 100 == 0 ? NAN : 1e300;
         if (i % 70 == 0) nr[0] *= 3.0;
         int method = (int)(3.0 * rbs_rng_uniform(&rng)), path = rbs_rebound_path(table, Vr, Wr, nr, a, method);
-        int st = rbs_rebound_spin(table, mix, Vr, Wr, nr, a, &rng, method, i % 2, V_out, W_out);
+        int st = rbs_rebound_rng(table, mix, Vr, Wr, nr, a, &rng, method, i % 2, V_out, W_out);
         CHECK(path != RBS_INVALID || st == RBS_INVALID, "random spin hit %d: path invalid, status %d", i, st);
         CHECK(st == RBS_REBOUNDED ? physical(V_out, W_out, nr) : all_nan(V_out, 3) && all_nan(W_out, 3),
               "random spin hit %d: status %d", i, st);
+    }
+    /* rbs_rebound_spin, kept for programs written against 0.x: rbs_rebound_rng's bits, its stream advanced alike */
+    rbs_rng r_new, r_old;
+    rbs_rng_seed_stream(&r_new, 28, 2);
+    r_old = r_new;
+    for (int i = 0; i < 40; i++) {
+        const double *Omega = i % 2 ? spin : still;
+        double V_new[3], W_new[3], V_old[3], W_old[3];
+        int st_new = rbs_rebound_rng(table, mix, V, Omega, n, a, &r_new, i % 3, RBS_SCALED, V_new, W_new);
+        int st_old = rbs_rebound_spin(table, mix, V, Omega, n, a, &r_old, i % 3, RBS_SCALED, V_old, W_old);
+        CHECK(st_new == st_old && memcmp(V_new, V_old, sizeof V_new) == 0 && memcmp(W_new, W_old, sizeof W_new) == 0
+              && memcmp(&r_new, &r_old, sizeof r_new) == 0, "rbs_rebound_spin (0.x), hit %d", i);
     }
 }
 
@@ -322,20 +334,20 @@ static void draw_from(const char *path)
     rbs_rng_fill(&rng, u, RBS_U_PER_DRAW * N);
     int rebounded = 0;
     for (int i = 0; i < N; i++) {
-        int st = rbs_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u + RBS_U_PER_DRAW * i, i % 2, V_one + 3 * i,
-                             W_one + 3 * i);
+        int st = rbs_table_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u + RBS_U_PER_DRAW * i, i % 2,
+                                   V_one + 3 * i, W_one + 3 * i);
         CHECK(st == RBS_REBOUNDED || st == RBS_TRAPPED || st == RBS_INVALID, "status %d", st);
         rebounded += st == RBS_REBOUNDED;
     }
     CHECK(rebounded > N / 2, "%d rebounded of %d", rebounded, N);
-    rbs_rebound_many(table, &mix, N, V, n, a, u, RBS_SCALED, V_out, Omega_out, status);
+    rbs_table_rebound_many(table, &mix, N, V, n, a, u, RBS_SCALED, V_out, Omega_out, status);
     for (int i = 0; i < N; i += 2)
         CHECK(memcmp(V_out + 3 * i, V_one + 3 * i, 3 * sizeof(double)) == 0 || isnan(V_out[3 * i]),
               "many differs from one at %d", i);
-    rbs_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_STOCHASTIC, V_out, Omega_out, status);
-    rbs_rebound_many_rng(table, &mix, 0, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
-    rbs_rebound_many_rng(table, &mix, 31, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
-    rbs_rebound_many(table, &mix, 33, V, n, a, u, 7, V_out, Omega_out, status);
+    rbs_table_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_STOCHASTIC, V_out, Omega_out, status);
+    rbs_table_rebound_many_rng(table, &mix, 0, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+    rbs_table_rebound_many_rng(table, &mix, 31, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+    rbs_table_rebound_many(table, &mix, 33, V, n, a, u, 7, V_out, Omega_out, status);
     CHECK(status[0] == RBS_INVALID && isnan(V_out[0]), "unknown interpolation gives invalid");
     for (int i = 0; i < 2000; i++) {
         double out[RBS_LOCAL_SIZE], alpha1 = -5.0 + 100.0 * u[i];
@@ -354,7 +366,8 @@ static void draw_from(const char *path)
     CHECK(rbs_draw_local(table, NULL, 45.0, 100.0, u, RBS_SCALED, out) == RBS_INVALID, "NULL mix");
     rbs_mix wrong = mix;
     wrong.n_shapes = n_shapes + 1;
-    CHECK(rbs_rebound(table, &wrong, V, n, a[0], u, RBS_SCALED, V_out, Omega_out) == RBS_INVALID, "mix of another table");
+    CHECK(rbs_table_rebound(table, &wrong, V, n, a[0], u, RBS_SCALED, V_out, Omega_out) == RBS_INVALID,
+          "mix of another table");
     free(V);
     free(n);
     free(a);

@@ -5,8 +5,8 @@
  *   rbs_test_threads TABLE.h5 THREADS ROWS
  *
  * Thread t draws ROWS incident states and their rebounds from stream t of seed 7
- * (rbs_rng_seed_stream), with rbs_rebound per particle, with rbs_rebound_many_rng and with rbs_rebound_spin
- * (every other hit spinning, |Ω⁻| a/|V⁻| = 0.5: the direct model answers it); then the main thread redoes
+ * (rbs_rng_seed_stream), with rbs_table_rebound per particle, with rbs_table_rebound_many_rng and with
+ * rbs_rebound_rng (every other hit spinning, |Ω⁻| a/|V⁻| = 0.5: the direct model answers it); then the main thread redoes
  * every stream alone and compares the bits.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -52,18 +52,18 @@ static void *draw(void *argument)
     for (size_t i = 0; i < N; i++) {
         double u[RBS_U_PER_DRAW];
         rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
-        w->status[i] = (signed char)rbs_rebound(w->table, w->mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
+        w->status[i] = (signed char)rbs_table_rebound(w->table, w->mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
                                                 w->V_out + 3 * i, w->Omega_out + 3 * i);
     }
-    rbs_rebound_many_rng(w->table, w->mix, N, V, n, a, &rng, RBS_SCALED, w->V_out + 3 * N, w->Omega_out + 3 * N,
+    rbs_table_rebound_many_rng(w->table, w->mix, N, V, n, a, &rng, RBS_SCALED, w->V_out + 3 * N, w->Omega_out + 3 * N,
                          w->status + N);
     for (size_t i = 0; i < N; i++) {
         const double *v = V + 3 * i;
         double w_i = i % 2 ? 0.5 * sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / a[i] : 0.0;
         const double Omega[3] = {0.6 * w_i, 0.0, 0.8 * w_i};
-        w->status[2 * N + i] = (signed char)rbs_rebound_spin(w->table, w->mix, v, Omega, n + 3 * i, a[i], &rng,
-                                                             RBS_AUTO, RBS_SCALED, w->V_out + 3 * (2 * N + i),
-                                                             w->Omega_out + 3 * (2 * N + i));
+        w->status[2 * N + i] = (signed char)rbs_rebound_rng(w->table, w->mix, v, Omega, n + 3 * i, a[i], &rng,
+                                                            RBS_AUTO, RBS_SCALED, w->V_out + 3 * (2 * N + i),
+                                                            w->Omega_out + 3 * (2 * N + i));
     }
     free(V);
     free(n);

@@ -156,55 +156,55 @@ class NativeTable:
         return code, mix, message.value.decode()
 
     # -- draws
-    def rebound(self, mix, V, n, a, u, interpolation=SCALED):
+    def table_rebound(self, mix, V, n, a, u, interpolation=SCALED):
         V, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, u))
         V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound(self.handle, ctypes.byref(mix), _ptr(V), _ptr(n), ctypes.c_double(a), _ptr(u),
-                                        interpolation, _ptr(V_out), _ptr(W_out))
+        status = self.lib.c.rbs_table_rebound(self.handle, ctypes.byref(mix), _ptr(V), _ptr(n), ctypes.c_double(a),
+                                              _ptr(u), interpolation, _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out
 
-    def rebound_many(self, mix, V, n, a, u, interpolation=SCALED):
+    def table_rebound_many(self, mix, V, n, a, u, interpolation=SCALED):
         V, n, a, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a, u))
         count = V.shape[0]
         assert n.shape == (count, 3) and a.shape == (count,) and u.shape == (count, U_PER_DRAW)
         V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        self.lib.c.rbs_rebound_many(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n), _ptr(a),
-                                    _ptr(u), interpolation, _ptr(V_out), _ptr(W_out), _ptr(status))
+        self.lib.c.rbs_table_rebound_many(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
+                                          _ptr(a), _ptr(u), interpolation, _ptr(V_out), _ptr(W_out), _ptr(status))
         return status, V_out, W_out
 
-    def rebound_many_rng(self, mix, V, n, a, state: np.ndarray, interpolation=SCALED):
+    def table_rebound_many_rng(self, mix, V, n, a, state: np.ndarray, interpolation=SCALED):
         """Returns (status, V_out, W_out, advanced state)."""
         V, n, a = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a))
         count = V.shape[0]
         rng = _rng(state)
         V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        self.lib.c.rbs_rebound_many_rng(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
-                                        _ptr(a), ctypes.byref(rng), interpolation, _ptr(V_out), _ptr(W_out),
-                                        _ptr(status))
+        self.lib.c.rbs_table_rebound_many_rng(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V),
+                                              _ptr(n), _ptr(a), ctypes.byref(rng), interpolation, _ptr(V_out),
+                                              _ptr(W_out), _ptr(status))
         return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
 
-    def rebound_direct(self, shape: int, V, Omega, n, a: float, u):
-        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_rebound_direct for one particle (shape code, 7 uniforms)."""
+    def direct_rebound(self, shape: int, V, Omega, n, a: float, u):
+        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_direct_rebound for one particle (shape code, 7 uniforms)."""
         V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
         V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound_direct(self.handle, shape, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a),
+        status = self.lib.c.rbs_direct_rebound(self.handle, shape, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a),
                                                _ptr(u), _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out
 
-    def rebound_spin_u(self, mix, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
+    def rebound(self, mix, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
         V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
         V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound_spin_u(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
-                                               ctypes.c_double(a), _ptr(u), method, interpolation, _ptr(V_out),
-                                               _ptr(W_out))
+        status = self.lib.c.rbs_rebound(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
+                                        ctypes.c_double(a), _ptr(u), method, interpolation, _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out
 
-    def rebound_spin(self, mix, V, Omega, n, a, state: np.ndarray, method=AUTO, interpolation=SCALED):
-        """Returns (status, V_out, W_out, advanced state)."""
+    def rebound_rng(self, mix, V, Omega, n, a, state: np.ndarray, method=AUTO, interpolation=SCALED,
+                    symbol="rbs_rebound_rng"):
+        """Returns (status, V_out, W_out, advanced state); ``symbol`` "rbs_rebound_spin" calls the 0.x name."""
         V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
         rng = _rng(state)
         V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound_spin(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
+        status = getattr(self.lib.c, symbol)(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
                                              ctypes.c_double(a), ctypes.byref(rng), method, interpolation,
                                              _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
@@ -254,20 +254,22 @@ class Native:
         c.rbs_mix_from_weights.restype = i
         c.rbs_mix_from_shape.argtypes = [vp, ctypes.c_char_p, ctypes.POINTER(Mix), ctypes.c_char_p, sz]
         c.rbs_mix_from_shape.restype = i
-        c.rbs_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, d, vp, i, vp, vp]
-        c.rbs_rebound.restype = i
-        c.rbs_rebound_many.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, vp, i, vp, vp, vp]
-        c.rbs_rebound_many.restype = None
-        c.rbs_rebound_many_rng.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, ctypes.POINTER(Rng), i, vp, vp, vp]
-        c.rbs_rebound_many_rng.restype = None
-        c.rbs_rebound_direct.argtypes = [vp, i, vp, vp, vp, d, vp, vp, vp]
-        c.rbs_rebound_direct.restype = i
+        c.rbs_table_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, d, vp, i, vp, vp]
+        c.rbs_table_rebound.restype = i
+        c.rbs_table_rebound_many.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, vp, i, vp, vp, vp]
+        c.rbs_table_rebound_many.restype = None
+        c.rbs_table_rebound_many_rng.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, ctypes.POINTER(Rng), i,
+                                                 vp, vp, vp]
+        c.rbs_table_rebound_many_rng.restype = None
+        c.rbs_direct_rebound.argtypes = [vp, i, vp, vp, vp, d, vp, vp, vp]
+        c.rbs_direct_rebound.restype = i
         c.rbs_draw_local.argtypes = [vp, ctypes.POINTER(Mix), d, d, vp, i, vp]
         c.rbs_draw_local.restype = i
-        c.rbs_rebound_spin_u.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, vp, i, i, vp, vp]
-        c.rbs_rebound_spin_u.restype = i
-        c.rbs_rebound_spin.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, ctypes.POINTER(Rng), i, i, vp, vp]
-        c.rbs_rebound_spin.restype = i
+        c.rbs_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, vp, i, i, vp, vp]
+        c.rbs_rebound.restype = i
+        for kept in ("rbs_rebound_rng", "rbs_rebound_spin"):     # rbs_rebound_spin: its 0.x name
+            getattr(c, kept).argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, ctypes.POINTER(Rng), i, i, vp, vp]
+            getattr(c, kept).restype = i
         c.rbs_rebound_path.argtypes = [vp, vp, vp, vp, d, i]
         c.rbs_rebound_path.restype = i
         c.rbs_rng_seed.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64]
@@ -275,7 +277,7 @@ class Native:
         c.rbs_rng_uniform.argtypes = [ctypes.POINTER(Rng)]
         c.rbs_rng_uniform.restype = d
         c.rbs_rng_fill.argtypes = [ctypes.POINTER(Rng), vp, sz]
-        c.rbs_rebound_uniforms.argtypes = [ctypes.POINTER(Rng), sz, vp]
+        c.rbs_table_rebound_uniforms.argtypes = [ctypes.POINTER(Rng), sz, vp]
         c.rbs_error_string.argtypes = [i]
         c.rbs_error_string.restype = ctypes.c_char_p
         c.rbs_version.restype = ctypes.c_char_p
@@ -319,9 +321,9 @@ class Native:
         x = self.c.rbs_rng_uniform(ctypes.byref(rng))
         return x, np.array(list(rng.s), dtype=np.uint64)
 
-    def rebound_uniforms(self, state: np.ndarray, count: int):
+    def table_rebound_uniforms(self, state: np.ndarray, count: int):
         rng, u = _rng(state), np.empty((count, U_PER_DRAW))
-        self.c.rbs_rebound_uniforms(ctypes.byref(rng), ctypes.c_size_t(count), _ptr(u))
+        self.c.rbs_table_rebound_uniforms(ctypes.byref(rng), ctypes.c_size_t(count), _ptr(u))
         return u, np.array(list(rng.s), dtype=np.uint64)
 
     # -- torque-free flight (rotation.c, internal functions exported by the shared library)

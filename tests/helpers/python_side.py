@@ -15,6 +15,7 @@ file checks and the samples' angle conversion from ``data_schema``.
 """
 
 import surrogate
+from direct_model import runtime as direct_runtime     # the parameter layout (P_*, U_*, N_PARAMS)
 from data_schema.samples import STATUS_FAILED, angles_to_velocity
 from direct_model.rotation import ROT_PARAMS_SIZE, carlson_rf, carlson_rj, rotation_at, rotation_init
 from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, load, mix_cdf, \

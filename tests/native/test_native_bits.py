@@ -2,9 +2,9 @@
 
 Over random incident states (random unit normals; α1 and |V⁻| over and beyond the table's grid; exact
 normal impact, grazing, trapped cells, invalid input), every shape alone, the equal mix and a weighted
-mix, both interpolations: V⁺, Ω⁺ and the status of rbs_rebound_many equal those of
-surrogate.kernels.table_rebound_many; rbs_rebound row by row equals rbs_rebound_many and table_rebound; the
-local draw, the derived kernel arrays and the random numbers equal surrogate's. The largest ulp
+mix, both interpolations: V⁺, Ω⁺ and the status of rbs_table_rebound_many equal those of
+surrogate.kernels.table_rebound_many; rbs_table_rebound row by row equals rbs_table_rebound_many and table_rebound;
+the local draw, the derived kernel arrays and the random numbers equal surrogate's. The largest ulp
 difference is printed (run with -s to see it) and must be 0.
 """
 
@@ -77,7 +77,7 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
         V_py, W_py = np.empty((STATES_PER_CASE, 3)), np.empty((STATES_PER_CASE, 3))
         status_py = np.empty(STATES_PER_CASE, dtype=np.int8)
         py.table_rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == "scaled")
-        status, V_c, W_c = native_table.rebound_many(_native_mix(native_table, spec), V, n, a, u,
+        status, V_c, W_c = native_table.table_rebound_many(_native_mix(native_table, spec), V, n, a, u,
                                                      INTERPOLATIONS[interpolation])
         assert np.array_equal(status, status_py), label
         counts = {s: int(np.sum(status == s)) for s in (py.STATUS_REBOUNDED, py.STATUS_TRAPPED, py.STATUS_INVALID)}
@@ -93,8 +93,8 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
     assert all(v == (0.0, 0.0) for v in worst.values()), worst
 
 
-def test_single_calls_equal_many_and_table_rebound(table_pair):
-    """rbs_rebound row by row = rbs_rebound_many = surrogate's table_rebound, both interpolations."""
+def test_single_calls_equal_many_and_rebound_tuple(table_pair):
+    """rbs_table_rebound row by row = rbs_table_rebound_many = surrogate's table_rebound, both interpolations."""
     table, native_table = table_pair
     rng = np.random.default_rng(7)
     count = 3000
@@ -104,9 +104,9 @@ def test_single_calls_equal_many_and_table_rebound(table_pair):
     mix = native_table.mix_equal()
     cdf = py.mix_cdf(table, "mix")
     for interpolation in (SCALED, STOCHASTIC):
-        status, V_many, W_many = native_table.rebound_many(mix, V, n, a, u, interpolation)
+        status, V_many, W_many = native_table.table_rebound_many(mix, V, n, a, u, interpolation)
         for i in range(count):
-            st, v, w = native_table.rebound(mix, V[i], n[i], a[i], u[i], interpolation)
+            st, v, w = native_table.table_rebound(mix, V[i], n[i], a[i], u[i], interpolation)
             st_py, v_py, w_py = py.table_rebound(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
                                                  interpolation == SCALED)
             assert st == status[i] == st_py, i
@@ -168,16 +168,16 @@ def test_uniforms_equal_fill_uniforms(native):
         assert x == u_py[0]
 
 
-def test_block_uniforms_and_table_rebound_many_rng(table_pair, native):
-    """rbs_rebound_uniforms = table_rebound_uniforms and rbs_rebound_many_rng = table_rebound_many_rng, bit for bit,
-    for row counts on and off the 32-row blocks."""
+def test_block_uniforms_and_rebound_many_rng(table_pair, native):
+    """rbs_table_rebound_uniforms = table_rebound_uniforms and rbs_table_rebound_many_rng = table_rebound_many_rng, bit for
+    bit, for row counts on and off the 32-row blocks."""
     table, native_table = table_pair
     mix, cdf = native_table.mix_equal(), py.mix_cdf(table, "mix")
     rng = np.random.default_rng(5)
     for count in (0, 1, 31, 32, 33, 1000, 20001):
         state = py.seed_state(count + 9)
         u_py = py.table_rebound_uniforms(state.copy(), count)
-        u_c, _ = native.rebound_uniforms(state, count)
+        u_c, _ = native.table_rebound_uniforms(state, count)
         assert np.array_equal(u_c, u_py), count
         V, n, a = incident_states(rng, count)
         for interpolation in (SCALED, STOCHASTIC):
@@ -185,7 +185,7 @@ def test_block_uniforms_and_table_rebound_many_rng(table_pair, native):
             py_state = state.copy()
             py.table_rebound_many_rng(table.kernel_data, cdf, V, n, a, py_state, V_py, W_py, status_py,
                                 interpolation == SCALED)
-            status, V_c, W_c, c_state = native_table.rebound_many_rng(mix, V, n, a, state, interpolation)
+            status, V_c, W_c, c_state = native_table.table_rebound_many_rng(mix, V, n, a, state, interpolation)
             assert np.array_equal(status, status_py) and np.array_equal(c_state, py_state), count
             assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0, count
 
@@ -203,9 +203,9 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     for interpolation in (SCALED, STOCHASTIC):
         V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
         py.table_rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == SCALED)
-        status, V_c, W_c = baseline.rebound_many(baseline.mix_equal(), V, n, a, u, interpolation)
+        status, V_c, W_c = baseline.table_rebound_many(baseline.mix_equal(), V, n, a, u, interpolation)
         assert np.array_equal(status, status_py)
         assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0
         for i in range(0, count, 500):
-            st, v, w = baseline.rebound(baseline.mix_equal(), V[i], n[i], a[i], u[i], interpolation)
+            st, v, w = baseline.table_rebound(baseline.mix_equal(), V[i], n[i], a[i], u[i], interpolation)
             assert st == status_py[i] and max_ulp(v, V_py[i]) == 0 and max_ulp(w, W_py[i]) == 0

@@ -1,18 +1,19 @@
-"""The direct model in C (native/src/direct.c and the kernels it calls: shapes.c, collision.c, flight.c,
-rebound.c, runtime.c) against numba, bit for bit for the same inputs and uniforms: the parameter array the
+"""The direct model in C (native/src/direct_path.c and the kernels it calls: shapes.c, collision.c, flight.c,
+body_rebound.c, runtime.c) against numba, bit for bit for the same inputs and uniforms: the parameter array the
 loader builds, the pieces (shapes, the normal quantile, the uniform quaternion, one collision), whole
 rebounds in random caller frames, and hostile inputs (RBS_INVALID with NaN, never a crash)."""
 
 from __future__ import annotations
 
 import ctypes
+import re
 
 import h5py
 import numpy as np
 import pytest
 
 from tests.helpers import python_side as py
-from tests.helpers.native_library import ERR_FORMAT
+from tests.helpers.native_library import ERR_FORMAT, NATIVE
 
 SPINS = (0.0, 0.02, 0.3, 1.0)     # |Ω⁻| a / |V⁻| of the whole-rebound comparisons
 PER_SHAPE = 2000                  # particles per shape and spin
@@ -24,8 +25,8 @@ _d, _i, _p = ctypes.c_double, ctypes.c_int, ctypes.c_void_p
 def _c(native):
     """The library with the model's functions typed (the internal kernels are exported for these tests)."""
     c = native.c
-    c.rbs_rebound_direct.argtypes = [_p, _i, _p, _p, _p, _d, _p, _p, _p]
-    c.rbs_rebound_direct.restype = _i
+    c.rbs_direct_rebound.argtypes = [_p, _i, _p, _p, _p, _d, _p, _p, _p]
+    c.rbs_direct_rebound.restype = _i
     c.rbs_collide.argtypes = [_p] * 7
     c.rbs_collide.restype = _i
     c.rbs_body_vertices.argtypes = [_i, _d, _d, _d, _d, _d, _p]
@@ -48,10 +49,10 @@ def _ptr(x):
 
 
 def _direct_c(c, table, shape, V, omega, n, a, u):
-    """(status, V⁺, Ω⁺) of rbs_rebound_direct."""
+    """(status, V⁺, Ω⁺) of rbs_direct_rebound."""
     V_out, W_out = np.zeros(3), np.zeros(3)
     arrays = [None if x is None else np.ascontiguousarray(x, dtype=np.float64) for x in (V, omega, n, u)]
-    status = c.rbs_rebound_direct(table, shape, *(_ptr(x) for x in arrays[:3]), a, _ptr(arrays[3]), _ptr(V_out),
+    status = c.rbs_direct_rebound(table, shape, *(_ptr(x) for x in arrays[:3]), a, _ptr(arrays[3]), _ptr(V_out),
                                   _ptr(W_out))
     return status, V_out, W_out
 
@@ -81,6 +82,34 @@ OLD = dict.fromkeys(("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low",
 
 
 # -- the parameters -------------------------------------------------------------------------------------
+
+_DEFINE = re.compile(r"^#define (\w+) \(?(\w+(?: \+ \w+)*)\)?(?=\s|$)", flags=re.M)
+
+
+def _integer_defines(*headers) -> dict:
+    """The #defines of the headers whose value is an integer or a sum of integers and earlier such names."""
+    values = {}
+    for header in headers:
+        for name, expression in _DEFINE.findall(header.read_text()):
+            terms = expression.split(" + ")
+            if all(t.isdigit() or t in values for t in terms):
+                values[name] = sum(int(t) if t.isdigit() else values[t] for t in terms)
+    return values
+
+
+def test_the_parameter_layout_is_direct_model_s(table_pair):
+    """runtime.h's layout is direct_model.runtime's: every P_* offset, U_* index and N_PARAMS, which both sides
+    derive from the shape count (P_KFAC, then one second-moment factor per shape code); the loader's array
+    has N_PARAMS elements."""
+    c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", NATIVE / "src" / "runtime.h")
+    c["U_PER_REBOUND"] = c["RBS_U_PER_REBOUND"]
+    layout = re.compile(r"P_[A-Z_]+|U_[A-Z_]+|N_PARAMS")
+    python = {name: value for name, value in vars(py.direct_runtime).items() if layout.fullmatch(name)}
+    assert {"P_KFAC", "N_PARAMS", "U_AXIS"} <= set(python)
+    assert {name: value for name, value in c.items() if layout.fullmatch(name)} == python
+    assert c["N_PARAMS"] == c["P_KFAC"] + len(py.SHAPES) == c["P_KFAC"] + c["RBS_MAX_SHAPES"]
+    assert table_pair[1].kernel_array("direct_parameters").size == python["N_PARAMS"]
+
 
 
 def test_the_parameter_array_is_surrogate_s(native, table_pair, small_table_path, tmp_path):
@@ -120,7 +149,7 @@ def test_an_old_table_takes_the_configuration_s_aspect_law(native, small_table_p
 
 def test_a_table_without_the_factors_has_no_direct_model(native, small_table_path, tmp_path):
     """An old table built at κ ≠ 0.3 does not record its second-moment factors: it loads, has no
-    "direct_parameters" (RBS_ERR_ARGUMENT), and rbs_rebound_direct gives RBS_INVALID with NaN."""
+    "direct_parameters" (RBS_ERR_ARGUMENT), and rbs_direct_rebound gives RBS_INVALID with NaN."""
     path = _old_table(small_table_path, tmp_path, "kappa.h5", **OLD, kappa=0.25)
     assert py.load(path).direct_parameters is None
     table = native.table(path)
@@ -238,7 +267,7 @@ def _particles(rng, count, spin):
 
 @pytest.mark.parametrize("spin", SPINS)
 def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
-    """rbs_rebound_direct against direct_rebound, PER_SHAPE particles of each shape in random caller frames,
+    """rbs_direct_rebound against direct_rebound, PER_SHAPE particles of each shape in random caller frames,
     the same uniforms: the same status, and for a rebound the same bits of V⁺ and Ω⁺ — multi-collision sequences
     included, so every operation of the port is numba's (a last-bit difference would grow through them)."""
     python, c_table = table_pair
@@ -308,7 +337,7 @@ def test_null_table_and_outputs(native, table_pair):
     out = np.zeros(3)
     for outputs in ((None, out), (out, None)):
         out[:] = 0.0
-        status = c.rbs_rebound_direct(table_pair[1].handle, 1, *(x.ctypes.data for x in args), 1e-3,
+        status = c.rbs_direct_rebound(table_pair[1].handle, 1, *(x.ctypes.data for x in args), 1e-3,
                                       GOOD["u"].ctypes.data, *(_ptr(x) for x in outputs))
         assert status == py.STATUS_INVALID
         assert np.isnan(out).all()

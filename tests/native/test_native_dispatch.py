@@ -74,13 +74,14 @@ def test_derived_arrays_equal_the_c_library(dispatch_runs, table_pair, case):
 
 @pytest.mark.parametrize("case", CASES)
 def test_draws_equal_the_c_library(dispatch_runs, table_pair, case):
-    """table_rebound_many's draws under each case equal rbs_rebound_many's for the same uniforms, 0 ulp."""
+    """table_rebound_many's draws under each case equal rbs_table_rebound_many's for the same uniforms, 0 ulp."""
     given, runs = dispatch_runs
     _, native_table = table_pair
     code, mix, message = native_table.mix_from_weights(WEIGHTS)
     assert code == 0, message
     for label, interpolation in (("scaled", SCALED), ("stochastic", STOCHASTIC)):
-        status, V_c, W_c = native_table.rebound_many(mix, given["V"], given["n"], given["a"], given["u"], interpolation)
+        status, V_c, W_c = native_table.table_rebound_many(mix, given["V"], given["n"], given["a"], given["u"],
+                                                           interpolation)
         got = runs[case][f"many_{label}"]
         assert np.array_equal(got[:, 6].astype(np.int8), status), (case, label)
         assert max_ulp(got[:, :3], V_c) == 0 and max_ulp(got[:, 3:6], W_c) == 0, (case, label)

@@ -103,7 +103,7 @@ def test_installed_package_config(native_build, tmp_path):
     consumer.mkdir()
     (consumer / "CMakeLists.txt").write_text(
         "cmake_minimum_required(VERSION 3.18)\nproject(consumer LANGUAGES C)\n"
-        "find_package(ReboundScatter 0.1 CONFIG REQUIRED)\n"
+        "find_package(ReboundScatter 1.0 CONFIG REQUIRED)\n"
         "add_executable(consumer main.c)\ntarget_link_libraries(consumer PRIVATE ReboundScatter::rebound_scatter)\n"
         "add_executable(consumer_static main.c)\n"
         "target_link_libraries(consumer_static PRIVATE ReboundScatter::rebound_scatter_static)\n")
@@ -117,7 +117,7 @@ def test_installed_package_config(native_build, tmp_path):
     done = run(["cmake", "--build", str(build)])
     assert done.returncode == 0, done.stdout + done.stderr
     outputs = {run([str(build / name)]).stdout for name in ("consumer", "consumer_static")}
-    assert len(outputs) == 1 and outputs.pop().startswith("0.1.0 ")
+    assert len(outputs) == 1 and outputs.pop().startswith("1.0.0 ")
 
 
 @pytest.mark.parametrize("script", ["install-deps.sh"])

@@ -1,4 +1,4 @@
-"""Every wall hit answered in C: rbs_rebound_path, rbs_rebound_spin_u and rbs_rebound_spin give the paths and
+"""Every wall hit answered in C: rbs_rebound_path, rbs_rebound and rbs_rebound_rng give the paths and
 the bits of surrogate.kernels.wall_hit (rebound_path, rebound) for the same uniforms.
 
 Over random incident states (over and beyond the table's grid, the hostile ones of tests.helpers.states.incident_states)
@@ -98,7 +98,7 @@ def test_paths_and_bits_equal_numba(spin_case, method):
         paths[i] = native_table.rebound_path(V[i], omega[i], n[i], a[i], code)
         assert paths[i] == py.rebound_path(table.kernel_data, tuple(V[i]), tuple(omega[i]), tuple(n[i]), a[i],
                                            code), i
-        st, v, w = native_table.rebound_spin_u(mix, V[i], omega[i], n[i], a[i], u[i], code)
+        st, v, w = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u[i], code)
         st_py, v_py, w_py = _numba(table, cdf, V[i], omega[i], n[i], a[i], u[i], code)
         assert st == st_py, (i, st, st_py)
         worst = max(worst, max_ulp(v, np.array(v_py)), max_ulp(w, np.array(w_py)))
@@ -141,8 +141,8 @@ def test_auto_picks_the_path_by_spin_and_grid(spin_case):
     assert at.sum() >= 20
 
 
-def test_table_path_is_rbs_rebound_bit_for_bit(spin_case):
-    """Where auto takes the table, and always under table, the answer is rbs_rebound's with the same
+def test_table_path_is_rbs_table_rebound_bit_for_bit(spin_case):
+    """Where auto takes the table, and always under table, the answer is rbs_table_rebound's with the same
     uniforms (both interpolations)."""
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     checked = 0
@@ -151,26 +151,40 @@ def test_table_path_is_rbs_rebound_bit_for_bit(spin_case):
             for method in (AUTO, TABLE):
                 if native_table.rebound_path(V[i], omega[i], n[i], a[i], method) != PATH_TABLE:
                     continue
-                st, v, w = native_table.rebound_spin_u(mix, V[i], omega[i], n[i], a[i], u[i], method, interpolation)
-                st_t, v_t, w_t = native_table.rebound(mix, V[i], n[i], a[i], u[i], interpolation)
+                st, v, w = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u[i], method, interpolation)
+                st_t, v_t, w_t = native_table.table_rebound(mix, V[i], n[i], a[i], u[i], interpolation)
                 assert st == st_t and max_ulp(v, v_t) == 0 and max_ulp(w, w_t) == 0, (i, method)
                 checked += 1
     assert checked > COUNT
 
 
 def test_rng_form_draws_thirteen_uniforms_whatever_the_path(spin_case, native):
-    """rbs_rebound_spin = rbs_rng_fill of 13 uniforms, then rbs_rebound_spin_u; the stream advances by 13 per
+    """rbs_rebound_rng = rbs_rng_fill of 13 uniforms, then rbs_rebound; the stream advances by 13 per
     hit whatever the path and the status (invalid hits too)."""
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     state = py.seed_state(2811)
     for i in range(0, COUNT, 5):
         for method in METHODS.values():
             u_i, after = native.fill(state, 13)
-            st, v, w, advanced = native_table.rebound_spin(mix, V[i], omega[i], n[i], a[i], state, method)
-            st_u, v_u, w_u = native_table.rebound_spin_u(mix, V[i], omega[i], n[i], a[i], u_i, method)
+            st, v, w, advanced = native_table.rebound_rng(mix, V[i], omega[i], n[i], a[i], state, method)
+            st_u, v_u, w_u = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u_i, method)
             assert np.array_equal(advanced, after), i
             assert st == st_u and max_ulp(v, v_u) == 0 and max_ulp(w, w_u) == 0, i
             state = advanced
+
+
+def test_the_0x_name_rbs_rebound_spin_is_rbs_rebound_rng(spin_case):
+    """rbs_rebound_spin, kept for programs written against 0.x: rbs_rebound_rng's statuses and bits, its stream
+    advanced alike, under every method."""
+    table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
+    state = py.seed_state(2812)
+    for i in range(0, COUNT, 25):
+        for method in METHODS.values():
+            new = native_table.rebound_rng(mix, V[i], omega[i], n[i], a[i], state, method)
+            old = native_table.rebound_rng(mix, V[i], omega[i], n[i], a[i], state, method, symbol="rbs_rebound_spin")
+            assert new[0] == old[0], (i, method)
+            assert all(np.array_equal(x.view(np.uint64), y.view(np.uint64)) for x, y in zip(new[1:], old[1:])), i
+            state = new[3]
 
 
 def test_hostile_arguments_give_invalid_and_nan(spin_case, native):
@@ -181,10 +195,10 @@ def test_hostile_arguments_give_invalid_and_nan(spin_case, native):
     Vi, Wi, ni, ui = (np.ascontiguousarray(x, dtype=np.float64) for x in (V[i], omega[i], n[i], u[i]))
     assert native_table.rebound_path(Vi, Wi, ni, a[i], AUTO) in (PATH_TABLE, PATH_DIRECT)
 
-    def spin_u(table_handle, mix_arg, V_, W_, n_, a_, u_, method, interpolation=SCALED, outputs=True):
+    def rebound(table_handle, mix_arg, V_, W_, n_, a_, u_, method, interpolation=SCALED, outputs=True):
         out = (np.full(3, 7.0), np.full(3, 7.0))
-        st = c.rbs_rebound_spin_u(table_handle, mix_arg, V_, W_, n_, ctypes.c_double(a_), u_, method, interpolation,
-                                  _ptr(out[0]) if outputs else None, _ptr(out[1]) if outputs else None)
+        st = c.rbs_rebound(table_handle, mix_arg, V_, W_, n_, ctypes.c_double(a_), u_, method, interpolation,
+                           _ptr(out[0]) if outputs else None, _ptr(out[1]) if outputs else None)
         return st, out
 
     mix_ref = ctypes.byref(mix)
@@ -196,11 +210,11 @@ def test_hostile_arguments_give_invalid_and_nan(spin_case, native):
              "method 3": (h, mix_ref, *good, 3), "method -1": (h, mix_ref, *good, -1),
              "mix of another shape count": (h, ctypes.byref(wrong_mix), *good, AUTO)}
     for label, args in cases.items():
-        st, (v, w) = spin_u(*args)
+        st, (v, w) = rebound(*args)
         assert st == INVALID and np.isnan(v).all() and np.isnan(w).all(), label
-    st, (v, w) = spin_u(h, mix_ref, *good, AUTO, interpolation=5)
+    st, (v, w) = rebound(h, mix_ref, *good, AUTO, interpolation=5)
     assert st == INVALID and np.isnan(v).all(), "unknown interpolation"
-    st, _ = spin_u(h, mix_ref, *good, AUTO, outputs=False)
+    st, _ = rebound(h, mix_ref, *good, AUTO, outputs=False)
     assert st == INVALID, "NULL outputs"
     for bad in (np.nan, np.inf, -np.inf):
         for k in range(3):
@@ -208,13 +222,13 @@ def test_hostile_arguments_give_invalid_and_nan(spin_case, native):
             W_bad[k] = bad
             for method in METHODS.values():
                 assert native_table.rebound_path(Vi, W_bad, ni, a[i], method) == INVALID
-                st, v, w = native_table.rebound_spin_u(mix, Vi, W_bad, ni, a[i], ui, method)
+                st, v, w = native_table.rebound(mix, Vi, W_bad, ni, a[i], ui, method)
                 assert st == INVALID and np.isnan(v).all() and np.isnan(w).all(), (bad, k, method)
     assert c.rbs_rebound_path(None, _ptr(Vi), _ptr(Wi), _ptr(ni), ctypes.c_double(a[i]), AUTO) == INVALID
     assert c.rbs_rebound_path(h, _ptr(Vi), None, _ptr(ni), ctypes.c_double(a[i]), AUTO) == INVALID
     # a NULL or all-zero rng: invalid, the state untouched
     for rng in (None, ctypes.byref(Rng())):
         out = (np.empty(3), np.empty(3))
-        st = c.rbs_rebound_spin(h, mix_ref, _ptr(Vi), _ptr(Wi), _ptr(ni), ctypes.c_double(a[i]), rng, AUTO, SCALED,
-                                _ptr(out[0]), _ptr(out[1]))
+        st = c.rbs_rebound_rng(h, mix_ref, _ptr(Vi), _ptr(Wi), _ptr(ni), ctypes.c_double(a[i]), rng, AUTO, SCALED,
+                               _ptr(out[0]), _ptr(out[1]))
         assert st == INVALID and np.isnan(out[0]).all() and np.isnan(out[1]).all()

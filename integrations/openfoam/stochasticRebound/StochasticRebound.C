@@ -483,7 +483,7 @@ bool Foam::StochasticRebound<CloudType>::correct
     {
         t0 = std::chrono::steady_clock::now();
     }
-    const int status = rbs_rebound_spin_u
+    const int status = rbs_rebound
     (
         table, &mix_, V, Omega, n, a, u, method_, interpolation_, Vout, Wout
     );

@@ -1,7 +1,7 @@
 /*
- * direct.c: the direct model at run time in the caller's frame (surrogate.kernels.direct: rebound_direct_tuple,
- * _valid, _rebound_direct): the checks of the inputs, the impact frame of the hit (frame.h, the sampler's),
- * the rebound in the model's frame (runtime.c), V⁺ and Ω⁺ back in the caller's frame (rbs_to_global).
+ * direct_path.c: the direct model at run time in the caller's frame (surrogate.kernels.direct_path:
+ * direct_rebound, _valid): the checks of the inputs, the impact frame of the hit (frame.h, the
+ * sampler's), the rebound in the model's frame (runtime.c), V⁺ and Ω⁺ back in the caller's frame (rbs_to_global).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -17,7 +17,7 @@ static void nan_out(double *x)
         for (int k = 0; k < 3; k++) x[k] = NAN;
 }
 
-/* the inputs in their ranges (surrogate.kernels.direct._valid): uniforms 0 <= u < 1 as numba compares them */
+/* the inputs in their ranges (surrogate.kernels.direct_path._valid): uniforms 0 <= u < 1 as numba compares them */
 static int valid(int shape, const double *V, const double *Omega, const double *n, double a, const double *u)
 {
     int ok = rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2]) && rbs_particle_ok(n[0], n[1], n[2], a)
@@ -26,7 +26,7 @@ static int valid(int shape, const double *V, const double *Omega, const double *
     return ok;
 }
 
-RBS_HOT int rbs_rebound_direct(const rbs_table *t, int shape, const double V[3], const double Omega[3],
+RBS_HOT int rbs_direct_rebound(const rbs_table *t, int shape, const double V[3], const double Omega[3],
                                const double n[3], double a, const double u[RBS_U_PER_REBOUND], double V_out[3],
                                double Omega_out[3])
 {

@@ -1,25 +1,25 @@
 /*
- * rebound.h: a whole rebound of the direct model, free flights and collisions alternating (direct_model.rebound).
- * Frame: the model's lab frame (wall y = 0, normal +Y); lengths in units of a, velocities in m/s, angular
- * velocities in (m/s)/a. Matrices row-major 3 × 3.
+ * body_rebound.h: a whole rebound of the direct model, free flights and collisions alternating
+ * (direct_model.body_rebound). Frame: the model's lab frame (wall y = 0, normal +Y); lengths in units of a,
+ * velocities in m/s, angular velocities in (m/s)/a. Matrices row-major 3 × 3.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
-#ifndef RBS_REBOUND_H
-#define RBS_REBOUND_H
+#ifndef RBS_BODY_REBOUND_H
+#define RBS_BODY_REBOUND_H
 
 /* R = the rotation matrix of the quaternion q = (w, x, y, z), normalised here
- * (direct_model.rebound.quaternion_to_matrix) */
+ * (direct_model.body_rebound.quaternion_to_matrix) */
 void rbs_quaternion_to_matrix(const double q[4], double R[9]);
 
-/* One particle's rebound (direct_model.rebound.rebound without history): shape code, semi = (1, b/a, c/a),
+/* One particle's rebound (direct_model.body_rebound.body_rebound without history): shape code, semi = (1, b/a, c/a),
  * kappa, hand ±1, kfac the shape's second-moment factor, R0 body → lab at the start, V0 (m/s) and W0 ((m/s)/a)
  * incident, wall = (k, p, q), n_max collisions allowed, contact_tol and set_tol (units of a), max_steps per
  * flight; V, W receive the state after the last collision. Returns RBS_REBOUNDED, RBS_TRAPPED or RBS_FAILED;
  * the collisions and search steps into *n_collisions, *n_steps. */
-int rbs_rebound_body(int shape, const double semi[3], double kappa, double hand, double kfac, const double R0[9],
+int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand, double kfac, const double R0[9],
                      const double V0[3], const double W0[3], const double wall[3], long long n_max, double contact_tol,
                      double set_tol, long long max_steps, double V[3], double W[3], long long *n_collisions,
                      long long *n_steps);
 
-#endif /* RBS_REBOUND_H */
+#endif /* RBS_BODY_REBOUND_H */

@@ -1,6 +1,6 @@
 /*
- * particle.c: one particle (surrogate.kernels.particle: rebound_tuple, draw_local): validity, impact frame,
- * grid look-up, cache hints, the draw in its cell, back to the global frame.
+ * table_path.c: one particle by the table's law (surrogate.kernels.table_path: table_rebound, draw_local):
+ * validity, impact frame, grid look-up, cache hints, the draw in its cell, back to the global frame.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -9,7 +9,7 @@
 #include "draw.h"
 #include "frame.h"
 #include "locate.h"
-#include "rebound_internal.h"
+#include "table_arguments.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
 static void nan_out(double *x, int count)
@@ -18,10 +18,10 @@ static void nan_out(double *x, int count)
         for (int k = 0; k < count; k++) x[k] = NAN;
 }
 
-RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
-                const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
+RBS_HOT int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
+                              const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
 {
-    if (!V || !n || !u || !V_out || !Omega_out || !rbs_arguments_ok(t, mix, interpolation)
+    if (!V || !n || !u || !V_out || !Omega_out || !rbs_table_arguments_ok(t, mix, interpolation)
         || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])) {
         nan_out(V_out, 3);
         nan_out(Omega_out, 3);
@@ -38,7 +38,8 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3
     return rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
 }
 
-/* a local incident state a draw takes (surrogate.kernels.particle.local_ok): α1 in (0, 90] deg, |V⁻| finite and > 0 m/s */
+/* a local incident state a draw takes (surrogate.kernels.table_path.local_ok): α1 in (0, 90] deg, |V⁻| finite
+ * and > 0 m/s */
 static inline int local_ok(double alpha1_deg, double speed_m_s)
 {
     return alpha1_deg > 0.0 && alpha1_deg <= 90.0 && speed_m_s > 0.0 && rbs_finite(speed_m_s);
@@ -47,7 +48,7 @@ static inline int local_ok(double alpha1_deg, double speed_m_s)
 RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                    const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE])
 {
-    if (!u || !out || !rbs_arguments_ok(t, mix, interpolation) || !local_ok(alpha1_deg, speed_m_s)) {
+    if (!u || !out || !rbs_table_arguments_ok(t, mix, interpolation) || !local_ok(alpha1_deg, speed_m_s)) {
         nan_out(out, RBS_LOCAL_SIZE);
         return RBS_INVALID;
     }

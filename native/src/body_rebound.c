@@ -1,17 +1,17 @@
 /*
- * rebound.c: a whole rebound of the direct model (direct_model.rebound: rebound, quaternion_to_matrix,
- * lab_tensor): with Ω⁻ = 0 the body starts touching the wall, otherwise with its centre at the bounding
- * radius; then search the flight for the next contact (flight.c, rotation.c) and collide (collision.c) until
- * the body escapes (rebounded), n_max is exceeded (trapped) or a search or collision fails (failed). The same
- * operations in the same order as the numba kernels; the work space on the stack.
+ * body_rebound.c: a whole rebound of the direct model (direct_model.body_rebound: body_rebound,
+ * quaternion_to_matrix, lab_tensor): with Ω⁻ = 0 the body starts touching the wall, otherwise with its centre at
+ * the bounding radius; then search the flight for the next contact (flight.c, rotation.c) and collide
+ * (collision.c) until the body escapes (rebounded), n_max is exceeded (trapped) or a search or collision fails
+ * (failed). The same operations in the same order as the numba kernels; the work space on the stack.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
 
+#include "body_rebound.h"
 #include "collision.h"
 #include "flight.h"
-#include "rebound.h"
 #include "rebound_scatter.h"
 #include "rotation.h"
 #include "shapes.h"
@@ -40,7 +40,7 @@ static void lab_tensor(const double *R, const double *diag, double *out)
                              + R[3 * i + 2] * diag[2] * R[3 * j + 2];
 }
 
-int rbs_rebound_body(int shape, const double semi[3], double kappa, double hand, double kfac, const double R0[9],
+int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand, double kfac, const double R0[9],
                      const double V0[3], const double W0[3], const double wall[3], long long n_max, double contact_tol,
                      double set_tol, long long max_steps, double V[3], double W[3], long long *n_collisions,
                      long long *n_steps)
