@@ -31,6 +31,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "bft_error.h"
 #include "bft_printf.h"
@@ -81,7 +83,7 @@ typedef struct {
 typedef struct {
   cs_gnum_t   hits, table_path, direct_path, rebounded, trapped, failed,
               invalid, outside_grid;
-  double      trapped_weight, failed_weight, direct_seconds;
+  double      trapped_weight, failed_weight, direct_seconds, cpu_seconds;
 } rbs_cs_counters_t;
 
 static int                 _initialized = 0;
@@ -93,6 +95,16 @@ static FILE               *_hits = NULL;
 static long long           _n_recorded = 0;
 static rbs_cs_counters_t   _count;
 static double              _alpha1_lo, _alpha1_hi, _speed_lo, _speed_hi;
+
+/* CPU seconds of the calling thread: what the hits cost whatever else runs on
+   the machine */
+static double
+_thread_cpu_seconds(void)
+{
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9*(double)t.tv_nsec;
+}
 
 /*----------------------------------------------------------------------------
  * Reading the settings
@@ -381,6 +393,12 @@ _open_hits(int rank)
     bft_error(__FILE__, __LINE__, 0,
               "rebound-scatter: cannot write the hits file %s (%s)", path,
               strerror(errno));
+  /* the table's absolute path: the records are read from other folders */
+  char table[2*RBS_CS_LINE + 2], cwd[RBS_CS_LINE];
+  if (_set.table_path[0] != '/' && getcwd(cwd, sizeof(cwd)) != NULL)
+    snprintf(table, sizeof(table), "%s/%s", cwd, _set.table_path);
+  else
+    _copy(table, _set.table_path);
   static const char *const m[] = {"auto", "table", "direct"};
   static const int mc[] = {RBS_AUTO, RBS_TABLE, RBS_DIRECT};
   static const char *const im[] = {"scaled", "stochastic"};
@@ -389,7 +407,7 @@ _open_hits(int rank)
           "# code_saturne rebound-scatter hits: seed %llu, stream %d, "
           "table %s, mix %s, halfSizeFactor %.17g, interpolation %s, "
           "method %s, spin tolerance %g\n",
-          (unsigned long long)_set.seed, rank, _set.table_path, _set.mix_name,
+          (unsigned long long)_set.seed, rank, table, _set.mix_name,
           _set.half_size_factor, _name(_set.interpolation, im, ic, 2),
           _name(_set.method, m, mc, 3), RBS_SPIN_TOLERANCE);
   fprintf(_hits,
@@ -478,10 +496,10 @@ rbs_cs_finalize(void)
   cs_gnum_t c[8] = {_count.hits, _count.table_path, _count.direct_path,
                     _count.rebounded, _count.trapped, _count.failed,
                     _count.invalid, _count.outside_grid};
-  double w[3] = {_count.trapped_weight, _count.failed_weight,
-                 _count.direct_seconds};
+  double w[4] = {_count.trapped_weight, _count.failed_weight,
+                 _count.direct_seconds, _count.cpu_seconds};
   cs_parall_counter(c, 8);
-  cs_parall_sum(3, CS_DOUBLE, w);
+  cs_parall_sum(4, CS_DOUBLE, w);
   const char *policy = _set.remove_trapped ? "removed" : "deposited";
   bft_printf("\n  rebound-scatter (%s), all ranks\n"
              "    - wall hits                    = %llu\n"
@@ -492,12 +510,13 @@ rbs_cs_finalize(void)
              "    - trapped, %s (number, weight) = %llu, %g\n"
              "    - failed (direct model), %s (number, weight) = %llu, %g\n"
              "    - invalid (solver's rebound)   = %llu\n"
-             "    - outside the table's grid     = %llu\n",
+             "    - outside the table's grid     = %llu\n"
+             "    - CPU time in the hits         = %g s (%g us per hit)\n",
              _set.mix_name, (unsigned long long)c[0], (unsigned long long)c[1],
              (unsigned long long)c[2], c[2] > 0 ? 1e6*w[2]/c[2] : 0.,
              (unsigned long long)c[3], policy, (unsigned long long)c[4], w[0],
              policy, (unsigned long long)c[5], w[1], (unsigned long long)c[6],
-             (unsigned long long)c[7]);
+             (unsigned long long)c[7], w[3], c[0] > 0 ? 1e6*w[3]/c[0] : 0.);
   if (_hits != NULL)
     fclose(_hits);
   _hits = NULL;
@@ -524,6 +543,7 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
 {
   CS_UNUSED(face_id);
   rbs_cs_initialize();
+  const double cpu0 = _thread_cpu_seconds();
 
   const cs_lagr_attribute_map_t *p_am = particles->p_am;
   unsigned char *particle = particles->p_buffer + p_am->extents * p_id;
@@ -682,4 +702,5 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
   }
 
   _record_hit(b_zone_id, d, a, V, n, status, path, Vout, Wout, u0);
+  _count.cpu_seconds += _thread_cpu_seconds() - cpu0;
 }
