@@ -433,6 +433,18 @@ def test_bad_setup_is_one_clear_error_from_the_solver(cs_build, case_table, tmp_
     assert not list((case / "RESU").glob("hits/hits_*.csv"))
 
 
+def test_hit_records_never_overwrite_another_file(cs_build, case_table, tmp_path_factory):
+    case = _copy_case(tmp_path_factory, "cs_foreign_hits")
+    (case / "results").mkdir()
+    (case / "results" / "hits_0.csv").write_text("someone else's data\n")
+    _set(case, "hits", "../results")
+    proc = _allrun(case, case_table, check=False)
+    assert proc.returncode != 0
+    assert "results/hits_0.csv exists and is not a rebound-scatter hits file" in \
+        (case / "RESU" / "error").read_text()
+    assert (case / "results" / "hits_0.csv").read_text() == "someone else's data\n"
+
+
 def test_settings_without_a_table_are_one_clear_error(cs_build, case_table, tmp_path_factory):
     case = _copy_case(tmp_path_factory, "cs_no_table")
     (case / "rebound_scatter.conf").write_text("seed = 1\n")

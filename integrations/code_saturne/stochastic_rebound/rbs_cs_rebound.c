@@ -388,6 +388,20 @@ _open_hits(int rank)
               "%s (%s)", _set.setup_path, _set.hits_dir, strerror(errno));
   char path[RBS_CS_LINE + 32];
   snprintf(path, sizeof(path), "%s/hits_%d.csv", _set.hits_dir, rank);
+  /* a new run starts our records again, and never overwrites another file */
+  static const char ours[] = "# code_saturne rebound-scatter hits:";
+  FILE *old = fopen(path, "r");
+  if (old != NULL) {
+    char first[sizeof(ours)] = "";
+    const int is_ours = fgets(first, sizeof(first), old) != NULL
+                        && strcmp(first, ours) == 0;
+    fclose(old);
+    if (!is_ours)
+      bft_error(__FILE__, __LINE__, 0,
+                "rebound-scatter settings %s: %s exists and is not a "
+                "rebound-scatter hits file; choose another hits folder",
+                _set.setup_path, path);
+  }
   _hits = fopen(path, "w");
   if (_hits == NULL)
     bft_error(__FILE__, __LINE__, 0,
@@ -404,10 +418,10 @@ _open_hits(int rank)
   static const char *const im[] = {"scaled", "stochastic"};
   static const int ic[] = {RBS_SCALED, RBS_STOCHASTIC};
   fprintf(_hits,
-          "# code_saturne rebound-scatter hits: seed %llu, stream %d, "
+          "%s seed %llu, stream %d, "
           "table %s, mix %s, halfSizeFactor %.17g, interpolation %s, "
           "method %s, spin tolerance %g\n",
-          (unsigned long long)_set.seed, rank, table, _set.mix_name,
+          ours, (unsigned long long)_set.seed, rank, table, _set.mix_name,
           _set.half_size_factor, _name(_set.interpolation, im, ic, 2),
           _name(_set.method, m, mc, 3), RBS_SPIN_TOLERANCE);
   fprintf(_hits,
