@@ -20,7 +20,8 @@ from importlib import import_module
 from importlib.util import find_spec
 
 # the distributions of the build extra (pyproject.toml), by the module each installs
-BUILD_EXTRA = {"scipy": "scipy", "sklearn": "scikit-learn", "threadpoolctl": "threadpoolctl", "tqdm": "tqdm"}
+BUILD_EXTRA = {"scipy": "scipy", "sklearn": "scikit-learn", "threadpoolctl": "threadpoolctl", "tqdm": "tqdm",
+               "trimesh": "trimesh"}
 
 
 def _require_build_extra() -> None:

@@ -8,7 +8,7 @@ from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
 from direct_model.shapes import MAX_VERTICES, body_vertices, second_moment_factor, shape_code
 
-from kernel_helpers import MIRROR, random_bodies, run_one
+from tests.helpers.one_particle import MIRROR, random_bodies, run_one
 
 BODIES = random_bodies(200, seed=7)
 

@@ -7,7 +7,7 @@ import numba
 import numpy as np
 import pytest
 
-from cli_helpers import user_error
+from tests.helpers.cli import user_error
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, read_samples
 from tablegen.cli import main as tablegen_main
 from direct_model.shapes import AspectRatioLaw

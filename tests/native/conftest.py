@@ -6,14 +6,9 @@ fails every test that needs it, with a message saying to run native/install-deps
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))     # the helper modules, whatever pytest's import mode
-
-from _native import INSTALL_HINT, BuildError, Native, build, missing_tools  # noqa: E402
+from tests.helpers.native_library import INSTALL_HINT, BuildError, Native, build, missing_tools
 
 
 def _require_tools(fortran=True, cxx=True):
@@ -66,5 +61,5 @@ def native(native_build):
 @pytest.fixture(scope="session")
 def table_pair(native, small_table_path):
     """(surrogate's table, the native table) of the session's small table."""
-    import _python_side as py
+    from tests.helpers import python_side as py
     return py.load(small_table_path), native.table(small_table_path)

@@ -8,7 +8,7 @@ numba's on the bench states are.
 import json
 import sys
 
-from _native import REPO
+from tests.helpers import REPO
 
 sys.path.insert(0, str(REPO / "benchmarks"))
 

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import _python_side as py
-from _native import SCALED, STOCHASTIC
-from _states import incident_states, max_ulp, uniforms
+from tests.helpers import python_side as py
+from tests.helpers.native_library import SCALED, STOCHASTIC
+from tests.helpers.states import incident_states, max_ulp, uniforms
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
                  "restitution_pieces")

@@ -11,8 +11,8 @@ import h5py
 import numpy as np
 import pytest
 
-import _python_side as py
-from _native import ERR_FORMAT
+from tests.helpers import python_side as py
+from tests.helpers.native_library import ERR_FORMAT
 
 SPINS = (0.0, 0.02, 0.3, 1.0)     # |Ω⁻| a / |V⁻| of the whole-rebound comparisons
 PER_SHAPE = 2000                  # particles per shape and spin

@@ -1,7 +1,7 @@
 """The C library's direct model (rbs_rebound_direct, in random caller's frames) draws the law of `tablegen
-simulate` at the 16 incident states of tests/direct_law.py (every shape at |Ω⁻|a/|V⁻| ∈ {0, 0.02, 0.3, 1.0},
+simulate` at the 16 incident states of tests/helpers/direct_law.py (every shape at |Ω⁻|a/|V⁻| ∈ {0, 0.02, 0.3, 1.0},
 60–280 m/s): KS over the six components of V⁺/|V⁻| and Ω⁺a/|V⁻|, a classifier two-sample test, the trapped
-fractions, with bounds from n and the number of comparisons (tests/direct_law.py). numba's kernel draws the
+fractions, with bounds from n and the number of comparisons (tests/helpers/direct_law.py). numba's kernel draws the
 same law (tests/surrogate/test_direct_law.py, with the control that shows these tests see a spin of 0.02),
 and the same bits as C for the same uniforms (test_native_direct.py). The C side's uniforms come from its
 own stream (rbs_rng, seed 13), independent of the reference's."""
@@ -9,7 +9,7 @@ own stream (rbs_rng, seed 13), independent of the reference's."""
 import numpy as np
 import pytest
 
-import _python_side as py
+from tests.helpers import python_side as py
 
 
 def _c_in_frame(table, state, seed):

@@ -4,8 +4,8 @@ numpy and OpenBLAS choose their kernels when they load (AVX-512, AVX2 or baselin
 product can come out in another order, so in other last bits, on another CPU. The runtime must not
 depend on that: every array the kernels derive from a table, every mix and every draw must be the
 same on an AVX-512 and an AVX2 machine, and equal to the C library's. Each case below runs
-_dispatch_child.py in a subprocess with numpy's dispatch targets, OpenBLAS's core type and numba's
-target CPU forced down to another level (tests/cpu_dispatch.py), checks that the process really took
+tests/helpers/dispatch_child.py in a subprocess with numpy's dispatch targets, OpenBLAS's core type and numba's
+target CPU forced down to another level (tests/helpers/cpu_dispatch.py), checks that the process really took
 other code paths, and compares its output bit for bit with the C library's and with the default
 process's.
 """
@@ -14,16 +14,15 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from _native import SCALED, STOCHASTIC
-from _states import incident_states, max_ulp, uniforms
-from cpu_dispatch import CASES, code_paths, environment
+from tests.helpers import REPO
+from tests.helpers.cpu_dispatch import CASES, code_paths, environment
+from tests.helpers.native_library import SCALED, STOCHASTIC
+from tests.helpers.states import incident_states, max_ulp, uniforms
 
-HERE = Path(__file__).resolve().parent
 STATES = 20_000
 WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
 
@@ -39,8 +38,8 @@ def dispatch_runs(small_table_path, tmp_path_factory):
     runs = {}
     for case in CASES:
         output = folder / f"{case.replace(' ', '_')}.npz"
-        done = subprocess.run([sys.executable, str(HERE / "_dispatch_child.py"), str(small_table_path), str(given),
-                               str(output)], env=environment(case), capture_output=True, text=True, timeout=900)
+        child = [sys.executable, "-m", "tests.helpers.dispatch_child", str(small_table_path), str(given), str(output)]
+        done = subprocess.run(child, cwd=REPO, env=environment(case), capture_output=True, text=True, timeout=900)
         assert done.returncode == 0, f"{case}: {done.stderr[-3000:]}"
         with np.load(output) as saved:
             runs[case] = {k: saved[k] for k in saved.files}

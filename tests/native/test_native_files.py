@@ -1,4 +1,4 @@
-"""One contract, two loaders: every file of the corpus of bad tables (_bad_files.py: each way a table can
+"""One contract, two loaders: every file of the corpus of bad tables (tests/helpers/bad_files.py: each way a table can
 break docs/format.md, "What makes a table valid") gets the same verdict from rbs_table_open and
 surrogate.load, the C code expected and messages naming the file and what is wrong. Another minor version,
 and a table of format 3.1, load in both. The same files run through the sanitizer build in
@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-import _python_side as py
-from _bad_files import bad_tables
-from _native import OK
+from tests.helpers import python_side as py
+from tests.helpers.bad_files import bad_tables
+from tests.helpers.native_library import OK
 
 
 @pytest.fixture(scope="module")

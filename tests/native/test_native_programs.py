@@ -8,8 +8,8 @@ import shutil
 
 import pytest
 
-from _native import INSTALL_HINT, NATIVE, run
-from _bad_files import bad_tables
+from tests.helpers.bad_files import bad_tables
+from tests.helpers.native_library import INSTALL_HINT, NATIVE, run
 
 SANITIZER_ENV = {"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0:halt_on_error=1",
                  "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1"}

@@ -19,8 +19,8 @@ import math
 import numpy as np
 import pytest
 
-import _python_side as py
-from _states import max_ulp
+from tests.helpers import python_side as py
+from tests.helpers.states import max_ulp
 
 STATES_PER_KIND = 400
 PREFILL = -7.25     # both parameter arrays start with it: the entries rotation_init leaves alone must agree too

@@ -1,7 +1,7 @@
 """Every wall hit answered in C: rbs_rebound_path, rbs_rebound_spin_u and rbs_rebound_spin give the paths and
 the bits of surrogate.kernels.spin (rebound_path, rebound_spin_tuple) for the same uniforms.
 
-Over random incident states (over and beyond the table's grid, the hostile ones of _states.incident_states)
+Over random incident states (over and beyond the table's grid, the hostile ones of tests.helpers.states.incident_states)
 with Ω⁻ zero, below the spin tolerance, at it, above it, large, and NaN or infinite, under the three methods:
 the path, the status and V⁺, Ω⁺ of C equal numba's (0 ulp); the paths follow the rule (checked here on the
 states' own numbers, away from the edges); where the table answers under auto, the table path's bits. Hostile
@@ -16,9 +16,10 @@ import ctypes
 import numpy as np
 import pytest
 
-import _python_side as py
-from _native import AUTO, DIRECT, INVALID, PATH_DIRECT, PATH_TABLE, SCALED, STOCHASTIC, TABLE, Mix, Rng, _ptr
-from _states import incident_states, max_ulp, uniforms
+from tests.helpers import python_side as py
+from tests.helpers.native_library import (AUTO, DIRECT, INVALID, PATH_DIRECT, PATH_TABLE, SCALED, STOCHASTIC, TABLE, Mix,
+                                          Rng, _ptr)
+from tests.helpers.states import incident_states, max_ulp, uniforms
 
 COUNT = 2500        # states per method: the direct path runs the model (microseconds each, twice)
 METHODS = {"auto": AUTO, "table": TABLE, "direct": DIRECT}
@@ -65,7 +66,7 @@ def spin_case(table_pair):
 
 
 def spin_states(table):
-    """COUNT incident states (_states.incident_states over and beyond the grid) with their spins and uniforms.
+    """COUNT incident states (tests.helpers.states.incident_states, over and beyond the grid), spins, uniforms.
 
     Speeds below 1e-6 or above 1e6 m/s are moved to the grid's top speed: numba's direct model does not
     return at |V⁻| = 1e-160 m/s (it stays in direct_model.rotation.rotation_init; C answers RBS_FAILED

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from cli_helpers import user_error
+from tests.helpers.cli import user_error
 from data_schema.output import FOLDER_MARKER
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from tablegen.cli import main as tablegen_main

@@ -24,7 +24,7 @@ from tablegen.study.validation import (
 )
 from tablegen.study.validation_report import document, precision
 
-from conftest import NEAR_NORMAL_POINT
+from tests.helpers.tables import NEAR_NORMAL_POINT
 
 N_DRAWS = 20_000
 KS_TARGET = 0.03

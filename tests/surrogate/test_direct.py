@@ -2,7 +2,7 @@
 frame, with the table's parameters; the model's invariants through it; bad inputs.
 
 The law against `tablegen simulate` at 16 incident states: test_direct_law.py. KS bounds here: those of
-tests/direct_law.py (Bonferroni over the module's comparisons, FAMILY_ALPHA = 1e-3), fixed seeds.
+tests/helpers/direct_law.py (Bonferroni over the module's comparisons, FAMILY_ALPHA = 1e-3), fixed seeds.
 """
 
 import subprocess
@@ -24,7 +24,7 @@ from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAUL
 from direct_model.wall import CORUNDUM_ON_STEEL
 from surrogate.kernels import rebound_direct_tuple
 
-from direct_law import A, kernel_in_frame, ks_bound, random_frame
+from tests.helpers.direct_law import A, kernel_in_frame, ks_bound, random_frame
 
 ROTATION_COMPARISONS = 6 * len(SHAPES)        # KS comparisons of test_rotating_the_frame_rotates_the_outputs
 

@@ -1,12 +1,12 @@
 """numba's run-time kernel (surrogate.rebound_direct, in random caller's frames) and `tablegen simulate`
 (direct_model.simulate, model frame) draw one law at 16 incident states: every shape at |Ω⁻|a/|V⁻| ∈
-{0, 0.02, 0.3, 1.0}, 60–280 m/s. Statistics and their bounds: tests/direct_law.py (KS over the six
+{0, 0.02, 0.3, 1.0}, 60–280 m/s. Statistics and their bounds: tests/helpers/direct_law.py (KS over the six
 components and a classifier two-sample test, both with bounds from n and the number of comparisons); the
 control shows the tests see the jump of the law between Ω⁻ = 0 and |Ω⁻|a/|V⁻| = 0.02."""
 
 import pytest
 
-from direct_law import STATES, assert_one_law, frame_of, kernel_in_frame, one_law, simulated, state_id
+from tests.helpers.direct_law import STATES, assert_one_law, frame_of, kernel_in_frame, one_law, simulated, state_id
 
 # the state where the law jumps most between Ω⁻ = 0 (the body starts touching the wall) and a spin of
 # 0.02 (it starts clear, the flight in simulated): KS 0.19 and classifier accuracy 0.75 at N = 4000. At the

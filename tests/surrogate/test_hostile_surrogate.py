@@ -14,7 +14,7 @@ from data_schema.samples import SAMPLES_FILE_TYPE
 from data_schema.table import TABLE_FILE_TYPE
 from surrogate.cli import main
 
-from cli_helpers import run_cli, user_error
+from tests.helpers.cli import run_cli, user_error
 
 GOOD = ["--alpha1", "45", "--speed", "150", "-n", "10", "--seed", "1"]
 

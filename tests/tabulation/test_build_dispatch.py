@@ -2,7 +2,7 @@
 
 The session's small table (built in this process, numpy's default kernels for this CPU) is built
 again by ``tablegen build`` in a subprocess with numpy's dispatch targets switched off
-(tests/cpu_dispatch.py): every dataset of the two files must be equal byte for byte. OpenBLAS keeps
+(tests/helpers/cpu_dispatch.py): every dataset of the two files must be equal byte for byte. OpenBLAS keeps
 its kernels: scikit-learn's k-means computes distances through it, and its partition still depends on
 them (docs/format.md, table minor version 3.2). numba keeps the host CPU here (a generic-CPU compile of
 the direct model would take minutes); tests/native/test_native_dispatch.py covers numba's kernels on
@@ -17,8 +17,8 @@ import sys
 import h5py
 import numpy as np
 
-from conftest import SMALL_TABLE_CONFIG
-from cpu_dispatch import code_paths, environment
+from tests.helpers.cpu_dispatch import code_paths, environment
+from tests.helpers.tables import SMALL_TABLE_CONFIG
 
 
 def _datasets(path) -> dict:

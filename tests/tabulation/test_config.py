@@ -2,7 +2,7 @@
 
 import pytest
 
-from cli_helpers import user_error
+from tests.helpers.cli import user_error
 
 from tablegen.cli import main as tablegen_main
 from tablegen.tabulation.config import PRESETS, ConfigError, load_config, parse_config

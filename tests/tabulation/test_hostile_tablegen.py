@@ -24,7 +24,7 @@ from tablegen.tabulation.driver import Checkpoint, CheckpointError, build_table,
 from tablegen.tabulation.config import parse_config
 from tablegen.cli import main
 
-from cli_helpers import run_cli, user_error
+from tests.helpers.cli import run_cli, user_error
 
 TINY = """
 [grid]

@@ -2,7 +2,7 @@
 
 :func:`build` configures and builds ``native/`` into a folder; :class:`Native` loads the shared library
 and wraps the functions the tests call, on NumPy arrays. Nothing here imports the Python packages: the
-Python side of every comparison comes through ``_python_side``.
+Python side of every comparison comes through :mod:`tests.helpers.python_side`.
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[2]
+from tests.helpers import REPO
+
 NATIVE = REPO / "native"
 INSTALL_HINT = ("run native/install-deps.sh (as root on Debian/Ubuntu it installs gcc, g++, cmake, libhdf5-dev, "
                 "gfortran and pkg-config; elsewhere it prints what to install)")

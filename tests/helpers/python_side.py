@@ -9,7 +9,7 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``rebound_direct_tuple`` and the kernels it calls (``direct_model``: collide, body_vertices,
 bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix); those of every
 hit (``surrogate.kernels.spin``: ``rebound_spin_tuple``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
-and PATH_* codes); the law comparisons of tests/direct_law.py (its states, ``tablegen simulate`` and the
+and PATH_* codes); the law comparisons of tests/helpers/direct_law.py (its states, ``tablegen simulate`` and the
 statistics); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks and the samples' angle conversion from ``data_schema``.
 """
@@ -25,9 +25,10 @@ from direct_model.collision import collide
 from direct_model.rebound import quaternion_to_matrix
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, normal_quantile, uniform_quaternion
 from direct_model.shapes import MAX_VERTICES, SHAPES, body_vertices, bounding_radius
-from direct_law import A, N, STATES, assert_one_law, frame_of, incident, one_law, simulated, state_id, to_model_frame
 from surrogate.kernels.spin import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE, SPIN_TOLERANCE,
                                     rebound_path, rebound_spin_tuple)
+from tests.helpers.direct_law import (A, N, STATES, assert_one_law, frame_of, incident, one_law, simulated, state_id,
+                                      to_model_frame)
 
 
 def build_table(config_text: str, path) -> None:

@@ -9,8 +9,8 @@ import shutil
 import h5py
 import numpy as np
 
-import _python_side as py
-from _native import ERR_FORMAT, ERR_IO, ERR_VERSION, OK
+from tests.helpers import python_side as py
+from tests.helpers.native_library import ERR_FORMAT, ERR_IO, ERR_VERSION, OK
 
 
 def _copy(source, folder, name, edit=None):

@@ -1,7 +1,7 @@
 """Run in a subprocess by test_native_dispatch.py, under one setting of numpy's, OpenBLAS's and numba's
 CPU dispatch: load a table, derive its kernel arrays and draw, and save everything to an .npz file.
 
-    python _dispatch_child.py TABLE.h5 INPUT.npz OUTPUT.npz
+    python -m tests.helpers.dispatch_child TABLE.h5 INPUT.npz OUTPUT.npz      (from the repository's root)
 
 INPUT holds V, n, a (incident states) and u (uniforms); OUTPUT the derived arrays (``array_<name>``),
 the mix CDFs, rebound_many's draws for both interpolations, sample_global's and sample_local's draws for
@@ -10,24 +10,11 @@ a fixed seed (the latter also as the velocities `surrogate sample` writes).
 
 from __future__ import annotations
 
-import importlib.util
 import sys
-from pathlib import Path
 
 import numpy as np
 
-
-def _load_direct_law() -> None:
-    """tests/direct_law.py, which _python_side imports, loaded by its path: putting tests/ on sys.path would
-    let its folders (tests/surrogate, ...) shadow the packages of the same names in this process."""
-    spec = importlib.util.spec_from_file_location("direct_law", Path(__file__).resolve().parents[1] / "direct_law.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["direct_law"] = module
-    spec.loader.exec_module(module)
-
-
-_load_direct_law()
-import _python_side as py  # noqa: E402
+from tests.helpers import python_side as py
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
                  "restitution_pieces")

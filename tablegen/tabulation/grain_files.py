@@ -1,0 +1,112 @@
+"""A user's grain from a mesh file or a list of points (docs/model.md §9): read, hull, canonical record.
+
+The body is the convex hull of the points (scipy's Qhull); a mesh that is not convex is replaced by its hull,
+with one line through ``log`` saying how much volume the hull adds. The hull is then placed in its canonical
+frame (:func:`direct_model.registry.grain`). Meshes are read with trimesh (the ``build`` extra): STL, OBJ, OFF
+and PLY, and a file of points alone (OBJ or PLY vertices without faces).
+
+Every problem is one :class:`GrainError` whose message starts with the file (or the config key) and says what
+is wrong: a folder, a missing, empty or unreadable file, NaN or inf, fewer than 4 points off a common plane, a
+flat hull, a hull larger than the runtime takes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from direct_model.registry import ShapeError, grain
+
+MESH_SUFFIXES = (".stl", ".obj", ".off", ".ply")
+NOT_CONVEX = 1e-6           # the hull adds more than this fraction of the mesh's volume: the mesh is not convex
+COPLANAR = 1e-9             # points whose spread off their best plane is below this of their size are coplanar
+
+
+class GrainError(ValueError):
+    """A grain that cannot be read or used; the message starts with its source."""
+
+
+def read_mesh(path):
+    """The points (n, 3) of a mesh file and the volume it encloses (None if its faces close no surface)."""
+    import trimesh                                  # here: the build extra, only when a mesh is read
+
+    path = Path(path)
+    if path.is_dir():
+        raise GrainError(f"{path}: is a folder; expected a mesh file ({', '.join(MESH_SUFFIXES)})")
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        raise GrainError(f"{path}: unknown mesh format {path.suffix!r}; allowed: {', '.join(MESH_SUFFIXES)}")
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise GrainError(f"{path}: cannot read the mesh: {exc.strerror}") from None
+    if size == 0:
+        raise GrainError(f"{path}: the file is empty")
+    try:
+        loaded = trimesh.load(path, process=False)     # as written: processing would drop NaN vertices silently
+        if isinstance(loaded, trimesh.Scene):           # an OBJ or PLY of several objects: one grain of all
+            loaded = trimesh.load(path, force="mesh", process=False)
+    except Exception as exc:                       # a parser of many formats: any failure means unreadable
+        raise GrainError(f"{path}: cannot read the mesh: {(str(exc) or type(exc).__name__).splitlines()[0]}") from None
+    points = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float).reshape(-1, 3)
+    if len(points) == 0:
+        raise GrainError(f"{path}: no vertices in the file (not a {path.suffix[1:].upper()} mesh, or an empty one)")
+    if not (isinstance(loaded, trimesh.Trimesh) and len(loaded.faces) > 0 and np.isfinite(points).all()):
+        return points, None
+    surface = trimesh.Trimesh(points, loaded.faces)     # merges the corners that STL repeats per triangle
+    return points, abs(float(surface.volume)) if surface.is_watertight else None
+
+
+def convex_hull(points, source):
+    """Vertices (k, 3) and triangles (m, 3), counter-clockwise from outside, of the points' convex hull."""
+    from scipy.spatial import ConvexHull, QhullError     # here: the build extra
+
+    points = np.asarray(points, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise GrainError(f"{source}: points must be a list of [x, y, z]; got an array of shape {points.shape}")
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if len(bad):
+        raise GrainError(f"{source}: point {bad[0]} is {points[bad[0]].tolist()}; coordinates must be finite "
+                         f"(no NaN or inf)")
+    points = np.unique(points, axis=0)
+    if len(points) < 4:
+        raise GrainError(f"{source}: {len(points)} distinct points; a grain needs at least 4 not in one plane")
+    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    if spread[2] <= COPLANAR * spread[0]:
+        raise GrainError(f"{source}: all {len(points)} points lie in one plane (or on one line); a grain needs "
+                         f"at least 4 not in one plane")
+    try:
+        hull = ConvexHull(points)
+    except QhullError as exc:
+        raise GrainError(f"{source}: degenerate hull: {str(exc).splitlines()[0]}") from None
+    triangles = hull.simplices.copy()
+    p = points[triangles]
+    normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    inward = (normal * hull.equations[:, :3]).sum(axis=1) < 0.0        # Qhull's own outward normals
+    triangles[inward] = triangles[inward][:, ::-1]
+    used = np.unique(triangles)
+    index = np.full(len(points), -1)
+    index[used] = np.arange(len(used))
+    return points[used], index[triangles], float(hull.volume)
+
+
+def grain_from_points(name, points, source, aspect=None, both_hands=False, mesh_volume=None, log=None):
+    """The record of the grain whose body is the hull of ``points`` (any frame and length unit).
+
+    ``mesh_volume``: the volume the mesh encloses, if it closes one; when the hull adds more than
+    :data:`NOT_CONVEX` of it, ``log`` (if given) gets one line saying how much.
+    """
+    vertices, triangles, volume = convex_hull(points, source)
+    if mesh_volume is not None and log is not None and volume > mesh_volume * (1.0 + NOT_CONVEX):
+        log(f"{source}: warning: the mesh is not convex; its convex hull, the body used, adds "
+            f"{100.0 * (volume / mesh_volume - 1.0):.3g}% to its volume")
+    try:
+        return grain(name, vertices, triangles, aspect=aspect, both_hands=both_hands)
+    except ShapeError as exc:
+        raise GrainError(f"{source}: {exc}") from None
+
+
+def grain_from_mesh(name, path, aspect=None, both_hands=False, log=None):
+    """The record of the grain in a mesh file (STL, OBJ, OFF, PLY): the hull of its vertices (module doc)."""
+    points, mesh_volume = read_mesh(path)
+    return grain_from_points(name, points, str(path), aspect, both_hands, mesh_volume, log)

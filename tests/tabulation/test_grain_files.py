@@ -1,0 +1,155 @@
+"""A user's grain from a mesh file or a config's points (docs/model.md §9): formats, the hull, hostile input."""
+
+import tomllib
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial.transform import Rotation
+
+from direct_model import shapes
+from direct_model.registry import MAX_HULL_VERTICES
+from tablegen.tabulation.config import ConfigError
+from tablegen.tabulation.grain_files import GrainError, grain_from_mesh, grain_from_points
+from tablegen.tabulation.shape_config import parse_shape_sections
+
+ROTATION = Rotation.random(random_state=3).as_matrix()
+
+
+def _irregular_mesh(seed=0, n=40):
+    """The hull of a random cloud: a closed convex mesh, its coordinates multiples of 1/16 so that every format
+    stores them exactly (binary STL holds float32, trimesh writes OBJ with 8 digits)."""
+    points = np.random.default_rng(seed).normal(size=(n, 3)) @ ROTATION.T * (1.0, 0.7, 0.5)
+    return trimesh.convex.convex_hull(np.round(16.0 * points) / 16.0 + 3.0)
+
+
+def _config(text, folder, log=None):
+    return parse_shape_sections(tomllib.loads(text)["shapes"], folder, "grains.toml", log)
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".obj", ".off", ".ply"])
+def test_every_mesh_format_gives_the_same_grain(tmp_path, suffix):
+    mesh = _irregular_mesh()
+    path = tmp_path / f"sand{suffix}"
+    mesh.export(path)
+    grain = grain_from_mesh("sand", path)
+    reference = grain_from_points("sand", mesh.vertices, "points")
+    np.testing.assert_allclose(grain.vertices, reference.vertices, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(grain.inertia, reference.inertia, rtol=1e-12)
+
+
+def test_a_non_convex_mesh_warns_once_with_the_added_volume(tmp_path):
+    """An L-shaped prism (volume 1.75): its hull fills half the missing corner, 0.125, so 7.14% of its volume."""
+    path = tmp_path / "notched.off"
+    trimesh.Trimesh(*_l_prism(), process=False).export(path)
+    lines = []
+    grain = grain_from_mesh("notched", path, log=lines.append)
+    assert len(lines) == 1
+    assert str(path) in lines[0] and "not convex" in lines[0] and "adds 7.14% to its volume" in lines[0], lines[0]
+    assert grain.volume > 0
+    lines.clear()
+    convex = tmp_path / "convex.off"
+    _irregular_mesh().export(convex)
+    grain_from_mesh("convex", convex, log=lines.append)
+    assert lines == []
+
+
+def _l_prism():
+    """Vertices and outward triangles of an L-shaped prism: a 2 × 1 rectangle less a 0.5 × 0.5 corner, z in [0, 1]."""
+    outline = [(-1.0, -0.5), (1.0, -0.5), (1.0, 0.0), (0.5, 0.0), (0.5, 0.5), (-1.0, 0.5)]   # counter-clockwise
+    n = len(outline)
+    vertices = [(x, y, 0.0) for x, y in outline] + [(x, y, 1.0) for x, y in outline]
+    caps = [(0, 5, 1), (1, 5, 2), (2, 5, 3), (3, 5, 4)]          # the L as four triangles, seen from below
+    triangles = [t for t in caps] + [(n + a, n + c, n + b) for a, b, c in caps]
+    for i in range(n):
+        j = (i + 1) % n
+        triangles += [(i, j, n + j), (i, n + j, n + i)]
+    return np.array(vertices), np.array(triangles)
+
+
+def test_config_reads_meshes_relative_to_it_and_vertex_lists(tmp_path):
+    (tmp_path / "grains").mkdir()
+    _irregular_mesh(1).export(tmp_path / "grains" / "sand_a.stl")
+    box = shapes.shape_vertices("prism", 1.0, 0.8, 0.6).tolist()
+    records = _config(f"""
+[shapes.sand_a]
+mesh = "grains/sand_a.stl"
+[shapes.sand_b]
+vertices = {box}
+aspect_ratio = {{mean = 0.7, sd = 0.1}}
+both_hands = true
+""", tmp_path)
+    assert list(records) == ["sand_a", "sand_b"]
+    assert records["sand_a"].aspect is None and not records["sand_a"].both_hands
+    assert records["sand_b"].aspect == shapes.AspectRatioLaw(mean=0.7, sd=0.1)
+    assert records["sand_b"].both_hands
+    assert records["sand_b"].volume == pytest.approx(8 * 0.8 * 0.6, rel=1e-13)
+
+
+def _hostile_files(folder):
+    """(config text, words of its one-line error), with the files it names written into ``folder``."""
+    (folder / "empty.stl").write_bytes(b"")
+    (folder / "garbage.obj").write_text("this is no mesh\n")
+    (folder / "truncated.ply").write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
+                                           b"property float x\nend_header\n\x01\x02")
+    (folder / "nan.off").write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\nnan 0 1\n3 0 1 2\n")
+    (folder / "flat.off").write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n")
+    (folder / "grain.xyz").write_text("0 0 0\n")
+    (folder / "a_folder.stl").mkdir()
+    sphere = np.random.default_rng(0).normal(size=(MAX_HULL_VERTICES + 1, 3))
+    trimesh.convex.convex_hull(sphere / np.linalg.norm(sphere, axis=1)[:, None]).export(folder / "big.ply")
+    thin = shapes.shape_vertices("prism", 1.0, 0.5, 1e-4).tolist()
+    return [
+        ('mesh = "missing.stl"', ["missing.stl", "cannot read"]),
+        ('mesh = "empty.stl"', ["empty.stl", "empty"]),
+        ('mesh = "garbage.obj"', ["garbage.obj", "no vertices"]),
+        ('mesh = "truncated.ply"', ["truncated.ply", "cannot read the mesh"]),
+        ('mesh = "a_folder.stl"', ["a_folder.stl", "folder"]),
+        ('mesh = "grain.xyz"', ["grain.xyz", "unknown mesh format", ".stl, .obj, .off, .ply"]),
+        ('mesh = "nan.off"', ["nan.off", "finite"]),
+        ('mesh = "flat.off"', ["flat.off", "one plane"]),
+        ('mesh = "big.ply"', ["big.ply", f"{MAX_HULL_VERTICES + 1} vertices", f"at most {MAX_HULL_VERTICES}"]),
+        ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]", ["shapes.sand.vertices", "3 distinct points", "at least 4"]),
+        ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 0]]", ["shapes.sand.vertices", "3 distinct points"]),
+        ("vertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]]", ["shapes.sand.vertices", "one plane"]),
+        ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, inf]]", ["shapes.sand.vertices", "point 3", "finite"]),
+        ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, nan]]", ["shapes.sand.vertices", "finite"]),
+        (f"vertices = {thin}", ["shapes.sand.vertices", "flat", "0.0001 of its largest", ">= 0.001"]),
+        ("vertices = [[0, 0], [1, 0]]", ["shapes.sand.vertices", "[x, y, z]"]),
+        ("vertices = [[0, 0, true], [1, 0, 0], [0, 1, 0], [0, 0, 1]]", ["shapes.sand.vertices", "[x, y, z]"]),
+        ('vertices = "cube"', ["shapes.sand.vertices", "[x, y, z]"]),
+        ('mesh = "flat.off"\nvertices = [[0, 0, 0]]', ["shapes.sand", "exactly one of mesh", "both"]),
+        ("both_hands = true", ["shapes.sand", "exactly one of mesh", "neither"]),
+        ("mesh = 3", ["shapes.sand.mesh", "file name"]),
+        ('mesh = "x.stl"\ncolour = "red"', ["shapes.sand.colour", "allowed: mesh, vertices"]),
+        ('mesh = "x.stl"\nboth_hands = 1', ["shapes.sand.both_hands", "true or false"]),
+        ('mesh = "x.stl"\naspect_ratio = {mean = 0.8, width = 1}', ["shapes.sand.aspect_ratio", "mean, sd, low, high"]),
+        ('mesh = "x.stl"\naspect_ratio = {low = 0.9, high = 0.5}', ["shapes.sand.aspect_ratio", "low < high"]),
+        ('mesh = "x.stl"\naspect_ratio = {sd = nan}', ["shapes.sand.aspect_ratio", "finite"]),
+    ]
+
+
+def test_hostile_grains_give_one_line_naming_the_file_or_key(tmp_path):
+    for body, words in _hostile_files(tmp_path):
+        with pytest.raises(ConfigError) as error:
+            _config(f"[shapes.sand]\n{body}\n", tmp_path)
+        message = str(error.value)
+        assert "\n" not in message and message.startswith("grains.toml: "), message
+        for word in words:
+            assert word in message, (body, message)
+
+
+@pytest.mark.parametrize("name", ["prism", "ellipsoid", "mix", "9lives", "sand-a"])
+def test_names_clashing_with_built_ins_or_malformed_are_refused(tmp_path, name):
+    with pytest.raises(ConfigError, match=f"shapes.{name}"):
+        _config(f'[shapes."{name}"]\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]\n', tmp_path)
+
+
+def test_the_shapes_table_must_hold_sections(tmp_path):
+    with pytest.raises(ConfigError, match="'shapes.sand' must be a table"):
+        _config('[shapes]\nsand = "grains/sand.stl"\n', tmp_path)
+
+
+def test_grain_error_names_the_points_source():
+    with pytest.raises(GrainError, match="^my points: point 1 is"):
+        grain_from_points("sand", [[0, 0, 0], [np.inf, 0, 0], [0, 1, 0], [0, 0, 1]], "my points")
