@@ -577,6 +577,11 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
      p_am->lb bytes reserved) and has no function to set it; the solver's own
      rebound moves it next to the hit point. The hit point it passes is
      start + t (end - start): check that we read the start we think we do */
+  if (p_am->lb < 3*sizeof(cs_real_t))
+    bft_error(__FILE__, __LINE__, 0,
+              "rebound-scatter: this code_saturne reserves no tracking work "
+              "area before a particle's attributes; rbs_cs_rebound.c is "
+              "written for code_saturne 6.0");
   cs_real_t *start = (cs_real_t *)particle;
   double mismatch = 0, scale = 0;
   for (int k = 0; k < 3; k++) {
@@ -585,7 +590,7 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
     scale = fmax(scale, fabs(coords[k]) + fabs(start[k]));
   }
   /* the same arithmetic as the solver's: equal but for rounding */
-  if (p_am->lb < 3*sizeof(cs_real_t) || !(mismatch <= 1e-12*scale))
+  if (!(mismatch <= 1e-12*scale))
     bft_error(__FILE__, __LINE__, 0,
               "rebound-scatter: this code_saturne does not keep the start of "
               "a trajectory segment where 6.0 does (hit point mismatch %g m); "
