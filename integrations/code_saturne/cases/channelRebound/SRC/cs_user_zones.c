@@ -1,0 +1,40 @@
+/*============================================================================
+ * channelRebound: the boundary zones (the mesh'\''s face groups: make_mesh.py)
+ *
+ * Copyright (C) 2026 the rebound-scatter authors
+ *
+ * This program is free software; you can redistribute it and/or modify it
+ * under the terms of the GNU General Public License as published by the Free
+ * Software Foundation; either version 2 of the License, or (at your option)
+ * any later version.
+ *
+ * This program is distributed in the hope that it will be useful, but WITHOUT
+ * ANY WARRANTY; without even the implied warranty of MERCHANTABILITY or
+ * FITNESS FOR A PARTICULAR PURPOSE.  See the GNU General Public License for
+ * more details.
+ *
+ * You should have received a copy of the GNU General Public License along with
+ * this program (integrations/code_saturne/LICENSE); if not, write to the Free
+ * Software Foundation, Inc., 51 Franklin Street, Fifth Floor, Boston, MA
+ * 02110-1301, USA.
+ *============================================================================*/
+
+#include "cs_defs.h"
+
+#include "cs_boundary_zone.h"
+#include "cs_prototypes.h"
+
+BEGIN_C_DECLS
+
+/* Gmsh 2.2 meshes give the preprocessor numbered groups: 1 inlet, 2 target,
+   3 walls (make_mesh.py) */
+
+void
+cs_user_zones(void)
+{
+  cs_boundary_zone_define("inlet", "1", 0);
+  cs_boundary_zone_define("target", "2", 0);
+  cs_boundary_zone_define("walls", "3", 0);
+}
+
+END_C_DECLS
