@@ -624,9 +624,9 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
   double t0 = 0, Vout[3], Wout[3];
   if (path == RBS_PATH_DIRECT)
     t0 = cs_timer_wtime();
-  const int status = rbs_rebound_spin(_table, &_mix, V, Omega, n, a, &_rng,
-                                      _set.method, _set.interpolation,
-                                      Vout, Wout);
+  const int status = rbs_rebound_rng(_table, &_mix, V, Omega, n, a, &_rng,
+                                     _set.method, _set.interpolation,
+                                     Vout, Wout);
   if (path == RBS_PATH_DIRECT) {
     _count.direct_seconds += cs_timer_wtime() - t0;
     _count.direct_path++;
