@@ -42,6 +42,10 @@ from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
 from data_schema.table import STATE_NAMES
 from surrogate.kernels import PATH_DIRECT, PATH_TABLE
 
+__all__ = ["FAMILY_ALPHA", "PATHS", "Agreement", "ComparisonReport", "SolverHits", "agreement",
+           "classifier_accuracy", "classifier_bound", "compare_hits", "hits_per_path", "impact_states",
+           "incident_states", "ks_bound", "path_rule", "specular_answers", "surrogate_answers"]
+
 FAMILY_ALPHA = 1e-3     # probability that one law fails any bound of one call
 PATHS = {"table": PATH_TABLE, "direct": PATH_DIRECT}   # path name: the hits' path code
 
