@@ -1,18 +1,21 @@
-"""The README's Python examples of the runtime sampler run as written and give physical rebounds."""
+"""The Python examples of the runtime sampler, in the README and in docs/runtime.md, run as written and give
+physical rebounds."""
 
 import re
 from pathlib import Path
 
 import numpy as np
 
-README = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text()
+RUNTIME_DOC = (ROOT / "docs" / "runtime.md").read_text()
 
 
-def _python_blocks(section: str) -> list:
-    """The ```python blocks of the README section titled ``section`` (up to the next level-2 title)."""
-    start = README.index(f"\n## {section}\n")
-    end = README.find("\n## ", start + 1)
-    return re.findall(r"```python\n(.*?)```", README[start:end], flags=re.S)
+def _python_blocks(text: str, section: str) -> list:
+    """The ```python blocks of the section of ``text`` titled ``section`` (up to the next level-2 title)."""
+    start = text.index(f"\n## {section}\n")
+    end = text.find("\n## ", start + 1)
+    return re.findall(r"```python\n(.*?)```", text[start:end], flags=re.S)
 
 
 def _run(code: str, namespace: dict, table_path) -> dict:
@@ -31,8 +34,9 @@ def _check_rebounds(result, V, n):
 
 
 def test_runtime_sampler_examples_run_and_draw_one_law(small_table_path):
-    numpy_api, numba_api = _python_blocks("Runtime sampler")
-    spin_api, direct_api = _python_blocks("Spinning particles and states beyond the table")
+    numpy_api, = _python_blocks(README, "Runtime sampler")
+    numba_api, = _python_blocks(RUNTIME_DOC, "From numba code")
+    spin_api, direct_api = _python_blocks(RUNTIME_DOC, "Spinning particles and states beyond the table")
     namespace = {}
     drawn = {"sample_global": _run(numpy_api, namespace, small_table_path)}
     # the direct model with spin (alone, and for the spinning half under "auto"): a law of its own (and spin can

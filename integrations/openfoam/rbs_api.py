@@ -2,19 +2,22 @@
 
 Every import of the project's packages by integrations/openfoam and
 tests/openfoam goes through this module, so a refactoring of the packages
-re-points these few lines only. Public API only: ``surrogate.load``,
-``surrogate.sample_global``, ``surrogate.sample_direct``, ``surrogate.STATUS_*`` and, to build a table,
+re-points these few lines only. Public API only: ``surrogate.load``, ``surrogate.STATUS_*``, the
+solver-neutral comparison of a solver's hits with surrogate (``tablegen.study.solver_comparison``, BSD-3:
+the statistics live there, this integration only reads OpenFOAM's files) and, to build a table,
 ``tablegen.build_table(tablegen.parse_config(text), path)``.
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 (see LICENSE in this folder).
 """
 
-from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load, sample_direct, \
-    sample_global
+from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load
+from tablegen.study.solver_comparison import (SolverHits, agreement, compare_hits, impact_states, incident_states,
+                                              path_rule, specular_answers, surrogate_answers)
 
-__all__ = ["STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "build_table_from_text", "load",
-           "sample_direct", "sample_global"]
+__all__ = ["STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SolverHits", "agreement",
+           "build_table_from_text", "compare_hits", "impact_states", "incident_states", "load", "path_rule",
+           "specular_answers", "surrogate_answers"]
 
 
 def build_table_from_text(config_text: str, path, **kwargs):

@@ -4,7 +4,7 @@ parallel pass (:func:`first_faults`), and the shapes of the arrays of the kernel
 raise would keep numba from running it in parallel).
 
 The NumPy API must name the first offending value of each kind of bad input
-(README, "Runtime sampler"). Done with NumPy, those checks cost several
+(docs/runtime.md, "From NumPy"). Done with NumPy, those checks cost several
 passes over (N, 3) temporaries (norms, dot products, arctangents), as much
 as the draws themselves. :func:`first_faults` makes one pass in numba and
 returns, for every check in the order the API reports them (the FAULT_*

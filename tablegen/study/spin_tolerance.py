@@ -9,7 +9,7 @@ two-sample test of :mod:`tablegen.study.validation` (accuracy 0.5: indistinguish
 √(0.25/n_test) with n_test = n). The tolerance is the largest candidate whose worst accuracy over all states
 and directions stays at most THRESHOLD. Rows at c = 0 give the table's own accuracy, the floor.
 
-With ``--spinning``, the accuracy of ``method="auto"`` at spinning states instead (README, "Accuracy"): at
+With ``--spinning``, the accuracy of ``method="auto"`` at spinning states instead (docs/runtime.md, "Accuracy at spinning states"): at
 SPINNING_STATES, ``surrogate.sample_global``'s draws (the direct model answers them) and, for contrast, the
 table's (``method="table"``) against the batch direct model of ``tablegen simulate`` with that spin.
 

@@ -6,7 +6,8 @@ an independent seed), and compare the rebounded states
 X = (α2, β2, s, Ω_x a/|V⁻|, Ω_y a/|V⁻|, Ω_z a/|V⁻|):
 
 * each marginal: the two-sample Kolmogorov–Smirnov statistic;
-* the joint law: a classifier two-sample test. A gradient-boosting
+* the joint law: a classifier two-sample test
+  (:func:`tablegen.study.solver_comparison.classifier_accuracy`). A gradient-boosting
   classifier learns to tell the two samples apart on half of them; its
   accuracy on the other half is 0.5 when the laws are the same (standard error
   √(0.25/n_test));
@@ -17,27 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.stats import ks_2samp
-from sklearn.ensemble import HistGradientBoostingClassifier
-from sklearn.model_selection import train_test_split
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED
 from data_schema.table import STATE_NAMES
 from direct_model.simulate import simulate
-
-
-def classifier_accuracy(X: np.ndarray, Y: np.ndarray, seed: int = 0) -> float:
-    """Held-out accuracy of a classifier telling rows of X from rows of Y (0.5: indistinguishable).
-
-    Stratified 50/50 split; scikit-learn's HistGradientBoostingClassifier with
-    200 iterations and a fixed random state, so the figure is reproducible.
-    """
-    Z = np.vstack([X, Y])
-    labels = np.r_[np.zeros(len(X)), np.ones(len(Y))]
-    Z_train, Z_test, y_train, y_test = train_test_split(Z, labels, test_size=0.5, random_state=seed,
-                                                        stratify=labels)
-    model = HistGradientBoostingClassifier(max_iter=200, random_state=seed).fit(Z_train, y_train)
-    return float(model.score(Z_test, y_test))
+from tablegen.study.solver_comparison import classifier_accuracy
 
 
 def table_states(table, shape, alpha1: float, speed: float, n: int, seed: int,

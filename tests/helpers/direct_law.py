@@ -9,7 +9,7 @@ outputs are rotated back. Compared per state, over the rebounded particles:
   each exceeds c·√((n+m)/(nm)) with probability at most α', c = √(−ln(α'/2)/2) (Kolmogorov's asymptotic
   tail, which bounds the exact one at these n); α' = FAMILY_ALPHA / (number of comparisons a test module
   makes), so that all of them pass together with probability ≥ 1 − FAMILY_ALPHA (Bonferroni).
-* Classifier: :func:`tablegen.study.validation.classifier_accuracy` (gradient boosting, held-out half) on
+* Classifier: :func:`tablegen.study.solver_comparison.classifier_accuracy` (gradient boosting, held-out half) on
   (α2, β2, s, Ω⁺a/|V⁻|), on the first min(n, m) rows of each sample so that guessing scores 0.5. Under one
   law the held-out accuracy over n_test rows has mean 0.5 and standard deviation √(0.25/n_test); the bound
   is 0.5 + z·√(0.25/n_test), z = Φ⁻¹(1 − α'), α' as above (one-sided).
@@ -17,7 +17,6 @@ outputs are rotated back. Compared per state, over the rebounded particles:
 """
 
 import math
-from statistics import NormalDist
 
 import numpy as np
 from scipy import stats
@@ -27,7 +26,8 @@ from threadpoolctl import threadpool_limits
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, rebound_angles
 from direct_model.simulate import simulate
-from tablegen.study.validation import classifier_accuracy
+from tablegen.study import solver_comparison
+from tablegen.study.solver_comparison import classifier_accuracy
 
 FAMILY_ALPHA = 1e-3         # probability that one law fails any comparison of a test module
 N = 4000                    # particles per sample
@@ -62,13 +62,12 @@ def state_id(state) -> str:
 
 def ks_bound(n: int, m: int, comparisons: int) -> float:
     """The KS statistic's bound for samples of n and m draws, one of ``comparisons`` (module doc)."""
-    c = math.sqrt(-math.log(FAMILY_ALPHA / comparisons / 2) / 2)
-    return c * math.sqrt((n + m) / (n * m))
+    return solver_comparison.ks_bound(n, m, FAMILY_ALPHA / comparisons)
 
 
 def classifier_bound(n_test: int, comparisons: int) -> float:
     """The held-out accuracy's bound over n_test rows, one of ``comparisons`` (module doc)."""
-    return 0.5 + NormalDist().inv_cdf(1 - FAMILY_ALPHA / comparisons) * math.sqrt(0.25 / n_test)
+    return solver_comparison.classifier_bound(n_test, FAMILY_ALPHA / comparisons)
 
 
 def random_frame(seed: int) -> np.ndarray:

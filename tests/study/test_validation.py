@@ -18,9 +18,9 @@ from scipy.stats import ks_2samp
 
 from data_schema.table import STATE_NAMES, read_table
 from surrogate.kernels.layout import ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
+from tablegen.study.solver_comparison import classifier_accuracy
 from tablegen.study.validation import (
-    SPEED_TARGETS, classifier_accuracy, compare, direct_states, grid_points, matrix_points, midpoints,
-    table_states,
+    SPEED_TARGETS, compare, direct_states, grid_points, matrix_points, midpoints, table_states,
 )
 from tablegen.study.validation_report import document, precision
 
