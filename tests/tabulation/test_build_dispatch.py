@@ -51,7 +51,10 @@ def _bytes(values) -> bytes:
 def test_table_bits_do_not_depend_on_numpy_or_openblas_kernels(case, small_table_path, tmp_path):
     env = environment(case, generic_numba=False)
     paths, default = code_paths(env), code_paths(environment("default"))
-    assert paths["openblas"] != default["openblas"] or paths["numpy"] != default["numpy"], (paths, default)
+    if case == "baseline":
+        assert paths["numpy"] == [] and paths["openblas"] != default["openblas"], (paths, default)
+    elif paths == default:      # a CPU without AVX-512 runs this case on its default kernels: nothing to compare
+        pytest.skip(f"the {case} kernels are this CPU's default ones ({paths})")
     config = tmp_path / "small.toml"
     config.write_text(SMALL_TABLE_CONFIG)
     rebuilt = tmp_path / "rebuilt.h5"
