@@ -2,17 +2,17 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (3, 2),
+    /                      attrs: file_type = "rebound_table", format_version = (3, 3),
                            created (ISO 8601 UTC), package_version, model_sha256, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
                            attrs: kappa, n_max, particles_per_cell,
                            restitution_k, restitution_p (the wall's normal-restitution law),
                            friction_q, wall_law (its friction exponent and name; since 3.1, optional);
-                           law (restitution_k, restitution_p) and shape_codes, checksummed copies of the
-                           attributes and names the law depends on (since 3.2); aspect_ratio_{mean,sd,low,high},
-                           contact_tol, set_tol, max_steps, second_moment_factors (the rest of the direct
-                           model's parameters; optional)
+                           aspect_ratio_{mean,sd,low,high}, contact_tol, set_tol, max_steps,
+                           second_moment_factors (the rest of the direct model's parameters; required since
+                           3.3); law and shape_codes, checksummed copies of the attributes (LAW_ATTRIBUTES;
+                           3.2: restitution_k, restitution_p only) and names the law depends on (since 3.2)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
@@ -49,6 +49,7 @@ sampler moves a draw between grid speeds by a law that depends on the regime
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import tomllib
 from pathlib import Path
 
@@ -60,7 +61,7 @@ from data_schema.samples import SHAPE_NAMES
 from data_schema.output import hdf5_bytes, write_output
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (3, 2)
+TABLE_VERSION = (3, 3)
 
 # grid speeds a table may hold, m/s (docs/format.md, "What makes a table valid"): the direct model's arithmetic
 # fails far outside (1e-100 m/s gives no rebound), and the runtime moves draws between consecutive grid speeds
@@ -68,6 +69,12 @@ TABLE_VERSION = (3, 2)
 SPEED_GRID_RANGE = (1e-3, 1e4)
 MAX_SPEED_RATIO = 16.0
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ cluster_weight − 1| allowed per cell
+# |value| allowed in the cell datasets a draw reads besides the dictionary (cluster_loc, cluster_scale,
+# cluster_slope, mean, std): built tables hold far less (the default table: |slope| < 200, |loc| < 50); the bound
+# keeps every product of a draw's chain finite (at most (10⁶)⁶), and drawn_ok refuses what the fold cannot mend
+CELL_VALUE_BOUND = 1e6
+# relative round-off allowed on the bound √L of a standardised quantile function (stored as float32)
+DICTIONARY_BOUND_TOLERANCE = 1e-6
 N_COLLISION_CLASSES = 11            # 1, 2, ..., 10 collisions and more than 10
 FEW_COLLISIONS = 2                  # regime 0 of a cluster: rebounds of at most this many collisions
 STATE_NAMES = ("alpha2", "beta2", "speed_ratio", "omega_x", "omega_y", "omega_z")
@@ -145,6 +152,12 @@ class TableResolution:
 
 # the checksummed copies of the law's attributes and shape names in group grid (since 3.2)
 LAW_DATASETS = ("law", "shape_codes")
+# the grid attributes grid/law copies, in its order (3.3; a 3.2 table copies the first two): every attribute the
+# runtime reads, the table path's wall law and the direct model's parameters (second_moment_factors: 4 numbers)
+LAW_ATTRIBUTES = ("restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean",
+                  "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol", "max_steps",
+                  "second_moment_factors")
+INTEGER_ATTRIBUTES = ("n_max", "particles_per_cell", "max_steps", "clusters", "dictionary_size", "levels")
 
 # name: (dtype, units, meaning) of the per-cell datasets
 CELL_DATASETS = {
@@ -222,6 +235,7 @@ class ReboundTable:
     set_tol: float = BUILT_WITH_TOLERANCES["set_tol"]
     max_steps: int = BUILT_WITH_TOLERANCES["max_steps"]
     second_moment_factors: tuple = (float("nan"),) * 4
+    format_version: tuple = TABLE_VERSION    # of the file read (what this package writes for a new table)
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -233,6 +247,12 @@ class ReboundTable:
             if self.cells[name].shape != lead + shape:
                 raise ValueError(f"dataset 'cells/{name}' has shape {self.cells[name].shape}, "
                                  f"expected {lead + shape}")
+
+    def law_values(self) -> np.ndarray:
+        """The attributes of :data:`LAW_ATTRIBUTES` in order, as float64: the content of ``grid/law`` (3.3)."""
+        values = [self.restitution_k, self.restitution_p, self.friction_q, self.kappa, self.n_max,
+                  *self.aspect_ratio, self.contact_tol, self.set_tol, self.max_steps, *self.second_moment_factors]
+        return np.array(values, dtype=np.float64)
 
     def cell(self, shape: str, i_alpha: int, i_speed: int) -> CellTable:
         """The cell of ``shape`` at grid indices (i_alpha, i_speed)."""
@@ -253,9 +273,9 @@ class ReboundTable:
             values = np.asarray(getattr(self, name), dtype=np.float64)
             grid.create_dataset(name, data=values, fletcher32=True).attrs["units"] = units
         grid.create_dataset("shapes", data=np.array(self.shapes, dtype=h5py.string_dtype()))
-        # checksummed copies of what the law depends on beyond the cell datasets (3.2): a flipped bit of an
-        # attribute or a swapped shape name fails to load
-        grid.create_dataset("law", data=np.array([self.restitution_k, self.restitution_p]), fletcher32=True)
+        # checksummed copies of what the law depends on beyond the cell datasets (3.2; every law attribute
+        # since 3.3): a flipped bit of an attribute or a swapped shape name fails to load
+        grid.create_dataset("law", data=self.law_values(), fletcher32=True)
         grid.create_dataset("shape_codes", data=np.array([SHAPE_NAMES.index(s) for s in self.shapes], dtype=np.uint8),
                             fletcher32=True)
         grid.attrs["kappa"] = self.kappa
@@ -302,23 +322,28 @@ class ReboundTable:
         if _minor(f) >= 2 and missing:
             raise DataFormatError(f"{where}: missing dataset(s) {', '.join('grid/' + n for n in missing)} (table "
                                   f"format 3.2)")
+        minor = _minor(f)
         try:
-            resolution = TableResolution(**{k: int(v) for k, v in f["resolution"].attrs.items()})
+            resolution = TableResolution(**{name: _number(f["resolution"], name)
+                                            for name in ("clusters", "dictionary_size", "levels")})
             table = cls(
                 alpha1_deg=alpha1_deg, speed_m_s=speed_m_s,
                 shapes=tuple(s.decode() if isinstance(s, bytes) else str(s) for s in grid["shapes"][()]),
-                resolution=resolution, cells=cells, kappa=float(grid.attrs["kappa"]),
-                n_max=int(grid.attrs["n_max"]), particles_per_cell=int(grid.attrs["particles_per_cell"]),
+                resolution=resolution, cells=cells, kappa=_number(grid, "kappa"),
+                n_max=_number(grid, "n_max"), particles_per_cell=_number(grid, "particles_per_cell"),
                 config_text=str(f.attrs["config"]), config_sha256=str(f.attrs["config_sha256"]),
                 master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
                 package_version=str(f.attrs["package_version"]),
                 model_sha256=str(f.attrs.get("model_sha256", "")),
-                restitution_k=float(grid.attrs["restitution_k"]), restitution_p=float(grid.attrs["restitution_p"]),
-                friction_q=float(grid.attrs.get("friction_q", float("nan"))),
-                wall_law=str(grid.attrs.get("wall_law", "")), **_direct_model_attributes(f))
+                restitution_k=_number(grid, "restitution_k"), restitution_p=_number(grid, "restitution_p"),
+                friction_q=_number(grid, "friction_q") if "friction_q" in grid.attrs or minor >= 3 else float("nan"),
+                wall_law=str(grid.attrs.get("wall_law", "")), format_version=(3, minor),
+                **_direct_model_attributes(f, minor))
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:
+            if isinstance(exc, DataFormatError):
+                raise DataFormatError(f"{where}: {exc}") from None
             raise DataFormatError(f"{where}: inconsistent table: {exc}") from exc
         check_contract(table, where, law)
         return table
@@ -329,10 +354,32 @@ def _minor(f: h5py.File) -> int:
     return int(f.attrs["format_version"][1])
 
 
+def _number(group: h5py.Group, name: str, count: int | None = 1):
+    """Attribute ``name`` of ``group``: ``count`` numbers (None: 1 to 8) as a float, an int
+    (:data:`INTEGER_ATTRIBUTES`) or a tuple of floats; DataFormatError (no file name) naming it if it is
+    missing or is not numbers of that kind (a string "0.61", say), the C loader's message."""
+    where = f"of group '{group.name.lstrip('/')}'"
+    if name not in group.attrs:
+        raise DataFormatError(f"missing attribute '{name}' {where}")
+    try:
+        values = np.asarray(group.attrs[name])
+    except (OSError, TypeError, ValueError):
+        values = np.asarray("unreadable")
+    integer = name in INTEGER_ATTRIBUTES
+    size_ok = values.size == count if count is not None else 1 <= values.size <= 8
+    if values.dtype.kind not in ("iu" if integer else "iuf") or not size_ok:
+        wanted = "one integer" if integer else "one number" if count == 1 else "1 to 8 numbers"
+        raise DataFormatError(f"cannot read the attribute '{name}' {where} as {wanted}")
+    if count is None:
+        return tuple(float(x) for x in values.ravel())
+    return int(values.ravel()[0]) if integer else float(values.ravel()[0])
+
+
 def check_contract(table: ReboundTable, where: str, law: dict) -> None:
     """DataFormatError naming the file and the value unless ``table`` obeys what makes a table valid beyond its
     layout (docs/format.md, "What makes a table valid"; the C loader checks the same). ``law`` holds the
-    datasets of :data:`LAW_DATASETS` the file has (3.2), which must equal the attributes and names."""
+    datasets of :data:`LAW_DATASETS` the file has (3.2), which must equal the attributes and names: the first two
+    of :data:`LAW_ATTRIBUTES` in a 3.2 table, all of them since 3.3."""
     def refuse(text):
         raise DataFormatError(f"{where}: {text}")
 
@@ -352,22 +399,31 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
         value = getattr(table, name)
         if not (np.isfinite(value) and value > 0.0):
             refuse(f"the attribute '{name}' of group 'grid' must be finite and > 0; got {float(value)!r}")
-    if "law" in law and not np.array_equal(np.asarray(law["law"]).view(np.uint8),
-                                          np.array([table.restitution_k, table.restitution_p]).view(np.uint8)):
-        refuse(f"the attributes restitution_k, restitution_p of group 'grid' ({table.restitution_k!r}, "
-               f"{table.restitution_p!r}) differ from their checksummed copy 'grid/law' {np.asarray(law['law']).tolist()}")
+    if "law" in law:
+        copied = table.law_values() if table.format_version[1] >= 3 else table.law_values()[:2]
+        found = np.asarray(law["law"], dtype=np.float64).ravel()
+        if found.shape != copied.shape:
+            refuse(f"dataset 'grid/law' has shape {np.shape(law['law'])}, expected ({len(copied)},)")
+        differ = np.flatnonzero(found.view(np.uint64) != copied.view(np.uint64))
+        if differ.size:
+            names = list(LAW_ATTRIBUTES[:-1]) + [f"second_moment_factors[{k}]" for k in range(4)]
+            refuse(f"the attribute {names[differ[0]]} of group 'grid' ({copied[differ[0]]!r}) differs from its "
+                   f"checksummed copy in 'grid/law' ({found[differ[0]]!r})")
     if "shape_codes" in law and [int(c) for c in np.ravel(law["shape_codes"])] != [SHAPE_NAMES.index(s) for s in table.shapes]:
         refuse(f"dataset 'grid/shapes' {list(table.shapes)} differs from its checksummed copy 'grid/shape_codes' "
                f"{np.ravel(law['shape_codes']).tolist()}")
     cells, m = table.cells, table.resolution.dictionary_size
+    bound = CELL_VALUE_BOUND
     rules = (("cluster_weight", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
-             ("cluster_scale", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("cluster_loc", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
+             ("cluster_scale", lambda x: (x >= 0.0) & (x <= bound), f"in [0, {bound:g}]"),
+             ("cluster_slope", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
              ("cluster_shape", lambda x: x < m, f"below the dictionary size {m}"),
              ("cluster_regime", lambda x: x <= 1, "0 or 1"),
              ("status_counts", lambda x: x >= 0, ">= 0"),
              ("collision_counts", lambda x: x >= 0, ">= 0"),
-             ("mean", np.isfinite, "finite"),
-             ("std", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("mean", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
+             ("std", lambda x: (x >= 0.0) & (x <= bound), f"in [0, {bound:g}]"),
              ("indicatrix_2d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
              ("indicatrix_3d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"))
     for name, ok, wanted in rules:
@@ -376,6 +432,7 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
         if bad.size:
             refuse(f"dataset 'cells/{name}' holds {values.ravel()[bad[0]].item()!r} at element {bad[0]}; its values "
                    f"must be {wanted}")
+    check_dictionary(np.asarray(cells["shape_dictionary"]), table.resolution.levels, refuse)
     weight_sum = np.asarray(cells["cluster_weight"]).sum(axis=-1).ravel()
     bad = np.flatnonzero(np.abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE)
     if bad.size:
@@ -387,26 +444,44 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
                f"particle")
 
 
-def _direct_model_attributes(f: h5py.File) -> dict:
+def check_dictionary(dictionary: np.ndarray, levels: int, refuse) -> None:
+    """``refuse`` (called with the message) unless every row of ``cells/shape_dictionary`` is a standardised
+    quantile function: non-decreasing, its knots within ±√L (the largest |knot| of L + 1 knots of mean 0 and
+    standard deviation 1; the build's non-decreasing pass only repeats knots) up to float32 round-off."""
+    bound = np.float32(np.sqrt(levels) * (1.0 + DICTIONARY_BOUND_TOLERANCE))
+    flat = dictionary.reshape(-1)
+    bad = np.flatnonzero(~(np.abs(flat) <= bound))
+    if bad.size:
+        refuse(f"dataset 'cells/shape_dictionary' holds {flat[bad[0]].item()!r} at element {bad[0]}; its values must "
+               f"be in [-{bound:.9g}, {bound:.9g}] (sqrt of the levels {levels})")
+    rows = dictionary.reshape(-1, dictionary.shape[-1])
+    bad = np.flatnonzero(np.any(np.diff(rows, axis=1) < 0.0, axis=1))
+    if bad.size:
+        refuse(f"dataset 'cells/shape_dictionary' row {bad[0]} decreases; each row (a quantile function) must be "
+               f"non-decreasing")
+
+
+def _direct_model_attributes(f: h5py.File, minor: int) -> dict:
     """The direct model's parameters of a table (ReboundTable fields). Tables that did not record them were built
     with the aspect-ratio law of their configuration, the tolerances BUILT_WITH_TOLERANCES and, at κ = 0.3,
-    BUILT_WITH_SECOND_MOMENT_FACTORS (NaN at another κ: not known without the build's code)."""
+    BUILT_WITH_SECOND_MOMENT_FACTORS (NaN at another κ: not known without the build's code). Since 3.3 every one
+    is required."""
     grid = f["grid"]
-    if all(name in grid.attrs for name in ASPECT_RATIO_ATTRIBUTES):
-        aspect = tuple(float(grid.attrs[name]) for name in ASPECT_RATIO_ATTRIBUTES)
+    recorded = minor >= 3 or all(name in grid.attrs for name in ASPECT_RATIO_ATTRIBUTES)
+    if recorded:
+        aspect = tuple(_number(grid, name) for name in ASPECT_RATIO_ATTRIBUTES)
     else:
         law = tomllib.loads(str(f.attrs["config"])).get("simulation", {}).get("aspect_ratio", {})
         aspect = tuple(float(law.get(key, "nan")) for key in ASPECT_RATIO_ATTRIBUTES.values())
-    if "second_moment_factors" in grid.attrs:
-        kfac = tuple(float(x) for x in np.asarray(grid.attrs["second_moment_factors"], dtype=np.float64))
-    elif float(grid.attrs["kappa"]) == BUILT_WITH_KAPPA:
+    if minor >= 3 or "second_moment_factors" in grid.attrs:
+        kfac = _number(grid, "second_moment_factors", None)
+    elif _number(grid, "kappa") == BUILT_WITH_KAPPA:
         kfac = BUILT_WITH_SECOND_MOMENT_FACTORS
     else:
         kfac = (float("nan"),) * len(BUILT_WITH_SECOND_MOMENT_FACTORS)
     return dict(aspect_ratio=aspect, second_moment_factors=kfac,
-                contact_tol=float(grid.attrs.get("contact_tol", BUILT_WITH_TOLERANCES["contact_tol"])),
-                set_tol=float(grid.attrs.get("set_tol", BUILT_WITH_TOLERANCES["set_tol"])),
-                max_steps=int(grid.attrs.get("max_steps", BUILT_WITH_TOLERANCES["max_steps"])))
+                **{name: _number(grid, name) if minor >= 3 or name in grid.attrs else default
+                   for name, default in BUILT_WITH_TOLERANCES.items()})
 
 
 def _read(group: h5py.Group, name: str) -> np.ndarray:
@@ -416,6 +491,43 @@ def _read(group: h5py.Group, name: str) -> np.ndarray:
     except (OSError, ValueError) as exc:
         raise DataFormatError(f"{group.file.filename}: dataset '{group[name].name.lstrip('/')}' cannot be read "
                               f"(corrupt file: {' '.join(str(exc).split())})") from exc
+
+
+# root attributes the fingerprint covers: the layout and the build's recipe (docs/format.md, "Fingerprint"); not
+# created, package_version or model_sha256, which say when and by which code, not what the table holds
+FINGERPRINT_ROOT_ATTRIBUTES = ("file_type", "format_version", "config", "config_sha256", "master_seed")
+FINGERPRINT_GROUPS = ("grid", "resolution", "cells")
+
+
+def table_fingerprint(path) -> str:
+    """SHA-256 of what a table holds (docs/format.md, "Fingerprint"), hex: the root attributes of
+    :data:`FINGERPRINT_ROOT_ATTRIBUTES`, then for each group of :data:`FINGERPRINT_GROUPS` its attributes and
+    its datasets in the order of their names, each hashed as its name, dtype, shape and little-endian bytes
+    (strings as UTF-8). Datasets' ``units`` and ``meaning`` attributes are descriptions and are left out; the
+    checksums and HDF5's chunking do not enter. A config and a seed give one fingerprint whatever built them."""
+    digest = hashlib.sha256()
+
+    def feed(name: str, value) -> None:
+        values = np.asarray(value)
+        if values.dtype.kind in "OSU":
+            items = [x.decode() if isinstance(x, bytes) else str(x) for x in values.ravel()]
+            kind, data = "str", "\0".join(items).encode()
+        else:
+            little = np.ascontiguousarray(values, dtype=values.dtype.newbyteorder("<"))
+            kind, data = little.dtype.str, little.tobytes()
+        for part in (name.encode(), kind.encode(), repr(values.shape).encode(), len(data).to_bytes(8, "little"), data):
+            digest.update(part + b"\0")
+
+    check_file(path, TABLE_FILE_TYPE, TABLE_VERSION[0])
+    with h5py.File(path, "r") as f:
+        for name in FINGERPRINT_ROOT_ATTRIBUTES:
+            feed(f"@{name}", f.attrs[name])
+        for group in FINGERPRINT_GROUPS:
+            for name in sorted(f[group].attrs):
+                feed(f"{group}@{name}", f[group].attrs[name])
+            for name in sorted(f[group]):
+                feed(f"{group}/{name}", _read(f[group], name))
+    return digest.hexdigest()
 
 
 def write_table(path, table: ReboundTable, overwrite: bool = False) -> Path:

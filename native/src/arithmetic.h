@@ -92,6 +92,16 @@ RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, doub
     x[5] = g * x[5];
 }
 
+/* |V⁺|²/|V⁻|² a rebound may reach above 1 (surrogate.kernels.arithmetic.SPEED_TOLERANCE) */
+#define RBS_SPEED_TOLERANCE 1e-12
+
+/* A drawn x (local frame, units of |V⁻|) that may be reported as a rebound whatever table was loaded: leaving
+ * the wall and no faster than it came (surrogate.kernels.arithmetic.drawn_ok). */
+RBS_INLINE int rbs_drawn_ok(const double x[6])
+{
+    return (x[1] > 0.0) & (fma(x[0], x[0], fma(x[1], x[1], x[2] * x[2])) <= 1.0 + RBS_SPEED_TOLERANCE);
+}
+
 /* the mirror symmetry Z → −Z when u < 1/2 */
 RBS_INLINE void rbs_mirrored(double u, double x[6])
 {
@@ -155,7 +165,7 @@ RBS_INLINE void rbs_arithmetic_block(const rbs_gathered *k, const rbs_frames *f,
         }
         /* rbs_to_global's status */
         int ok = f->ok[b] != 0.0, trapped = k->trapped[b] > 0.5;
-        int rebounded = ok & (trapped == 0) & rbs_rebound_ok(v, o, n);
+        int rebounded = ok & (trapped == 0) & rbs_drawn_ok(x) & rbs_rebound_ok(v, o, n);
         r->status[b] = rebounded ? (double)RBS_REBOUNDED : ok & trapped ? (double)RBS_TRAPPED : (double)RBS_INVALID;
         for (int j = 0; j < 3; j++) {
             r->V[j][b] = rebounded ? v[j] : NAN;

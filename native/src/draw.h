@@ -13,7 +13,7 @@
 #include "locate.h"
 
 /* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
- * returns the status (NaN state when trapped). */
+ * returns the status (NaN state when trapped; RBS_INVALID for a draw rbs_drawn_ok refuses). */
 RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
                                    const double *u, int scaled, double x[6])
 {
@@ -45,7 +45,7 @@ RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double
         rbs_to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, x);
     }
     rbs_mirrored(u[11], x);
-    return RBS_REBOUNDED;
+    return rbs_drawn_ok(x) ? RBS_REBOUNDED : RBS_INVALID;
 }
 
 #endif /* RBS_DRAW_H */

@@ -70,6 +70,9 @@
 #define SPEED_GRID_MAX 1e4          /* m/s */
 #define MAX_SPEED_RATIO 16.0        /* between consecutive grid speeds */
 #define WEIGHT_SUM_TOLERANCE 1e-9   /* |Σ cluster_weight − 1| per cell */
+#define CELL_VALUE_BOUND 1e6        /* |value| of cluster_loc, cluster_scale, cluster_slope, mean, std */
+#define DICTIONARY_BOUND_TOLERANCE 1e-6     /* relative, on the bound √L of a shape_dictionary knot */
+#define LAW_SIZE 16                 /* numbers in grid/law since 3.3 (data_schema.table.LAW_ATTRIBUTES) */
 
 struct rbs_table {
     char *path;
@@ -110,6 +113,13 @@ typedef struct rbs_raw_cells {
     float *indicatrix_2d;       /* (cells, 72): likewise */
     float *indicatrix_3d;       /* (cells, 72, 72): likewise */
 } rbs_raw_cells;
+
+/* old_tables.c: what a table before format 3.3 may leave out, as data_schema.table._direct_model_attributes
+ * reads it. The aspect-ratio law (mean, sd, low, high) from the build configuration's TOML text (NaN for what
+ * it does not give); the tolerances every build used; s per shape code at κ = 0.3 (NaN at another κ). */
+void rbs_config_aspect(const char *config, double aspect[4]);
+void rbs_built_with_tolerances(double *contact_tol, double *set_tol, long long *max_steps);
+void rbs_built_with_second_moment_factors(double kappa, double kfac[RBS_MAX_SHAPES]);
 
 /* layout.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
  * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */

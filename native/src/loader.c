@@ -1,6 +1,7 @@
 /*
  * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), and the
- * accessors of a loaded table. The kernel arrays are derived in layout.c.
+ * accessors of a loaded table. The kernel arrays are derived in layout.c; what tables before format 3.3 leave
+ * out is read by old_tables.c.
  *
  * Every error names the file and what is wrong with it; HDF5's own error printing is switched off
  * around each HDF5 call that may fail (H5E_BEGIN_TRY), so the library prints nothing.
@@ -109,8 +110,9 @@ static int read_string_attribute(hid_t where, const char *name, char *out, size_
     return status;
 }
 
-/* A numeric attribute of `count` elements (exactly) as `memtype`; 0 on success. */
-static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, void *out, hssize_t count)
+/* A numeric attribute of `count` elements (exactly) as `memtype`, of HDF5 class integer (or also float unless
+ * `integer`: an integer attribute stored as a float is refused, as data_schema.table._number does); 0 on success. */
+static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, void *out, hssize_t count, int integer)
 {
     int status = -1;
     hid_t attr = -1, type = -1, space = -1;
@@ -119,7 +121,7 @@ static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, 
         if (attr >= 0) type = H5Aget_type(attr);
         if (type >= 0) space = H5Aget_space(attr);
         if (space >= 0 && H5Sget_simple_extent_npoints(space) == count
-            && (H5Tget_class(type) == H5T_INTEGER || H5Tget_class(type) == H5T_FLOAT)
+            && (H5Tget_class(type) == H5T_INTEGER || (!integer && H5Tget_class(type) == H5T_FLOAT))
             && H5Aread(attr, memtype, out) >= 0)
             status = 0;
     } H5E_END_TRY;
@@ -132,7 +134,7 @@ static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, 
 static int read_double_attribute(loader *ld, hid_t where, const char *group, const char *name, double *out)
 {
     if (!attribute_exists(where, name)) return fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
-    if (read_numeric_attribute(where, name, H5T_NATIVE_DOUBLE, out, 1) != 0)
+    if (read_numeric_attribute(where, name, H5T_NATIVE_DOUBLE, out, 1, 0) != 0)
         return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one number", name, group);
     return RBS_OK;
 }
@@ -140,7 +142,7 @@ static int read_double_attribute(loader *ld, hid_t where, const char *group, con
 static int read_integer_attribute(loader *ld, hid_t where, const char *group, const char *name, long long *out)
 {
     if (!attribute_exists(where, name)) return fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
-    if (read_numeric_attribute(where, name, H5T_NATIVE_LLONG, out, 1) != 0)
+    if (read_numeric_attribute(where, name, H5T_NATIVE_LLONG, out, 1, 1) != 0)
         return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one integer", name, group);
     return RBS_OK;
 }
@@ -353,7 +355,7 @@ static hid_t check_file(loader *ld, rbs_table *t)
     }
     long long version[2] = {0, 0};
     if (!attribute_exists(file, "format_version")
-        || read_numeric_attribute(file, "format_version", H5T_NATIVE_LLONG, version, 2) != 0) {
+        || read_numeric_attribute(file, "format_version", H5T_NATIVE_LLONG, version, 2, 0) != 0) {
         fail(ld, RBS_ERR_FORMAT, "missing or malformed 'format_version' attribute");
         H5Fclose(file);
         return -1;
@@ -406,24 +408,94 @@ static int check_shape_names(loader *ld, const rbs_table *t)
     return RBS_OK;
 }
 
-/* Since 3.2: the checksummed copies grid/law (restitution_k, restitution_p) and grid/shape_codes equal the
- * attributes and the names, bit for bit (data_schema.table.LAW_DATASETS). */
+/* The second-moment factors attribute of group grid: 1 to 8 numbers into kfac, their count into *n_kfac. */
+static int read_second_moment_factors(loader *ld, hid_t grid, double kfac[8], int *n_kfac)
+{
+    hid_t attr = -1, space = -1;
+    hssize_t count = -1;
+    if (!attribute_exists(grid, "second_moment_factors"))
+        return fail(ld, RBS_ERR_FORMAT, "missing attribute 'second_moment_factors' of group 'grid'");
+    H5E_BEGIN_TRY {
+        attr = H5Aopen(grid, "second_moment_factors", H5P_DEFAULT);
+        if (attr >= 0) space = H5Aget_space(attr);
+        if (space >= 0) count = H5Sget_simple_extent_npoints(space);
+    } H5E_END_TRY;
+    if (space >= 0) H5Sclose(space);
+    if (attr >= 0) H5Aclose(attr);
+    if (count < 1 || count > 8
+        || read_numeric_attribute(grid, "second_moment_factors", H5T_NATIVE_DOUBLE, kfac, count, 0) != 0)
+        return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute 'second_moment_factors' of group 'grid' as 1 to 8 "
+                    "numbers");
+    *n_kfac = (int)count;
+    return RBS_OK;
+}
+
+/* the attributes grid/law copies, in its order (data_schema.table.LAW_ATTRIBUTES; the last holds 4 numbers) */
+static const char *const LAW_ATTRIBUTES[] = {
+    "restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean", "aspect_ratio_sd",
+    "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol", "max_steps", "second_moment_factors"};
+#define N_LAW_ATTRIBUTES (sizeof LAW_ATTRIBUTES / sizeof LAW_ATTRIBUTES[0])
+
+/* The attributes of LAW_ATTRIBUTES as grid/law holds them (data_schema.table.ReboundTable.law_values): every
+ * one required, integers (n_max, max_steps) converted to double. */
+static int law_values(loader *ld, hid_t grid, double values[LAW_SIZE])
+{
+    int n = 0;
+    for (size_t i = 0; i + 1 < N_LAW_ATTRIBUTES; i++) {
+        const char *name = LAW_ATTRIBUTES[i];
+        if (strcmp(name, "n_max") == 0 || strcmp(name, "max_steps") == 0) {
+            long long integer = 0;
+            if (read_integer_attribute(ld, grid, "grid", name, &integer) != RBS_OK) return ld->code;
+            values[n++] = (double)integer;
+        } else if (read_double_attribute(ld, grid, "grid", name, &values[n++]) != RBS_OK) {
+            return ld->code;
+        }
+    }
+    double kfac[8];
+    int n_kfac = 0;
+    if (read_second_moment_factors(ld, grid, kfac, &n_kfac) != RBS_OK) return ld->code;
+    if (n + n_kfac != LAW_SIZE)
+        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%d,), expected (%d,) (the attribute "
+                    "'second_moment_factors' of group 'grid' holds %d numbers, not %d)", LAW_SIZE, n + n_kfac, n_kfac,
+                    LAW_SIZE - n);
+    memcpy(values + n, kfac, (size_t)n_kfac * sizeof(double));
+    return RBS_OK;
+}
+
+/* Since 3.2: the checksummed copies grid/law and grid/shape_codes equal the attributes (restitution_k,
+ * restitution_p in 3.2; every one of LAW_ATTRIBUTES since 3.3) and the names, bit for bit
+ * (data_schema.table.check_contract). */
 static int check_law_copies(loader *ld, hid_t grid, const rbs_table *t)
 {
     static const char *const known[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
     if (t->format_minor < 2) return RBS_OK;
-    const hsize_t two = 2, shapes = (hsize_t)t->n_shapes;
-    double *law = read_dataset(ld, grid, "grid", "law", H5T_NATIVE_DOUBLE, sizeof(double), 1, &two);
+    double attributes[LAW_SIZE] = {t->restitution_k, t->restitution_p};
+    const int size = t->format_minor >= 3 ? LAW_SIZE : 2;
+    if (size == LAW_SIZE && law_values(ld, grid, attributes) != RBS_OK) return ld->code;
+    int rank = 0;
+    hsize_t dims[8];
+    if (dataset_shape(ld, grid, "grid", "law", &rank, dims) != RBS_OK) return ld->code;
+    if (rank != 1 || dims[0] != (hsize_t)size)
+        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%llu%s), expected (%d,)",
+                    rank ? (unsigned long long)dims[0] : 0ULL, rank == 1 ? "," : ", ...", size);
+    const hsize_t n_law = (hsize_t)size, shapes = (hsize_t)t->n_shapes;
+    double *law = read_dataset(ld, grid, "grid", "law", H5T_NATIVE_DOUBLE, sizeof(double), 1, &n_law);
     if (!law) return ld->code;
-    const double attributes[2] = {t->restitution_k, t->restitution_p};
-    int same = memcmp(law, attributes, sizeof attributes) == 0;
-    if (!same)
-        fail(ld, RBS_ERR_FORMAT, "the attributes restitution_k, restitution_p of group 'grid' (%.17g, %.17g) differ "
-             "from their checksummed copy 'grid/law' (%.17g, %.17g)", t->restitution_k, t->restitution_p, law[0], law[1]);
+    int differ = -1;
+    for (int i = 0; differ < 0 && i < size; i++)
+        if (memcmp(&law[i], &attributes[i], sizeof(double)) != 0) differ = i;
+    if (differ >= 0) {
+        char name[64];
+        if (differ < (int)N_LAW_ATTRIBUTES - 1) snprintf(name, sizeof name, "%s", LAW_ATTRIBUTES[differ]);
+        else snprintf(name, sizeof name, "second_moment_factors[%d]", differ - ((int)N_LAW_ATTRIBUTES - 1));
+        fail(ld, RBS_ERR_FORMAT, "the attribute %s of group 'grid' (%.17g) differs from its checksummed copy in "
+             "'grid/law' (%.17g)", name, attributes[differ], law[differ]);
+    }
     free(law);
-    if (!same) return ld->code;
+    if (differ >= 0) return ld->code;
     uint8_t *codes = read_dataset(ld, grid, "grid", "shape_codes", H5T_NATIVE_UINT8, 1, 1, &shapes);
     if (!codes) return ld->code;
+    int same = 1;
     for (int i = 0; same && i < t->n_shapes; i++)
         same = codes[i] < RBS_MAX_SHAPES && strcmp(known[codes[i]], t->shape_names[i]) == 0;
     free(codes);
@@ -445,8 +517,27 @@ static int check_law_copies(loader *ld, hid_t grid, const rbs_table *t)
         }                                                       \
     } while (0)
 
+/* Every row of shape_dictionary a standardised quantile function: non-decreasing, knots within ±√L up to
+ * float32 round-off (data_schema.table.check_dictionary). */
+static int check_dictionary(loader *ld, const float *dictionary, size_t rows, long long L)
+{
+    const float bound = (float)(sqrt((double)L) * (1.0 + DICTIONARY_BOUND_TOLERANCE));
+    const size_t knots = (size_t)L + 1;
+    for (size_t i = 0; i < rows * knots; i++)
+        if (!(fabsf(dictionary[i]) <= bound))
+            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' holds %g at element %zu; its values must "
+                        "be in [-%.9g, %.9g] (sqrt of the levels %lld)", (double)dictionary[i], i, (double)bound,
+                        (double)bound, L);
+    for (size_t row = 0; row < rows; row++)
+        for (size_t i = 1; i < knots; i++)
+            if (dictionary[row * knots + i] < dictionary[row * knots + i - 1])
+                return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' row %zu decreases; each row (a "
+                            "quantile function) must be non-decreasing", row);
+    return RBS_OK;
+}
+
 /* The values of the cell datasets (data_schema.table.check_contract, the same rules in the same order). */
-static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cells, size_t C, long long M)
+static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cells, size_t C, long long M, long long L)
 {
     size_t bad;
 #define RULE(field, n, ok, wanted)                                                                                 \
@@ -457,16 +548,19 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
                         #field, (double)raw->field[bad], bad, wanted);                                             \
     } while (0)
     RULE(cluster_weight, n_cells * C, isfinite(v) && v >= 0.0, "finite and >= 0");
-    RULE(cluster_scale, n_cells * C * N_CHAIN, isfinite(v) && v >= 0.0, "finite and >= 0");
+    RULE(cluster_loc, n_cells * C * N_CHAIN, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
+    RULE(cluster_scale, n_cells * C * N_CHAIN, v >= 0.0 && v <= CELL_VALUE_BOUND, "in [0, 1e+06]");
+    RULE(cluster_slope, n_cells * C * N_SLOPES, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
     RULE(cluster_shape, n_cells * C * N_CHAIN, v < (double)M, "below the dictionary size");
     RULE(cluster_regime, n_cells * C, v <= 1.0, "0 or 1");
     RULE(status_counts, n_cells * 3, v >= 0.0, ">= 0");
     RULE(collision_counts, n_cells * 11, v >= 0.0, ">= 0");
-    RULE(mean, n_cells * 6, isfinite(v), "finite");
-    RULE(std, n_cells * 6, isfinite(v) && v >= 0.0, "finite and >= 0");
+    RULE(mean, n_cells * 6, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
+    RULE(std, n_cells * 6, v >= 0.0 && v <= CELL_VALUE_BOUND, "in [0, 1e+06]");
     RULE(indicatrix_2d, n_cells * 72, isfinite(v) && v >= 0.0, "finite and >= 0");
     RULE(indicatrix_3d, n_cells * 72 * 72, isfinite(v) && v >= 0.0, "finite and >= 0");
 #undef RULE
+    if (check_dictionary(ld, raw->shape_dictionary, n_cells * N_CHAIN * (size_t)M, L) != RBS_OK) return ld->code;
     for (size_t cell = 0; cell < n_cells; cell++) {
         double sum = 0.0;
         for (size_t c = 0; c < C; c++) sum += raw->cluster_weight[cell * C + c];
@@ -482,113 +576,42 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
 
 /* ------------------------------------------------------------------------- the direct model's parameters */
 
-/* the direct model's tolerances every build used before tables recorded them, and s per shape code at
- * κ = 0.3 (data_schema.table.BUILT_WITH_TOLERANCES, BUILT_WITH_KAPPA, BUILT_WITH_SECOND_MOMENT_FACTORS) */
-#define BUILT_WITH_CONTACT_TOL 1e-10
-#define BUILT_WITH_SET_TOL 1e-9
-#define BUILT_WITH_MAX_STEPS 100000
-#define BUILT_WITH_KAPPA 0.3
-static const double BUILT_WITH_SECOND_MOMENT_FACTORS[RBS_MAX_SHAPES] = {
-    0.2, 0.33333333333333337, 0.3309571404654277, 0.20000000000000004};
-static const char *const ASPECT_KEYS[4] = {"mean", "sd", "low", "high"};
-
-/* p past spaces and tabs */
-static const char *skip_blanks(const char *p)
-{
-    while (*p == ' ' || *p == '\t') p++;
-    return p;
-}
-
-/* `key = number` pairs of the aspect-ratio law from p up to `end` (an inline table's '}' or a line's end) */
-static void parse_aspect_pairs(const char *p, const char *end, double aspect[4])
-{
-    while (p < end) {
-        p = skip_blanks(p);
-        for (int k = 0; k < 4; k++) {
-            size_t len = strlen(ASPECT_KEYS[k]);
-            const char *q = skip_blanks(p + len);
-            if (strncmp(p, ASPECT_KEYS[k], len) == 0 && *q == '=') {
-                char *after;
-                double x = strtod(q + 1, &after);
-                if (after != q + 1) aspect[k] = x;
-            }
-        }
-        while (p < end && *p != ',' && *p != '\n') p++;
-        p++;
-    }
-}
-
-/* The aspect-ratio law of the build's configuration (TOML text, as tablegen's to_toml writes it): the
- * inline table `aspect_ratio = {mean = ..., sd = ..., low = ..., high = ...}` of [simulation], or a
- * [simulation.aspect_ratio] table; NaN for what it does not give (data_schema.table._direct_model_attributes). */
-static void config_aspect(const char *text, double aspect[4])
-{
-    int in_simulation = 0, in_law = 0;
-    for (const char *line = text; line && *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
-        const char *p = skip_blanks(line), *eol = strchr(p, '\n');
-        if (!eol) eol = p + strlen(p);
-        if (*p == '[') {
-            in_simulation = strncmp(p, "[simulation]", 12) == 0;
-            in_law = strncmp(p, "[simulation.aspect_ratio]", 25) == 0;
-        } else if (in_law) {
-            parse_aspect_pairs(p, eol, aspect);
-        } else if (in_simulation && strncmp(p, "aspect_ratio", 12) == 0) {
-            const char *q = skip_blanks(p + 12);
-            const char *close = strchr(q, '}');
-            if (*q == '=' && *(q = skip_blanks(q + 1)) == '{' && close && close < eol) parse_aspect_pairs(q + 1, close, aspect);
-        }
-    }
-}
-
-/* The attributes of the direct model (data_schema.table._direct_model_attributes, the same fallbacks for
- * tables that did not record them) into aspect, kfac (*n_kfac of them), the tolerances and q. */
-static int direct_attributes(loader *ld, hid_t file, hid_t grid, double kappa, double aspect[4], double kfac[8],
-                             int *n_kfac, double *contact_tol, double *set_tol, long long *max_steps, double *q)
+/* The attributes of the direct model (data_schema.table._direct_model_attributes: every one required since
+ * 3.3, the fallbacks of old_tables.c before) into aspect, kfac (*n_kfac of them), the tolerances and q. */
+static int direct_attributes(loader *ld, hid_t file, hid_t grid, const rbs_table *t, double kappa, double aspect[4],
+                             double kfac[8], int *n_kfac, double *contact_tol, double *set_tol, long long *max_steps,
+                             double *q)
 {
     static const char *const aspect_names[4] = {"aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low",
                                                 "aspect_ratio_high"};
+    const int required = t->format_minor >= 3;
     int recorded = 1;
     for (int k = 0; k < 4; k++) {
         aspect[k] = NAN;
         recorded &= attribute_exists(grid, aspect_names[k]);
     }
-    if (recorded) {
+    if (recorded || required) {
         for (int k = 0; k < 4; k++)
             if (read_double_attribute(ld, grid, "grid", aspect_names[k], &aspect[k]) != RBS_OK) return ld->code;
     } else {
         const size_t size = 1 << 20;
         char *config = malloc(size);
         if (!config) return fail(ld, RBS_ERR_MEMORY, "out of memory reading the root attribute 'config'");
-        if (read_string_attribute(file, "config", config, size) == 0) config_aspect(config, aspect);
+        if (read_string_attribute(file, "config", config, size) == 0) rbs_config_aspect(config, aspect);
         free(config);
     }
     *n_kfac = RBS_MAX_SHAPES;
-    if (attribute_exists(grid, "second_moment_factors")) {
-        hid_t attr = -1, space = -1;
-        hssize_t count = -1;
-        H5E_BEGIN_TRY {
-            attr = H5Aopen(grid, "second_moment_factors", H5P_DEFAULT);
-            if (attr >= 0) space = H5Aget_space(attr);
-            if (space >= 0) count = H5Sget_simple_extent_npoints(space);
-        } H5E_END_TRY;
-        if (space >= 0) H5Sclose(space);
-        if (attr >= 0) H5Aclose(attr);
-        if (count < 1 || count > 8
-            || read_numeric_attribute(grid, "second_moment_factors", H5T_NATIVE_DOUBLE, kfac, count) != 0)
-            return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute 'second_moment_factors' of group 'grid' as 1 to 8 "
-                        "numbers");
-        *n_kfac = (int)count;
+    if (required || attribute_exists(grid, "second_moment_factors")) {
+        if (read_second_moment_factors(ld, grid, kfac, n_kfac) != RBS_OK) return ld->code;
     } else {
-        for (int k = 0; k < RBS_MAX_SHAPES; k++) kfac[k] = kappa == BUILT_WITH_KAPPA ? BUILT_WITH_SECOND_MOMENT_FACTORS[k] : NAN;
+        rbs_built_with_second_moment_factors(kappa, kfac);
     }
-    *contact_tol = BUILT_WITH_CONTACT_TOL;
-    *set_tol = BUILT_WITH_SET_TOL;
-    *max_steps = BUILT_WITH_MAX_STEPS;
+    rbs_built_with_tolerances(contact_tol, set_tol, max_steps);
     *q = NAN;
-    if ((attribute_exists(grid, "contact_tol") && read_double_attribute(ld, grid, "grid", "contact_tol", contact_tol))
-        || (attribute_exists(grid, "set_tol") && read_double_attribute(ld, grid, "grid", "set_tol", set_tol))
-        || (attribute_exists(grid, "max_steps") && read_integer_attribute(ld, grid, "grid", "max_steps", max_steps))
-        || (attribute_exists(grid, "friction_q") && read_double_attribute(ld, grid, "grid", "friction_q", q)))
+    if (((required || attribute_exists(grid, "contact_tol")) && read_double_attribute(ld, grid, "grid", "contact_tol", contact_tol))
+        || ((required || attribute_exists(grid, "set_tol")) && read_double_attribute(ld, grid, "grid", "set_tol", set_tol))
+        || ((required || attribute_exists(grid, "max_steps")) && read_integer_attribute(ld, grid, "grid", "max_steps", max_steps))
+        || ((required || attribute_exists(grid, "friction_q")) && read_double_attribute(ld, grid, "grid", "friction_q", q)))
         return ld->code;
     return RBS_OK;
 }
@@ -609,7 +632,7 @@ static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table 
     double aspect[4], kfac[8], contact_tol, set_tol, q;
     long long max_steps = 0;
     int n_kfac = 0;
-    if (direct_attributes(ld, file, grid, kappa, aspect, kfac, &n_kfac, &contact_tol, &set_tol, &max_steps, &q) != RBS_OK)
+    if (direct_attributes(ld, file, grid, t, kappa, aspect, kfac, &n_kfac, &contact_tol, &set_tol, &max_steps, &q) != RBS_OK)
         return ld->code;
     for (int k = 0; k < n_kfac; k++)
         if (!isfinite(kfac[k])) return RBS_OK;
@@ -796,7 +819,7 @@ static int load(loader *ld, rbs_table *t)
     READ_CELLS(indicatrix_2d, 11, H5T_NATIVE_FLOAT, float);
     READ_CELLS(indicatrix_3d, 12, H5T_NATIVE_FLOAT, float);
 #undef READ_CELLS
-    if (check_cell_values(ld, &raw, n_cells, (size_t)C, M) != RBS_OK) goto done;
+    if (check_cell_values(ld, &raw, n_cells, (size_t)C, M, L) != RBS_OK) goto done;
     {
         const char *what = NULL;
         int code = rbs_derive(t, &raw, &what);

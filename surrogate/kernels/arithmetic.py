@@ -125,11 +125,24 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     return vx * shrink, vy * shrink, vz * shrink, g * wx, g * wy, g * wz
 
 
+# |V⁺|²/|V⁻|² a rebound may reach above 1: the round-off of the sines and cosines that build V⁺ from s ≤ 1
+SPEED_TOLERANCE = 1e-12
+
+
+@numba.njit(inline="always", **JIT)
+def drawn_ok(vx, vy, vz):
+    """A drawn V⁺ (local frame, units of |V⁻|) that may be reported as a rebound, whatever table was loaded:
+    leaving the wall (V⁺_y > 0) and no faster than it came (|V⁺| ≤ |V⁻| up to :data:`SPEED_TOLERANCE`; tables
+    are built with Ω⁻ = 0, so a table draw never gains kinetic energy). A valid table's draws always pass (the
+    folds of :func:`_folded` and :func:`to_speed`); values outside docs/format.md's bounds might not."""
+    return (vy > 0.0) & (fma(vx, vx, fma(vy, vy, vz * vz)) <= 1.0 + SPEED_TOLERANCE)
+
+
 @numba.njit(inline="always", **JIT)
 def arithmetic(gathered, cos_alpha1, sin_alpha1, scaled):
     """The reflected state from the values :func:`surrogate.kernels.gather.gather` returns, at cos α1, sin α1:
     (status, V⁺_x, V⁺_y, V⁺_z, Ω_x, Ω_y, Ω_z), local frame, V⁺ in units of |V⁻|, Ω in units of |V⁻|/a;
-    NaN and STATUS_TRAPPED when trapped.
+    NaN and STATUS_TRAPPED when trapped; STATUS_INVALID for a draw that fails :func:`drawn_ok`.
 
     The chain (:func:`_chain`), then with ``scaled`` the move to the incident α1 when wa > 0
     (:func:`_moved`) and to the incident speed when wv > 0 (:func:`to_speed`), then the mirror sign.
@@ -146,6 +159,7 @@ def arithmetic(gathered, cos_alpha1, sin_alpha1, scaled):
     moved = to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, state[3], state[4], state[5])
     vx, vy, vz, wx, wy, wz = _pick6(scaled and wv > 0.0, moved, local)
     status, vx, vy, vz, wx, wy, wz = _mirrored(mirror, vx, vy, vz, wx, wy, wz)
+    status = status if drawn_ok(vx, vy, vz) else STATUS_INVALID
     out = _pick6(trapped > 0.5, NAN6, (vx, vy, vz, wx, wy, wz))
     return (STATUS_TRAPPED if trapped > 0.5 else status,) + out
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from data_schema.samples import STATUS_NAMES
-from data_schema.table import TABLE_VERSION, ReboundTable
+from data_schema.table import ReboundTable, table_fingerprint
 
 STEP_DECIMALS = 9       # grid steps equal to this many decimals count as one step (round-off of {start, stop, step})
 
@@ -21,14 +21,15 @@ def _grid(values) -> str:
 
 
 def describe_table(table: ReboundTable, path: Path | None = None) -> str:
-    """Format version, grids, shapes, counts per cell (summarised), size, config hash."""
+    """Format version, fingerprint (with ``path``), grids, shapes, counts per cell (summarised), size, config hash."""
     counts = table.cells["status_counts"]            # (shape, alpha, speed, status)
     total = counts.sum(axis=-1)
     lines = []
     if path is not None:
-        lines.append(f"{path}: rebound table, {path.stat().st_size / 1e6:.1f} MB")
+        lines += [f"{path}: rebound table, {path.stat().st_size / 1e6:.1f} MB",
+                  f"fingerprint sha256 {table_fingerprint(path)} (its content: docs/format.md, 'Fingerprint')"]
     lines += [
-        f"format version {TABLE_VERSION[0]}.{TABLE_VERSION[1]}, made {table.created} by package "
+        f"format version {table.format_version[0]}.{table.format_version[1]}, made {table.created} by package "
         f"version {table.package_version}",
         f"config sha256 {table.config_sha256}, master seed {table.master_seed}",
         f"alpha1 (deg): {_grid(table.alpha1_deg)}",

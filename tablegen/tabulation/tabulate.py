@@ -15,6 +15,13 @@ the cell's samples (each sample is in one cluster), which is what lets the
 table reproduce the joint law: a law built from a subsample carries that
 subsample's noise, which a classifier detects (docs/design/table_representation.md).
 
+CPU independence: every floating-point reduction here (the k-means distances
+and centres, the moments, the least-squares fits) is a numba loop in a fixed
+order, compiled without fastmath (no reassociation, no fused multiply-add),
+and the random choices are integers and doubles from numpy's PCG64 stream; no
+BLAS, LAPACK or numpy reduction whose SIMD kernel depends on the CPU, so a
+seed gives the same bits on every x86-64 CPU (docs/design/build.md).
+
 Mirror folding: the model is exactly symmetric under Z → −Z, which maps
 (β2, Ω_x, Ω_y) to their negatives; every sample is mapped to its image with
 β2 ≥ 0, so all n samples inform one half-space and the runtime restores the
@@ -26,8 +33,6 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from sklearn.cluster import KMeans, MiniBatchKMeans
-from threadpoolctl import threadpool_limits
 
 from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet, rebound_angles
 from data_schema.table import (
@@ -42,6 +47,8 @@ RIDGE = 2.0                   # slope shrinkage: regressor sums of squares × (1
 MAX_STATES = 4_000_000        # rebounds kept per cell for the representation: bounds memory at 10⁸ particles
 KMEANS_BATCH_SIZE = 4096      # mini-batch size of the partition
 KMEANS_EPOCHS = 5             # random centres and a few epochs suffice (docs/design/build.md)
+DICTIONARY_ITERATIONS = 300   # Lloyd iterations of the dictionary's k-means at most (it stops when no label moves)
+PARTITION_KEY, DICTIONARY_KEY = 0, 1    # spawn keys of the partition's and the dictionary's random streams
 SPREAD_TOL = 1e-9             # relative to the variable's scale: below it a cluster has no shape
 
 
@@ -132,19 +139,143 @@ class CellAccumulator:
             indicatrix_3d=(self.hist3 / (n * np.outer(d_a2, d_b2))).astype(np.float32))
 
 
-def _partition(z: np.ndarray, n_clusters: int, seed: int) -> np.ndarray:
+def _stream(seed: int, *key: int) -> np.random.Generator:
+    """The random stream of one use of a cell's representation seed (PCG64: the same numbers on every CPU)."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
+
+
+def _partition(z: np.ndarray, n_clusters: int, rng: np.random.Generator) -> np.ndarray:
     """Cluster label of each row of z (already scaled): mini-batch k-means.
 
-    Centres are fitted on the first :data:`KMEANS_FIT_SAMPLES` rows (the
-    samples are in random order), then every row goes to its nearest centre.
-    Random initial centres and a few epochs suffice: the chains fitted inside
-    the clusters, not the centres, carry the law.
+    Centres start at ``n_clusters`` distinct rows drawn from the first
+    :data:`KMEANS_FIT_SAMPLES` (the samples are in random order), are moved by
+    :data:`KMEANS_EPOCHS` epochs of mini-batches of those rows, each epoch a
+    fresh permutation (:func:`_minibatch_epochs`), then every row goes to its
+    nearest centre. Random initial centres and a few epochs suffice: the chains
+    fitted inside the clusters, not the centres, carry the law.
     """
     if n_clusters == 1:
         return np.zeros(len(z), dtype=np.int64)
-    km = MiniBatchKMeans(n_clusters, init="random", n_init=1, batch_size=KMEANS_BATCH_SIZE, max_iter=KMEANS_EPOCHS,
-                         max_no_improvement=2, random_state=seed).fit(z[:KMEANS_FIT_SAMPLES])
-    return km.predict(z).astype(np.int64)
+    n_fit = min(len(z), KMEANS_FIT_SAMPLES)
+    centres = np.ascontiguousarray(z[rng.choice(n_fit, size=n_clusters, replace=False)])
+    order = np.concatenate([rng.permutation(n_fit) for _ in range(KMEANS_EPOCHS)])
+    _minibatch_epochs(z, centres, order, KMEANS_BATCH_SIZE)
+    labels = np.empty(len(z), dtype=np.int64)
+    _assign(z, centres, labels)
+    return labels
+
+
+@numba.njit(cache=True, nogil=True)
+def _nearest(z, i, centres):
+    """Index of the centre nearest row i of z (squared distance summed in column order; the first on a tie)."""
+    best, best_d = 0, np.inf
+    for c in range(centres.shape[0]):
+        d = 0.0
+        for j in range(z.shape[1]):
+            t = z[i, j] - centres[c, j]
+            d += t * t
+        if d < best_d:
+            best, best_d = c, d
+    return best
+
+
+@numba.njit(cache=True, nogil=True)
+def _assign(z, centres, labels):
+    """labels[i] = the centre nearest row i of z."""
+    for i in range(z.shape[0]):
+        labels[i] = _nearest(z, i, centres)
+
+
+@numba.njit(cache=True, nogil=True)
+def _minibatch_epochs(z, centres, order, batch_size):
+    """Mini-batch k-means (Sculley 2010) over the rows of z in ``order``, batches of ``batch_size``; moves
+    ``centres`` in place. Each centre becomes the mean of every row assigned to it so far (per-centre
+    learning rate 1/count), batch by batch; a centre no row reached keeps its place."""
+    k, d = centres.shape
+    count = np.zeros(k)
+    batch_count = np.zeros(k)
+    batch_sum = np.zeros((k, d))
+    for start in range(0, len(order), batch_size):
+        batch_count[:] = 0.0
+        batch_sum[:] = 0.0
+        for i in order[start:start + batch_size]:
+            c = _nearest(z, i, centres)
+            batch_count[c] += 1.0
+            for j in range(d):
+                batch_sum[c, j] += z[i, j]
+        for c in range(k):
+            if batch_count[c] > 0.0:
+                total = count[c] + batch_count[c]
+                for j in range(d):
+                    centres[c, j] = (centres[c, j] * count[c] + batch_sum[c, j]) / total
+                count[c] = total
+
+
+@numba.njit(cache=True, nogil=True)
+def _kmeans(x, u, max_iterations):
+    """k-means (Lloyd) of the rows of x into len(u) centres, started by k-means++ with the uniforms u:
+    (centres, label of each row). Stops when no label moves; an empty centre keeps its place."""
+    n, d = x.shape
+    k = len(u)
+    centres = np.empty((k, d))
+    nearest = np.full(n, np.inf)
+    chosen = min(int(u[0] * n), n - 1)
+    for c in range(k):
+        centres[c] = x[chosen]
+        total = 0.0
+        for i in range(n):
+            dist = 0.0
+            for j in range(d):
+                t = x[i, j] - centres[c, j]
+                dist += t * t
+            nearest[i] = min(nearest[i], dist)
+            total += nearest[i]
+        if c + 1 < k:        # the next centre: a row drawn with probability ∝ its squared distance
+            target, cumulative, chosen = u[c + 1] * total, 0.0, n - 1
+            for i in range(n):
+                cumulative += nearest[i]
+                if cumulative > target:
+                    chosen = i
+                    break
+    labels = np.full(n, -1, dtype=np.int64)
+    sums = np.zeros((k, d))
+    counts = np.zeros(k)
+    for _ in range(max_iterations):
+        moved = False
+        for i in range(n):
+            c = _nearest(x, i, centres)
+            moved |= c != labels[i]
+            labels[i] = c
+        if not moved:
+            break
+        sums[:] = 0.0
+        counts[:] = 0.0
+        for i in range(n):
+            counts[labels[i]] += 1.0
+            for j in range(d):
+                sums[labels[i], j] += x[i, j]
+        for c in range(k):
+            if counts[c] > 0.0:
+                for j in range(d):
+                    centres[c, j] = sums[c, j] / counts[c]
+    return centres, labels
+
+
+@numba.njit(cache=True, nogil=True)
+def _row_moments(x):
+    """(mean, standard deviation) of each row of x, summed in column order (numpy's ddof = 0)."""
+    n, d = x.shape
+    mean = np.zeros(n)
+    std = np.zeros(n)
+    for i in range(n):
+        for j in range(d):
+            mean[i] += x[i, j]
+        mean[i] /= d
+        for j in range(d):
+            t = x[i, j] - mean[i]
+            std[i] += t * t
+        std[i] = np.sqrt(std[i] / d)
+    return mean, std
 
 
 def _group_quantiles(x: np.ndarray, group: np.ndarray, counts: np.ndarray, levels: int) -> np.ndarray:
@@ -159,46 +290,119 @@ def _group_quantiles(x: np.ndarray, group: np.ndarray, counts: np.ndarray, level
     return xs[starts[:, None] + lo] * (1.0 - f) + xs[starts[:, None] + hi] * f
 
 
-def _group_slopes(A: np.ndarray, x: np.ndarray, group: np.ndarray, counts: np.ndarray) -> np.ndarray:
+@numba.njit(cache=True, nogil=True)
+def _group_slopes(A, x, group, counts):
     """(G, p) least-squares slopes of x on the p columns of A within each group (both centred per group).
 
     Ridge: each regressor's within-group sum of squares is multiplied by
     1 + RIDGE/count, negligible for clusters of hundreds, a shrinkage towards 0
-    for clusters of a few samples.
+    for clusters of a few samples. Sums in row order; each group's p × p
+    system solved by Gaussian elimination with partial pivoting.
     """
-    G, p = len(counts), A.shape[1]
-    mean_A = np.stack([np.bincount(group, A[:, i], G) for i in range(p)], axis=1) / counts[:, None]
-    Ac = A - mean_A[group]
-    xc = x - (np.bincount(group, x, G) / counts)[group]
-    S = np.empty((G, p, p))
-    r = np.empty((G, p))
-    for i in range(p):
-        r[:, i] = np.bincount(group, Ac[:, i] * xc, G)
-        for j in range(i, p):
-            S[:, i, j] = S[:, j, i] = np.bincount(group, Ac[:, i] * Ac[:, j], G)
-    diag = np.maximum(np.einsum("gii->gi", S), 1e-300)
-    S += (RIDGE * diag / counts[:, None])[:, :, None] * np.eye(p)
-    return np.linalg.solve(S, r[..., None])[..., 0]
+    G, p, n = len(counts), A.shape[1], A.shape[0]
+    mean_A = np.zeros((G, p))
+    mean_x = np.zeros(G)
+    for i in range(n):
+        g = group[i]
+        mean_x[g] += x[i]
+        for j in range(p):
+            mean_A[g, j] += A[i, j]
+    for g in range(G):
+        mean_x[g] /= counts[g]
+        for j in range(p):
+            mean_A[g, j] /= counts[g]
+    S = np.zeros((G, p, p))
+    r = np.zeros((G, p))
+    for i in range(n):
+        g = group[i]
+        xc = x[i] - mean_x[g]
+        for j in range(p):
+            aj = A[i, j] - mean_A[g, j]
+            r[g, j] += aj * xc
+            for l in range(j, p):
+                S[g, j, l] += aj * (A[i, l] - mean_A[g, l])
+    slopes = np.empty((G, p))
+    for g in range(G):
+        for j in range(p):
+            S[g, j, j] += RIDGE * max(S[g, j, j], 1e-300) / counts[g]
+            for l in range(j + 1, p):
+                S[g, l, j] = S[g, j, l]
+        slopes[g] = _solve(S[g], r[g])
+    return slopes
 
 
-def _dictionary(shapes: np.ndarray, size: int, seed: int):
+@numba.njit(cache=True, nogil=True)
+def _solve(S, r):
+    """x with S x = r (S p × p, overwritten with r), Gaussian elimination with partial pivoting."""
+    p = len(r)
+    for col in range(p):
+        pivot = col
+        for row in range(col + 1, p):
+            if abs(S[row, col]) > abs(S[pivot, col]):
+                pivot = row
+        for j in range(p):
+            S[col, j], S[pivot, j] = S[pivot, j], S[col, j]
+        r[col], r[pivot] = r[pivot], r[col]
+        for row in range(col + 1, p):
+            f = S[row, col] / S[col, col]
+            for j in range(col, p):
+                S[row, j] -= f * S[col, j]
+            r[row] -= f * r[col]
+    x = np.empty(p)
+    for row in range(p - 1, -1, -1):
+        t = r[row]
+        for j in range(row + 1, p):
+            t -= S[row, j] * x[j]
+        x[row] = t / S[row, row]
+    return x
+
+
+@numba.njit(cache=True, nogil=True)
+def _residual(x, A, b, group):
+    """x minus each row's fitted part Σ_j A[i, j] b[group[i], j] (summed in column order)."""
+    out = np.empty(len(x))
+    for i in range(len(x)):
+        t = 0.0
+        for j in range(A.shape[1]):
+            t += A[i, j] * b[group[i], j]
+        out[i] = x[i] - t
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _column_moments(z):
+    """(mean, standard deviation) of each column of z, summed in row order (numpy's ddof = 0)."""
+    n, d = z.shape
+    mean = np.zeros(d)
+    std = np.zeros(d)
+    for i in range(n):
+        for j in range(d):
+            mean[j] += z[i, j]
+    mean /= n
+    for i in range(n):
+        for j in range(d):
+            t = z[i, j] - mean[j]
+            std[j] += t * t
+    return mean, np.sqrt(std / n)
+
+
+def _dictionary(shapes: np.ndarray, size: int, rng: np.random.Generator):
     """Compress standardised quantile functions (G, L+1) into ``size`` shapes: (dictionary, index per row).
 
-    Dictionary shapes are k-means centres, re-standardised and made
-    non-decreasing (a quantile function); unused rows repeat the first.
+    Dictionary shapes are k-means centres (:func:`_kmeans`), re-standardised
+    and made non-decreasing (a quantile function); unused rows repeat the first.
     """
     if len(shapes) == 0:                               # no cluster with a spread: any standard shape will do
-        ramp = np.linspace(-1.0, 1.0, shapes.shape[1])
-        return np.repeat((ramp / ramp.std())[None], size, axis=0), np.zeros(0, dtype=np.int64)
+        ramp = np.linspace(-1.0, 1.0, shapes.shape[1])[None]
+        return np.repeat(ramp / _row_moments(ramp)[1][0], size, axis=0), np.zeros(0, dtype=np.int64)
     m = min(size, len(shapes))
-    km = KMeans(m, n_init=1, random_state=seed).fit(shapes)
-    centres = km.cluster_centers_
-    centres = (centres - centres.mean(axis=1, keepdims=True)) / np.maximum(centres.std(axis=1, keepdims=True),
-                                                                            1e-300)
+    centres, labels = _kmeans(np.ascontiguousarray(shapes), rng.random(m), DICTIONARY_ITERATIONS)
+    mean, std = _row_moments(centres)
+    centres = (centres - mean[:, None]) / np.maximum(std, 1e-300)[:, None]
     centres = np.maximum.accumulate(centres, axis=1)
     dictionary = np.repeat(centres[:1], size, axis=0)
     dictionary[:m] = centres
-    return dictionary, km.labels_
+    return dictionary, labels
 
 
 def regime_clusters(counts, clusters: int) -> list:
@@ -225,7 +429,7 @@ def _regime_partition(z: np.ndarray, regime: np.ndarray, clusters: int, seed: in
         rows = np.flatnonzero(regime == reg)
         if rows.size == 0:
             continue
-        label = _partition(z[rows], c, seed + reg)
+        label = _partition(np.ascontiguousarray(z[rows]), c, _stream(seed, PARTITION_KEY, reg))
         used = np.bincount(label, minlength=c) > 0          # k-means may leave a centre without samples
         group[rows] = len(label_regime) + (np.cumsum(used) - 1)[label]
         label_regime += [reg] * int(used.sum())
@@ -238,42 +442,40 @@ def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolutio
     ``regime`` (n,) is each state's collision regime (:func:`collision_regime`).
     Uses at most min(C, n // 25) clusters (at least one per regime present);
     the remaining rows of the C-row arrays have weight 0 and are never drawn.
-    Single-threaded BLAS and OpenMP (threadpool_limits), so the arrays do not
-    depend on the thread count.
+    The arrays depend on the seed alone: not on the thread count or the CPU (module doc).
     """
     r = resolution
-    seed = seed % 2 ** 31                              # scikit-learn takes 32-bit seeds (seed + 5 still fits)
-    z = folded[:, list(CHAIN_TO_STATE)].astype(np.float64)
+    z = np.ascontiguousarray(folded[:, list(CHAIN_TO_STATE)], dtype=np.float64)
     n = len(z)
-    with threadpool_limits(1):
-        scale = z.std(axis=0)
-        group, label_regime = _regime_partition((z - z.mean(axis=0)) / np.where(scale > 0, scale, 1.0),
-                                                np.asarray(regime, dtype=np.int64), r.clusters, seed)
-        G = len(label_regime)
-        counts = np.bincount(group, minlength=G)
-        weight = np.zeros(r.clusters)
-        weight[:G] = counts / n
-        cluster_regime = np.zeros(r.clusters, dtype=np.uint8)
-        cluster_regime[:G] = label_regime
-        loc = np.zeros((r.clusters, N_CHAIN))
-        scl = np.zeros((r.clusters, N_CHAIN))
-        shape_id = np.zeros((r.clusters, N_CHAIN), dtype=np.uint8)
-        slope = np.zeros((r.clusters, N_SLOPES))
-        dictionary = np.empty((N_CHAIN, r.dictionary_size, r.levels + 1))
-        for k in range(N_CHAIN):
-            residual = z[:, k]
-            if k:
-                b = _group_slopes(z[:, :k], residual, group, counts)
-                slope[:G, slope_index(k, 0):slope_index(k, 0) + k] = b
-                residual = residual - np.einsum("ij,ij->i", z[:, :k], b[group])
-            q = _group_quantiles(residual, group, counts, r.levels)
-            loc[:G, k] = q.mean(axis=1)
-            scl[:G, k] = q.std(axis=1)
-            # a cluster of one value (a few samples) has no shape: scale 0 and shape 0
-            spread = scl[:G, k] > SPREAD_TOL * max(scale[k], 1e-300)
-            scl[:G, k][~spread] = 0.0
-            standard = (q[spread] - loc[:G, k, None][spread]) / scl[:G, k, None][spread]
-            dictionary[k], shape_id[:G, k][spread] = _dictionary(standard, r.dictionary_size, seed + k)
+    mean, scale = _column_moments(z)
+    group, label_regime = _regime_partition((z - mean) / np.where(scale > 0, scale, 1.0),
+                                            np.asarray(regime, dtype=np.int64), r.clusters, seed)
+    G = len(label_regime)
+    counts = np.bincount(group, minlength=G)
+    weight = np.zeros(r.clusters)
+    weight[:G] = counts / n
+    cluster_regime = np.zeros(r.clusters, dtype=np.uint8)
+    cluster_regime[:G] = label_regime
+    loc = np.zeros((r.clusters, N_CHAIN))
+    scl = np.zeros((r.clusters, N_CHAIN))
+    shape_id = np.zeros((r.clusters, N_CHAIN), dtype=np.uint8)
+    slope = np.zeros((r.clusters, N_SLOPES))
+    dictionary = np.empty((N_CHAIN, r.dictionary_size, r.levels + 1))
+    for k in range(N_CHAIN):
+        residual = z[:, k]
+        if k:
+            A = np.ascontiguousarray(z[:, :k])
+            b = _group_slopes(A, residual, group, counts.astype(np.float64))
+            slope[:G, slope_index(k, 0):slope_index(k, 0) + k] = b
+            residual = _residual(residual, A, b, group)
+        q = _group_quantiles(residual, group, counts, r.levels)
+        loc[:G, k], scl[:G, k] = _row_moments(q)
+        # a cluster of one value (a few samples) has no shape: scale 0 and shape 0
+        spread = scl[:G, k] > SPREAD_TOL * max(scale[k], 1e-300)
+        scl[:G, k][~spread] = 0.0
+        standard = (q[spread] - loc[:G, k, None][spread]) / scl[:G, k, None][spread]
+        dictionary[k], shape_id[:G, k][spread] = _dictionary(standard, r.dictionary_size,
+                                                             _stream(seed, DICTIONARY_KEY, k))
     return {"cluster_weight": weight, "cluster_loc": loc.astype(np.float32), "cluster_scale": scl.astype(np.float32),
             "cluster_shape": shape_id, "cluster_slope": slope.astype(np.float32), "cluster_regime": cluster_regime,
             "shape_dictionary": dictionary.astype(np.float32)}

@@ -69,6 +69,10 @@ def _old_table(small_table_path, tmp_path, name, **changes):
     path = tmp_path / name
     path.write_bytes(small_table_path.read_bytes())
     with h5py.File(path, "r+") as f:
+        f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)      # its grid/law: restitution_k, _p
+        law = f["grid/law"][:2]
+        del f["grid/law"]
+        f["grid"].create_dataset("law", data=law, fletcher32=True)
         for key, value in changes.items():
             if value is None:
                 del f["grid"].attrs[key]

@@ -127,6 +127,10 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
     old = tmp_path / "old.h5"
     old.write_bytes(small_table_path.read_bytes())
     with h5py.File(old, "r+") as f:
+        f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)      # its grid/law: restitution_k, _p
+        law = f["grid/law"][:2]
+        del f["grid/law"]
+        f["grid"].create_dataset("law", data=law, fletcher32=True)
         for name in ("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol",
                      "set_tol", "max_steps", "second_moment_factors", "friction_q"):
             del f["grid"].attrs[name]

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from data_schema.common import DataFormatError
-from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table
+from data_schema.table import CELL_DATASETS, TABLE_VERSION, read_table, table_fingerprint
 from data_schema.output import OutputError
 from tablegen.tabulation.driver import BuildError, Checkpoint, CheckpointError, build_table
 from tablegen.tabulation.config import parse_config
@@ -74,6 +74,7 @@ def test_table_contents_are_consistent(tiny_table):
 def test_bit_identical_for_one_or_two_workers(tiny_table, tmp_path):
     two = build_table(parse_config(TINY), tmp_path / "two.h5", workers=2)
     assert _cell_bytes(two) == _cell_bytes(tiny_table)
+    assert table_fingerprint(two) == table_fingerprint(tiny_table)
 
 
 def test_bit_identical_on_a_dask_cluster(tiny_table, tmp_path):
@@ -82,6 +83,7 @@ def test_bit_identical_on_a_dask_cluster(tiny_table, tmp_path):
                                   dashboard_address=None) as cluster:
         path = build_table(parse_config(TINY), tmp_path / "dask.h5", scheduler=cluster.scheduler_address)
     assert _cell_bytes(path) == _cell_bytes(tiny_table)
+    assert table_fingerprint(path) == table_fingerprint(tiny_table)
 
 
 def test_resume_after_sigkill_gives_the_same_table(tmp_path):
@@ -173,7 +175,8 @@ def test_info_describes_the_table(tiny_table, capsys):
     from tablegen.cli import main
     assert main(["info", str(tiny_table)]) == 0
     out = capsys.readouterr().out
-    for text in (f"format version {TABLE_VERSION[0]}.{TABLE_VERSION[1]}", "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
+    for text in (f"format version {TABLE_VERSION[0]}.{TABLE_VERSION[1]}", f"fingerprint sha256 {table_fingerprint(tiny_table)}",
+                 "alpha1 (deg): 2 values", "prism", "tetrahedron", "config sha256",
                  "3000 particles"):
         assert text in out
 
