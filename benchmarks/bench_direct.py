@@ -45,9 +45,10 @@ per shape (a figure only: the exit code does not depend on it). Where the time g
 checks and the uniforms), the same without the trapped particles (each runs n_max collisions), the mean
 flights, collisions and contact-search steps per particle, and a split of the rebound's time: each piece
 timed alone on the bodies of the first PIECE_ROWS rows (inputs that stay in cache), times its count per
-rebound: a flight's setup (K in the lab frame,
-rotation_init, curvature_bound; once per flight), the free flight's orientation at one instant
-(rotation_at) and the body's lowest points there (lowest_points; both once per search step), a collision
+rebound: a flight's setup (K in the lab frame, curvature_bound, jerk_bound and rotation_init; counted once per
+flight, an upper count: a flight decided at its first step skips rotation_init), the free flight's orientation
+at one instant (rotation_at; once per search step but a flight's first), the body's lowest points there with
+their rates and curvatures (lowest_points; once per search step), a collision
 (K⁻¹ in the lab frame and collide); the rest is the body's setup, the search's own logic and the frame.
 The C program times the same pieces in C (rbs_rotation_init, rbs_rotation_at, rbs_lowest_points,
 rbs_collide: the model's internal kernels) on the same inputs, and C's rebound alone
@@ -98,7 +99,7 @@ import numpy as np
 import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.collision import collide
-from direct_model.flight import curvature_bound, lowest_points
+from direct_model.flight import curvature_bound, jerk_bound, lowest_points
 from direct_model.body_rebound import lab_tensor, quaternion_to_matrix
 from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
 from direct_model.runtime import (P_KAPPA, P_KFAC, P_WALL, SCRATCH_SIZE, U_AXIS, U_HAND, U_ORIENTATION,
@@ -258,8 +259,8 @@ def _bodies(params, shape, u_all, semi, R, verts, nv):
 
 @numba.njit
 def _flight_setups(params, shape, semi, R, verts, nv, W, rot):
-    """What rebound does at the start of every flight: K in the lab frame, ℓ = KΩ, rotation_init,
-    curvature_bound; rot[i] receives the rotation parameters."""
+    """What rebound does at the start of a flight: K in the lab frame, ℓ = KΩ, curvature_bound, jerk_bound and
+    (at the flight's second search step, if it has one) rotation_init; rot[i] receives the rotation parameters."""
     K, K_lab, ell = np.empty(3), np.empty((3, 3)), np.empty(3)
     for i in range(semi.shape[0]):
         a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
@@ -269,8 +270,9 @@ def _flight_setups(params, shape, semi, R, verts, nv, W, rot):
         for j in range(3):
             ell[j] = K_lab[j, 0] * W[i, 0] + K_lab[j, 1] * W[i, 1] + K_lab[j, 2] * W[i, 2]
         rotation_init(K, R[i], ell, rot[i])
-        curvature_bound(shape, semi[i], bounding_radius(shape, 1.0, semi[i, 1], semi[i, 2], verts[i], nv[i]), K, ell,
-                        W[i])
+        Rb = bounding_radius(shape, 1.0, semi[i, 1], semi[i, 2], verts[i], nv[i])
+        curvature_bound(shape, semi[i], Rb, K, ell, W[i])
+        jerk_bound(shape, semi[i], Rb, K, ell, W[i])
 
 
 @numba.njit
@@ -283,32 +285,39 @@ def _orientations(rot, t):
 
 
 @numba.njit
-def _lowest_points(shape, semi, R, verts, nv):
-    """The candidate lowest points of the body (lowest_points): what every search step computes."""
-    h, r_all = np.empty(MAX_VERTICES), np.empty((MAX_VERTICES, 3))
+def _lowest_points(params, shape, semi, R, verts, nv, W):
+    """The candidate lowest points of the body, their heights, rates and curvatures (lowest_points): what every
+    search step computes."""
+    h, h1, h2, K = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3)
     for i in range(semi.shape[0]):
-        lowest_points(shape, verts[i], nv[i], semi[i], R[i], 1.0, h, r_all)
+        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
+        kfac = params[P_KFAC + shape]
+        K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
+        lowest_points(shape, verts[i], nv[i], semi[i], K, R[i], W[i], 1.0, 0.0, h, h1, h2)
 
 
 @numba.njit
 def _collisions(params, shape, semi, R, verts, nv, model, out):
     """One collision per row, the body at rest touching the wall at its lowest point, hit at V⁻ (the first
     collision of a rebound with Ω⁻ = 0): K⁻¹ in the lab frame and collide. out[i] = collide's outcome."""
-    Kinv, Kinv_lab = np.empty(3), np.empty((3, 3))
-    h, r_all = np.empty(MAX_VERTICES), np.empty((MAX_VERTICES, 3))
+    K, Kinv, Kinv_lab = np.empty(3), np.empty(3), np.empty((3, 3))
+    h, h1, h2, r = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3)
     V, W, dV, dW = np.empty(3), np.zeros(3), np.empty(3), np.empty(3)
     wall = params[P_WALL:P_WALL + 3]
     for i in range(semi.shape[0]):
-        m = lowest_points(shape, verts[i], nv[i], semi[i], R[i], 0.0, h, r_all)
+        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
+        kfac = params[P_KFAC + shape]
+        K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
+        m = lowest_points(shape, verts[i], nv[i], semi[i], K, R[i], W, 0.0, 0.0, h, h1, h2)
         low = 0
         for j in range(m):
             low = j if h[j] < h[low] else low
-        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
-        kfac = params[P_KFAC + shape]
-        Kinv[0], Kinv[1], Kinv[2] = 1.0 / (kfac * (b2 + c2)), 1.0 / (kfac * (a2 + c2)), 1.0 / (kfac * (a2 + b2))
+        for j in range(3):
+            r[j] = R[i, j, 0] * verts[i, low, 0] + R[i, j, 1] * verts[i, low, 1] + R[i, j, 2] * verts[i, low, 2]
+            Kinv[j] = 1.0 / K[j]
         lab_tensor(R[i], Kinv, Kinv_lab)
         V[0], V[1], V[2] = model[i, 0], model[i, 1], 0.0
-        out[i] = collide(V, W, r_all[low], Kinv_lab, wall, dV, dW)
+        out[i] = collide(V, W, r, Kinv_lab, wall, dV, dW)
 
 
 def _best(fn, repeats) -> float:
@@ -360,14 +369,15 @@ def piece_costs(params, shape_code, pieces: dict, repeats) -> dict:
     return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(params, shape_code, semi, R, verts, nv, W, rot),
                                              runs) / m,
             "us_orientation": 1e6 * _best(lambda: _orientations(rot, t), runs) / m,
-            "us_lowest_points": 1e6 * _best(lambda: _lowest_points(shape_code, semi, R, verts, nv), runs) / m,
+            "us_lowest_points": 1e6 * _best(lambda: _lowest_points(params, shape_code, semi, R, verts, nv, W), runs) / m,
             "us_collision": 1e6 * _best(lambda: _collisions(params, shape_code, semi, R, verts, nv, model, outcome),
                                         runs) / m}
 
 
 def split(row: dict, costs: dict, total_us: float) -> dict:
     """Each piece's share (%) of total_us at the row's counts per rebound; the rest."""
-    counts = {"flight_setup": row["flights_per_rebound"], "orientation": row["search_steps_per_rebound"],
+    counts = {"flight_setup": row["flights_per_rebound"],
+              "orientation": row["search_steps_per_rebound"] - row["flights_per_rebound"],
               "lowest_points": row["search_steps_per_rebound"], "collision": row["collisions_per_rebound"]}
     shares = {f"pct_{k}": 100 * counts[k] * costs[f"us_{k}"] / total_us for k in PIECES}
     shares["pct_rest"] = 100 - sum(shares.values())
@@ -542,10 +552,11 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
                       for r in hopper))
     print("\nWhere numba's time goes (rebound alone): µs per call of each piece on the rows' bodies, times its\n"
           "count per rebound above, as a share of 'frame us'. setup: a flight's start (K in the lab frame, ℓ,\n"
-          "rotation_init, curvature_bound), once per flight; orient: the free flight's orientation at one\n"
-          "instant (rotation_at) and lowest: the body's lowest points there (lowest_points), once per search\n"
-          "step; coll: one collision (K⁻¹ in the lab frame, collide), once per collision. rest: the body's setup,\n"
-          "the search's own logic (safe and Newton steps, the contact choice), the frame's rotations; the pieces\n"
+          "the bounds, rotation_init), counted once per flight (an upper count: a flight decided at its first\n"
+          "step skips rotation_init); orient: the free flight's orientation at one instant (rotation_at), once\n"
+          "per search step but a flight's first; lowest: the body's lowest points with their rates and\n"
+          "curvatures (lowest_points), once per search step; coll: one collision (K⁻¹ in the lab frame, collide), once per collision. rest: the body's setup,\n"
+          "the search's own logic (the safe and Newton steps, the contact choice), the frame's rotations; the pieces\n"
           "timed alone run hotter in cache than inside a rebound, so rest is uncertain by about ±10 points.\n"
           "trapped %: the share of the time spent on trapped particles (1 − untrapped time / all).")
     _print_rows(rows, SPLIT_COLUMNS)

@@ -30,8 +30,9 @@ from data_schema.samples import (
 )
 from direct_model.options import JIT
 from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
-from direct_model.flight import SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, lowest_points
-from direct_model.rotation import ROT_PARAMS_SIZE, rotation_init
+from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, jerk_bound,
+                                  lowest_points)
+from direct_model.rotation import ROT_PARAMS_SIZE
 from direct_model.shapes import MAX_VERTICES, body_vertices, bounding_radius
 
 HISTORY_COLUMNS = 17
@@ -39,8 +40,9 @@ HISTORY_COLUMNS = 17
 # layout of the scratch array of :func:`body_rebound`
 _VERTS = 0
 _HEIGHTS = _VERTS + 3 * MAX_VERTICES
-_OFFSETS = _HEIGHTS + MAX_VERTICES
-_PARAMS = _OFFSETS + 3 * MAX_VERTICES
+_RATES = _HEIGHTS + MAX_VERTICES
+_CURVATURES = _RATES + MAX_VERTICES
+_PARAMS = _CURVATURES + MAX_VERTICES
 _R = _PARAMS + ROT_PARAMS_SIZE
 _K_LAB = _R + 9
 _KINV_LAB = _K_LAB + 9
@@ -97,7 +99,8 @@ def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contac
     """
     verts = work[_VERTS:_VERTS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
     h = work[_HEIGHTS:_HEIGHTS + MAX_VERTICES]
-    r_all = work[_OFFSETS:_OFFSETS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
+    h1 = work[_RATES:_RATES + MAX_VERTICES]
+    h2 = work[_CURVATURES:_CURVATURES + MAX_VERTICES]
     params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
     R = work[_R:_R + 9].reshape((3, 3))
     K_lab = work[_K_LAB:_K_LAB + 9].reshape((3, 3))
@@ -120,7 +123,7 @@ def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contac
     W[:] = W0
 
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
-        n = lowest_points(shape, verts, nv, semi, R, 0.0, h, r_all)
+        n = lowest_points(shape, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2)
         y = -h[:n].min()
     else:
         y = Rb
@@ -144,11 +147,11 @@ def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contac
         for i in range(3):
             ell[i] = K_lab[i, 0] * W[0] + K_lab[i, 1] * W[1] + K_lab[i, 2] * W[2]
         e_rot = 0.5 * (W[0] * ell[0] + W[1] * ell[1] + W[2] * ell[2])
-        rotation_init(K, R, ell, params)
         M = curvature_bound(shape, semi, Rb, K, ell, W)
+        M3 = jerk_bound(shape, semi, Rb, K, ell, W)
         Wt[:] = W
-        code, t, steps = find_contact(shape, verts, nv, semi, Rb, M, params, y, V[1],
-                                      contact_tol, set_tol, max_steps, 0.0, R, Wt, h, r_all, rc)
+        code, t, steps = find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
+                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, h2, rc)
         n_steps += steps
         if code == SEARCH_ESCAPED:
             status = STATUS_REBOUNDED

@@ -5,158 +5,224 @@ uniformly, the orientation by exact torque-free rotation
 (:mod:`direct_model.rotation`). Only the height y of the centre of mass matters for
 contact; lengths are in units of a, velocities in m/s, times in a/(m/s).
 
-Contact search: conservative advancement with a second-order bound. Every
-body point's height h(t) has |h''| ≤ M, with M from the invariants of the
-flight (|L| and energy), so from the current height h and rate h' no point
-can reach the wall before the smallest positive root τ of
+Candidate points. A polyhedron's candidates are its vertices p (body frame);
+an ellipsoid's is its support point in direction −n, p = −A² g / |A g|. With
+g = Rᵀ e_y the lab's normal seen from the body, a point's height is
+h = y + g·p. The body sees g turn as ġ = g × ω, g̈ = ġ × ω + g × ω̇ (ω the
+body-frame angular velocity, K ω̇ = (K ω) × ω), so a vertex has h' = v + ġ·p
+and h'' = g̈·p exactly; the ellipsoid's lowest point has h = y − σ, σ = |A g|,
+h' = v + ġ·p (the support point's material velocity) and h'' = −σ'' from
+φ = gᵀA²g, σ'' = φ''/(2σ) − φ'²/(4σ³).
+
+Contact search: conservative advancement. Every candidate's height has
+|h''| ≤ M and |h'''| ≤ M3, with M and M3 from the invariants of the flight
+(|L| and energy), so from the current h, h' no point can reach the wall before
+the first positive root τ of
 
     h + h' τ − ½ M τ² = 0,
 
-taken over the vertices (polyhedron) or the support point (ellipsoid). The
-step τ is never too long: no contact is missed, however fast the spin.
+taken over the candidates. The binding point b (smallest τ) gets a longer
+step from its exact curvature: on [0, T], h_b ≥ h + h'τ + ½(h'' − M3 T/3) τ²,
+whose first root (capped at T, T at most the other points' τ and 4 times b's)
+is safe too. The step is never too long: no contact is missed, however fast
+the spin.
 
-Near an approaching contact the search takes Newton steps τ_N = h/|h'| of the
-binding point b instead, where they are provably safe: τ_N shorter than every
-other point's safe step, and h_b' + Mτ_N < 0 so that b approaches the wall
-monotonically during the step. Landing above the wall then proves that b did
-not cross it; landing below brackets the contact, which safeguarded Newton
-(bisection fallback) refines. Either way convergence is quadratic with the
-true curvature of h_b rather than the bound M. The search stops when the
+Near an approaching contact the search takes second-order Newton steps τ_T,
+the root nearest 0 of h + h'τ + ½h''τ² for point b, where they are provably
+safe: τ_T shorter than every other point's safe step, and b approaching the
+wall monotonically during the step (h_b' + Mτ_T < 0, or
+h_b' + h_b''τ_T + ½M3τ_T² < 0). Landing above the wall then proves that b did
+not cross it; landing below brackets the contact, which the same steps
+(bisection fallback) refine. Convergence is cubic. The search stops when the
 lowest point is within ``contact_tol`` (units of a) of the wall, and a
 collision follows if the contact point is approaching.
 
-Bounds used (K = J/m principal values, ℓ = L/m, T = energy/m):
-|Ω| ≤ ω_max = min(|ℓ|/K_min, √(2T/K_min));
-|dΩ/dt| ≤ ½(K_max − K_min) ω_max² / K_min   (Euler: K Ω̇ = (KΩ) × Ω);
-vertex at distance ≤ R from the centroid: |h''| ≤ (|Ω̇| + |Ω|²) R;
-ellipsoid support height σ = |A Rᵀ e_y|: |σ''| ≤ 2 a_max² ω²/a_min + a_max (|Ω̇| + ω²).
+Bounds used (K = J/m principal values, ℓ = L/m, T = energy/m, Δ = K_max − K_min):
+|Ω| ≤ ω = min(|ℓ|/K_min, √(2T/K_min));
+|ω̇| ≤ ω̇_b = ½Δ ω² / K_min   (Euler: K ω̇ = (K ω) × ω = ((K − cI) ω) × ω);
+|ω̈| ≤ Δ ω ω̇_b / K_min       (K ω̈ = ((K − cI) ω̇) × ω + ((K − cI) ω) × ω̇);
+|g̈| ≤ g₂ = ω̇_b + ω², |g⃛| ≤ g₃ = |ω̈| + 3 ω ω̇_b + ω³;
+vertex at distance ≤ R_b: M = g₂ R_b, M3 = g₃ R_b;
+ellipsoid (|A²g| ≤ a_max σ, σ ≥ a_min): M = a_max² ω² / a_min + a_max g₂,
+M3 = 6 a_max² ω g₂ / a_min + a_max g₃ + 6 a_max³ ω³ / a_min².
+
+The flight's rotation set-up (:func:`direct_model.rotation.rotation_init`) is
+done at the first step that needs the orientation at a later time: a flight
+decided at its start (a contact at t = 0, an escape) never pays for it.
 """
+
+import math
 
 import numba
 import numpy as np
 
 from direct_model.options import JIT
-from direct_model.rotation import rotation_at
+from direct_model.rotation import rotation_at, rotation_init
 from direct_model.shapes import ELLIPSOID
 
 SEARCH_CONTACT = 0      # a point touches the wall (within contact_tol) and approaches it
 SEARCH_ESCAPED = 1      # the body can never reach the wall again
 SEARCH_STALLED = 2      # max_steps reached without a decision
 
+HORIZON = 4.0           # the binding point's longer step looks at most this many safe steps ahead
+
 
 @numba.njit(**JIT)
-def curvature_bound(shape, semi, Rb, K, ell, W):
-    """Bound M on |h''| of any body point's height during a flight (module doc).
-
-    ``K`` principal J/m (a²), ``ell`` = L/m and ``W`` = Ω at any instant of the
-    flight (lab frame); 2T = ℓ·Ω is the flight's invariant.
-    """
+def _rate_bounds(K, ell, W):
+    """Bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (module doc)."""
     kmin = min(K[0], min(K[1], K[2]))
     kmax = max(K[0], max(K[1], K[2]))
     l2 = ell[0] ** 2 + ell[1] ** 2 + ell[2] ** 2
     two_t = max(ell[0] * W[0] + ell[1] * W[1] + ell[2] * W[2], 0.0)
     w = min(np.sqrt(l2) / kmin, np.sqrt(two_t / kmin))
-    if w == 0.0:
-        return 0.0
     wdot = 0.5 * (kmax - kmin) * w * w / kmin
+    return w, wdot, (kmax - kmin) * w * wdot / kmin
+
+
+@numba.njit(**JIT)
+def curvature_bound(shape, semi, Rb, K, ell, W):
+    """Bound M on |h''| of any candidate point's height during a flight (module doc).
+
+    ``K`` principal J/m (a²), ``ell`` = L/m and ``W`` = Ω at any instant of the
+    flight (lab frame); 2T = ℓ·Ω is the flight's invariant.
+    """
+    w, wdot, _ = _rate_bounds(K, ell, W)
     if shape == ELLIPSOID:
         amax = max(semi[0], max(semi[1], semi[2]))
         amin = min(semi[0], min(semi[1], semi[2]))
-        return 2.0 * amax * amax * w * w / amin + amax * (wdot + w * w)
+        return amax * amax * w * w / amin + amax * (wdot + w * w)
     return (wdot + w * w) * Rb
 
 
 @numba.njit(**JIT)
+def jerk_bound(shape, semi, Rb, K, ell, W):
+    """Bound M3 on |h'''| of any candidate point's height during a flight (module doc)."""
+    w, wdot, wddot = _rate_bounds(K, ell, W)
+    g3 = wddot + 3.0 * w * wdot + w * w * w
+    if shape == ELLIPSOID:
+        amax = max(semi[0], max(semi[1], semi[2]))
+        amin = min(semi[0], min(semi[1], semi[2]))
+        return (6.0 * amax * amax * w * (wdot + w * w) / amin + amax * g3
+                + 6.0 * amax * amax * amax * w * w * w / (amin * amin))
+    return g3 * Rb
+
+
+@numba.njit(**JIT)
 def safe_step(h, hdot, M):
-    """Time until h + hdot·τ − ½Mτ² first reaches 0 (h ≥ 0); inf if never."""
+    """First τ ≥ 0 where h + hdot·τ − ½Mτ² reaches 0 (h < 0 taken as 0; M of any sign); inf if never."""
     if h < 0.0:
         h = 0.0
+    disc = hdot * hdot + 2.0 * M * h
     if hdot <= 0.0:
-        den = np.sqrt(hdot * hdot + 2.0 * M * h) - hdot
+        if disc < 0.0:
+            return np.inf
+        den = np.sqrt(disc) - hdot
         return 2.0 * h / den if den > 0.0 else 0.0
-    if M == 0.0:
+    if M <= 0.0:
         return np.inf
-    return (hdot + np.sqrt(hdot * hdot + 2.0 * M * h)) / M
+    return (hdot + np.sqrt(disc)) / M
 
 
 @numba.njit(**JIT)
-def point_height_rate(v, W, r):
-    """Height rate dh/dt of the body point at r (lab, from the centroid): v + (Ω × r)_y."""
-    return v + W[2] * r[0] - W[0] * r[2]
+def taylor_root(h, hdot, hddot):
+    """Root nearest 0 of h + hdot·s + ½hddot·s² (Newton's −h/hdot where it has none)."""
+    disc = hdot * hdot - 2.0 * h * hddot
+    if disc < 0.0:
+        return -h / hdot
+    return -2.0 * h / (hdot + math.copysign(np.sqrt(disc), hdot))
 
 
 @numba.njit(**JIT)
-def lowest_points(shape, verts, nv, semi, R, y, h, r_all):
-    """Heights ``h[i]`` and lab offsets ``r_all[i]`` of the candidate lowest points.
+def lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2):
+    """Heights ``h[i]``, rates ``h1[i]`` and curvatures ``h2[i]`` of the candidate lowest points.
 
-    Polyhedron: every vertex. Ellipsoid: the single support point in direction
-    −n, r = −R A² u / |A u| with u = Rᵀ e_y. Returns the number of points.
+    ``R``, ``W``: orientation and lab Ω now; ``y``, ``v``: the centre's height and vertical
+    velocity. Candidates (body frame): the vertices ``verts[:nv]``, or the ellipsoid's support
+    point, written into ``verts[0]``. Returns the number of candidates (module doc).
     """
+    g0, g1, g2 = R[1, 0], R[1, 1], R[1, 2]
+    w0 = R[0, 0] * W[0] + R[1, 0] * W[1] + R[2, 0] * W[2]      # ω = Rᵀ Ω
+    w1 = R[0, 1] * W[0] + R[1, 1] * W[1] + R[2, 1] * W[2]
+    w2 = R[0, 2] * W[0] + R[1, 2] * W[1] + R[2, 2] * W[2]
+    m0, m1, m2 = K[0] * w0, K[1] * w1, K[2] * w2
+    e0 = (m1 * w2 - m2 * w1) / K[0]                               # ω̇ = K⁻¹ (K ω) × ω
+    e1 = (m2 * w0 - m0 * w2) / K[1]
+    e2 = (m0 * w1 - m1 * w0) / K[2]
+    d0, d1, d2 = g1 * w2 - g2 * w1, g2 * w0 - g0 * w2, g0 * w1 - g1 * w0      # ġ = g × ω
+    a0 = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1)                  # g̈ = ġ × ω + g × ω̇
+    a1 = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2)
+    a2 = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0)
     if shape == ELLIPSOID:
-        u0, u1, u2 = R[1, 0] * semi[0], R[1, 1] * semi[1], R[1, 2] * semi[2]
+        u0, u1, u2 = semi[0] * g0, semi[1] * g1, semi[2] * g2
         sigma = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-        b0, b1, b2 = -semi[0] * u0 / sigma, -semi[1] * u1 / sigma, -semi[2] * u2 / sigma
-        for k in range(3):
-            r_all[0, k] = R[k, 0] * b0 + R[k, 1] * b1 + R[k, 2] * b2
-        h[0] = y + r_all[0, 1]
+        q0, q1, q2 = semi[0] * u0, semi[1] * u1, semi[2] * u2      # A² g
+        verts[0, 0], verts[0, 1], verts[0, 2] = -q0 / sigma, -q1 / sigma, -q2 / sigma
+        phi1 = 2.0 * (q0 * d0 + q1 * d1 + q2 * d2)
+        phi2 = 2.0 * (semi[0] * semi[0] * d0 * d0 + semi[1] * semi[1] * d1 * d1 + semi[2] * semi[2] * d2 * d2
+                      + (q0 * a0 + q1 * a1 + q2 * a2))
+        h[0] = y - sigma
+        h1[0] = v - 0.5 * phi1 / sigma
+        h2[0] = (0.25 * phi1 * phi1 / (sigma * sigma) - 0.5 * phi2) / sigma
         return 1
     for i in range(nv):
-        for k in range(3):
-            r_all[i, k] = R[k, 0] * verts[i, 0] + R[k, 1] * verts[i, 1] + R[k, 2] * verts[i, 2]
-        h[i] = y + r_all[i, 1]
+        p0, p1, p2 = verts[i, 0], verts[i, 1], verts[i, 2]
+        h[i] = y + (g0 * p0 + g1 * p1 + g2 * p2)
+        h1[i] = v + (d0 * p0 + d1 * p1 + d2 * p2)
+        h2[i] = a0 * p0 + a1 * p1 + a2 * p2
     return nv
 
 
 @numba.njit(**JIT)
-def choose_contact(n, h, r_all, v, W, set_tol, rc):
+def choose_contact(n, verts, h, h1, R, set_tol, rc):
     """Contact point among touching candidates (docs/model.md §4); False if none approaches.
 
     The points within ``set_tol`` of the lowest form the contact set. One
     point: it is the contact if it approaches the wall. Several (an edge or a
-    face): their centroid if it approaches, else the lowest approaching point
-    of the set (otherwise the body could pass through the wall).
+    face): their centroid if it approaches (the mean of their rates is its rate),
+    else the lowest approaching point of the set (otherwise the body could pass
+    through the wall). ``rc`` receives the contact point from the centroid, lab frame.
     """
     hmin = np.inf
     for i in range(n):
         hmin = min(hmin, h[i])
     count = 0
-    rc[:] = 0.0
+    p0, p1, p2, rate = 0.0, 0.0, 0.0, 0.0
     best, best_h = -1, np.inf
     for i in range(n):
         if h[i] <= hmin + set_tol:
             count += 1
-            for k in range(3):
-                rc[k] += r_all[i, k]
-            if point_height_rate(v, W, r_all[i]) < 0.0 and h[i] < best_h:
+            p0, p1, p2, rate = p0 + verts[i, 0], p1 + verts[i, 1], p2 + verts[i, 2], rate + h1[i]
+            if h1[i] < 0.0 and h[i] < best_h:
                 best, best_h = i, h[i]
-    rc /= count
-    if count > 1 and point_height_rate(v, W, rc) < 0.0:
-        return True
-    if best < 0:
-        return False
-    rc[:] = r_all[best]
+    if not (count > 1 and rate < 0.0):
+        if best < 0:
+            return False
+        p0, p1, p2, count = verts[best, 0], verts[best, 1], verts[best, 2], 1
+    p0, p1, p2 = p0 / count, p1 / count, p2 / count
+    for k in range(3):
+        rc[k] = R[k, 0] * p0 + R[k, 1] * p1 + R[k, 2] * p2
     return True
 
 
 @numba.njit(**JIT)
-def find_contact(shape, verts, nv, semi, Rb, M, params, y0, v, contact_tol, set_tol,
-                 max_steps, t, R, W, h, r_all, rc):
-    """Advance the flight from time ``t`` to the next collision or to escape.
+def find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
+                 max_steps, R, W, h, h1, h2, rc):
+    """Advance a flight from its start (t = 0) to the next collision or to escape.
 
     Parameters
     ----------
     shape, verts, nv, semi, Rb : the body (codes and arrays of :mod:`direct_model.shapes`).
-    M : curvature bound from :func:`curvature_bound` for this flight.
-    params : rotation parameters of this flight (:func:`direct_model.rotation.rotation_init`).
-    y0, v : centre-of-mass height at the flight's t = 0 (units of a) and its
-        vertical velocity (m/s).
+    K, ell : principal J/m (a²) and ℓ = L/m (lab) of the flight.
+    M, M3 : bounds from :func:`curvature_bound` and :func:`jerk_bound` for this flight.
+    params : the flight's rotation parameters, filled here by
+        :func:`direct_model.rotation.rotation_init` when first needed.
+    y0, v : centre-of-mass height at t = 0 (units of a) and its vertical velocity (m/s).
     contact_tol : a point this close to the wall touches it (units of a).
     set_tol : points this close to the lowest one share the contact (units of a).
     max_steps : step budget of this search.
-    t : start time of the search (a/(m/s)), ≥ 0.
-    R, W : on entry the orientation and lab angular velocity at time ``t``; on
+    R, W : on entry the orientation and lab angular velocity at t = 0; on
         return, at the returned time.
-    h, r_all, rc : work arrays; for a contact, rc receives the contact point
+    h, h1, h2, rc : work arrays; for a contact, rc receives the contact point
         relative to the centroid (lab frame).
 
     Returns
@@ -164,48 +230,58 @@ def find_contact(shape, verts, nv, semi, Rb, M, params, y0, v, contact_tol, set_
     (code, t, n_steps) with code one of the ``SEARCH_*`` values.
     """
     b = -1                # the binding point of the last step
-    t_lo = t              # latest time known to precede any contact
-    t_hi = np.inf         # a time past the contact of point b, once a Newton step overshoots
+    t = 0.0
+    t_lo = 0.0            # latest time known to precede any contact
+    t_hi = np.inf         # a time past the contact of point b, once a step overshoots
     for step in range(max_steps):
         if step > 0:
+            if step == 1:
+                rotation_init(K, R, ell, params)
             rotation_at(params, t, R, W)
         y = y0 + v * t
-        n = lowest_points(shape, verts, nv, semi, R, y, h, r_all)
-        hmin = np.inf
+        n = lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2)
+        hmin, low = np.inf, 0
         for i in range(n):
-            hmin = min(hmin, h[i])
-        if -contact_tol <= hmin <= contact_tol and choose_contact(n, h, r_all, v, W, set_tol, rc):
+            if h[i] < hmin:
+                hmin, low = h[i], i
+        if -contact_tol <= hmin <= contact_tol and choose_contact(n, verts, h, h1, R, set_tol, rc):
             return SEARCH_CONTACT, t, step + 1
         if hmin < -contact_tol or t_hi < np.inf:
             # Bracket [t_lo, t_hi] in which only point b reaches the wall, monotonically:
-            # safeguarded Newton on its height.
+            # safeguarded second-order Newton on its height.
+            if b < 0:             # below the wall at the start: no bracket, the budget ends it
+                b = low
             if h[b] < 0.0:
                 t_hi = t
             else:
                 t_lo = t
-            t_new = t - h[b] / point_height_rate(v, W, r_all[b])
+            t_new = t + taylor_root(h[b], h1[b], h2[b])
             t = t_new if t_lo < t_new < t_hi else 0.5 * (t_lo + t_hi)
             continue
         if v > 0.0 and y > Rb:
             return SEARCH_ESCAPED, t, step + 1
         tau, tau_other = np.inf, np.inf
         for i in range(n):
-            tau_i = safe_step(h[i], point_height_rate(v, W, r_all[i]), M)
+            tau_i = safe_step(h[i], h1[i], M)
             if tau_i < tau:
                 tau, tau_other, b = tau_i, tau, i
             else:
                 tau_other = min(tau_other, tau_i)
+        if 0.0 < tau < np.inf:
+            # b's longer step from its exact curvature, valid up to the horizon (module doc)
+            horizon = min(tau_other, HORIZON * tau)
+            tau = max(tau, min(horizon, safe_step(h[b], h1[b], min(M, M3 * horizon / 3.0 - h2[b]))))
         if v > 0.0 and tau >= (Rb - y) / v:
             return SEARCH_ESCAPED, t, step + 1
         if not (0.0 < tau < np.inf):
             return SEARCH_STALLED, t, step + 1
-        # Newton step of the binding point where it is safe (module doc): no other
-        # point can reach the wall first, and b approaches monotonically.
-        rate_b = point_height_rate(v, W, r_all[b])
-        if rate_b < 0.0:
-            t_newton = h[b] / -rate_b
-            if t_newton < tau_other and t_newton * M < -rate_b:
-                tau = max(tau, t_newton)
+        # second-order Newton step of b where it is safe (module doc): no other point can
+        # reach the wall first, and b approaches monotonically
+        if h1[b] < 0.0:
+            t_newton = taylor_root(h[b], h1[b], h2[b])
+            if tau < t_newton < tau_other and (h1[b] + M * t_newton < 0.0
+                                                or h1[b] + (h2[b] + 0.5 * M3 * t_newton) * t_newton < 0.0):
+                tau = t_newton
         t_lo = t
         t += tau
     return SEARCH_STALLED, t, max_steps

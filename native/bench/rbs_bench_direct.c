@@ -15,9 +15,9 @@
  * 3), vertex count, Ω after the rebound ((m/s)/a, 3), a time t (a/(m/s)), the model-frame inputs vt, vn, wx,
  * wy, wz, the RBS_U_PER_REBOUND uniforms), the pieces of bench_direct.py's time split are timed as its numba
  * loops time them, in µs per call: us_model_frame (rbs_rebound_model_frame alone), us_flight_setup (K in the
- * lab frame, ℓ, rbs_rotation_init, rbs_curvature_bound), us_orientation (rbs_rotation_at at t),
- * us_lowest_points (rbs_lowest_points), us_collision (the body at rest touching the wall at its lowest point
- * hit at (vt, vn, 0): K⁻¹ in the lab frame, rbs_collide); each the best of 5 × REPEATS.
+ * lab frame, ℓ, rbs_rotation_init, rbs_curvature_bound, rbs_jerk_bound), us_orientation (rbs_rotation_at at t),
+ * us_lowest_points (rbs_lowest_points with the rates and curvatures), us_collision (the body at rest touching
+ * the wall at its lowest point hit at (vt, vn, 0): K⁻¹ in the lab frame, rbs_collide); each the best of 5 × REPEATS.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -70,9 +70,11 @@ static void principal(const double *params, int shape, const double *semi, doubl
 /* the pieces, piece k over all m rows (see the header); returns a sum that keeps the calls alive */
 static double run_piece(int k, const double *params, int shape, const double *rows, size_t m, double *rot)
 {
-    double sum = 0.0, K[3], Kinv[3], T[9], ell[3], R[9], W[3], h[MAX_VERTICES], r_all[3 * MAX_VERTICES];
+    double sum = 0.0, K[3], Kinv[3], T[9], ell[3], R[9], W[3], h[MAX_VERTICES], h1[MAX_VERTICES], h2[MAX_VERTICES];
+    double verts[3 * MAX_VERTICES];
     for (size_t i = 0; i < m; i++) {
-        const double *x = rows + i * PIECE_SIZE, *semi = x + PIECE_SEMI, *verts = x + PIECE_VERTS;
+        const double *x = rows + i * PIECE_SIZE, *semi = x + PIECE_SEMI;
+        for (int j = 0; j < 3 * MAX_VERTICES; j++) verts[j] = x[PIECE_VERTS + j];
         int nv = (int)x[PIECE_NV];
         if (k == 0) {
             double V[3], Wo[3];
@@ -84,21 +86,26 @@ static double run_piece(int k, const double *params, int shape, const double *ro
             lab_tensor(x + PIECE_R, K, T);
             for (int j = 0; j < 3; j++) ell[j] = T[3 * j] * Wr[0] + T[3 * j + 1] * Wr[1] + T[3 * j + 2] * Wr[2];
             rbs_rotation_init(K, x + PIECE_R, ell, rot + i * RBS_ROT_PARAMS_SIZE);
-            sum += rbs_curvature_bound(shape, semi, rbs_bounding_radius(shape, 1.0, semi[1], semi[2], verts, nv), K, ell,
-                                       Wr);
+            double Rb = rbs_bounding_radius(shape, 1.0, semi[1], semi[2], verts, nv);
+            sum += rbs_curvature_bound(shape, semi, Rb, K, ell, Wr) + rbs_jerk_bound(shape, semi, Rb, K, ell, Wr);
         } else if (k == 2) {
             rbs_rotation_at(rot + i * RBS_ROT_PARAMS_SIZE, x[PIECE_T], R, W);
             sum += R[0];
         } else if (k == 3) {
-            sum += rbs_lowest_points(shape, verts, nv, semi, x + PIECE_R, 1.0, h, r_all);
-        } else {
-            int n = rbs_lowest_points(shape, verts, nv, semi, x + PIECE_R, 0.0, h, r_all), low = 0;
-            for (int j = 0; j < n; j++) low = h[j] < h[low] ? j : low;
             principal(params, shape, semi, K);
-            for (int j = 0; j < 3; j++) Kinv[j] = 1.0 / K[j];
-            lab_tensor(x + PIECE_R, Kinv, T);
-            double V[3] = {x[PIECE_MODEL], x[PIECE_MODEL + 1], 0.0}, W0[3] = {0.0, 0.0, 0.0}, dV[3], dW[3];
-            sum += rbs_collide(V, W0, r_all + 3 * low, T, params + P_WALL, dV, dW);
+            sum += rbs_lowest_points(shape, verts, nv, semi, K, x + PIECE_R, x + PIECE_W, 1.0, 0.0, h, h1, h2);
+        } else {
+            double V[3] = {x[PIECE_MODEL], x[PIECE_MODEL + 1], 0.0}, W0[3] = {0.0, 0.0, 0.0}, dV[3], dW[3], r[3];
+            const double *Ri = x + PIECE_R;
+            principal(params, shape, semi, K);
+            int n = rbs_lowest_points(shape, verts, nv, semi, K, Ri, W0, 0.0, 0.0, h, h1, h2), low = 0;
+            for (int j = 0; j < n; j++) low = h[j] < h[low] ? j : low;
+            for (int j = 0; j < 3; j++) {
+                r[j] = Ri[3 * j] * verts[3 * low] + Ri[3 * j + 1] * verts[3 * low + 1] + Ri[3 * j + 2] * verts[3 * low + 2];
+                Kinv[j] = 1.0 / K[j];
+            }
+            lab_tensor(Ri, Kinv, T);
+            sum += rbs_collide(V, W0, r, T, params + P_WALL, dV, dW);
         }
     }
     return sum;

@@ -45,8 +45,7 @@ int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand,
                      double set_tol, long long max_steps, double V[3], double W[3], long long *n_collisions,
                      long long *n_steps)
 {
-    /* h and r_all hold MAX_VERTICES points whatever the shape, as numba's work space (find_contact's index −1) */
-    double verts[3 * MAX_VERTICES], h[MAX_VERTICES] = {0.0}, r_all[3 * MAX_VERTICES] = {0.0};
+    double verts[3 * MAX_VERTICES], h[MAX_VERTICES], h1[MAX_VERTICES], h2[MAX_VERTICES];
     double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
     double K[3], Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
 
@@ -65,7 +64,7 @@ int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand,
 
     double y;
     if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
-        int n = rbs_lowest_points(shape, verts, nv, semi, R, 0.0, h, r_all);
+        int n = rbs_lowest_points(shape, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2);
         /* numpy's min: the first NaN, else the smallest */
         double lowest = h[0];
         for (int i = 1; i < n && lowest == lowest; i++)
@@ -79,13 +78,13 @@ int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand,
     for (;;) {
         lab_tensor(R, K, K_lab);
         for (int i = 0; i < 3; i++) ell[i] = K_lab[3 * i] * W[0] + K_lab[3 * i + 1] * W[1] + K_lab[3 * i + 2] * W[2];
-        rbs_rotation_init(K, R, ell, params);
         double M = rbs_curvature_bound(shape, semi, Rb, K, ell, W);
+        double M3 = rbs_jerk_bound(shape, semi, Rb, K, ell, W);
         for (int k = 0; k < 3; k++) Wt[k] = W[k];
         double t = 0.0;
         long long steps = 0;
-        int code = rbs_find_contact(shape, verts, nv, semi, Rb, M, params, y, V[1], contact_tol, set_tol, max_steps,
-                                    &t, R, Wt, h, r_all, rc, &steps);
+        int code = rbs_find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1], contact_tol, set_tol,
+                                    max_steps, &t, R, Wt, h, h1, h2, rc, &steps);
         steps_total += steps;
         if (code == SEARCH_ESCAPED) {
             status = RBS_REBOUNDED;

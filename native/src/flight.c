@@ -1,6 +1,6 @@
 /*
- * flight.c: the search for the next contact of a free flight (direct_model.flight: curvature_bound, safe_step,
- * point_height_rate, lowest_points, choose_contact, find_contact); the flight itself is rotation.c's. The same
+ * flight.c: the search for the next contact of a free flight (direct_model.flight: curvature_bound, jerk_bound,
+ * safe_step, taylor_root, lowest_points, choose_contact, find_contact); the flight itself is rotation.c's. The same
  * operations in the same order as the numba kernels (plain products and sums, libm's sqrt).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -13,120 +13,187 @@
 #include "rotation.h"
 #include "shapes.h"
 
-double rbs_curvature_bound(int shape, const double semi[3], double Rb, const double K[3], const double ell[3],
-                           const double W[3])
+#define HORIZON 4.0 /* direct_model.flight.HORIZON */
+
+/* bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (direct_model.flight._rate_bounds) */
+static void rate_bounds(const double K[3], const double ell[3], const double W[3], double *w, double *wdot,
+                        double *wddot)
 {
     double kmin = py_min(K[0], py_min(K[1], K[2]));
     double kmax = py_max(K[0], py_max(K[1], K[2]));
     double l2 = ell[0] * ell[0] + ell[1] * ell[1] + ell[2] * ell[2];
     double two_t = py_max(ell[0] * W[0] + ell[1] * W[1] + ell[2] * W[2], 0.0);
-    double w = py_min(sqrt(l2) / kmin, sqrt(two_t / kmin));
-    if (w == 0.0) return 0.0;
-    double wdot = 0.5 * (kmax - kmin) * w * w / kmin;
+    *w = py_min(sqrt(l2) / kmin, sqrt(two_t / kmin));
+    *wdot = 0.5 * (kmax - kmin) * *w * *w / kmin;
+    *wddot = (kmax - kmin) * *w * *wdot / kmin;
+}
+
+double rbs_curvature_bound(int shape, const double semi[3], double Rb, const double K[3], const double ell[3],
+                           const double W[3])
+{
+    double w, wdot, wddot;
+    rate_bounds(K, ell, W, &w, &wdot, &wddot);
     if (shape == RBS_ELLIPSOID) {
         double amax = py_max(semi[0], py_max(semi[1], semi[2]));
         double amin = py_min(semi[0], py_min(semi[1], semi[2]));
-        return 2.0 * amax * amax * w * w / amin + amax * (wdot + w * w);
+        return amax * amax * w * w / amin + amax * (wdot + w * w);
     }
     return (wdot + w * w) * Rb;
 }
 
-/* time until h + hdot τ − ½Mτ² first reaches 0 (h >= 0); inf if never */
+double rbs_jerk_bound(int shape, const double semi[3], double Rb, const double K[3], const double ell[3],
+                      const double W[3])
+{
+    double w, wdot, wddot;
+    rate_bounds(K, ell, W, &w, &wdot, &wddot);
+    double g3 = wddot + 3.0 * w * wdot + w * w * w;
+    if (shape == RBS_ELLIPSOID) {
+        double amax = py_max(semi[0], py_max(semi[1], semi[2]));
+        double amin = py_min(semi[0], py_min(semi[1], semi[2]));
+        return 6.0 * amax * amax * w * (wdot + w * w) / amin + amax * g3
+               + 6.0 * amax * amax * amax * w * w * w / (amin * amin);
+    }
+    return g3 * Rb;
+}
+
+/* first τ >= 0 where h + hdot τ − ½Mτ² reaches 0 (h < 0 taken as 0; M of any sign); inf if never */
 static double safe_step(double h, double hdot, double M)
 {
     if (h < 0.0) h = 0.0;
+    double disc = hdot * hdot + 2.0 * M * h;
     if (hdot <= 0.0) {
-        double den = sqrt(hdot * hdot + 2.0 * M * h) - hdot;
+        if (disc < 0.0) return INFINITY;
+        double den = sqrt(disc) - hdot;
         return den > 0.0 ? 2.0 * h / den : 0.0;
     }
-    if (M == 0.0) return INFINITY;
-    return (hdot + sqrt(hdot * hdot + 2.0 * M * h)) / M;
+    if (M <= 0.0) return INFINITY;
+    return (hdot + sqrt(disc)) / M;
 }
 
-/* height rate dh/dt of the body point at r (lab, from the centroid): v + (Ω × r)_y */
-static inline double point_height_rate(double v, const double *W, const double *r)
+/* root nearest 0 of h + hdot s + ½hddot s² (Newton's −h/hdot where it has none) */
+static double taylor_root(double h, double hdot, double hddot)
 {
-    return v + W[2] * r[0] - W[0] * r[2];
+    double disc = hdot * hdot - 2.0 * h * hddot;
+    if (disc < 0.0) return -h / hdot;
+    return -2.0 * h / (hdot + copysign(sqrt(disc), hdot));
 }
 
-int rbs_lowest_points(int shape, const double *verts, int nv, const double semi[3], const double R[9], double y,
-                      double *h, double *r_all)
+int rbs_lowest_points(int shape, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
+                      const double W[3], double y, double v, double *h, double *h1, double *h2)
 {
+    double g0 = R[3], g1 = R[4], g2 = R[5];
+    double w0 = R[0] * W[0] + R[3] * W[1] + R[6] * W[2]; /* ω = Rᵀ Ω */
+    double w1 = R[1] * W[0] + R[4] * W[1] + R[7] * W[2];
+    double w2 = R[2] * W[0] + R[5] * W[1] + R[8] * W[2];
+    double m0 = K[0] * w0, m1 = K[1] * w1, m2 = K[2] * w2;
+    double e0 = (m1 * w2 - m2 * w1) / K[0]; /* ω̇ = K⁻¹ (K ω) × ω */
+    double e1 = (m2 * w0 - m0 * w2) / K[1];
+    double e2 = (m0 * w1 - m1 * w0) / K[2];
+    double d0 = g1 * w2 - g2 * w1, d1 = g2 * w0 - g0 * w2, d2 = g0 * w1 - g1 * w0; /* ġ = g × ω */
+    double a0 = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1);                           /* g̈ = ġ × ω + g × ω̇ */
+    double a1 = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2);
+    double a2 = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0);
     if (shape == RBS_ELLIPSOID) {
-        double u0 = R[3] * semi[0], u1 = R[4] * semi[1], u2 = R[5] * semi[2];
+        double u0 = semi[0] * g0, u1 = semi[1] * g1, u2 = semi[2] * g2;
         double sigma = sqrt(u0 * u0 + u1 * u1 + u2 * u2);
-        double b0 = -semi[0] * u0 / sigma, b1 = -semi[1] * u1 / sigma, b2 = -semi[2] * u2 / sigma;
-        for (int k = 0; k < 3; k++) r_all[k] = R[3 * k] * b0 + R[3 * k + 1] * b1 + R[3 * k + 2] * b2;
-        h[0] = y + r_all[1];
+        double q0 = semi[0] * u0, q1 = semi[1] * u1, q2 = semi[2] * u2; /* A² g */
+        verts[0] = -q0 / sigma;
+        verts[1] = -q1 / sigma;
+        verts[2] = -q2 / sigma;
+        double phi1 = 2.0 * (q0 * d0 + q1 * d1 + q2 * d2);
+        double phi2 = 2.0 * (semi[0] * semi[0] * d0 * d0 + semi[1] * semi[1] * d1 * d1 + semi[2] * semi[2] * d2 * d2
+                             + (q0 * a0 + q1 * a1 + q2 * a2));
+        h[0] = y - sigma;
+        h1[0] = v - 0.5 * phi1 / sigma;
+        h2[0] = (0.25 * phi1 * phi1 / (sigma * sigma) - 0.5 * phi2) / sigma;
         return 1;
     }
     for (int i = 0; i < nv; i++) {
-        const double *p = verts + 3 * i;
-        for (int k = 0; k < 3; k++) r_all[3 * i + k] = R[3 * k] * p[0] + R[3 * k + 1] * p[1] + R[3 * k + 2] * p[2];
-        h[i] = y + r_all[3 * i + 1];
+        double p0 = verts[3 * i], p1 = verts[3 * i + 1], p2 = verts[3 * i + 2];
+        h[i] = y + (g0 * p0 + g1 * p1 + g2 * p2);
+        h1[i] = v + (d0 * p0 + d1 * p1 + d2 * p2);
+        h2[i] = a0 * p0 + a1 * p1 + a2 * p2;
     }
     return nv;
 }
 
-/* the contact point among touching candidates into rc; 0 if none approaches (the points within set_tol of the
- * lowest form the contact set: their centroid if it approaches, else the lowest approaching point of the set) */
-static int choose_contact(int n, const double *h, const double *r_all, double v, const double *W, double set_tol,
-                          double *rc)
+/* the contact point among touching candidates into rc (lab); 0 if none approaches (the points within set_tol of
+ * the lowest form the contact set: their centroid if it approaches, else the lowest approaching point of the set) */
+static int choose_contact(int n, const double *verts, const double *h, const double *h1, const double *R,
+                          double set_tol, double *rc)
 {
     double hmin = INFINITY;
     for (int i = 0; i < n; i++) hmin = py_min(hmin, h[i]);
     int count = 0, best = -1;
-    double best_h = INFINITY;
-    rc[0] = rc[1] = rc[2] = 0.0;
+    double p0 = 0.0, p1 = 0.0, p2 = 0.0, rate = 0.0, best_h = INFINITY;
     for (int i = 0; i < n; i++) {
         if (h[i] <= hmin + set_tol) {
             count += 1;
-            for (int k = 0; k < 3; k++) rc[k] += r_all[3 * i + k];
-            if (point_height_rate(v, W, r_all + 3 * i) < 0.0 && h[i] < best_h) {
+            p0 = p0 + verts[3 * i];
+            p1 = p1 + verts[3 * i + 1];
+            p2 = p2 + verts[3 * i + 2];
+            rate = rate + h1[i];
+            if (h1[i] < 0.0 && h[i] < best_h) {
                 best = i;
                 best_h = h[i];
             }
         }
     }
-    for (int k = 0; k < 3; k++) rc[k] = rc[k] / (double)count;
-    if (count > 1 && point_height_rate(v, W, rc) < 0.0) return 1;
-    if (best < 0) return 0;
-    for (int k = 0; k < 3; k++) rc[k] = r_all[3 * best + k];
+    if (!(count > 1 && rate < 0.0)) {
+        if (best < 0) return 0;
+        p0 = verts[3 * best];
+        p1 = verts[3 * best + 1];
+        p2 = verts[3 * best + 2];
+        count = 1;
+    }
+    p0 = p0 / (double)count;
+    p1 = p1 / (double)count;
+    p2 = p2 / (double)count;
+    for (int k = 0; k < 3; k++) rc[k] = R[3 * k] * p0 + R[3 * k + 1] * p1 + R[3 * k + 2] * p2;
     return 1;
 }
 
-int rbs_find_contact(int shape, const double *verts, int nv, const double semi[3], double Rb, double M,
-                     const double *params, double y0, double v, double contact_tol, double set_tol, long long max_steps,
-                     double *t_io, double R[9], double W[3], double *h, double *r_all, double rc[3], long long *n_steps)
+int rbs_find_contact(int shape, double *verts, int nv, const double semi[3], double Rb, const double K[3],
+                     const double ell[3], double M, double M3, double *params, double y0, double v, double contact_tol,
+                     double set_tol, long long max_steps, double *t_out, double R[9], double W[3], double *h,
+                     double *h1, double *h2, double rc[3], long long *n_steps)
 {
     int b = -1;                 /* the binding point of the last step */
-    double t = *t_io;
-    double t_lo = t;            /* latest time known to precede any contact */
-    double t_hi = INFINITY;     /* a time past the contact of point b, once a Newton step overshoots */
+    double t = 0.0;
+    double t_lo = 0.0;          /* latest time known to precede any contact */
+    double t_hi = INFINITY;     /* a time past the contact of point b, once a step overshoots */
     for (long long step = 0; step < max_steps; step++) {
-        if (step > 0) rbs_rotation_at(params, t, R, W);
+        if (step > 0) {
+            if (step == 1) rbs_rotation_init(K, R, ell, params);
+            rbs_rotation_at(params, t, R, W);
+        }
         double y = y0 + v * t;
-        int n = rbs_lowest_points(shape, verts, nv, semi, R, y, h, r_all);
+        int n = rbs_lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2);
         double hmin = INFINITY;
-        for (int i = 0; i < n; i++) hmin = py_min(hmin, h[i]);
+        int low = 0;
+        for (int i = 0; i < n; i++)
+            if (h[i] < hmin) {
+                hmin = h[i];
+                low = i;
+            }
         *n_steps = step + 1;
-        *t_io = t;
-        if (-contact_tol <= hmin && hmin <= contact_tol && choose_contact(n, h, r_all, v, W, set_tol, rc))
+        *t_out = t;
+        if (-contact_tol <= hmin && hmin <= contact_tol && choose_contact(n, verts, h, h1, R, set_tol, rc))
             return SEARCH_CONTACT;
         if (hmin < -contact_tol || t_hi < INFINITY) {
-            /* bracket [t_lo, t_hi] in which only point b reaches the wall, monotonically: safeguarded Newton
-             * on its height (numba's index −1, the last point of the work space, before any binding point) */
-            int bi = b < 0 ? b + MAX_VERTICES : b;
-            if (h[bi] < 0.0) t_hi = t;
+            /* bracket [t_lo, t_hi] in which only point b reaches the wall, monotonically: safeguarded
+             * second-order Newton on its height */
+            if (b < 0) b = low; /* below the wall at the start: no bracket, the budget ends it */
+            if (h[b] < 0.0) t_hi = t;
             else t_lo = t;
-            double t_new = t - h[bi] / point_height_rate(v, W, r_all + 3 * bi);
+            double t_new = t + taylor_root(h[b], h1[b], h2[b]);
             t = t_lo < t_new && t_new < t_hi ? t_new : 0.5 * (t_lo + t_hi);
             continue;
         }
         if (v > 0.0 && y > Rb) return SEARCH_ESCAPED;
         double tau = INFINITY, tau_other = INFINITY;
         for (int i = 0; i < n; i++) {
-            double tau_i = safe_step(h[i], point_height_rate(v, W, r_all + 3 * i), M);
+            double tau_i = safe_step(h[i], h1[i], M);
             if (tau_i < tau) {
                 tau_other = tau;
                 tau = tau_i;
@@ -135,19 +202,25 @@ int rbs_find_contact(int shape, const double *verts, int nv, const double semi[3
                 tau_other = py_min(tau_other, tau_i);
             }
         }
+        if (0.0 < tau && tau < INFINITY) {
+            /* b's longer step from its exact curvature, valid up to the horizon */
+            double horizon = py_min(tau_other, HORIZON * tau);
+            tau = py_max(tau, py_min(horizon, safe_step(h[b], h1[b], py_min(M, M3 * horizon / 3.0 - h2[b]))));
+        }
         if (v > 0.0 && tau >= (Rb - y) / v) return SEARCH_ESCAPED;
         if (!(0.0 < tau && tau < INFINITY)) return SEARCH_STALLED;
-        /* Newton step of the binding point where it is safe: no other point can reach the wall first, and b
+        /* second-order Newton step of b where it is safe: no other point can reach the wall first, and b
          * approaches monotonically */
-        double rate_b = point_height_rate(v, W, r_all + 3 * b);
-        if (rate_b < 0.0) {
-            double t_newton = h[b] / -rate_b;
-            if (t_newton < tau_other && t_newton * M < -rate_b) tau = py_max(tau, t_newton);
+        if (h1[b] < 0.0) {
+            double t_newton = taylor_root(h[b], h1[b], h2[b]);
+            if (tau < t_newton && t_newton < tau_other
+                && (h1[b] + M * t_newton < 0.0 || h1[b] + (h2[b] + 0.5 * M3 * t_newton) * t_newton < 0.0))
+                tau = t_newton;
         }
         t_lo = t;
         t += tau;
     }
     *n_steps = max_steps;
-    *t_io = t;
+    *t_out = t;
     return SEARCH_STALLED;
 }
