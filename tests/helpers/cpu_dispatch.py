@@ -4,6 +4,8 @@ numpy and OpenBLAS pick their kernels per CPU when they load (AVX-512, AVX2, bas
 compiles for the host CPU; an AVX-512 kernel may sum or round in another order than an AVX2 one. A
 test runs the same work under :func:`environment` for each of :data:`CASES` and compares the bits,
 which proves on one machine what would otherwise need an AVX2 and an AVX-512 machine side by side.
+The subprocesses of the two tests that do so run here (:func:`child_runs`, :func:`baseline_rebuild`),
+started by tests/conftest.py when the session starts (tests.helpers.background).
 """
 
 from __future__ import annotations
@@ -12,6 +14,11 @@ import json
 import os
 import subprocess
 import sys
+
+import numpy as np
+
+from tests.helpers import REPO, background
+from tests.helpers.states import incident_states, uniforms
 
 CASES = ("default", "no AVX-512", "baseline")
 
@@ -66,3 +73,42 @@ def code_paths(env: dict) -> dict:
     done = subprocess.run([sys.executable, "-c", _PATHS], env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     return json.loads(done.stdout)
+
+
+CHILD_STATES = 20_000
+
+
+def child_runs(table_path, folder) -> tuple:
+    """tests/native/test_native_dispatch.py's runs: (the input, {case: output}) of tests/helpers/dispatch_child.py on
+    ``table_path`` for each of :data:`CASES`, on CHILD_STATES random incident states and their uniforms; each
+    output also holds the case's code paths under "paths"."""
+    rng = np.random.default_rng(2024)
+    V, n, a = incident_states(rng, CHILD_STATES, (0.0, 90.0), (10.0, 375.0))
+    given = {"V": V, "n": n, "a": a, "u": uniforms(rng, CHILD_STATES)}
+    np.savez(folder / "input.npz", **given)
+    runs = {}
+    for case in CASES:
+        output = folder / f"{case.replace(' ', '_')}.npz"
+        child = [sys.executable, "-m", "tests.helpers.dispatch_child", str(table_path), str(folder / "input.npz"),
+                 str(output)]
+        done = background.run(child, cwd=REPO, env=environment(case), timeout=900)
+        assert done.returncode == 0, f"{case}: {done.stderr[-3000:]}"
+        with np.load(output) as saved:
+            runs[case] = {k: saved[k] for k in saved.files}
+        runs[case]["paths"] = code_paths(environment(case))
+    return given, runs
+
+
+def baseline_rebuild(config_text, folder) -> tuple:
+    """tests/tabulation/test_build_dispatch.py's run: ``tablegen build`` of ``config_text`` with numpy's dispatch
+    targets switched off, OpenBLAS's and numba's kept; (its code paths, the default ones, the finished process,
+    the table's path)."""
+    env = environment("baseline", generic_numba=False)
+    env.pop("OPENBLAS_CORETYPE")
+    paths, default = code_paths(env), code_paths(environment("default"))
+    config = folder / "small.toml"
+    config.write_text(config_text)
+    rebuilt = folder / "rebuilt.h5"
+    done = background.run([sys.executable, "-m", "tablegen.cli", "build", "--config", str(config), "-o", str(rebuilt)],
+                          env=env, timeout=1200)
+    return paths, default, done, rebuilt

@@ -2,23 +2,17 @@
 
 The session's small table (built in this process, numpy's default kernels for this CPU) is built
 again by ``tablegen build`` in a subprocess with numpy's dispatch targets switched off
-(tests/helpers/cpu_dispatch.py): every dataset of the two files must be equal byte for byte. OpenBLAS keeps
-its kernels: scikit-learn's k-means computes distances through it, and its partition still depends on
-them (docs/format.md, table minor version 3.2). numba keeps the host CPU here (a generic-CPU compile of
-the direct model would take minutes); tests/native/test_native_dispatch.py covers numba's kernels on
-a generic CPU.
+(tests.helpers.cpu_dispatch.baseline_rebuild, started with the session): every dataset of the two
+files must be equal byte for byte. OpenBLAS keeps its kernels: scikit-learn's k-means computes
+distances through it, and its partition still depends on them (docs/format.md, table minor version
+3.2). numba keeps the host CPU here (a generic-CPU compile of the direct model would take minutes);
+tests/native/test_native_dispatch.py covers numba's kernels on a generic CPU.
 """
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import h5py
 import numpy as np
-
-from tests.helpers.cpu_dispatch import code_paths, environment
-from tests.helpers.tables import SMALL_TABLE_CONFIG
 
 
 def _datasets(path) -> dict:
@@ -33,16 +27,9 @@ def _bytes(values) -> bytes:
     return repr(values.tolist()).encode() if values.dtype.kind in "OSU" else np.ascontiguousarray(values).tobytes()
 
 
-def test_table_bits_do_not_depend_on_numpy_kernels(small_table_path, tmp_path):
-    env = environment("baseline", generic_numba=False)
-    env.pop("OPENBLAS_CORETYPE")
-    paths, default = code_paths(env), code_paths(environment("default"))
+def test_table_bits_do_not_depend_on_numpy_kernels(small_table_path, numpy_baseline_rebuild):
+    paths, default, done, rebuilt = numpy_baseline_rebuild.result()     # started with the session
     assert paths["numpy"] == [] and default["numpy"] != [], (paths, default)
-    config = tmp_path / "small.toml"
-    config.write_text(SMALL_TABLE_CONFIG)
-    rebuilt = tmp_path / "rebuilt.h5"
-    done = subprocess.run([sys.executable, "-m", "tablegen.cli", "build", "--config", str(config), "-o", str(rebuilt)],
-                          env=env, capture_output=True, text=True, timeout=1200)
     assert done.returncode == 0, done.stderr[-3000:]
     expected, got = _datasets(small_table_path), _datasets(rebuilt)
     assert sorted(got) == sorted(expected)
