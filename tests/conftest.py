@@ -1,8 +1,11 @@
-"""Shared fixtures: small tables built once per test session (2e4 particles per cell, all four shapes)."""
+"""Shared fixtures: small tables built once per test session (2e4 particles per cell, all four shapes), and the
+long subprocesses that tests only wait for, started when the session starts (tests.helpers.background)."""
 
 import pytest
 
 from tablegen import build_table, parse_config
+from tests.helpers import background, cpu_dispatch
+from tests.helpers.plain_install import install_and_draw
 from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG, SMALL_TABLE_CONFIG,
                                   WIDE_GRAZING_TABLE_CONFIG)
 
@@ -44,3 +47,37 @@ def near_normal_table(tmp_path_factory):
     """A table for comparisons between grid speeds near normal impact (see NEAR_NORMAL_TABLE_CONFIG)."""
     import surrogate
     return surrogate.load(_build(tmp_path_factory, "near_normal", NEAR_NORMAL_TABLE_CONFIG))
+
+
+# fixtures whose subprocesses run next to the tests from the session's start, in this order (the order their
+# tests come in); each is started only when a selected test uses it
+STARTED_WITH_THE_SESSION = ("dispatch_children", "forced_rebuilds", "plain_install")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _start_subprocesses(request):
+    used = {name for item in request.session.items for name in item.fixturenames}
+    for name in STARTED_WITH_THE_SESSION:
+        if name in used:
+            request.getfixturevalue(name)
+    yield
+    background.stop()
+
+
+@pytest.fixture(scope="session")
+def dispatch_children(small_table_path, tmp_path_factory):
+    """The future of tests/native/test_native_dispatch.py's runs (tests.helpers.cpu_dispatch.child_runs)."""
+    return background.submit(cpu_dispatch.child_runs, small_table_path, tmp_path_factory.mktemp("dispatch"))
+
+
+@pytest.fixture(scope="session")
+def forced_rebuilds(tmp_path_factory):
+    """The future of tests/tabulation/test_build_dispatch.py's rebuilds of the small table under forced numpy and
+    OpenBLAS kernels (tests.helpers.cpu_dispatch.forced_rebuilds)."""
+    return background.submit(cpu_dispatch.forced_rebuilds, SMALL_TABLE_CONFIG, tmp_path_factory.mktemp("rebuild"))
+
+
+@pytest.fixture(scope="session")
+def plain_install(small_table_path, tmp_path_factory):
+    """The future of tests/test_install.py's fresh install and draw (tests.helpers.plain_install.install_and_draw)."""
+    return background.submit(install_and_draw, small_table_path, tmp_path_factory.mktemp("install"))

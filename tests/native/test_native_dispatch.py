@@ -12,39 +12,21 @@ process's.
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
-from tests.helpers import REPO
-from tests.helpers.cpu_dispatch import CASES, code_paths, environment
+from tests.helpers.cpu_dispatch import CASES
 from tests.helpers.native_library import SCALED, STOCHASTIC
-from tests.helpers.states import incident_states, max_ulp, uniforms
+from tests.helpers.states import max_ulp
 
-STATES = 20_000
 WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
 
 
 @pytest.fixture(scope="module")
-def dispatch_runs(small_table_path, tmp_path_factory):
-    """{case: the child's output} for the three cases, on one set of incident states and uniforms."""
-    folder = tmp_path_factory.mktemp("dispatch")
-    rng = np.random.default_rng(2024)
-    V, n, a = incident_states(rng, STATES, (0.0, 90.0), (10.0, 375.0))
-    given = folder / "input.npz"
-    np.savez(given, V=V, n=n, a=a, u=uniforms(rng, STATES))
-    runs = {}
-    for case in CASES:
-        output = folder / f"{case.replace(' ', '_')}.npz"
-        child = [sys.executable, "-m", "tests.helpers.dispatch_child", str(small_table_path), str(given), str(output)]
-        done = subprocess.run(child, cwd=REPO, env=environment(case), capture_output=True, text=True, timeout=900)
-        assert done.returncode == 0, f"{case}: {done.stderr[-3000:]}"
-        with np.load(output) as saved:
-            runs[case] = {k: saved[k] for k in saved.files}
-        runs[case]["paths"] = code_paths(environment(case))
-    return np.load(given), runs
+def dispatch_runs(dispatch_children):
+    """(the input, {case: the child's output}) for the three cases, on one set of incident states and uniforms
+    (tests.helpers.cpu_dispatch.child_runs, started with the session)."""
+    return dispatch_children.result()
 
 
 def test_cases_take_other_code_paths(dispatch_runs):

@@ -1,7 +1,8 @@
 """A table built from a seed has the same bits whichever SIMD kernels numpy, OpenBLAS and numba use.
 
 The session's small table (built in this process with the kernels numpy, OpenBLAS and numba pick for this
-CPU) is built again by ``tablegen build`` in a subprocess under each forced case of tests/helpers/cpu_dispatch.py:
+CPU) is built again by ``tablegen build`` in a subprocess under each forced case of tests/helpers/cpu_dispatch.py
+(tests.helpers.cpu_dispatch.forced_rebuilds, started with the session):
 numpy without its AVX-512 targets and OpenBLAS's Haswell kernels, then numpy without any dispatch target and
 OpenBLAS's Prescott kernels. Every dataset of the files must be equal byte for byte. numba keeps the host CPU
 for the whole build (a generic-CPU compile of the direct model takes minutes; tests/native/test_native_dispatch.py
@@ -20,8 +21,7 @@ import numpy as np
 import pytest
 
 from data_schema.table import TableResolution, table_fingerprint
-from tests.helpers.cpu_dispatch import code_paths, environment
-from tests.helpers.tables import SMALL_TABLE_CONFIG
+from tests.helpers.cpu_dispatch import REBUILD_CASES, code_paths, environment
 
 # hashes the arrays of tablegen.tabulation.tabulate.represent for the states saved in argv[1]
 _REPRESENT = """
@@ -47,19 +47,13 @@ def _bytes(values) -> bytes:
     return repr(values.tolist()).encode() if values.dtype.kind in "OSU" else np.ascontiguousarray(values).tobytes()
 
 
-@pytest.mark.parametrize("case", ["no AVX-512", "baseline"])
-def test_table_bits_do_not_depend_on_numpy_or_openblas_kernels(case, small_table_path, tmp_path):
-    env = environment(case, generic_numba=False)
-    paths, default = code_paths(env), code_paths(environment("default"))
+@pytest.mark.parametrize("case", REBUILD_CASES)
+def test_table_bits_do_not_depend_on_numpy_or_openblas_kernels(case, small_table_path, forced_rebuilds):
+    paths, default, done, rebuilt = forced_rebuilds.result()[case]      # started with the session
     if case == "baseline":
         assert paths["numpy"] == [] and paths["openblas"] != default["openblas"], (paths, default)
-    elif paths == default:      # a CPU without AVX-512 runs this case on its default kernels: nothing to compare
+    elif done is None:      # a CPU without AVX-512 runs this case on its default kernels: nothing to compare
         pytest.skip(f"the {case} kernels are this CPU's default ones ({paths})")
-    config = tmp_path / "small.toml"
-    config.write_text(SMALL_TABLE_CONFIG)
-    rebuilt = tmp_path / "rebuilt.h5"
-    done = subprocess.run([sys.executable, "-m", "tablegen.cli", "build", "--config", str(config), "-o", str(rebuilt)],
-                          env=env, capture_output=True, text=True, timeout=3600)
     assert done.returncode == 0, done.stderr[-3000:]
     expected, got = _datasets(small_table_path), _datasets(rebuilt)
     assert sorted(got) == sorted(expected)

@@ -1,0 +1,50 @@
+"""tests/test_install.py's run: the packages copied from this checkout, ``pip install .`` into a fresh virtual
+environment (no extra), and a draw there from a table; started by tests/conftest.py with the session
+(tests.helpers.background)."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import tomllib
+
+from tests.helpers import REPO, background
+
+PYPROJECT = tomllib.loads((REPO / "pyproject.toml").read_text())
+RUNTIME_ONLY = ("scipy", "sklearn", "threadpoolctl", "tqdm", "matplotlib", "dask")     # modules it must not bring
+
+DRAW = """
+import importlib.util, json, sys
+import numpy as np
+import surrogate
+table = surrogate.load(sys.argv[1])
+V = np.tile([120.0, -80.0, 10.0], (200, 1))
+V_out, Omega_out, status = surrogate.sample_global(table, V, [0.0, 1.0, 0.0], 5e-5, shape="mix", random_state=7)
+missing = [m for m in sys.argv[2:] if importlib.util.find_spec(m) is None]
+try:
+    import tablegen
+    refused = ""
+except ImportError as error:
+    refused = str(error)
+print(json.dumps({"V": V_out.tolist(), "Omega": Omega_out.tolist(), "status": status.tolist(), "missing": missing,
+                  "refused": refused, "where": surrogate.__file__}))
+"""
+
+
+def install_and_draw(table_path, folder) -> tuple:
+    """(pip's finished process, DRAW's finished process or None if pip failed, the environment's folder)."""
+    source = folder / "checkout"
+    ignore = shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc", "*.egg-info")
+    for package in (pattern.rstrip("*") for pattern in PYPROJECT["tool"]["setuptools"]["packages"]["find"]["include"]):
+        shutil.copytree(REPO / package, source / package, ignore=ignore)
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(REPO / name, source / name)
+    env = folder / "venv"
+    made = background.run([sys.executable, "-m", "venv", str(env)])
+    if made.returncode != 0:
+        return made, None, env
+    python = env / "bin" / "python"
+    install = background.run([python, "-m", "pip", "install", "--quiet", str(source)])
+    if install.returncode != 0:
+        return install, None, env
+    return install, background.run([python, "-c", DRAW, str(table_path), *RUNTIME_ONLY], cwd=folder), env
