@@ -33,8 +33,8 @@ CASE = CS_DIR / "cases" / "channelRebound"
 
 sys.path.insert(0, str(CS_DIR))
 
-import make_case_table  # noqa: E402
-from rbs_api import STATUS_INVALID, STATUS_REBOUNDED, build_table_from_text, load, sample_global  # noqa: E402
+import make_channel_table  # noqa: E402
+from saturne_api import STATUS_INVALID, STATUS_REBOUNDED, build_table_from_text, load, sample_global  # noqa: E402
 from read_hits import PATH_DIRECT, PATH_TABLE, read_cpu_seconds, read_hits, read_summary  # noqa: E402
 
 INSTALL_HINT = ("run `bash integrations/code_saturne/install-deps.sh` (as root on Debian bookworm: it installs "
@@ -69,9 +69,9 @@ def cs_build():
 
 @pytest.fixture(scope="session")
 def case_table(tmp_path_factory):
-    """The case's table (make_case_table.py's configuration), built once."""
+    """The case's table (make_channel_table.py's configuration), built once."""
     path = tmp_path_factory.mktemp("cs_table") / "rebound_table.h5"
-    build_table_from_text(make_case_table.CASE_TABLE_CONFIG, path)
+    build_table_from_text(make_channel_table.CASE_TABLE_CONFIG, path)
     return path
 
 

@@ -1,6 +1,6 @@
 """Build the rebound table of the code_saturne case channelRebound.
 
-    python make_case_table.py OUT.h5 [--overwrite]
+    python make_channel_table.py OUT.h5 [--overwrite]
 
 Prisms and tetrahedra (the case mixes them 0.7/0.3), α1 from 1° to 90°, |V⁻|
 from 50 to 300 m/s (the case injects at 50–300 m/s; slower hits go to the
@@ -17,7 +17,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rbs_api import build_table_from_text  # noqa: E402
+from saturne_api import build_table_from_text  # noqa: E402
 
 CASE_TABLE_CONFIG = """\
 [grid]
