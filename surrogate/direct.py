@@ -91,6 +91,6 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, omega=(0.0
     codes = _shape_codes(shape, n)
     V_out, Omega_out, status = _outputs(out, n, (V, nrm, a, W))
     states = chunk_states(check_random_state(random_state), n)
-    direct_rebound_parallel_rng(params, V, _rows(nrm, n), _rows(a, n), _rows(W, n), codes, states, V_out, Omega_out,
+    direct_rebound_parallel_rng(params, codes, V, _rows(W, n), _rows(nrm, n), _rows(a, n), states, V_out, Omega_out,
                                 status)
     return V_out, Omega_out, status

@@ -411,8 +411,9 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
     params = np.zeros(0) if table.direct_parameters is None else table.direct_parameters
     states = chunk_states(check_random_state(random_state), n_particles)
-    rebound_parallel_rng(table.kernel_data, params, table.model_shapes, cdf, V, W, _rows(nrm, n_particles),
-                              _rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
+    rebound_parallel_rng(table.kernel_data, params, table.model_shapes, cdf, np.zeros(0, np.int64), V, W,
+                         _rows(nrm, n_particles), _rows(a, n_particles), states, code, V_out, Omega_out, status, path,
+                         scaled)
     if old_table:
         _check_direct_parameters(table, path, V, W, a)
         for target, result in zip(outputs, (V_out, Omega_out, status, path)):
