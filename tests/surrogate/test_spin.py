@@ -328,7 +328,7 @@ def test_cli_sample_with_omega_and_method(small_table_path):
     outside = _cli(*base[:4], "--speed", "400", *base[6:])
     assert outside.returncode == 0 and "by the direct model 300" in outside.stdout
     for args, words in [(("--method", "tabel"), ["'tabel'", "auto", "table", "direct"]),
-                        (("--omega", "nan", "0", "0"), ["--omega", "nan", "finite"]),
+                        (("--omega", "nan", "0", "0"), ["'omega'", "nan", "finite"]),
                         (("--speed", "400", "--method", "table"), ["400", "[50, 250]"])]:
         run = _cli(*base, *args)
         assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
