@@ -516,7 +516,7 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
         if table_path is None and native:
             table_path = tmp / "direct.h5"
             build_table(parse_config(BENCH_TABLE_CONFIG), table_path)
-        params = (surrogate.direct_model_parameters(surrogate.load(table_path)) if table_path is not None
+        params = (surrogate.load(table_path).direct_parameters if table_path is not None
                   else model_parameters(AspectRatioLaw(), 0.3, DEFAULT_N_MAX, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL,
                                         DEFAULT_SET_TOL, DEFAULT_MAX_STEPS, second_moment_factors(0.3)))
         c_side = None

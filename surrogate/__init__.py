@@ -25,17 +25,20 @@ model answers: :func:`sample_global` with its default ``method="auto"`` picks, p
 valid (|Ω⁻|a/|V⁻| ≤ :data:`SPIN_TOLERANCE`, inside the grid) and the direct model elsewhere; from numba,
 :func:`surrogate.kernels.rebound` (13 uniforms per hit whatever the path) and
 :func:`surrogate.kernels.rebound_path`. The direct model alone: :func:`sample_direct` from NumPy,
-:func:`surrogate.kernels.direct_rebound` from numba with :func:`direct_model_parameters` and
+:func:`surrogate.kernels.direct_rebound` from numba with ``table.direct_parameters`` and
 ``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
+
+Every argument of the NumPy API goes through :mod:`surrogate.validation` (``check_random_state``,
+``check_shape``, ``mix_cdf``, ...), which a caller may use too.
 """
 
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import U_PER_REBOUND
-from surrogate.direct import direct_model_parameters, sample_direct
 from surrogate.kernels import SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
-from surrogate.sampling import METHODS, LocalDraws, check_random_state, mix_cdf, sample_global, sample_local
+from surrogate.sampling import LocalDraws, sample_direct, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
+from surrogate.validation import METHODS, check_random_state, mix_cdf
 
 __all__ = ["LocalDraws", "METHODS", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
-           "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "direct_model_parameters", "fill_uniforms", "load",
-           "mix_cdf", "sample_direct", "sample_global", "sample_local", "seed_state"]
+           "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "fill_uniforms",
+           "load", "mix_cdf", "sample_direct", "sample_global", "sample_local", "seed_state"]

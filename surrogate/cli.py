@@ -18,8 +18,8 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.common import DataFormatError
 from data_schema.output import check_memory, check_output, kind_of
 from data_schema.samples import (
-    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_FAILED, STATUS_NAMES, SampleSet, angles_to_velocity,
-    read_samples, rebound_angles, write_samples,
+    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_FAILED, STATUS_NAMES, SampleSet, alpha1_is_physical,
+    angles_to_velocity, read_samples, rebound_angles, write_samples,
 )
 from data_schema.table import TABLE_FILE_TYPE
 
@@ -28,23 +28,15 @@ BYTES_PER_DRAW = 300
 
 
 def _mix(args):
+    """(the ``shape`` argument of the NumPy API, the label of the samples) from --shape or --mix; the values are
+    checked by :func:`surrogate.validation.check_shape`, as the API checks them."""
     if args.mix is None:
         return args.shape or "ellipsoid", args.shape or "ellipsoid"
     try:
         weights = [float(w) for w in args.mix.split(",")]
     except ValueError:
         raise ValueError(f"--mix must be {len(SHAPE_NAMES)} comma-separated numbers; got {args.mix!r}") from None
-    if len(weights) != len(SHAPE_NAMES):
-        raise ValueError(f"--mix must have {len(SHAPE_NAMES)} weights ({','.join(SHAPE_NAMES)}); got {args.mix!r}")
     return weights, "mix:" + ",".join(f"{w:g}" for w in weights)
-
-
-def _omega(args) -> np.ndarray:
-    """--omega as an array of 3 finite numbers (Ω⁻ a/|V⁻|, lab frame)."""
-    omega = np.array(args.omega, dtype=np.float64)
-    if not np.all(np.isfinite(omega)):
-        raise ValueError(f"--omega must be 3 finite numbers (Omega- a/|V-|, lab frame); got {' '.join(map(repr, args.omega))}")
-    return omega
 
 
 def _draw(table, args, shape, omega):
@@ -56,13 +48,14 @@ def _draw(table, args, shape, omega):
     those of ``sample_global``."""
     import surrogate
     from surrogate.kernels import PATH_DIRECT, PATH_TABLE, rebound_path
+    from surrogate.validation import check_method
 
     a1, speed = math.radians(args.alpha1), args.speed
     V = (speed * math.cos(a1), -speed * math.sin(a1), 0.0)
     half_size = 1.0        # m: any value; the draws and Omega- are given in units of |V-| and |V-|/a
     spin = tuple(float(w) * speed / half_size for w in omega)
-    path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, surrogate.METHODS[args.method])
-            if 0.0 < args.alpha1 <= 90.0 and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
+    path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, check_method(args.method))
+            if alpha1_is_physical(args.alpha1) and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
     if path != PATH_DIRECT:
         draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, shape, random_state=args.seed,
                                        clamp=args.clamp)
@@ -77,13 +70,15 @@ def _draw(table, args, shape, omega):
 
 def _sample(args) -> int:
     import surrogate
+    from surrogate.validation import check_omega, check_shape
 
     if args.out is not None:
         check_output(args.out, SAMPLES_FILE_TYPE, args.overwrite, inputs=(args.table,))
     check_memory(args.n, BYTES_PER_DRAW, "-n")
     shape, label = _mix(args)
-    omega = _omega(args)
+    omega = check_omega(args.omega, 1)[0]         # Ω⁻ a/|V⁻|, lab frame
     table = surrogate.load(args.table)
+    check_shape(table, shape)
     draws, velocity, path = _draw(table, args, shape, omega)
     speed = args.speed
     samples = SampleSet(velocity=velocity, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
@@ -158,7 +153,7 @@ def main(argv=None) -> int:
                         help="incident speed |V-| in m/s, > 0 (with --method table: in the table's range, unless "
                              "--clamp)")
     group = sample.add_mutually_exclusive_group()
-    group.add_argument("--shape", choices=SHAPE_NAMES)
+    group.add_argument("--shape", metavar="NAME", help=f"one of {', '.join(SHAPE_NAMES)} (default ellipsoid)")
     group.add_argument("--mix", metavar="W1,W2,W3,W4", help="weights of ellipsoid, prism, cut_prism, tetrahedron")
     sample.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of draws, >= 1")
     sample.add_argument("--seed", type=seed_argument, default=None, help="random seed in [0, 2**63)")

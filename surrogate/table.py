@@ -37,7 +37,9 @@ class SurrogateTable:
     restitution_k: float       # the wall's normal restitution exp(−k V^p) the table was built with, (m/s)^(−p)
     restitution_p: float
     kernel_data: KernelData
-    direct_parameters: np.ndarray | None = None   # the direct model's parameters (:func:`direct_parameters`)
+    # the parameters of the direct model the table was built with, as the kernels take them
+    # (:func:`direct_model.runtime.model_parameters`); None if the table does not record them
+    direct_parameters: np.ndarray | None = None
 
     @functools.cached_property
     def model_shapes(self) -> np.ndarray:
@@ -64,13 +66,13 @@ class SurrogateTable:
                    speed_m_s=frozen(speed), particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, restitution_k=table.restitution_k,
                    restitution_p=table.restitution_p, kernel_data=data,
-                   direct_parameters=direct_parameters(table, path))
+                   direct_parameters=_read_direct_parameters(table, path))
 
 
-def direct_parameters(table: ReboundTable, path: str = "<memory>") -> np.ndarray | None:
-    """The parameters of the direct model the table was built with, as the run-time kernel takes them
-    (:func:`direct_model.runtime.model_parameters`), or None if the table does not record its second-moment
-    factors (built at κ ≠ 0.3 before tables recorded them); DataFormatError naming a value out of range."""
+def _read_direct_parameters(table: ReboundTable, path: str) -> np.ndarray | None:
+    """``SurrogateTable.direct_parameters`` from the file's attributes, or None if the table does not record its
+    second-moment factors (built at κ ≠ 0.3 before tables recorded them); DataFormatError naming a value out
+    of range."""
     if not np.all(np.isfinite(table.second_moment_factors)):
         return None
     # tables without friction_q (before 3.1) were built before the wall law was configurable: q = 1

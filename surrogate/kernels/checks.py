@@ -20,6 +20,7 @@ import numpy as np
 
 from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.frame import dot, impact_frame, unit_normal
+from surrogate.kernels.locate import SHAPE_FROM_MIX
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
 
@@ -137,6 +138,19 @@ def check_states(states, n_rows):
     if states.shape[0] != n_chunks(n_rows) or states.shape[1] != 4:
         raise ValueError("'states' must hold one xoshiro256+ state (4 words) per CHUNK_ROWS rows, as "
                          "surrogate.kernels.rng.chunk_states(generator, n_rows) gives")
+
+
+@numba.njit(**JIT)
+def check_shapes(shapes, rows, n_shapes):
+    """ValueError unless ``shapes`` is empty (every row's shape from the mix) or holds one shape index per row,
+    each SHAPE_FROM_MIX (−1) or in [0, n_shapes) (the table's shapes): another index would read outside the
+    table."""
+    if shapes.shape[0] != 0 and shapes.shape[0] != rows:
+        raise ValueError(shape_error("shapes", shapes.shape, "(" + str(rows) + ",) or (0,)"))
+    for i in range(shapes.shape[0]):
+        if shapes[i] < SHAPE_FROM_MIX or shapes[i] >= n_shapes:
+            raise ValueError("'shapes' must hold -1 (drawn from the mix) or a shape index in [0, "
+                             + str(n_shapes) + "); row " + str(i) + " holds " + str(shapes[i]))
 
 
 @numba.njit(**JIT)

@@ -44,6 +44,9 @@ def grid_interval(axis, n, x):
     return j, min(max(w, 0.0), 1.0)
 
 
+SHAPE_FROM_MIX = -1    # a per-particle shape index (``shapes`` of the many-particle kernels): drawn from the mix
+
+
 @numba.njit(inline="always", **JIT)
 def mix_shape(mix_cdf, u0):
     """The shape drawn from the mix with the uniform u0: the first k with u0 < mix_cdf[k]."""
@@ -53,17 +56,40 @@ def mix_shape(mix_cdf, u0):
     return shape
 
 
+@numba.njit(**JIT)
+def mix_shapes(mix_cdf, u0):
+    """:func:`mix_shape` for each uniform of u0 (N,): (N,) int64 shape indices, table order."""
+    shapes = np.empty(u0.shape[0], dtype=np.int64)
+    for i in range(u0.shape[0]):
+        shapes[i] = mix_shape(mix_cdf, u0[i])
+    return shapes
+
+
+@numba.njit(inline="always", **JIT)
+def row_shape(mix_cdf, shapes, i, u0):
+    """The shape of row i: ``shapes[i]`` where given (≥ 0), else drawn from the mix with u0 (``shapes`` empty:
+    every row's is). u0 is that row's u[0], consumed either way, so the streams stay aligned."""
+    given = shapes.shape[0] > 0 and shapes[i] != SHAPE_FROM_MIX
+    return shapes[i] if given else mix_shape(mix_cdf, u0)
+
+
 @numba.njit(inline="always", **JIT)
 def locate(data, mix_cdf, alpha1, speed, u):
-    """The cell a draw reads: (drawn, below, wa, jv, wv, iv).
+    """The cell a draw reads: (drawn, below, wa, jv, wv, iv), its shape drawn from the mix with u[0]
+    (:func:`locate_in_shape`)."""
+    return locate_in_shape(data, mix_shape(mix_cdf, u[0]), alpha1, speed, u)
 
-    Shape from u[0] and the mix; grid intervals (ja, jv) with the weights of
+
+@numba.njit(inline="always", **JIT)
+def locate_in_shape(data, shape, alpha1, speed, u):
+    """The cell a draw of the shape ``shape`` (its index in the table) reads: (drawn, below, wa, jv, wv, iv).
+
+    Grid intervals (ja, jv) with the weights of
     their upper points (wa, wv); the neighbour cell (ia, iv) drawn with those
     weights from u[1], u[2] (stochastic interpolation). ``drawn`` is the
     number of cell (shape, ia, iv) (:class:`surrogate.kernels.layout.KernelData`),
     ``below`` that of (shape, ja, iv), the lower α1 neighbour at the drawn speed.
     """
-    shape = mix_shape(mix_cdf, u[0])
     ja, wa = grid_interval(data.alpha1_axis, data.n_alpha1, alpha1)
     jv, wv = grid_interval(data.speed_axis, data.n_speed, speed)
     ia = ja + (u[1] < wa)       # integer + comparison: no branch to mispredict
@@ -161,15 +187,16 @@ def cell_at(index, weights, b):
 
 
 @numba.njit(inline="always", **JIT)
-def locate_block(data, mix_cdf, V, n, a, ub, given, start, m, fr, index, weights):
-    """Stage 1 for the m rows from ``start`` (their uniforms ``ub``, checked if ``given``): the frame records ``fr``
-    (:func:`surrogate.kernels.frame.frame_block`), the cells, and cache hints for the component rows the
-    uniforms pick (before the alias table)."""
+def locate_block(data, mix_cdf, shapes, V, n, a, ub, given, start, m, fr, index, weights):
+    """Stage 1 for the m rows from ``start`` (their uniforms ``ub``, checked if ``given``; their shapes
+    :func:`row_shape`): the frame records ``fr`` (:func:`surrogate.kernels.frame.frame_block`), the cells, and
+    cache hints for the component rows the uniforms pick (before the alias table)."""
     frame_block(V, n, a, ub, given, start, m, fr)
     for b in range(m):
         if is_valid(fr, b):
-            _put_cell(data, mix_cdf, field(fr, FRAME_ALPHA1, b), field(fr, FRAME_SPEED, b), uniforms(ub, b), index,
-                      weights, b)
+            u = uniforms(ub, b)
+            _put_cell(data, row_shape(mix_cdf, shapes, start + b, u[0]), field(fr, FRAME_ALPHA1, b),
+                      field(fr, FRAME_SPEED, b), u, index, weights, b)
         else:
             _no_cell(index, weights, b)
     for b in range(m):
@@ -178,9 +205,9 @@ def locate_block(data, mix_cdf, V, n, a, ub, given, start, m, fr, index, weights
 
 
 @numba.njit(inline="always", **JIT)
-def _put_cell(data, mix_cdf, alpha1, speed, u, index, weights, b):
-    """Particle b's cell and the row u[4] picks in it before the alias table."""
-    cell = locate(data, mix_cdf, alpha1, speed, u)
+def _put_cell(data, shape, alpha1, speed, u, index, weights, b):
+    """Particle b's cell in the shape ``shape`` and the row u[4] picks in it before the alias table."""
+    cell = locate_in_shape(data, shape, alpha1, speed, u)
     index[I_ROW * BLOCK + b] = first_row(data, cell[0], u[4])[2]
     drawn, below, wa, jv, wv, iv = cell
     for f, value in ((I_DRAWN, drawn), (I_BELOW, below), (I_JV, jv), (I_IV, iv)):

@@ -10,11 +10,11 @@ parallel loop (:mod:`surrogate.kernels.checks`).
 
 import numba
 
-from surrogate.kernels.options import JIT
-from surrogate.kernels.table_path import draw_local
 from surrogate.kernels.checks import check_local_rows, check_rows, check_states, check_uniforms
-from surrogate.kernels.pipeline import no_state, no_uniforms, table_rebound_uniforms, run_blocks
+from surrogate.kernels.options import JIT
+from surrogate.kernels.pipeline import no_shapes, no_state, no_uniforms, run_blocks, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
+from surrogate.kernels.table_path import draw_local
 
 
 @numba.njit(parallel=True, **JIT)
@@ -52,8 +52,8 @@ def _chunk(j, n_rows):
 def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled, lo, hi):
     """:func:`surrogate.kernels.pipeline.table_rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows,
     or :func:`surrogate.kernels.pipeline.table_rebound_many_rng` with ``state``."""
-    run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], Omega_out[lo:hi], status[lo:hi],
-                scaled)
+    run_blocks(data, mix_cdf, no_shapes(), V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], Omega_out[lo:hi],
+               status[lo:hi], scaled)
 
 
 @numba.njit(parallel=True, **JIT)

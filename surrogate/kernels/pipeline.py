@@ -49,7 +49,7 @@ def table_rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scal
     """
     check_rows(V, n, a, V_out, Omega_out, status)
     check_uniforms(u, V.shape[0], "V")
-    run_blocks(data, mix_cdf, V, n, a, u, no_state(), V_out, Omega_out, status, scaled)
+    run_blocks(data, mix_cdf, no_shapes(), V, n, a, u, no_state(), V_out, Omega_out, status, scaled)
 
 
 @numba.njit(**JIT)
@@ -67,7 +67,7 @@ def table_rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, stat
     """
     check_state(state)
     check_rows(V, n, a, V_out, Omega_out, status)
-    run_blocks(data, mix_cdf, V, n, a, no_uniforms(), state, V_out, Omega_out, status, scaled)
+    run_blocks(data, mix_cdf, no_shapes(), V, n, a, no_uniforms(), state, V_out, Omega_out, status, scaled)
 
 
 @numba.njit(**JIT)
@@ -92,12 +92,19 @@ def _lanes():
 
 
 @numba.njit(inline="always", **JIT)
-def run_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled):
+def run_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, scaled):
     """The pipeline (:func:`table_rebound_many` with ``u``, :func:`table_rebound_many_rng` with ``state``; the other
     argument empty: :func:`no_state`, :func:`no_uniforms`) with its scratch, V, n, a made C-contiguous
-    (copied if they are not)."""
-    _rebound_blocks(data, mix_cdf, np.ascontiguousarray(V), np.ascontiguousarray(n), np.ascontiguousarray(a), u,
-                    state, V_out, Omega_out, status, scaled, *_block_scratch())
+    (copied if they are not). ``shapes``: each row's shape index in the table, or SHAPE_FROM_MIX
+    (:func:`surrogate.kernels.locate.row_shape`); empty (:func:`no_shapes`): every row's from the mix."""
+    _rebound_blocks(data, mix_cdf, shapes, np.ascontiguousarray(V), np.ascontiguousarray(n),
+                    np.ascontiguousarray(a), u, state, V_out, Omega_out, status, scaled, *_block_scratch())
+
+
+@numba.njit(inline="always", **JIT)
+def no_shapes():
+    """The ``shapes`` argument of :func:`run_blocks` when every row's shape is drawn from the mix."""
+    return np.zeros(0, dtype=np.int64)
 
 
 @numba.njit(inline="always", **JIT)
@@ -123,8 +130,8 @@ def _block_scratch():
 
 
 @numba.njit(**KERNEL)
-def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled, us, fr, index, weights, g, out,
-                    lanes):
+def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, scaled, us, fr, index, weights, g,
+                    out, lanes):
     """:func:`table_rebound_many` (uniforms ``u``) or :func:`table_rebound_many_rng` (uniforms drawn from ``state``)
     with its scratch arrays (:func:`_block_scratch`): a pipeline of STAGES blocks, so that a block's table
     reads have a whole step to arrive before they are used."""
@@ -137,8 +144,8 @@ def _rebound_blocks(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, 
         if k < n_blocks:
             j, start = k % STAGES, k * BLOCK
             _block_uniforms(u, state, lanes, start, min(BLOCK, rows - start), us[j])
-            locate_block(data, mix_cdf, V_flat, n_flat, a, us[j], state.shape[0] != 4, start, min(BLOCK, rows - start),
-                         fr[j], index[j], weights[j])
+            locate_block(data, mix_cdf, shapes, V_flat, n_flat, a, us[j], state.shape[0] != 4, start,
+                         min(BLOCK, rows - start), fr[j], index[j], weights[j])
         if 1 <= k <= n_blocks:
             j, start = (k - 1) % STAGES, (k - 1) * BLOCK
             resolve_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j])

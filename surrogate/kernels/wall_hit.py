@@ -16,7 +16,9 @@ One hit consumes U_PER_DRAW = 13 uniforms whatever path answers it, so streams s
 is :func:`surrogate.kernels.table_path.table_rebound` with those 13. The direct path draws the shape from the mix
 with u[0] exactly as the table path does (:func:`surrogate.kernels.locate.locate`), maps the table's shape to
 the model's shape code (``model_shapes``), and gives the model u[1..7] as its U_PER_REBOUND uniforms (u[1 + k]
-is the model's u[k]; the axis at normal impact is u[7]).
+is the model's u[k]; the axis at normal impact is u[7]). :func:`rebound_parallel_rng` also takes one shape per
+particle (``shapes``, the table's shape index, or SHAPE_FROM_MIX): a particle given its shape still consumes its
+u[0], on either path (:func:`surrogate.kernels.locate.row_shape`).
 
 Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
 gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a
@@ -33,11 +35,12 @@ from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
 from surrogate.kernels.direct_path import inline_direct_rebound
 from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
 from surrogate.kernels.layout import AXIS_GRID
-from surrogate.kernels.locate import mix_shape
+from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
+from surrogate.kernels.checks import check_shapes
 from surrogate.kernels.options import JIT
-from surrogate.kernels.table_path import inline_table_rebound
-from surrogate.kernels.pipeline import no_uniforms, table_rebound_uniforms, run_blocks
+from surrogate.kernels.pipeline import no_uniforms, run_blocks, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS
+from surrogate.kernels.table_path import inline_table_rebound
 
 METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
 PATH_TABLE, PATH_DIRECT = 0, 1
@@ -113,16 +116,18 @@ def rebound(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHO
     if path == PATH_TABLE:
         return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
-        return _direct_path(params, model_shapes, mix_cdf, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
+        return _direct_path(params, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
     return STATUS_INVALID, NAN3, NAN3
 
 
 @numba.njit(inline="always", **JIT)
-def _direct_path(params, model_shapes, mix_cdf, V, omega, n, a, u, scratch):
-    """The direct path of :func:`rebound` with its scratch space given."""
+def _direct_path(params, model_shapes, mix_cdf, shape, V, omega, n, a, u, scratch):
+    """The direct path of :func:`rebound` with its scratch space given; ``shape`` the table's shape index, or
+    SHAPE_FROM_MIX to draw it from the mix with u[0]."""
     if not (uniforms_ok(u) and params.shape[0] == N_PARAMS and model_shapes.shape[0] == mix_cdf.shape[0]):
         return STATUS_INVALID, NAN3, NAN3
-    shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
+    if shape == SHAPE_FROM_MIX:
+        shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
     return inline_direct_rebound(params, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND], scratch)
 
 
@@ -140,10 +145,14 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, states, method, V_out, Omega_out,
-                              status, path, scaled=True):
+def rebound_parallel_rng(data, params, model_shapes, mix_cdf, shapes, V, omega, n, a, states, method, V_out,
+                         Omega_out, status, path, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
     a (N,), on all threads; the path of each row into ``path`` (N,).
+
+    ``shapes``: (N,) int64, each row's shape (its index in the table, or SHAPE_FROM_MIX to draw it from
+    ``mix_cdf``), or empty, every row's from the mix (:func:`surrogate.kernels.locate.row_shape`); ValueError
+    for another length or an index outside the table's shapes.
 
     The uniforms are those :func:`surrogate.kernels.parallel.table_rebound_parallel_rng` draws: chunk j's rows
     (CHUNK_ROWS rows) from a copy of ``states[j]``, U_PER_DRAW per row. Where the table answers every row
@@ -157,6 +166,7 @@ def rebound_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, st
     """
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
+    check_shapes(shapes, V.shape[0], mix_cdf.shape[0])
     rows = V.shape[0]
     last_omega = omega.shape[0] - 1
     for j in numba.prange(states.shape[0]):
@@ -169,8 +179,8 @@ def rebound_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, st
         for i in range(lo, hi):
             n_table += path[i] == PATH_TABLE
         if n_table > 0:
-            run_blocks(data, mix_cdf, V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), states[j].copy(), V_out[lo:hi],
-                       Omega_out[lo:hi], status[lo:hi], scaled)
+            run_blocks(data, mix_cdf, shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), states[j].copy(),
+                       V_out[lo:hi], Omega_out[lo:hi], status[lo:hi], scaled)
         if n_table < hi - lo:
             u = table_rebound_uniforms(states[j].copy(), hi - lo)
             scratch = np.empty(SCRATCH_SIZE)
@@ -180,8 +190,9 @@ def rebound_parallel_rng(data, params, model_shapes, mix_cdf, V, omega, n, a, st
                 w = min(i, last_omega)
                 st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
                 if path[i] == PATH_DIRECT:
+                    shape = shapes[i] if shapes.shape[0] > 0 else SHAPE_FROM_MIX
                     st, V_new, Omega_new = _direct_path(
-                        params, model_shapes, mix_cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                        params, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
                         (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo],
                         scratch)
                 status[i] = st

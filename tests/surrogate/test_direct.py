@@ -31,7 +31,7 @@ ROTATION_COMPARISONS = 6 * len(SHAPES)        # KS comparisons of test_rotating_
 
 @pytest.fixture(scope="module")
 def params(small_table):
-    return surrogate.direct_model_parameters(small_table)
+    return small_table.direct_parameters
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -106,7 +106,8 @@ def test_same_seed_same_bits_whatever_the_threads(small_table):
     runs = []
     for threads in (1, numba.config.NUMBA_NUM_THREADS):
         numba.set_num_threads(threads)
-        runs.append(surrogate.sample_direct(small_table, V, [0.0, 1.0, 0.0], A, W, shapes, random_state=3))
+        runs.append(surrogate.sample_direct(small_table, V, [0.0, 1.0, 0.0], A, np.array(SHAPES)[shapes],
+                                            random_state=3, omega=W))
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     for one, many in zip(*runs):
         np.testing.assert_array_equal(one, many)
@@ -117,7 +118,7 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
     """A table records the model's parameters; one without them (3.0–3.2, built before) gets those its build
     used: the configuration's aspect-ratio law, the simulate defaults, s at κ = 0.3; at another κ the runtime
     refuses it."""
-    mine = surrogate.direct_model_parameters(small_table)
+    mine = small_table.direct_parameters
     expected = model_parameters(AspectRatioLaw(), 0.3, 1000, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL, DEFAULT_SET_TOL,
                                 DEFAULT_MAX_STEPS, second_moment_factors(0.3))
     np.testing.assert_array_equal(mine, expected)
@@ -134,11 +135,13 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
         for name in ("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol",
                      "set_tol", "max_steps", "second_moment_factors", "friction_q"):
             del f["grid"].attrs[name]
-    np.testing.assert_array_equal(surrogate.direct_model_parameters(surrogate.load(old)), expected)
+    np.testing.assert_array_equal(surrogate.load(old).direct_parameters, expected)
     with h5py.File(old, "r+") as f:
         f["grid"].attrs["kappa"] = 0.25
+    old_table = surrogate.load(old)
+    assert old_table.direct_parameters is None
     with pytest.raises(ValueError, match=r"^The table .* does not record the direct model's second-moment factors"):
-        surrogate.direct_model_parameters(surrogate.load(old))
+        surrogate.sample_direct(old_table, [[100.0, -100.0, 0.0]], [0.0, 1.0, 0.0], A)
 
 
 @pytest.mark.parametrize("change", [
@@ -178,9 +181,11 @@ def test_a_state_whose_flight_underflows_ends(params):
     (dict(normal=[0.0, 2.0, 0.0]), "The 'normal' at index 0 has length 2.0"),
     (dict(half_size=-1.0), "The 'half_size' at index 0 must be finite and > 0 m, with |V-|/a <= 1e+300 1/s"),
     (dict(omega=[0.0, np.inf, 0.0]), "The 'omega' vector at index 0 is not finite: [0.0, inf, 0.0]."),
-    (dict(shape="sphere"), "The 'shape' at index 0 must be one of ellipsoid, prism, cut_prism, tetrahedron; "
+    (dict(shape="sphere"), "The 'shape' parameter must name one of ellipsoid, prism, cut_prism, tetrahedron; "
                            "got 'sphere'."),
-    (dict(shape=[1, 7]), "The 'shape' code at index 1 must be in [0, 3]; got 7."),
+    (dict(shape=["prism", "sphere"]), "The 'shape' at index 1 must be one of ellipsoid, prism, cut_prism, "
+                                      "tetrahedron; got 'sphere'."),
+    (dict(shape=["prism"]), "The 'shape' parameter must be one shape name per particle, shape (2,); got (1,)."),
     (dict(velocity=np.zeros((2, 2))), "The 'velocity' parameter must have shape (N, 3); got (2, 2)."),
 ])
 def test_bad_python_input_is_a_one_line_error(small_table, change, message):

@@ -219,8 +219,28 @@ def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table
     outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
     with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
         rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
-                                  surrogate.mix_cdf(small_table, "mix"), V, np.zeros((1, 3)), np.tile(NORMAL, (3, 1)),
-                                  np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3, *outputs)
+                             surrogate.mix_cdf(small_table, "mix"), np.zeros(0, np.int64), V, np.zeros((1, 3)),
+                             np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3,
+                             *outputs)
+
+
+@pytest.mark.parametrize("shapes, message", [
+    (np.array([0, 1], np.int64), r"'shapes' has shape \(2,\); needed \(3,\) or \(0,\)"),
+    (np.array([0, 4, 1], np.int64), r"'shapes' must hold -1 \(drawn from the mix\) or a shape index in \[0, 4\); row 1 "
+                                     r"holds 4"),
+    (np.array([0, 1, -2], np.int64), r"row 2 holds -2"),
+])
+def test_the_many_hit_kernel_refuses_shape_indices_outside_the_table(small_table, shapes, message):
+    """A per-particle shape index outside the table's shapes would read outside the table: a ValueError before
+    the parallel loop."""
+    from surrogate.kernels import rebound_parallel_rng
+    V = np.array(_in_grid(3, 1))
+    outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
+    with pytest.raises(ValueError, match=message):
+        rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
+                             surrogate.mix_cdf(small_table, "mix"), shapes, V, np.zeros((1, 3)),
+                             np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 0,
+                             *outputs)
 
 
 def test_auto_sends_states_outside_the_grid_to_the_model_and_table_keeps_its_errors(small_table):
@@ -308,8 +328,39 @@ def test_cli_sample_with_omega_and_method(small_table_path):
     outside = _cli(*base[:4], "--speed", "400", *base[6:])
     assert outside.returncode == 0 and "by the direct model 300" in outside.stdout
     for args, words in [(("--method", "tabel"), ["'tabel'", "auto", "table", "direct"]),
-                        (("--omega", "nan", "0", "0"), ["--omega", "nan", "finite"]),
+                        (("--omega", "nan", "0", "0"), ["'omega'", "nan", "finite"]),
                         (("--speed", "400", "--method", "table"), ["400", "[50, 250]"])]:
         run = _cli(*base, *args)
         assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
         assert all(w in run.stderr for w in words), run.stderr
+
+
+@pytest.mark.parametrize("method", [METHOD_TABLE, METHOD_DIRECT])
+def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, method):
+    """Per-particle shapes (the table's index, or -1 to draw from the mix), on both paths: a row given shape k
+    gets the bits the one-shape mix of k gives it, a row given -1 those of the mix, and every row still
+    consumes its u[0] (the other rows' bits do not move). 2 chunks and a part, so the chunks' slices are
+    taken."""
+    from surrogate.kernels import rebound_parallel_rng
+    m = 2 * CHUNK_ROWS + 50
+    V = _in_grid(m, 8)
+    W = _spinning(V, 0.3, 9) if method == METHOD_DIRECT else np.zeros((1, 3))
+    shapes = np.random.default_rng(10).integers(-1, len(small_table.shapes), m)
+    data, params, model_shapes = small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes
+
+    def run(cdf, rows):
+        outputs = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, np.int8), np.empty(m, np.int8)
+        rebound_parallel_rng(data, params, model_shapes, cdf, rows, V, W, np.tile(NORMAL, (m, 1)), np.full(m, A),
+                             chunk_states(np.random.default_rng(11), m), method, *outputs)
+        return outputs
+
+    mix = surrogate.mix_cdf(small_table, {"prism": 0.5, "tetrahedron": 0.5})
+    given = run(mix, shapes)
+    expected = [(shapes == -1, run(mix, np.zeros(0, np.int64)))]
+    expected += [(shapes == k, run(surrogate.mix_cdf(small_table, name), np.zeros(0, np.int64)))
+                 for k, name in enumerate(small_table.shapes)]
+    for rows, want in expected:
+        assert rows.any()
+        for got, wanted in zip(given, want):
+            np.testing.assert_array_equal(got[rows], wanted[rows])
+    assert np.mean(given[2] == STATUS_REBOUNDED) > 0.5
