@@ -624,7 +624,7 @@ static double normal_cdf(double x)
 
 #define OUT_OF_RANGE "the direct model's parameters are out of range: "
 
-/* The direct model's parameters (surrogate.table.direct_parameters): none (has_direct = 0) if the table does
+/* The direct model's parameters (surrogate.table.SurrogateTable.direct_parameters): none (has_direct = 0) if the table does
  * not record its second-moment factors, else the P_* array of direct_model.runtime.model_parameters after
  * the same range checks in the same order (RBS_ERR_FORMAT naming the value). */
 static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table *t, double kappa)
