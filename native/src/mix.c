@@ -1,5 +1,5 @@
 /*
- * mix.c: shape mixes (surrogate.sampling.mix_cdf): cumulative weights in the table's shape order.
+ * mix.c: shape mixes (surrogate.validation.mix_cdf): cumulative weights in the table's shape order.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
