@@ -70,7 +70,7 @@ SPEED_GRID_RANGE = (1e-3, 1e4)
 MAX_SPEED_RATIO = 16.0
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ cluster_weight − 1| allowed per cell
 # |value| allowed in the cell datasets a draw reads besides the dictionary (cluster_loc, cluster_scale,
-# cluster_slope, mean, std): built tables hold far less (the default table: |slope| < 200, |loc| < 50); the bound
+# cluster_slope, mean, std): built tables hold far less (the default table: |slope| < 1700, |loc| < 400); the bound
 # keeps every product of a draw's chain finite (at most (10⁶)⁶), and drawn_ok refuses what the fold cannot mend
 CELL_VALUE_BOUND = 1e6
 # relative round-off allowed on the bound √L of a standardised quantile function (stored as float32)
