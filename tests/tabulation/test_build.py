@@ -209,4 +209,4 @@ def test_every_model_source_is_hashed():
     for pattern in MODEL_SOURCES:
         matched = set(SOURCE_ROOT.glob(pattern))
         assert matched and matched <= hashed, pattern
-    assert {"cells.py", "resolution.py", "tabulate.py", "rebound.py"} <= {path.name for path in hashed}
+    assert {"cells.py", "resolution.py", "tabulate.py", "body_rebound.py"} <= {path.name for path in hashed}
