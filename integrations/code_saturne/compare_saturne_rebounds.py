@@ -30,15 +30,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from saturne_api import SolverHits, compare_hits, load, path_rule  # noqa: E402
+from saturne_api import compare_hits, load, path_rule, solver_hits  # noqa: E402
 from read_hits import read_hits  # noqa: E402
-
-
-def solver_hits(hits: dict, settings: dict) -> SolverHits:
-    """The hit records of :func:`read_hits.read_hits` as the solver-neutral record of
-    tablegen.study.solver_comparison (``settings``: a hits file's header, :func:`read_hits.parse_header`)."""
-    return SolverHits(V=hits["V"], Omega=hits["Win"], n=hits["n"], a=hits["a"], shape=settings["shape"],
-                      V_out=hits["Vout"], Omega_out=hits["Wout"], status=hits["status"], path=hits["path"])
 
 
 def compare(run_dir: Path, table_path: Path | None = None, seed: int = 1, classifier: bool = True) -> dict:

@@ -4,7 +4,8 @@ Every import of the project's packages by integrations/code_saturne and
 tests/code_saturne goes through this module, so a refactoring of the packages
 re-points these few lines only. Public API only: ``surrogate.load``, ``surrogate.STATUS_*``, the
 solver-neutral comparison of a solver's hits with surrogate (``tablegen.study.solver_comparison``, BSD-3:
-the statistics live there, this integration only reads code_saturne's files) and, to build a table,
+the statistics live there), the hit records' reader (``tablegen.study.hit_records``, BSD-3: the layout both
+adapters write; this integration only finds code_saturne's files) and, to build a table,
 ``tablegen.build_table(tablegen.parse_config(text), path)``.
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-2.0-or-later
@@ -12,10 +13,13 @@ Copyright (C) 2026 the rebound-scatter authors. License: GPL-2.0-or-later
 """
 
 from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load
-from tablegen.study.solver_comparison import SolverHits, compare_hits, path_rule
+from surrogate.kernels import PATH_DIRECT, PATH_TABLE
+from tablegen.study.hit_records import rank_files, read_hit_files, solver_hits, summary_counts
+from tablegen.study.solver_comparison import compare_hits, path_rule
 
-__all__ = ["STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "SolverHits",
-           "build_table_from_text", "compare_hits", "load", "path_rule"]
+__all__ = ["PATH_DIRECT", "PATH_TABLE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED",
+           "build_table_from_text", "compare_hits", "load", "path_rule", "rank_files", "read_hit_files",
+           "solver_hits", "summary_counts"]
 
 
 def build_table_from_text(config_text: str, path, **kwargs):

@@ -47,13 +47,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rbs_api import (STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, SolverHits,  # noqa: E402
-                     agreement, compare_hits, impact_states, incident_states, load, path_rule, specular_answers,
-                     surrogate_answers)
+from rbs_api import (PATH_DIRECT, PATH_TABLE, STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED,  # noqa: E402
+                     STATUS_TRAPPED, SolverHits, agreement, compare_hits, impact_states, incident_states, load, path_rule,
+                     rank_files, read_hit_files, solver_hits, specular_answers, surrogate_answers)
 
-HIT_COLUMNS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,nx,ny,nz,Uwx,Uwy,Uwz,status,path,"
-               "Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0").split(",")
-PATH_TABLE, PATH_DIRECT = 0, 1   # the hits file's path column (rbs_rebound_path; -1: invalid)
+HITS_TITLE = "stochasticRebound"   # the hits files' header: "# stochasticRebound hits: seed ..."
 
 
 # ----------------------------------------------------------------------------- reading
@@ -66,51 +64,9 @@ def hits_dir(case: Path) -> Path:
     return found[0]
 
 
-def parse_header(line: str) -> dict:
-    """The run's settings from the first line of a hits file."""
-    m = re.match(r"# stochasticRebound hits: seed (\d+), stream (\d+), table (.*), mix (.*), "
-                 r"halfSizeFactor (\S+), interpolation (\w+), method (\w+), spin tolerance (\S+)$", line.strip())
-    if not m:
-        raise ValueError(f"not a stochasticRebound hits header: {line!r}")
-    mix = m.group(4)
-    if mix.startswith("weights ("):
-        shape = {k: float(v) for k, v in (item.split() for item in mix[len("weights ("):-1].split(", "))}
-    else:
-        shape = mix
-    return {"seed": int(m.group(1)), "stream": int(m.group(2)), "table": m.group(3), "shape": shape,
-            "half_size_factor": float(m.group(5)), "interpolation": m.group(6), "method": m.group(7),
-            "spin_tolerance": float(m.group(8))}
-
-
 def read_hits(case: Path) -> tuple[dict, list]:
-    """All ranks' hit records as columns, and each file's header settings."""
-    files = sorted(hits_dir(case).glob("hits_*.csv"), key=lambda p: int(p.stem.split("_")[1]))
-    if not files:
-        raise FileNotFoundError(f"{hits_dir(case)}: no hits_<rank>.csv")
-    headers, rows = [], []
-    for f in files:
-        with open(f) as fh:
-            headers.append(parse_header(fh.readline()))
-            fh.readline()
-            if fh.readline().strip().split(",") != HIT_COLUMNS:
-                raise ValueError(f"{f}: unexpected columns")
-            rows.extend(line.rstrip("\n").split(",") for line in fh if line.strip())
-    cols = {}
-    for j, name in enumerate(HIT_COLUMNS):
-        values = [r[j] for r in rows]
-        if name == "patch":
-            cols[name] = np.array(values, dtype=object)
-        elif name in ("rank", "origProc", "origId", "status", "path"):
-            cols[name] = np.array(values, dtype=np.int64)
-        else:
-            cols[name] = np.array(values, dtype=float)
-    cols["V"] = np.column_stack([cols["Vx"], cols["Vy"], cols["Vz"]])
-    cols["Win"] = np.column_stack([cols["Winx"], cols["Winy"], cols["Winz"]])
-    cols["n"] = np.column_stack([cols["nx"], cols["ny"], cols["nz"]])
-    cols["Uw"] = np.column_stack([cols["Uwx"], cols["Uwy"], cols["Uwz"]])
-    cols["Vout"] = np.column_stack([cols["Voutx"], cols["Vouty"], cols["Voutz"]])
-    cols["Wout"] = np.column_stack([cols["Wx"], cols["Wy"], cols["Wz"]])
-    return cols, headers
+    """All ranks' hit records as columns, and each file's header settings (tablegen.study.hit_records)."""
+    return read_hit_files(rank_files(hits_dir(case)), HITS_TITLE)
 
 
 def read_patch_post(case: Path) -> dict:
@@ -165,13 +121,6 @@ def check_records(hits: dict, post: dict) -> dict:
     return {"hits_per_patch_adapter": counts_adapter, "hits_per_patch_patchPostProcessing": counts_post,
             "parcels_matched": matched, "parcels_mismatched": mismatched + len(set(seq_post) - set(seq_adapter)),
             "max_relative_difference_of_incident_velocity": worst}
-
-
-def solver_hits(hits: dict, settings: dict) -> SolverHits:
-    """The hit records of :func:`read_hits` as the solver-neutral record of tablegen.study.solver_comparison
-    (``settings``: a hits file's header, :func:`parse_header`)."""
-    return SolverHits(V=hits["V"], Omega=hits["Win"], n=hits["n"], a=hits["a"], shape=settings["shape"],
-                      V_out=hits["Vout"], Omega_out=hits["Wout"], status=hits["status"], path=hits["path"])
 
 
 def compare_paths(case: Path, table_path: Path | None = None) -> dict:

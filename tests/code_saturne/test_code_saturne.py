@@ -35,8 +35,8 @@ sys.path.insert(0, str(CS_DIR))
 
 import compare_saturne_rebounds  # noqa: E402
 import make_channel_table  # noqa: E402
-from saturne_api import STATUS_REBOUNDED, build_table_from_text  # noqa: E402
-from read_hits import PATH_DIRECT, PATH_TABLE, read_cpu_seconds, read_hits, read_summary  # noqa: E402
+from read_hits import read_cpu_seconds, read_hits, read_summary  # noqa: E402
+from saturne_api import PATH_DIRECT, PATH_TABLE, STATUS_REBOUNDED, build_table_from_text  # noqa: E402
 
 INSTALL_HINT = ("run `bash integrations/code_saturne/install-deps.sh` (as root on Debian bookworm: it installs "
                 "Debian's code_saturne 6.0 with its headers and Open MPI) and then "

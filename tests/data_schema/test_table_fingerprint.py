@@ -1,26 +1,18 @@
 """The fingerprint of a table (data_schema.table.table_fingerprint; docs/format.md, "Fingerprint"): it covers
 every dataset and every attribute that decides the law, and nothing that says when or where it was built."""
 
-import shutil
 
 import h5py
 import numpy as np
 import pytest
 
 from data_schema.table import table_fingerprint
+from tests.helpers.tables import edited_copy
 
 
 @pytest.fixture(scope="module")
 def fingerprint(small_table_path):
     return table_fingerprint(small_table_path)
-
-
-def _edited(source, folder, name, edit):
-    path = folder / name
-    shutil.copyfile(source, path)
-    with h5py.File(path, "r+") as f:
-        edit(f)
-    return path
 
 
 def test_build_time_host_and_descriptions_do_not_enter(small_table_path, fingerprint, tmp_path):
@@ -30,7 +22,7 @@ def test_build_time_host_and_descriptions_do_not_enter(small_table_path, fingerp
         f.attrs["model_sha256"] = "0" * 64
         f["cells/mean"].attrs["meaning"] = "another description"
 
-    assert table_fingerprint(_edited(small_table_path, tmp_path, "provenance.h5", provenance)) == fingerprint
+    assert table_fingerprint(edited_copy(small_table_path, tmp_path, "provenance.h5", provenance)) == fingerprint
 
 
 def test_every_dataset_and_law_attribute_enters(small_table_path, fingerprint, tmp_path):
@@ -60,5 +52,5 @@ def test_every_dataset_and_law_attribute_enters(small_table_path, fingerprint, t
     edits += [lambda f: f.attrs.__setitem__("master_seed", np.uint64(12)),
               lambda f: f.attrs.__setitem__("config", str(f.attrs["config"]) + "\n")]
     for i, edit in enumerate(edits):
-        seen.add(table_fingerprint(_edited(small_table_path, tmp_path, f"edit_{i}.h5", edit)))
+        seen.add(table_fingerprint(edited_copy(small_table_path, tmp_path, f"edit_{i}.h5", edit)))
     assert len(seen) == len(edits) + 1

@@ -4,22 +4,13 @@ surrogate.load and rbs_table_open; test_native_programs.py: the C loader under t
 
 from __future__ import annotations
 
-import shutil
 
 import h5py
 import numpy as np
 
 from tests.helpers import python_side as py
 from tests.helpers.native_library import ERR_FORMAT, ERR_IO, ERR_VERSION, OK
-
-
-def _copy(source, folder, name, edit=None):
-    path = folder / name
-    shutil.copyfile(source, path)
-    if edit is not None:
-        with h5py.File(path, "r+") as f:
-            edit(f)
-    return path
+from tests.helpers.tables import edited_copy
 
 
 def _replace(f, name, values, **options):
@@ -100,57 +91,57 @@ def bad_tables(good, folder) -> list:
             f.attrs["format_version"] = np.array([major, minor], dtype=np.int64)
         return edit
 
-    cases.append((_copy(good, folder, "v4.h5", version(4, 0)), ERR_VERSION, "4.0"))
-    cases.append((_copy(good, folder, "v2.h5", version(2, 1)), ERR_VERSION, "2.1"))
-    cases.append((_copy(good, folder, "v3_9.h5", version(3, 9)), OK, ""))
+    cases.append((edited_copy(good, folder, "v4.h5", version(4, 0)), ERR_VERSION, "4.0"))
+    cases.append((edited_copy(good, folder, "v2.h5", version(2, 1)), ERR_VERSION, "2.1"))
+    cases.append((edited_copy(good, folder, "v3_9.h5", version(3, 9)), OK, ""))
 
     def format_3_1(f):      # a table written before 3.2: no checksummed copies of the law's attributes
         version(3, 1)(f)
         del f["grid/law"], f["grid/shape_codes"]
 
-    cases.append((_copy(good, folder, "v3_1.h5", format_3_1), OK, ""))
-    cases.append((_copy(good, folder, "no_version.h5", lambda f: f.attrs.__delitem__("format_version")),
+    cases.append((edited_copy(good, folder, "v3_1.h5", format_3_1), OK, ""))
+    cases.append((edited_copy(good, folder, "no_version.h5", lambda f: f.attrs.__delitem__("format_version")),
                   ERR_FORMAT, "format_version"))
-    cases.append((_copy(good, folder, "no_mean.h5", lambda f: f["cells"].__delitem__("mean")), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "no_mean.h5", lambda f: f["cells"].__delitem__("mean")), ERR_FORMAT,
                   "cells/mean"))
-    cases.append((_copy(good, folder, "no_shapes.h5", lambda f: f["grid"].__delitem__("shapes")), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "no_shapes.h5", lambda f: f["grid"].__delitem__("shapes")), ERR_FORMAT,
                   "grid/shapes"))
-    cases.append((_copy(good, folder, "no_resolution.h5", lambda f: f.__delitem__("resolution")), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "no_resolution.h5", lambda f: f.__delitem__("resolution")), ERR_FORMAT,
                   "resolution"))
-    cases.append((_copy(good, folder, "wrong_shape.h5",
+    cases.append((edited_copy(good, folder, "wrong_shape.h5",
                         lambda f: _replace(f, "cells/std", f["cells/std"][()][..., :5])), ERR_FORMAT, "cells/std"))
-    cases.append((_copy(good, folder, "no_wall_law.h5", lambda f: f["grid"].attrs.__delitem__("restitution_k")),
+    cases.append((edited_copy(good, folder, "no_wall_law.h5", lambda f: f["grid"].attrs.__delitem__("restitution_k")),
                   ERR_FORMAT, "restitution_k"))
-    cases.append((_copy(good, folder, "no_kappa.h5", lambda f: f["grid"].attrs.__delitem__("kappa")), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "no_kappa.h5", lambda f: f["grid"].attrs.__delitem__("kappa")), ERR_FORMAT,
                   "kappa"))
-    cases.append((_copy(good, folder, "no_config.h5", lambda f: f.attrs.__delitem__("config")), ERR_FORMAT, "config"))
-    cases.append((_copy(good, folder, "no_law_copy.h5", lambda f: f["grid"].__delitem__("law")), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "no_config.h5", lambda f: f.attrs.__delitem__("config")), ERR_FORMAT, "config"))
+    cases.append((edited_copy(good, folder, "no_law_copy.h5", lambda f: f["grid"].__delitem__("law")), ERR_FORMAT,
                   "grid/law"))
-    cases.append((_copy(good, folder, "nan_std.h5", _set("cells/std", (0, 0, 0, 2), np.nan)), ERR_FORMAT, "cells/std"))
-    cases.append((_copy(good, folder, "negative_std.h5", _set("cells/std", (0, 0, 0, 2), -0.01)), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "nan_std.h5", _set("cells/std", (0, 0, 0, 2), np.nan)), ERR_FORMAT, "cells/std"))
+    cases.append((edited_copy(good, folder, "negative_std.h5", _set("cells/std", (0, 0, 0, 2), -0.01)), ERR_FORMAT,
                   "cells/std"))
-    cases.append((_copy(good, folder, "shape_index.h5", _set("cells/cluster_shape", (0, 0, 0, 1, 1), 255)), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "shape_index.h5", _set("cells/cluster_shape", (0, 0, 0, 1, 1), 255)), ERR_FORMAT,
                   "cluster_shape"))
-    cases.append((_copy(good, folder, "shape_index_m.h5", _set("cells/cluster_shape", (0, 0, 0, 0, 0), 16)), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "shape_index_m.h5", _set("cells/cluster_shape", (0, 0, 0, 0, 0), 16)), ERR_FORMAT,
                   "cluster_shape"))
-    cases.append((_copy(good, folder, "negative_status.h5", _set("cells/status_counts", (0, 0, 0, 2), -5)), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "negative_status.h5", _set("cells/status_counts", (0, 0, 0, 2), -5)), ERR_FORMAT,
                   "status_counts"))
-    cases.append((_copy(good, folder, "no_draw.h5", _set("cells/status_counts", (0, 0, 0), [0, 0, 10])), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "no_draw.h5", _set("cells/status_counts", (0, 0, 0), [0, 0, 10])), ERR_FORMAT,
                   "status_counts"))
-    cases.append((_copy(good, folder, "negative_collisions.h5", _set("cells/collision_counts", (0, 0, 0, 1), -1)),
+    cases.append((edited_copy(good, folder, "negative_collisions.h5", _set("cells/collision_counts", (0, 0, 0, 1), -1)),
                   ERR_FORMAT, "collision_counts"))
-    cases.append((_copy(good, folder, "negative_scale.h5", _set("cells/cluster_scale", (0, 0, 0, 0, 0), -1.0)),
+    cases.append((edited_copy(good, folder, "negative_scale.h5", _set("cells/cluster_scale", (0, 0, 0, 0, 0), -1.0)),
                   ERR_FORMAT, "cluster_scale"))
-    cases.append((_copy(good, folder, "regime_2.h5", _set("cells/cluster_regime", (0, 0, 0, 0), 2)), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "regime_2.h5", _set("cells/cluster_regime", (0, 0, 0, 0), 2)), ERR_FORMAT,
                   "cluster_regime"))
-    cases.append((_copy(good, folder, "weights_sum.h5", _set("cells/cluster_weight", (0, 0, 0, 0), 0.5)), ERR_FORMAT,
+    cases.append((edited_copy(good, folder, "weights_sum.h5", _set("cells/cluster_weight", (0, 0, 0, 0), 0.5)), ERR_FORMAT,
                   "cluster_weight"))
-    cases.append((_copy(good, folder, "negative_indicatrix.h5", _set("cells/indicatrix_3d", (0, 0, 0, 5, 5), -1.0)),
+    cases.append((edited_copy(good, folder, "negative_indicatrix.h5", _set("cells/indicatrix_3d", (0, 0, 0, 5, 5), -1.0)),
                   ERR_FORMAT, "indicatrix_3d"))
-    cases.append((_copy(good, folder, "alpha1_grid.h5", lambda f: _replace(f, "grid/alpha1_deg",
+    cases.append((edited_copy(good, folder, "alpha1_grid.h5", lambda f: _replace(f, "grid/alpha1_deg",
                                                                            np.linspace(-30.0, 200.0, f["grid/alpha1_deg"].shape[0]))),
                   ERR_FORMAT, "grid/alpha1_deg"))
-    cases.append((_copy(good, folder, "speed_ratio.h5", lambda f: _replace(f, "grid/speed_m_s",
+    cases.append((edited_copy(good, folder, "speed_ratio.h5", lambda f: _replace(f, "grid/speed_m_s",
                                                                            f["grid/speed_m_s"][()] ** 2)),
                   ERR_FORMAT, "grid/speed_m_s"))
 
@@ -159,25 +150,25 @@ def bad_tables(good, folder) -> list:
         names[0] = "banana"
         _replace(f, "grid/shapes", np.array(names, dtype=h5py.string_dtype()))
 
-    cases.append((_copy(good, folder, "banana.h5", banana), ERR_FORMAT, "grid/shapes"))
+    cases.append((edited_copy(good, folder, "banana.h5", banana), ERR_FORMAT, "grid/shapes"))
 
     def swapped(f):         # two valid names swapped: only the checksummed copy tells
         names = [s.decode() if isinstance(s, bytes) else s for s in f["grid/shapes"][()]]
         names[0], names[1] = names[1], names[0]
         _replace(f, "grid/shapes", np.array(names, dtype=h5py.string_dtype()))
 
-    cases.append((_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shape_codes"))
+    cases.append((edited_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shape_codes"))
     for name, value in (("restitution_p", 0.0), ("restitution_p", -0.61), ("restitution_k", np.nan)):
-        cases.append((_copy(good, folder, f"{name}_{value}.h5", _attribute("grid", name, value)), ERR_FORMAT, name))
+        cases.append((edited_copy(good, folder, f"{name}_{value}.h5", _attribute("grid", name, value)), ERR_FORMAT, name))
 
     def flipped_p(f):       # one flipped bit of restitution_p (0.61 → 1.22) changed the law and loaded
         f["grid"].attrs["restitution_p"] = _flip_bit(float(f["grid"].attrs["restitution_p"]), 52)
 
-    cases.append((_copy(good, folder, "flipped_p.h5", flipped_p), ERR_FORMAT, "grid/law"))
-    checksum = _copy(good, folder, "checksum.h5")
+    cases.append((edited_copy(good, folder, "flipped_p.h5", flipped_p), ERR_FORMAT, "grid/law"))
+    checksum = edited_copy(good, folder, "checksum.h5")
     _corrupt_checksummed(checksum)
     cases.append((checksum, ERR_FORMAT, "cells/cluster_loc"))
     for name in ("cells/indicatrix_2d", "cells/indicatrix_3d", "cells/collision_counts", "grid/law"):
-        path = _corrupt_chunk(_copy(good, folder, f"checksum_{name.replace('/', '_')}.h5"), name)
+        path = _corrupt_chunk(edited_copy(good, folder, f"checksum_{name.replace('/', '_')}.h5"), name)
         cases.append((path, ERR_FORMAT, name))
     return cases

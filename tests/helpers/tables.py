@@ -1,5 +1,19 @@
 """The configurations of the small tables the session builds once (tests/conftest.py): 2e4 particles per cell,
-all four shapes."""
+all four shapes; and edited copies of a table."""
+
+import shutil
+
+import h5py
+
+
+def edited_copy(source, folder, name, edit=None):
+    """A copy of the table file ``source`` as ``folder/name``, opened for writing and passed to ``edit(f)``."""
+    path = folder / name
+    shutil.copyfile(source, path)
+    if edit is not None:
+        with h5py.File(path, "r+") as f:
+            edit(f)
+    return path
 
 
 def _table_config(alpha1_deg, speed_m_s, seed):

@@ -12,7 +12,6 @@ in format 3.3.
 
 from __future__ import annotations
 
-import shutil
 
 import h5py
 import numpy as np
@@ -20,6 +19,7 @@ import pytest
 
 from tests.helpers import python_side as py
 from tests.helpers.native_library import ERR_FORMAT, OK
+from tests.helpers.tables import edited_copy
 
 # element (shape, α1, speed, cluster, chain variable) of a used cluster: the first cluster of the first cell
 CLUSTER, VARIABLE = (0, 0, 0, 0), (0, 0, 0, 0, 2)
@@ -41,14 +41,6 @@ OUT_OF_RANGE = {      # dataset: (element, values outside its allowed range)
 LAW_ATTRIBUTES = ("restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean",
                   "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol", "max_steps",
                   "second_moment_factors")
-
-
-def _copy(source, folder, name, edit):
-    path = folder / name
-    shutil.copyfile(source, path)
-    with h5py.File(path, "r+") as f:
-        edit(f)
-    return path
 
 
 def _set(name, index, value):
@@ -77,7 +69,7 @@ def test_every_value_a_draw_reads_is_bounded_in_both_loaders(native, small_table
         assert f["cells/cluster_weight"][CLUSTER] > 0      # the edited cluster is drawn
     for name, (element, values) in OUT_OF_RANGE.items():
         for i, value in enumerate(values):
-            path = _copy(small_table_path, tmp_path, f"{name.replace('/', '_')}_{i}.h5", _set(name, element, value))
+            path = edited_copy(small_table_path, tmp_path, f"{name.replace('/', '_')}_{i}.h5", _set(name, element, value))
             _same_verdict(native, path, ERR_FORMAT, name)
 
 
@@ -89,7 +81,7 @@ def test_a_decreasing_quantile_function_is_refused(native, small_table_path, tmp
         row[1] = row[0] - 1.0
         f["cells/shape_dictionary"][...] = values
 
-    _same_verdict(native, _copy(small_table_path, tmp_path, "decreasing.h5", decreasing), ERR_FORMAT,
+    _same_verdict(native, edited_copy(small_table_path, tmp_path, "decreasing.h5", decreasing), ERR_FORMAT,
                   "cells/shape_dictionary")
 
 
@@ -101,7 +93,7 @@ def test_a_flipped_bit_of_any_law_attribute_fails_to_load(native, small_table_pa
         bits.reshape(-1)[0] ^= 1 << 3
         f["grid"].attrs[name] = value
 
-    _same_verdict(native, _copy(small_table_path, tmp_path, f"flip_{name}.h5", flip), ERR_FORMAT, "grid/law")
+    _same_verdict(native, edited_copy(small_table_path, tmp_path, f"flip_{name}.h5", flip), ERR_FORMAT, "grid/law")
 
 
 @pytest.mark.parametrize("name, value, wanted", [
@@ -112,12 +104,12 @@ def test_an_attribute_of_the_wrong_type_is_refused_alike(native, small_table_pat
     def retype(f):
         f["grid"].attrs[name] = value
 
-    _same_verdict(native, _copy(small_table_path, tmp_path, f"type_{name}.h5", retype), ERR_FORMAT,
+    _same_verdict(native, edited_copy(small_table_path, tmp_path, f"type_{name}.h5", retype), ERR_FORMAT,
                   f"the attribute '{name}' of group 'grid' {wanted}")
 
 
 def test_a_missing_direct_model_attribute_is_refused_since_3_3(native, small_table_path, tmp_path):
-    _same_verdict(native, _copy(small_table_path, tmp_path, "no_set_tol.h5",
+    _same_verdict(native, edited_copy(small_table_path, tmp_path, "no_set_tol.h5",
                                 lambda f: f["grid"].attrs.__delitem__("set_tol")), ERR_FORMAT, "set_tol")
 
 
@@ -152,7 +144,7 @@ def test_status_0_leaves_the_wall_no_faster_whatever_the_table(native, small_tab
         slope[..., 1] = 900.0
         f["cells/cluster_slope"][...] = slope
 
-    path = _copy(small_table_path, tmp_path, "absurd.h5", absurd)
+    path = edited_copy(small_table_path, tmp_path, "absurd.h5", absurd)
     (c_status, c_V), (status, V), speed = _draws(native, path)
     assert np.array_equal(c_status, status)
     assert np.count_nonzero(status == py.STATUS_INVALID) > 0.9 * len(status)
@@ -169,7 +161,7 @@ def test_a_table_of_format_3_2_draws_the_same_bits(native, small_table_path, tmp
         del f["grid/law"]
         f["grid"].create_dataset("law", data=law, fletcher32=True)
 
-    old = _copy(small_table_path, tmp_path, "v3_2.h5", format_3_2)
+    old = edited_copy(small_table_path, tmp_path, "v3_2.h5", format_3_2)
     (c_new, c_V_new), (py_new, V_new), _ = _draws(native, small_table_path, n=2_000)
     (c_old, c_V_old), (py_old, V_old), _ = _draws(native, old, n=2_000)
     assert np.array_equal(c_new, c_old) and np.array_equal(py_new, py_old)

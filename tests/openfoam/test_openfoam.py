@@ -38,7 +38,7 @@ sys.path.insert(0, str(OPENFOAM_DIR))
 
 import compare_rebounds  # noqa: E402
 import make_case_table  # noqa: E402
-from rbs_api import build_table_from_text  # noqa: E402
+from rbs_api import build_table_from_text, summary_counts  # noqa: E402
 
 INSTALL_HINT = ("run `bash integrations/openfoam/install-deps.sh` (as root on Debian bookworm: it installs "
                 "Debian's OpenFOAM v1912 and Open MPI, unpacks the v1912 headers from the source package "
@@ -62,18 +62,11 @@ def _timings(case: Path) -> dict:
 
 
 def _cloud_info(log: str) -> dict:
-    """The stochasticRebound counts of the last time step in a solver log."""
+    """The stochasticRebound counts of the last time step in a solver log, and the incoming spin's mean and max."""
     block = log[log.rindex("Stochastic rebound"):]
     spin = re.search(r"incoming spin \|Omega\|a/\|V\|\s*= mean\s*([-0-9.eE+]+), max\s*([-0-9.eE+]+)", block)
-    def number(label):
-        return float(re.search(re.escape(label) + r"[^=]*=\s*([-0-9.eE+]+)", block).group(1))
-    cost = re.search(r"answered by the direct model\s*=\s*\d+ \(mean cost\s*([-0-9.eE+]+) us per hit\)", block)
-    return {"hits": int(number("- wall hits")), "table": int(number("- answered by the table")),
-            "direct": int(number("- answered by the direct model")), "direct_us": float(cost.group(1)),
-            "rebounded": int(number("- rebounded")), "trapped": int(number("- trapped")),
-            "failed": int(number("- failed (direct model)")), "invalid": int(number("- invalid")),
-            "outside": int(number("- outside the table's grid")),
-            "spin_mean": float(spin.group(1)) if spin else None, "spin_max": float(spin.group(2)) if spin else None}
+    return dict(summary_counts(block), spin_mean=float(spin.group(1)) if spin else None,
+                spin_max=float(spin.group(2)) if spin else None)
 
 
 def _cpu_seconds(case: Path) -> float:

@@ -1,6 +1,6 @@
 """integrations/openfoam/sample_hits.py: every k-th hit of a hits file with its Ω⁻ (the columns Winx, Winy, Winz),
 checked against the run's own spin_ratio column, read back by benchmarks/bench_direct.py. Needs no OpenFOAM:
-the hits files are written here, with the adapter's columns (compare_rebounds.HIT_COLUMNS).
+the hits files are written here, with the adapter's columns (HIT_COLUMNS).
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 (see integrations/openfoam/LICENSE).
@@ -17,13 +17,13 @@ REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "integrations" / "openfoam"))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
-import compare_rebounds  # noqa: E402
 import sample_hits  # noqa: E402
+from rbs_api import HIT_COLUMNS  # noqa: E402
 from bench_direct import read_hits_sample  # noqa: E402
 
 HEADER = ("# stochasticRebound hits: seed 7, stream 0, table /x/t.h5, mix prism, halfSizeFactor 1, "
           "interpolation scaled, method auto, spin tolerance 1e-06\n# columns\n"
-          + ",".join(compare_rebounds.HIT_COLUMNS) + "\n")
+          + ",".join(HIT_COLUMNS) + "\n")
 A = 1e-4   # m
 
 
@@ -33,12 +33,12 @@ def _case(tmp_path, hits):
     folder.mkdir(parents=True)
     lines = [HEADER]
     for i, (V, W, ratio) in enumerate(hits):
-        row = dict.fromkeys(compare_rebounds.HIT_COLUMNS, "0")
+        row = dict.fromkeys(HIT_COLUMNS, "0")
         row.update(time=repr(0.1 * (i + 1)), patch="walls", origId=str(i), d=repr(2 * A), a=repr(A), ny="1",
                    Voutx="1", Vouty="1", Wx="5e3", spin_ratio=repr(ratio), u0="0.5")
         row.update({f"V{c}": repr(v) for c, v in zip("xyz", V)})
         row.update({f"Win{c}": repr(w) for c, w in zip("xyz", W)})
-        lines.append(",".join(row[c] for c in compare_rebounds.HIT_COLUMNS) + "\n")
+        lines.append(",".join(row[c] for c in HIT_COLUMNS) + "\n")
     (folder / "hits_0.csv").write_text("".join(lines))
     return tmp_path
 

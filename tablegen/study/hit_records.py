@@ -1,0 +1,123 @@
+"""The wall-hit records a solver adapter writes, read into arrays: the layout both adapters share.
+
+The OpenFOAM adapter (integrations/openfoam) and the code_saturne user sources (integrations/code_saturne)
+write one CSV file per rank, ``hits_<rank>.csv``:
+
+* line 1, the run's settings: ``# <title> hits: seed S, stream K, table PATH, mix MIX, halfSizeFactor F,
+  interpolation I, method M, spin tolerance T``, MIX a shape name, ``mix`` or ``weights (name w, ...)``
+  (OpenFOAM writes ``name w``, code_saturne ``name:w``);
+* line 2, free text; line 3, the column names :data:`HIT_COLUMNS`;
+* a row per hit: time (s), rank, the boundary (``patch``), origProc/origId (−1 where the solver has no
+  persistent particle id), d (m), a (m), V⁻ relative to the wall (m/s), Ω⁻ (rad/s), n into the gas, U_w (m/s),
+  status (``surrogate.STATUS_*``), path (0 table, 1 direct model, −1 invalid), V⁺, Ω⁺, |Ω⁻|a/|V⁻| and the
+  draw's first uniform; all in the solver's frame.
+
+The solver's log ends with a summary of counts (``- wall hits = N`` and so on, :func:`summary_counts`).
+What is a solver's own (where the files are, its other records) stays in its integration; the comparison's
+statistics are :mod:`tablegen.study.solver_comparison`'s.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from tablegen.study.solver_comparison import SolverHits
+
+__all__ = ["HIT_COLUMNS", "parse_header", "rank_files", "read_hit_files", "solver_hits", "summary_counts"]
+
+HIT_COLUMNS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,nx,ny,nz,Uwx,Uwy,Uwz,status,path,"
+               "Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0").split(",")
+_INTEGER_COLUMNS = ("rank", "origProc", "origId", "status", "path")
+_VECTORS = {"V": "Vx Vy Vz", "Win": "Winx Winy Winz", "n": "nx ny nz", "Uw": "Uwx Uwy Uwz",
+            "Vout": "Voutx Vouty Voutz", "Wout": "Wx Wy Wz"}
+_COUNTS = {"hits": "- wall hits", "table": "- answered by the table", "direct": "- answered by the direct model",
+           "rebounded": "- rebounded", "trapped": "- trapped", "failed": "- failed (direct model)",
+           "invalid": "- invalid", "outside": "- outside the table's grid"}
+
+
+def parse_header(line: str, title: str) -> dict:
+    """The run's settings from the first line of a hits file whose header starts ``# <title> hits:``.
+
+    Returns seed, stream, table, shape (a name or a dict of weights), half_size_factor, interpolation, method
+    and spin_tolerance. ValueError if the line is not such a header.
+    """
+    m = re.match(rf"# {re.escape(title)} hits: seed (\d+), stream (\d+), table (.*), mix (.*), "
+                 r"halfSizeFactor (\S+), interpolation (\w+), method (\w+), spin tolerance (\S+)$", line.strip())
+    if not m:
+        raise ValueError(f"not a {title} hits header: {line!r}")
+    mix = m.group(4)
+    if mix.startswith("weights ("):
+        items = (re.split(r"[:\s]+", item.strip()) for item in mix[len("weights ("):-1].split(","))
+        shape = {name: float(weight) for name, weight in items}
+    else:
+        shape = mix
+    return {"seed": int(m.group(1)), "stream": int(m.group(2)), "table": m.group(3), "shape": shape,
+            "half_size_factor": float(m.group(5)), "interpolation": m.group(6), "method": m.group(7),
+            "spin_tolerance": float(m.group(8))}
+
+
+def read_hit_files(files, title: str) -> tuple[dict, list]:
+    """The hit records of ``files`` (in the order given) as columns, and each file's settings.
+
+    Columns by :data:`HIT_COLUMNS` name (``patch`` strings, the integer columns int64, the rest float64), plus
+    the (N, 3) arrays V, Win, n, Uw, Vout and Wout. ValueError naming the file and line for a file of
+    another layout.
+    """
+    headers, rows = [], []
+    for f in files:
+        with open(f) as fh:
+            headers.append(parse_header(fh.readline(), title))
+            fh.readline()
+            if fh.readline().strip().split(",") != HIT_COLUMNS:
+                raise ValueError(f"{f}: line 3 is not the hits columns {','.join(HIT_COLUMNS)}")
+            for line_no, line in enumerate(fh, start=4):
+                if not line.strip():
+                    continue
+                row = line.rstrip("\n").split(",")
+                if len(row) != len(HIT_COLUMNS):
+                    raise ValueError(f"{f}, line {line_no}: {len(row)} fields, not {len(HIT_COLUMNS)}")
+                rows.append(row)
+    cols = {}
+    for j, name in enumerate(HIT_COLUMNS):
+        values = [r[j] for r in rows]
+        dtype = object if name == "patch" else np.int64 if name in _INTEGER_COLUMNS else float
+        cols[name] = np.array(values, dtype=dtype)
+    for vector, names in _VECTORS.items():
+        cols[vector] = np.column_stack([cols[c] for c in names.split()]).reshape(-1, 3)
+    return cols, headers
+
+
+def rank_files(folder: Path) -> list:
+    """The ``hits_<rank>.csv`` files of a folder in rank order (FileNotFoundError if there are none)."""
+    files = sorted(Path(folder).glob("hits_*.csv"), key=lambda p: int(p.stem.split("_")[1]))
+    if not files:
+        raise FileNotFoundError(f"{folder}: no hits_<rank>.csv")
+    return files
+
+
+def solver_hits(hits: dict, settings: dict) -> SolverHits:
+    """The columns of :func:`read_hit_files` as a :class:`SolverHits` (``settings``: a file's header)."""
+    return SolverHits(V=hits["V"], Omega=hits["Win"], n=hits["n"], a=hits["a"], shape=settings["shape"],
+                      V_out=hits["Vout"], Omega_out=hits["Wout"], status=hits["status"], path=hits["path"])
+
+
+def summary_counts(block: str) -> dict:
+    """The counts of an adapter's summary (``- wall hits = N`` ...) in a block of a solver's log.
+
+    Keys: hits, table, direct, rebounded, trapped, failed, invalid, outside, and direct_us, the direct model's
+    mean cost per hit (µs). ValueError naming the first count missing from the block.
+    """
+    out = {}
+    for key, label in _COUNTS.items():
+        m = re.search(re.escape(label) + r"[^=]*=\s*([-0-9.eE+]+)", block)
+        if m is None:
+            raise ValueError(f"the summary has no count {label!r}")
+        out[key] = int(float(m.group(1)))
+    cost = re.search(r"answered by the direct model\s*=\s*\d+ \(mean cost\s*([-0-9.eE+]+) us per hit\)", block)
+    if cost is None:
+        raise ValueError("the summary has no mean cost of the direct model")
+    out["direct_us"] = float(cost.group(1))
+    return out

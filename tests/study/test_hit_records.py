@@ -1,0 +1,77 @@
+"""The hit records both solver adapters write (tablegen.study.hit_records): header, columns, counts."""
+
+import numpy as np
+import pytest
+
+from tablegen.study.hit_records import (HIT_COLUMNS, parse_header, rank_files, read_hit_files, solver_hits,
+                                        summary_counts)
+
+OPENFOAM = ("# stochasticRebound hits: seed 7, stream 1, table /t/a.h5, mix weights (prism 0.25, tetrahedron 0.75), "
+            "halfSizeFactor 0.5, interpolation nearest, method auto, spin tolerance 0.001")
+SATURNE = ("# code_saturne rebound-scatter hits: seed 7, stream 0, table /t/a.h5, mix weights (prism:0.25, "
+           "tetrahedron:0.75), halfSizeFactor 0.5, interpolation nearest, method auto, spin tolerance 0.001")
+
+
+def _write(path, header, rows):
+    lines = [header, "# free text", ",".join(HIT_COLUMNS)]
+    for k in range(rows):
+        values = dict.fromkeys(HIT_COLUMNS, "0.5")
+        values.update(rank="1", patch=f"wall{k}", origProc="-1", origId=str(k), status="0", path=str(k % 2),
+                      Vx=str(k), Vy="-3", Vz="0.25")
+        lines.append(",".join(values[c] for c in HIT_COLUMNS))
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("title, header", [("stochasticRebound", OPENFOAM),
+                                           ("code_saturne rebound-scatter", SATURNE)])
+def test_both_headers_give_the_same_settings(title, header):
+    settings = parse_header(header, title)
+    assert settings["shape"] == {"prism": 0.25, "tetrahedron": 0.75}
+    assert (settings["seed"], settings["table"], settings["method"], settings["spin_tolerance"]) == (
+        7, "/t/a.h5", "auto", 0.001)
+    with pytest.raises(ValueError, match="not a other hits header"):
+        parse_header(header, "other")
+
+
+def test_files_read_in_rank_order_with_vectors_and_types(tmp_path):
+    _write(tmp_path / "hits_10.csv", OPENFOAM, 2)
+    _write(tmp_path / "hits_2.csv", OPENFOAM.replace("stream 1", "stream 2"), 3)
+    files = rank_files(tmp_path)
+    assert [f.name for f in files] == ["hits_2.csv", "hits_10.csv"]
+    cols, headers = read_hit_files(files, "stochasticRebound")
+    assert [h["stream"] for h in headers] == [2, 1]
+    assert cols["V"].shape == (5, 3) and cols["V"][:, 0].tolist() == [0, 1, 2, 0, 1]
+    assert cols["path"].dtype == np.int64 and cols["patch"].tolist()[:2] == ["wall0", "wall1"]
+    record = solver_hits(cols, headers[0])
+    assert record.shape == {"prism": 0.25, "tetrahedron": 0.75} and np.array_equal(record.V, cols["V"])
+
+
+def test_a_file_of_another_layout_is_named(tmp_path):
+    _write(tmp_path / "hits_0.csv", OPENFOAM, 1)
+    text = (tmp_path / "hits_0.csv").read_text()
+    (tmp_path / "hits_0.csv").write_text(text + "1,2,3\n")
+    with pytest.raises(ValueError, match=r"hits_0.csv, line 5: 3 fields, not 29"):
+        read_hit_files(rank_files(tmp_path), "stochasticRebound")
+    (tmp_path / "hits_0.csv").write_text(text.replace("Winx", "Wx0"))
+    with pytest.raises(ValueError, match="line 3 is not the hits columns"):
+        read_hit_files(rank_files(tmp_path), "stochasticRebound")
+    with pytest.raises(FileNotFoundError, match="no hits_<rank>.csv"):
+        rank_files(tmp_path / "empty")
+
+
+def test_summary_counts():
+    block = """rebound-scatter (2 ranks):
+      - wall hits                   = 12057
+      - answered by the table       = 6305
+      - answered by the direct model = 5752 (mean cost 4.5 us per hit)
+      - rebounded                   = 12000
+      - trapped                     = 50
+      - failed (direct model)       = 7
+      - invalid                     = 0
+      - outside the table's grid    = 12
+    """
+    counts = summary_counts(block)
+    assert counts == {"hits": 12057, "table": 6305, "direct": 5752, "rebounded": 12000, "trapped": 50,
+                      "failed": 7, "invalid": 0, "outside": 12, "direct_us": 4.5}
+    with pytest.raises(ValueError, match="no count '- trapped'"):
+        summary_counts(block.replace("- trapped", "- kept"))
