@@ -166,24 +166,32 @@ def _partition(z: np.ndarray, n_clusters: int, rng: np.random.Generator) -> np.n
 
 
 @numba.njit(cache=True, nogil=True)
-def _nearest(z, i, centres):
-    """Index of the centre nearest row i of z (squared distance summed in column order; the first on a tie)."""
+def _nearest(z, i, columns, dist):
+    """Index of the centre nearest row i of z: the least squared distance summed in column order, the first
+    on a tie. ``columns`` (d, k) holds the centres column by column, so that the distances to all k centres
+    are summed a column at a time, k at once (SIMD; each centre's sum keeps its order, so its bits);
+    ``dist`` (k,) is work space."""
+    d, k = columns.shape
+    dist[:] = 0.0
+    for j in range(d):
+        x = z[i, j]
+        for c in range(k):
+            t = x - columns[j, c]
+            dist[c] += t * t
     best, best_d = 0, np.inf
-    for c in range(centres.shape[0]):
-        d = 0.0
-        for j in range(z.shape[1]):
-            t = z[i, j] - centres[c, j]
-            d += t * t
-        if d < best_d:
-            best, best_d = c, d
+    for c in range(k):
+        if dist[c] < best_d:
+            best, best_d = c, dist[c]
     return best
 
 
 @numba.njit(cache=True, nogil=True)
 def _assign(z, centres, labels):
     """labels[i] = the centre nearest row i of z."""
+    columns = np.ascontiguousarray(centres.T)
+    dist = np.empty(centres.shape[0])
     for i in range(z.shape[0]):
-        labels[i] = _nearest(z, i, centres)
+        labels[i] = _nearest(z, i, columns, dist)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -195,11 +203,13 @@ def _minibatch_epochs(z, centres, order, batch_size):
     count = np.zeros(k)
     batch_count = np.zeros(k)
     batch_sum = np.zeros((k, d))
+    dist = np.empty(k)
     for start in range(0, len(order), batch_size):
         batch_count[:] = 0.0
         batch_sum[:] = 0.0
+        columns = np.ascontiguousarray(centres.T)
         for i in order[start:start + batch_size]:
-            c = _nearest(z, i, centres)
+            c = _nearest(z, i, columns, dist)
             batch_count[c] += 1.0
             for j in range(d):
                 batch_sum[c, j] += z[i, j]
@@ -240,10 +250,12 @@ def _kmeans(x, u, max_iterations):
     labels = np.full(n, -1, dtype=np.int64)
     sums = np.zeros((k, d))
     counts = np.zeros(k)
+    dist = np.empty(k)
     for _ in range(max_iterations):
         moved = False
+        columns = np.ascontiguousarray(centres.T)
         for i in range(n):
-            c = _nearest(x, i, centres)
+            c = _nearest(x, i, columns, dist)
             moved |= c != labels[i]
             labels[i] = c
         if not moved:
