@@ -94,7 +94,7 @@ extern "C" {
 #define RBS_U_PER_DRAW 13       /* uniforms per draw (surrogate.U_PER_DRAW) */
 #define RBS_MAX_SHAPES 4        /* the shapes an rbs_mix value holds (1.0's mix); a table may hold more ("Shape mixes") */
 #define RBS_TABLE_MAX_SHAPES 4096   /* the most shapes a table holds (data_schema.shape_records.MAX_TABLE_SHAPES) */
-#define RBS_SHAPE_NAME_SIZE 65  /* bytes of a shape's name with its NUL (direct_model.registry.NAME_PATTERN: 64) */
+#define RBS_SHAPE_NAME_SIZE 65  /* bytes of a shape's name with its NUL (direct_model.registry.NAME_PATTERN, 64 at most) */
 #define RBS_TABLE_MAJOR 3       /* the table format major version read (any minor) */
 #define RBS_BLOCK 32            /* rows per block of rbs_table_rebound_many*, lanes of rbs_table_rebound_many_rng */
 #define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */

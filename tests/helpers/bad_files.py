@@ -106,7 +106,7 @@ def bad_tables(good, folder) -> list:
 
     def format_3_1(f):      # a table written before 3.2: no checksummed copies of the law's attributes
         version(3, 1)(f)
-        del f["grid/law"], f["grid/shape_codes"]
+        del f["grid/law"], f["grid/shape_codes"], f["shapes"]
 
     cases.append((_copy(good, folder, "v3_1.h5", format_3_1), OK, ""))
     cases.append((_copy(good, folder, "no_version.h5", lambda f: f.attrs.__delitem__("format_version")),
@@ -166,7 +166,7 @@ def bad_tables(good, folder) -> list:
         names[0], names[1] = names[1], names[0]
         _replace(f, "grid/shapes", np.array(names, dtype=h5py.string_dtype()))
 
-    cases.append((_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shape_codes"))
+    cases.append((_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shapes"))
     for name, value in (("restitution_p", 0.0), ("restitution_p", -0.61), ("restitution_k", np.nan)):
         cases.append((_copy(good, folder, f"{name}_{value}.h5", _attribute("grid", name, value)), ERR_FORMAT, name))
 

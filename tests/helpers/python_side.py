@@ -67,7 +67,7 @@ def many_shape_table(source, path, n_shapes: int = 64) -> tuple:
     import numpy as np
     from data_schema.table import read_table, write_table
     table = read_table(source)
-    own = table.shape_records()
+    own = table.shape_records()[:n_shapes]
     records = tuple(own) + tuple(user_grains(n_shapes - len(own)))
     rows = np.arange(n_shapes) % len(own)
     cells = {name: np.ascontiguousarray(values[rows]) for name, values in table.cells.items()}
