@@ -381,9 +381,9 @@ def _records(table: ReboundTable, shapes: dict | None, where: str) -> tuple:
         return records_from_arrays(shapes, table.shapes, table.kappa, table.aspect_ratio, refuse)
     try:
         return family_records(table.shapes, table.kappa, table.aspect_ratio)
-    except ValueError as exc:
-        refuse(f"the records of the built-in shapes cannot be made from the table's kappa {table.kappa!r} and "
-               f"aspect-ratio law {list(table.aspect_ratio)} (group 'grid'): {exc}")
+    except ValueError as exc:       # κ and the law are the direct model's parameters: the C loader's words
+        refuse(f"the direct model's parameters are out of range: {exc} (the built-in shapes' records cannot be "
+               f"made from the table's kappa {table.kappa!r} and aspect-ratio law {list(table.aspect_ratio)})")
 
 
 def _minor(f: h5py.File) -> int:

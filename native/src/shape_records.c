@@ -88,9 +88,9 @@ static int allocate(loader *ld, rbs_shape_records *r, int n, int64_t n_vertices)
 static int synthesise(loader *ld, rbs_table *t, double kappa, const double aspect[4], const double kfac[RBS_N_FAMILIES])
 {
     if (!law_ok(aspect) || !(kappa >= 0.0 && kappa < 1.0))
-        return rbs_fail(ld, RBS_ERR_FORMAT, "the records of the built-in shapes cannot be made from the table's kappa "
-                        "%.17g and aspect-ratio law (%.17g, %.17g, %.17g, %.17g) (group 'grid')", kappa, aspect[0],
-                        aspect[1], aspect[2], aspect[3]);
+        return rbs_fail(ld, RBS_ERR_FORMAT, "the direct model's parameters are out of range: the built-in shapes' "
+                        "records cannot be made from the table's kappa %.17g and aspect-ratio law (%.17g, %.17g, "
+                        "%.17g, %.17g)", kappa, aspect[0], aspect[1], aspect[2], aspect[3]);
     rbs_shape_records *r = &t->shapes;
     if (allocate(ld, r, t->n_shapes, (int64_t)t->n_shapes * MAX_VERTICES) != RBS_OK) return ld->code;
     for (int i = 0; i < t->n_shapes; i++) {
