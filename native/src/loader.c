@@ -1,7 +1,8 @@
 /*
  * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), and the
- * accessors of a loaded table. The kernel arrays are derived in layout.c; what tables before format 3.3 leave
- * out is read by old_tables.c.
+ * accessors of a loaded table. The kernel arrays are derived in layout.c; the shapes (group shapes, format 3.4)
+ * are read by shape_records.c, with the helpers loader.h declares; what tables before format 3.3 leave out is
+ * read by old_tables.c.
  *
  * Every error names the file and what is wrong with it; HDF5's own error printing is switched off
  * around each HDF5 call that may fail (H5E_BEGIN_TRY), so the library prints nothing.
