@@ -2,7 +2,7 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (3, 3),
+    /                      attrs: file_type = "rebound_table", format_version = (3, 4),
                            created (ISO 8601 UTC), package_version, model_sha256, config (TOML text),
                            config_sha256, master_seed
     /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
@@ -12,7 +12,10 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
                            aspect_ratio_{mean,sd,low,high}, contact_tol, set_tol, max_steps,
                            second_moment_factors (the rest of the direct model's parameters; required since
                            3.3); law and shape_codes, checksummed copies of the attributes (LAW_ATTRIBUTES;
-                           3.2: restitution_k, restitution_p only) and names the law depends on (since 3.2)
+                           3.2: restitution_k, restitution_p only) and names the law depends on (since 3.2;
+                           since 3.4 shape_codes holds USER_SHAPE_CODE for a shape that is not a family)
+    /shapes                (since 3.4) the definition of every shape the table holds, one row per shape
+                           (data_schema.shape_records: name, kind, vertices, triangles, inertia, aspect law, hands)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
@@ -58,10 +61,13 @@ import numpy as np
 
 from data_schema.common import DataFormatError, check_file, write_header
 from data_schema.samples import SHAPE_NAMES
+from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_arrays,
+                                       family_records, records_from_arrays, write_shape_records)
 from data_schema.output import hdf5_bytes, write_output
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (3, 3)
+TABLE_VERSION = (3, 4)
+SHAPES_SINCE = 4        # the minor version from which a table holds group /shapes
 
 # grid speeds a table may hold, m/s (docs/format.md, "What makes a table valid"): the direct model's arithmetic
 # fails far outside (1e-100 m/s gives no rebound), and the runtime moves draws between consecutive grid speeds
@@ -236,6 +242,9 @@ class ReboundTable:
     max_steps: int = BUILT_WITH_TOLERANCES["max_steps"]
     second_moment_factors: tuple = (float("nan"),) * 4
     format_version: tuple = TABLE_VERSION    # of the file read (what this package writes for a new table)
+    # the registry record (direct_model.registry) of each shape, in the order of ``shapes``; () for the built-in
+    # families at ``kappa`` and ``aspect_ratio`` (:meth:`shape_records`)
+    records: tuple = ()
 
     def __post_init__(self):
         lead = (len(self.shapes), len(self.alpha1_deg), len(self.speed_m_s))
@@ -247,6 +256,12 @@ class ReboundTable:
             if self.cells[name].shape != lead + shape:
                 raise ValueError(f"dataset 'cells/{name}' has shape {self.cells[name].shape}, "
                                  f"expected {lead + shape}")
+        if self.records and tuple(r.name for r in self.records) != tuple(self.shapes):
+            raise ValueError(f"the records name {[r.name for r in self.records]}, the table {list(self.shapes)}")
+
+    def shape_records(self) -> tuple:
+        """The registry record of each shape, table order: ``records``, or the families' at κ and the aspect law."""
+        return self.records or family_records(self.shapes, self.kappa, self.aspect_ratio)
 
     def law_values(self) -> np.ndarray:
         """The attributes of :data:`LAW_ATTRIBUTES` in order, as float64: the content of ``grid/law`` (3.3)."""
@@ -276,8 +291,7 @@ class ReboundTable:
         # checksummed copies of what the law depends on beyond the cell datasets (3.2; every law attribute
         # since 3.3): a flipped bit of an attribute or a swapped shape name fails to load
         grid.create_dataset("law", data=self.law_values(), fletcher32=True)
-        grid.create_dataset("shape_codes", data=np.array([SHAPE_NAMES.index(s) for s in self.shapes], dtype=np.uint8),
-                            fletcher32=True)
+        grid.create_dataset("shape_codes", data=shape_codes(self.shapes), fletcher32=True)
         grid.attrs["kappa"] = self.kappa
         grid.attrs["n_max"] = self.n_max
         grid.attrs["particles_per_cell"] = self.particles_per_cell
@@ -293,6 +307,7 @@ class ReboundTable:
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
+        write_shape_records(f, self.shape_records())
         cells = f.create_group("cells")
         for name, (dtype, units, meaning) in CELL_DATASETS.items():
             values = np.asarray(self.cells[name], dtype=dtype)
@@ -323,6 +338,9 @@ class ReboundTable:
             raise DataFormatError(f"{where}: missing dataset(s) {', '.join('grid/' + n for n in missing)} (table "
                                   f"format 3.2)")
         minor = _minor(f)
+        if minor >= SHAPES_SINCE and SHAPES_GROUP not in f:
+            raise DataFormatError(f"{where}: missing group '{SHAPES_GROUP}' (table format 3.{SHAPES_SINCE})")
+        shapes = _read_group(f[SHAPES_GROUP]) if SHAPES_GROUP in f else None
         try:
             resolution = TableResolution(**{name: _number(f["resolution"], name)
                                             for name in ("clusters", "dictionary_size", "levels")})
@@ -345,8 +363,27 @@ class ReboundTable:
             if isinstance(exc, DataFormatError):
                 raise DataFormatError(f"{where}: {exc}") from None
             raise DataFormatError(f"{where}: inconsistent table: {exc}") from exc
-        check_contract(table, where, law)
-        return table
+        check_contract(table, where, law, shapes)
+        return dataclasses.replace(table, records=_records(table, shapes, where))
+
+
+def shape_codes(names) -> np.ndarray:
+    """``grid/shapes``' checksummed copy ``grid/shape_codes``: each family's code, USER_SHAPE_CODE for another."""
+    return np.array([SHAPE_NAMES.index(s) if s in SHAPE_NAMES else USER_SHAPE_CODE for s in names], dtype=np.uint8)
+
+
+def _records(table: ReboundTable, shapes: dict | None, where: str) -> tuple:
+    """The records of a checked table: from its /shapes datasets, or (before 3.4) the families'."""
+    def refuse(text):
+        raise DataFormatError(f"{where}: {text}")
+
+    if shapes is not None:
+        return records_from_arrays(shapes, table.shapes, table.kappa, table.aspect_ratio, refuse)
+    try:
+        return family_records(table.shapes, table.kappa, table.aspect_ratio)
+    except ValueError as exc:       # κ and the law are the direct model's parameters: the C loader's words
+        refuse(f"the direct model's parameters are out of range: {exc} (the built-in shapes' records cannot be "
+               f"made from the table's kappa {table.kappa!r} and aspect-ratio law {list(table.aspect_ratio)})")
 
 
 def _minor(f: h5py.File) -> int:
@@ -375,17 +412,21 @@ def _number(group: h5py.Group, name: str, count: int | None = 1):
     return int(values.ravel()[0]) if integer else float(values.ravel()[0])
 
 
-def check_contract(table: ReboundTable, where: str, law: dict) -> None:
+def check_contract(table: ReboundTable, where: str, law: dict, shapes: dict | None = None) -> None:
     """DataFormatError naming the file and the value unless ``table`` obeys what makes a table valid beyond its
     layout (docs/format.md, "What makes a table valid"; the C loader checks the same). ``law`` holds the
     datasets of :data:`LAW_DATASETS` the file has (3.2), which must equal the attributes and names: the first two
-    of :data:`LAW_ATTRIBUTES` in a 3.2 table, all of them since 3.3."""
+    of :data:`LAW_ATTRIBUTES` in a 3.2 table, all of them since 3.3. ``shapes`` holds the datasets of group
+    /shapes (3.4; :func:`data_schema.shape_records.check_shape_arrays`); a table without them holds the families
+    only."""
     def refuse(text):
         raise DataFormatError(f"{where}: {text}")
 
-    if not all(name in SHAPE_NAMES for name in table.shapes) or len(set(table.shapes)) != len(table.shapes):
-        refuse(f"dataset 'grid/shapes' must name distinct shapes among {', '.join(SHAPE_NAMES)}; got "
-               f"{list(table.shapes)}")
+    if shapes is not None:
+        check_shape_arrays(shapes, table.shapes, refuse)
+    elif not all(name in SHAPE_NAMES for name in table.shapes) or len(set(table.shapes)) != len(table.shapes):
+        refuse(f"dataset 'grid/shapes' must name distinct shapes among {', '.join(SHAPE_NAMES)} (a table before "
+               f"format 3.{SHAPES_SINCE}); got {list(table.shapes)}")
     alpha1, speed = np.asarray(table.alpha1_deg, dtype=np.float64), np.asarray(table.speed_m_s, dtype=np.float64)
     if not (np.all((alpha1 > 0.0) & (alpha1 <= 90.0)) and np.all(np.diff(alpha1) > 0.0)):
         refuse(f"dataset 'grid/alpha1_deg' must be strictly increasing in (0, 90] deg; got {alpha1.tolist()}")
@@ -409,7 +450,7 @@ def check_contract(table: ReboundTable, where: str, law: dict) -> None:
             names = list(LAW_ATTRIBUTES[:-1]) + [f"second_moment_factors[{k}]" for k in range(4)]
             refuse(f"the attribute {names[differ[0]]} of group 'grid' ({copied[differ[0]]!r}) differs from its "
                    f"checksummed copy in 'grid/law' ({found[differ[0]]!r})")
-    if "shape_codes" in law and [int(c) for c in np.ravel(law["shape_codes"])] != [SHAPE_NAMES.index(s) for s in table.shapes]:
+    if "shape_codes" in law and np.ravel(law["shape_codes"]).tolist() != shape_codes(table.shapes).tolist():
         refuse(f"dataset 'grid/shapes' {list(table.shapes)} differs from its checksummed copy 'grid/shape_codes' "
                f"{np.ravel(law['shape_codes']).tolist()}")
     cells, m = table.cells, table.resolution.dictionary_size
@@ -484,6 +525,22 @@ def _direct_model_attributes(f: h5py.File, minor: int) -> dict:
                    for name, default in BUILT_WITH_TOLERANCES.items()})
 
 
+def _read_group(group: h5py.Group) -> dict:
+    """Every dataset of :data:`SHAPE_DATASETS` in ``group``, converted to its dtype; DataFormatError naming one
+    that is missing, of another class (strings, integers, floats: as the C loader's H5Tget_class) or cannot be
+    read."""
+    arrays = {}
+    for name, (dtype, _, _) in SHAPE_DATASETS.items():
+        where = f"{group.file.filename}: dataset '{group.name.lstrip('/')}/{name}'"
+        if name not in group:
+            raise DataFormatError(f"{group.file.filename}: missing dataset '{group.name.lstrip('/')}/{name}'")
+        stored, wanted = group[name].dtype, np.dtype(dtype)
+        if not isinstance(group[name], h5py.Dataset) or stored.kind.replace("u", "i") != wanted.kind.replace("u", "i"):
+            raise DataFormatError(f"{where} is of type {stored}, expected {wanted}")
+        arrays[name] = _read(group, name).astype(wanted)
+    return arrays
+
+
 def _read(group: h5py.Group, name: str) -> np.ndarray:
     """A dataset's array; DataFormatError naming it if it cannot be read (its checksum fails, say)."""
     try:
@@ -496,7 +553,7 @@ def _read(group: h5py.Group, name: str) -> np.ndarray:
 # root attributes the fingerprint covers: the layout and the build's recipe (docs/format.md, "Fingerprint"); not
 # created, package_version or model_sha256, which say when and by which code, not what the table holds
 FINGERPRINT_ROOT_ATTRIBUTES = ("file_type", "format_version", "config", "config_sha256", "master_seed")
-FINGERPRINT_GROUPS = ("grid", "resolution", "cells")
+FINGERPRINT_GROUPS = ("grid", "resolution", "cells", SHAPES_GROUP)     # those the table has (shapes: 3.4)
 
 
 def table_fingerprint(path) -> str:
@@ -522,7 +579,7 @@ def table_fingerprint(path) -> str:
     with h5py.File(path, "r") as f:
         for name in FINGERPRINT_ROOT_ATTRIBUTES:
             feed(f"@{name}", f.attrs[name])
-        for group in FINGERPRINT_GROUPS:
+        for group in (g for g in FINGERPRINT_GROUPS if g in f):
             for name in sorted(f[group].attrs):
                 feed(f"{group}@{name}", f[group].attrs[name])
             for name in sorted(f[group]):

@@ -45,7 +45,7 @@ from surrogate.kernels.direct_path import direct_rebound_parallel_rng
 from surrogate.kernels.locate import mix_shapes
 from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
-from surrogate.kernels.wall_hit import METHOD_TABLE, rebound_parallel_rng
+from surrogate.kernels.wall_hit import METHOD_DIRECT, METHOD_TABLE, rebound_parallel_rng
 from surrogate.table import SurrogateTable
 from surrogate.validation import (as_rows, check_direct_parameters, check_direct_paths, check_half_size,
                                   check_incident, check_interpolation, check_local_states, check_method, check_omega,
@@ -144,7 +144,9 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     failed; rare, never dropped: count them with ``status == surrogate.STATUS_FAILED``); NaN rows unless
     rebounded. Every check runs before anything is written: on a ValueError the ``out`` arrays are unchanged.
     The direct model needs ``table.direct_parameters``: with a table that lacks them, a hit the model must
-    answer is a ValueError.
+    answer is a ValueError. It takes the four families only, so far: a user's grain (a table of format 3.4)
+    under ``method="direct"`` is a ValueError, and under ``"auto"`` a hit of one that the model would answer
+    gets status -1 (invalid) and NaN.
     """
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
     n_particles = V.shape[0]
@@ -152,6 +154,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # the grid's range is an error only where the table must answer every hit
     check_incident(table, V, nrm, a, grid=not clamp and code == METHOD_TABLE)
     cdf, shapes = check_shape(table, shape, n_particles)
+    if code == METHOD_DIRECT:
+        _check_direct_shapes(table, cdf, shapes)
     scaled = check_interpolation(interpolation)
     outputs = check_out(out, n_particles, (V, nrm, a, W), 4 if return_path else 3)
     old_table = table.direct_parameters is None and code != METHOD_TABLE
@@ -198,7 +202,8 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     -------
     (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8): STATUS_REBOUNDED (0), STATUS_TRAPPED (1)
     or STATUS_FAILED (2, a collision solve or contact search failed); NaN rows unless rebounded. A table
-    without ``direct_parameters`` is a ValueError.
+    without ``direct_parameters``, or a mix giving weight to a user's grain (the model takes the four families
+    only, so far), is a ValueError.
     """
     params = check_direct_parameters(table)
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
@@ -206,6 +211,7 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # every state moving into its wall is in the model's range: the table's grid is no error here
     check_incident(table, V, nrm, a, grid=False)
     cdf, shapes = check_shape(table, shape, n_particles)
+    _check_direct_shapes(table, cdf, shapes)
     V_out, Omega_out, status = check_out(out, n_particles, (V, nrm, a, W))
     generator = check_random_state(random_state)
     if shapes.size == 0:
@@ -215,6 +221,16 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     direct_rebound_parallel_rng(params, codes, V, as_rows(W, n_particles), as_rows(nrm, n_particles),
                                 as_rows(a, n_particles), states, V_out, Omega_out, status)
     return V_out, Omega_out, status
+
+
+def _check_direct_shapes(table: SurrogateTable, cdf: np.ndarray, shapes: np.ndarray) -> None:
+    """ValueError naming a user's grain the direct model would have to answer (those of ``shapes``, or of positive
+    weight in ``cdf``): the direct model takes the four families only, so far; the table path draws any shape."""
+    used = np.unique(shapes) if shapes.size else np.flatnonzero(np.diff(cdf, prepend=0.0) > 0.0)
+    grains = [table.shapes[k] for k in used if table.model_shapes[k] < 0]
+    if grains:
+        raise ValueError(f"The direct model does not take the user's grain {grains[0]!r} yet (the four families "
+                         f"only); draw it from the table (sample_global with method='table').")
 
 
 def _mix_rows(cdf: np.ndarray, n: int, generator: np.random.Generator) -> np.ndarray:

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from data_schema.common import DataFormatError
+from data_schema.shape_records import shape_arrays
 from data_schema.table import ReboundTable, read_table
 from direct_model.runtime import model_parameters
 from direct_model.shapes import SHAPES, AspectRatioLaw
@@ -40,12 +41,23 @@ class SurrogateTable:
     # the parameters of the direct model the table was built with, as the kernels take them
     # (:func:`direct_model.runtime.model_parameters`); None if the table does not record them
     direct_parameters: np.ndarray | None = None
+    # the registry record (direct_model.registry) of each shape, table order, as the table holds it (format 3.4)
+    # or, for an older table, the families' at its κ and aspect-ratio law
+    records: tuple = ()
 
     @functools.cached_property
     def model_shapes(self) -> np.ndarray:
         """The direct model's shape code (:data:`direct_model.shapes.SHAPES`) of each of the table's shapes, in
-        the table's order: read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound` takes it."""
-        return frozen(np.array([SHAPES.index(name) for name in self.shapes], dtype=np.int64))
+        the table's order, −1 for a user's grain (the direct model does not take one yet: such a hit gets
+        STATUS_INVALID): read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound` takes it."""
+        return frozen(np.array([SHAPES.index(r.name) if r.name in SHAPES else -1 for r in self.records],
+                               dtype=np.int64))
+
+    @functools.cached_property
+    def shape_arrays(self) -> dict:
+        """The records as the arrays of the table's group /shapes (:data:`data_schema.shape_records.SHAPE_DATASETS`:
+        kind, vertex_start, vertices, inertia, aspect, both_hands, ...), read-only: the form kernels take."""
+        return {name: frozen(values) for name, values in shape_arrays(self.records).items()}
 
     @property
     def alpha1_range(self) -> tuple:
@@ -66,7 +78,7 @@ class SurrogateTable:
                    speed_m_s=frozen(speed), particles_per_cell=table.particles_per_cell, n_max=table.n_max,
                    config_sha256=table.config_sha256, restitution_k=table.restitution_k,
                    restitution_p=table.restitution_p, kernel_data=data,
-                   direct_parameters=_read_direct_parameters(table, path))
+                   direct_parameters=_read_direct_parameters(table, path), records=table.shape_records())
 
 
 def _read_direct_parameters(table: ReboundTable, path: str) -> np.ndarray | None:

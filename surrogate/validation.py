@@ -140,8 +140,9 @@ def _shape_indices(table, names) -> np.ndarray:
     """(n,) int64: the table's index of each name; ValueError naming the first unknown or absent one."""
     index = {name: k for k, name in enumerate(table.shapes)}
     for i, name in enumerate(names):
-        if name not in SHAPE_NAMES:
-            raise ValueError(f"The 'shape' at index {i} must be one of {', '.join(SHAPE_NAMES)}; got {name!r}.")
+        if name not in SHAPE_NAMES and name not in index:
+            raise ValueError(f"The 'shape' at index {i} must be one of the table's shapes ({', '.join(table.shapes)}) "
+                             f"or a built-in ({', '.join(SHAPE_NAMES)}); got {name!r}.")
         if name not in index:
             raise ValueError(f"The 'shape' at index {i}, {name!r}, is not in the table {table.path} (it holds "
                              f"{', '.join(table.shapes)}).")
@@ -190,8 +191,9 @@ def mix_cdf(table, shape) -> np.ndarray:
                              f"got {values!r}.")
         weights = dict(zip(SHAPE_NAMES, values))
     for name, w in weights.items():
-        if name not in SHAPE_NAMES:
-            raise ValueError(f"The 'shape' parameter must name one of {', '.join(SHAPE_NAMES)}; got {name!r}.")
+        if name not in SHAPE_NAMES and name not in table.shapes:
+            raise ValueError(f"The 'shape' parameter must name one of the table's shapes ({', '.join(table.shapes)}) "
+                             f"or a built-in ({', '.join(SHAPE_NAMES)}); got {name!r}.")
         if not (np.isfinite(w) and w >= 0):
             raise ValueError(f"The mix weight of {name!r} must be finite and >= 0; got {float(w)!r}.")
         if w > 0 and name not in table.shapes:

@@ -97,8 +97,11 @@ int main(int argc, char **argv)
         return 1;
     }
     fclose(f);
-    rbs_mix mix;
-    rbs_mix_equal(table, &mix);
+    rbs_mix *mix = rbs_mix_new_equal(table);      /* the table's shapes, however many, equal weights */
+    if (!mix) {
+        fprintf(stderr, "out of memory\n");
+        return 1;
+    }
     /* first touch of the outputs, and a warm-up of every loop */
     for (size_t i = 0; i < 3 * N; i++) V_out[i] = Omega_out[i] = 0.0;
     rbs_rng rng;
@@ -117,7 +120,7 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < N; i++) {
             double u[RBS_U_PER_DRAW];
             rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
-            status[i] = (signed char)rbs_table_rebound(table, &mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
+            status[i] = (signed char)rbs_table_rebound(table, mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
                                                        V_out + 3 * i, Omega_out + 3 * i);
         }
         dt = now() - t0;
@@ -127,7 +130,7 @@ int main(int argc, char **argv)
         rbs_rng_seed(&rng, seed);
         t0 = now();
         c0 = cpu_now();
-        rbs_table_rebound_many_rng(table, &mix, N, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+        rbs_table_rebound_many_rng(table, mix, N, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[1], &cpu[1]);
         checksum += V_out[0];
@@ -143,7 +146,7 @@ int main(int argc, char **argv)
         /* (3) many particles, uniforms given */
         t0 = now();
         c0 = cpu_now();
-        rbs_table_rebound_many(table, &mix, N, V, n, a, U, RBS_SCALED, V_out, Omega_out, status);
+        rbs_table_rebound_many(table, mix, N, V, n, a, U, RBS_SCALED, V_out, Omega_out, status);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[2], &cpu[2]);
         checksum += V_out[0];
@@ -172,7 +175,7 @@ int main(int argc, char **argv)
         t0 = now();
         c0 = cpu_now();
         for (size_t i = 0; i < N; i++)
-            status[i] = (signed char)rbs_rebound_rng(table, &mix, V + 3 * i, still, n + 3 * i, a[i], &rng, RBS_AUTO,
+            status[i] = (signed char)rbs_rebound_rng(table, mix, V + 3 * i, still, n + 3 * i, a[i], &rng, RBS_AUTO,
                                                      RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[5], &cpu[5]);
@@ -200,7 +203,7 @@ int main(int argc, char **argv)
     rbs_rng_seed(&rng, seed);
     double t0 = now();
     for (size_t i = 0; i < n_spin; i++)
-        status[i] = (signed char)rbs_rebound_rng(table, &mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
+        status[i] = (signed char)rbs_rebound_rng(table, mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
                                                  RBS_AUTO, RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
     double spinning_us = (now() - t0) / (double)n_spin * 1e6;
     size_t spin_failed = 0;
@@ -222,6 +225,7 @@ int main(int argc, char **argv)
     free(Omega_out);
     free(U);
     free(status);
+    rbs_mix_free(mix);
     rbs_table_close(table);
     return 0;
 }

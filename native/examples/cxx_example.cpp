@@ -23,8 +23,9 @@ int main(int argc, char **argv)
         return 1;
     }
     std::unique_ptr<rbs_table, decltype(&rbs_table_close)> table(raw, &rbs_table_close);
-    rbs_mix mix;
-    rbs_mix_equal(table.get(), &mix);
+    // the table's shapes, however many, with equal weights; freed with the table's lifetime's end
+    std::unique_ptr<rbs_mix, decltype(&rbs_mix_free)> mix(rbs_mix_new_equal(table.get()), &rbs_mix_free);
+    if (!mix) return 1;
     rbs_rng rng;
     rbs_rng_seed_stream(&rng, 1, 0);
     const std::size_t count = 100;
@@ -35,14 +36,15 @@ int main(int argc, char **argv)
         V[3 * i + 1] = -60.0 - static_cast<double>(i);
         n[3 * i + 1] = 1.0;
     }
-    rbs_table_rebound_many_rng(table.get(), &mix, count, V.data(), n.data(), a.data(), &rng, RBS_SCALED,
+    rbs_table_rebound_many_rng(table.get(), mix.get(), count, V.data(), n.data(), a.data(), &rng, RBS_SCALED,
                                V_out.data(), Omega_out.data(), status.data());
     std::array<double, RBS_U_PER_DRAW> u{};
     rbs_rng_fill(&rng, u.data(), u.size());
     double one[3], spin[3];
-    int st = rbs_table_rebound(table.get(), &mix, V.data(), n.data(), 1e-4, u.data(), RBS_STOCHASTIC, one, spin);
+    int st = rbs_table_rebound(table.get(), mix.get(), V.data(), n.data(), 1e-4, u.data(), RBS_STOCHASTIC, one, spin);
     std::size_t rebounded = 0;
     for (signed char s : status) rebounded += s == RBS_REBOUNDED;
-    std::printf("C++: %zu of %zu rebounded; one more: status %d; library %s\n", rebounded, count, st, rbs_version());
+    std::printf("C++: %zu of %zu rebounded over %d shapes; one more: status %d; library %s\n", rebounded, count,
+                rbs_table_n_shapes(table.get()), st, rbs_version());
     return rebounded > 0 ? 0 : 1;
 }

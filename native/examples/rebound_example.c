@@ -26,8 +26,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "error %d (%s): %s\n", code, rbs_error_string(code), message);
         return 1;
     }
-    rbs_mix mix;
-    rbs_mix_equal(table, &mix);                 /* the four shapes with equal weights */
+    rbs_mix *mix = rbs_mix_new_equal(table);    /* the table's shapes, however many, with equal weights */
+    if (!mix) {
+        fprintf(stderr, "out of memory\n");
+        rbs_table_close(table);
+        return 1;
+    }
+    printf("%d shapes, the first %s\n", rbs_table_n_shapes(table), rbs_table_shape_name(table, 0));
     rbs_rng rng;
     rbs_rng_seed(&rng, 1);                      /* == surrogate.seed_state(1) */
 
@@ -43,7 +48,7 @@ int main(int argc, char **argv)
         double V_out[3], Omega_out[3];
         /* RBS_AUTO: the table where its law is valid, the direct model for the other hits */
         int path = rbs_rebound_path(table, V, Omega, n, a, RBS_AUTO);
-        int status = rbs_rebound_rng(table, &mix, V, Omega, n, a, &rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out);
+        int status = rbs_rebound_rng(table, mix, V, Omega, n, a, &rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out);
         printf("%d Omega- = (%g, %g, %g) rad/s, %s: status %2d  V+ = (%9.3f, %9.3f, %9.3f) m/s  "
                "Omega+ = (%11.1f, %11.1f, %11.1f) rad/s\n", i, Omega[0], Omega[1], Omega[2],
                path == RBS_PATH_TABLE ? "table" : "direct model", status, V_out[0], V_out[1], V_out[2],
@@ -51,6 +56,7 @@ int main(int argc, char **argv)
         rebounded += status == RBS_REBOUNDED;
     }
     printf("%d of %d rebounded\n", rebounded, count);
+    rbs_mix_free(mix);
     rbs_table_close(table);
     return 0;
 }

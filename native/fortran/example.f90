@@ -9,7 +9,7 @@ program rebound_example
   implicit none
   integer, parameter :: n_many = 1000
   type(c_ptr) :: table
-  type(rbs_mix) :: mix
+  type(rbs_mix), pointer :: mix
   type(rbs_rng) :: rng
   character(len=1024) :: path, message
   real(c_double) :: V(3), n(3), u(RBS_U_PER_DRAW), V_out(3), Omega_out(3), Omega(3), ud(RBS_U_PER_REBOUND)
@@ -27,7 +27,9 @@ program rebound_example
     print '(a, i0, 3a)', "error ", code, " (", rbs_error_string(code), "): " // trim(message)
     stop 1
   end if
-  code = rbs_mix_equal(table, mix)
+  mix => rbs_mix_new_equal(table)       ! a mix sized by the table: any number of shapes
+  if (.not. associated(mix)) stop 7
+  print '(i0, a)', rbs_table_n_shapes(table), " shapes, equal weights"
   call rbs_rng_seed(rng, 1_c_int64_t)
 
   ! one particle at a time, every hit answered (here no spin: the table answers)
@@ -65,6 +67,7 @@ program rebound_example
       " rebounded, ", count_status(RBS_TRAPPED), " trapped"
   if (count_status(RBS_REBOUNDED) + count_status(RBS_TRAPPED) /= n_many) stop 3
   if (any(status == RBS_REBOUNDED .and. Vs_out(2, :) <= 0.0_c_double)) stop 4   ! rebounds leave the wall
+  call rbs_mix_free(mix)
   call rbs_table_close(table)
   print '(a)', "ok"
 

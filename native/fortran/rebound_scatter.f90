@@ -23,7 +23,9 @@ module rebound_scatter
   integer(c_int), parameter :: RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1
   real(c_double), parameter :: RBS_SPIN_TOLERANCE = 0.001_c_double
 
-  ! cumulative shape weights in the table's shape order (rbs_mix)
+  ! cumulative shape weights in the table's shape order (rbs_mix). A mix of any table: a pointer from
+  ! rbs_mix_new_equal or rbs_mix_new_from_shape (freed by rbs_mix_free); a variable of this type holds a mix of a
+  ! table of at most RBS_MAX_SHAPES shapes (rbs_mix_equal, rbs_mix_from_shape). The draws take either.
   type, bind(c) :: rbs_mix
     integer(c_int) :: n_shapes
     real(c_double) :: cdf(RBS_MAX_SHAPES)
@@ -80,6 +82,25 @@ module rebound_scatter
       character(kind=c_char), dimension(*), intent(inout) :: message
       integer(c_size_t), value :: message_size
     end function rbs_mix_from_shape_c
+
+    type(c_ptr) function rbs_mix_new_equal_c(table) bind(c, name="rbs_mix_new_equal")
+      import :: c_ptr
+      type(c_ptr), value :: table
+    end function rbs_mix_new_equal_c
+
+    type(c_ptr) function rbs_mix_new_from_shape_c(table, name, message, message_size) &
+        bind(c, name="rbs_mix_new_from_shape")
+      import :: c_ptr, c_char, c_size_t
+      type(c_ptr), value :: table
+      character(kind=c_char), dimension(*), intent(in) :: name
+      character(kind=c_char), dimension(*), intent(inout) :: message
+      integer(c_size_t), value :: message_size
+    end function rbs_mix_new_from_shape_c
+
+    subroutine rbs_mix_free_c(mix) bind(c, name="rbs_mix_free")
+      import :: c_ptr
+      type(c_ptr), value :: mix
+    end subroutine rbs_mix_free_c
 
     ! Every wall hit: call this first. The table where its law is valid, the direct model elsewhere; Omega the
     ! incident angular velocity in rad/s; method RBS_AUTO, RBS_TABLE or RBS_DIRECT; u RBS_U_PER_DRAW uniforms
@@ -251,6 +272,34 @@ contains
     character(kind=c_char) :: buffer(512)
     code = rbs_mix_from_shape_c(table, trim(name) // c_null_char, mix, buffer, int(size(buffer), c_size_t))
   end function rbs_mix_from_shape
+
+  ! The equal mix of a table of any number of shapes, sized by the table; not associated if out of memory.
+  ! Pass it to the draws as any mix; free it with rbs_mix_free.
+  function rbs_mix_new_equal(table) result(mix)
+    type(c_ptr), intent(in) :: table
+    type(rbs_mix), pointer :: mix
+    mix => null()
+    call c_f_pointer(rbs_mix_new_equal_c(table), mix)
+  end function rbs_mix_new_equal
+
+  ! A mix of one shape of the table ("mix": equal weights), sized by the table; not associated for a name the
+  ! table does not hold. Free it with rbs_mix_free.
+  function rbs_mix_new_from_shape(table, name) result(mix)
+    type(c_ptr), intent(in) :: table
+    character(len=*), intent(in) :: name
+    type(rbs_mix), pointer :: mix
+    character(kind=c_char) :: buffer(512)
+    mix => null()
+    call c_f_pointer(rbs_mix_new_from_shape_c(table, trim(name) // c_null_char, buffer, &
+                                              int(size(buffer), c_size_t)), mix)
+  end function rbs_mix_new_from_shape
+
+  ! Free a mix of rbs_mix_new_equal or rbs_mix_new_from_shape (not associated: nothing); mix is nullified.
+  subroutine rbs_mix_free(mix)
+    type(rbs_mix), pointer, intent(inout) :: mix
+    if (associated(mix)) call rbs_mix_free_c(c_loc(mix))
+    mix => null()
+  end subroutine rbs_mix_free
 
   ! The description of an error code, as a Fortran string.
   function rbs_error_string(code) result(text)

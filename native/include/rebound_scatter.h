@@ -11,7 +11,8 @@
  * wall hit: it answers any hit, from the table where the table's law is valid (the table path), from the
  * direct model elsewhere (the direct path), per particle (surrogate.kernels.wall_hit.rebound). Before
  * the loop: rbs_table_open (a table `tablegen build` wrote, format 3.x, docs/format.md), a shape mix
- * (rbs_mix_equal, rbs_mix_from_shape, rbs_mix_from_weights) and one rbs_rng per thread.
+ * (rbs_mix_new_equal, rbs_mix_new_from_shape, rbs_mix_new_from_weights; "Shape mixes" below) and one rbs_rng per
+ * thread.
  * Each path can also be called alone: the table path rbs_table_rebound
  * (surrogate.kernels.table_path.table_rebound), its many-particle forms rbs_table_rebound_many and
  * rbs_table_rebound_many_rng (surrogate.kernels.pipeline), rbs_draw_local; the direct path
@@ -20,7 +21,9 @@
  * One naming rule: no suffix, the uniforms are given; _rng, they are drawn from an rbs_rng. One argument
  * order: table, the mix or the shape, V, Omega, n, a, the uniforms or the rng, then options and outputs.
  * Version 1.0 renamed the draws of 0.x; rbs_rebound_spin and rbs_rebound_path keep working with their 0.x
- * arguments (end of this header).
+ * arguments (end of this header). Version 1.1 reads tables of any number of shapes (format 3.4: the families and
+ * the user's own grains, each stored as data; rbs_table_shape_info) and adds the mixes sized by the table
+ * (rbs_mix_new_*); every 1.0 program compiles and runs unchanged on tables of at most 4 shapes.
  *
  * Frames and units
  * ----------------
@@ -51,7 +54,7 @@
  * Threads
  * -------
  * No global mutable state. An rbs_table is immutable once opened: any number
- * of threads may draw from one table at once. An rbs_mix is a plain value.
+ * of threads may draw from one table at once. An rbs_mix is read only by the draws: threads may share one.
  * An rbs_rng is mutable: one per thread (or per MPI rank, per stream), e.g.
  * rbs_rng_seed_stream(&rng, seed, thread_or_rank). rbs_table_open and
  * rbs_table_close call HDF5: call them from one thread at a time unless your
@@ -85,11 +88,13 @@ extern "C" {
 #endif
 
 #define RBS_VERSION_MAJOR 1
-#define RBS_VERSION_MINOR 0
+#define RBS_VERSION_MINOR 1
 #define RBS_VERSION_PATCH 0
 
 #define RBS_U_PER_DRAW 13       /* uniforms per draw (surrogate.U_PER_DRAW) */
-#define RBS_MAX_SHAPES 4        /* the direct model's shapes (direct_model.shapes.SHAPES), the most a table holds */
+#define RBS_MAX_SHAPES 4        /* the shapes an rbs_mix value holds (1.0's mix); a table may hold more ("Shape mixes") */
+#define RBS_TABLE_MAX_SHAPES 4096   /* the most shapes a table holds (data_schema.shape_records.MAX_TABLE_SHAPES) */
+#define RBS_SHAPE_NAME_SIZE 65  /* bytes of a shape's name with its NUL (direct_model.registry.NAME_PATTERN, 64 at most) */
 #define RBS_TABLE_MAJOR 3       /* the table format major version read (any minor) */
 #define RBS_BLOCK 32            /* rows per block of rbs_table_rebound_many*, lanes of rbs_table_rebound_many_rng */
 #define RBS_LOCAL_SIZE 6        /* outputs of rbs_draw_local */
@@ -101,8 +106,12 @@ extern "C" {
  * failed; count and report it, never drop it. */
 enum { RBS_REBOUNDED = 0, RBS_TRAPPED = 1, RBS_FAILED = 2, RBS_INVALID = -1 };
 
-/* Shape codes of the direct model (direct_model.shapes.SHAPES order; a table's own shape order may differ). */
+/* Shape codes of the direct model, its four built-in families (direct_model.shapes.SHAPES order; a table's own
+ * shape order may differ). */
 enum { RBS_ELLIPSOID = 0, RBS_PRISM = 1, RBS_CUT_PRISM = 2, RBS_TETRAHEDRON = 3 };
+
+/* Kinds of a shape (rbs_shape_info.kind; data_schema.shape_records.KIND_SMOOTH, KIND_POLYHEDRON). */
+enum { RBS_SMOOTH = 0, RBS_POLYHEDRON = 1 };
 
 /* Error codes. */
 enum {
@@ -129,11 +138,28 @@ enum { RBS_FLOAT64 = 0, RBS_FLOAT32 = 1 };
 /* A loaded table: opaque, immutable after rbs_table_open, shareable by threads. */
 typedef struct rbs_table rbs_table;
 
-/* Cumulative shape weights in the table's shape order (cdf[n_shapes - 1] = 1): surrogate.mix_cdf. */
+/* Cumulative shape weights in the table's shape order (cdf[n_shapes - 1] = 1): surrogate.mix_cdf.
+ * Two ways to hold one (section "Shape mixes"): a value of this type that the caller owns (1.0's way; tables of at
+ * most RBS_MAX_SHAPES shapes), or a pointer from rbs_mix_new_* (any table; free it with rbs_mix_free). The draws
+ * take either as `const rbs_mix *`. A mix of more than RBS_MAX_SHAPES shapes is longer than this struct: use it
+ * through its pointer only, never copy *mix (the copy would lose the weights past the fourth). */
 typedef struct rbs_mix {
     int n_shapes;
     double cdf[RBS_MAX_SHAPES];
 } rbs_mix;
+
+/* One shape of a table (rbs_table_shape_info), in the body frame (centre of mass at the origin, principal axes of
+ * inertia along ξ, η, ζ) and units of a (the largest half-extent along a principal axis), at b/a = c/b = 1. */
+typedef struct rbs_shape_info {
+    const char *name;           /* valid until rbs_table_close */
+    int kind;                   /* RBS_SMOOTH (the ellipsoid) or RBS_POLYHEDRON */
+    int family;                 /* RBS_ELLIPSOID .. RBS_TETRAHEDRON for a built-in family, −1 for a user's grain */
+    int n_vertices;             /* hull vertices (4 to 256), 0 for a smooth body */
+    const double *vertices;     /* n_vertices × 3, row-major, valid until rbs_table_close; NULL if none */
+    double inertia[3];          /* principal J/m along ξ, η, ζ, units of a² */
+    double aspect[4];           /* the law of b/a and c/b: mean, sd, low, high; NaN: fixed proportions */
+    int both_hands;             /* 1: half of the particles are the mirror image (ζ → −ζ) */
+} rbs_shape_info;
 
 /* One xoshiro256+ state (four 64-bit words, not all zero): one per thread / MPI rank / stream. */
 typedef struct rbs_rng {
@@ -177,6 +203,11 @@ const char *rbs_table_path(const rbs_table *table);
 int rbs_table_n_shapes(const rbs_table *table);
 const char *rbs_table_shape_name(const rbs_table *table, int i);
 
+/* The record of shape i as the table stores it (format 3.4, group /shapes; for an older table, the families' at
+ * its κ and aspect-ratio law, their inertia J/m = s (b² + c², ...) from its second-moment factors, NaN if it does
+ * not record them). RBS_OK, or RBS_ERR_ARGUMENT for a NULL table or info or i out of range. */
+int rbs_table_shape_info(const rbs_table *table, int i, rbs_shape_info *info);
+
 /* The α1 grid's first and last points, degrees; the |V⁻| grid's, m/s. */
 void rbs_table_alpha1_range(const rbs_table *table, double *lo_deg, double *hi_deg);
 void rbs_table_speed_range(const rbs_table *table, double *lo_m_s, double *hi_m_s);
@@ -201,18 +232,35 @@ int rbs_table_kernel_array(const rbs_table *table, const char *name, const void 
 
 /* ---------------------------------------------------------------- shape mixes */
 
-/* A mix from named weights (surrogate.mix_cdf with a dict): names among ellipsoid, prism, cut_prism,
- * tetrahedron, each at most once; weights finite and >= 0, summing to 1 within 1e-9 (summed in the
- * order given); a shape with a positive weight must be in the table. Shapes not named get weight 0.
- * Returns RBS_OK or RBS_ERR_ARGUMENT with a message. */
+/* A mix sized by the table, for a table of any number of shapes: allocated here, freed by rbs_mix_free, read only
+ * by the draws (threads may share it). Why a pointer: a table holds as many shapes as its build gave it (the
+ * families and the user's grains, up to RBS_TABLE_MAX_SHAPES), so a mix held by value would either fix a largest
+ * size in the binary interface again or change the size of the 1.0 rbs_mix that programs put on their stacks; a
+ * pointer to a block the library sizes does neither, and the draws keep taking `const rbs_mix *`, so a 1.0
+ * program's value mixes still work (tables of at most 4 shapes) and the two kinds never need two sets of draws.
+ * Migration from 1.0: `rbs_mix mix; rbs_mix_equal(table, &mix); ... &mix` becomes
+ * `rbs_mix *mix = rbs_mix_new_equal(table); ... mix; rbs_mix_free(mix);`.
+ *
+ * rbs_mix_new_from_weights: named weights (surrogate.mix_cdf with a dict): names of the table's shapes or
+ * built-in families (ellipsoid, prism, cut_prism, tetrahedron), each at most once; weights finite and >= 0,
+ * summing to 1 within 1e-9 (summed in the order given); a shape with a positive weight must be in the table.
+ * Shapes not named get weight 0. rbs_mix_new_from_shape: one shape alone (surrogate.mix_cdf(table, name)); "mix"
+ * gives the equal mix. rbs_mix_new_equal: equal weights over the table's shapes (surrogate.mix_cdf(table, "mix")).
+ * Each returns the mix, or NULL with a message (a bad argument, out of memory). */
+rbs_mix *rbs_mix_new_from_weights(const rbs_table *table, int n, const char *const names[], const double weights[],
+                                  char *message, size_t message_size);
+rbs_mix *rbs_mix_new_from_shape(const rbs_table *table, const char *name, char *message, size_t message_size);
+rbs_mix *rbs_mix_new_equal(const rbs_table *table);
+
+/* Free a mix of rbs_mix_new_* (NULL: nothing). Never pass it a value mix. */
+void rbs_mix_free(rbs_mix *mix);
+
+/* The same mixes into a value the caller owns (1.0): a table of at most RBS_MAX_SHAPES shapes, else
+ * RBS_ERR_ARGUMENT with a message saying to use rbs_mix_new_*. Returns RBS_OK or RBS_ERR_ARGUMENT. */
 int rbs_mix_from_weights(const rbs_table *table, int n, const char *const names[], const double weights[],
                          rbs_mix *mix, char *message, size_t message_size);
-
-/* One shape alone (surrogate.mix_cdf(table, name)); "mix" gives rbs_mix_equal. RBS_OK or RBS_ERR_ARGUMENT. */
 int rbs_mix_from_shape(const rbs_table *table, const char *name, rbs_mix *mix, char *message,
                        size_t message_size);
-
-/* The equal mix over the table's shapes (surrogate.mix_cdf(table, "mix")). RBS_OK or RBS_ERR_ARGUMENT. */
 int rbs_mix_equal(const rbs_table *table, rbs_mix *mix);
 
 /* ---------------------------------------------------------------- every wall hit: call this first */
@@ -237,7 +285,7 @@ enum { RBS_PATH_TABLE = 0, RBS_PATH_DIRECT = 1 };
  *   RBS_PATH_DIRECT  the shape drawn from the mix with u[0] as rbs_table_rebound draws it, then
  *                    rbs_direct_rebound with that shape's code and u[1..RBS_U_PER_REBOUND] as its uniforms.
  * A hit consumes RBS_U_PER_DRAW uniforms whatever the path, so streams stay aligned.
- *   mix      the shape mix (rbs_mix_equal, rbs_mix_from_shape, rbs_mix_from_weights)
+ *   mix      the shape mix (rbs_mix_new_equal, rbs_mix_new_from_shape, rbs_mix_new_from_weights, or a value mix)
  *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
  *   Omega    incident angular velocity Ω⁻, rad/s (finite)
  *   n        unit wall normal into the gas (| |n| − 1 | <= RBS_NORMAL_TOLERANCE)
@@ -323,7 +371,8 @@ int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg
  * the impulse model itself (docs/model.md), flights and collisions simulated, where the table's law does not
  * apply (a spinning particle, say). The same bits as the numba kernel for the same uniforms.
  *   shape    RBS_ELLIPSOID, RBS_PRISM, RBS_CUT_PRISM or RBS_TETRAHEDRON (any of the four, whatever
- *            shapes the table holds)
+ *            shapes the table holds). The model does not take a user's grain yet: under rbs_rebound, a hit of
+ *            one that the direct path answers gets RBS_INVALID (rbs_shape_info.family is −1 for those)
  *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
  *   Omega    incident angular velocity Ω⁻, rad/s (finite); exactly zero: the body starts touching the
  *            wall (the tables' case), otherwise the flight in from a clear start is simulated

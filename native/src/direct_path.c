@@ -21,7 +21,7 @@ static void nan_out(double *x)
 static int valid(int shape, const double *V, const double *Omega, const double *n, double a, const double *u)
 {
     int ok = rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2]) && rbs_particle_ok(n[0], n[1], n[2], a)
-             && rbs_finite(Omega[0] + Omega[1] + Omega[2]) && shape >= 0 && shape < RBS_MAX_SHAPES;
+             && rbs_finite(Omega[0] + Omega[1] + Omega[2]) && shape >= 0 && shape < RBS_N_FAMILIES;
     for (int k = 0; ok && k < RBS_U_PER_REBOUND; k++) ok = 0.0 <= u[k] && u[k] < 1.0;
     return ok;
 }

@@ -62,7 +62,6 @@
 #define N_SLOPES 15
 #define RESTITUTION_DEGREE 9   /* surrogate.kernels.fastmath.DEGREE */
 #define RESTITUTION_PIECE_RATIO 1.25   /* surrogate.kernels.fastmath.PIECE_RATIO */
-#define SHAPE_NAME_SIZE 32
 
 /* what makes a table valid (docs/format.md; data_schema.table.SPEED_GRID_RANGE, MAX_SPEED_RATIO,
  * WEIGHT_SUM_TOLERANCE) */
@@ -73,6 +72,21 @@
 #define CELL_VALUE_BOUND 1e6        /* |value| of cluster_loc, cluster_scale, cluster_slope, mean, std */
 #define DICTIONARY_BOUND_TOLERANCE 1e-6     /* relative, on the bound √L of a shape_dictionary knot */
 #define LAW_SIZE 16                 /* numbers in grid/law since 3.3 (data_schema.table.LAW_ATTRIBUTES) */
+#define SHAPES_SINCE 4              /* the minor version from which a table holds group /shapes (data_schema.table) */
+#define USER_SHAPE_CODE 255         /* grid/shape_codes of a shape that is no family (data_schema.shape_records) */
+
+/* The shapes of a table as data (data_schema.shape_records: group /shapes since 3.4; the families' records,
+ * synthesised, before), table order; shape_records.c reads, checks and frees them. Triangles are read to check
+ * them and their checksum, then freed: the runtime needs the vertices, not the surface. */
+typedef struct rbs_shape_records {
+    int8_t *kind;               /* (n) RBS_SMOOTH or RBS_POLYHEDRON */
+    int *family;                /* (n) RBS_ELLIPSOID .. RBS_TETRAHEDRON, or −1 for a user's grain */
+    int64_t *vertex_start;      /* (n + 1) shape i's vertices are rows vertex_start[i] .. vertex_start[i+1] − 1 */
+    double *vertices;           /* (vertex_start[n], 3) body frame, units of a, at b/a = c/b = 1 */
+    double *inertia;            /* (n, 3) principal J/m, units of a² */
+    double *aspect;             /* (n, 4) mean, sd, low, high of b/a and c/b; NaN row: fixed proportions */
+    uint8_t *both_hands;        /* (n) 0 or 1 */
+} rbs_shape_records;
 
 struct rbs_table {
     char *path;
@@ -80,7 +94,8 @@ struct rbs_table {
     int format_major, format_minor;
     long long particles_per_cell, n_max;
     double restitution_k, restitution_p;
-    char shape_names[RBS_MAX_SHAPES][SHAPE_NAME_SIZE];
+    char (*shape_names)[RBS_SHAPE_NAME_SIZE];       /* (n_shapes) names, grid/shapes */
+    rbs_shape_records shapes;
     double *alpha1_deg, *speed_m_s;                 /* the grids */
     double *alpha1_axis, *speed_axis;
     size_t alpha1_axis_len, speed_axis_len;
@@ -119,7 +134,24 @@ typedef struct rbs_raw_cells {
  * it does not give); the tolerances every build used; s per shape code at κ = 0.3 (NaN at another κ). */
 void rbs_config_aspect(const char *config, double aspect[4]);
 void rbs_built_with_tolerances(double *contact_tol, double *set_tol, long long *max_steps);
-void rbs_built_with_second_moment_factors(double kappa, double kfac[RBS_MAX_SHAPES]);
+void rbs_built_with_second_moment_factors(double kappa, double kfac[RBS_N_FAMILIES]);
+
+/* A mix of rbs_mix_new_*: the 1.0 value as its head (n_shapes; cdf too when n_shapes <= RBS_MAX_SHAPES), then
+ * the whole cdf. The draws reach it from the head's address (a pointer to a struct's first member converts back
+ * to the struct, C11 6.7.2.1). */
+typedef struct rbs_mix_block {
+    rbs_mix head;
+    double cdf[];
+} rbs_mix_block;
+
+/* the cumulative weights of a mix, value or block (n_shapes of them) */
+static inline const double *rbs_mix_cdf(const rbs_mix *mix)
+{
+    return mix->n_shapes <= RBS_MAX_SHAPES ? mix->cdf : ((const rbs_mix_block *)(const void *)mix)->cdf;
+}
+
+/* shape_records.c: free what a table's shape records hold (loader.h reads them) */
+void rbs_shape_records_free(rbs_shape_records *records);
 
 /* layout.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
  * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */

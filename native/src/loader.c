@@ -1,7 +1,8 @@
 /*
  * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), and the
- * accessors of a loaded table. The kernel arrays are derived in layout.c; what tables before format 3.3 leave
- * out is read by old_tables.c.
+ * accessors of a loaded table. The kernel arrays are derived in layout.c; the shapes (group shapes, format 3.4)
+ * are read by shape_records.c, with the helpers loader.h declares; what tables before format 3.3 leave out is
+ * read by old_tables.c.
  *
  * Every error names the file and what is wrong with it; HDF5's own error printing is switched off
  * around each HDF5 call that may fail (H5E_BEGIN_TRY), so the library prints nothing.
@@ -17,27 +18,11 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include <hdf5.h>
-
-#include "internal.h"
+#include "loader.h"
 
 #define TABLE_FILE_TYPE "rebound_table"
 
-/* what a failed step leaves: code and message (the first error wins) */
-typedef struct loader {
-    const char *path;
-    char *message;
-    size_t message_size;
-    int code;
-} loader;
-
-static int fail(loader *ld, int code, const char *format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-static int fail(loader *ld, int code, const char *format, ...)
+int rbs_fail(loader *ld, int code, const char *format, ...)
 {
     if (ld->code != RBS_OK) return ld->code;
     ld->code = code;
@@ -54,7 +39,7 @@ static int fail(loader *ld, int code, const char *format, ...)
 
 /* ------------------------------------------------------------------------- HDF5 helpers */
 
-static int link_exists(hid_t where, const char *name)
+int rbs_link_exists(hid_t where, const char *name)
 {
     htri_t found = 0;
     H5E_BEGIN_TRY { found = H5Lexists(where, name, H5P_DEFAULT); } H5E_END_TRY;
@@ -133,17 +118,17 @@ static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, 
 
 static int read_double_attribute(loader *ld, hid_t where, const char *group, const char *name, double *out)
 {
-    if (!attribute_exists(where, name)) return fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
+    if (!attribute_exists(where, name)) return rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
     if (read_numeric_attribute(where, name, H5T_NATIVE_DOUBLE, out, 1, 0) != 0)
-        return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one number", name, group);
+        return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one number", name, group);
     return RBS_OK;
 }
 
 static int read_integer_attribute(loader *ld, hid_t where, const char *group, const char *name, long long *out)
 {
-    if (!attribute_exists(where, name)) return fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
+    if (!attribute_exists(where, name)) return rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
     if (read_numeric_attribute(where, name, H5T_NATIVE_LLONG, out, 1, 1) != 0)
-        return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one integer", name, group);
+        return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one integer", name, group);
     return RBS_OK;
 }
 
@@ -151,22 +136,22 @@ static int read_integer_attribute(loader *ld, hid_t where, const char *group, co
 static hid_t open_group(loader *ld, hid_t file, const char *name)
 {
     hid_t group = -1;
-    if (!link_exists(file, name)) {
-        fail(ld, RBS_ERR_FORMAT, "missing group '%s'", name);
+    if (!rbs_link_exists(file, name)) {
+        rbs_fail(ld, RBS_ERR_FORMAT, "missing group '%s'", name);
         return -1;
     }
     H5E_BEGIN_TRY { group = H5Gopen2(file, name, H5P_DEFAULT); } H5E_END_TRY;
-    if (group < 0) fail(ld, RBS_ERR_FORMAT, "'%s' is not a readable group (truncated or corrupt?)", name);
+    if (group < 0) rbs_fail(ld, RBS_ERR_FORMAT, "'%s' is not a readable group (truncated or corrupt?)", name);
     return group;
 }
 
 /* The shape of dataset `name` in `group`: its rank into *rank and dims (up to 8); 0 on success. */
-static int dataset_shape(loader *ld, hid_t group, const char *group_name, const char *name, int *rank,
-                         hsize_t dims[8])
+int rbs_dataset_shape(loader *ld, hid_t group, const char *group_name, const char *name, int *rank,
+                      hsize_t dims[8])
 {
     hid_t ds = -1, space = -1;
     int r = -1;
-    if (!link_exists(group, name)) return fail(ld, RBS_ERR_FORMAT, "missing dataset '%s/%s'", group_name, name);
+    if (!rbs_link_exists(group, name)) return rbs_fail(ld, RBS_ERR_FORMAT, "missing dataset '%s/%s'", group_name, name);
     H5E_BEGIN_TRY {
         ds = H5Dopen2(group, name, H5P_DEFAULT);
         if (ds >= 0) space = H5Dget_space(ds);
@@ -175,19 +160,19 @@ static int dataset_shape(loader *ld, hid_t group, const char *group_name, const 
     } H5E_END_TRY;
     if (space >= 0) H5Sclose(space);
     if (ds >= 0) H5Dclose(ds);
-    if (r < 0 || r > 8) return fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated or corrupt?)", group_name, name);
+    if (r < 0 || r > 8) return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated or corrupt?)", group_name, name);
     *rank = r;
     return RBS_OK;
 }
 
 /* Read dataset `name` whole as `memtype` into a new buffer of `count` elements of `size` bytes, after
  * checking its shape is `rank` × `dims`. */
-static void *read_dataset(loader *ld, hid_t group, const char *group_name, const char *name, hid_t memtype,
-                          size_t size, int rank, const hsize_t *dims)
+void *rbs_read_dataset(loader *ld, hid_t group, const char *group_name, const char *name, hid_t memtype,
+                       size_t size, int rank, const hsize_t *dims)
 {
     int found_rank = 0;
     hsize_t found[8];
-    if (dataset_shape(ld, group, group_name, name, &found_rank, found) != RBS_OK) return NULL;
+    if (rbs_dataset_shape(ld, group, group_name, name, &found_rank, found) != RBS_OK) return NULL;
     int same = found_rank == rank;
     size_t count = 1;
     for (int i = 0; same && i < rank; i++) {
@@ -202,12 +187,12 @@ static void *read_dataset(loader *ld, hid_t group, const char *group_name, const
             snprintf(got + strlen(got), sizeof got - strlen(got), "%s%llu", i ? ", " : "", (unsigned long long)found[i]);
         strcat(want, ")");
         strcat(got, ")");
-        fail(ld, RBS_ERR_FORMAT, "dataset '%s/%s' has shape %s, expected %s", group_name, name, got, want);
+        rbs_fail(ld, RBS_ERR_FORMAT, "dataset '%s/%s' has shape %s, expected %s", group_name, name, got, want);
         return NULL;
     }
     void *buffer = malloc(count ? count * size : 1);
     if (!buffer) {
-        fail(ld, RBS_ERR_MEMORY, "out of memory reading dataset '%s/%s' (%zu elements)", group_name, name, count);
+        rbs_fail(ld, RBS_ERR_MEMORY, "out of memory reading dataset '%s/%s' (%zu elements)", group_name, name, count);
         return NULL;
     }
     herr_t status = -1;
@@ -219,21 +204,26 @@ static void *read_dataset(loader *ld, hid_t group, const char *group_name, const
     if (ds >= 0) H5Dclose(ds);
     if (status < 0) {
         free(buffer);
-        fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated, corrupt or failed checksum?)", group_name, name);
+        rbs_fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated, corrupt or failed checksum?)", group_name, name);
         return NULL;
     }
     return buffer;
 }
 
-/* The shape names (a 1-D dataset of strings) into the table. */
+/* The shape names (a 1-D dataset of strings, 1 to RBS_TABLE_MAX_SHAPES of them) into the table. */
 static int read_shapes(loader *ld, hid_t grid, rbs_table *t)
 {
     int rank = 0;
     hsize_t dims[8];
-    if (dataset_shape(ld, grid, "grid", "shapes", &rank, dims) != RBS_OK) return ld->code;
-    if (rank != 1 || dims[0] < 1 || dims[0] > RBS_MAX_SHAPES)
-        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must hold 1 to %d shape names", RBS_MAX_SHAPES);
+    if (rbs_dataset_shape(ld, grid, "grid", "shapes", &rank, dims) != RBS_OK) return ld->code;
+    if (rank != 1 || dims[0] < 1)
+        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must hold at least one shape name");
+    if (dims[0] > RBS_TABLE_MAX_SHAPES)
+        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' holds %llu shapes; a table may hold at most %d",
+                        (unsigned long long)dims[0], RBS_TABLE_MAX_SHAPES);
     int n = (int)dims[0], ok = 0;
+    t->shape_names = calloc((size_t)n, sizeof *t->shape_names);
+    if (!t->shape_names) return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory reading the shape names");
     hid_t ds = -1, type = -1, memtype = -1, space = -1;
     H5E_BEGIN_TRY {
         ds = H5Dopen2(grid, "shapes", H5P_DEFAULT);
@@ -241,14 +231,14 @@ static int read_shapes(loader *ld, hid_t grid, rbs_table *t)
         if (type >= 0 && H5Tget_class(type) == H5T_STRING) {
             memtype = H5Tcopy(H5T_C_S1);
             if (H5Tis_variable_str(type) > 0) {
-                char *names[RBS_MAX_SHAPES] = {NULL};
+                char **names = calloc((size_t)n, sizeof *names);
                 H5Tset_size(memtype, H5T_VARIABLE);
                 H5Tset_cset(memtype, H5Tget_cset(type));
-                if (H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, names) >= 0) {
+                if (names && H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, names) >= 0) {
                     ok = 1;
                     for (int i = 0; i < n; i++) {
-                        if (!names[i] || strlen(names[i]) >= SHAPE_NAME_SIZE) ok = 0;
-                        else snprintf(t->shape_names[i], SHAPE_NAME_SIZE, "%s", names[i]);
+                        if (!names[i] || strlen(names[i]) >= RBS_SHAPE_NAME_SIZE) ok = 0;
+                        else snprintf(t->shape_names[i], RBS_SHAPE_NAME_SIZE, "%s", names[i]);
                     }
                     space = H5Dget_space(ds);
 #if H5_VERSION_GE(1, 12, 0)
@@ -257,14 +247,16 @@ static int read_shapes(loader *ld, hid_t grid, rbs_table *t)
                     H5Dvlen_reclaim(memtype, space, H5P_DEFAULT, names);
 #endif
                 }
+                free(names);
             } else {
                 size_t length = H5Tget_size(type);
                 char *text = calloc((size_t)n, length + 1);
                 H5Tset_size(memtype, length + 1);
                 H5Tset_strpad(memtype, H5T_STR_NULLTERM);
-                if (text && length < SHAPE_NAME_SIZE && H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) >= 0) {
+                if (text && length < RBS_SHAPE_NAME_SIZE && H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) >= 0) {
                     ok = 1;
-                    for (int i = 0; i < n; i++) snprintf(t->shape_names[i], SHAPE_NAME_SIZE, "%s", text + (size_t)i * (length + 1));
+                    for (int i = 0; i < n; i++)
+                        snprintf(t->shape_names[i], RBS_SHAPE_NAME_SIZE, "%s", text + (size_t)i * (length + 1));
                 }
                 free(text);
             }
@@ -274,7 +266,9 @@ static int read_shapes(loader *ld, hid_t grid, rbs_table *t)
     if (memtype >= 0) H5Tclose(memtype);
     if (type >= 0) H5Tclose(type);
     if (ds >= 0) H5Dclose(ds);
-    if (!ok) return fail(ld, RBS_ERR_FORMAT, "cannot read the shape names of 'grid/shapes' (strings of fewer than %d bytes)", SHAPE_NAME_SIZE);
+    if (!ok)
+        return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the shape names of 'grid/shapes' (strings of fewer than %d bytes)",
+                        RBS_SHAPE_NAME_SIZE);
     t->n_shapes = n;
     return RBS_OK;
 }
@@ -286,23 +280,23 @@ static double *read_grid(loader *ld, hid_t grid, const char *name, double lo, in
 {
     int rank = 0;
     hsize_t dims[8];
-    if (dataset_shape(ld, grid, "grid", name, &rank, dims) != RBS_OK) return NULL;
+    if (rbs_dataset_shape(ld, grid, "grid", name, &rank, dims) != RBS_OK) return NULL;
     if (rank != 1 || dims[0] < 1 || dims[0] > 100000) {
-        fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be a 1-D grid of at least one point", name);
+        rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be a 1-D grid of at least one point", name);
         return NULL;
     }
-    double *values = read_dataset(ld, grid, "grid", name, H5T_NATIVE_DOUBLE, sizeof(double), 1, dims);
+    double *values = rbs_read_dataset(ld, grid, "grid", name, H5T_NATIVE_DOUBLE, sizeof(double), 1, dims);
     if (!values) return NULL;
     for (hsize_t i = 0; i < dims[0]; i++) {
         double x = values[i];
         if (!(open_low ? x > lo : x >= lo) || !(x <= hi) || (i > 0 && !(x > values[i - 1]))) {
-            fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be strictly increasing in %c%g, %g] %s (value %g at index "
+            rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' must be strictly increasing in %c%g, %g] %s (value %g at index "
                  "%llu)", name, open_low ? '(' : '[', lo, hi, units, x, (unsigned long long)i);
             free(values);
             return NULL;
         }
         if (ratio > 0.0 && i > 0 && x > ratio * values[i - 1]) {
-            fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' has consecutive speeds more than a factor %g apart (%g and %g "
+            rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/%s' has consecutive speeds more than a factor %g apart (%g and %g "
                  "%s)", name, ratio, values[i - 1], x, units);
             free(values);
             return NULL;
@@ -319,16 +313,16 @@ static hid_t check_file(loader *ld, rbs_table *t)
 {
     struct stat info;
     if (stat(ld->path, &info) != 0) {
-        fail(ld, RBS_ERR_IO, "no such file");
+        rbs_fail(ld, RBS_ERR_IO, "no such file");
         return -1;
     }
     if (!S_ISREG(info.st_mode)) {
-        fail(ld, RBS_ERR_IO, "not a regular file");
+        rbs_fail(ld, RBS_ERR_IO, "not a regular file");
         return -1;
     }
     FILE *probe = fopen(ld->path, "rb");
     if (!probe) {
-        fail(ld, RBS_ERR_IO, "cannot open the file for reading");
+        rbs_fail(ld, RBS_ERR_IO, "cannot open the file for reading");
         return -1;
     }
     fclose(probe);
@@ -339,29 +333,29 @@ static hid_t check_file(loader *ld, rbs_table *t)
         if (is_hdf5 > 0) file = H5Fopen(ld->path, H5F_ACC_RDONLY, H5P_DEFAULT);
     } H5E_END_TRY;
     if (file < 0) {
-        fail(ld, RBS_ERR_FORMAT, "not a readable HDF5 file (truncated or corrupt?)");
+        rbs_fail(ld, RBS_ERR_FORMAT, "not a readable HDF5 file (truncated or corrupt?)");
         return -1;
     }
     char found[128];
     if (!attribute_exists(file, "file_type") || read_string_attribute(file, "file_type", found, sizeof found) != 0) {
-        fail(ld, RBS_ERR_FORMAT, "file_type is missing, expected '%s'", TABLE_FILE_TYPE);
+        rbs_fail(ld, RBS_ERR_FORMAT, "file_type is missing, expected '%s'", TABLE_FILE_TYPE);
         H5Fclose(file);
         return -1;
     }
     if (strcmp(found, TABLE_FILE_TYPE) != 0) {
-        fail(ld, RBS_ERR_FORMAT, "file_type is '%s', expected '%s'", found, TABLE_FILE_TYPE);
+        rbs_fail(ld, RBS_ERR_FORMAT, "file_type is '%s', expected '%s'", found, TABLE_FILE_TYPE);
         H5Fclose(file);
         return -1;
     }
     long long version[2] = {0, 0};
     if (!attribute_exists(file, "format_version")
         || read_numeric_attribute(file, "format_version", H5T_NATIVE_LLONG, version, 2, 0) != 0) {
-        fail(ld, RBS_ERR_FORMAT, "missing or malformed 'format_version' attribute");
+        rbs_fail(ld, RBS_ERR_FORMAT, "missing or malformed 'format_version' attribute");
         H5Fclose(file);
         return -1;
     }
     if (version[0] != RBS_TABLE_MAJOR) {
-        fail(ld, RBS_ERR_VERSION, "format version %lld.%lld is not readable by this version of the library, which "
+        rbs_fail(ld, RBS_ERR_VERSION, "format version %lld.%lld is not readable by this version of the library, which "
              "reads major version %d; make the file again with a matching version of tablegen "
              "(docs/format.md, 'Identification and versions')", version[0], version[1], RBS_TABLE_MAJOR);
         H5Fclose(file);
@@ -393,17 +387,18 @@ static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dim
     }
 }
 
-/* The shape names: distinct, among the four (data_schema.table.check_contract). */
-static int check_shape_names(loader *ld, const rbs_table *t)
+/* A table before format 3.4 holds the built-in families only: its names distinct, each a family's
+ * (data_schema.table.check_contract; since 3.4 shape_records.c checks the names). */
+static int check_family_names(loader *ld, const rbs_table *t)
 {
-    static const char *const known[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
+    if (t->format_minor >= SHAPES_SINCE) return RBS_OK;
     for (int i = 0; i < t->n_shapes; i++) {
-        int found = 0;
-        for (int k = 0; k < RBS_MAX_SHAPES; k++) found |= strcmp(t->shape_names[i], known[k]) == 0;
+        int found = rbs_shape_code(t->shape_names[i]) >= 0;
         for (int j = 0; j < i; j++) found &= strcmp(t->shape_names[i], t->shape_names[j]) != 0;
         if (!found)
-            return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must name distinct shapes among ellipsoid, prism, "
-                        "cut_prism, tetrahedron; got '%s' at index %d", t->shape_names[i], i);
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must name distinct shapes among ellipsoid, prism, "
+                            "cut_prism, tetrahedron (a table before format 3.%d); got '%s' at index %d", SHAPES_SINCE,
+                            t->shape_names[i], i);
     }
     return RBS_OK;
 }
@@ -414,7 +409,7 @@ static int read_second_moment_factors(loader *ld, hid_t grid, double kfac[8], in
     hid_t attr = -1, space = -1;
     hssize_t count = -1;
     if (!attribute_exists(grid, "second_moment_factors"))
-        return fail(ld, RBS_ERR_FORMAT, "missing attribute 'second_moment_factors' of group 'grid'");
+        return rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute 'second_moment_factors' of group 'grid'");
     H5E_BEGIN_TRY {
         attr = H5Aopen(grid, "second_moment_factors", H5P_DEFAULT);
         if (attr >= 0) space = H5Aget_space(attr);
@@ -424,7 +419,7 @@ static int read_second_moment_factors(loader *ld, hid_t grid, double kfac[8], in
     if (attr >= 0) H5Aclose(attr);
     if (count < 1 || count > 8
         || read_numeric_attribute(grid, "second_moment_factors", H5T_NATIVE_DOUBLE, kfac, count, 0) != 0)
-        return fail(ld, RBS_ERR_FORMAT, "cannot read the attribute 'second_moment_factors' of group 'grid' as 1 to 8 "
+        return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the attribute 'second_moment_factors' of group 'grid' as 1 to 8 "
                     "numbers");
     *n_kfac = (int)count;
     return RBS_OK;
@@ -455,7 +450,7 @@ static int law_values(loader *ld, hid_t grid, double values[LAW_SIZE])
     int n_kfac = 0;
     if (read_second_moment_factors(ld, grid, kfac, &n_kfac) != RBS_OK) return ld->code;
     if (n + n_kfac != LAW_SIZE)
-        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%d,), expected (%d,) (the attribute "
+        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%d,), expected (%d,) (the attribute "
                     "'second_moment_factors' of group 'grid' holds %d numbers, not %d)", LAW_SIZE, n + n_kfac, n_kfac,
                     LAW_SIZE - n);
     memcpy(values + n, kfac, (size_t)n_kfac * sizeof(double));
@@ -463,23 +458,22 @@ static int law_values(loader *ld, hid_t grid, double values[LAW_SIZE])
 }
 
 /* Since 3.2: the checksummed copies grid/law and grid/shape_codes equal the attributes (restitution_k,
- * restitution_p in 3.2; every one of LAW_ATTRIBUTES since 3.3) and the names, bit for bit
- * (data_schema.table.check_contract). */
+ * restitution_p in 3.2; every one of LAW_ATTRIBUTES since 3.3) and the names (each family's code, USER_SHAPE_CODE
+ * for another shape), bit for bit (data_schema.table.check_contract, shape_codes). */
 static int check_law_copies(loader *ld, hid_t grid, const rbs_table *t)
 {
-    static const char *const known[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
     if (t->format_minor < 2) return RBS_OK;
     double attributes[LAW_SIZE] = {t->restitution_k, t->restitution_p};
     const int size = t->format_minor >= 3 ? LAW_SIZE : 2;
     if (size == LAW_SIZE && law_values(ld, grid, attributes) != RBS_OK) return ld->code;
     int rank = 0;
     hsize_t dims[8];
-    if (dataset_shape(ld, grid, "grid", "law", &rank, dims) != RBS_OK) return ld->code;
+    if (rbs_dataset_shape(ld, grid, "grid", "law", &rank, dims) != RBS_OK) return ld->code;
     if (rank != 1 || dims[0] != (hsize_t)size)
-        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%llu%s), expected (%d,)",
+        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%llu%s), expected (%d,)",
                     rank ? (unsigned long long)dims[0] : 0ULL, rank == 1 ? "," : ", ...", size);
     const hsize_t n_law = (hsize_t)size, shapes = (hsize_t)t->n_shapes;
-    double *law = read_dataset(ld, grid, "grid", "law", H5T_NATIVE_DOUBLE, sizeof(double), 1, &n_law);
+    double *law = rbs_read_dataset(ld, grid, "grid", "law", H5T_NATIVE_DOUBLE, sizeof(double), 1, &n_law);
     if (!law) return ld->code;
     int differ = -1;
     for (int i = 0; differ < 0 && i < size; i++)
@@ -488,19 +482,21 @@ static int check_law_copies(loader *ld, hid_t grid, const rbs_table *t)
         char name[64];
         if (differ < (int)N_LAW_ATTRIBUTES - 1) snprintf(name, sizeof name, "%s", LAW_ATTRIBUTES[differ]);
         else snprintf(name, sizeof name, "second_moment_factors[%d]", differ - ((int)N_LAW_ATTRIBUTES - 1));
-        fail(ld, RBS_ERR_FORMAT, "the attribute %s of group 'grid' (%.17g) differs from its checksummed copy in "
+        rbs_fail(ld, RBS_ERR_FORMAT, "the attribute %s of group 'grid' (%.17g) differs from its checksummed copy in "
              "'grid/law' (%.17g)", name, attributes[differ], law[differ]);
     }
     free(law);
     if (differ >= 0) return ld->code;
-    uint8_t *codes = read_dataset(ld, grid, "grid", "shape_codes", H5T_NATIVE_UINT8, 1, 1, &shapes);
+    uint8_t *codes = rbs_read_dataset(ld, grid, "grid", "shape_codes", H5T_NATIVE_UINT8, 1, 1, &shapes);
     if (!codes) return ld->code;
     int same = 1;
-    for (int i = 0; same && i < t->n_shapes; i++)
-        same = codes[i] < RBS_MAX_SHAPES && strcmp(known[codes[i]], t->shape_names[i]) == 0;
+    for (int i = 0; same && i < t->n_shapes; i++) {
+        int family = rbs_shape_code(t->shape_names[i]);
+        same = codes[i] == (family >= 0 ? family : USER_SHAPE_CODE);
+    }
     free(codes);
     if (!same)
-        return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' differs from its checksummed copy 'grid/shape_codes'");
+        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' differs from its checksummed copy 'grid/shape_codes'");
     return RBS_OK;
 }
 
@@ -525,13 +521,13 @@ static int check_dictionary(loader *ld, const float *dictionary, size_t rows, lo
     const size_t knots = (size_t)L + 1;
     for (size_t i = 0; i < rows * knots; i++)
         if (!(fabsf(dictionary[i]) <= bound))
-            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' holds %g at element %zu; its values must "
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' holds %g at element %zu; its values must "
                         "be in [-%.9g, %.9g] (sqrt of the levels %lld)", (double)dictionary[i], i, (double)bound,
                         (double)bound, L);
     for (size_t row = 0; row < rows; row++)
         for (size_t i = 1; i < knots; i++)
             if (dictionary[row * knots + i] < dictionary[row * knots + i - 1])
-                return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' row %zu decreases; each row (a "
+                return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' row %zu decreases; each row (a "
                             "quantile function) must be non-decreasing", row);
     return RBS_OK;
 }
@@ -544,7 +540,7 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
     do {                                                                                                           \
         FIRST_BAD(raw->field, n, ok, bad);                                                                         \
         if (bad < (n))                                                                                             \
-            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/%s' holds %g at element %zu; its values must be %s", \
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/%s' holds %g at element %zu; its values must be %s", \
                         #field, (double)raw->field[bad], bad, wanted);                                             \
     } while (0)
     RULE(cluster_weight, n_cells * C, isfinite(v) && v >= 0.0, "finite and >= 0");
@@ -565,10 +561,10 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
         double sum = 0.0;
         for (size_t c = 0; c < C; c++) sum += raw->cluster_weight[cell * C + c];
         if (!(fabs(sum - 1.0) <= WEIGHT_SUM_TOLERANCE))
-            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_weight' of cell %zu sums to %.17g; each cell's "
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/cluster_weight' of cell %zu sums to %.17g; each cell's "
                         "weights must sum to 1 within %g", cell, sum, WEIGHT_SUM_TOLERANCE);
         if (raw->status_counts[3 * cell] + raw->status_counts[3 * cell + 1] <= 0)
-            return fail(ld, RBS_ERR_FORMAT, "dataset 'cells/status_counts' of cell %zu has no rebounded or trapped "
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/status_counts' of cell %zu has no rebounded or trapped "
                         "particle", cell);
     }
     return RBS_OK;
@@ -596,11 +592,11 @@ static int direct_attributes(loader *ld, hid_t file, hid_t grid, const rbs_table
     } else {
         const size_t size = 1 << 20;
         char *config = malloc(size);
-        if (!config) return fail(ld, RBS_ERR_MEMORY, "out of memory reading the root attribute 'config'");
+        if (!config) return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory reading the root attribute 'config'");
         if (read_string_attribute(file, "config", config, size) == 0) rbs_config_aspect(config, aspect);
         free(config);
     }
-    *n_kfac = RBS_MAX_SHAPES;
+    *n_kfac = RBS_N_FAMILIES;
     if (required || attribute_exists(grid, "second_moment_factors")) {
         if (read_second_moment_factors(ld, grid, kfac, n_kfac) != RBS_OK) return ld->code;
     } else {
@@ -626,46 +622,49 @@ static double normal_cdf(double x)
 
 /* The direct model's parameters (surrogate.table.SurrogateTable.direct_parameters): none (has_direct = 0) if the table does
  * not record its second-moment factors, else the P_* array of direct_model.runtime.model_parameters after
- * the same range checks in the same order (RBS_ERR_FORMAT naming the value). */
-static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table *t, double kappa)
+ * the same range checks in the same order (RBS_ERR_FORMAT naming the value). The aspect-ratio law and the
+ * second-moment factors read (NaN where unknown) into aspect and family_kfac, for the shapes' records. */
+static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table *t, double kappa,
+                                  double aspect[4], double family_kfac[RBS_N_FAMILIES])
 {
-    double aspect[4], kfac[8], contact_tol, set_tol, q;
+    double kfac[8], contact_tol, set_tol, q;
     long long max_steps = 0;
     int n_kfac = 0;
     if (direct_attributes(ld, file, grid, t, kappa, aspect, kfac, &n_kfac, &contact_tol, &set_tol, &max_steps, &q) != RBS_OK)
         return ld->code;
+    for (int k = 0; k < RBS_N_FAMILIES; k++) family_kfac[k] = n_kfac == RBS_N_FAMILIES ? kfac[k] : NAN;
     for (int k = 0; k < n_kfac; k++)
         if (!isfinite(kfac[k])) return RBS_OK;
     /* tables without friction_q (before 3.1) were built before the wall law was configurable: q = 1 */
     if (!isfinite(q)) q = 1.0;
     double mean = aspect[0], sd = aspect[1], low = aspect[2], high = aspect[3];
     if (!(0.0 < low && low < high && high <= 1.0))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio bounds must satisfy 0 < low < high <= 1; got "
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio bounds must satisfy 0 < low < high <= 1; got "
                     "low=%.17g, high=%.17g.", low, high);
     if (!(sd > 0.0 && isfinite(sd)))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'sd' must be finite and > 0; got %.17g.", sd);
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'sd' must be finite and > 0; got %.17g.", sd);
     if (!isfinite(mean))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'mean' must be finite; got %.17g.", mean);
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'mean' must be finite; got %.17g.", mean);
     if (!(0.0 <= kappa && kappa < 1.0))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'kappa' parameter must be in [0, 1); got %.17g.", kappa);
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'kappa' parameter must be in [0, 1); got %.17g.", kappa);
     const long long two53 = 9007199254740992LL;
     if (!(t->n_max >= 1 && t->n_max < two53))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'n_max' parameter must be an integer in [1, 2**53); got %lld.",
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'n_max' parameter must be an integer in [1, 2**53); got %lld.",
                     t->n_max);
     if (!(max_steps >= 1 && max_steps < two53))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'max_steps' parameter must be an integer in [1, 2**53); got "
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'max_steps' parameter must be an integer in [1, 2**53); got "
                     "%lld.", max_steps);
     if (!(isfinite(contact_tol) && contact_tol > 0.0))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'contact_tol' parameter must be finite and > 0 (units of a); "
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'contact_tol' parameter must be finite and > 0 (units of a); "
                     "got %.17g.", contact_tol);
     if (!(isfinite(set_tol) && set_tol > 0.0))
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'set_tol' parameter must be finite and > 0 (units of a); got "
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'set_tol' parameter must be finite and > 0 (units of a); got "
                     "%.17g.", set_tol);
-    int kfac_ok = n_kfac == RBS_MAX_SHAPES;
+    int kfac_ok = n_kfac == RBS_N_FAMILIES;
     for (int k = 0; kfac_ok && k < n_kfac; k++) kfac_ok = kfac[k] > 0.0 && kfac[k] < 1.0;
     if (!kfac_ok)
-        return fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'second_moment_factors' parameter must be %d numbers in (0, "
-                    "1), one per shape code; got %d numbers, the first %.17g.", RBS_MAX_SHAPES, n_kfac, kfac[0]);
+        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'second_moment_factors' parameter must be %d numbers in (0, "
+                    "1), one per shape code; got %d numbers, the first %.17g.", RBS_N_FAMILIES, n_kfac, kfac[0]);
     double *p = t->direct_parameters;
     p[P_ASPECT_MEAN] = mean;
     p[P_ASPECT_SD] = sd;
@@ -681,7 +680,7 @@ static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table 
     p[P_CONTACT_TOL] = contact_tol;
     p[P_SET_TOL] = set_tol;
     p[P_MAX_STEPS] = (double)max_steps;
-    for (int k = 0; k < RBS_MAX_SHAPES; k++) p[P_KFAC + k] = kfac[k];
+    for (int k = 0; k < RBS_N_FAMILIES; k++) p[P_KFAC + k] = kfac[k];
     t->has_direct = 1;
     return RBS_OK;
 }
@@ -719,19 +718,19 @@ static int load(loader *ld, rbs_table *t)
     /* grid: the three datasets, then every cell dataset present (the Python reader's order of checks) */
     for (int i = 0; i < 3; i++) {
         static const char *const names[] = {"alpha1_deg", "speed_m_s", "shapes"};
-        if (!link_exists(grid, names[i])) {
-            fail(ld, RBS_ERR_FORMAT, "missing dataset 'grid/%s'", names[i]);
+        if (!rbs_link_exists(grid, names[i])) {
+            rbs_fail(ld, RBS_ERR_FORMAT, "missing dataset 'grid/%s'", names[i]);
             goto done;
         }
     }
     {
         char missing[512] = "";
         for (size_t i = 0; i < N_CELL_NAMES; i++)
-            if (!link_exists(cells, CELL_NAMES[i]))
+            if (!rbs_link_exists(cells, CELL_NAMES[i]))
                 snprintf(missing + strlen(missing), sizeof missing - strlen(missing), "%scells/%s",
                          missing[0] ? ", " : "", CELL_NAMES[i]);
         if (missing[0]) {
-            fail(ld, RBS_ERR_FORMAT, "missing dataset(s) %s", missing);
+            rbs_fail(ld, RBS_ERR_FORMAT, "missing dataset(s) %s", missing);
             goto done;
         }
     }
@@ -741,7 +740,7 @@ static int load(loader *ld, rbs_table *t)
         || read_integer_attribute(ld, resolution, "resolution", "levels", &L) != RBS_OK)
         goto done;
     if (C < 1 || C > 1000000 || M < 1 || M > 256 || L < 1 || L > 1000000) {
-        fail(ld, RBS_ERR_FORMAT, "inconsistent table: resolution clusters %lld, dictionary_size %lld, levels %lld "
+        rbs_fail(ld, RBS_ERR_FORMAT, "inconsistent table: resolution clusters %lld, dictionary_size %lld, levels %lld "
              "(each must be >= 1, dictionary_size <= 256)", C, M, L);
         goto done;
     }
@@ -753,7 +752,7 @@ static int load(loader *ld, rbs_table *t)
     for (int i = 0; i < 5; i++) {
         static const char *const names[] = {"created", "package_version", "config", "config_sha256", "master_seed"};
         if (!attribute_exists(file, names[i])) {
-            fail(ld, RBS_ERR_FORMAT, "missing root attribute '%s'", names[i]);
+            rbs_fail(ld, RBS_ERR_FORMAT, "missing root attribute '%s'", names[i]);
             goto done;
         }
     }
@@ -765,12 +764,12 @@ static int load(loader *ld, rbs_table *t)
         || read_integer_attribute(ld, grid, "grid", "n_max", &t->n_max) != RBS_OK)
         goto done;
     if (!(isfinite(t->restitution_k) && t->restitution_k > 0.0 && isfinite(t->restitution_p) && t->restitution_p > 0.0)) {
-        fail(ld, RBS_ERR_FORMAT, "the wall law attributes of group 'grid' must be finite and > 0: restitution_k = %g, "
+        rbs_fail(ld, RBS_ERR_FORMAT, "the wall law attributes of group 'grid' must be finite and > 0: restitution_k = %g, "
              "restitution_p = %g", t->restitution_k, t->restitution_p);
         goto done;
     }
     if (read_shapes(ld, grid, t) != RBS_OK) goto done;
-    if (check_shape_names(ld, t) != RBS_OK) goto done;
+    if (check_family_names(ld, t) != RBS_OK) goto done;
     t->alpha1_deg = read_grid(ld, grid, "alpha1_deg", 0.0, 1, 90.0, 0.0, "deg", &t->n_alpha1);
     if (!t->alpha1_deg) goto done;
     t->speed_m_s = read_grid(ld, grid, "speed_m_s", SPEED_GRID_MIN, 0, SPEED_GRID_MAX, MAX_SPEED_RATIO, "m/s",
@@ -781,7 +780,7 @@ static int load(loader *ld, rbs_table *t)
     const hsize_t lead[3] = {(hsize_t)t->n_shapes, (hsize_t)t->n_alpha1, (hsize_t)t->n_speed};
     const size_t n_cells = (size_t)t->n_shapes * (size_t)t->n_alpha1 * (size_t)t->n_speed;
     if ((double)n_cells * (double)C * ROW_SIZE > 4e9 || (double)n_cells * 6.0 * (double)M * (double)(L + 1) > 4e9) {
-        fail(ld, RBS_ERR_FORMAT, "inconsistent table: %zu cells of %lld components are too large", n_cells, C);
+        rbs_fail(ld, RBS_ERR_FORMAT, "inconsistent table: %zu cells of %lld components are too large", n_cells, C);
         goto done;
     }
     /* every cell dataset's shape (only metadata: nothing read yet) */
@@ -789,11 +788,11 @@ static int load(loader *ld, rbs_table *t)
         hsize_t want[8], found[8];
         int rank = 3 + cell_trailing(i, (hsize_t)C, (hsize_t)M, (hsize_t)L, want + 3), found_rank = 0;
         memcpy(want, lead, sizeof lead);
-        if (dataset_shape(ld, cells, "cells", CELL_NAMES[i], &found_rank, found) != RBS_OK) goto done;
+        if (rbs_dataset_shape(ld, cells, "cells", CELL_NAMES[i], &found_rank, found) != RBS_OK) goto done;
         int same = found_rank == rank;
         for (int k = 0; same && k < rank; k++) same = found[k] == want[k];
         if (!same) {
-            read_dataset(ld, cells, "cells", CELL_NAMES[i], H5T_NATIVE_DOUBLE, sizeof(double), rank, want);
+            rbs_read_dataset(ld, cells, "cells", CELL_NAMES[i], H5T_NATIVE_DOUBLE, sizeof(double), rank, want);
             goto done;
         }
     }
@@ -802,7 +801,7 @@ static int load(loader *ld, rbs_table *t)
 #define READ_CELLS(field, index, memtype, ctype)                                                              \
     do {                                                                                                      \
         int rank_ = 3 + cell_trailing(index, (hsize_t)C, (hsize_t)M, (hsize_t)L, dims + 3);                   \
-        raw.field = read_dataset(ld, cells, "cells", CELL_NAMES[index], memtype, sizeof(ctype), rank_, dims); \
+        raw.field = rbs_read_dataset(ld, cells, "cells", CELL_NAMES[index], memtype, sizeof(ctype), rank_, dims); \
         if (!raw.field) goto done;                                                                            \
     } while (0)
     READ_CELLS(cluster_weight, 0, H5T_NATIVE_DOUBLE, double);
@@ -823,10 +822,14 @@ static int load(loader *ld, rbs_table *t)
     {
         const char *what = NULL;
         int code = rbs_derive(t, &raw, &what);
-        if (code == RBS_ERR_MEMORY) fail(ld, code, "out of memory deriving the kernel arrays");
-        else if (code != RBS_OK) fail(ld, code, "the derived kernel array %s is not finite (inconsistent table)", what);
+        if (code == RBS_ERR_MEMORY) rbs_fail(ld, code, "out of memory deriving the kernel arrays");
+        else if (code != RBS_OK) rbs_fail(ld, code, "the derived kernel array %s is not finite (inconsistent table)", what);
     }
-    if (ld->code == RBS_OK) read_direct_parameters(ld, file, grid, t, kappa);
+    if (ld->code == RBS_OK) {
+        double aspect[4], kfac[RBS_N_FAMILIES];
+        if (read_direct_parameters(ld, file, grid, t, kappa, aspect, kfac) == RBS_OK)
+            rbs_shape_records_load(ld, file, t, kappa, aspect, kfac);
+    }
 
 done:
     free_raw(&raw);
@@ -843,15 +846,15 @@ int rbs_table_open(const char *path, rbs_table **table, char *message, size_t me
 {
     loader ld = {path ? path : "(null)", message, message_size, RBS_OK};
     if (message && message_size > 0) message[0] = '\0';
-    if (!table) return fail(&ld, RBS_ERR_ARGUMENT, "no place for the table (table is NULL)");
+    if (!table) return rbs_fail(&ld, RBS_ERR_ARGUMENT, "no place for the table (table is NULL)");
     *table = NULL;
-    if (!path) return fail(&ld, RBS_ERR_ARGUMENT, "no path given");
+    if (!path) return rbs_fail(&ld, RBS_ERR_ARGUMENT, "no path given");
     rbs_table *t = calloc(1, sizeof *t);
-    if (!t) return fail(&ld, RBS_ERR_MEMORY, "out of memory");
+    if (!t) return rbs_fail(&ld, RBS_ERR_MEMORY, "out of memory");
     t->path = malloc(strlen(path) + 1);
     if (!t->path) {
         free(t);
-        return fail(&ld, RBS_ERR_MEMORY, "out of memory");
+        return rbs_fail(&ld, RBS_ERR_MEMORY, "out of memory");
     }
     strcpy(t->path, path);
     if (load(&ld, t) != RBS_OK) {
@@ -875,6 +878,8 @@ void rbs_table_close(rbs_table *t)
     free(t->dictionary);
     free(t->speed_restitution);
     free(t->restitution_pieces);
+    free(t->shape_names);
+    rbs_shape_records_free(&t->shapes);
     free(t);
 }
 
@@ -885,6 +890,21 @@ int rbs_table_n_shapes(const rbs_table *t) { return t ? t->n_shapes : 0; }
 const char *rbs_table_shape_name(const rbs_table *t, int i)
 {
     return t && i >= 0 && i < t->n_shapes ? t->shape_names[i] : NULL;
+}
+
+int rbs_table_shape_info(const rbs_table *t, int i, rbs_shape_info *info)
+{
+    if (!t || !info || i < 0 || i >= t->n_shapes) return RBS_ERR_ARGUMENT;
+    const rbs_shape_records *r = &t->shapes;
+    info->name = t->shape_names[i];
+    info->kind = r->kind[i];
+    info->family = r->family[i];
+    info->n_vertices = (int)(r->vertex_start[i + 1] - r->vertex_start[i]);
+    info->vertices = info->n_vertices ? r->vertices + 3 * r->vertex_start[i] : NULL;
+    memcpy(info->inertia, r->inertia + 3 * i, sizeof info->inertia);
+    memcpy(info->aspect, r->aspect + 4 * i, sizeof info->aspect);
+    info->both_hands = r->both_hands[i];
+    return RBS_OK;
 }
 
 void rbs_table_alpha1_range(const rbs_table *t, double *lo, double *hi)

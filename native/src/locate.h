@@ -163,7 +163,7 @@ RBS_INLINE void rbs_locate_block(const rbs_table *t, const rbs_mix *mix, const d
             continue;
         }
         double ub[3] = {u[0][b], u[1][b], u[2][b]};
-        rbs_cell c = rbs_cell_of(t, mix->cdf, mix->n_shapes, f->alpha1[b], f->speed[b], ub);
+        rbs_cell c = rbs_cell_of(t, rbs_mix_cdf(mix), mix->n_shapes, f->alpha1[b], f->speed[b], ub);
         double x;
         int64_t first;
         k->drawn[b] = c.drawn;

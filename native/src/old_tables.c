@@ -19,7 +19,7 @@
 #define BUILT_WITH_SET_TOL 1e-9
 #define BUILT_WITH_MAX_STEPS 100000
 #define BUILT_WITH_KAPPA 0.3
-static const double BUILT_WITH_SECOND_MOMENT_FACTORS[RBS_MAX_SHAPES] = {
+static const double BUILT_WITH_SECOND_MOMENT_FACTORS[RBS_N_FAMILIES] = {
     0.2, 0.33333333333333337, 0.3309571404654277, 0.20000000000000004};
 static const char *const ASPECT_KEYS[4] = {"mean", "sd", "low", "high"};
 
@@ -30,9 +30,9 @@ void rbs_built_with_tolerances(double *contact_tol, double *set_tol, long long *
     *max_steps = BUILT_WITH_MAX_STEPS;
 }
 
-void rbs_built_with_second_moment_factors(double kappa, double kfac[RBS_MAX_SHAPES])
+void rbs_built_with_second_moment_factors(double kappa, double kfac[RBS_N_FAMILIES])
 {
-    for (int k = 0; k < RBS_MAX_SHAPES; k++) kfac[k] = kappa == BUILT_WITH_KAPPA ? BUILT_WITH_SECOND_MOMENT_FACTORS[k] : NAN;
+    for (int k = 0; k < RBS_N_FAMILIES; k++) kfac[k] = kappa == BUILT_WITH_KAPPA ? BUILT_WITH_SECOND_MOMENT_FACTORS[k] : NAN;
 }
 
 /* p past spaces and tabs */

@@ -13,7 +13,7 @@
 #include "pymath.h"
 #include "runtime.h"
 
-_Static_assert(RBS_TETRAHEDRON + 1 == RBS_MAX_SHAPES, "RBS_MAX_SHAPES counts the shape codes (N_PARAMS rests on it)");
+_Static_assert(RBS_TETRAHEDRON + 1 == RBS_N_FAMILIES, "RBS_N_FAMILIES counts the family codes (N_PARAMS rests on it)");
 
 double rbs_normal_quantile(double p)
 {

@@ -8,6 +8,7 @@
 #define RBS_RUNTIME_H
 
 #include "rebound_scatter.h"
+#include "shapes.h"
 
 /* layout of the parameter array (float64; direct_model.runtime: P_ASPECT_MEAN ... P_KFAC, N_PARAMS) */
 #define P_ASPECT_MEAN 0     /* the aspect-ratio law (b/a and c/b): mean, sd, low, high */
@@ -23,7 +24,7 @@
 #define P_SET_TOL 12        /* units of a */
 #define P_MAX_STEPS 13      /* search steps per flight */
 #define P_KFAC 14           /* second-moment factor s per shape code, 14..17 */
-#define N_PARAMS (P_KFAC + RBS_MAX_SHAPES)     /* one factor per shape code, as direct_model.runtime derives it */
+#define N_PARAMS (P_KFAC + RBS_N_FAMILIES)     /* one factor per family code, as direct_model.runtime derives it */
 
 /* the uniforms of one rebound (direct_model.runtime: U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS) */
 #define U_ORIENTATION 0

@@ -10,11 +10,11 @@
 #include "pymath.h"
 #include "shapes.h"
 
-const char *const rbs_shape_names[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
+const char *const rbs_shape_names[RBS_N_FAMILIES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
 
 int rbs_shape_code(const char *name)
 {
-    for (int k = 0; k < RBS_MAX_SHAPES; k++)
+    for (int k = 0; k < RBS_N_FAMILIES; k++)
         if (strcmp(name, rbs_shape_names[k]) == 0) return k;
     return -1;
 }

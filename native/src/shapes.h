@@ -10,11 +10,13 @@
 #include "rebound_scatter.h"
 
 #define MAX_VERTICES 24     /* direct_model.shapes.MAX_VERTICES: the cut prism's */
+#define RBS_N_FAMILIES 4    /* the built-in families, codes RBS_ELLIPSOID .. RBS_TETRAHEDRON (direct_model.shapes.SHAPES) */
 
-/* The shapes' names by code, RBS_ELLIPSOID .. RBS_TETRAHEDRON (direct_model.shapes.SHAPES) */
-extern const char *const rbs_shape_names[RBS_MAX_SHAPES];
+/* The built-in families' names by code (direct_model.shapes.SHAPES): the registry the loader consults for a
+ * table's built-in names and for the records of a table before format 3.4 */
+extern const char *const rbs_shape_names[RBS_N_FAMILIES];
 
-/* The code of a shape's name, −1 for a name that is none (direct_model.shapes.SHAPES.index) */
+/* The code of a built-in family's name, −1 for a name that is none (direct_model.shapes.SHAPES.index) */
 int rbs_shape_code(const char *name);
 
 /* out[0..n) = the body-frame vertices (row-major n × 3) of the polyhedron `shape` with half-extents a, b, c,

@@ -31,7 +31,7 @@ RBS_HOT int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const doub
     rbs_frame f;
     double x[6];
     rbs_impact_frame(Vi, ni, u[12], &f);
-    rbs_cell cell = rbs_cell_of(t, mix->cdf, mix->n_shapes, f.alpha1, f.speed, u);
+    rbs_cell cell = rbs_cell_of(t, rbs_mix_cdf(mix), mix->n_shapes, f.alpha1, f.speed, u);
     rbs_hint_draw(t, cell.drawn, u);
     int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, interpolation == RBS_SCALED, x);
     int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);
@@ -52,7 +52,7 @@ RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1
         nan_out(out, RBS_LOCAL_SIZE);
         return RBS_INVALID;
     }
-    rbs_cell cell = rbs_cell_of(t, mix->cdf, mix->n_shapes, alpha1_deg, speed_m_s, u);
+    rbs_cell cell = rbs_cell_of(t, rbs_mix_cdf(mix), mix->n_shapes, alpha1_deg, speed_m_s, u);
     rbs_hint_draw(t, cell.drawn, u);
     double sin_a1, cos_a1, x[6];
     rbs_sincos(alpha1_deg * RBS_DEG_TO_RAD, &sin_a1, &cos_a1);

@@ -9,6 +9,8 @@ import numpy as np
 
 from data_schema.samples import STATUS_NAMES
 from data_schema.table import ReboundTable, table_fingerprint
+from direct_model.registry import ConvexPolyhedron
+from direct_model.shapes import SHAPES
 
 STEP_DECIMALS = 9       # grid steps equal to this many decimals count as one step (round-off of {start, stop, step})
 
@@ -20,8 +22,22 @@ def _grid(values) -> str:
     return f"{len(v)} values, {v[0]:g} to {v[-1]:g}{step}"
 
 
+def _shape(record) -> str:
+    """One shape of a table: name, kind, vertex count, its aspect-ratio law and hands."""
+    if isinstance(record, ConvexPolyhedron):
+        kind = f"convex polyhedron, {len(record.vertices)} vertices"
+    else:
+        kind = "smooth body (ellipsoid)"
+    law = record.aspect
+    scaled = (f"b/a, c/b ~ N({law.mean:g}, {law.sd:g}) in [{law.low:g}, {law.high:g}]" if law is not None
+              else "fixed proportions")
+    built_in = "built-in" if record.name in SHAPES else "user grain"
+    return f"{record.name:<16} {built_in}, {kind}; {scaled}{'; both hands' if record.both_hands else ''}"
+
+
 def describe_table(table: ReboundTable, path: Path | None = None) -> str:
-    """Format version, fingerprint (with ``path``), grids, shapes, counts per cell (summarised), size, config hash."""
+    """Format version, fingerprint (with ``path``), grids, shapes (one line each: name, kind, vertex count, law),
+    counts per cell (summarised), size, config hash."""
     counts = table.cells["status_counts"]            # (shape, alpha, speed, status)
     total = counts.sum(axis=-1)
     lines = []
@@ -34,7 +50,8 @@ def describe_table(table: ReboundTable, path: Path | None = None) -> str:
         f"config sha256 {table.config_sha256}, master seed {table.master_seed}",
         f"alpha1 (deg): {_grid(table.alpha1_deg)}",
         f"speed (m/s):  {_grid(table.speed_m_s)}",
-        f"shapes: {', '.join(table.shapes)} (cut_prism kappa = {table.kappa:g}); n_max = {table.n_max}",
+        f"shapes: {len(table.shapes)} (cut_prism kappa = {table.kappa:g}); n_max = {table.n_max}",
+        *(f"  {_shape(record)}" for record in table.shape_records()),
         f"wall law: {table.wall_law or 'not recorded'} (k = {table.restitution_k:g}, p = {table.restitution_p:g}, "
         f"q = {table.friction_q:g})",
         f"cells: {total.size}, {table.particles_per_cell} particles each",

@@ -26,12 +26,12 @@ def test_build_time_host_and_descriptions_do_not_enter(small_table_path, fingerp
 
 
 def test_every_dataset_and_law_attribute_enters(small_table_path, fingerprint, tmp_path):
-    """One element of every dataset, one bit of every grid and resolution attribute, the root's recipe:
-    each change gives another fingerprint."""
+    """One element of every dataset (the shapes' records of format 3.4 too), one bit of every grid and resolution
+    attribute, the root's recipe: each change gives another fingerprint."""
     with h5py.File(small_table_path, "r") as f:
-        datasets = [f"{group}/{name}" for group in ("grid", "cells") for name in f[group]]
+        datasets = [f"{group}/{name}" for group in ("grid", "cells", "shapes") for name in f[group]]
         attributes = [(group, name) for group in ("grid", "resolution") for name in f[group].attrs]
-    assert len(datasets) == 18 and ("grid", "kappa") in attributes and ("grid", "aspect_ratio_sd") in attributes
+    assert len(datasets) == 27 and "shapes/vertices" in datasets and ("grid", "kappa") in attributes and ("grid", "aspect_ratio_sd") in attributes
     seen = {fingerprint}
 
     def change_dataset(name):

@@ -4,7 +4,6 @@ surrogate.load and rbs_table_open; test_native_programs.py: the C loader under t
 
 from __future__ import annotations
 
-
 import h5py
 import numpy as np
 
@@ -97,7 +96,7 @@ def bad_tables(good, folder) -> list:
 
     def format_3_1(f):      # a table written before 3.2: no checksummed copies of the law's attributes
         version(3, 1)(f)
-        del f["grid/law"], f["grid/shape_codes"]
+        del f["grid/law"], f["grid/shape_codes"], f["shapes"]
 
     cases.append((edited_copy(good, folder, "v3_1.h5", format_3_1), OK, ""))
     cases.append((edited_copy(good, folder, "no_version.h5", lambda f: f.attrs.__delitem__("format_version")),
@@ -157,7 +156,7 @@ def bad_tables(good, folder) -> list:
         names[0], names[1] = names[1], names[0]
         _replace(f, "grid/shapes", np.array(names, dtype=h5py.string_dtype()))
 
-    cases.append((edited_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shape_codes"))
+    cases.append((edited_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shapes"))
     for name, value in (("restitution_p", 0.0), ("restitution_p", -0.61), ("restitution_k", np.nan)):
         cases.append((edited_copy(good, folder, f"{name}_{value}.h5", _attribute("grid", name, value)), ERR_FORMAT, name))
 

@@ -75,6 +75,33 @@ class Mix(ctypes.Structure):
     _fields_ = [("n_shapes", ctypes.c_int), ("cdf", ctypes.c_double * MAX_SHAPES)]
 
 
+class ShapeInfo(ctypes.Structure):
+    _fields_ = [("name", ctypes.c_char_p), ("kind", ctypes.c_int), ("family", ctypes.c_int),
+                ("n_vertices", ctypes.c_int), ("vertices", ctypes.POINTER(ctypes.c_double)),
+                ("inertia", ctypes.c_double * 3), ("aspect", ctypes.c_double * 4), ("both_hands", ctypes.c_int)]
+
+
+class OwnedMix:
+    """A mix of rbs_mix_new_* (sized by the table), freed with rbs_mix_free on garbage collection."""
+
+    def __init__(self, lib, pointer):
+        self.lib, self.pointer = lib, pointer
+
+    @property
+    def n_shapes(self) -> int:
+        return self.pointer.contents.n_shapes
+
+    def __del__(self):
+        if self.pointer:
+            self.lib.c.rbs_mix_free(self.pointer)
+            self.pointer = None
+
+
+def _mix_ref(mix):
+    """What a draw takes for a mix: the pointer of an :class:`OwnedMix`, or a value :class:`Mix` by reference."""
+    return mix.pointer if isinstance(mix, OwnedMix) else ctypes.byref(mix)
+
+
 class Rng(ctypes.Structure):
     _fields_ = [("s", ctypes.c_uint64 * 4)]
 
@@ -155,11 +182,37 @@ class NativeTable:
         code = self.lib.c.rbs_mix_from_shape(self.handle, name.encode(), ctypes.byref(mix), message, len(message))
         return code, mix, message.value.decode()
 
+    def mix_new(self, shape="mix", weights: dict | None = None):
+        """(OwnedMix or None, message): rbs_mix_new_from_weights with ``weights``, else rbs_mix_new_from_shape
+        (``"mix"``: rbs_mix_new_equal)."""
+        c, message = self.lib.c, ctypes.create_string_buffer(1024)
+        if weights is not None:
+            names = (ctypes.c_char_p * max(1, len(weights)))(*[k.encode() for k in weights])
+            values = np.ascontiguousarray(list(weights.values()) or [0.0], dtype=np.float64)
+            pointer = c.rbs_mix_new_from_weights(self.handle, len(weights), names, _ptr(values), message,
+                                                 len(message))
+        elif shape == "mix":
+            pointer = c.rbs_mix_new_equal(self.handle)
+        else:
+            pointer = c.rbs_mix_new_from_shape(self.handle, shape.encode(), message, len(message))
+        return (OwnedMix(self.lib, pointer) if pointer else None), message.value.decode()
+
+    def shape_info(self, i: int) -> dict | None:
+        """rbs_table_shape_info of shape i as a dict (vertices copied), or None (RBS_ERR_ARGUMENT)."""
+        info = ShapeInfo()
+        if self.lib.c.rbs_table_shape_info(self.handle, i, ctypes.byref(info)) != OK:
+            return None
+        n = info.n_vertices
+        vertices = (np.ctypeslib.as_array(info.vertices, shape=(n, 3)).copy() if n else np.zeros((0, 3)))
+        return {"name": info.name.decode(), "kind": info.kind, "family": info.family, "vertices": vertices,
+                "inertia": np.array(info.inertia[:]), "aspect": np.array(info.aspect[:]),
+                "both_hands": info.both_hands}
+
     # -- draws
     def table_rebound(self, mix, V, n, a, u, interpolation=SCALED):
         V, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, u))
         V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_table_rebound(self.handle, ctypes.byref(mix), _ptr(V), _ptr(n), ctypes.c_double(a),
+        status = self.lib.c.rbs_table_rebound(self.handle, _mix_ref(mix), _ptr(V), _ptr(n), ctypes.c_double(a),
                                               _ptr(u), interpolation, _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out
 
@@ -168,7 +221,7 @@ class NativeTable:
         count = V.shape[0]
         assert n.shape == (count, 3) and a.shape == (count,) and u.shape == (count, U_PER_DRAW)
         V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        self.lib.c.rbs_table_rebound_many(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
+        self.lib.c.rbs_table_rebound_many(self.handle, _mix_ref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
                                           _ptr(a), _ptr(u), interpolation, _ptr(V_out), _ptr(W_out), _ptr(status))
         return status, V_out, W_out
 
@@ -178,7 +231,7 @@ class NativeTable:
         count = V.shape[0]
         rng = _rng(state)
         V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        self.lib.c.rbs_table_rebound_many_rng(self.handle, ctypes.byref(mix), ctypes.c_size_t(count), _ptr(V),
+        self.lib.c.rbs_table_rebound_many_rng(self.handle, _mix_ref(mix), ctypes.c_size_t(count), _ptr(V),
                                               _ptr(n), _ptr(a), ctypes.byref(rng), interpolation, _ptr(V_out),
                                               _ptr(W_out), _ptr(status))
         return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
@@ -194,7 +247,7 @@ class NativeTable:
     def rebound(self, mix, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
         V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
         V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
+        status = self.lib.c.rbs_rebound(self.handle, _mix_ref(mix), _ptr(V), _ptr(Omega), _ptr(n),
                                         ctypes.c_double(a), _ptr(u), method, interpolation, _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out
 
@@ -204,7 +257,7 @@ class NativeTable:
         V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
         rng = _rng(state)
         V_out, W_out = np.empty(3), np.empty(3)
-        status = getattr(self.lib.c, symbol)(self.handle, ctypes.byref(mix), _ptr(V), _ptr(Omega), _ptr(n),
+        status = getattr(self.lib.c, symbol)(self.handle, _mix_ref(mix), _ptr(V), _ptr(Omega), _ptr(n),
                                              ctypes.c_double(a), ctypes.byref(rng), method, interpolation,
                                              _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
@@ -216,7 +269,7 @@ class NativeTable:
     def draw_local(self, mix, alpha1, speed, u, interpolation=SCALED):
         u = np.ascontiguousarray(u, dtype=np.float64)
         out = np.empty(6)
-        status = self.lib.c.rbs_draw_local(self.handle, ctypes.byref(mix), ctypes.c_double(alpha1),
+        status = self.lib.c.rbs_draw_local(self.handle, _mix_ref(mix), ctypes.c_double(alpha1),
                                            ctypes.c_double(speed), _ptr(u), interpolation, _ptr(out))
         return status, out
 
@@ -254,6 +307,16 @@ class Native:
         c.rbs_mix_from_weights.restype = i
         c.rbs_mix_from_shape.argtypes = [vp, ctypes.c_char_p, ctypes.POINTER(Mix), ctypes.c_char_p, sz]
         c.rbs_mix_from_shape.restype = i
+        c.rbs_mix_new_equal.argtypes = [vp]
+        c.rbs_mix_new_equal.restype = ctypes.POINTER(Mix)
+        c.rbs_mix_new_from_shape.argtypes = [vp, ctypes.c_char_p, ctypes.c_char_p, sz]
+        c.rbs_mix_new_from_shape.restype = ctypes.POINTER(Mix)
+        c.rbs_mix_new_from_weights.argtypes = [vp, i, ctypes.POINTER(ctypes.c_char_p), vp, ctypes.c_char_p, sz]
+        c.rbs_mix_new_from_weights.restype = ctypes.POINTER(Mix)
+        c.rbs_mix_free.argtypes = [ctypes.POINTER(Mix)]
+        c.rbs_mix_free.restype = None
+        c.rbs_table_shape_info.argtypes = [vp, i, ctypes.POINTER(ShapeInfo)]
+        c.rbs_table_shape_info.restype = i
         c.rbs_table_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, d, vp, i, vp, vp]
         c.rbs_table_rebound.restype = i
         c.rbs_table_rebound_many.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, vp, i, vp, vp, vp]

@@ -44,6 +44,37 @@ def check_table_file(path) -> None:
     read_table(path)
 
 
+def user_grains(count: int, seed: int = 34) -> list:
+    """``count`` registry records of user grains: hulls of random point clouds (8 to 40 points, axes 1 : 0.45..1),
+    named grain_00, grain_01, ...; every third with an aspect-ratio law, every fifth drawn in both hands."""
+    import numpy as np
+    from direct_model.shapes import AspectRatioLaw
+    from tablegen.tabulation.grain_files import grain_from_points
+    rng = np.random.default_rng(seed)
+    records = []
+    for k in range(count):
+        points = rng.normal(size=(int(rng.integers(8, 41)), 3)) * np.sort(rng.uniform(0.45, 1.0, 3))[::-1]
+        law = AspectRatioLaw(0.85, 0.1, 0.6, 1.0) if k % 3 == 0 else None
+        records.append(grain_from_points(f"grain_{k:02d}", points, "test cloud", aspect=law, both_hands=k % 5 == 0))
+    return records
+
+
+def many_shape_table(source, path, n_shapes: int = 64) -> tuple:
+    """A table of ``n_shapes`` shapes written to ``path`` from the table at ``source`` (format 3.4): its own shapes
+    first, then user grains (:func:`user_grains`) whose cells are copies of the source's, shape k drawing the
+    cells of source shape k mod n_source (a synthetic table: the table path draws any cells). Returns the names."""
+    import dataclasses
+    import numpy as np
+    from data_schema.table import read_table, write_table
+    table = read_table(source)
+    own = table.shape_records()[:n_shapes]
+    records = tuple(own) + tuple(user_grains(n_shapes - len(own)))
+    rows = np.arange(n_shapes) % len(own)
+    cells = {name: np.ascontiguousarray(values[rows]) for name, values in table.cells.items()}
+    write_table(path, dataclasses.replace(table, shapes=tuple(r.name for r in records), records=records, cells=cells))
+    return tuple(r.name for r in records)
+
+
 def write_samples_file(path) -> None:
     """A small raw-samples file (another file type) at ``path``."""
     import numpy as np
@@ -56,6 +87,7 @@ def write_samples_file(path) -> None:
 
 __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", "rotation_at", "rotation_init",
            "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED", "U_PER_DRAW", "build_table", "check_table_file",
+           "many_shape_table", "user_grains",
            "draw_local", "fill_uniforms", "load", "mix_cdf", "table_rebound_many", "table_rebound_many_rng",
            "table_rebound", "table_rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
            "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",

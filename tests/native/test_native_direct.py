@@ -70,6 +70,7 @@ def _old_table(small_table_path, tmp_path, name, **changes):
     path.write_bytes(small_table_path.read_bytes())
     with h5py.File(path, "r+") as f:
         f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)      # its grid/law: restitution_k, _p
+        del f["shapes"]                                                    # and no group shapes (3.4)
         law = f["grid/law"][:2]
         del f["grid/law"]
         f["grid"].create_dataset("law", data=law, fletcher32=True)
@@ -105,13 +106,14 @@ def test_the_parameter_layout_is_direct_model_s(table_pair):
     """runtime.h's layout is direct_model.runtime's: every P_* offset, U_* index and N_PARAMS, which both sides
     derive from the shape count (P_KFAC, then one second-moment factor per shape code); the loader's array
     has N_PARAMS elements."""
-    c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", NATIVE / "src" / "runtime.h")
+    c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", NATIVE / "src" / "shapes.h",
+                         NATIVE / "src" / "runtime.h")
     c["U_PER_REBOUND"] = c["RBS_U_PER_REBOUND"]
     layout = re.compile(r"P_[A-Z_]+|U_[A-Z_]+|N_PARAMS")
     python = {name: value for name, value in vars(py.direct_runtime).items() if layout.fullmatch(name)}
     assert {"P_KFAC", "N_PARAMS", "U_AXIS"} <= set(python)
     assert {name: value for name, value in c.items() if layout.fullmatch(name)} == python
-    assert c["N_PARAMS"] == c["P_KFAC"] + len(py.SHAPES) == c["P_KFAC"] + c["RBS_MAX_SHAPES"]
+    assert c["N_PARAMS"] == c["P_KFAC"] + len(py.SHAPES) == c["P_KFAC"] + c["RBS_N_FAMILIES"]
     assert table_pair[1].kernel_array("direct_parameters").size == python["N_PARAMS"]
 
 

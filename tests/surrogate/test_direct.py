@@ -129,6 +129,7 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
     old.write_bytes(small_table_path.read_bytes())
     with h5py.File(old, "r+") as f:
         f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)      # its grid/law: restitution_k, _p
+        del f["shapes"]                                                    # and no group shapes (3.4)
         law = f["grid/law"][:2]
         del f["grid/law"]
         f["grid"].create_dataset("law", data=law, fletcher32=True)
@@ -181,10 +182,11 @@ def test_a_state_whose_flight_underflows_ends(params):
     (dict(normal=[0.0, 2.0, 0.0]), "The 'normal' at index 0 has length 2.0"),
     (dict(half_size=-1.0), "The 'half_size' at index 0 must be finite and > 0 m, with |V-|/a <= 1e+300 1/s"),
     (dict(omega=[0.0, np.inf, 0.0]), "The 'omega' vector at index 0 is not finite: [0.0, inf, 0.0]."),
-    (dict(shape="sphere"), "The 'shape' parameter must name one of ellipsoid, prism, cut_prism, tetrahedron; "
-                           "got 'sphere'."),
-    (dict(shape=["prism", "sphere"]), "The 'shape' at index 1 must be one of ellipsoid, prism, cut_prism, "
-                                      "tetrahedron; got 'sphere'."),
+    (dict(shape="sphere"), "The 'shape' parameter must name one of the table's shapes (ellipsoid, prism, cut_prism, "
+                           "tetrahedron) or a built-in (ellipsoid, prism, cut_prism, tetrahedron); got 'sphere'."),
+    (dict(shape=["prism", "sphere"]), "The 'shape' at index 1 must be one of the table's shapes (ellipsoid, prism, "
+                                      "cut_prism, tetrahedron) or a built-in (ellipsoid, prism, cut_prism, "
+                                      "tetrahedron); got 'sphere'."),
     (dict(shape=["prism"]), "The 'shape' parameter must be one shape name per particle, shape (2,); got (1,)."),
     (dict(velocity=np.zeros((2, 2))), "The 'velocity' parameter must have shape (N, 3); got (2, 2)."),
 ])

@@ -60,6 +60,7 @@
  *----------------------------------------------------------------------------*/
 
 #define RBS_CS_DEFAULT_SETUP "rebound_scatter.conf"
+#define RBS_CS_MAX_WEIGHTS 256     /* shape:weight items of the weights setting */
 #define RBS_CS_LINE 4096
 
 /* The solver's own rebound restarts the next segment this fraction of the
@@ -89,7 +90,7 @@ typedef struct {
 static int                 _initialized = 0;
 static rbs_cs_settings_t   _set;
 static rbs_table          *_table = NULL;
-static rbs_mix             _mix;
+static rbs_mix            *_mix = NULL;   /* sized by the table (rbs_mix_new_*) */
 static rbs_rng             _rng;
 static FILE               *_hits = NULL;
 static long long           _n_recorded = 0;
@@ -240,18 +241,18 @@ static void
 _parse_weights(const char *text)
 {
   char buf[RBS_CS_LINE], msg[512];
-  const char *names[RBS_MAX_SHAPES];
-  double weights[RBS_MAX_SHAPES];
+  const char *names[RBS_CS_MAX_WEIGHTS];
+  double weights[RBS_CS_MAX_WEIGHTS];
   int n = 0;
   snprintf(buf, sizeof(buf), "%s", text);
   for (char *item = strtok(buf, ","); item != NULL; item = strtok(NULL, ",")) {
     char *colon = strchr(item, ':');
     char *end = NULL;
-    if (colon == NULL || n == RBS_MAX_SHAPES)
+    if (colon == NULL || n == RBS_CS_MAX_WEIGHTS)
       bft_error(__FILE__, __LINE__, 0,
                 "rebound-scatter settings %s: weights must be up to %d "
                 "shape:weight items separated by commas, not \"%s\"",
-                _set.setup_path, RBS_MAX_SHAPES, text);
+                _set.setup_path, RBS_CS_MAX_WEIGHTS, text);
     *colon = '\0';
     names[n] = _trim(item);
     weights[n] = strtod(_trim(colon + 1), &end);
@@ -262,8 +263,8 @@ _parse_weights(const char *text)
                 _trim(colon + 1));
     n++;
   }
-  if (rbs_mix_from_weights(_table, n, names, weights, &_mix, msg, sizeof(msg))
-      != RBS_OK)
+  _mix = rbs_mix_new_from_weights(_table, n, names, weights, msg, sizeof(msg));
+  if (_mix == NULL)
     bft_error(__FILE__, __LINE__, 0,
               "rebound-scatter settings %s: bad weights \"%s\": %s",
               _set.setup_path, text, msg);
@@ -308,7 +309,8 @@ _read_settings(void)
   else {
     if (shape == NULL)
       shape = "mix";
-    if (rbs_mix_from_shape(_table, shape, &_mix, msg, sizeof(msg)) != RBS_OK)
+    _mix = rbs_mix_new_from_shape(_table, shape, msg, sizeof(msg));
+    if (_mix == NULL)
       bft_error(__FILE__, __LINE__, 0,
                 "rebound-scatter settings %s: bad shape \"%s\": %s",
                 _set.setup_path, shape, msg);
@@ -534,6 +536,8 @@ rbs_cs_finalize(void)
   if (_hits != NULL)
     fclose(_hits);
   _hits = NULL;
+  rbs_mix_free(_mix);
+  _mix = NULL;
   rbs_table_close(_table);
   _table = NULL;
   _initialized = 0;
@@ -624,7 +628,7 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
   double t0 = 0, Vout[3], Wout[3];
   if (path == RBS_PATH_DIRECT)
     t0 = cs_timer_wtime();
-  const int status = rbs_rebound_rng(_table, &_mix, V, Omega, n, a, &_rng,
+  const int status = rbs_rebound_rng(_table, _mix, V, Omega, n, a, &_rng,
                                      _set.method, _set.interpolation,
                                      Vout, Wout);
   if (path == RBS_PATH_DIRECT) {

@@ -135,12 +135,16 @@ void Foam::StochasticRebound<CloudType>::openTable(const dictionary& dict)
             weights[i] = wd.get<scalar>(names[i]);
             desc<< (i ? ", " : "") << names[i] << ' ' << weights[i];
         }
-        const int e = rbs_mix_from_weights
+        mix_.reset
         (
-            table, names.size(), cnames.cdata(), weights.cdata(), &mix_,
-            message, sizeof(message)
+            rbs_mix_new_from_weights
+            (
+                table, names.size(), cnames.cdata(), weights.cdata(),
+                message, sizeof(message)
+            ),
+            rbs_mix_free
         );
-        if (e != RBS_OK)
+        if (!mix_)
         {
             FatalIOErrorInFunction(dict)
                 << "Bad shape weights: " << message << exit(FatalIOError);
@@ -150,23 +154,14 @@ void Foam::StochasticRebound<CloudType>::openTable(const dictionary& dict)
     else
     {
         const word shape(dict.getOrDefault<word>("shape", "mix"));
-        int e = RBS_OK;
-        if (shape == "mix")
-        {
-            e = rbs_mix_equal(table, &mix_);
-            std::snprintf(message, sizeof(message), "no equal mix");
-        }
-        else
-        {
-            // One shape: the weight 1 on it
-            const char* names[1] = {shape.c_str()};
-            const double weights[1] = {1.0};
-            e = rbs_mix_from_weights
-            (
-                table, 1, names, weights, &mix_, message, sizeof(message)
-            );
-        }
-        if (e != RBS_OK)
+        // A mix sized by the table (any number of shapes): one shape, or
+        // "mix", equal weights over the table's shapes
+        mix_.reset
+        (
+            rbs_mix_new_from_shape(table, shape.c_str(), message, sizeof(message)),
+            rbs_mix_free
+        );
+        if (!mix_)
         {
             FatalIOErrorInFunction(dict)
                 << "Bad shape " << shape << ": " << message
@@ -485,7 +480,7 @@ bool Foam::StochasticRebound<CloudType>::correct
     }
     const int status = rbs_rebound
     (
-        table, &mix_, V, Omega, n, a, u, method_, interpolation_, Vout, Wout
+        table, mix_.get(), V, Omega, n, a, u, method_, interpolation_, Vout, Wout
     );
     if (path == RBS_PATH_DIRECT)
     {

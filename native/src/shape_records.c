@@ -1,0 +1,309 @@
+/*
+ * shape_records.c: the shapes a table holds, as data (data_schema.shape_records): group /shapes of a table of
+ * format 3.4 read and checked as check_shape_arrays and records_from_arrays check it, in the same order; the
+ * families' records synthesised for an older table (data_schema.shape_records.family_records). The only place
+ * the C library reads these arrays.
+ *
+ * A built-in family's row must be the family's record at the table's κ and aspect-ratio law: kind, vertices (the
+ * body of direct_model.registry.built_in_shape: rbs_body_vertices at b/a = c/b = 1, rows sorted and repeated
+ * corners dropped, as numpy.unique), law and hands are compared bit for bit here; the Python loader, which has
+ * the registry's surface and mass properties, also compares the triangles and inertia, and rebuilds a user's
+ * grain's inertia from its vertices.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "loader.h"
+#include "shapes.h"
+
+#define MIN_HULL_VERTICES 4         /* data_schema.shape_records.MIN_HULL_VERTICES */
+#define MAX_HULL_VERTICES 256       /* direct_model.registry.MAX_HULL_VERTICES */
+#define MIN_THICKNESS 1e-3          /* direct_model.registry.MIN_THICKNESS, units of a */
+#define FRAME_CHECK 1e-9            /* direct_model.registry.FRAME_CHECK */
+#define VERTEX_BOUND (1.5 * (1.0 + FRAME_CHECK))            /* data_schema.shape_records.VERTEX_BOUND */
+#define INERTIA_BOUND (2.0 * VERTEX_BOUND * VERTEX_BOUND)   /* data_schema.shape_records.INERTIA_BOUND */
+#define NAME_MAX_LENGTH (RBS_SHAPE_NAME_SIZE - 1)
+
+void rbs_shape_records_free(rbs_shape_records *r)
+{
+    free(r->kind);
+    free(r->family);
+    free(r->vertex_start);
+    free(r->vertices);
+    free(r->inertia);
+    free(r->aspect);
+    free(r->both_hands);
+    memset(r, 0, sizeof *r);
+}
+
+/* lexicographic order of two vertex rows (numpy.unique's order along axis 0) */
+static int compare_rows(const void *a, const void *b)
+{
+    const double *p = a, *q = b;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+/* The family's body at b/a = c/b = 1 (direct_model.registry._unit_body): its distinct vertices, sorted, into out
+ * (at most MAX_VERTICES rows); returns their number, 0 for the ellipsoid. */
+static int family_vertices(int family, double kappa, double *out)
+{
+    int n = rbs_body_vertices(family, 1.0, 1.0, 1.0, kappa, 1.0, out), kept = 0;
+    qsort(out, (size_t)n, 3 * sizeof(double), compare_rows);
+    for (int i = 0; i < n; i++)
+        if (kept == 0 || compare_rows(out + 3 * i, out + 3 * (kept - 1)) != 0) {
+            memmove(out + 3 * kept, out + 3 * i, 3 * sizeof(double));
+            kept++;
+        }
+    return kept;
+}
+
+/* the law (mean, sd, low, high) is one direct_model.shapes.AspectRatioLaw takes */
+static int law_ok(const double *law)
+{
+    return isfinite(law[0]) && isfinite(law[1]) && law[1] > 0.0 && 0.0 < law[2] && law[2] < law[3] && law[3] <= 1.0;
+}
+
+static int allocate(loader *ld, rbs_shape_records *r, int n, int64_t n_vertices)
+{
+    r->kind = calloc((size_t)n, sizeof *r->kind);
+    r->family = calloc((size_t)n, sizeof *r->family);
+    r->vertex_start = calloc((size_t)n + 1, sizeof *r->vertex_start);
+    r->vertices = calloc((size_t)n_vertices * 3 + 1, sizeof *r->vertices);
+    r->inertia = calloc((size_t)n * 3, sizeof *r->inertia);
+    r->aspect = calloc((size_t)n * 4, sizeof *r->aspect);
+    r->both_hands = calloc((size_t)n, sizeof *r->both_hands);
+    if (!r->kind || !r->family || !r->vertex_start || !r->vertices || !r->inertia || !r->aspect || !r->both_hands)
+        return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory for the shapes' records");
+    return RBS_OK;
+}
+
+/* A table before 3.4: the families' records at κ and the aspect-ratio law (data_schema.shape_records.family_records);
+ * their inertia J/m = s (b² + c², a² + c², a² + b²) = 2 s at b/a = c/b = 1, s the table's second-moment factor. */
+static int synthesise(loader *ld, rbs_table *t, double kappa, const double aspect[4], const double kfac[RBS_N_FAMILIES])
+{
+    if (!law_ok(aspect) || !(kappa >= 0.0 && kappa < 1.0))
+        return rbs_fail(ld, RBS_ERR_FORMAT, "the direct model's parameters are out of range: the built-in shapes' "
+                        "records cannot be made from the table's kappa %.17g and aspect-ratio law (%.17g, %.17g, "
+                        "%.17g, %.17g)", kappa, aspect[0], aspect[1], aspect[2], aspect[3]);
+    rbs_shape_records *r = &t->shapes;
+    if (allocate(ld, r, t->n_shapes, (int64_t)t->n_shapes * MAX_VERTICES) != RBS_OK) return ld->code;
+    for (int i = 0; i < t->n_shapes; i++) {
+        int family = rbs_shape_code(t->shape_names[i]);     /* a family's: checked by the loader */
+        int n = family_vertices(family, kappa, r->vertices + 3 * r->vertex_start[i]);
+        r->vertex_start[i + 1] = r->vertex_start[i] + n;
+        r->family[i] = family;
+        r->kind[i] = family == RBS_ELLIPSOID ? RBS_SMOOTH : RBS_POLYHEDRON;
+        for (int k = 0; k < 3; k++) r->inertia[3 * i + k] = 2.0 * kfac[family];
+        memcpy(r->aspect + 4 * i, aspect, 4 * sizeof(double));
+        r->both_hands[i] = family == RBS_TETRAHEDRON;
+    }
+    return RBS_OK;
+}
+
+/* Dataset `name` of group shapes, of HDF5 class `cls` (a string, integer or float: data_schema.table._read_group's
+ * check), read as `memtype` after checking its shape (`rank` × dims; dims[0] < 0: any first dimension, returned
+ * in *rows). */
+static void *read_member(loader *ld, hid_t group, const char *name, H5T_class_t cls, hid_t memtype, size_t size,
+                         int rank, long long first, long long second, int64_t *rows)
+{
+    int found_rank = 0;
+    hsize_t found[8], dims[2] = {(hsize_t)(first < 0 ? 0 : first), (hsize_t)second};
+    if (rbs_dataset_shape(ld, group, "shapes", name, &found_rank, found) != RBS_OK) return NULL;
+    hid_t ds = -1, type = -1;
+    H5T_class_t stored = H5T_NO_CLASS;
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(group, name, H5P_DEFAULT);
+        if (ds >= 0) type = H5Dget_type(ds);
+        if (type >= 0) stored = H5Tget_class(type);
+    } H5E_END_TRY;
+    if (type >= 0) H5Tclose(type);
+    if (ds >= 0) H5Dclose(ds);
+    if (stored != cls) {
+        rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/%s' is of another type (HDF5 class %d, expected %d)", name,
+                 (int)stored, (int)cls);
+        return NULL;
+    }
+    if (first < 0 && found_rank == rank) dims[0] = found[0];
+    if (rows) *rows = (int64_t)dims[0];
+    return rbs_read_dataset(ld, group, "shapes", name, memtype, size, rank, dims);
+}
+
+/* The checks of data_schema.shape_records.check_shape_arrays, then the families' rows (records_from_arrays). */
+static int check_records(loader *ld, rbs_table *t, const char *names, const int32_t *triangles,
+                         const int64_t *triangle_start, int64_t n_vertex, int64_t n_triangle, double kappa,
+                         const double aspect[4])
+{
+    rbs_shape_records *r = &t->shapes;
+    const int n = t->n_shapes;
+    for (int i = 0; i < n; i++) {
+        const char *name = t->shape_names[i], *copy = names + (size_t)i * RBS_SHAPE_NAME_SIZE;
+        if (strcmp(name, copy) != 0)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' ('%s' at index %d) differs from its checksummed "
+                            "copy 'shapes/name' ('%s')", name, i, copy);
+        size_t length = strlen(name);
+        int ok = length >= 1 && length <= NAME_MAX_LENGTH
+                 && ((name[0] >= 'A' && name[0] <= 'Z') || (name[0] >= 'a' && name[0] <= 'z'));
+        for (size_t k = 1; ok && k < length; k++)
+            ok = (name[k] >= 'A' && name[k] <= 'Z') || (name[k] >= 'a' && name[k] <= 'z')
+                 || (name[k] >= '0' && name[k] <= '9') || name[k] == '_';
+        ok = ok && strcmp(name, "mix") != 0;
+        for (int j = 0; ok && j < i; j++) ok = strcmp(name, t->shape_names[j]) != 0;
+        if (!ok)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/name' holds '%s' at index %d; each name must be a "
+                            "built-in's (ellipsoid, prism, cut_prism, tetrahedron) or 1-64 letters, digits or "
+                            "underscores starting with a letter (not 'mix'), each once", name, i);
+        r->family[i] = rbs_shape_code(name);
+    }
+    for (int i = 0; i < n; i++)
+        if (r->kind[i] != RBS_SMOOTH && r->kind[i] != RBS_POLYHEDRON)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/kind' holds %d at element %d; its values must be 0 "
+                            "(smooth) or 1 (convex polyhedron)", (int)r->kind[i], i);
+    for (int which = 0; which < 2; which++) {
+        const int64_t *start = which ? triangle_start : r->vertex_start, total = which ? n_triangle : n_vertex;
+        int ok = start[0] == 0 && start[n] == total;
+        for (int i = 0; ok && i < n; i++) ok = start[i + 1] >= start[i];
+        if (!ok)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/%s_start' must rise from 0 to %lld (the rows of "
+                            "'shapes/%ss')", which ? "triangle" : "vertex", (long long)total,
+                            which ? "triangle" : "vertex");
+    }
+    for (int i = 0; i < n; i++) {
+        int64_t nv = r->vertex_start[i + 1] - r->vertex_start[i], nt = triangle_start[i + 1] - triangle_start[i];
+        int polyhedral = r->kind[i] == RBS_POLYHEDRON;
+        if (polyhedral ? nv < MIN_HULL_VERTICES || nv > MAX_HULL_VERTICES : nv != 0)
+            return rbs_fail(ld, RBS_ERR_FORMAT, polyhedral ? "dataset 'shapes/vertex_start' gives shape '%s' %lld "
+                            "vertices; allowed: 4 to 256 for a convex polyhedron" : "dataset 'shapes/vertex_start' "
+                            "gives shape '%s' %lld vertices; allowed: 0 for a smooth body", t->shape_names[i],
+                            (long long)nv);
+        if (nt != (polyhedral ? 2 * nv - 4 : 0))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/triangle_start' gives shape '%s' %lld triangles; a hull "
+                            "of %lld vertices has %lld", t->shape_names[i], (long long)nt, (long long)nv,
+                            (long long)(nv > 2 ? 2 * nv - 4 : 0));
+        for (int64_t k = 3 * triangle_start[i]; k < 3 * triangle_start[i + 1]; k++)
+            if (triangles[k] < 0 || triangles[k] >= nv)
+                return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/triangles' of shape '%s' holds a vertex index "
+                                "outside 0..%lld", t->shape_names[i], (long long)(nv - 1));
+    }
+    for (int64_t k = 0; k < 3 * n_vertex; k++)
+        if (!(fabs(r->vertices[k]) <= VERTEX_BOUND))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/vertices' holds %.17g at element %lld; its values must "
+                            "be finite and in [-%.17g, %.17g] (units of a)", r->vertices[k], (long long)k, VERTEX_BOUND,
+                            VERTEX_BOUND);
+    for (int i = 0; i < n; i++) {
+        if (r->kind[i] != RBS_POLYHEDRON) continue;
+        double half[3], largest = 0.0, thinnest = INFINITY;
+        for (int c = 0; c < 3; c++) {
+            double lo = INFINITY, hi = -INFINITY;
+            for (int64_t v = r->vertex_start[i]; v < r->vertex_start[i + 1]; v++) {
+                lo = fmin(lo, r->vertices[3 * v + c]);
+                hi = fmax(hi, r->vertices[3 * v + c]);
+            }
+            half[c] = (hi - lo) / 2.0;
+            largest = fmax(largest, half[c]);
+            thinnest = fmin(thinnest, half[c]);
+        }
+        if (!(fabs(largest - 1.0) <= FRAME_CHECK && thinnest >= MIN_THICKNESS))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/vertices' gives shape '%s' half-extents [%.17g, %.17g, "
+                            "%.17g]; the largest must be 1 within %g (units of a) and the thinnest >= %g",
+                            t->shape_names[i], half[0], half[1], half[2], FRAME_CHECK, MIN_THICKNESS);
+    }
+    for (int k = 0; k < 3 * n; k++)
+        if (!(r->inertia[k] > 0.0 && r->inertia[k] <= INERTIA_BOUND))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/inertia' holds %.17g at element %d; its values must be "
+                            "in (0, %.17g] (units of a^2)", r->inertia[k], k, INERTIA_BOUND);
+    for (int i = 0; i < n; i++) {
+        const double *J = r->inertia + 3 * i, sum = J[0] + J[1] + J[2];
+        if (2.0 * J[0] >= sum || 2.0 * J[1] >= sum || 2.0 * J[2] >= sum)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/inertia' row %d [%.17g, %.17g, %.17g] breaks the "
+                            "triangle inequality; each principal J/m must be below the sum of the other two", i, J[0],
+                            J[1], J[2]);
+    }
+    for (int i = 0; i < n; i++) {
+        const double *law = r->aspect + 4 * i;
+        if (isnan(law[0]) && isnan(law[1]) && isnan(law[2]) && isnan(law[3])) continue;
+        if (!law_ok(law))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/aspect' row %d is [%.17g, %.17g, %.17g, %.17g]; a law "
+                            "(mean, sd, low, high) must be finite with sd > 0 and 0 < low < high <= 1, or all NaN "
+                            "(fixed proportions)", i, law[0], law[1], law[2], law[3]);
+    }
+    for (int i = 0; i < n; i++)
+        if (r->both_hands[i] > 1)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/both_hands' holds %d at element %d; its values must be "
+                            "0 or 1", (int)r->both_hands[i], i);
+    /* a built-in name carries the family's record (records_from_arrays) */
+    for (int i = 0; i < n; i++) {
+        int family = r->family[i];
+        if (family < 0) continue;
+        if (!law_ok(aspect) || !(kappa >= 0.0 && kappa < 1.0))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "the built-in shape '%s' cannot be made at the table's kappa %.17g and "
+                            "aspect-ratio law (%.17g, %.17g, %.17g, %.17g)", t->shape_names[i], kappa, aspect[0],
+                            aspect[1], aspect[2], aspect[3]);
+        double body[3 * MAX_VERTICES];
+        int nv = family_vertices(family, kappa, body);
+        const char *differs = NULL;
+        if (r->kind[i] != (family == RBS_ELLIPSOID ? RBS_SMOOTH : RBS_POLYHEDRON)) differs = "kind";
+        else if (r->vertex_start[i + 1] - r->vertex_start[i] != nv
+                 || memcmp(r->vertices + 3 * r->vertex_start[i], body, (size_t)nv * 3 * sizeof(double)) != 0)
+            differs = "vertices";
+        else if (memcmp(r->aspect + 4 * i, aspect, 4 * sizeof(double)) != 0) differs = "aspect";
+        else if (r->both_hands[i] != (family == RBS_TETRAHEDRON)) differs = "both_hands";
+        if (differs)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/%s' of the built-in shape '%s' differs from the "
+                            "family's record at the table's kappa and aspect-ratio law (group 'grid')", differs,
+                            t->shape_names[i]);
+    }
+    return RBS_OK;
+}
+
+int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, const double aspect[4],
+                           const double kfac[RBS_N_FAMILIES])
+{
+    if (!rbs_link_exists(file, "shapes")) {
+        if (t->format_minor >= SHAPES_SINCE)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "missing group 'shapes' (table format 3.%d)", SHAPES_SINCE);
+        return synthesise(ld, t, kappa, aspect, kfac);
+    }
+    hid_t group = -1, name_type = -1;
+    H5E_BEGIN_TRY { group = H5Gopen2(file, "shapes", H5P_DEFAULT); } H5E_END_TRY;
+    if (group < 0) return rbs_fail(ld, RBS_ERR_FORMAT, "'shapes' is not a readable group (truncated or corrupt?)");
+    rbs_shape_records *r = &t->shapes;
+    const long long n = t->n_shapes;
+    char *names = NULL;
+    int64_t *triangle_start = NULL, n_vertex = 0, n_triangle = 0;
+    int32_t *triangles = NULL;
+    name_type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(name_type, RBS_SHAPE_NAME_SIZE);
+    H5Tset_strpad(name_type, H5T_STR_NULLTERM);
+    r->family = calloc((size_t)n, sizeof *r->family);
+    if (!r->family) {
+        rbs_fail(ld, RBS_ERR_MEMORY, "out of memory for the shapes' records");
+        goto done;
+    }
+    /* the datasets in the order of data_schema.shape_records.SHAPE_DATASETS */
+    if (!(names = read_member(ld, group, "name", H5T_STRING, name_type, RBS_SHAPE_NAME_SIZE, 1, n, 0, NULL))
+        || !(r->kind = read_member(ld, group, "kind", H5T_INTEGER, H5T_NATIVE_INT8, 1, 1, n, 0, NULL))
+        || !(r->vertex_start = read_member(ld, group, "vertex_start", H5T_INTEGER, H5T_NATIVE_INT64, 8, 1, n + 1, 0,
+                                           NULL))
+        || !(r->vertices = read_member(ld, group, "vertices", H5T_FLOAT, H5T_NATIVE_DOUBLE, 8, 2, -1, 3, &n_vertex))
+        || !(triangle_start = read_member(ld, group, "triangle_start", H5T_INTEGER, H5T_NATIVE_INT64, 8, 1, n + 1, 0,
+                                          NULL))
+        || !(triangles = read_member(ld, group, "triangles", H5T_INTEGER, H5T_NATIVE_INT32, 4, 2, -1, 3, &n_triangle))
+        || !(r->inertia = read_member(ld, group, "inertia", H5T_FLOAT, H5T_NATIVE_DOUBLE, 8, 2, n, 3, NULL))
+        || !(r->aspect = read_member(ld, group, "aspect", H5T_FLOAT, H5T_NATIVE_DOUBLE, 8, 2, n, 4, NULL))
+        || !(r->both_hands = read_member(ld, group, "both_hands", H5T_INTEGER, H5T_NATIVE_UINT8, 1, 1, n, 0, NULL)))
+        goto done;
+    check_records(ld, t, names, triangles, triangle_start, n_vertex, n_triangle, kappa, aspect);
+done:
+    free(names);
+    free(triangle_start);
+    free(triangles);
+    if (name_type >= 0) H5Tclose(name_type);
+    H5Gclose(group);
+    return ld->code;
+}

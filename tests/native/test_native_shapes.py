@@ -1,0 +1,230 @@
+"""Tables store their shapes (format 3.4, group /shapes; docs/format.md, "Shapes"), and both runtimes read them
+from there: registry records round trip through the file bit for bit; a table of 64 shapes (the families and
+60 user grains) loads in Python and C with the same records, its mix draws each shape with its weight, and the
+C and numba kernels draw the same bits from it; a flipped bit or an out-of-range value in any /shapes dataset
+fails to load in both loaders with a message naming the dataset; a table without the group (before 3.4) gets
+the families' records from its κ and aspect-ratio law, in both runtimes, and draws its bits unchanged."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+
+from tests.helpers import python_side as py
+from tests.helpers.bad_files import _copy, _corrupt_chunk, _flip_bit, _set
+from tests.helpers.native_library import ERR_FORMAT
+
+SHAPE_DATASETS = ("name", "kind", "vertex_start", "vertices", "triangle_start", "triangles", "inertia", "aspect",
+                  "both_hands")
+
+
+@pytest.fixture(scope="module")
+def many_shapes(small_table_path, tmp_path_factory):
+    path = tmp_path_factory.mktemp("many") / "many_shapes.h5"
+    return path, py.many_shape_table(small_table_path, path, 64)
+
+
+def _refused_alike(native, path, names):
+    code, table, message = native.open(path)
+    assert code == ERR_FORMAT and table is None and names in message, (path.name, code, message)
+    with pytest.raises(ValueError) as info:
+        py.load(path)
+    assert str(path) in str(info.value) and names in str(info.value), (path.name, str(info.value))
+
+
+def _same_arrays(a, b):
+    return a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def test_records_round_trip_through_the_file(small_table_path, tmp_path):
+    """The families at the table's κ and law and a user grain (direct_model.registry.grain) come back from the
+    file as the same records: names, kinds, vertices, triangles, inertia, laws and hands, bit for bit."""
+    from data_schema.shape_records import shape_arrays
+    from data_schema.table import read_table
+    path = tmp_path / "round_trip.h5"
+    py.many_shape_table(small_table_path, path, 5)
+    written = read_table(small_table_path).shape_records() + tuple(py.user_grains(1))
+    read = read_table(path).records
+    assert [r.name for r in read] == [r.name for r in written] == ["ellipsoid", "prism", "cut_prism", "tetrahedron",
+                                                                   "grain_00"]
+    assert [type(r) for r in read] == [type(r) for r in written]
+    for key, values in shape_arrays(written).items():
+        assert _same_arrays(shape_arrays(read)[key], values), key
+    grain = read[-1]
+    assert grain.aspect == written[-1].aspect and grain.both_hands and len(grain.triangles) == 2 * len(grain.vertices) - 4
+
+
+def test_a_table_of_64_shapes_loads_alike_in_python_and_c(native, many_shapes):
+    path, names = many_shapes
+    table = py.load(path)
+    assert table.shapes == names and len(names) == 64
+    assert table.model_shapes.tolist() == [0, 1, 2, 3] + [-1] * 60
+    arrays = table.shape_arrays
+    c_table = native.table(path)
+    try:
+        assert c_table.shapes == names
+        for i, name in enumerate(names):
+            info = c_table.shape_info(i)
+            start, stop = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
+            assert info["name"] == name and info["kind"] == arrays["kind"][i]
+            assert info["family"] == table.model_shapes[i] and info["both_hands"] == arrays["both_hands"][i]
+            assert _same_arrays(info["vertices"], arrays["vertices"][start:stop])
+            assert _same_arrays(info["inertia"], arrays["inertia"][i]) and _same_arrays(info["aspect"], arrays["aspect"][i])
+        assert c_table.shape_info(64) is None
+    finally:
+        c_table.close()
+
+
+def _distinct_cells(source, folder):
+    """The 64-shape table with the α2 location of every cluster of shape k moved by k · 1e-6 rad, so that a draw
+    tells which shape the mix gave it."""
+    def edit(f):
+        loc = f["cells/cluster_loc"][()]
+        loc[..., 0] += (np.arange(loc.shape[0]) * 1e-6).reshape(-1, 1, 1, 1).astype(np.float32)
+        f["cells/cluster_loc"][...] = loc
+    return _copy(source, folder, "distinct.h5", edit)
+
+
+def test_the_mix_draws_each_of_64_shapes_with_its_weight_in_c_and_python_alike(native, many_shapes, tmp_path):
+    """Weights w_k ∝ k + 1 over the 64 shapes; n = 64 000 draws in C (rbs_table_rebound_many, a mix of
+    rbs_mix_new_from_weights) and numba (the same uniforms, surrogate.mix_cdf): the same bits. Each draw's shape
+    is found as the one whose single-shape mix gives the same bits; the counts' chi-square over 63 degrees of
+    freedom stays below its 1 - 1e-6 quantile, 131.4 (fixed seed: the test is deterministic; a correct mix fails
+    it for one seed in a million)."""
+    from scipy.stats import chi2
+    path = _distinct_cells(many_shapes[0], tmp_path)
+    names = many_shapes[1]
+    n, k = 64_000, len(names)
+    weights = np.arange(1, k + 1, dtype=np.float64)
+    weights /= weights.sum()
+    rng = np.random.default_rng(64)
+    u = rng.random((n, py.U_PER_DRAW))
+    u[:, 3] = 0.999999                       # never trapped: every draw is a rebound that names its shape
+    V = np.tile([150.0 * np.cos(np.radians(30.0)), -150.0 * np.sin(np.radians(30.0)), 0.0], (n, 1))
+    normal, a = np.tile([0.0, 1.0, 0.0], (n, 1)), np.full(n, 1e-4)
+    c_table, table = native.table(path), py.load(path)
+    try:
+        mix, message = c_table.mix_new(weights=dict(zip(names, weights)))
+        assert mix is not None, message
+        status, c_V, _ = c_table.table_rebound_many(mix, V, normal, a, u)
+        V_out, W_out, py_status = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int8)
+        py.table_rebound_many(table.kernel_data, py.mix_cdf(table, dict(zip(names, weights))), V, normal, a, u, V_out,
+                              W_out, py_status)
+        assert np.array_equal(status, py_status) and c_V.tobytes() == V_out.tobytes()
+        assert np.all(status == py.STATUS_REBOUNDED)
+        shape = np.full(n, -1)
+        for j, name in enumerate(names):
+            single, _ = c_table.mix_new(name)
+            _, V_j, _ = c_table.table_rebound_many(single, V, normal, a, u)
+            same = np.all(V_j == c_V, axis=1)
+            assert np.all(shape[same] == -1)         # one shape only gives a draw's bits
+            shape[same] = j
+    finally:
+        c_table.close()
+    assert np.all(shape >= 0)
+    counts = np.bincount(shape, minlength=k)
+    expected = n * weights
+    statistic = float(((counts - expected) ** 2 / expected).sum())
+    assert statistic < chi2.ppf(1.0 - 1e-6, k - 1), (statistic, counts)
+
+
+def test_a_flipped_bit_in_any_shapes_dataset_fails_to_load_in_both(native, small_table_path, tmp_path):
+    for name in SHAPE_DATASETS:
+        path = _corrupt_chunk(_copy(small_table_path, tmp_path, f"flip_{name}.h5"), f"shapes/{name}")
+        _refused_alike(native, path, f"shapes/{name}")
+
+
+# dataset: edits (HDF5 rewrites the chunk with a fresh Fletcher-32) that break what /shapes may hold, one per rule (the small table: rows
+# ellipsoid, prism (vertices 0-7), cut_prism (8-31), tetrahedron (32-35))
+BAD_VALUES = {
+    "name": [_set("shapes/name", 1, b"prisma"), _set("shapes/name", 0, b"mix")],
+    "kind": [_set("shapes/kind", 1, 2), _set("shapes/kind", 1, -1)],
+    "vertex_start": [_set("shapes/vertex_start", 4, 35), _set("shapes/vertex_start", 2, 3)],
+    "vertices": [_set("shapes/vertices", (3, 1), np.nan), _set("shapes/vertices", (3, 1), 1.6),
+                 _set("shapes/vertices", (3, 1), 0.5)],
+    "triangle_start": [_set("shapes/triangle_start", 2, 11)],
+    "triangles": [_set("shapes/triangles", (0, 0), 8), _set("shapes/triangles", (0, 0), -1)],
+    "inertia": [_set("shapes/inertia", (1, 0), -0.5), _set("shapes/inertia", (1, 0), np.inf),
+                _set("shapes/inertia", (1, 0), 1.5)],
+    "aspect": [_set("shapes/aspect", (1, 2), 1.0), _set("shapes/aspect", (1, 1), 0.0),
+               _set("shapes/aspect", (1, 0), np.nan)],
+    "both_hands": [_set("shapes/both_hands", 1, 2), _set("shapes/both_hands", 3, 0)],
+}
+
+
+def test_a_bad_value_in_any_shapes_dataset_is_refused_by_both(native, small_table_path, tmp_path):
+    for name, edits in BAD_VALUES.items():
+        for k, edit in enumerate(edits):
+            _refused_alike(native, _copy(small_table_path, tmp_path, f"bad_{name}_{k}.h5", edit), f"shapes/{name}")
+
+
+def test_a_bad_value_in_a_user_grain_is_refused_by_both(native, many_shapes, tmp_path):
+    """A user grain's row (shape 4): a name outside NAME_PATTERN, a vertex count over 256 or under 4, a vertex
+    outside the unit box's bound, a law with low >= high, and the group missing from a 3.4 table."""
+    path = many_shapes[0]
+    with h5py.File(path, "r") as f:
+        start = f["shapes/vertex_start"][()]
+    edits = {"name": _set("shapes/name", 4, b"4grain"), "vertex_start": _set("shapes/vertex_start", 5, start[4] + 3),
+             "vertices": _set("shapes/vertices", (start[4], 2), -1.7), "aspect": _set("shapes/aspect", (4, 2), 1.0)}
+    for name, edit in edits.items():
+        _refused_alike(native, _copy(path, tmp_path, f"grain_{name}.h5", edit), f"shapes/{name}")
+    _refused_alike(native, _copy(path, tmp_path, "no_group.h5", lambda f: f.__delitem__("shapes")), "'shapes'")
+
+
+def test_a_table_before_3_4_gets_the_families_records_and_draws_the_same_bits(native, small_table_path, tmp_path):
+    """Group /shapes deleted and the version set to 3.3: both runtimes synthesise the families' records at the
+    table's κ and law (C: inertia 2 s from the second-moment factors, within 4 ulp of the registry's mass
+    properties), and both draw the bits of the 3.4 file."""
+    def format_3_3(f):
+        f.attrs["format_version"] = np.array([3, 3], dtype=np.int64)
+        del f["shapes"]
+
+    old = _copy(small_table_path, tmp_path, "v3_3.h5", format_3_3)
+    new_table, old_table = py.load(small_table_path), py.load(old)
+    assert old_table.records and all(a.name == b.name for a, b in zip(old_table.records, new_table.records))
+    for key, values in new_table.shape_arrays.items():
+        assert _same_arrays(old_table.shape_arrays[key], values), key
+    c_old = native.table(old)
+    try:
+        for i, name in enumerate(old_table.shapes):
+            info, arrays = c_old.shape_info(i), new_table.shape_arrays
+            start, stop = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
+            assert info["name"] == name and _same_arrays(info["vertices"], arrays["vertices"][start:stop])
+            assert _same_arrays(info["aspect"], arrays["aspect"][i]) and info["both_hands"] == arrays["both_hands"][i]
+            assert np.allclose(info["inertia"], arrays["inertia"][i], rtol=4 * np.finfo(float).eps, atol=0.0)
+    finally:
+        c_old.close()
+    rng = np.random.default_rng(33)
+    n = 5_000
+    u = rng.random((n, py.U_PER_DRAW))
+    V = np.tile([100.0, -120.0, 5.0], (n, 1))
+    normal, a = np.tile([0.0, 1.0, 0.0], (n, 1)), np.full(n, 1e-4)
+    draws = []
+    for path in (small_table_path, old):
+        t = native.table(path)
+        try:
+            status, V_out, _ = t.table_rebound_many(t.mix_equal(), V, normal, a, u)
+        finally:
+            t.close()
+        draws.append((status.tobytes(), V_out.tobytes()))
+    assert draws[0] == draws[1]
+
+
+def test_a_flipped_kappa_bit_changes_the_families_and_is_refused(native, small_table_path, tmp_path):
+    """κ decides the cut prism's record: a flipped bit of the attribute fails to load (grid/law), and a table
+    whose cut prism's vertices were made at another κ (its checksums rewritten) is refused by both."""
+    def other_kappa(f):
+        from direct_model.registry import built_in_shape
+        from direct_model.shapes import AspectRatioLaw
+        law = AspectRatioLaw(*(float(f["grid"].attrs[k]) for k in ("aspect_ratio_mean", "aspect_ratio_sd",
+                                                                    "aspect_ratio_low", "aspect_ratio_high")))
+        start = f["shapes/vertex_start"][()]
+        vertices = f["shapes/vertices"][()]
+        vertices[start[2]:start[3]] = built_in_shape("cut_prism", 0.25, law).vertices
+        f["shapes/vertices"][...] = vertices
+
+    _refused_alike(native, _copy(small_table_path, tmp_path, "kappa_vertices.h5", other_kappa), "shapes/vertices")
+    flipped = _copy(small_table_path, tmp_path, "kappa_bit.h5",
+                    lambda f: f["grid"].attrs.__setitem__("kappa", _flip_bit(float(f["grid"].attrs["kappa"]), 40)))
+    _refused_alike(native, flipped, "kappa")

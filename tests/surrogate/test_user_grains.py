@@ -1,0 +1,60 @@
+"""A table holding user grains (format 3.4) in the Python runtime: the table path draws them by name, the direct
+model does not take them yet and says so (a one-line ValueError under method "direct" and in sample_direct,
+status -1 for a hit "auto" sends to it), and `tablegen info` lists every shape with its kind and vertex count."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import surrogate
+from tests.helpers.python_side import many_shape_table
+
+V = [[100.0, -120.0, 5.0]] * 200
+NORMAL = [0.0, 1.0, 0.0]
+A = 1e-4
+
+
+@pytest.fixture(scope="module")
+def grains_path(small_table_path, tmp_path_factory):
+    path = tmp_path_factory.mktemp("grains") / "grains.h5"
+    many_shape_table(small_table_path, path, 6)
+    return path
+
+
+def test_the_table_path_draws_a_user_grain_by_name(grains_path):
+    table = surrogate.load(grains_path)
+    assert table.shapes[4:] == ("grain_00", "grain_01") and table.model_shapes.tolist() == [0, 1, 2, 3, -1, -1]
+    for shape in ("grain_01", {"grain_00": 0.5, "prism": 0.5}):
+        V_out, _, status = surrogate.sample_global(table, V, NORMAL, A, shape=shape, random_state=1, method="table")
+        rebounded = status == surrogate.STATUS_REBOUNDED
+        assert np.all(rebounded | (status == surrogate.STATUS_TRAPPED)) and rebounded.sum() > 150
+        assert np.all(V_out[rebounded, 1] > 0.0)
+
+
+def test_the_direct_model_refuses_a_user_grain_for_now(grains_path):
+    table = surrogate.load(grains_path)
+    wanted = "The direct model does not take the user's grain 'grain_00' yet"
+    with pytest.raises(ValueError, match=wanted):
+        surrogate.sample_direct(table, V, NORMAL, A, shape="grain_00", random_state=1)
+    with pytest.raises(ValueError, match=wanted):
+        surrogate.sample_global(table, V, NORMAL, A, shape="grain_00", random_state=1, method="direct")
+    # under "auto", a spinning hit goes to the direct model: status -1 (invalid), NaN
+    spin = [0.0, 0.0, 0.3 * np.linalg.norm(V[0]) / A]
+    V_out, _, status = surrogate.sample_global(table, V, NORMAL, A, shape="grain_00", random_state=1, omega=spin)
+    assert np.all(status == surrogate.STATUS_INVALID) and np.all(np.isnan(V_out))
+    V_out, _, status = surrogate.sample_direct(table, V, NORMAL, A, shape="prism", random_state=1)
+    assert np.all(status != surrogate.STATUS_INVALID)
+
+
+def test_info_lists_every_shape(grains_path, capsys):
+    from tablegen.cli import main
+    table = surrogate.load(grains_path)
+    assert main(["info", str(grains_path)]) == 0
+    out = capsys.readouterr().out
+    assert "shapes: 6 (cut_prism kappa = 0.3)" in out
+    assert "  prism            built-in, convex polyhedron, 8 vertices; b/a, c/b ~ N(0.8, 0.2) in [0.5, 1]" in out
+    count = len(table.records[4].vertices)
+    assert (f"  grain_00         user grain, convex polyhedron, {count} vertices; b/a, c/b ~ N(0.85, 0.1) in "
+            f"[0.6, 1]; both hands") in out
+    assert "  grain_01         user grain, convex polyhedron" in out and "fixed proportions" in out
