@@ -21,7 +21,7 @@ import numpy as np
 
 from direct_model.options import JIT
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, body_rebound
-from direct_model.shapes import SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa
+from direct_model.shapes import SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, normal_cdf
 from direct_model.wall import WallMaterial
 
 U_PER_REBOUND = 7
@@ -42,11 +42,6 @@ _V0 = _R0 + 9
 SCRATCH_SIZE = _V0 + 12
 
 
-def _normal_cdf(x: float) -> float:
-    """Φ(x), the standard normal CDF (libm's erfc: no scipy at run time)."""
-    return 0.5 * math.erfc(-x / math.sqrt(2.0))
-
-
 def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: WallMaterial, contact_tol: float,
                      set_tol: float, max_steps: int, second_moment_factors) -> np.ndarray:
     """The parameter array of :func:`rebound_model_frame` (P_* layout), read-only; ValueError naming a value
@@ -64,8 +59,8 @@ def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: Wal
                          f"shape code; got {second_moment_factors!r}.")
     p = np.empty(N_PARAMS)
     p[P_ASPECT_MEAN:P_ASPECT_HIGH + 1] = aspect.mean, aspect.sd, aspect.low, aspect.high
-    p[P_CDF_LOW] = _normal_cdf((aspect.low - aspect.mean) / aspect.sd)
-    p[P_CDF_HIGH] = _normal_cdf((aspect.high - aspect.mean) / aspect.sd)
+    p[P_CDF_LOW] = normal_cdf((aspect.low - aspect.mean) / aspect.sd)
+    p[P_CDF_HIGH] = normal_cdf((aspect.high - aspect.mean) / aspect.sd)
     p[P_KAPPA], p[P_N_MAX] = kappa, n_max
     p[P_WALL:P_WALL + 3] = wall.as_array()
     p[P_CONTACT_TOL], p[P_SET_TOL], p[P_MAX_STEPS] = contact_tol, set_tol, max_steps

@@ -34,6 +34,7 @@ check against the closed forms.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numba
 import numpy as np
@@ -172,6 +173,11 @@ def second_moment_factor(shape: str, kappa: float = DEFAULT_KAPPA) -> float:
 def second_moment_factors(kappa: float = DEFAULT_KAPPA) -> np.ndarray:
     """Array of :func:`second_moment_factor` indexed by shape code (kernel input)."""
     return np.array([second_moment_factor(s, kappa) for s in SHAPES])
+
+
+def normal_cdf(x: float) -> float:
+    """Φ(x), the standard normal CDF (libm's erfc: no scipy at run time); the aspect-ratio law's CDF bounds."""
+    return 0.5 * math.erfc(-x / math.sqrt(2.0))
 
 
 @dataclasses.dataclass(frozen=True)
