@@ -100,17 +100,6 @@ def body_vertices(shape, a, b, c, kappa, hand, out):
     return n
 
 
-@numba.njit(**JIT)
-def bounding_radius(shape, a, b, c, verts, nv):
-    """Radius of the smallest centroid-centred sphere holding the body (units of a)."""
-    if shape == ELLIPSOID:
-        return max(a, max(b, c))
-    r2 = 0.0
-    for i in range(nv):
-        r2 = max(r2, verts[i, 0] ** 2 + verts[i, 1] ** 2 + verts[i, 2] ** 2)
-    return np.sqrt(r2)
-
-
 def shape_vertices(shape: str, a: float = 1.0, b: float = 1.0, c: float = 1.0,
                    kappa: float = DEFAULT_KAPPA, hand: int = 1) -> np.ndarray:
     """Body-frame vertices (n, 3) of a polyhedral shape (Python wrapper)."""

@@ -17,7 +17,8 @@ import numpy as np
 
 from data_schema.common import DataFormatError
 from data_schema.table import ReboundTable, read_table
-from direct_model.runtime import model_parameters
+from direct_model.runtime import family_shapes, model_parameters
+from direct_model.shape_arrays import ShapeArrays, from_stored
 from direct_model.shapes import SHAPES, AspectRatioLaw
 from direct_model.wall import WallMaterial
 from surrogate.kernels.layout import KernelData, check_kernel_data, frozen, kernel_data
@@ -43,9 +44,20 @@ class SurrogateTable:
 
     @functools.cached_property
     def model_shapes(self) -> np.ndarray:
-        """The direct model's shape code (:data:`direct_model.shapes.SHAPES`) of each of the table's shapes, in
-        the table's order: read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound` takes it."""
+        """Each of the table's shapes, in the table's order, as its index in :attr:`shape_arrays` (today the
+        family's code, :data:`direct_model.shapes.SHAPES`): read-only int64 (n_shapes,), as
+        :func:`surrogate.kernels.rebound` takes it."""
         return frozen(np.array([SHAPES.index(name) for name in self.shapes], dtype=np.int64))
+
+    @functools.cached_property
+    def shape_arrays(self) -> ShapeArrays:
+        """The direct model's shapes as the kernels take them (:class:`direct_model.shape_arrays.ShapeArrays`):
+        the four families at the κ, aspect-ratio law and factors s of :attr:`direct_parameters`; no shape for
+        a table without them."""
+        if self.direct_parameters is None:
+            return from_stored(np.zeros(0), [0], np.zeros((0, 3)), [0], np.zeros((0, 3)), np.zeros((0, 3)),
+                               np.zeros((0, 4)), np.zeros(0))
+        return family_shapes(self.direct_parameters)
 
     @property
     def alpha1_range(self) -> tuple:

@@ -95,6 +95,10 @@ struct rbs_table {
     size_t restitution_pieces_len;
     int has_direct;                                 /* the table records the direct model's parameters */
     double direct_parameters[N_PARAMS];             /* surrogate.table.SurrogateTable.direct_parameters (P_*) */
+    /* the direct model's shapes (surrogate.table.SurrogateTable.shape_arrays): the four families, built from
+     * the parameters; model_shape[i] is the index there of the table's shape i */
+    rbs_family_shapes direct_shapes;
+    int model_shape[RBS_MAX_SHAPES];
 };
 
 /* The raw cell datasets a loader reads (layout.c turns them into the kernel arrays). */

@@ -393,17 +393,17 @@ static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dim
     }
 }
 
-/* The shape names: distinct, among the four (data_schema.table.check_contract). */
-static int check_shape_names(loader *ld, const rbs_table *t)
+/* The shape names: distinct, among the four (data_schema.table.check_contract); each one's index in the direct
+ * model's shape arrays (a family's code) into t->model_shape, so that a direct hit looks up no name. */
+static int check_shape_names(loader *ld, rbs_table *t)
 {
-    static const char *const known[RBS_MAX_SHAPES] = {"ellipsoid", "prism", "cut_prism", "tetrahedron"};
     for (int i = 0; i < t->n_shapes; i++) {
-        int found = 0;
-        for (int k = 0; k < RBS_MAX_SHAPES; k++) found |= strcmp(t->shape_names[i], known[k]) == 0;
+        int code = rbs_shape_code(t->shape_names[i]), found = code >= 0;
         for (int j = 0; j < i; j++) found &= strcmp(t->shape_names[i], t->shape_names[j]) != 0;
         if (!found)
             return fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must name distinct shapes among ellipsoid, prism, "
                         "cut_prism, tetrahedron; got '%s' at index %d", t->shape_names[i], i);
+        t->model_shape[i] = code;
     }
     return RBS_OK;
 }
@@ -616,7 +616,7 @@ static int direct_attributes(loader *ld, hid_t file, hid_t grid, const rbs_table
     return RBS_OK;
 }
 
-/* Φ(x), the standard normal CDF (direct_model.runtime._normal_cdf: libm's erfc, as CPython's math.erfc) */
+/* Φ(x), the standard normal CDF (direct_model.shapes.normal_cdf: libm's erfc, as CPython's math.erfc) */
 static double normal_cdf(double x)
 {
     return 0.5 * erfc(-x / sqrt(2.0));
@@ -682,6 +682,7 @@ static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table 
     p[P_SET_TOL] = set_tol;
     p[P_MAX_STEPS] = (double)max_steps;
     for (int k = 0; k < RBS_MAX_SHAPES; k++) p[P_KFAC + k] = kfac[k];
+    rbs_family_shapes_init(&t->direct_shapes, kappa, p + P_ASPECT_MEAN, p + P_CDF_LOW, kfac);
     t->has_direct = 1;
     return RBS_OK;
 }

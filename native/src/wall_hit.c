@@ -12,7 +12,6 @@
 
 #include "frame.h"
 #include "locate.h"
-#include "shapes.h"
 #include "table_arguments.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
@@ -65,10 +64,9 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3
     }
     if (path == RBS_PATH_TABLE)
         return rbs_table_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
-    /* the table's shape drawn as the table path draws it, then its model code (a loaded table names known
-     * shapes only) */
+    /* the table's shape drawn as the table path draws it, then its index in the direct model's shapes */
     int64_t shape = rbs_mix_shape(mix->cdf, mix->n_shapes, u[0]);
-    return rbs_direct_rebound(t, rbs_shape_code(t->shape_names[shape]), V, Omega, n, a, u + 1, V_out, Omega_out);
+    return rbs_direct_rebound(t, t->model_shape[shape], V, Omega, n, a, u + 1, V_out, Omega_out);
 }
 
 int rbs_rebound_rng(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3], const double n[3],

@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 
 from direct_model import shapes
-from direct_model.registry import AspectRatioLaw, built_in_shapes, grain
+from direct_model.registry import AspectRatioLaw, built_in_shapes
 from direct_model.shape_arrays import (
     KIND_ELLIPSOID, KIND_POLYHEDRON, STORED, bounding_radius, family_shape_arrays, from_stored, particle_body,
     shape_arrays, shape_records,
 )
-from tablegen.tabulation.grain_files import convex_hull
+from tests.helpers.grains import cloud_grain
 
 LAW = AspectRatioLaw()
 
@@ -23,13 +23,6 @@ def _bits(x):
 def _equal(one, other):
     """Every stored array the same bits."""
     return all(np.array_equal(_bits(getattr(one, f)), _bits(getattr(other, f))) for f in STORED)
-
-
-def random_grain(name, n_points, seed, aspect=None, both_hands=False):
-    """The canonical record of the hull of a random Gaussian cloud (proportions about 1 : 0.7 : 0.5)."""
-    rng = np.random.default_rng(seed)
-    vertices, triangles, _ = convex_hull(rng.normal(size=(n_points, 3)) * (1.0, 0.7, 0.5), name)
-    return grain(name, vertices, triangles, aspect=aspect, both_hands=both_hands)
 
 
 def test_the_families_are_the_kernels_bodies_and_factors():
@@ -52,8 +45,8 @@ def test_the_families_are_the_kernels_bodies_and_factors():
 @pytest.mark.parametrize("kappa", [0.0, 0.1, 0.3, 0.5, 0.77, 0.99])
 def test_records_round_trip_bit_for_bit(kappa):
     """arrays → records → arrays gives the same bits, families (every κ, the factors kept) and user grains."""
-    records = list(built_in_shapes(kappa, LAW).values()) + [random_grain("sand_a", 60, 1, LAW),
-                                                            random_grain("sand_b", 200, 2, None, True)]
+    records = list(built_in_shapes(kappa, LAW).values()) + [cloud_grain("sand_a", 60, 1, LAW),
+                                                            cloud_grain("sand_b", 200, 2, None, True)]
     arrays = shape_arrays(records)
     names = [r.name for r in records]
     back = shape_records(arrays, names)
@@ -66,7 +59,7 @@ def test_records_round_trip_bit_for_bit(kappa):
 
 
 def test_a_grain_s_arrays_are_its_canonical_hull():
-    sand = random_grain("sand", 120, 3)
+    sand = cloud_grain("sand", 120, 3)
     arrays = shape_arrays([sand])
     assert np.array_equal(arrays.vertices, sand.vertices) and np.array_equal(arrays.triangles, sand.triangles)
     second = arrays.second_moments[0]
@@ -90,7 +83,7 @@ def test_arrays_out_of_their_ranges_are_refused(change, message):
 
 
 def test_a_hull_over_the_limit_is_refused():
-    stored = shape_arrays([random_grain("sand", 60, 4)]).stored()
+    stored = shape_arrays([cloud_grain("sand", 60, 4)]).stored()
     count = 257
     stored.update(vertex_start=[0, count], vertices=np.zeros((count, 3)))
     with pytest.raises(ValueError, match="has 257 vertices; allowed: 4 to 256"):
@@ -100,7 +93,7 @@ def test_a_hull_over_the_limit_is_refused():
 @pytest.mark.parametrize("hand", [1.0, -1.0])
 def test_a_particle_s_body_is_the_record_stretched(hand):
     """particle_body = the registry's stretched(): vertices, J/m, half-extents (largest 1) and radius."""
-    sand = random_grain("sand", 150, 5, LAW)
+    sand = cloud_grain("sand", 150, 5, LAW)
     arrays = shape_arrays([sand])
     verts, K, semi = np.empty((256, 3)), np.empty(3), np.empty(3)
     for ba, cb in [(1.0, 1.0), (0.7, 0.9), (0.5, 0.5)]:
@@ -116,7 +109,7 @@ def test_a_particle_s_body_is_the_record_stretched(hand):
 
 
 def test_fixed_proportions_ignore_the_ratios():
-    sand = random_grain("sand", 80, 6)
+    sand = cloud_grain("sand", 80, 6)
     arrays = shape_arrays([sand])
     one, other = (np.empty((256, 3)), np.empty(3), np.empty(3)), (np.empty((256, 3)), np.empty(3), np.empty(3))
     n1 = particle_body(arrays, 0, 1.0, 1.0, 1.0, *one)
