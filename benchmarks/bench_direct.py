@@ -102,11 +102,11 @@ from direct_model.collision import collide
 from direct_model.flight import curvature_bound, jerk_bound, lowest_points
 from direct_model.body_rebound import lab_tensor, quaternion_to_matrix
 from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
-from direct_model.runtime import (P_KAPPA, P_KFAC, P_WALL, SCRATCH_SIZE, U_AXIS, U_HAND, U_ORIENTATION,
-                                  U_PER_REBOUND, U_RATIOS, aspect_ratio, model_parameters, rebound_model_frame,
+from direct_model.runtime import (P_WALL, SCRATCH_SIZE, U_AXIS, U_HAND, U_ORIENTATION, U_PER_REBOUND, U_RATIOS,
+                                  aspect_ratio, family_shapes, model_parameters, rebound_model_frame,
                                   uniform_quaternion)
-from direct_model.shapes import (MAX_VERTICES, TETRAHEDRON, AspectRatioLaw, body_vertices, bounding_radius,
-                                 second_moment_factors)
+from direct_model.shape_arrays import bounding_radius, particle_body
+from direct_model.shapes import MAX_VERTICES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_SET_TOL, simulate
 from direct_model.wall import CORUNDUM_ON_STEEL
 from bench_native import build_native  # benchmarks/, next to this script
@@ -206,13 +206,13 @@ STATE_SETS = ("random, 0", "random, spin", "hopper")
 
 
 @numba.njit
-def _kernel_loop(params, shape, V, omega, n, a, state, status, V_out, W_out):
+def _kernel_loop(params, shapes, shape, V, omega, n, a, state, status, V_out, W_out):
     """direct_rebound on every row, uniforms from ``state``: what a solver's loop does."""
     u = np.empty(U_PER_REBOUND)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        st, Vo, Wo = direct_rebound(params, shape, (V[i, 0], V[i, 1], V[i, 2]), (omega[i, 0], omega[i, 1], omega[i, 2]),
-                                    (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        st, Vo, Wo = direct_rebound(params, shapes, shape, (V[i, 0], V[i, 1], V[i, 2]),
+                                    (omega[i, 0], omega[i, 1], omega[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
         status[i] = st
         for k in range(3):
             V_out[i, k], W_out[i, k] = Vo[k], Wo[k]
@@ -230,13 +230,13 @@ def _model_frame_inputs(V, n, a, omega, state, u_all, model):
 
 
 @numba.njit
-def _model_frame_loop(params, model, shape, u_all, counts, W_after):
+def _model_frame_loop(params, shapes, model, shape, u_all, counts, W_after):
     """rebound_model_frame alone on the rows' model-frame inputs; counts[i] = (status, collisions, steps),
     W_after[i] = Ω⁺ ((m/s)/a, model frame)."""
     scratch = np.empty(SCRATCH_SIZE)
     for i in range(model.shape[0]):
         st, n_coll, n_steps, _, _, _, wx, wy, wz = rebound_model_frame(
-            params, shape, model[i, 0], model[i, 1], model[i, 2], model[i, 3], model[i, 4], u_all[i], scratch)
+            params, shapes, shape, model[i, 0], model[i, 1], model[i, 2], model[i, 3], model[i, 4], u_all[i], scratch)
         counts[i, 0], counts[i, 1], counts[i, 2] = st, n_coll, n_steps
         W_after[i, 0], W_after[i, 1], W_after[i, 2] = wx, wy, wz
 
@@ -244,35 +244,33 @@ def _model_frame_loop(params, model, shape, u_all, counts, W_after):
 # ----------------------------------------------------------------------------- the pieces of a rebound
 
 @numba.njit
-def _bodies(params, shape, u_all, semi, R, verts, nv):
-    """The bodies the rows' uniforms draw (as rebound_model_frame draws them): semi-axes, orientation R,
+def _bodies(shapes, shape, u_all, semi, K, R, verts, nv):
+    """The bodies the rows' uniforms draw (as rebound_model_frame draws them): half-extents, J/m, orientation R,
     vertices (untimed)."""
     q = np.empty(4)
+    law, cdf = shapes.aspect[shape], shapes.aspect_cdf[shape]
     for i in range(u_all.shape[0]):
         uniform_quaternion(u_all[i, U_ORIENTATION], u_all[i, U_ORIENTATION + 1], u_all[i, U_ORIENTATION + 2], q)
         quaternion_to_matrix(q, R[i])
-        b = aspect_ratio(params, u_all[i, U_RATIOS])
-        semi[i, 0], semi[i, 1], semi[i, 2] = 1.0, b, b * aspect_ratio(params, u_all[i, U_RATIOS + 1])
-        hand = 1.0 if shape != TETRAHEDRON or u_all[i, U_HAND] < 0.5 else -1.0
-        nv[i] = body_vertices(shape, 1.0, semi[i, 1], semi[i, 2], params[P_KAPPA], hand, verts[i])
+        ratio_ba, ratio_cb = aspect_ratio(law, cdf, u_all[i, U_RATIOS]), aspect_ratio(law, cdf, u_all[i, U_RATIOS + 1])
+        hand = 1.0 if shapes.both_hands[shape] == 0 or u_all[i, U_HAND] < 0.5 else -1.0
+        nv[i] = particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts[i], K[i], semi[i])
 
 
 @numba.njit
-def _flight_setups(params, shape, semi, R, verts, nv, W, rot):
+def _flight_setups(shapes, shape, semi, K, R, verts, nv, W, rot):
     """What rebound does at the start of a flight: K in the lab frame, ℓ = KΩ, curvature_bound, jerk_bound and
     (at the flight's second search step, if it has one) rotation_init; rot[i] receives the rotation parameters."""
-    K, K_lab, ell = np.empty(3), np.empty((3, 3)), np.empty(3)
+    K_lab, ell = np.empty((3, 3)), np.empty(3)
+    kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
-        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
-        kfac = params[P_KFAC + shape]
-        K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
-        lab_tensor(R[i], K, K_lab)
+        lab_tensor(R[i], K[i], K_lab)
         for j in range(3):
             ell[j] = K_lab[j, 0] * W[i, 0] + K_lab[j, 1] * W[i, 1] + K_lab[j, 2] * W[i, 2]
-        rotation_init(K, R[i], ell, rot[i])
-        Rb = bounding_radius(shape, 1.0, semi[i, 1], semi[i, 2], verts[i], nv[i])
-        curvature_bound(shape, semi[i], Rb, K, ell, W[i])
-        jerk_bound(shape, semi[i], Rb, K, ell, W[i])
+        rotation_init(K[i], R[i], ell, rot[i])
+        Rb = bounding_radius(kind, semi[i], verts[i], nv[i])
+        curvature_bound(kind, semi[i], Rb, K[i], ell, W[i])
+        jerk_bound(kind, semi[i], Rb, K[i], ell, W[i])
 
 
 @numba.njit
@@ -285,36 +283,32 @@ def _orientations(rot, t):
 
 
 @numba.njit
-def _lowest_points(params, shape, semi, R, verts, nv, W):
+def _lowest_points(shapes, shape, semi, K, R, verts, nv, W):
     """The candidate lowest points of the body, their heights, rates and curvatures (lowest_points): what every
     search step computes."""
-    h, h1, h2, K = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3)
+    h, h1, h2 = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES)
+    kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
-        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
-        kfac = params[P_KFAC + shape]
-        K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
-        lowest_points(shape, verts[i], nv[i], semi[i], K, R[i], W[i], 1.0, 0.0, h, h1, h2)
+        lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W[i], 1.0, 0.0, h, h1, h2)
 
 
 @numba.njit
-def _collisions(params, shape, semi, R, verts, nv, model, out):
+def _collisions(params, shapes, shape, semi, K, R, verts, nv, model, out):
     """One collision per row, the body at rest touching the wall at its lowest point, hit at V⁻ (the first
     collision of a rebound with Ω⁻ = 0): K⁻¹ in the lab frame and collide. out[i] = collide's outcome."""
-    K, Kinv, Kinv_lab = np.empty(3), np.empty(3), np.empty((3, 3))
+    Kinv, Kinv_lab = np.empty(3), np.empty((3, 3))
     h, h1, h2, r = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3)
     V, W, dV, dW = np.empty(3), np.zeros(3), np.empty(3), np.empty(3)
     wall = params[P_WALL:P_WALL + 3]
+    kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
-        a2, b2, c2 = semi[i, 0] ** 2, semi[i, 1] ** 2, semi[i, 2] ** 2
-        kfac = params[P_KFAC + shape]
-        K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
-        m = lowest_points(shape, verts[i], nv[i], semi[i], K, R[i], W, 0.0, 0.0, h, h1, h2)
+        m = lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W, 0.0, 0.0, h, h1, h2)
         low = 0
         for j in range(m):
             low = j if h[j] < h[low] else low
         for j in range(3):
             r[j] = R[i, j, 0] * verts[i, low, 0] + R[i, j, 1] * verts[i, low, 1] + R[i, j, 2] * verts[i, low, 2]
-            Kinv[j] = 1.0 / K[j]
+            Kinv[j] = 1.0 / K[i, j]
         lab_tensor(R[i], Kinv, Kinv_lab)
         V[0], V[1], V[2] = model[i, 0], model[i, 1], 0.0
         out[i] = collide(V, W, r, Kinv_lab, wall, dV, dW)
@@ -336,16 +330,16 @@ PIECES = ("flight_setup", "orientation", "lowest_points", "collision")
 PIECE_ROWS = 2048     # the pieces run on the first rows only: their inputs stay in cache, as inside a rebound
 
 
-def piece_inputs(params, shape_code, u_all, model, W_after) -> dict:
+def piece_inputs(shapes, shape_code, u_all, model, W_after) -> dict:
     """The inputs of the pieces (module doc), from the rows' bodies: a flight's setup with the spin after the
     rebound, the orientation 0.5 a/|V⁻| into that flight, the lowest points, a first collision; the first
     PIECE_ROWS rows."""
     u_all, model, W_after = u_all[:PIECE_ROWS], model[:PIECE_ROWS], W_after[:PIECE_ROWS]
     m = len(u_all)
-    semi, R = np.empty((m, 3)), np.empty((m, 3, 3))
+    semi, K, R = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3, 3))
     verts, nv = np.zeros((m, MAX_VERTICES, 3)), np.empty(m, dtype=np.int64)
-    _bodies(params, shape_code, u_all, semi, R, verts, nv)
-    return {"semi": semi, "R": R, "verts": verts, "nv": nv, "W": np.where(np.isfinite(W_after), W_after, 0.0),
+    _bodies(shapes, shape_code, u_all, semi, K, R, verts, nv)
+    return {"semi": semi, "K": K, "R": R, "verts": verts, "nv": nv, "W": np.where(np.isfinite(W_after), W_after, 0.0),
             "t": 0.5 / np.hypot(model[:, 0], model[:, 1]), "model": model, "u": u_all}
 
 
@@ -359,19 +353,20 @@ def write_pieces(path: Path, pieces: dict) -> None:
         f.write(np.ascontiguousarray(rows, dtype=np.float64).tobytes())
 
 
-def piece_costs(params, shape_code, pieces: dict, repeats) -> dict:
+def piece_costs(params, shapes, shape_code, pieces: dict, repeats) -> dict:
     """µs per call of numba's pieces of a rebound; each is cheap: the best of 5 × ``repeats`` runs."""
-    semi, R, verts, nv, W, t, model = (pieces[k] for k in ("semi", "R", "verts", "nv", "W", "t", "model"))
+    semi, K, R, verts, nv, W, t, model = (pieces[k] for k in ("semi", "K", "R", "verts", "nv", "W", "t", "model"))
     m = len(t)
     rot = np.empty((m, ROT_PARAMS_SIZE))
     outcome = np.empty(m, dtype=np.int64)
     runs = 5 * repeats
-    return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(params, shape_code, semi, R, verts, nv, W, rot),
+    return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(shapes, shape_code, semi, K, R, verts, nv, W, rot),
                                              runs) / m,
             "us_orientation": 1e6 * _best(lambda: _orientations(rot, t), runs) / m,
-            "us_lowest_points": 1e6 * _best(lambda: _lowest_points(params, shape_code, semi, R, verts, nv, W), runs) / m,
-            "us_collision": 1e6 * _best(lambda: _collisions(params, shape_code, semi, R, verts, nv, model, outcome),
-                                        runs) / m}
+            "us_lowest_points": 1e6 * _best(lambda: _lowest_points(shapes, shape_code, semi, K, R, verts, nv, W),
+                                            runs) / m,
+            "us_collision": 1e6 * _best(lambda: _collisions(params, shapes, shape_code, semi, K, R, verts, nv, model,
+                                                            outcome), runs) / m}
 
 
 def split(row: dict, costs: dict, total_us: float) -> dict:
@@ -454,21 +449,22 @@ def c_runtime(program: Path, table: Path, states: dict, shape_code: int, repeats
 
 # ----------------------------------------------------------------------------- one row
 
-def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats: int, native=None) -> dict:
+def bench_runtime(params, shapes, states: dict, set_name: str, shape_code: int, repeats: int, native=None) -> dict:
     """µs per rebound of the run-time kernel on one set of states with one shape, the C kernel's if
     ``native`` = (program, table, folder), counts per rebound and the time split (module doc)."""
     V, n, a, W = states["V"], states["n"], states["a"], states["omega"]
     m = len(a)
     status, V_out, W_out = np.empty(m, dtype=np.int8), np.empty((m, 3)), np.empty((m, 3))
-    best = _best(lambda: _kernel_loop(params, shape_code, V, W, n, a, seed_state(SEED), status, V_out, W_out),
+    best = _best(lambda: _kernel_loop(params, shapes, shape_code, V, W, n, a, seed_state(SEED), status, V_out, W_out),
                  repeats)
     u_all, model = np.empty((m, U_PER_REBOUND)), np.empty((m, 5))
     counts, W_after = np.empty((m, 3), dtype=np.int64), np.empty((m, 3))
     _model_frame_inputs(V, n, a, W, seed_state(SEED), u_all, model)
-    best_model = _best(lambda: _model_frame_loop(params, model, shape_code, u_all, counts, W_after), repeats)
+    best_model = _best(lambda: _model_frame_loop(params, shapes, model, shape_code, u_all, counts, W_after), repeats)
     rest = counts[:, 0] != STATUS_TRAPPED            # a trapped particle costs n_max collisions
     sub_model, sub_u, sub_counts, sub_W = model[rest], u_all[rest], counts[rest], W_after[rest]
-    best_rest = _best(lambda: _model_frame_loop(params, sub_model, shape_code, sub_u, sub_counts, sub_W), repeats)
+    best_rest = _best(lambda: _model_frame_loop(params, shapes, sub_model, shape_code, sub_u, sub_counts, sub_W),
+                      repeats)
     ok = counts[:, 0] == STATUS_REBOUNDED
     row = {"shape": SHAPES[shape_code], "states": set_name, "n": m,
            "us_per_rebound": 1e6 * best / m, "us_model_frame": 1e6 * best_model / m,
@@ -482,8 +478,8 @@ def bench_runtime(params, states: dict, set_name: str, shape_code: int, repeats:
            "us_c": math.nan, "c_over_numba": math.nan, "c_same_bits": None}
     # the split: counts per rebound × µs per piece; the rest is the body's setup, the search's own logic
     # (the contact choice, Newton and safe steps) and the frame
-    pieces = piece_inputs(params, shape_code, u_all, model, W_after)
-    row.update(piece_costs(params, shape_code, pieces, repeats))
+    pieces = piece_inputs(shapes, shape_code, u_all, model, W_after)
+    row.update(piece_costs(params, shapes, shape_code, pieces, repeats))
     row.update(split(row, row, row["us_model_frame"]))
     row["pct_trapped"] = 100 * (1 - best_rest / best_model) if not rest.all() else 0.0
     if native is not None:
@@ -519,6 +515,7 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
         params = (surrogate.load(table_path).direct_parameters if table_path is not None
                   else model_parameters(AspectRatioLaw(), 0.3, DEFAULT_N_MAX, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL,
                                         DEFAULT_SET_TOL, DEFAULT_MAX_STEPS, second_moment_factors(0.3)))
+        shapes = family_shapes(params)
         c_side = None
         if native:
             folder = build_dir if build_dir is not None else build_native(tmp / "build", "rbs_bench_direct")
@@ -528,13 +525,13 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
             c_side = (program, table_path, tmp)
         warm = {k: v[:16] for k, v in random_states(16, True, SEED).items()}
         for code in range(len(SHAPES)):                  # warm-up: compile the loops
-            bench_runtime(params, warm, "warm-up", code, 1)
+            bench_runtime(params, shapes, warm, "warm-up", code, 1)
         print(f"\nRun-time kernels, one thread, best of {repeats}: numba (surrogate.kernels.direct_rebound)"
               + (" and C (rbs_direct_rebound)" if native else "") + f"; states: {states} random per row with Ω⁻ = 0 "
               f"('random, 0') or spinning ('random, spin'), and {len(sets['hopper']['a'])} hopperRebound hits "
               f"({hits_path.name}, {np.mean(np.any(sets['hopper']['omega'] != 0, axis=1)):.0%} spinning) run with "
               "each shape ('hopper')")
-        rows = [bench_runtime(params, sets[name], name, code, repeats, c_side)
+        rows = [bench_runtime(params, shapes, sets[name], name, code, repeats, c_side)
                 for code in range(len(SHAPES)) for name in STATE_SETS]
     _print_rows(rows, RUNTIME_COLUMNS)
     print("numba us, C us: µs per rebound of the whole call (uniforms, frame, checks, rebound), the mean over all\n"

@@ -61,7 +61,7 @@ def _aspect_row(law: AspectRatioLaw | None) -> list:
     return [math.nan] * 4 if law is None else [law.mean, law.sd, law.low, law.high]
 
 
-def shape_arrays(records) -> dict:
+def shape_datasets(records) -> dict:
     """The datasets of :data:`SHAPE_DATASETS` (numpy arrays of their dtypes) for registry records, table order."""
     n = len(records)
     vertices, triangles = [np.zeros((0, 3))], [np.zeros((0, 3), dtype=np.int32)]
@@ -87,9 +87,9 @@ def shape_arrays(records) -> dict:
 
 
 def write_shape_records(f: h5py.File, records) -> None:
-    """Group /shapes of an open table file: :func:`shape_arrays` as Fletcher-32 checksummed datasets."""
+    """Group /shapes of an open table file: :func:`shape_datasets` as Fletcher-32 checksummed datasets."""
     group = f.create_group(SHAPES_GROUP)
-    for name, values in shape_arrays(records).items():
+    for name, values in shape_datasets(records).items():
         dtype, units, meaning = SHAPE_DATASETS[name]
         # chunked (a filter needs chunks) in one chunk; an empty dataset (no polyhedron) keeps a chunk of one row
         chunks = tuple(max(1, d) for d in values.shape)
@@ -106,7 +106,7 @@ def family_records(names, kappa: float, aspect: tuple) -> tuple:
     return tuple(built_in_shape(name, kappa, law) for name in names)
 
 
-def check_shape_arrays(arrays: dict, names, refuse) -> None:
+def check_shape_datasets(arrays: dict, names, refuse) -> None:
     """``refuse`` (called with the message) unless the /shapes datasets obey the contract (docs/format.md,
     "Shapes"): their shapes, the names (the table's, each a built-in's or a user shape's allowed name), kinds,
     index ranges and vertex counts, bounded vertices (finite, |coordinate| <= VERTEX_BOUND, half-extents within
@@ -189,7 +189,7 @@ def check_shape_arrays(arrays: dict, names, refuse) -> None:
 
 
 def records_from_arrays(arrays: dict, names, kappa: float, aspect: tuple, refuse) -> tuple:
-    """The registry records of checked /shapes datasets (:func:`check_shape_arrays`). A built-in family's row must
+    """The registry records of checked /shapes datasets (:func:`check_shape_datasets`). A built-in family's row must
     be the family's record at κ and the aspect-ratio law ``aspect`` bit for bit; a user grain's record is rebuilt
     from its vertices and triangles (:func:`direct_model.registry.polyhedron`), whose mass properties must give
     the stored inertia bit for bit. ``refuse`` names the first row that does not."""
@@ -201,7 +201,7 @@ def records_from_arrays(arrays: dict, names, kappa: float, aspect: tuple, refuse
             except ValueError as exc:
                 refuse(f"the built-in shape {name!r} cannot be made at the table's kappa {kappa!r} and aspect-ratio "
                        f"law {list(aspect)}: {exc}")
-            expected = shape_arrays([record])
+            expected = shape_datasets([record])
             for key in ("kind", "vertices", "triangles", "inertia", "aspect", "both_hands"):
                 if not np.array_equal(_row(arrays, key, i).view(np.uint8), expected[key].view(np.uint8)):
                     refuse(f"dataset 'shapes/{key}' of the built-in shape {name!r} differs from the family's record "

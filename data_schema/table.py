@@ -61,7 +61,7 @@ import numpy as np
 
 from data_schema.common import DataFormatError, check_file, write_header
 from data_schema.samples import SHAPE_NAMES
-from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_arrays,
+from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_datasets,
                                        family_records, records_from_arrays, write_shape_records)
 from data_schema.output import hdf5_bytes, write_output
 
@@ -417,13 +417,13 @@ def check_contract(table: ReboundTable, where: str, law: dict, shapes: dict | No
     layout (docs/format.md, "What makes a table valid"; the C loader checks the same). ``law`` holds the
     datasets of :data:`LAW_DATASETS` the file has (3.2), which must equal the attributes and names: the first two
     of :data:`LAW_ATTRIBUTES` in a 3.2 table, all of them since 3.3. ``shapes`` holds the datasets of group
-    /shapes (3.4; :func:`data_schema.shape_records.check_shape_arrays`); a table without them holds the families
+    /shapes (3.4; :func:`data_schema.shape_records.check_shape_datasets`); a table without them holds the families
     only."""
     def refuse(text):
         raise DataFormatError(f"{where}: {text}")
 
     if shapes is not None:
-        check_shape_arrays(shapes, table.shapes, refuse)
+        check_shape_datasets(shapes, table.shapes, refuse)
     elif not all(name in SHAPE_NAMES for name in table.shapes) or len(set(table.shapes)) != len(table.shapes):
         refuse(f"dataset 'grid/shapes' must name distinct shapes among {', '.join(SHAPE_NAMES)} (a table before "
                f"format 3.{SHAPES_SINCE}); got {list(table.shapes)}")

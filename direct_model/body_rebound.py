@@ -32,22 +32,22 @@ from direct_model.options import JIT
 from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
 from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, jerk_bound,
                                   lowest_points)
+from direct_model.registry import MAX_HULL_VERTICES
 from direct_model.rotation import ROT_PARAMS_SIZE
-from direct_model.shapes import MAX_VERTICES, body_vertices, bounding_radius
+from direct_model.shape_arrays import bounding_radius, particle_body
 
 HISTORY_COLUMNS = 17
 
-# layout of the scratch array of :func:`body_rebound`
-_VERTS = 0
-_HEIGHTS = _VERTS + 3 * MAX_VERTICES
-_RATES = _HEIGHTS + MAX_VERTICES
-_CURVATURES = _RATES + MAX_VERTICES
-_PARAMS = _CURVATURES + MAX_VERTICES
+# layout of the scratch array of :func:`body_rebound`: the candidate points' heights, rates and curvatures first
+_HEIGHTS = 0
+_RATES = _HEIGHTS + MAX_HULL_VERTICES
+_CURVATURES = _RATES + MAX_HULL_VERTICES
+_PARAMS = _CURVATURES + MAX_HULL_VERTICES
 _R = _PARAMS + ROT_PARAMS_SIZE
 _K_LAB = _R + 9
 _KINV_LAB = _K_LAB + 9
-_K = _KINV_LAB + 9                 # then seven 3-vectors: K, 1/K, ℓ, r_c, ΔV, ΔΩ, Ω(t)
-WORK_SIZE = _K + 21
+_K = _KINV_LAB + 9                 # then six 3-vectors: 1/K, ℓ, r_c, ΔV, ΔΩ, Ω(t)
+WORK_SIZE = _K + 18
 _BLOCKS = 1024                     # parallel work units of body_rebound_batch (scratch allocated per block)
 
 
@@ -70,15 +70,16 @@ def lab_tensor(R, diag, out):
 
 
 @numba.njit(**JIT)
-def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contact_tol, set_tol,
-            max_steps, V, W, history, work):
+def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_tol, set_tol, max_steps, V, W,
+                 history, work):
     """Simulate one particle's rebound.
 
     Parameters
     ----------
-    shape : int shape code; semi : (3,) half-extents (a, b, c) in units of a.
-    kappa : cut-prism truncation; hand : ±1 tetrahedron hand.
-    kfac : second-moment factor s of the shape (J/m = s·(b²+c², a²+c², a²+b²)).
+    kind, verts, nv, semi, K, Rb : the particle's body (:func:`direct_model.shape_arrays.particle_body`): its
+        kind, its nv vertices in ``verts`` (body frame, units of a; the ellipsoid's support point is written into
+        ``verts[0]``, so at least one row), its half-extents (an ellipsoid's semi-axes), its principal J/m (a²)
+        and its bounding radius (:func:`direct_model.shape_arrays.bounding_radius`).
     R0 : (3, 3) body→lab orientation at the start.
     V0 : (3,) incident velocity, m/s; W0 : (3,) incident angular velocity, (m/s)/a.
     wall : (3,) wall-law coefficients.
@@ -97,33 +98,27 @@ def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contac
     with e_rot = ½ Ω·KΩ, the rotational energy per unit mass after the rebound, and
     failure_reason one of the FAILURE_* codes of :mod:`data_schema.samples`.
     """
-    verts = work[_VERTS:_VERTS + 3 * MAX_VERTICES].reshape((MAX_VERTICES, 3))
-    h = work[_HEIGHTS:_HEIGHTS + MAX_VERTICES]
-    h1 = work[_RATES:_RATES + MAX_VERTICES]
-    h2 = work[_CURVATURES:_CURVATURES + MAX_VERTICES]
+    h = work[_HEIGHTS:_HEIGHTS + MAX_HULL_VERTICES]
+    h1 = work[_RATES:_RATES + MAX_HULL_VERTICES]
+    h2 = work[_CURVATURES:_CURVATURES + MAX_HULL_VERTICES]
     params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
     R = work[_R:_R + 9].reshape((3, 3))
     K_lab = work[_K_LAB:_K_LAB + 9].reshape((3, 3))
     Kinv_lab = work[_KINV_LAB:_KINV_LAB + 9].reshape((3, 3))
-    K = work[_K:_K + 3]
-    Kinv = work[_K + 3:_K + 6]
-    ell = work[_K + 6:_K + 9]
-    rc = work[_K + 9:_K + 12]
-    dV = work[_K + 12:_K + 15]
-    dW = work[_K + 15:_K + 18]
-    Wt = work[_K + 18:_K + 21]          # angular velocity during the search
+    Kinv = work[_K:_K + 3]
+    ell = work[_K + 3:_K + 6]
+    rc = work[_K + 6:_K + 9]
+    dV = work[_K + 9:_K + 12]
+    dW = work[_K + 12:_K + 15]
+    Wt = work[_K + 15:_K + 18]          # angular velocity during the search
 
-    nv = body_vertices(shape, semi[0], semi[1], semi[2], kappa, hand, verts)
-    Rb = bounding_radius(shape, semi[0], semi[1], semi[2], verts, nv)
-    a2, b2, c2 = semi[0] ** 2, semi[1] ** 2, semi[2] ** 2
-    K[0], K[1], K[2] = kfac * (b2 + c2), kfac * (a2 + c2), kfac * (a2 + b2)
     Kinv[:] = 1.0 / K
     R[:] = R0
     V[:] = V0
     W[:] = W0
 
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
-        n = lowest_points(shape, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2)
+        n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2)
         y = -h[:n].min()
     else:
         y = Rb
@@ -147,10 +142,10 @@ def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contac
         for i in range(3):
             ell[i] = K_lab[i, 0] * W[0] + K_lab[i, 1] * W[1] + K_lab[i, 2] * W[2]
         e_rot = 0.5 * (W[0] * ell[0] + W[1] * ell[1] + W[2] * ell[2])
-        M = curvature_bound(shape, semi, Rb, K, ell, W)
-        M3 = jerk_bound(shape, semi, Rb, K, ell, W)
+        M = curvature_bound(kind, semi, Rb, K, ell, W)
+        M3 = jerk_bound(kind, semi, Rb, K, ell, W)
         Wt[:] = W
-        code, t, steps = find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
+        code, t, steps = find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
                                       contact_tol, set_tol, max_steps, R, Wt, h, h1, h2, rc)
         n_steps += steps
         if code == SEARCH_ESCAPED:
@@ -178,30 +173,33 @@ def body_rebound(shape, semi, kappa, hand, kfac, R0, V0, W0, wall, n_max, contac
 
 
 @numba.njit(parallel=True, **JIT)
-def body_rebound_batch(shapes, ratios, hands, quats, V0, W0, kfacs, kappa, wall, n_max,
-                  contact_tol, set_tol, max_steps,
-                  out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi):
+def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall, n_max, contact_tol, set_tol,
+                       max_steps, out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi):
     """Run :func:`body_rebound` for every particle i (parallel over blocks of particles).
 
-    Inputs per particle: ``shapes[i]`` code, ``ratios[i] = (b/a, c/b)``,
+    Inputs per particle: ``shapes[i]`` its shape's index in ``shape_arrays``
+    (:class:`direct_model.shape_arrays.ShapeArrays`), ``ratios[i] = (b/a, c/b)``,
     ``hands[i]`` = ±1, ``quats[i]`` orientation quaternion (any norm > 0).
-    Common: V0, W0 (lab; m/s and (m/s)/a), ``kfacs[code]`` second-moment
-    factors, kappa, wall and the tolerances. Outputs are filled per particle;
-    each particle's result depends on its inputs only, not on the blocking.
+    Common: V0, W0 (lab; m/s and (m/s)/a), wall and the tolerances. Outputs are
+    filled per particle; each particle's result depends on its inputs only, not
+    on the blocking.
     """
     n = shapes.shape[0]
     n_blocks = min(n, _BLOCKS)
     for block in numba.prange(n_blocks):
         no_history = np.empty((0, HISTORY_COLUMNS))
         work = np.empty(WORK_SIZE)
+        verts = np.empty((MAX_HULL_VERTICES, 3))
+        K = np.empty(3)
         semi = np.empty(3)
         R0 = np.empty((3, 3))
         for i in range(block * n // n_blocks, (block + 1) * n // n_blocks):
-            semi[0], semi[1], semi[2] = 1.0, ratios[i, 0], ratios[i, 0] * ratios[i, 1]
+            nv = particle_body(shape_arrays, shapes[i], ratios[i, 0], ratios[i, 1], float(hands[i]), verts, K, semi)
+            kind = shape_arrays.kind[shapes[i]]
             quaternion_to_matrix(quats[i], R0)
             status, failure, ncoll, steps, multi, erot = body_rebound(
-                shapes[i], semi, kappa, float(hands[i]), kfacs[shapes[i]], R0, V0, W0, wall,
-                n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
+                kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, wall, n_max,
+                contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
             out_status[i] = status
             out_failure[i] = failure
             out_ncoll[i] = ncoll

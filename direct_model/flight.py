@@ -58,7 +58,7 @@ import numpy as np
 
 from direct_model.options import JIT
 from direct_model.rotation import rotation_at, rotation_init
-from direct_model.shapes import ELLIPSOID
+from direct_model.shape_arrays import KIND_ELLIPSOID
 
 SEARCH_CONTACT = 0      # a point touches the wall (within contact_tol) and approaches it
 SEARCH_ESCAPED = 1      # the body can never reach the wall again
@@ -80,14 +80,14 @@ def _rate_bounds(K, ell, W):
 
 
 @numba.njit(**JIT)
-def curvature_bound(shape, semi, Rb, K, ell, W):
+def curvature_bound(kind, semi, Rb, K, ell, W):
     """Bound M on |h''| of any candidate point's height during a flight (module doc).
 
     ``K`` principal J/m (a²), ``ell`` = L/m and ``W`` = Ω at any instant of the
     flight (lab frame); 2T = ℓ·Ω is the flight's invariant.
     """
     w, wdot, _ = _rate_bounds(K, ell, W)
-    if shape == ELLIPSOID:
+    if kind == KIND_ELLIPSOID:
         amax = max(semi[0], max(semi[1], semi[2]))
         amin = min(semi[0], min(semi[1], semi[2]))
         return amax * amax * w * w / amin + amax * (wdot + w * w)
@@ -95,11 +95,11 @@ def curvature_bound(shape, semi, Rb, K, ell, W):
 
 
 @numba.njit(**JIT)
-def jerk_bound(shape, semi, Rb, K, ell, W):
+def jerk_bound(kind, semi, Rb, K, ell, W):
     """Bound M3 on |h'''| of any candidate point's height during a flight (module doc)."""
     w, wdot, wddot = _rate_bounds(K, ell, W)
     g3 = wddot + 3.0 * w * wdot + w * w * w
-    if shape == ELLIPSOID:
+    if kind == KIND_ELLIPSOID:
         amax = max(semi[0], max(semi[1], semi[2]))
         amin = min(semi[0], min(semi[1], semi[2]))
         return (6.0 * amax * amax * w * (wdot + w * w) / amin + amax * g3
@@ -133,7 +133,7 @@ def taylor_root(h, hdot, hddot):
 
 
 @numba.njit(**JIT)
-def lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2):
+def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2):
     """Heights ``h[i]``, rates ``h1[i]`` and curvatures ``h2[i]`` of the candidate lowest points.
 
     ``R``, ``W``: orientation and lab Ω now; ``y``, ``v``: the centre's height and vertical
@@ -152,7 +152,7 @@ def lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2):
     a0 = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1)                  # g̈ = ġ × ω + g × ω̇
     a1 = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2)
     a2 = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0)
-    if shape == ELLIPSOID:
+    if kind == KIND_ELLIPSOID:
         u0, u1, u2 = semi[0] * g0, semi[1] * g1, semi[2] * g2
         sigma = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
         q0, q1, q2 = semi[0] * u0, semi[1] * u1, semi[2] * u2      # A² g
@@ -205,13 +205,14 @@ def choose_contact(n, verts, h, h1, R, set_tol, rc):
 
 
 @numba.njit(**JIT)
-def find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
+def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
                  max_steps, R, W, h, h1, h2, rc):
     """Advance a flight from its start (t = 0) to the next collision or to escape.
 
     Parameters
     ----------
-    shape, verts, nv, semi, Rb : the body (codes and arrays of :mod:`direct_model.shapes`).
+    kind, verts, nv, semi, Rb : the body (:func:`direct_model.shape_arrays.particle_body`): its kind, its nv
+        vertices (body frame), its half-extents (an ellipsoid's semi-axes) and its bounding radius.
     K, ell : principal J/m (a²) and ℓ = L/m (lab) of the flight.
     M, M3 : bounds from :func:`curvature_bound` and :func:`jerk_bound` for this flight.
     params : the flight's rotation parameters, filled here by
@@ -239,7 +240,7 @@ def find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, conta
                 rotation_init(K, R, ell, params)
             rotation_at(params, t, R, W)
         y = y0 + v * t
-        n = lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2)
+        n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2)
         hmin, low = np.inf, 0
         for i in range(n):
             if h[i] < hmin:

@@ -1,14 +1,17 @@
 """The direct model at run time: one particle's whole rebound from U_PER_REBOUND uniforms (docs/model.md §10).
 
 :func:`rebound_model_frame` is :func:`direct_model.body_rebound.body_rebound` with its random inputs drawn from
-uniforms the caller passes, and with every model parameter taken from one float64 array
+uniforms the caller passes, the particle's shape from the shapes as arrays
+(:class:`direct_model.shape_arrays.ShapeArrays`) and every other model parameter from one float64 array
 (:func:`model_parameters`, layout P_*), so that a runtime reads the parameters a table was built with and
-calls the model from ``@njit`` code. It works in the model's frame (wall y = 0, normal +Y; docs/model.md
+calls the model from ``@njit`` code. The P_* array still holds the families' law, κ and factors s, from which a
+runtime builds their arrays (:func:`direct_model.shape_arrays.family_shape_arrays`). It works in the model's frame (wall y = 0, normal +Y; docs/model.md
 §2); :func:`surrogate.kernels.direct_path.direct_rebound` puts a hit in that frame and back.
 
 The uniforms, all in [0, 1): u[0:3] the orientation (Shoemake's uniform quaternion: Haar measure, like the
-batch's normalised Gaussian quaternion), u[3:5] b/a and c/b (inverse CDF of the truncated normal law, like
-:meth:`direct_model.shapes.AspectRatioLaw.ppf`), u[5] the tetrahedron's hand (+1 below ½), u[6] the
+batch's normalised Gaussian quaternion), u[3:5] b/a and c/b (inverse CDF of the shape's truncated normal law,
+like :meth:`direct_model.shapes.AspectRatioLaw.ppf`; unused for fixed proportions), u[5] the hand of a shape
+drawn in both hands (the tetrahedron; +1 below ½), u[6] the
 direction ex of the model frame at normal impact (used by the caller's frame, not here). A fixed count,
 so the caller draws them from any stream (xoshiro256+ in :mod:`surrogate`, ``rbs_rng`` in C) and the same
 uniforms give the same rebound in every implementation. Needs numpy and numba only.
@@ -21,7 +24,9 @@ import numpy as np
 
 from direct_model.options import JIT
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, body_rebound
-from direct_model.shapes import SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa
+from direct_model.registry import MAX_HULL_VERTICES
+from direct_model.shape_arrays import ShapeArrays, bounding_radius, family_shape_arrays, particle_body
+from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa, normal_cdf
 from direct_model.wall import WallMaterial
 
 U_PER_REBOUND = 7
@@ -35,16 +40,13 @@ P_CONTACT_TOL, P_SET_TOL, P_MAX_STEPS = 11, 12, 13  # units of a, units of a, se
 P_KFAC = 14                                          # second-moment factor s per shape code, 14..17
 N_PARAMS = P_KFAC + len(SHAPES)
 
-# the scratch of one call: rebound's work, then semi-axes, R0, V0, W0, V, W
-_SEMI = WORK_SIZE
-_R0 = _SEMI + 3
+# the scratch of one call: rebound's work, then the body's vertices, its half-extents and J/m, R0, V0, W0, V, W
+_VERTS = WORK_SIZE
+_SEMI = _VERTS + 3 * MAX_HULL_VERTICES
+_K = _SEMI + 3
+_R0 = _K + 3
 _V0 = _R0 + 9
 SCRATCH_SIZE = _V0 + 12
-
-
-def _normal_cdf(x: float) -> float:
-    """Φ(x), the standard normal CDF (libm's erfc: no scipy at run time)."""
-    return 0.5 * math.erfc(-x / math.sqrt(2.0))
 
 
 def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: WallMaterial, contact_tol: float,
@@ -64,14 +66,22 @@ def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: Wal
                          f"shape code; got {second_moment_factors!r}.")
     p = np.empty(N_PARAMS)
     p[P_ASPECT_MEAN:P_ASPECT_HIGH + 1] = aspect.mean, aspect.sd, aspect.low, aspect.high
-    p[P_CDF_LOW] = _normal_cdf((aspect.low - aspect.mean) / aspect.sd)
-    p[P_CDF_HIGH] = _normal_cdf((aspect.high - aspect.mean) / aspect.sd)
+    p[P_CDF_LOW] = normal_cdf((aspect.low - aspect.mean) / aspect.sd)
+    p[P_CDF_HIGH] = normal_cdf((aspect.high - aspect.mean) / aspect.sd)
     p[P_KAPPA], p[P_N_MAX] = kappa, n_max
     p[P_WALL:P_WALL + 3] = wall.as_array()
     p[P_CONTACT_TOL], p[P_SET_TOL], p[P_MAX_STEPS] = contact_tol, set_tol, max_steps
     p[P_KFAC:] = kfac
     p.flags.writeable = False
     return p
+
+
+def family_shapes(params, grains=()) -> ShapeArrays:
+    """The four families' shape arrays at the κ, aspect-ratio law and factors s of a parameter array
+    (:func:`model_parameters`), in shape-code order, then the records ``grains`` (a table's user grains): what
+    a runtime builds from a table."""
+    law = AspectRatioLaw(*map(float, params[P_ASPECT_MEAN:P_ASPECT_HIGH + 1]))
+    return family_shape_arrays(float(params[P_KAPPA]), law, params[P_KFAC:P_KFAC + len(SHAPES)], grains)
 
 
 @numba.njit(**JIT)
@@ -107,11 +117,13 @@ def normal_quantile(p):
 
 
 @numba.njit(**JIT)
-def aspect_ratio(params, u):
-    """The aspect-ratio law's quantile at u ∈ [0, 1): mean + sd Φ⁻¹(Φ_low + u (Φ_high − Φ_low)), in [low, high]."""
-    lo, hi = params[P_CDF_LOW], params[P_CDF_HIGH]
-    x = params[P_ASPECT_MEAN] + params[P_ASPECT_SD] * normal_quantile(lo + u * (hi - lo))
-    return min(max(x, params[P_ASPECT_LOW]), params[P_ASPECT_HIGH])
+def aspect_ratio(law, cdf, u):
+    """The quantile at u ∈ [0, 1) of the aspect-ratio law ``law`` = (mean, sd, low, high) whose CDF bounds are
+    ``cdf`` = (Φ_low, Φ_high) (:class:`direct_model.shape_arrays.ShapeArrays`' aspect and aspect_cdf rows):
+    mean + sd Φ⁻¹(Φ_low + u (Φ_high − Φ_low)), in [low, high]."""
+    lo, hi = cdf[0], cdf[1]
+    x = law[0] + law[1] * normal_quantile(lo + u * (hi - lo))
+    return min(max(x, law[2]), law[3])
 
 
 @numba.njit(**JIT)
@@ -123,13 +135,14 @@ def uniform_quaternion(u0, u1, u2, q):
 
 
 @numba.njit(**JIT)
-def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
+def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scratch):
     """One particle's whole rebound (docs/model.md §5) in the model frame, its random inputs from ``u``.
 
     Parameters
     ----------
     params : (N_PARAMS,) :func:`model_parameters`.
-    shape : shape code 0..3 (:data:`direct_model.shapes.SHAPES`).
+    shape_arrays : the shapes (:class:`direct_model.shape_arrays.ShapeArrays`).
+    shape : the particle's shape, an index into ``shape_arrays``.
     vt, vn : incident velocity (vt, vn, 0) in m/s, model frame (vn < 0: into the wall y = 0).
     wx, wy, wz : incident angular velocity in (m/s)/a, i.e. Ω⁻ (rad/s) times a (m), model frame; all zero:
         the body starts touching the wall, otherwise clear of it with the flight in simulated (§5.3).
@@ -141,20 +154,23 @@ def rebound_model_frame(params, shape, vt, vn, wx, wy, wz, u, scratch):
     (status, n_collisions, n_search_steps, V⁺ as 3 floats in m/s, Ω⁺ as 3 floats in (m/s)/a), model frame;
     status as in :func:`direct_model.body_rebound.body_rebound`.
     """
-    semi = scratch[_SEMI:_SEMI + 3]
+    verts = scratch[_VERTS:_VERTS + 3 * MAX_HULL_VERTICES].reshape((MAX_HULL_VERTICES, 3))
+    semi, K = scratch[_SEMI:_SEMI + 3], scratch[_K:_K + 3]
     R0 = scratch[_R0:_R0 + 9].reshape((3, 3))
     V0, W0 = scratch[_V0:_V0 + 3], scratch[_V0 + 3:_V0 + 6]
     V, W = scratch[_V0 + 6:_V0 + 9], scratch[_V0 + 9:_V0 + 12]
     quat = scratch[_V0 + 6:_V0 + 10]        # V and W[0]: free until rebound starts from V0, W0
     uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat)
     quaternion_to_matrix(quat, R0)
-    b_over_a = aspect_ratio(params, u[U_RATIOS])
-    semi[0], semi[1], semi[2] = 1.0, b_over_a, b_over_a * aspect_ratio(params, u[U_RATIOS + 1])
-    hand = 1.0 if shape != TETRAHEDRON or u[U_HAND] < 0.5 else -1.0
+    law, cdf = shape_arrays.aspect[shape], shape_arrays.aspect_cdf[shape]
+    ratio_ba, ratio_cb = aspect_ratio(law, cdf, u[U_RATIOS]), aspect_ratio(law, cdf, u[U_RATIOS + 1])
+    hand = 1.0 if shape_arrays.both_hands[shape] == 0 or u[U_HAND] < 0.5 else -1.0
+    nv = particle_body(shape_arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi)
+    kind = shape_arrays.kind[shape]
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
     status, _, n_coll, n_steps, _, _ = body_rebound(
-        shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params[P_WALL:P_WALL + 3],
+        kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, params[P_WALL:P_WALL + 3],
         int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
         scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])
     return status, n_coll, n_steps, V[0], V[1], V[2], W[0], W[1], W[2]

@@ -34,6 +34,7 @@ check against the closed forms.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numba
 import numpy as np
@@ -99,17 +100,6 @@ def body_vertices(shape, a, b, c, kappa, hand, out):
     return n
 
 
-@numba.njit(**JIT)
-def bounding_radius(shape, a, b, c, verts, nv):
-    """Radius of the smallest centroid-centred sphere holding the body (units of a)."""
-    if shape == ELLIPSOID:
-        return max(a, max(b, c))
-    r2 = 0.0
-    for i in range(nv):
-        r2 = max(r2, verts[i, 0] ** 2 + verts[i, 1] ** 2 + verts[i, 2] ** 2)
-    return np.sqrt(r2)
-
-
 def shape_vertices(shape: str, a: float = 1.0, b: float = 1.0, c: float = 1.0,
                    kappa: float = DEFAULT_KAPPA, hand: int = 1) -> np.ndarray:
     """Body-frame vertices (n, 3) of a polyhedral shape (Python wrapper)."""
@@ -172,6 +162,11 @@ def second_moment_factor(shape: str, kappa: float = DEFAULT_KAPPA) -> float:
 def second_moment_factors(kappa: float = DEFAULT_KAPPA) -> np.ndarray:
     """Array of :func:`second_moment_factor` indexed by shape code (kernel input)."""
     return np.array([second_moment_factor(s, kappa) for s in SHAPES])
+
+
+def normal_cdf(x: float) -> float:
+    """Φ(x), the standard normal CDF (libm's erfc: no scipy at run time); the aspect-ratio law's CDF bounds."""
+    return 0.5 * math.erfc(-x / math.sqrt(2.0))
 
 
 @dataclasses.dataclass(frozen=True)

@@ -18,8 +18,10 @@ import numpy as np
 from data_schema.common import package_version
 from data_schema.samples import ALPHA1_RANGE_TEXT, SampleSet, alpha1_is_physical
 from direct_model.body_rebound import body_rebound_batch
+from direct_model.registry import ConvexPolyhedron, Ellipsoid
+from direct_model.shape_arrays import family_shape_arrays, shape_arrays
 from direct_model.shapes import (
-    DEFAULT_KAPPA, MIX, SHAPES, TETRAHEDRON, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
+    DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
 )
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
@@ -83,23 +85,24 @@ def incident_velocity(alpha1: float, speed: float) -> np.ndarray:
     return np.array([speed * math.cos(a), -speed * math.sin(a), 0.0])
 
 
-def draw_inputs(rng: np.random.Generator, m: int, shape: str, aspect: AspectRatioLaw):
-    """Random inputs of m particles: shape codes, (b/a, c/b), hands, quaternions.
+def draw_inputs(rng: np.random.Generator, m: int, code: int, both_hands: np.ndarray, aspect: AspectRatioLaw):
+    """Random inputs of m particles: shape indices, (b/a, c/b), hands, quaternions.
 
-    The orientation is uniform on SO(3) (normalised 4-D Gaussian quaternion).
-    The tetrahedron's hand is ±1 with probability ½ each; other shapes get +1.
-    The same number of variates is drawn whatever the shape.
+    ``code``: every particle's shape index in the batch's shape arrays, or −1 for each one's drawn from the
+    four families with weight ¼ (``mix``). The orientation is uniform on SO(3) (normalised 4-D Gaussian
+    quaternion). The hand of a shape drawn in both hands (``both_hands[index]``, the tetrahedron's) is ±1 with
+    probability ½ each; other shapes get +1. The same number of variates is drawn whatever the shape.
     """
     quats = rng.standard_normal((m, 4))
     ratios = aspect.sample(rng, m)
     hands = np.where(rng.random(m) < 0.5, 1, -1).astype(np.int8)
     mixed = rng.integers(0, len(SHAPES), m).astype(np.int8)
-    codes = mixed if shape == MIX else np.full(m, shape_code(shape), dtype=np.int8)
-    hands[codes != TETRAHEDRON] = 1
+    codes = mixed if code < 0 else np.full(m, code, dtype=np.int8)
+    hands[both_hands[codes] == 0] = 1
     return codes, ratios, hands, quats
 
 
-def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None = None,
+def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None,
              omega_in=(0.0, 0.0, 0.0), *, kappa: float = DEFAULT_KAPPA,
              aspect: AspectRatioLaw = AspectRatioLaw(), wall: WallMaterial = CORUNDUM_ON_STEEL,
              n_max: int = DEFAULT_N_MAX, contact_tol: float = DEFAULT_CONTACT_TOL, set_tol: float = DEFAULT_SET_TOL,
@@ -109,7 +112,9 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     Parameters
     ----------
     shape : ``"ellipsoid"``, ``"prism"``, ``"cut_prism"``, ``"tetrahedron"`` or
-        ``"mix"`` (each particle's shape drawn from the four with weight ¼).
+        ``"mix"`` (each particle's shape drawn from the four with weight ¼); or a shape's
+        record (:mod:`direct_model.registry`, a user's grain say), stretched per particle by its own
+        law (``aspect`` and ``kappa`` are the families'), in both hands if it says so.
     alpha1 : incidence angle from the wall, degrees, in (0, 90].
     speed : incident speed |V⁻|, m/s, > 0 (the default wall law is validated
         for 50–300 m/s; outside it a warning is issued).
@@ -131,7 +136,8 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     SampleSet with V⁺ (m/s), Ω⁺a/|V⁻| (lab frame), collision counts, status and
     per-particle extras (shape code, hand, b/a, c/b, E_Ω⁺/E_V⁻, search steps).
     """
-    if shape != MIX:
+    record = shape if isinstance(shape, (Ellipsoid, ConvexPolyhedron)) else None
+    if record is None and shape != MIX:
         shape_code(shape)
     alpha1 = check_alpha1(alpha1)
     speed = check_speed(speed)
@@ -151,7 +157,13 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
 
     V0 = incident_velocity(alpha1, speed)
     W0 = omega_arr * speed                      # (m/s)/a
-    kfacs = second_moment_factors(kappa)
+    if record is None:
+        arrays = family_shape_arrays(kappa, aspect, second_moment_factors(kappa))
+        code, name, law = (-1 if shape == MIX else SHAPES.index(shape)), shape, aspect
+    else:
+        arrays, code, name, law = shape_arrays([record]), 0, record.name, record.aspect
+        # a record of fixed proportions ignores the ratios; they are drawn all the same (the same variates)
+        aspect = law or aspect
     wall_arr = wall.as_array()
     out_V = np.empty((n, 3))
     out_W = np.empty((n, 3))
@@ -168,26 +180,25 @@ def simulate(shape: str, alpha1: float, speed: float, n: int, seed: int | None =
     for k, start in enumerate(range(0, n, CHUNK_SIZE)):
         stop = min(start + CHUNK_SIZE, n)
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
-        c, r, hnd, q = draw_inputs(rng, CHUNK_SIZE, shape, aspect)
+        c, r, hnd, q = draw_inputs(rng, CHUNK_SIZE, code, arrays.both_hands, aspect)
         m = stop - start
         codes[start:stop], ratios[start:stop], hands[start:stop] = c[:m], r[:m], hnd[:m]
         sl = slice(start, stop)
-        body_rebound_batch(codes[sl], ratios[sl], hands[sl], q[:m], V0, W0, kfacs, kappa, wall_arr,
-                      n_max, contact_tol, set_tol, max_steps,
-                      out_V[sl], out_W[sl], out_erot[sl], out_ncoll[sl], out_status[sl],
-                      out_failure[sl], out_steps[sl], out_multi[sl])
+        body_rebound_batch(arrays, codes[sl], ratios[sl], hands[sl], q[:m], V0, W0, wall_arr, n_max, contact_tol,
+                           set_tol, max_steps, out_V[sl], out_W[sl], out_erot[sl], out_ncoll[sl], out_status[sl],
+                           out_failure[sl], out_steps[sl], out_multi[sl])
         if progress is not None:
             progress(m)
 
     return SampleSet(
         velocity=out_V, omega=out_W / speed, n_collisions=out_ncoll, status=out_status,
-        alpha1=alpha1, speed=speed, shape=shape, seed=seed, producer="tablegen simulate",
+        alpha1=alpha1, speed=speed, shape=name, seed=seed, producer="tablegen simulate",
         extra={"shape_code": codes, "hand": hands, "b_over_a": ratios[:, 0], "c_over_b": ratios[:, 1],
                "e_rot_ratio": out_erot / (0.5 * speed ** 2), "n_search_steps": out_steps,
                "n_multiple_roots": out_multi, "failure_reason": out_failure},
         provenance={"omega_in": omega_arr, "kappa": kappa, "n_max": n_max,
                     "contact_tol": contact_tol, "set_tol": set_tol, "max_steps": max_steps,
-                    "aspect_mean": aspect.mean, "aspect_sd": aspect.sd,
-                    "aspect_low": aspect.low, "aspect_high": aspect.high,
+                    **dict(zip(("aspect_mean", "aspect_sd", "aspect_low", "aspect_high"),
+                               (law.mean, law.sd, law.low, law.high) if law else (np.nan,) * 4)),
                     "wall_law": wall.name, "wall_k": wall.k, "wall_p": wall.p, "wall_q": wall.q,
                     "chunk_size": CHUNK_SIZE, "package_version": package_version()})

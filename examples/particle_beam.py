@@ -90,14 +90,14 @@ def hit_time(p, v, geometry, radius):
 
 
 @njit   # not cache=True: a cached copy would not notice later edits to surrogate.kernels
-def track(pos, vel, omega, t_end, dt, geometry, radius, model, data, params, model_shapes, mix_cdf, half_size, e,
-          rng_state):
+def track(pos, vel, omega, t_end, dt, geometry, radius, model, data, params, shape_arrays, model_shapes, mix_cdf,
+          half_size, e, rng_state):
     """Move every particle to time t_end (in place); rebound it at its wall hit.
 
     pos, vel, omega : (N, 3) start positions (m), velocities (m/s) and spins (rad/s, kept in free flight),
         global frame.
-    model : TABLE (surrogate kernel: table.kernel_data, table.direct_parameters, table.model_shapes) or
-        SPECULAR (sphere with restitution e).
+    model : TABLE (surrogate kernel: table.kernel_data, table.direct_parameters, table.shape_arrays,
+        table.model_shapes) or SPECULAR (sphere with restitution e).
     rng_state : (4,) uint64 xoshiro256+ state (surrogate.seed_state), advanced in place.
     Returns (V+ at the hit (N, 3) m/s, NaN if missed or trapped; outcome (N,) int8).
     """
@@ -125,9 +125,9 @@ def track(pos, vel, omega, t_end, dt, geometry, radius, model, data, params, mod
                 normal[0], normal[1], normal[2] = p[0] / r, p[1] / r, 0.0
             if model == TABLE:
                 fill_uniforms(rng_state, u)
-                status, V_new, _ = rebound(data, params, model_shapes, mix_cdf, (v[0], v[1], v[2]),
-                                                      (omega[i, 0], omega[i, 1], omega[i, 2]),
-                                                      (normal[0], normal[1], normal[2]), half_size, u, METHOD_AUTO)
+                status, V_new, _ = rebound(data, params, shape_arrays, model_shapes, mix_cdf, (v[0], v[1], v[2]),
+                                           (omega[i, 0], omega[i, 1], omega[i, 2]),
+                                           (normal[0], normal[1], normal[2]), half_size, u, METHOD_AUTO)
                 vo[0], vo[1], vo[2] = V_new
             else:
                 vn = v[0] * normal[0] + v[1] * normal[1] + v[2] * normal[2]
@@ -177,7 +177,7 @@ def run(pos, vel, t_end, geometry, model, table, cdf, e, seed, spin=0.0):
     dt = 0.02 * RADIUS / SPEED_RANGE[1]        # 0.2 mm per step at the top speed
     params = table.direct_parameters if table.direct_parameters is not None else np.zeros(0)
     v_out, outcome = track(pos, vel, beam_spin(vel, spin), t_end, dt, geometry, RADIUS, model, table.kernel_data,
-                           params, table.model_shapes, cdf, HALF_SIZE, e, seed_state(seed))
+                           params, table.shape_arrays, table.model_shapes, cdf, HALF_SIZE, e, seed_state(seed))
     return pos, v_out, outcome
 
 

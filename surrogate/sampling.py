@@ -165,7 +165,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
     params = np.zeros(0) if table.direct_parameters is None else table.direct_parameters
     states = chunk_states(check_random_state(random_state), n_particles)
-    rebound_parallel_rng(table.kernel_data, params, table.model_shapes, cdf, shapes, V, W, as_rows(nrm, n_particles),
+    rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, V, W,
+                         as_rows(nrm, n_particles),
                          as_rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
     if old_table:
         check_direct_paths(table, path, V, W, a)
@@ -218,7 +219,7 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
         shapes = _mix_rows(cdf, n_particles, generator)
     codes = np.ascontiguousarray(table.model_shapes[shapes])
     states = chunk_states(generator, n_particles)
-    direct_rebound_parallel_rng(params, codes, V, as_rows(W, n_particles), as_rows(nrm, n_particles),
+    direct_rebound_parallel_rng(params, table.shape_arrays, codes, V, as_rows(W, n_particles), as_rows(nrm, n_particles),
                                 as_rows(a, n_particles), states, V_out, Omega_out, status)
     return V_out, Omega_out, status
 

@@ -16,9 +16,11 @@ import math
 import numpy as np
 
 from data_schema.common import DataFormatError
-from data_schema.shape_records import shape_arrays
+from data_schema.shape_records import shape_datasets
 from data_schema.table import ReboundTable, read_table
-from direct_model.runtime import model_parameters
+from direct_model.registry import ConvexPolyhedron
+from direct_model.runtime import family_shapes, model_parameters
+from direct_model.shape_arrays import ShapeArrays, from_stored
 from direct_model.shapes import SHAPES, AspectRatioLaw
 from direct_model.wall import WallMaterial
 from surrogate.kernels.layout import KernelData, check_kernel_data, frozen, kernel_data
@@ -46,18 +48,39 @@ class SurrogateTable:
     records: tuple = ()
 
     @functools.cached_property
+    def shape_arrays(self) -> ShapeArrays:
+        """The direct model's shapes as the kernels take them (:class:`direct_model.shape_arrays.ShapeArrays`):
+        the four families in code order at the κ, aspect-ratio law and factors s of :attr:`direct_parameters`,
+        then the table's user grains in table order; no shape for a table without those parameters."""
+        if self.direct_parameters is None:
+            return from_stored(np.zeros(0), [0], np.zeros((0, 3)), [0], np.zeros((0, 3)), np.zeros((0, 3)),
+                               np.zeros((0, 4)), np.zeros(0))
+        return family_shapes(self.direct_parameters, self._grains)
+
+    @functools.cached_property
     def model_shapes(self) -> np.ndarray:
-        """The direct model's shape code (:data:`direct_model.shapes.SHAPES`) of each of the table's shapes, in
-        the table's order, −1 for a user's grain (the direct model does not take one yet: such a hit gets
-        STATUS_INVALID): read-only int64 (n_shapes,), as :func:`surrogate.kernels.rebound` takes it."""
-        return frozen(np.array([SHAPES.index(r.name) if r.name in SHAPES else -1 for r in self.records],
+        """Each of the table's shapes, in the table's order, as its index in :attr:`shape_arrays`: a family's code
+        (:data:`direct_model.shapes.SHAPES`), 4 + k for the table's k-th user grain, −1 for a table without the
+        direct model's parameters (the direct path then answers STATUS_INVALID): read-only int64 (n_shapes,),
+        as :func:`surrogate.kernels.rebound` takes it."""
+        if self.direct_parameters is None:
+            return frozen(np.full(len(self.shapes), -1, dtype=np.int64))
+        grains = iter(range(len(SHAPES), len(SHAPES) + len(self._grains)))
+        return frozen(np.array([SHAPES.index(r.name) if r.name in SHAPES
+                                else next(grains) if isinstance(r, ConvexPolyhedron) else -1 for r in self.records],
                                dtype=np.int64))
 
     @functools.cached_property
-    def shape_arrays(self) -> dict:
-        """The records as the arrays of the table's group /shapes (:data:`data_schema.shape_records.SHAPE_DATASETS`:
-        kind, vertex_start, vertices, inertia, aspect, both_hands, ...), read-only: the form kernels take."""
-        return {name: frozen(values) for name, values in shape_arrays(self.records).items()}
+    def shape_datasets(self) -> dict:
+        """The records as the datasets of the table's group /shapes (:data:`data_schema.shape_records.SHAPE_DATASETS`:
+        name, kind, vertex_start, vertices, inertia, aspect, both_hands, ...), read-only."""
+        return {name: frozen(values) for name, values in shape_datasets(self.records).items()}
+
+    @property
+    def _grains(self) -> tuple:
+        """The table's user grains (polyhedra that are no family), in table order; a smooth body that is no family
+        has no semi-axes on file, and the direct path refuses it (:attr:`model_shapes` −1)."""
+        return tuple(r for r in self.records if r.name not in SHAPES and isinstance(r, ConvexPolyhedron))
 
     @property
     def alpha1_range(self) -> tuple:

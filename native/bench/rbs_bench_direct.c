@@ -68,17 +68,19 @@ static void principal(const double *params, int shape, const double *semi, doubl
 }
 
 /* the pieces, piece k over all m rows (see the header); returns a sum that keeps the calls alive */
-static double run_piece(int k, const double *params, int shape, const double *rows, size_t m, double *rot)
+static double run_piece(int k, const double *params, const rbs_shape_arrays *shapes, int shape, const double *rows,
+                        size_t m, double *rot)
 {
     double sum = 0.0, K[3], Kinv[3], T[9], ell[3], R[9], W[3], h[MAX_VERTICES], h1[MAX_VERTICES], h2[MAX_VERTICES];
     double verts[3 * MAX_VERTICES];
+    int kind = shapes->kind[shape];
     for (size_t i = 0; i < m; i++) {
         const double *x = rows + i * PIECE_SIZE, *semi = x + PIECE_SEMI;
         for (int j = 0; j < 3 * MAX_VERTICES; j++) verts[j] = x[PIECE_VERTS + j];
         int nv = (int)x[PIECE_NV];
         if (k == 0) {
             double V[3], Wo[3];
-            sum += rbs_rebound_model_frame(params, shape, x[PIECE_MODEL], x[PIECE_MODEL + 1], x[PIECE_MODEL + 2],
+            sum += rbs_rebound_model_frame(params, shapes, shape, x[PIECE_MODEL], x[PIECE_MODEL + 1], x[PIECE_MODEL + 2],
                                            x[PIECE_MODEL + 3], x[PIECE_MODEL + 4], x + PIECE_U, V, Wo);
         } else if (k == 1) {
             const double *Wr = x + PIECE_W;
@@ -86,19 +88,19 @@ static double run_piece(int k, const double *params, int shape, const double *ro
             lab_tensor(x + PIECE_R, K, T);
             for (int j = 0; j < 3; j++) ell[j] = T[3 * j] * Wr[0] + T[3 * j + 1] * Wr[1] + T[3 * j + 2] * Wr[2];
             rbs_rotation_init(K, x + PIECE_R, ell, rot + i * RBS_ROT_PARAMS_SIZE);
-            double Rb = rbs_bounding_radius(shape, 1.0, semi[1], semi[2], verts, nv);
-            sum += rbs_curvature_bound(shape, semi, Rb, K, ell, Wr) + rbs_jerk_bound(shape, semi, Rb, K, ell, Wr);
+            double Rb = rbs_bounding_radius(kind, semi, verts, nv);
+            sum += rbs_curvature_bound(kind, semi, Rb, K, ell, Wr) + rbs_jerk_bound(kind, semi, Rb, K, ell, Wr);
         } else if (k == 2) {
             rbs_rotation_at(rot + i * RBS_ROT_PARAMS_SIZE, x[PIECE_T], R, W);
             sum += R[0];
         } else if (k == 3) {
             principal(params, shape, semi, K);
-            sum += rbs_lowest_points(shape, verts, nv, semi, K, x + PIECE_R, x + PIECE_W, 1.0, 0.0, h, h1, h2);
+            sum += rbs_lowest_points(kind, verts, nv, semi, K, x + PIECE_R, x + PIECE_W, 1.0, 0.0, h, h1, h2);
         } else {
             double V[3] = {x[PIECE_MODEL], x[PIECE_MODEL + 1], 0.0}, W0[3] = {0.0, 0.0, 0.0}, dV[3], dW[3], r[3];
             const double *Ri = x + PIECE_R;
             principal(params, shape, semi, K);
-            int n = rbs_lowest_points(shape, verts, nv, semi, K, Ri, W0, 0.0, 0.0, h, h1, h2), low = 0;
+            int n = rbs_lowest_points(kind, verts, nv, semi, K, Ri, W0, 0.0, 0.0, h, h1, h2), low = 0;
             for (int j = 0; j < n; j++) low = h[j] < h[low] ? j : low;
             for (int j = 0; j < 3; j++) {
                 r[j] = Ri[3 * j] * verts[3 * low] + Ri[3 * j + 1] * verts[3 * low + 1] + Ri[3 * j + 2] * verts[3 * low + 2];
@@ -134,6 +136,8 @@ static int time_pieces(const rbs_table *table, int shape, const char *path, int 
         return 0;
     }
     fclose(f);
+    rbs_family_shapes families;     /* the runtime's shapes, as the loader builds them from the parameters */
+    rbs_family_shapes_init(&families, params[P_KAPPA], params + P_ASPECT_MEAN, params + P_CDF_LOW, params + P_KFAC);
     static const char *names[5] = {"us_model_frame", "us_flight_setup", "us_orientation", "us_lowest_points",
                                    "us_collision"};
     double keep = 0.0;
@@ -141,7 +145,7 @@ static int time_pieces(const rbs_table *table, int shape, const char *path, int 
         double best = INFINITY;
         for (int r = 0; r < runs + 1; r++) {    /* run 0 is the warm-up */
             double c0 = seconds(CLOCK_THREAD_CPUTIME_ID);
-            keep += run_piece(k, params, shape, rows, m, rot);
+            keep += run_piece(k, params, &families.arrays, shape, rows, m, rot);
             double cpu = seconds(CLOCK_THREAD_CPUTIME_ID) - c0;
             if (r > 0 && cpu < best) best = cpu;
         }

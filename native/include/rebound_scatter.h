@@ -159,6 +159,8 @@ typedef struct rbs_shape_info {
     double inertia[3];          /* principal J/m along ξ, η, ζ, units of a² */
     double aspect[4];           /* the law of b/a and c/b: mean, sd, low, high; NaN: fixed proportions */
     int both_hands;             /* 1: half of the particles are the mirror image (ζ → −ζ) */
+    int direct_shape;           /* its `shape` for rbs_direct_rebound: the family's code, 4 + k for the table's
+                                 * k-th user grain; −1 for a table without the direct model's parameters */
 } rbs_shape_info;
 
 /* One xoshiro256+ state (four 64-bit words, not all zero): one per thread / MPI rank / stream. */
@@ -371,8 +373,8 @@ int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg
  * the impulse model itself (docs/model.md), flights and collisions simulated, where the table's law does not
  * apply (a spinning particle, say). The same bits as the numba kernel for the same uniforms.
  *   shape    RBS_ELLIPSOID, RBS_PRISM, RBS_CUT_PRISM or RBS_TETRAHEDRON (any of the four, whatever
- *            shapes the table holds). The model does not take a user's grain yet: under rbs_rebound, a hit of
- *            one that the direct path answers gets RBS_INVALID (rbs_shape_info.family is −1 for those)
+ *            shapes the table holds), or 4 + k for the table's k-th user grain in table order
+ *            (rbs_shape_info.direct_shape gives it for each of the table's shapes)
  *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
  *   Omega    incident angular velocity Ω⁻, rad/s (finite); exactly zero: the body starts touching the
  *            wall (the tables' case), otherwise the flight in from a clear start is simulated
@@ -388,7 +390,7 @@ int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg
  * "direct_parameters" (rbs_table_kernel_array), so a table and its direct model never disagree.
  * Returns RBS_REBOUNDED; RBS_TRAPPED (still colliding after n_max collisions) or RBS_FAILED (a collision
  * solve or a contact search failed) with NaN outputs; RBS_INVALID with NaN outputs for an input outside
- * the ranges above, a NULL pointer, a shape outside 0..3, or a table without direct parameters (a NULL
+ * the ranges above, a NULL pointer, a shape outside those, or a table without direct parameters (a NULL
  * output gets nothing). Thread-safe: scratch on the stack, the table read only. */
 int rbs_direct_rebound(const rbs_table *table, int shape, const double V[3], const double Omega[3],
                        const double n[3], double a, const double u[RBS_U_PER_REBOUND],

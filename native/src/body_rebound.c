@@ -3,7 +3,8 @@
  * quaternion_to_matrix, lab_tensor): with Ω⁻ = 0 the body starts touching the wall, otherwise with its centre at
  * the bounding radius; then search the flight for the next contact (flight.c, rotation.c) and collide
  * (collision.c) until the body escapes (rebounded), n_max is exceeded (trapped) or a search or collision fails
- * (failed). The same operations in the same order as the numba kernels; the work space on the stack.
+ * (failed). The same operations in the same order as the numba kernels; the work space on the stack: the heights,
+ * rates and curvatures of up to MAX_HULL_VERTICES vertices (6 KiB) and a few 3-vectors and matrices.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -40,21 +41,15 @@ static void lab_tensor(const double *R, const double *diag, double *out)
                              + R[3 * i + 2] * diag[2] * R[3 * j + 2];
 }
 
-int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand, double kfac, const double R0[9],
-                     const double V0[3], const double W0[3], const double wall[3], long long n_max, double contact_tol,
-                     double set_tol, long long max_steps, double V[3], double W[3], long long *n_collisions,
-                     long long *n_steps)
+int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
+                     const double R0[9], const double V0[3], const double W0[3], const double wall[3], long long n_max,
+                     double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
+                     long long *n_collisions, long long *n_steps)
 {
-    double verts[3 * MAX_VERTICES], h[MAX_VERTICES], h1[MAX_VERTICES], h2[MAX_VERTICES];
+    double h[MAX_HULL_VERTICES], h1[MAX_HULL_VERTICES], h2[MAX_HULL_VERTICES];
     double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
-    double K[3], Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
+    double Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
 
-    int nv = rbs_body_vertices(shape, semi[0], semi[1], semi[2], kappa, hand, verts);
-    double Rb = rbs_bounding_radius(shape, semi[0], semi[1], semi[2], verts, nv);
-    double a2 = semi[0] * semi[0], b2 = semi[1] * semi[1], c2 = semi[2] * semi[2];
-    K[0] = kfac * (b2 + c2);
-    K[1] = kfac * (a2 + c2);
-    K[2] = kfac * (a2 + b2);
     for (int k = 0; k < 3; k++) Kinv[k] = 1.0 / K[k];
     for (int k = 0; k < 9; k++) R[k] = R0[k];
     for (int k = 0; k < 3; k++) {
@@ -64,7 +59,7 @@ int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand,
 
     double y;
     if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
-        int n = rbs_lowest_points(shape, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2);
+        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2);
         /* numpy's min: the first NaN, else the smallest */
         double lowest = h[0];
         for (int i = 1; i < n && lowest == lowest; i++)
@@ -78,12 +73,12 @@ int rbs_body_rebound(int shape, const double semi[3], double kappa, double hand,
     for (;;) {
         lab_tensor(R, K, K_lab);
         for (int i = 0; i < 3; i++) ell[i] = K_lab[3 * i] * W[0] + K_lab[3 * i + 1] * W[1] + K_lab[3 * i + 2] * W[2];
-        double M = rbs_curvature_bound(shape, semi, Rb, K, ell, W);
-        double M3 = rbs_jerk_bound(shape, semi, Rb, K, ell, W);
+        double M = rbs_curvature_bound(kind, semi, Rb, K, ell, W);
+        double M3 = rbs_jerk_bound(kind, semi, Rb, K, ell, W);
         for (int k = 0; k < 3; k++) Wt[k] = W[k];
         double t = 0.0;
         long long steps = 0;
-        int code = rbs_find_contact(shape, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1], contact_tol, set_tol,
+        int code = rbs_find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1], contact_tol, set_tol,
                                     max_steps, &t, R, Wt, h, h1, h2, rc, &steps);
         steps_total += steps;
         if (code == SEARCH_ESCAPED) {

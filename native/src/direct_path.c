@@ -18,10 +18,11 @@ static void nan_out(double *x)
 }
 
 /* the inputs in their ranges (surrogate.kernels.direct_path._valid): uniforms 0 <= u < 1 as numba compares them */
-static int valid(int shape, const double *V, const double *Omega, const double *n, double a, const double *u)
+static int valid(const rbs_shape_arrays *shapes, int shape, const double *V, const double *Omega, const double *n,
+                 double a, const double *u)
 {
     int ok = rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2]) && rbs_particle_ok(n[0], n[1], n[2], a)
-             && rbs_finite(Omega[0] + Omega[1] + Omega[2]) && shape >= 0 && shape < RBS_N_FAMILIES;
+             && rbs_finite(Omega[0] + Omega[1] + Omega[2]) && shape >= 0 && shape < shapes->n_shapes;
     for (int k = 0; ok && k < RBS_U_PER_REBOUND; k++) ok = 0.0 <= u[k] && u[k] < 1.0;
     return ok;
 }
@@ -31,7 +32,7 @@ RBS_HOT int rbs_direct_rebound(const rbs_table *t, int shape, const double V[3],
                                double Omega_out[3])
 {
     if (!t || !t->has_direct || !V || !Omega || !n || !u || !V_out || !Omega_out
-        || !valid(shape, V, Omega, n, a, u)) {
+        || !valid(&t->direct_shapes, shape, V, Omega, n, a, u)) {
         nan_out(V_out);
         nan_out(Omega_out);
         return RBS_INVALID;
@@ -42,7 +43,7 @@ RBS_HOT int rbs_direct_rebound(const rbs_table *t, int shape, const double V[3],
     /* Ω⁻ in (m/s)/a, the model's unit: rad/s times a */
     double x[6];
     int status = rbs_rebound_model_frame(
-        t->direct_parameters, shape, rbs_dot(V[0], V[1], V[2], ex[0], ex[1], ex[2]),
+        t->direct_parameters, &t->direct_shapes, shape, rbs_dot(V[0], V[1], V[2], ex[0], ex[1], ex[2]),
         rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]), a * rbs_dot(Omega[0], Omega[1], Omega[2], ex[0], ex[1], ex[2]),
         a * rbs_dot(Omega[0], Omega[1], Omega[2], n[0], n[1], n[2]),
         a * rbs_dot(Omega[0], Omega[1], Omega[2], ez[0], ez[1], ez[2]), u, x, x + 3);

@@ -28,12 +28,12 @@ static void rate_bounds(const double K[3], const double ell[3], const double W[3
     *wddot = (kmax - kmin) * *w * *wdot / kmin;
 }
 
-double rbs_curvature_bound(int shape, const double semi[3], double Rb, const double K[3], const double ell[3],
+double rbs_curvature_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
                            const double W[3])
 {
     double w, wdot, wddot;
     rate_bounds(K, ell, W, &w, &wdot, &wddot);
-    if (shape == RBS_ELLIPSOID) {
+    if (kind == KIND_ELLIPSOID) {
         double amax = py_max(semi[0], py_max(semi[1], semi[2]));
         double amin = py_min(semi[0], py_min(semi[1], semi[2]));
         return amax * amax * w * w / amin + amax * (wdot + w * w);
@@ -41,13 +41,13 @@ double rbs_curvature_bound(int shape, const double semi[3], double Rb, const dou
     return (wdot + w * w) * Rb;
 }
 
-double rbs_jerk_bound(int shape, const double semi[3], double Rb, const double K[3], const double ell[3],
+double rbs_jerk_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
                       const double W[3])
 {
     double w, wdot, wddot;
     rate_bounds(K, ell, W, &w, &wdot, &wddot);
     double g3 = wddot + 3.0 * w * wdot + w * w * w;
-    if (shape == RBS_ELLIPSOID) {
+    if (kind == KIND_ELLIPSOID) {
         double amax = py_max(semi[0], py_max(semi[1], semi[2]));
         double amin = py_min(semi[0], py_min(semi[1], semi[2]));
         return 6.0 * amax * amax * w * (wdot + w * w) / amin + amax * g3
@@ -78,7 +78,7 @@ static double taylor_root(double h, double hdot, double hddot)
     return -2.0 * h / (hdot + copysign(sqrt(disc), hdot));
 }
 
-int rbs_lowest_points(int shape, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
+int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
                       const double W[3], double y, double v, double *h, double *h1, double *h2)
 {
     double g0 = R[3], g1 = R[4], g2 = R[5];
@@ -93,7 +93,7 @@ int rbs_lowest_points(int shape, double *verts, int nv, const double semi[3], co
     double a0 = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1);                           /* g̈ = ġ × ω + g × ω̇ */
     double a1 = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2);
     double a2 = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0);
-    if (shape == RBS_ELLIPSOID) {
+    if (kind == KIND_ELLIPSOID) {
         double u0 = semi[0] * g0, u1 = semi[1] * g1, u2 = semi[2] * g2;
         double sigma = sqrt(u0 * u0 + u1 * u1 + u2 * u2);
         double q0 = semi[0] * u0, q1 = semi[1] * u1, q2 = semi[2] * u2; /* A² g */
@@ -153,7 +153,7 @@ static int choose_contact(int n, const double *verts, const double *h, const dou
     return 1;
 }
 
-int rbs_find_contact(int shape, double *verts, int nv, const double semi[3], double Rb, const double K[3],
+int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], double Rb, const double K[3],
                      const double ell[3], double M, double M3, double *params, double y0, double v, double contact_tol,
                      double set_tol, long long max_steps, double *t_out, double R[9], double W[3], double *h,
                      double *h1, double *h2, double rc[3], long long *n_steps)
@@ -168,7 +168,7 @@ int rbs_find_contact(int shape, double *verts, int nv, const double semi[3], dou
             rbs_rotation_at(params, t, R, W);
         }
         double y = y0 + v * t;
-        int n = rbs_lowest_points(shape, verts, nv, semi, K, R, W, y, v, h, h1, h2);
+        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2);
         double hmin = INFINITY;
         int low = 0;
         for (int i = 0; i < n; i++)

@@ -110,6 +110,11 @@ struct rbs_table {
     size_t restitution_pieces_len;
     int has_direct;                                 /* the table records the direct model's parameters */
     double direct_parameters[N_PARAMS];             /* surrogate.table.SurrogateTable.direct_parameters (P_*) */
+    /* the direct model's shapes (surrogate.table.SurrogateTable.shape_arrays): the four families in code order,
+     * from the parameters, then the table's user grains in table order; model_shape[i] is the index there of the
+     * table's shape i (shape_records.c: rbs_direct_shapes_build; NULL without direct parameters) */
+    rbs_shape_arrays direct_shapes;
+    int *model_shape;
 };
 
 /* The raw cell datasets a loader reads (layout.c turns them into the kernel arrays). */
@@ -152,6 +157,18 @@ static inline const double *rbs_mix_cdf(const rbs_mix *mix)
 
 /* shape_records.c: free what a table's shape records hold (loader.h reads them) */
 void rbs_shape_records_free(rbs_shape_records *records);
+
+/* shape_records.c: t->direct_shapes and t->model_shape from the direct parameters and the shape records
+ * (surrogate.table.SurrogateTable.shape_arrays, model_shapes): RBS_OK or RBS_ERR_MEMORY; freed by
+ * rbs_direct_shapes_free (which takes a table without them too). */
+int rbs_direct_shapes_build(rbs_table *t);
+void rbs_direct_shapes_free(rbs_table *t);
+
+/* Φ(x), the standard normal CDF (direct_model.shapes.normal_cdf: libm's erfc, as CPython's math.erfc) */
+static inline double rbs_normal_cdf(double x)
+{
+    return 0.5 * erfc(-x / sqrt(2.0));
+}
 
 /* layout.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
  * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */

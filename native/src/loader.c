@@ -612,12 +612,6 @@ static int direct_attributes(loader *ld, hid_t file, hid_t grid, const rbs_table
     return RBS_OK;
 }
 
-/* Φ(x), the standard normal CDF (direct_model.runtime._normal_cdf: libm's erfc, as CPython's math.erfc) */
-static double normal_cdf(double x)
-{
-    return 0.5 * erfc(-x / sqrt(2.0));
-}
-
 #define OUT_OF_RANGE "the direct model's parameters are out of range: "
 
 /* The direct model's parameters (surrogate.table.SurrogateTable.direct_parameters): none (has_direct = 0) if the table does
@@ -670,8 +664,8 @@ static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table 
     p[P_ASPECT_SD] = sd;
     p[P_ASPECT_LOW] = low;
     p[P_ASPECT_HIGH] = high;
-    p[P_CDF_LOW] = normal_cdf((low - mean) / sd);
-    p[P_CDF_HIGH] = normal_cdf((high - mean) / sd);
+    p[P_CDF_LOW] = rbs_normal_cdf((low - mean) / sd);
+    p[P_CDF_HIGH] = rbs_normal_cdf((high - mean) / sd);
     p[P_KAPPA] = kappa;
     p[P_N_MAX] = (double)t->n_max;
     p[P_WALL] = t->restitution_k;
@@ -827,8 +821,10 @@ static int load(loader *ld, rbs_table *t)
     }
     if (ld->code == RBS_OK) {
         double aspect[4], kfac[RBS_N_FAMILIES];
-        if (read_direct_parameters(ld, file, grid, t, kappa, aspect, kfac) == RBS_OK)
-            rbs_shape_records_load(ld, file, t, kappa, aspect, kfac);
+        if (read_direct_parameters(ld, file, grid, t, kappa, aspect, kfac) == RBS_OK
+            && rbs_shape_records_load(ld, file, t, kappa, aspect, kfac) == RBS_OK && t->has_direct
+            && rbs_direct_shapes_build(t) != RBS_OK)
+            rbs_fail(ld, RBS_ERR_MEMORY, "out of memory building the direct model's shapes");
     }
 
 done:
@@ -880,6 +876,7 @@ void rbs_table_close(rbs_table *t)
     free(t->restitution_pieces);
     free(t->shape_names);
     rbs_shape_records_free(&t->shapes);
+    rbs_direct_shapes_free(t);
     free(t);
 }
 
@@ -904,6 +901,7 @@ int rbs_table_shape_info(const rbs_table *t, int i, rbs_shape_info *info)
     memcpy(info->inertia, r->inertia + 3 * i, sizeof info->inertia);
     memcpy(info->aspect, r->aspect + 4 * i, sizeof info->aspect);
     info->both_hands = r->both_hands[i];
+    info->direct_shape = t->model_shape ? t->model_shape[i] : -1;
     return RBS_OK;
 }
 

@@ -1,8 +1,10 @@
 /*
  * runtime.c: the direct model at run time (direct_model.runtime: normal_quantile, aspect_ratio,
  * uniform_quaternion, rebound_model_frame): the random inputs of one rebound from RBS_U_PER_REBOUND uniforms,
- * every model parameter from the P_* array, then the rebound (body_rebound.c). The same operations in the same
- * order as the numba kernels; libm's sqrt, log, sin and cos.
+ * the particle's body from the shape arrays (shapes.c), every other model parameter from the P_* array, then the
+ * rebound (body_rebound.c). The same operations in the same order as the numba kernels; libm's sqrt, log, sin
+ * and cos. The work space on the stack: the body's vertices, MAX_HULL_VERTICES rows (6 KiB), and
+ * rbs_body_rebound's (about 6.5 KiB): 13 KiB in all.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -12,6 +14,7 @@
 #include "fastmath.h"
 #include "pymath.h"
 #include "runtime.h"
+#include "shapes.h"
 
 _Static_assert(RBS_TETRAHEDRON + 1 == RBS_N_FAMILIES, "RBS_N_FAMILIES counts the family codes (N_PARAMS rests on it)");
 
@@ -48,11 +51,11 @@ double rbs_normal_quantile(double p)
     return q < 0.0 ? -x : x;
 }
 
-double rbs_aspect_ratio(const double *params, double u)
+double rbs_aspect_ratio(const double law[4], const double cdf[2], double u)
 {
-    double lo = params[P_CDF_LOW], hi = params[P_CDF_HIGH];
-    double x = params[P_ASPECT_MEAN] + params[P_ASPECT_SD] * rbs_normal_quantile(lo + u * (hi - lo));
-    return py_min(py_max(x, params[P_ASPECT_LOW]), params[P_ASPECT_HIGH]);
+    double lo = cdf[0], hi = cdf[1];
+    double x = law[0] + law[1] * rbs_normal_quantile(lo + u * (hi - lo));
+    return py_min(py_max(x, law[2]), law[3]);
 }
 
 void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4])
@@ -64,19 +67,22 @@ void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4])
     q[3] = c * cos(2.0 * RBS_PI * u2);
 }
 
-int rbs_rebound_model_frame(const double *params, int shape, double vt, double vn, double wx, double wy, double wz,
-                            const double *u, double V[3], double W[3])
+int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes, int shape, double vt, double vn,
+                            double wx, double wy, double wz, const double *u, double V[3], double W[3])
 {
-    double quat[4], R0[9];
+    double quat[4], R0[9], verts[3 * MAX_HULL_VERTICES], K[3], semi[3];
     rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat);
     rbs_quaternion_to_matrix(quat, R0);
-    double b_over_a = rbs_aspect_ratio(params, u[U_RATIOS]);
-    const double semi[3] = {1.0, b_over_a, b_over_a * rbs_aspect_ratio(params, u[U_RATIOS + 1])};
-    double hand = shape != RBS_TETRAHEDRON || u[U_HAND] < 0.5 ? 1.0 : -1.0;
+    const double *law = shapes->aspect + 4 * shape, *cdf = shapes->aspect_cdf + 2 * shape;
+    double ratio_ba = rbs_aspect_ratio(law, cdf, u[U_RATIOS]), ratio_cb = rbs_aspect_ratio(law, cdf, u[U_RATIOS + 1]);
+    double hand = !shapes->both_hands[shape] || u[U_HAND] < 0.5 ? 1.0 : -1.0;
+    int nv = rbs_particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi);
+    int kind = shapes->kind[shape];
+    double Rb = rbs_bounding_radius(kind, semi, verts, nv);
     const double V0[3] = {vt, vn, 0.0}, W0[3] = {wx, wy, wz};
     long long n_collisions, n_steps;
     /* n_max and max_steps as numba's int() of the float64 parameters */
-    return rbs_body_rebound(shape, semi, params[P_KAPPA], hand, params[P_KFAC + shape], R0, V0, W0, params + P_WALL,
-                            rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
-                            rbs_trunc(params[P_MAX_STEPS]), V, W, &n_collisions, &n_steps);
+    return rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL, rbs_trunc(params[P_N_MAX]),
+                            params[P_CONTACT_TOL], params[P_SET_TOL], rbs_trunc(params[P_MAX_STEPS]), V, W,
+                            &n_collisions, &n_steps);
 }

@@ -35,18 +35,20 @@
 /* Φ⁻¹(p) for p in (0, 1): Wichura's AS 241 (direct_model.runtime.normal_quantile) */
 double rbs_normal_quantile(double p);
 
-/* the aspect-ratio law's quantile at u in [0, 1), in [low, high] (direct_model.runtime.aspect_ratio) */
-double rbs_aspect_ratio(const double *params, double u);
+/* the quantile at u in [0, 1) of the aspect-ratio law (mean, sd, low, high) with CDF bounds cdf = (Φ_low, Φ_high), in
+ * [low, high] (direct_model.runtime.aspect_ratio) */
+double rbs_aspect_ratio(const double law[4], const double cdf[2], double u);
 
 /* q = a unit quaternion (w, x, y, z) uniform on S³ from three uniforms (Shoemake;
  * direct_model.runtime.uniform_quaternion) */
 void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4]);
 
 /* One particle's whole rebound in the model's frame (direct_model.runtime.rebound_model_frame): params the
- * P_* array, shape code 0..3, incident velocity (vt, vn, 0) m/s (vn < 0), angular velocity (wx, wy, wz) in
- * (m/s)/a (all zero: the body starts touching the wall), u RBS_U_PER_REBOUND uniforms. V⁺ (m/s) into V and
- * Ω⁺ ((m/s)/a) into W; returns RBS_REBOUNDED, RBS_TRAPPED or RBS_FAILED. */
-int rbs_rebound_model_frame(const double *params, int shape, double vt, double vn, double wx, double wy, double wz,
-                            const double *u, double V[3], double W[3]);
+ * P_* array, shape the index of the particle's shape in `shapes` (0 .. shapes->n_shapes − 1), incident velocity
+ * (vt, vn, 0) m/s (vn < 0), angular velocity (wx, wy, wz) in (m/s)/a (all zero: the body starts touching the
+ * wall), u RBS_U_PER_REBOUND uniforms. V⁺ (m/s) into V and Ω⁺ ((m/s)/a) into W; returns RBS_REBOUNDED,
+ * RBS_TRAPPED or RBS_FAILED. */
+int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes, int shape, double vt, double vn,
+                            double wx, double wy, double wz, const double *u, double V[3], double W[3]);
 
 #endif /* RBS_RUNTIME_H */

@@ -1,6 +1,6 @@
 /*
  * shape_records.c: the shapes a table holds, as data (data_schema.shape_records): group /shapes of a table of
- * format 3.4 read and checked as check_shape_arrays and records_from_arrays check it, in the same order; the
+ * format 3.4 read and checked as check_shape_datasets and records_from_arrays check it, in the same order; the
  * families' records synthesised for an older table (data_schema.shape_records.family_records). The only place
  * the C library reads these arrays.
  *
@@ -18,10 +18,10 @@
 #include <string.h>
 
 #include "loader.h"
+#include "runtime.h"
 #include "shapes.h"
 
 #define MIN_HULL_VERTICES 4         /* data_schema.shape_records.MIN_HULL_VERTICES */
-#define MAX_HULL_VERTICES 256       /* direct_model.registry.MAX_HULL_VERTICES */
 #define MIN_THICKNESS 1e-3          /* direct_model.registry.MIN_THICKNESS, units of a */
 #define FRAME_CHECK 1e-9            /* direct_model.registry.FRAME_CHECK */
 #define VERTEX_BOUND (1.5 * (1.0 + FRAME_CHECK))            /* data_schema.shape_records.VERTEX_BOUND */
@@ -134,7 +134,7 @@ static void *read_member(loader *ld, hid_t group, const char *name, H5T_class_t 
     return rbs_read_dataset(ld, group, "shapes", name, memtype, size, rank, dims);
 }
 
-/* The checks of data_schema.shape_records.check_shape_arrays, then the families' rows (records_from_arrays). */
+/* The checks of data_schema.shape_records.check_shape_datasets, then the families' rows (records_from_arrays). */
 static int check_records(loader *ld, rbs_table *t, const char *names, const int32_t *triangles,
                          const int64_t *triangle_start, int64_t n_vertex, int64_t n_triangle, double kappa,
                          const double aspect[4])
@@ -306,4 +306,73 @@ done:
     if (name_type >= 0) H5Tclose(name_type);
     H5Gclose(group);
     return ld->code;
+}
+
+void rbs_direct_shapes_free(rbs_table *t)
+{
+    rbs_shape_arrays *d = &t->direct_shapes;
+    free((void *)d->kind);
+    free((void *)d->vertex_start);
+    free((void *)d->vertices);
+    free((void *)d->second_moments);
+    free((void *)d->aspect);
+    free((void *)d->aspect_cdf);
+    free((void *)d->both_hands);
+    free(t->model_shape);
+    memset(d, 0, sizeof *d);
+    t->model_shape = NULL;
+}
+
+int rbs_direct_shapes_build(rbs_table *t)
+{
+    const rbs_shape_records *r = &t->shapes;
+    const double *p = t->direct_parameters;
+    int n = RBS_N_FAMILIES;
+    int64_t rows = FAMILY_VERTEX_ROWS;
+    for (int i = 0; i < t->n_shapes; i++)
+        if (r->family[i] < 0 && r->kind[i] == KIND_POLYHEDRON) {
+            n++;
+            rows += r->vertex_start[i + 1] - r->vertex_start[i];
+        }
+    int8_t *kind = malloc((size_t)n);
+    int64_t *vertex_start = malloc((size_t)(n + 1) * sizeof *vertex_start);
+    double *vertices = malloc((size_t)rows * 3 * sizeof *vertices);
+    double *second_moments = malloc((size_t)n * 3 * sizeof *second_moments);
+    double *aspect = malloc((size_t)n * 4 * sizeof *aspect);
+    double *aspect_cdf = malloc((size_t)n * 2 * sizeof *aspect_cdf);
+    uint8_t *both_hands = malloc((size_t)n);
+    t->model_shape = malloc((size_t)t->n_shapes * sizeof *t->model_shape);
+    t->direct_shapes = (rbs_shape_arrays){n, kind, vertex_start, vertices, second_moments, aspect, aspect_cdf,
+                                          both_hands};
+    if (!kind || !vertex_start || !vertices || !second_moments || !aspect || !aspect_cdf || !both_hands
+        || !t->model_shape) {
+        rbs_direct_shapes_free(t);
+        return RBS_ERR_MEMORY;
+    }
+    rbs_family_shapes_fill(kind, vertex_start, vertices, second_moments, aspect, aspect_cdf, both_hands, p[P_KAPPA],
+                           p + P_ASPECT_MEAN, p + P_CDF_LOW, p + P_KFAC);
+    /* then each user grain (surrogate.table.SurrogateTable.shape_arrays: direct_model.shape_arrays.shape_arrays of
+     * its record); a smooth body that is no family has no semi-axes on file: the direct path refuses it (−1) */
+    int j = RBS_N_FAMILIES;
+    for (int i = 0; i < t->n_shapes; i++) {
+        if (r->family[i] >= 0 || r->kind[i] != KIND_POLYHEDRON) {
+            t->model_shape[i] = r->family[i];
+            continue;
+        }
+        t->model_shape[i] = j;
+        int64_t lo = r->vertex_start[i], count = r->vertex_start[i + 1] - lo;
+        kind[j] = KIND_POLYHEDRON;
+        vertex_start[j + 1] = vertex_start[j] + count;
+        memcpy(vertices + 3 * vertex_start[j], r->vertices + 3 * lo, (size_t)count * 3 * sizeof *vertices);
+        const double *inertia = r->inertia + 3 * i;
+        double half_sum = (inertia[0] + inertia[1] + inertia[2]) / 2.0;
+        for (int k = 0; k < 3; k++) second_moments[3 * j + k] = half_sum - inertia[k];
+        const double *law = r->aspect + 4 * i;
+        memcpy(aspect + 4 * j, law, 4 * sizeof *aspect);
+        aspect_cdf[2 * j] = isnan(law[0]) ? NAN : rbs_normal_cdf((law[2] - law[0]) / law[1]);
+        aspect_cdf[2 * j + 1] = isnan(law[0]) ? NAN : rbs_normal_cdf((law[3] - law[0]) / law[1]);
+        both_hands[j] = r->both_hands[i];
+        j++;
+    }
+    return RBS_OK;
 }

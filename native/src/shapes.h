@@ -1,16 +1,37 @@
 /*
- * shapes.h: the particle shapes of the direct model (direct_model.shapes): body-frame vertices and bounding
- * radius, lengths in units of the half-size a.
+ * shapes.h: the particle shapes of the direct model. The shapes as plain arrays (direct_model.shape_arrays: the
+ * form, one particle's body from it), the four families' unit bodies (direct_model.shapes.body_vertices) and
+ * their names. Lengths in units of the particle's half-size a, body frame Oξηζ (principal axes).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #ifndef RBS_SHAPES_H
 #define RBS_SHAPES_H
 
+#include <stdint.h>
+
 #include "rebound_scatter.h"
 
-#define MAX_VERTICES 24     /* direct_model.shapes.MAX_VERTICES: the cut prism's */
 #define RBS_N_FAMILIES 4    /* the built-in families, codes RBS_ELLIPSOID .. RBS_TETRAHEDRON (direct_model.shapes.SHAPES) */
+#define MAX_VERTICES 24             /* direct_model.shapes.MAX_VERTICES: the cut prism's */
+#define MAX_HULL_VERTICES 256       /* direct_model.registry.MAX_HULL_VERTICES: the most a shape has */
+#define KIND_ELLIPSOID 0            /* direct_model.shape_arrays.KIND_ELLIPSOID */
+#define KIND_POLYHEDRON 1           /* direct_model.shape_arrays.KIND_POLYHEDRON */
+#define FAMILY_VERTEX_ROWS 37       /* the families' unit bodies: the ellipsoid's semi-axes, 8, 24 and 4 vertices */
+
+/* Every shape as plain arrays (direct_model.shape_arrays.ShapeArrays; its module doc says what each holds):
+ * shape i is row i of each per-shape array, its vertices rows vertex_start[i] .. vertex_start[i + 1] of
+ * `vertices` (row-major × 3). The kernels read, never write them. */
+typedef struct rbs_shape_arrays {
+    int n_shapes;
+    const int8_t *kind;             /* KIND_ELLIPSOID or KIND_POLYHEDRON */
+    const int64_t *vertex_start;    /* n_shapes + 1 */
+    const double *vertices;         /* the unit bodies: hull vertices, or an ellipsoid's semi-axes (one row) */
+    const double *second_moments;   /* n_shapes × 3: ∫ξ² dm/m, ∫η² dm/m, ∫ζ² dm/m of the unit body, a² */
+    const double *aspect;           /* n_shapes × 4: the b/a, c/b law (mean, sd, low, high); NaN: fixed */
+    const double *aspect_cdf;       /* n_shapes × 2: Φ((low − mean)/sd), Φ((high − mean)/sd) */
+    const uint8_t *both_hands;      /* 1: half of the particles are the mirror image */
+} rbs_shape_arrays;
 
 /* The built-in families' names by code (direct_model.shapes.SHAPES): the registry the loader consults for a
  * table's built-in names and for the records of a table before format 3.4 */
@@ -24,8 +45,21 @@ int rbs_shape_code(const char *name);
  * (direct_model.shapes.body_vertices). */
 int rbs_body_vertices(int shape, double a, double b, double c, double kappa, double hand, double *out);
 
+/* The four families' rows of shape arrays, in code order (direct_model.shape_arrays.family_shape_arrays), into
+ * arrays with room for RBS_N_FAMILIES shapes and FAMILY_VERTEX_ROWS vertex rows: from κ, the b/a, c/b law
+ * (mean, sd, low, high) and its CDF bounds, and the factor s per shape code. */
+void rbs_family_shapes_fill(int8_t *kind, int64_t *vertex_start, double *vertices, double *second_moments,
+                            double *aspect, double *aspect_cdf, uint8_t *both_hands, double kappa,
+                            const double law[4], const double law_cdf[2], const double kfac[RBS_N_FAMILIES]);
+
+/* One particle's body from shape `shape` of `s` (direct_model.shape_arrays.particle_body): b/a and c/b
+ * (ignored for fixed proportions), hand ±1; the vertices into verts (row-major, at most MAX_HULL_VERTICES),
+ * the principal J/m into K (a²), the half-extents into semi; returns their number, 0 for an ellipsoid. */
+int rbs_particle_body(const rbs_shape_arrays *s, int shape, double ratio_ba, double ratio_cb, double hand,
+                      double *verts, double K[3], double semi[3]);
+
 /* Radius of the smallest centroid-centred sphere holding the body, units of a
- * (direct_model.shapes.bounding_radius). */
-double rbs_bounding_radius(int shape, double a, double b, double c, const double *verts, int nv);
+ * (direct_model.shape_arrays.bounding_radius). */
+double rbs_bounding_radius(int kind, const double semi[3], const double *verts, int nv);
 
 #endif /* RBS_SHAPES_H */

@@ -64,10 +64,9 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3
     }
     if (path == RBS_PATH_TABLE)
         return rbs_table_rebound(t, mix, V, n, a, u, interpolation, V_out, Omega_out);
-    /* the table's shape drawn as the table path draws it, then its family code (−1 for a user's grain, which the
-     * direct model does not take yet: RBS_INVALID) */
+    /* the table's shape drawn as the table path draws it, then its index in the direct model's shapes */
     int64_t shape = rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, u[0]);
-    return rbs_direct_rebound(t, t->shapes.family[shape], V, Omega, n, a, u + 1, V_out, Omega_out);
+    return rbs_direct_rebound(t, t->model_shape ? t->model_shape[shape] : -1, V, Omega, n, a, u + 1, V_out, Omega_out);
 }
 
 int rbs_rebound_rng(const rbs_table *t, const rbs_mix *mix, const double V[3], const double Omega[3], const double n[3],

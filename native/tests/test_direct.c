@@ -4,7 +4,7 @@
  *   - a collision never adds energy, ½|V|² + ½ΩᵀKΩ per unit mass (m²/s², lengths in units of a);
  *   - a collision keeps the angular momentum about the contact point, KΩ − r_c × V;
  *   - a free flight keeps the energy ½ΩᵀKΩ and the angular momentum L = KΩ (lab) to 1e-9;
- *   - a whole rebound never adds energy;
+ *   - a whole rebound never adds energy, for the four families and a grain of MAX_HULL_VERTICES vertices;
  * then hostile calls of rbs_direct_rebound on a table (RBS_INVALID and NaN, never a crash), and four threads
  * calling it on one table give the bits of one thread.
  *
@@ -26,6 +26,7 @@
 #include "rebound_scatter.h"
 #include "rotation.h"
 #include "runtime.h"
+#include "shapes.h"
 
 #define TRIALS 20000
 
@@ -141,15 +142,59 @@ static void free_flights(rbs_rng *rng)
     printf("free flights: energy kept to %.3g relative, L (lab vector) to %.3g relative\n", worst_energy, worst_momentum);
 }
 
+/* The shapes of the rebounds: the four families (κ = 0.3, the default law) and, as shape 4, a grain of
+ * MAX_HULL_VERTICES vertices on the ellipsoid of semi-axes (1, 0.7, 0.5) (each one a hull vertex; its second
+ * moments the ellipsoid's, a valid inertia for the energy check), both hands, fixed proportions. */
+typedef struct test_shapes {
+    rbs_shape_arrays arrays;
+    int8_t kind[5];
+    int64_t vertex_start[6];
+    double vertices[3 * (FAMILY_VERTEX_ROWS + MAX_HULL_VERTICES)], second_moments[15], aspect[20], aspect_cdf[10];
+    uint8_t both_hands[5];
+} test_shapes;
+
+static void make_shapes(test_shapes *s, rbs_rng *rng)
+{
+    const double law[4] = {0.8, 0.2, 0.5, 1.0}, cdf[2] = {0.06680720126885804, 0.8413447460685428};
+    const double kfac[4] = {0.2, 0.33333333333333337, 0.3309571404654277, 0.2}, semi[3] = {1.0, 0.7, 0.5};
+    rbs_family_shapes f;
+    rbs_family_shapes_init(&f, 0.3, law, cdf, kfac);
+    memcpy(s->kind, f.kind, sizeof f.kind);
+    memcpy(s->vertex_start, f.vertex_start, sizeof f.vertex_start);
+    memcpy(s->vertices, f.vertices, sizeof f.vertices);
+    memcpy(s->second_moments, f.second_moments, sizeof f.second_moments);
+    memcpy(s->aspect, f.aspect, sizeof f.aspect);
+    memcpy(s->aspect_cdf, f.aspect_cdf, sizeof f.aspect_cdf);
+    memcpy(s->both_hands, f.both_hands, sizeof f.both_hands);
+    s->kind[4] = KIND_POLYHEDRON;
+    s->vertex_start[5] = FAMILY_VERTEX_ROWS + MAX_HULL_VERTICES;
+    for (int i = 0; i < MAX_HULL_VERTICES; i++) {
+        double p[3], norm = 0.0;
+        for (int k = 0; k < 3; k++) {      /* a direction uniform enough for a test: a cube's point, normalised */
+            p[k] = 2.0 * rbs_rng_uniform(rng) - 1.0;
+            norm += p[k] * p[k];
+        }
+        for (int k = 0; k < 3; k++) s->vertices[3 * (FAMILY_VERTEX_ROWS + i) + k] = semi[k] * p[k] / sqrt(norm);
+    }
+    for (int k = 0; k < 3; k++) s->second_moments[12 + k] = semi[k] * semi[k] / 5.0;
+    for (int k = 0; k < 4; k++) s->aspect[16 + k] = NAN;
+    s->aspect_cdf[8] = s->aspect_cdf[9] = NAN;
+    s->both_hands[4] = 1;
+    s->arrays = (rbs_shape_arrays){5, s->kind, s->vertex_start, s->vertices, s->second_moments, s->aspect,
+                                   s->aspect_cdf, s->both_hands};
+}
+
 static void rebounds(rbs_rng *rng)
 {
-    const double wall[3] = {0.1, 0.61, 1.0}, kfac[4] = {0.2, 0.33333333333333337, 0.3309571404654277, 0.2};
-    double worst = -INFINITY;
+    const double wall[3] = {0.1, 0.61, 1.0};
+    test_shapes shapes;
+    make_shapes(&shapes, rng);
+    double worst = -INFINITY, verts[3 * MAX_HULL_VERTICES];
     int counts[3] = {0, 0, 0};
     for (int trial = 0; trial < TRIALS / 10; trial++) {
-        int shape = trial % 4;
-        double b = 0.5 + 0.5 * rbs_rng_uniform(rng), c = b * (0.5 + 0.5 * rbs_rng_uniform(rng));
-        const double semi[3] = {1.0, b, c};
+        int shape = trial % 5;
+        double ratio_ba = 0.5 + 0.5 * rbs_rng_uniform(rng), ratio_cb = 0.5 + 0.5 * rbs_rng_uniform(rng);
+        double hand = rbs_rng_uniform(rng) < 0.5 ? 1.0 : -1.0, semi[3];
         double q[4], R0[9], V0[3], W0[3], V[3], W[3], K[3], K0[9], KW0[3];
         rbs_uniform_quaternion(rbs_rng_uniform(rng), rbs_rng_uniform(rng), rbs_rng_uniform(rng), q);
         rbs_quaternion_to_matrix(q, R0);
@@ -158,12 +203,12 @@ static void rebounds(rbs_rng *rng)
         V0[1] = -speed * sin(angle);
         V0[2] = 0.0;
         for (int k = 0; k < 3; k++) W0[k] = trial % 8 < 4 ? 0.0 : 0.3 * speed * (2.0 * rbs_rng_uniform(rng) - 1.0);
-        K[0] = kfac[shape] * (b * b + c * c);
-        K[1] = kfac[shape] * (1.0 + c * c);
-        K[2] = kfac[shape] * (1.0 + b * b);
+        int nv = rbs_particle_body(&shapes.arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi);
+        int kind = shapes.kind[shape];
+        double Rb = rbs_bounding_radius(kind, semi, verts, nv);
         long long n_coll, n_steps;
-        int status = rbs_body_rebound(shape, semi, 0.3, 1.0, kfac[shape], R0, V0, W0, wall, 1000, 1e-10, 1e-9, 100000,
-                                      V, W, &n_coll, &n_steps);
+        int status = rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, 1000, 1e-10, 1e-9, 100000, V, W,
+                                      &n_coll, &n_steps);
         CHECK(status == RBS_REBOUNDED || status == RBS_TRAPPED || status == RBS_FAILED, "status %d", status);
         if (status >= 0 && status < 3) counts[status]++;
         if (status != RBS_REBOUNDED) continue;

@@ -6,8 +6,8 @@ Per hit the model frame is built as the table's draws build theirs
 (:func:`surrogate.kernels.frame.impact_frame`): ey = n, ex the direction of the tangential part of V⁻
 (uniform in the wall plane at normal impact, from u[U_AXIS]), ez = ex × ey; there
 :func:`direct_model.runtime.rebound_model_frame` runs the whole rebound, and V⁺, Ω⁺ come back in the
-caller's frame. Units: V in m/s, Ω in rad/s, a in m. The model parameters come from the table
-(``table.direct_parameters``), so a table and its direct model never disagree.
+caller's frame. Units: V in m/s, Ω in rad/s, a in m. The model parameters and the shapes come from the table
+(``table.direct_parameters``, ``table.shape_arrays``), so a table and its direct model never disagree.
 """
 
 import math
@@ -17,21 +17,22 @@ import numpy as np
 
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_model_frame
-from direct_model.shapes import SHAPES
 from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, particle_ok, to_global
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
 
 
 @numba.njit(**JIT)
-def direct_rebound(params, shape, V, omega, n, a, u):
+def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
     """One particle's rebound by the direct model, in the caller's frame: (status, V⁺, Ω⁺) with V⁺ in m/s
     and Ω⁺ in rad/s as 3-tuples.
 
     Parameters
     ----------
     params : ``table.direct_parameters`` (:func:`direct_model.runtime.model_parameters`).
-    shape : shape code 0..3 (ellipsoid, prism, cut prism, tetrahedron).
+    shape_arrays : ``table.shape_arrays``, the direct model's shapes (:class:`direct_model.shape_arrays.ShapeArrays`).
+    shape : the particle's shape, an index into ``shape_arrays``: today the four families' codes 0..3 (ellipsoid,
+        prism, cut prism, tetrahedron; ``table.model_shapes`` maps the table's shapes to them).
     V : incident velocity V⁻, m/s (3-tuple or (3,) array); must move into the wall (V·n < 0).
     omega : incident angular velocity Ω⁻, rad/s; exactly zero: the body starts touching the wall (the
         tables' case), otherwise the flight in from a clear start is simulated (docs/model.md §5.3).
@@ -44,14 +45,14 @@ def direct_rebound(params, shape, V, omega, n, a, u):
     (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID with NaN vectors for
     an input outside the ranges above.
     """
-    return inline_direct_rebound(params, shape, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
+    return inline_direct_rebound(params, shape_arrays, shape, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
 
 
 @numba.njit(inline="always", **JIT)
-def _valid(shape, V, omega, n, a, u):
+def _valid(shape_arrays, shape, V, omega, n, a, u):
     """The inputs of :func:`direct_rebound` are in their ranges."""
     ok = (moves_into_wall(V, n) and particle_ok(n, a)
-          and math.isfinite(omega[0] + omega[1] + omega[2]) and 0 <= shape < len(SHAPES)
+          and math.isfinite(omega[0] + omega[1] + omega[2]) and 0 <= shape < shape_arrays.kind.shape[0]
           and u.shape[0] >= U_PER_REBOUND)
     for k in range(U_PER_REBOUND if ok else 0):
         ok = ok and 0.0 <= u[k] < 1.0
@@ -59,15 +60,15 @@ def _valid(shape, V, omega, n, a, u):
 
 
 @numba.njit(inline="always", **JIT)
-def inline_direct_rebound(params, shape, V, omega, n, a, u, scratch):
+def inline_direct_rebound(params, shape_arrays, shape, V, omega, n, a, u, scratch):
     """:func:`direct_rebound` with its scratch space given, inlined into its caller (the parallel kernel, and
     the call that answers any hit, :func:`surrogate.kernels.wall_hit.rebound`)."""
-    if not _valid(shape, V, omega, n, a, u):
+    if not _valid(shape_arrays, shape, V, omega, n, a, u):
         return STATUS_INVALID, NAN3, NAN3
     ex, ez = _frame_axes(V, n, u[U_AXIS])
     # Ω⁻ in (m/s)/a, the model's unit (direct_model.body_rebound): rad/s times a
     status, _, _, vx, vy, vz, wx, wy, wz = rebound_model_frame(
-        params, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez), u, scratch)
+        params, shape_arrays, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez), u, scratch)
     if status != STATUS_REBOUNDED:
         return (STATUS_TRAPPED if status == STATUS_TRAPPED else STATUS_FAILED), NAN3, NAN3
     return to_global(status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
@@ -81,8 +82,9 @@ def _frame_axes(V, n, u_axis):
 
 
 @numba.njit(parallel=True, **JIT)
-def direct_rebound_parallel_rng(params, shape, V, omega, n, a, states, V_out, Omega_out, status):
-    """:func:`direct_rebound` for every row i of shape (N,) codes, V, omega, n (N, 3) and a (N,), on all
+def direct_rebound_parallel_rng(params, shape_arrays, shape, V, omega, n, a, states, V_out, Omega_out, status):
+    """:func:`direct_rebound` for every row i of shape (N,) indices into ``shape_arrays``, V, omega, n (N, 3) and
+    a (N,), on all
     threads: chunk j of CHUNK_ROWS rows draws its uniforms, U_PER_REBOUND per row in row order, from a copy of
     the xoshiro256+ state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the results do not
     depend on the number of threads. Outputs V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,)."""
@@ -92,7 +94,7 @@ def direct_rebound_parallel_rng(params, shape, V, omega, n, a, states, V_out, Om
         scratch = np.empty(SCRATCH_SIZE)
         for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
             fill_uniforms(state, u)
-            st, V_new, Omega_new = inline_direct_rebound(params, shape[i], (V[i, 0], V[i, 1], V[i, 2]),
+            st, V_new, Omega_new = inline_direct_rebound(params, shape_arrays, shape[i], (V[i, 0], V[i, 1], V[i, 2]),
                                                          (omega[i, 0], omega[i, 1], omega[i, 2]),
                                                          (n[i, 0], n[i, 1], n[i, 2]), a[i], u, scratch)
             status[i] = st

@@ -15,7 +15,8 @@ METHOD_DIRECT, always the direct model. Paths: PATH_TABLE, PATH_DIRECT.
 One hit consumes U_PER_DRAW = 13 uniforms whatever path answers it, so streams stay aligned. The table path
 is :func:`surrogate.kernels.table_path.table_rebound` with those 13. The direct path draws the shape from the mix
 with u[0] exactly as the table path does (:func:`surrogate.kernels.locate.locate`), maps the table's shape to
-the model's shape code (``model_shapes``), and gives the model u[1..7] as its U_PER_REBOUND uniforms (u[1 + k]
+its index in the direct model's shapes (``model_shapes``, into ``shape_arrays``), and gives the model u[1..7] as
+its U_PER_REBOUND uniforms (u[1 + k]
 is the model's u[k]; the axis at normal impact is u[7]). :func:`rebound_parallel_rng` also takes one shape per
 particle (``shapes``, the table's shape index, or SHAPE_FROM_MIX): a particle given its shape still consumes its
 u[0], on either path (:func:`surrogate.kernels.locate.row_shape`).
@@ -94,7 +95,7 @@ def rebound_path(data, V, omega, n, a, method):
 
 
 @numba.njit(**JIT)
-def rebound(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True):
+def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True):
     """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
     3-tuples in the caller's frame.
 
@@ -103,7 +104,8 @@ def rebound(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHO
     data : ``table.kernel_data``.
     params : ``table.direct_parameters`` (:func:`direct_model.runtime.model_parameters`); a table without
         them: an empty array, and a hit the direct model must answer is STATUS_INVALID.
-    model_shapes : ``table.model_shapes``, (n_shapes,) int64: the direct model's shape code of each table shape.
+    shape_arrays : ``table.shape_arrays``, the direct model's shapes (:class:`direct_model.shape_arrays.ShapeArrays`).
+    model_shapes : ``table.model_shapes``, (n_shapes,) int64: each table shape's index in ``shape_arrays``.
     mix_cdf : cumulative shape weights, table shape order (:func:`surrogate.mix_cdf`).
     V, omega, n, a, method : as :func:`rebound_path`.
     u : (U_PER_DRAW,) array of uniforms in [0, 1) (module doc for how each path uses them).
@@ -116,19 +118,21 @@ def rebound(data, params, model_shapes, mix_cdf, V, omega, n, a, u, method=METHO
     if path == PATH_TABLE:
         return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
-        return _direct_path(params, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
+        return _direct_path(params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u,
+                            np.empty(SCRATCH_SIZE))
     return STATUS_INVALID, NAN3, NAN3
 
 
 @numba.njit(inline="always", **JIT)
-def _direct_path(params, model_shapes, mix_cdf, shape, V, omega, n, a, u, scratch):
+def _direct_path(params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n, a, u, scratch):
     """The direct path of :func:`rebound` with its scratch space given; ``shape`` the table's shape index, or
     SHAPE_FROM_MIX to draw it from the mix with u[0]."""
     if not (uniforms_ok(u) and params.shape[0] == N_PARAMS and model_shapes.shape[0] == mix_cdf.shape[0]):
         return STATUS_INVALID, NAN3, NAN3
     if shape == SHAPE_FROM_MIX:
         shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
-    return inline_direct_rebound(params, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND], scratch)
+    return inline_direct_rebound(params, shape_arrays, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND],
+                                 scratch)
 
 
 @numba.njit(**JIT)
@@ -145,8 +149,8 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_parallel_rng(data, params, model_shapes, mix_cdf, shapes, V, omega, n, a, states, method, V_out,
-                         Omega_out, status, path, scaled=True):
+def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, V, omega, n, a, states, method,
+                         V_out, Omega_out, status, path, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
     a (N,), on all threads; the path of each row into ``path`` (N,).
 
@@ -192,7 +196,7 @@ def rebound_parallel_rng(data, params, model_shapes, mix_cdf, shapes, V, omega, 
                 if path[i] == PATH_DIRECT:
                     shape = shapes[i] if shapes.shape[0] > 0 else SHAPE_FROM_MIX
                     st, V_new, Omega_new = _direct_path(
-                        params, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
+                        params, shape_arrays, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
                         (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo],
                         scratch)
                 status[i] = st

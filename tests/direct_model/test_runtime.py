@@ -32,8 +32,9 @@ def test_normal_quantile_is_scipy_s_to_round_off():
 def test_aspect_ratio_is_the_batch_s_inverse_cdf(law):
     """The kernel's quantile equals AspectRatioLaw.ppf (the batch's draw) to round-off, so both draw one law."""
     params = _params(law)
+    rows = params[:P_CDF_LOW], params[P_CDF_LOW:P_CDF_HIGH + 1]       # the law and its CDF bounds
     u = np.random.default_rng(3).random(20_000)
-    mine = np.array([aspect_ratio(params, x) for x in u])
+    mine = np.array([aspect_ratio(*rows, x) for x in u])
     np.testing.assert_allclose(mine, law.ppf(u), rtol=0, atol=1e-14)
     assert mine.min() >= law.low and mine.max() <= law.high
 

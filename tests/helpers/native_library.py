@@ -106,6 +106,19 @@ class Rng(ctypes.Structure):
     _fields_ = [("s", ctypes.c_uint64 * 4)]
 
 
+class ShapeArrays(ctypes.Structure):
+    """rbs_shape_arrays (native/src/shapes.h): pointers into a direct_model.shape_arrays.ShapeArrays' arrays."""
+
+    FIELDS = ("kind", "vertex_start", "vertices", "second_moments", "aspect", "aspect_cdf", "both_hands")
+    _fields_ = [("n_shapes", ctypes.c_int)] + [(name, ctypes.c_void_p) for name in FIELDS]
+
+    @classmethod
+    def of(cls, arrays):
+        """The struct over ``arrays`` (C-contiguous; the caller keeps them alive while C reads them)."""
+        assert all(getattr(arrays, name).flags.c_contiguous for name in cls.FIELDS)
+        return cls(len(arrays.kind), *(getattr(arrays, name).ctypes.data for name in cls.FIELDS))
+
+
 class Info(ctypes.Structure):
     _fields_ = [("n_shapes", ctypes.c_int), ("n_alpha1", ctypes.c_int), ("n_speed", ctypes.c_int),
                 ("n_clusters", ctypes.c_int), ("n_levels", ctypes.c_int), ("n_dictionary", ctypes.c_int),

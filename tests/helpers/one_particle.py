@@ -1,36 +1,68 @@
-"""Call the single-particle rebound kernel from tests with explicit inputs."""
+"""Call the single-particle rebound kernel from tests with explicit inputs: a family by name or any shape's
+record (a user's grain), its (b/a, c/b) and hand, an orientation and an incident state."""
+
+from typing import NamedTuple
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, body_rebound
-from direct_model.shapes import second_moment_factor, shape_code
+from direct_model.registry import MAX_HULL_VERTICES
+from direct_model.shape_arrays import bounding_radius, family_shape_arrays, particle_body, shape_arrays
+from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import incident_velocity
 from direct_model.wall import CORUNDUM_ON_STEEL
 
 MIRROR = np.diag([1.0, 1.0, -1.0])     # reflection Z → −Z (lab) and ζ → −ζ (body)
 
 
-def run_one(shape, semi, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0), hand=1,
+class Body(NamedTuple):
+    """One particle's body (:func:`direct_model.shape_arrays.particle_body`), units of a."""
+
+    kind: int
+    vertices: np.ndarray     # (nv, 3) body frame; (0, 3) for an ellipsoid
+    semi: np.ndarray         # half-extents along ξ, η, ζ (an ellipsoid's semi-axes)
+    K: np.ndarray            # principal J/m, a²
+    radius: float            # bounding radius
+
+
+def body(shape, ratios=(1.0, 1.0), hand=1, kappa=0.3) -> Body:
+    """The body of a family (by name, at κ) or of a record, at (b/a, c/b) and hand."""
+    if isinstance(shape, str):
+        arrays, index = family_shape_arrays(kappa, AspectRatioLaw(), second_moment_factors(kappa)), SHAPES.index(shape)
+    else:
+        arrays, index = shape_arrays([shape]), 0
+    verts, K, semi = np.empty((MAX_HULL_VERTICES, 3)), np.empty(3), np.empty(3)
+    nv = particle_body(arrays, index, float(ratios[0]), float(ratios[1]), float(hand), verts, K, semi)
+    kind = int(arrays.kind[index])
+    return Body(kind, verts[:nv].copy(), semi, K, bounding_radius(kind, semi, verts, nv))
+
+
+def run_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0), hand=1,
             kappa=0.3, n_max=1000, contact_tol=1e-10, set_tol=1e-9, max_steps=100_000, history_rows=0):
-    """Rebound of one particle; returns (V⁺ m/s, Ω⁺ (m/s)/a, status, n_coll, e_rot, history)."""
+    """Rebound of one particle (``shape`` and ``ratios`` as :func:`body`); returns (V⁺ m/s, Ω⁺ (m/s)/a, status,
+    n_coll, e_rot, history)."""
+    b = body(shape, ratios, hand, kappa)
+    verts = np.zeros((MAX_HULL_VERTICES, 3))
+    verts[:len(b.vertices)] = b.vertices
     V, W = np.empty(3), np.empty(3)
     history = np.full((history_rows, HISTORY_COLUMNS), np.nan)
     status, _, ncoll, _, _, erot = body_rebound(
-        shape_code(shape), np.asarray(semi, dtype=float), kappa, float(hand),
-        second_moment_factor(shape, kappa), np.ascontiguousarray(R0), incident_velocity(alpha1, speed),
-        np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(), n_max,
-        contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE))
+        b.kind, verts, len(b.vertices), b.semi, b.K, b.radius, np.ascontiguousarray(R0),
+        incident_velocity(alpha1, speed), np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(),
+        n_max, contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE))
     return V, W, status, ncoll, erot, history
 
 
 def random_bodies(n, seed, shapes=("ellipsoid", "prism", "cut_prism", "tetrahedron")):
-    """n random (shape, semi-axes, orientation matrix, hand) tuples."""
+    """n random (shape, (b/a, c/b), orientation matrix, hand) tuples; a shape is a family's name or a record
+    (hands drawn for the tetrahedron and for a record in both hands)."""
     rng = np.random.default_rng(seed)
     out = []
     for i in range(n):
         shape = shapes[i % len(shapes)]
-        ba, cb = rng.uniform(0.5, 1.0, 2)
-        out.append((shape, np.array([1.0, ba, ba * cb]), Rotation.random(random_state=rng).as_matrix(),
-                    int(rng.choice([-1, 1])) if shape == "tetrahedron" else 1))
+        ratios = tuple(rng.uniform(0.5, 1.0, 2))
+        both = shape == "tetrahedron" or getattr(shape, "both_hands", False)
+        out.append((shape, ratios, Rotation.random(random_state=rng).as_matrix(),
+                    int(rng.choice([-1, 1])) if both else 1))
     return out

@@ -6,8 +6,9 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
 ``table_rebound``, ``table_rebound_many``, ``table_rebound_many_rng``, ``table_rebound_uniforms``,
 ``draw_local``; the direct model's free flight from ``direct_model.rotation``, its run-time kernel
-``direct_rebound`` and the kernels it calls (``direct_model``: collide, body_vertices,
-bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix); those of every
+``direct_rebound`` and the kernels it calls (``direct_model``: collide, body_vertices, the shape arrays and
+particle_body, bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix,
+rebound_model_frame), user grains (tests/helpers/grains.py); those of every
 hit (``surrogate.kernels.wall_hit``: ``rebound``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
 and PATH_* codes); the law comparisons of tests/helpers/direct_law.py (its states, ``tablegen simulate`` and the
 statistics); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
@@ -24,8 +25,11 @@ from surrogate.kernels import draw_local, table_rebound, table_rebound_many, tab
 from surrogate.kernels.direct_path import direct_rebound
 from direct_model.collision import collide
 from direct_model.body_rebound import quaternion_to_matrix
-from direct_model.runtime import U_PER_REBOUND, aspect_ratio, normal_quantile, uniform_quaternion
-from direct_model.shapes import MAX_VERTICES, SHAPES, body_vertices, bounding_radius
+from direct_model.runtime import (SCRATCH_SIZE, U_PER_REBOUND, aspect_ratio, normal_quantile, rebound_model_frame,
+                                  uniform_quaternion)
+from direct_model.shape_arrays import bounding_radius, particle_body, shape_arrays
+from direct_model.shapes import MAX_VERTICES, SHAPES, AspectRatioLaw, body_vertices
+from tests.helpers.grains import cloud_grain, hull_grain
 from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
                                         SPIN_TOLERANCE, rebound, rebound_path)
 from tests.helpers.direct_law import (A, N, STATES, assert_one_law, frame_of, incident, one_law, simulated, state_id,
@@ -91,6 +95,8 @@ __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", 
            "draw_local", "fill_uniforms", "load", "mix_cdf", "table_rebound_many", "table_rebound_many_rng",
            "table_rebound", "table_rebound_uniforms", "seed_state", "surrogate", "write_samples_file",
            "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",
+           "SCRATCH_SIZE", "AspectRatioLaw", "cloud_grain", "hull_grain", "particle_body", "rebound_model_frame",
+           "shape_arrays",
            "collide", "normal_quantile", "quaternion_to_matrix", "direct_rebound", "uniform_quaternion",
            "A", "N", "SHAPES", "STATES", "assert_one_law", "frame_of", "incident", "one_law", "simulated", "state_id",
            "to_model_frame", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE",

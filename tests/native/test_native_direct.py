@@ -1,7 +1,8 @@
 """The direct model in C (native/src/direct_path.c and the kernels it calls: shapes.c, collision.c, flight.c,
 body_rebound.c, runtime.c) against numba, bit for bit for the same inputs and uniforms: the parameter array the
-loader builds, the pieces (shapes, the normal quantile, the uniform quaternion, one collision), whole
-rebounds in random caller frames, and hostile inputs (RBS_INVALID with NaN, never a crash)."""
+loader builds, the pieces (shapes, a particle's body, the normal quantile, the uniform quaternion, one
+collision), whole rebounds in random caller frames, user grains of 8 to 256 hull vertices, and hostile inputs
+(RBS_INVALID with NaN, never a crash)."""
 
 from __future__ import annotations
 
@@ -13,11 +14,15 @@ import numpy as np
 import pytest
 
 from tests.helpers import python_side as py
-from tests.helpers.native_library import ERR_FORMAT, NATIVE
+from tests.helpers.native_library import ERR_FORMAT, NATIVE, ShapeArrays
 
 SPINS = (0.0, 0.02, 0.3, 1.0)     # |Ω⁻| a / |V⁻| of the whole-rebound comparisons
 PER_SHAPE = 2000                  # particles per shape and spin
 N_COLLISIONS = 10_000
+LAW = py.AspectRatioLaw()
+# user grains: hulls of 8 to 256 vertices in both hands, of fixed proportions or stretched by the families' law
+GRAINS = [py.hull_grain(f"grain_{n}", n, seed=n, aspect=LAW if n in (24, 256) else None, both_hands=True)
+          for n in (8, 24, 64, 256)] + [py.cloud_grain("cloud", 300, seed=3, aspect=LAW)]
 
 _d, _i, _p = ctypes.c_double, ctypes.c_int, ctypes.c_void_p
 
@@ -31,11 +36,15 @@ def _c(native):
     c.rbs_collide.restype = _i
     c.rbs_body_vertices.argtypes = [_i, _d, _d, _d, _d, _d, _p]
     c.rbs_body_vertices.restype = _i
-    c.rbs_bounding_radius.argtypes = [_i, _d, _d, _d, _p, _i]
+    c.rbs_bounding_radius.argtypes = [_i, _p, _p, _i]
     c.rbs_bounding_radius.restype = _d
+    c.rbs_particle_body.argtypes = [_p, _i, _d, _d, _d, _p, _p, _p]
+    c.rbs_particle_body.restype = _i
+    c.rbs_rebound_model_frame.argtypes = [_p, _p, _i, _d, _d, _d, _d, _d, _p, _p, _p]
+    c.rbs_rebound_model_frame.restype = _i
     c.rbs_normal_quantile.argtypes = [_d]
     c.rbs_normal_quantile.restype = _d
-    c.rbs_aspect_ratio.argtypes = [_p, _d]
+    c.rbs_aspect_ratio.argtypes = [_p, _p, _d]
     c.rbs_aspect_ratio.restype = _d
     c.rbs_uniform_quaternion.argtypes = [_d, _d, _d, _p]
     c.rbs_uniform_quaternion.restype = None
@@ -187,7 +196,7 @@ def test_parameters_out_of_range_refuse_the_table(native, small_table_path, tmp_
 
 
 def test_shapes_bit_for_bit(native):
-    """Vertices and bounding radius of every shape, random half-extents, κ and hand."""
+    """The families' vertices at random half-extents, κ and hand."""
     c = _c(native)
     rng = np.random.default_rng(5)
     for trial in range(2000):
@@ -198,8 +207,26 @@ def test_shapes_bit_for_bit(native):
         n = c.rbs_body_vertices(shape, a, b, c_, kappa, hand, mine.ctypes.data)
         assert n == py.body_vertices(shape, a, b, c_, kappa, hand, theirs)
         assert _same(mine[:n], theirs[:n])
-        assert _same(c.rbs_bounding_radius(shape, a, b, c_, mine.ctypes.data, n),
-                     py.bounding_radius(shape, a, b, c_, theirs, n))
+
+
+def test_particle_bodies_bit_for_bit(native, table_pair):
+    """One particle's body from the shape arrays (rbs_particle_body, rbs_bounding_radius): vertices, J/m,
+    half-extents and radius as numba's, for the table's families and the user grains, random ratios and hands."""
+    c = _c(native)
+    rng = np.random.default_rng(4)
+    for arrays in (table_pair[0].shape_arrays, py.shape_arrays(GRAINS)):
+        struct = ShapeArrays.of(arrays)
+        for trial in range(1000):
+            shape = trial % arrays.n_shapes
+            ba, cb = rng.uniform(0.5, 1.0, 2)
+            hand = (1.0, -1.0)[trial % 8 // 4]
+            out = [(np.zeros((256, 3)), np.zeros(3), np.zeros(3)) for _ in range(2)]
+            n = c.rbs_particle_body(ctypes.byref(struct), shape, ba, cb, hand, *(x.ctypes.data for x in out[0]))
+            assert n == py.particle_body(arrays, shape, ba, cb, hand, *out[1])
+            assert all(_same(mine, theirs) for mine, theirs in zip(*out))
+            kind = int(arrays.kind[shape])
+            assert _same(c.rbs_bounding_radius(kind, out[0][2].ctypes.data, out[0][0].ctypes.data, n),
+                         py.bounding_radius(kind, out[1][2], out[1][0], n))
 
 
 def test_random_inputs_bit_for_bit(native, table_pair):
@@ -211,9 +238,11 @@ def test_random_inputs_bit_for_bit(native, table_pair):
     p = np.concatenate([rng.random(20000), 10.0 ** -rng.uniform(1, 300, 2000), 1.0 - 10.0 ** -rng.uniform(1, 16, 2000),
                         [0.075, 0.925, 0.5, 5e-324]])
     assert _same([c.rbs_normal_quantile(x) for x in p], [py.normal_quantile(x) for x in p])
-    params_c = np.ascontiguousarray(params)
+    arrays = table_pair[0].shape_arrays
+    law, cdf = arrays.aspect[0], arrays.aspect_cdf[0]
     u = np.concatenate([rng.random(5000), [0.0, np.nextafter(1.0, 0.0)]])
-    assert _same([c.rbs_aspect_ratio(params_c.ctypes.data, x) for x in u], [py.aspect_ratio(params, x) for x in u])
+    assert _same([c.rbs_aspect_ratio(law.ctypes.data, cdf.ctypes.data, x) for x in u],
+                 [py.aspect_ratio(law, cdf, x) for x in u])
     for u0, u1, u2 in rng.random((5000, 3)):
         mine, theirs = np.zeros(4), np.zeros(4)
         c.rbs_uniform_quaternion(u0, u1, u2, mine.ctypes.data)
@@ -283,7 +312,7 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
     statuses = {}
     for shape in range(4):
         for V, n, a, omega, u in _particles(rng, PER_SHAPE, spin):
-            status, V_py, W_py = py.direct_rebound(params, shape, V, omega, n, a, u)
+            status, V_py, W_py = py.direct_rebound(params, python.shape_arrays, shape, V, omega, n, a, u)
             mine = _direct_c(c, c_table.handle, shape, V, omega, n, a, u)
             assert mine[0] == status
             if status == py.STATUS_REBOUNDED:
@@ -295,6 +324,37 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
     print(f"\n|Ω⁻|a/|V⁻| = {spin}: {4 * PER_SHAPE} particles, statuses {statuses}, 0 differing")
 
 
+@pytest.mark.parametrize("spin", SPINS)
+def test_grain_rebounds_bit_for_bit(native, table_pair, spin):
+    """A user's grain rebounds in C as in numba: rbs_rebound_model_frame against rebound_model_frame over the
+    grains' arrays (hulls of 8 to 256 vertices), 400 particles each at random incidence, the same uniforms:
+    the same status and, for a rebound, the same bits of V⁺ and Ω⁺."""
+    c = _c(native)
+    params = table_pair[0].direct_parameters
+    arrays = py.shape_arrays(GRAINS)
+    struct = ShapeArrays.of(arrays)
+    rng = np.random.default_rng(int(100 * spin) + 21)
+    scratch = np.empty(py.SCRATCH_SIZE)
+    statuses = {}
+    for k in range(400 * len(GRAINS)):
+        shape = k % len(GRAINS)
+        alpha1, speed = rng.uniform(0.02, np.pi / 2), rng.uniform(20.0, 300.0)
+        omega = rng.normal(size=3)
+        omega *= spin * speed / np.linalg.norm(omega)
+        u = rng.random(py.U_PER_REBOUND)
+        state = (speed * np.cos(alpha1), -speed * np.sin(alpha1), *omega)
+        theirs = py.rebound_model_frame(params, arrays, shape, *state, u, scratch)
+        V, W = np.zeros(3), np.zeros(3)
+        status = c.rbs_rebound_model_frame(params.ctypes.data, ctypes.byref(struct), shape, *state, u.ctypes.data,
+                                           V.ctypes.data, W.ctypes.data)
+        assert status == theirs[0]
+        if status == py.STATUS_REBOUNDED:
+            assert _same(V, theirs[3:6]) and _same(W, theirs[6:9]), (GRAINS[shape].name, state, u)
+        statuses[status] = statuses.get(status, 0) + 1
+    assert statuses.get(py.STATUS_REBOUNDED, 0) > 0.9 * 400 * len(GRAINS)
+    print(f"\n|Ω⁻|a/|V⁻| = {spin}: {400 * len(GRAINS)} grains, statuses {statuses}, 0 differing")
+
+
 def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_table_path):
     """The library built for the x86-64 baseline (the frame's fma() from the C library, not the FMA
     instruction): the same bits as numba on 2000 spinning particles of every shape."""
@@ -302,7 +362,7 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     c, table = _c(native_baseline), native_baseline.table(small_table_path)
     rng = np.random.default_rng(11)
     for k, (V, n, a, omega, u) in enumerate(_particles(rng, 2000, 0.3)):
-        status, V_py, W_py = py.direct_rebound(python.direct_parameters, k % 4, V, omega, n, a, u)
+        status, V_py, W_py = py.direct_rebound(python.direct_parameters, python.shape_arrays, k % 4, V, omega, n, a, u)
         mine = _direct_c(c, table.handle, k % 4, V, omega, n, a, u)
         assert mine[0] == status and (status != py.STATUS_REBOUNDED or (_same(mine[1], V_py) and _same(mine[2], W_py)))
 
@@ -328,7 +388,8 @@ def test_bad_input_is_invalid_with_nan(native, table_pair, change):
                              args["u"])
     assert status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
     if all(args[k] is not None for k in ("V", "omega", "n", "u")):
-        theirs = py.direct_rebound(table_pair[0].direct_parameters, args["shape"], np.asarray(args["V"], float),
+        theirs = py.direct_rebound(table_pair[0].direct_parameters, table_pair[0].shape_arrays, args["shape"],
+                                   np.asarray(args["V"], float),
                                    np.asarray(args["omega"], float), np.asarray(args["n"], float), args["a"],
                                    args["u"])
         assert theirs[0] == py.STATUS_INVALID
@@ -355,6 +416,7 @@ def test_minus_zero_uniform_is_taken_as_numba_takes_it(native, table_pair):
     u = np.full(7, 0.5)
     u[3] = -0.0
     status, V, W = _direct_c(c, table_pair[1].handle, 2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
-    theirs = py.direct_rebound(table_pair[0].direct_parameters, 2, np.asarray(GOOD["V"]), np.asarray(GOOD["omega"]),
+    theirs = py.direct_rebound(table_pair[0].direct_parameters, table_pair[0].shape_arrays, 2, np.asarray(GOOD["V"]),
+                               np.asarray(GOOD["omega"]),
                                np.asarray(GOOD["n"]), GOOD["a"], u)
     assert status == theirs[0] == py.STATUS_REBOUNDED and _same(V, theirs[1]) and _same(W, theirs[2])

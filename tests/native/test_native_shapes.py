@@ -40,7 +40,7 @@ def _same_arrays(a, b):
 def test_records_round_trip_through_the_file(small_table_path, tmp_path):
     """The families at the table's κ and law and a user grain (direct_model.registry.grain) come back from the
     file as the same records: names, kinds, vertices, triangles, inertia, laws and hands, bit for bit."""
-    from data_schema.shape_records import shape_arrays
+    from data_schema.shape_records import shape_datasets
     from data_schema.table import read_table
     path = tmp_path / "round_trip.h5"
     py.many_shape_table(small_table_path, path, 5)
@@ -49,8 +49,8 @@ def test_records_round_trip_through_the_file(small_table_path, tmp_path):
     assert [r.name for r in read] == [r.name for r in written] == ["ellipsoid", "prism", "cut_prism", "tetrahedron",
                                                                    "grain_00"]
     assert [type(r) for r in read] == [type(r) for r in written]
-    for key, values in shape_arrays(written).items():
-        assert _same_arrays(shape_arrays(read)[key], values), key
+    for key, values in shape_datasets(written).items():
+        assert _same_arrays(shape_datasets(read)[key], values), key
     grain = read[-1]
     assert grain.aspect == written[-1].aspect and grain.both_hands and len(grain.triangles) == 2 * len(grain.vertices) - 4
 
@@ -60,7 +60,7 @@ def test_a_table_of_64_shapes_loads_alike_in_python_and_c(native, many_shapes):
     table = py.load(path)
     assert table.shapes == names and len(names) == 64
     assert table.model_shapes.tolist() == [0, 1, 2, 3] + [-1] * 60
-    arrays = table.shape_arrays
+    arrays = table.shape_datasets
     c_table = native.table(path)
     try:
         assert c_table.shapes == names
@@ -183,12 +183,12 @@ def test_a_table_before_3_4_gets_the_families_records_and_draws_the_same_bits(na
     old = _copy(small_table_path, tmp_path, "v3_3.h5", format_3_3)
     new_table, old_table = py.load(small_table_path), py.load(old)
     assert old_table.records and all(a.name == b.name for a, b in zip(old_table.records, new_table.records))
-    for key, values in new_table.shape_arrays.items():
-        assert _same_arrays(old_table.shape_arrays[key], values), key
+    for key, values in new_table.shape_datasets.items():
+        assert _same_arrays(old_table.shape_datasets[key], values), key
     c_old = native.table(old)
     try:
         for i, name in enumerate(old_table.shapes):
-            info, arrays = c_old.shape_info(i), new_table.shape_arrays
+            info, arrays = c_old.shape_info(i), new_table.shape_datasets
             start, stop = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
             assert info["name"] == name and _same_arrays(info["vertices"], arrays["vertices"][start:stop])
             assert _same_arrays(info["aspect"], arrays["aspect"][i]) and info["both_hands"] == arrays["both_hands"][i]

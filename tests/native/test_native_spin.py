@@ -84,8 +84,8 @@ def spin_states(table):
 
 
 def _numba(table, cdf, V, omega, n, a, u, method, scaled=True):
-    return py.rebound(table.kernel_data, table.direct_parameters, table.model_shapes, cdf, tuple(V),
-                                 tuple(omega), tuple(n), a, u, method, scaled)
+    return py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes, cdf,
+                      tuple(V), tuple(omega), tuple(n), a, u, method, scaled)
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))

@@ -19,6 +19,7 @@ import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import BUILT_WITH_SECOND_MOMENT_FACTORS, BUILT_WITH_TOLERANCES
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, model_parameters
+from direct_model.shape_arrays import family_shape_arrays
 from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL
 from direct_model.wall import CORUNDUM_ON_STEEL
@@ -32,6 +33,11 @@ ROTATION_COMPARISONS = 6 * len(SHAPES)        # KS comparisons of test_rotating_
 @pytest.fixture(scope="module")
 def params(small_table):
     return small_table.direct_parameters
+
+
+@pytest.fixture(scope="module")
+def shapes(small_table):
+    return small_table.shape_arrays
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -54,12 +60,13 @@ def test_rotating_the_frame_rotates_the_outputs(small_table, shape):
 
 
 @pytest.mark.parametrize("shape", SHAPES)
-def test_a_rebound_never_adds_energy(params, shape):
+def test_a_rebound_never_adds_energy(params, shapes, shape):
     """Through the kernel, in a random frame: ½|V⁺|² + ½ K_min |Ω⁺ a|² ≤ ½|V⁻|² + ½ K_max |Ω⁻ a|² per unit mass
     (lengths in m), K_min, K_max the extreme principal values of J/(m a²) of the particle drawn from the same
     uniforms: the kinetic energy ½|V|² + ½ Ω·JΩ/m lies between these bounds, and collisions never add to it."""
     rng = np.random.default_rng(31)
-    kfac = second_moment_factors()[SHAPES.index(shape)]
+    code = SHAPES.index(shape)
+    kfac, law, cdf = second_moment_factors()[code], shapes.aspect[code], shapes.aspect_cdf[code]
     u = np.empty(U_PER_REBOUND)
     checked = 0
     for i in range(400):
@@ -67,11 +74,11 @@ def test_a_rebound_never_adds_energy(params, shape):
         V = Q @ (rng.normal(size=3) * [100.0, 0.0, 100.0] - [0.0, rng.uniform(30.0, 250.0), 0.0])
         W = rng.normal(size=3) * 150.0 / A * (i % 3) / 2             # |Ω⁻|a/|V⁻| around 0, 1, 2
         u[:] = rng.random(U_PER_REBOUND)
-        status, V_out, W_out = direct_rebound(params, SHAPES.index(shape), V, W, Q[:, 1], A, u)
+        status, V_out, W_out = direct_rebound(params, shapes, code, V, W, Q[:, 1], A, u)
         if status != STATUS_REBOUNDED:
             continue
-        b = aspect_ratio(params, u[3])
-        c = b * aspect_ratio(params, u[4])
+        b = aspect_ratio(law, cdf, u[3])
+        c = b * aspect_ratio(law, cdf, u[4])
         K = kfac * np.array([b * b + c * c, 1.0 + c * c, 1.0 + b * b])
         before = 0.5 * V @ V + 0.5 * K.max() * (W @ W) * A * A
         after = 0.5 * np.dot(V_out, V_out) + 0.5 * K.min() * np.dot(W_out, W_out) * A * A
@@ -83,14 +90,15 @@ def test_a_rebound_never_adds_energy(params, shape):
 def test_near_sphere_keeps_angular_momentum_about_the_contact_point():
     """An ellipsoid with b/a, c/b ∈ [0.999999, 1] and Ω⁻ = 0 collides once at the point −a n below its centre:
     (2/5) a² Ω⁺ + a n × V⁺ = a n × V⁻ (per unit mass) in the caller's frame, to the sphere's asphericity."""
-    near = model_parameters(AspectRatioLaw(1.0, 1e-3, 0.999999, 1.0), 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9,
-                            100_000, second_moment_factors())
+    law = AspectRatioLaw(1.0, 1e-3, 0.999999, 1.0)
+    near = model_parameters(law, 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9, 100_000, second_moment_factors())
+    near_shapes = family_shape_arrays(0.3, law, second_moment_factors())
     rng = np.random.default_rng(41)
     for i in range(200):
         Q = random_frame(300 + i)
         n = Q[:, 1]
         V = Q @ (rng.normal(size=3) * [80.0, 0.0, 80.0] - [0.0, rng.uniform(40.0, 250.0), 0.0])
-        status, V_out, W_out = direct_rebound(near, 0, V, np.zeros(3), n, A, rng.random(U_PER_REBOUND))
+        status, V_out, W_out = direct_rebound(near, near_shapes, 0, V, np.zeros(3), n, A, rng.random(U_PER_REBOUND))
         assert status == STATUS_REBOUNDED
         before = A * np.cross(n, V)
         after = 0.4 * A * A * np.asarray(W_out) + A * np.cross(n, V_out)
@@ -150,21 +158,21 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
     dict(n=(0.0, np.nan, 0.0)), dict(a=0.0), dict(a=np.inf), dict(omega=(0.0, np.nan, 0.0)), dict(shape=4),
     dict(shape=-1), dict(u=np.full(U_PER_REBOUND, 1.0)), dict(u=np.full(U_PER_REBOUND - 1, 0.5)),
 ])
-def test_bad_kernel_input_is_invalid_with_nan(params, change):
+def test_bad_kernel_input_is_invalid_with_nan(params, shapes, change):
     args = dict(V=(100.0, -100.0, 0.0), n=(0.0, 1.0, 0.0), a=A, omega=(0.0, 0.0, 0.0), shape=1,
                 u=np.full(U_PER_REBOUND, 0.5))
-    assert direct_rebound(params, **args)[0] == STATUS_REBOUNDED
+    assert direct_rebound(params, shapes, **args)[0] == STATUS_REBOUNDED
     args.update(change)
-    status, V_out, W_out = direct_rebound(params, **args)
+    status, V_out, W_out = direct_rebound(params, shapes, **args)
     assert status == STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
 
 
-def test_a_state_whose_flight_underflows_ends(params):
+def test_a_state_whose_flight_underflows_ends(params, shapes):
     """|V⁻| ~ 1e-160 m/s underflows the free flight's invariants to NaN; the kernel used to loop for ever in
     the AGM of direct_model.rotation. It must end (here: STATUS_FAILED with NaN), as the C twin does. Run
     in a daemon thread so that a regression fails after the timeout instead of hanging the suite."""
     n = np.array([0.34523645, 0.41333518, 0.84259469])
-    args = (params, 0, (-3.77668607e-161, -7.47222348e-161, -5.46831954e-161),
+    args = (params, shapes, 0, (-3.77668607e-161, -7.47222348e-161, -5.46831954e-161),
             (-1.50979875e-158, -2.14919893e-158, 1.32388636e-157), tuple(n / np.linalg.norm(n)), 8.635989814806125e-4,
             np.array([0.29739859, 0.48706842, 0.90535956, 0.39282742, 0.62082272, 0.55552379, 0.17284464]))
     result = []
@@ -204,9 +212,11 @@ def test_runtime_kernel_needs_no_scipy():
     code = ("import sys; sys.modules['scipy'] = None; import numpy as np; "
             "from direct_model.runtime import model_parameters, U_PER_REBOUND; "
             "from direct_model.shapes import AspectRatioLaw; from direct_model.wall import CORUNDUM_ON_STEEL; "
+            "from direct_model.shape_arrays import family_shape_arrays; "
             "from surrogate.kernels import direct_rebound; "
             "p = model_parameters(AspectRatioLaw(), 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9, 100000, "
             "(0.2, 1 / 3, 0.33, 0.2)); "
-            "s = direct_rebound(p, 2, (100.0, -100.0, 0.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 1e-3, "
+            "shapes = family_shape_arrays(0.3, AspectRatioLaw(), (0.2, 1 / 3, 0.33, 0.2)); "
+            "s = direct_rebound(p, shapes, 2, (100.0, -100.0, 0.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 1e-3, "
             "np.full(U_PER_REBOUND, 0.5))[0]; sys.exit(s)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == STATUS_REBOUNDED

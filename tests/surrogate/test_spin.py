@@ -98,8 +98,8 @@ def test_direct_method_is_the_direct_model_with_the_hit_s_uniforms(small_table):
     cdf = surrogate.mix_cdf(small_table, weights)
     for i in range(0, m, 7):
         shape = small_table.model_shapes[np.searchsorted(cdf, u[i, 0], side="right")]
-        st, v, w = direct_rebound(small_table.direct_parameters, shape, tuple(V[i]), tuple(W[i]), NORMAL, A,
-                                  u[i, 1:1 + U_PER_REBOUND])
+        st, v, w = direct_rebound(small_table.direct_parameters, small_table.shape_arrays, shape, tuple(V[i]),
+                                  tuple(W[i]), NORMAL, A, u[i, 1:1 + U_PER_REBOUND])
         assert st == status[i]
         np.testing.assert_array_equal(np.array(v), V_out[i])
         np.testing.assert_array_equal(np.array(w), W_out[i])
@@ -109,26 +109,27 @@ def test_rebound_is_the_table_or_the_direct_kernel_by_path(small_table):
     """Per particle: the table path is table_rebound's bits, the direct path direct_rebound's with
     u[1..7]; a uniform outside [0, 1) is STATUS_INVALID on either path, as a bad method."""
     data, params, shapes = small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes
+    arrays = small_table.shape_arrays
     cdf = surrogate.mix_cdf(small_table, "mix")
     rng = np.random.default_rng(8)
     for i in range(60):
         u = rng.random(13)
         V = _velocity(rng.uniform(30, 90), rng.uniform(50, 250), rng.uniform(0, 6))
         W = tuple(rng.normal(size=3) * (1e4 if i % 2 else 0.0))
-        got = rebound(data, params, shapes, cdf, V, W, NORMAL, A, u, METHOD_AUTO, True)
+        got = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, u, METHOD_AUTO, True)
         if i % 2 == 0:
             want = table_rebound(data, cdf, V, NORMAL, A, u, True)
         else:
             shape = shapes[np.searchsorted(cdf, u[0], side="right")]
-            want = direct_rebound(params, shape, V, W, NORMAL, A, u[1:8])
+            want = direct_rebound(params, arrays, shape, V, W, NORMAL, A, u[1:8])
         assert got[0] == want[0]
         np.testing.assert_array_equal(np.array(got[1:]), np.array(want[1:]))
         for method in (METHOD_TABLE, METHOD_DIRECT):
             bad = u.copy()
             bad[12] = 1.0
-            st, v, _ = rebound(data, params, shapes, cdf, V, W, NORMAL, A, bad, method, True)
+            st, v, _ = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, bad, method, True)
             assert st == STATUS_INVALID and np.all(np.isnan(v))
-    st, v, _ = rebound(data, params, shapes, cdf, V, W, NORMAL, A, rng.random(13), 3, True)
+    st, v, _ = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, rng.random(13), 3, True)
     assert st == STATUS_INVALID and np.all(np.isnan(v))
 
 
@@ -218,7 +219,8 @@ def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table
     V = np.array(_in_grid(3, 1))
     outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
     with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
-        rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
+        rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
+                             small_table.model_shapes,
                              surrogate.mix_cdf(small_table, "mix"), np.zeros(0, np.int64), V, np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3,
                              *outputs)
@@ -237,7 +239,8 @@ def test_the_many_hit_kernel_refuses_shape_indices_outside_the_table(small_table
     V = np.array(_in_grid(3, 1))
     outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
     with pytest.raises(ValueError, match=message):
-        rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes,
+        rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
+                             small_table.model_shapes,
                              surrogate.mix_cdf(small_table, "mix"), shapes, V, np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 0,
                              *outputs)
@@ -350,7 +353,8 @@ def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, me
 
     def run(cdf, rows):
         outputs = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, np.int8), np.empty(m, np.int8)
-        rebound_parallel_rng(data, params, model_shapes, cdf, rows, V, W, np.tile(NORMAL, (m, 1)), np.full(m, A),
+        rebound_parallel_rng(data, params, small_table.shape_arrays, model_shapes, cdf, rows, V, W,
+                             np.tile(NORMAL, (m, 1)), np.full(m, A),
                              chunk_states(np.random.default_rng(11), m), method, *outputs)
         return outputs
 
