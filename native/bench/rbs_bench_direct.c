@@ -136,8 +136,15 @@ static int time_pieces(const rbs_table *table, int shape, const char *path, int 
         return 0;
     }
     fclose(f);
-    rbs_family_shapes families;     /* the runtime's shapes, as the loader builds them from the parameters */
-    rbs_family_shapes_init(&families, params[P_KAPPA], params + P_ASPECT_MEAN, params + P_CDF_LOW, params + P_KFAC);
+    /* the families' shapes, as the loader builds them from the parameters */
+    int8_t kind[RBS_N_FAMILIES];
+    int64_t vertex_start[RBS_N_FAMILIES + 1];
+    double vertices[3 * FAMILY_VERTEX_ROWS], moments[3 * RBS_N_FAMILIES], law[4 * RBS_N_FAMILIES];
+    double law_cdf[2 * RBS_N_FAMILIES];
+    uint8_t hands[RBS_N_FAMILIES];
+    rbs_family_shapes_fill(kind, vertex_start, vertices, moments, law, law_cdf, hands, params[P_KAPPA],
+                           params + P_ASPECT_MEAN, params + P_CDF_LOW, params + P_KFAC);
+    rbs_shape_arrays families = {RBS_N_FAMILIES, kind, vertex_start, vertices, moments, law, law_cdf, hands};
     static const char *names[5] = {"us_model_frame", "us_flight_setup", "us_orientation", "us_lowest_points",
                                    "us_collision"};
     double keep = 0.0;
@@ -145,7 +152,7 @@ static int time_pieces(const rbs_table *table, int shape, const char *path, int 
         double best = INFINITY;
         for (int r = 0; r < runs + 1; r++) {    /* run 0 is the warm-up */
             double c0 = seconds(CLOCK_THREAD_CPUTIME_ID);
-            keep += run_piece(k, params, &families.arrays, shape, rows, m, rot);
+            keep += run_piece(k, params, &families, shape, rows, m, rot);
             double cpu = seconds(CLOCK_THREAD_CPUTIME_ID) - c0;
             if (r > 0 && cpu < best) best = cpu;
         }

@@ -15,6 +15,7 @@
 #define RBS_INTERNAL_H
 
 #include <stddef.h>
+#include <math.h>
 #include <stdint.h>
 
 #include "rebound_scatter.h"

@@ -78,7 +78,8 @@ class Mix(ctypes.Structure):
 class ShapeInfo(ctypes.Structure):
     _fields_ = [("name", ctypes.c_char_p), ("kind", ctypes.c_int), ("family", ctypes.c_int),
                 ("n_vertices", ctypes.c_int), ("vertices", ctypes.POINTER(ctypes.c_double)),
-                ("inertia", ctypes.c_double * 3), ("aspect", ctypes.c_double * 4), ("both_hands", ctypes.c_int)]
+                ("inertia", ctypes.c_double * 3), ("aspect", ctypes.c_double * 4), ("both_hands", ctypes.c_int),
+                ("direct_shape", ctypes.c_int)]
 
 
 class OwnedMix:
@@ -219,7 +220,7 @@ class NativeTable:
         vertices = (np.ctypeslib.as_array(info.vertices, shape=(n, 3)).copy() if n else np.zeros((0, 3)))
         return {"name": info.name.decode(), "kind": info.kind, "family": info.family, "vertices": vertices,
                 "inertia": np.array(info.inertia[:]), "aspect": np.array(info.aspect[:]),
-                "both_hands": info.both_hands}
+                "both_hands": info.both_hands, "direct_shape": info.direct_shape}
 
     # -- draws
     def table_rebound(self, mix, V, n, a, u, interpolation=SCALED):
