@@ -144,9 +144,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     failed; rare, never dropped: count them with ``status == surrogate.STATUS_FAILED``); NaN rows unless
     rebounded. Every check runs before anything is written: on a ValueError the ``out`` arrays are unchanged.
     The direct model needs ``table.direct_parameters``: with a table that lacks them, a hit the model must
-    answer is a ValueError. It takes the four families only, so far: a user's grain (a table of format 3.4)
-    under ``method="direct"`` is a ValueError, and under ``"auto"`` a hit of one that the model would answer
-    gets status -1 (invalid) and NaN.
+    answer is a ValueError. It takes the families and the table's user grains (convex polyhedra, format 3.4).
     """
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
     n_particles = V.shape[0]
@@ -154,7 +152,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # the grid's range is an error only where the table must answer every hit
     check_incident(table, V, nrm, a, grid=not clamp and code == METHOD_TABLE)
     cdf, shapes = check_shape(table, shape, n_particles)
-    if code == METHOD_DIRECT:
+    if code == METHOD_DIRECT and table.direct_parameters is not None:
         _check_direct_shapes(table, cdf, shapes)
     scaled = check_interpolation(interpolation)
     outputs = check_out(out, n_particles, (V, nrm, a, W), 4 if return_path else 3)
@@ -203,8 +201,7 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     -------
     (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8): STATUS_REBOUNDED (0), STATUS_TRAPPED (1)
     or STATUS_FAILED (2, a collision solve or contact search failed); NaN rows unless rebounded. A table
-    without ``direct_parameters``, or a mix giving weight to a user's grain (the model takes the four families
-    only, so far), is a ValueError.
+    without ``direct_parameters`` is a ValueError.
     """
     params = check_direct_parameters(table)
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
@@ -225,13 +222,14 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
 
 
 def _check_direct_shapes(table: SurrogateTable, cdf: np.ndarray, shapes: np.ndarray) -> None:
-    """ValueError naming a user's grain the direct model would have to answer (those of ``shapes``, or of positive
-    weight in ``cdf``): the direct model takes the four families only, so far; the table path draws any shape."""
+    """ValueError naming a shape the direct model would have to answer but cannot (those of ``shapes``, or of
+    positive weight in ``cdf``): a smooth body that is no built-in family, whose semi-axes the table does not
+    hold (:attr:`surrogate.table.SurrogateTable.model_shapes` −1); the table path draws any shape."""
     used = np.unique(shapes) if shapes.size else np.flatnonzero(np.diff(cdf, prepend=0.0) > 0.0)
-    grains = [table.shapes[k] for k in used if table.model_shapes[k] < 0]
-    if grains:
-        raise ValueError(f"The direct model does not take the user's grain {grains[0]!r} yet (the four families "
-                         f"only); draw it from the table (sample_global with method='table').")
+    refused = [table.shapes[k] for k in used if table.model_shapes[k] < 0]
+    if refused:
+        raise ValueError(f"The direct model cannot answer the shape {refused[0]!r}: a smooth body that is no "
+                         f"built-in family; draw it from the table (sample_global with method='table').")
 
 
 def _mix_rows(cdf: np.ndarray, n: int, generator: np.random.Generator) -> np.ndarray:
