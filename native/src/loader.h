@@ -38,7 +38,7 @@ void *rbs_read_dataset(loader *ld, hid_t group, const char *group_name, const ch
                        int rank, const hsize_t *dims);
 
 /* shape_records.c: group /shapes of a table of format 3.4 into t->shapes, checked as
- * data_schema.shape_records.check_shape_arrays and records_from_arrays check them (a built-in family's row against
+ * data_schema.shape_records.check_shape_datasets and records_from_arrays check them (a built-in family's row against
  * the family's record at κ and the aspect-ratio law `aspect`); before 3.4, the families' records synthesised
  * from κ, `aspect` and the second-moment factors `kfac` (NaN if not recorded). RBS_OK or the error's code. */
 int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, const double aspect[4],
