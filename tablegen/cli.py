@@ -95,8 +95,9 @@ def _build_parser() -> argparse.ArgumentParser:
                         help="draw from a table, at its grid alpha1 and its grid speed nearest 200 m/s")
     source.add_argument("--direct", action="store_true", help="run the direct model at 200 m/s")
     report.add_argument("-o", "--out", required=True, metavar="FOLDER", help="output folder (must not exist)")
-    report.add_argument("--shapes", nargs="+", choices=SHAPES + (MIX,), default=list(SHAPES + (MIX,)),
-                        help="shapes to report, and 'mix' for the equal-weight mix (default: all)")
+    report.add_argument("--shapes", nargs="+", metavar="NAME",
+                        help=f"shapes to report, and 'mix' for the equal-weight mix (default: all): with --direct "
+                             f"among {', '.join(SHAPES + (MIX,))}; with --table the table's (its user grains too)")
     report.add_argument("-n", type=count_argument, default=REPORT_DEFAULT_N, metavar="N",
                         help="particles (--direct) or draws (--table) per shape and alpha1, >= 1 "
                              "(default %(default)s)")
@@ -222,7 +223,12 @@ def _report(args) -> int:
     check_output(args.out, REPORT_KIND, args.overwrite, folder=True)
     require_matplotlib()
     if args.direct:
-        data = direct_data(args.shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args))
+        shapes = args.shapes or SHAPES + (MIX,)
+        unknown = [s for s in shapes if s not in SHAPES + (MIX,)]
+        if unknown:
+            raise ValueError(f"--shapes with --direct must be among {', '.join(SHAPES + (MIX,))}; got {unknown[0]!r} "
+                             f"(a user grain: report it from a table of it, --table)")
+        data = direct_data(shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args))
     else:
         data = table_data(args.table, args.shapes, args.alpha1, args.n, seed)
     path = write_report(data, args.out, overwrite=args.overwrite)
