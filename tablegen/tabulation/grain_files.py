@@ -4,8 +4,9 @@ The body is the convex hull of the points (scipy's Qhull); a mesh that is not co
 with one line through ``log`` saying how much volume the hull adds. The hull is then placed in its canonical
 frame (:func:`direct_model.registry.grain`) and settled (:func:`settled`): its vertices rounded to multiples of
 :data:`SETTLE`, vertices and triangles put in an order of their own, so that a moved, turned or rescaled copy of
-a file, whose canonical vertices agree to round-off only, gives the same bits, hence the same table. Meshes are read with trimesh (the ``build`` extra): STL, OBJ, OFF
-and PLY, and a file of points alone (OBJ or PLY vertices without faces).
+a file, whose canonical vertices agree to round-off only, gives the same bits, hence the same table. Meshes are
+read with trimesh (the ``build`` extra): STL, OBJ, OFF and PLY, and a file of points alone (OBJ or PLY vertices
+without faces).
 
 Every problem is one :class:`GrainError` whose message starts with the file (or the config key) and says what
 is wrong: a folder, a missing, empty or unreadable file, NaN or inf, fewer than 4 points off a common plane, a
@@ -135,8 +136,9 @@ def canonical_grain(name, vertices, triangles, source, aspect=None, both_hands=F
 
 def settled(record):
     """The canonical record with its vertices rounded to multiples of :data:`SETTLE` and put in ascending order of
-    (their height along SORT_DIRECTION, as canonical_frame orders them, then ξ, η, ζ), its triangles each turned to start at its smallest index (a cyclic turn keeps it
-    counter-clockwise) and in ascending order; mass properties recomputed from these (module doc)."""
+    (their height along SORT_DIRECTION, as canonical_frame orders them, then ξ, η, ζ), its triangles each turned
+    to start at its smallest index (a cyclic turn keeps it counter-clockwise) and in ascending order; mass
+    properties recomputed from these (module doc)."""
     vertices = np.round(record.vertices / SETTLE) * SETTLE
     along = sum(vertices[:, i] * SORT_DIRECTION[i] for i in range(3))         # elementwise: no BLAS
     order = np.lexsort((vertices[:, 2], vertices[:, 1], vertices[:, 0], along))

@@ -14,10 +14,11 @@
 
 Exactly one of ``mesh`` and ``vertices``. ``triangles`` (indices into ``vertices``, counter-clockwise from
 outside) says that the vertices are already the canonical hull (body frame, units of a): what a table's stored
-configuration holds (:meth:`tablegen.tabulation.config.BuildConfig.to_toml`), so that it rebuilds the record bit for
-bit; they must then be a convex hull in a principal frame of unit size, or ConfigError. Without ``aspect_ratio`` the grain keeps the proportions of its file;
-with it, each particle's grain is stretched along η and ζ by the drawn b/a and (b/a)(c/b)
-(:meth:`direct_model.registry.ConvexPolyhedron.stretched`), as the families are.
+configuration holds (:meth:`tablegen.tabulation.config.BuildConfig.to_toml`), so that it rebuilds the record
+bit for bit; they must then be a convex hull in a principal frame of unit size, or ConfigError.
+
+Without ``aspect_ratio`` the grain keeps the proportions of its file; with it, each particle's grain is stretched
+along η and ζ by the drawn b/a and (b/a)(c/b) (:meth:`direct_model.registry.ConvexPolyhedron.stretched`), as the families are.
 
 :func:`parse_shape_sections` turns the parsed TOML table ``shapes`` into records;
 :func:`tablegen.tabulation.config.parse_config` calls it for the sections of a build configuration.

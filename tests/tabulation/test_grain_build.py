@@ -45,7 +45,8 @@ def test_two_grains_build_and_the_table_holds_what_rebuilds_it(grain_table_path)
 
 def _obj(path, vertices, triangles):
     """An OBJ file of the mesh, coordinates as exact float reprs."""
-    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices] + [f"f {i + 1} {j + 1} {k + 1}" for i, j, k in triangles]
+    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in vertices]
+    lines += [f"f {i + 1} {j + 1} {k + 1}" for i, j, k in triangles]
     path.write_text("\n".join(lines) + "\n")
 
 
