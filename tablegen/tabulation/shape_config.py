@@ -18,7 +18,8 @@ configuration holds (:meth:`tablegen.tabulation.config.BuildConfig.to_toml`), so
 bit for bit; they must then be a convex hull in a principal frame of unit size, or ConfigError.
 
 Without ``aspect_ratio`` the grain keeps the proportions of its file; with it, each particle's grain is stretched
-along η and ζ by the drawn b/a and (b/a)(c/b) (:meth:`direct_model.registry.ConvexPolyhedron.stretched`), as the families are.
+along η and ζ by the drawn b/a and (b/a)(c/b) (:meth:`direct_model.registry.ConvexPolyhedron.stretched`), as
+the families are.
 
 :func:`parse_shape_sections` turns the parsed TOML table ``shapes`` into records;
 :func:`tablegen.tabulation.config.parse_config` calls it for the sections of a build configuration.
