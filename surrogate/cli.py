@@ -153,7 +153,9 @@ def main(argv=None) -> int:
                         help="incident speed |V-| in m/s, > 0 (with --method table: in the table's range, unless "
                              "--clamp)")
     group = sample.add_mutually_exclusive_group()
-    group.add_argument("--shape", metavar="NAME", help=f"one of {', '.join(SHAPE_NAMES)} (default ellipsoid)")
+    group.add_argument("--shape", metavar="NAME", help=f"a shape of the table: one of {', '.join(SHAPE_NAMES)} or "
+                                                       f"a user grain it holds (tablegen info lists them; default "
+                                                       f"ellipsoid)")
     group.add_argument("--mix", metavar="W1,W2,W3,W4", help="weights of ellipsoid, prism, cut_prism, tetrahedron")
     sample.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of draws, >= 1")
     sample.add_argument("--seed", type=seed_argument, default=None, help="random seed in [0, 2**63)")

@@ -34,7 +34,12 @@ def _build_parser() -> argparse.ArgumentParser:
     sim = sub.add_parser("simulate", help="simulate n rebounds at one incident state and print a summary",
                          description="Simulate n rebounds at one incident state (lab frame: wall y = 0, "
                                      "V- = |V-|(cos a1, -sin a1, 0)) and print a summary.")
-    sim.add_argument("--shape", required=True, choices=SHAPES + (MIX,), help="particle shape or the equal-weight mix")
+    sim.add_argument("--shape", required=True, metavar="NAME",
+                     help=f"particle shape: {', '.join(SHAPES)}, {MIX} (the families' equal-weight mix), or a user "
+                          f"grain of --config")
+    sim.add_argument("--config", metavar="FILE",
+                     help="TOML build configuration whose [shapes.NAME] section defines the grain --shape names "
+                          "(only the grains are taken from it)")
     sim.add_argument("--alpha1", type=float, required=True, metavar="DEG", help=f"incidence angle from the wall, {ALPHA1_RANGE_TEXT}")
     sim.add_argument("--speed", type=float, required=True, metavar="M_PER_S", help="incident speed |V-| in m/s, > 0")
     sim.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of particles, >= 1")
@@ -90,8 +95,9 @@ def _build_parser() -> argparse.ArgumentParser:
                         help="draw from a table, at its grid alpha1 and its grid speed nearest 200 m/s")
     source.add_argument("--direct", action="store_true", help="run the direct model at 200 m/s")
     report.add_argument("-o", "--out", required=True, metavar="FOLDER", help="output folder (must not exist)")
-    report.add_argument("--shapes", nargs="+", choices=SHAPES + (MIX,), default=list(SHAPES + (MIX,)),
-                        help="shapes to report, and 'mix' for the equal-weight mix (default: all)")
+    report.add_argument("--shapes", nargs="+", metavar="NAME",
+                        help=f"shapes to report, and 'mix' for the equal-weight mix (default: all): with --direct "
+                             f"among {', '.join(SHAPES + (MIX,))}; with --table the table's (its user grains too)")
     report.add_argument("-n", type=count_argument, default=REPORT_DEFAULT_N, metavar="N",
                         help="particles (--direct) or draws (--table) per shape and alpha1, >= 1 "
                              "(default %(default)s)")
@@ -127,12 +133,32 @@ def _simulate(args) -> int:
     if args.out is not None:
         check_output(args.out, SAMPLES_FILE_TYPE, args.overwrite)
     check_memory(args.n, BYTES_PER_PARTICLE, "-n")
-    samples = simulate(args.shape, args.alpha1, args.speed, args.n, seed=args.seed, omega_in=args.omega,
+    samples = simulate(_shape(args), args.alpha1, args.speed, args.n, seed=args.seed, omega_in=args.omega,
                        kappa=args.kappa, n_max=args.n_max, wall=_wall(args), progress=_progress(args))
     print(format_summary(samples, summarize(samples)))
     if args.out is not None:
         print(f"samples written to {write_samples(args.out, samples, overwrite=args.overwrite)}")
     return 0
+
+
+def _shape(args):
+    """--shape: a family's name or the mix, or the record of a user grain of --config; ValueError naming it."""
+    if args.config is None:
+        if args.shape not in SHAPES + (MIX,):
+            raise ValueError(f"--shape must be one of {', '.join(SHAPES + (MIX,))}, or a user grain with --config "
+                             f"FILE defining its [shapes.NAME] section; got {args.shape!r}")
+        return args.shape
+    from tablegen.tabulation.config import load_config
+
+    config = load_config(args.config, log=lambda line: print(line, file=sys.stderr))
+    if args.shape in SHAPES + (MIX,):
+        return args.shape
+    record = config.grain(args.shape)
+    if record is None:
+        names = ", ".join(g.name for g in config.grains) or "none"
+        raise ValueError(f"--shape {args.shape!r} is neither a built-in shape ({', '.join(SHAPES + (MIX,))}) nor a "
+                         f"user grain of {args.config} (its grains: {names})")
+    return record
 
 
 def _wall(args) -> WallMaterial:
@@ -152,7 +178,7 @@ def _build(args) -> int:
     from tablegen.tabulation.driver import BuildError, build_table
     from tablegen.tabulation.config import load_config
 
-    config = load_config(args.config, args.preset)
+    config = load_config(args.config, args.preset, log=lambda line: print(line, file=sys.stderr))
     if args.print_config:
         print(config.to_toml(), end="")
         return 0
@@ -197,7 +223,12 @@ def _report(args) -> int:
     check_output(args.out, REPORT_KIND, args.overwrite, folder=True)
     require_matplotlib()
     if args.direct:
-        data = direct_data(args.shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args))
+        shapes = args.shapes or SHAPES + (MIX,)
+        unknown = [s for s in shapes if s not in SHAPES + (MIX,)]
+        if unknown:
+            raise ValueError(f"--shapes with --direct must be among {', '.join(SHAPES + (MIX,))}; got {unknown[0]!r} "
+                             f"(a user grain: report it from a table of it, --table)")
+        data = direct_data(shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args))
     else:
         data = table_data(args.table, args.shapes, args.alpha1, args.n, seed)
     path = write_report(data, args.out, overwrite=args.overwrite)

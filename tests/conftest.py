@@ -3,11 +3,11 @@ long subprocesses that tests only wait for, started when the session starts (tes
 
 import pytest
 
-from tablegen import build_table, parse_config
+from tablegen import build_table, load_config, parse_config
 from tests.helpers import background, cpu_dispatch
 from tests.helpers.plain_install import install_and_draw
 from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG, SMALL_TABLE_CONFIG,
-                                  WIDE_GRAZING_TABLE_CONFIG)
+                                  WIDE_GRAZING_TABLE_CONFIG, write_grain_config)
 
 
 def _build(tmp_path_factory, name, config_text):
@@ -20,6 +20,16 @@ def _build(tmp_path_factory, name, config_text):
 def small_table_path(tmp_path_factory):
     """A table on a 3 × 3 grid."""
     return _build(tmp_path_factory, "small", SMALL_TABLE_CONFIG)
+
+
+@pytest.fixture(scope="session")
+def grain_table_path(tmp_path_factory):
+    """A table of two user grains, one from a mesh file and one from a config's points (GRAIN_TABLE_CONFIG), built
+    from its configuration file; its configuration is grains.toml beside it."""
+    folder = tmp_path_factory.mktemp("grain_table")
+    path = folder / "grains.h5"
+    build_table(load_config(write_grain_config(folder)), path)
+    return path
 
 
 @pytest.fixture(scope="session")

@@ -61,3 +61,19 @@ def test_runtime_sampler_examples_run_and_draw_one_law(small_table_path):
         other = rebounds[name]
         se = np.sqrt(reference.var(axis=0) / len(reference) + other.var(axis=0) / len(other))
         assert np.all(np.abs(reference.mean(axis=0) - other.mean(axis=0)) < 5 * se), name
+
+
+def test_the_tables_config_of_user_grains_builds_its_shapes(tmp_path):
+    """The README's ```toml block (section "Tables") parses, its mesh path read beside the configuration, into
+    the prism and the two grains it names."""
+    import trimesh
+    from tablegen.tabulation.config import load_config
+
+    start = README.index("\n## Tables\n")
+    block, = re.findall(r"```toml\n(.*?)```", README[start:README.find("\n## ", start + 1)], flags=re.S)
+    (tmp_path / "grains").mkdir()
+    trimesh.load(ROOT / "examples" / "grains" / "grain_1.obj", process=False).export(tmp_path / "grains" / "sand_a.stl")
+    (tmp_path / "grains.toml").write_text(block)
+    config = load_config(tmp_path / "grains.toml")
+    assert config.shapes == ("prism", "sand_a", "sand_b")
+    assert [g.name for g in config.grains] == ["sand_a", "sand_b"] and len(config.grain("sand_b").vertices) == 5

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime
+import math
 import tomllib
 from pathlib import Path
 
@@ -42,7 +43,6 @@ from tablegen.study.statistics import (
 PAPER_SPEED = 200.0                                    # m/s, incident speed of the paper's study
 DEFAULT_ALPHA1 = tuple(float(a) for a in range(5, 91, 5))   # deg
 DEFAULT_N = 20_000
-REPORT_SHAPES = SHAPES + (MIX,)
 INERTIA_QUADRATURE_POINTS = 4096                       # midpoint rule of ⟨r²⟩ over the aspect-ratio law
 
 
@@ -59,6 +59,17 @@ def isotropic_inertia(shape: str, kappa: float, aspect: AspectRatioLaw) -> float
     u = (np.arange(INERTIA_QUADRATURE_POINTS) + 0.5) / INERTIA_QUADRATURE_POINTS
     r2 = float(np.mean(aspect.ppf(u) ** 2))
     return 2.0 / 3.0 * second_moment_factor(shape, kappa) * (1.0 + r2 + r2 * r2)
+
+
+def grain_isotropic_inertia(record) -> float:
+    """tr J/(3 m a²) of a user's grain (a registry record), units of a²: of its body if it keeps its proportions,
+    else the mean over its own b/a, c/b law, on a midpoint grid of √INERTIA_QUADRATURE_POINTS quantiles each
+    (the stretched body's a moves with the ratios, so no closed form)."""
+    if record.aspect is None:
+        return float(record.inertia.sum()) / 3.0
+    side = math.isqrt(INERTIA_QUADRATURE_POINTS)
+    ratios = record.aspect.ppf((np.arange(side) + 0.5) / side)
+    return float(np.mean([record.stretched(r1, r2).inertia.sum() for r1 in ratios for r2 in ratios])) / 3.0
 
 
 # -- data stage -------------------------------------------------------------
@@ -110,21 +121,24 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
         bar.close()
     return ReportData(
         source="direct model (`direct_model.simulate.simulate`)", speed=PAPER_SPEED, alpha1=alpha1,
-        shapes=_ordered(shapes), mix_of=SHAPES, n=n, seed=seed,
+        shapes=_ordered(shapes, SHAPES), mix_of=SHAPES, n=n, seed=seed,
         counts_note=f"Counted over the {n} simulated particles per shape.",
         e_rot_method="exact: E_Ω⁺ = ½ Ω⁺·JΩ⁺ with each particle's own inertia tensor and orientation "
                      "(docs/model.md §5.4).",
         points=_with_mix(parts, shapes, alpha1, SHAPES))
 
 
-def table_data(path, shapes, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> ReportData:
+def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> ReportData:
     """Draw ``n`` reflected states per shape and α1 from a table, at its grid speed nearest 200 m/s.
+
+    ``shapes``: names of the table's shapes (families or user grains) and ``"mix"``; None: all and the mix.
 
     ``alpha1`` (deg) must be grid points of the table (default: all of them),
     so every draw comes from one cell. The statuses and collision counts are
     those the table stores per cell (its build's particles). E_Ω⁺/E_V⁻ uses
     :func:`isotropic_inertia`: a table holds Ω⁺ but not the particle's
-    orientation or aspect ratio. The mix pools the table's shapes.
+    orientation or aspect ratio (:func:`grain_isotropic_inertia` for a user's grain). The mix pools the table's
+    shapes.
     """
     import surrogate
     from data_schema.table import read_table
@@ -133,6 +147,7 @@ def table_data(path, shapes, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> 
     sampler = surrogate.load(path)
     grid = np.asarray(table.alpha1_deg, dtype=float)
     alpha1 = tuple(float(a) for a in grid) if alpha1 is None else _grid_points(alpha1, grid)
+    shapes = tuple(table.shapes) + (MIX,) if shapes is None else shapes
     missing = [s for s in shapes if s != MIX and s not in table.shapes]
     if missing:
         raise ValueError(f"The 'shapes' {', '.join(missing)} are not in the table {path} "
@@ -141,9 +156,12 @@ def table_data(path, shapes, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> 
     speed = float(table.speed_m_s[i_speed])
     mix_of = _constituents(shapes, tuple(table.shapes))
     aspect = _aspect_law(table.config_text)
+    records = dict(zip(table.shapes, table.shape_records()))
+    inertias = {s: isotropic_inertia(s, table.kappa, aspect) if s in SHAPES else grain_isotropic_inertia(records[s])
+                for s in mix_of}
     parts = {}
     for shape in mix_of:
-        inertia = isotropic_inertia(shape, table.kappa, aspect)
+        inertia = inertias[shape]
         for a in alpha1:
             cell = (table.shapes.index(shape), int(np.argmin(np.abs(grid - a))), i_speed)
             d = surrogate.sample_local(sampler, np.full(n, a), speed, shape, random_state=seed)
@@ -154,11 +172,12 @@ def table_data(path, shapes, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> 
                 e_rot_ratio=inertia * np.sum(d.omega[ok] ** 2, axis=1),
                 status_counts=np.asarray(table.cells["status_counts"][cell], dtype=np.int64),
                 collision_counts=np.r_[collisions[:5], collisions[5:].sum()].astype(np.int64))
-    inertias = ", ".join(f"{s} {isotropic_inertia(s, table.kappa, aspect):.4f}" for s in mix_of)
+    inertias = ", ".join(f"{s} {value:.4f}" for s, value in inertias.items())
     return ReportData(
         source=f"table `{path}` (made {table.created}, config sha256 {table.config_sha256[:12]}…), "
                f"drawn with `surrogate.sample_local`",
-        speed=speed, alpha1=alpha1, shapes=_ordered(shapes), mix_of=tuple(table.shapes), n=n, seed=seed,
+        speed=speed, alpha1=alpha1, shapes=_ordered(shapes, tuple(table.shapes)), mix_of=tuple(table.shapes), n=n,
+        seed=seed,
         counts_note=f"From the table's cells: {table.particles_per_cell} direct-model particles per shape.",
         e_rot_method="approximate: a table stores Ω⁺ but not the particle's orientation or aspect ratio, so "
                      "E_Ω⁺/E_V⁻ = k̄ |Ω⁺a/V|² with k̄ the isotropic inertia ⟨tr J⟩/(3 m a²) averaged over the "
@@ -168,8 +187,9 @@ def table_data(path, shapes, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> 
         points=_with_mix(parts, shapes, alpha1, tuple(table.shapes)))
 
 
-def _ordered(shapes) -> tuple:
-    return tuple(s for s in REPORT_SHAPES if s in shapes)
+def _ordered(shapes, available) -> tuple:
+    """The reported shapes in the order of the available ones (the families', or the table's), then the mix."""
+    return tuple(s for s in tuple(available) + (MIX,) if s in shapes)
 
 
 def _grid_points(alpha1, grid) -> tuple:

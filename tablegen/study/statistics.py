@@ -77,7 +77,7 @@ class ReportData:
     source : markdown line naming where the samples come from.
     speed : incident speed |V⁻|, m/s.
     alpha1 : incidence angles, deg, ascending.
-    shapes : reported shapes, in :data:`tablegen.study.report.REPORT_SHAPES` order (may hold ``"mix"``).
+    shapes : reported shapes, in the order of the families or the table's shapes, then ``"mix"`` if reported.
     mix_of : the shapes pooled with equal weight into ``"mix"``.
     n : particles (direct model) or draws (table) per (shape, α1).
     seed : the seed of every run.

@@ -27,9 +27,16 @@ def derive_seed(seed: int, *key: int) -> int:
     return (int(hi) << 31) ^ int(lo)
 
 
+def shape_key(shape: str) -> int:
+    """The spawn key of a shape's cells: a family's index in SHAPES (0-3), a user grain's name read as a big-endian
+    integer (its UTF-8 bytes: distinct names give distinct keys, each >= 65 as a name starts with a letter), so a
+    grain's cells have the same seeds whatever the other shapes of the table."""
+    return SHAPES.index(shape) if shape in SHAPES else int.from_bytes(shape.encode(), "big")
+
+
 def cell_seed(master_seed: int, shape: str, i_alpha: int, i_speed: int) -> int:
-    """The seed of one cell, derived from the master seed, the shape and the grid indices."""
-    return derive_seed(master_seed, SHAPES.index(shape), i_alpha, i_speed)
+    """The seed of one cell, derived from the master seed, the shape (:func:`shape_key`) and the grid indices."""
+    return derive_seed(master_seed, shape_key(shape), i_alpha, i_speed)
 
 
 def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> str:
@@ -39,12 +46,14 @@ def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> s
 
 
 def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> CellTable:
-    """Simulate one cell and build its stored representation (runs in a worker)."""
+    """Simulate one cell and build its stored representation (runs in a worker): a family by its name, a user's
+    grain by its record (its own law of b/a and c/b, if any, instead of the families')."""
     seed = cell_seed(config.seed, shape, i_alpha, i_speed)
+    body = config.grain(shape) or shape
     acc = CellAccumulator()
     for chunk, start in enumerate(range(0, config.particles_per_cell, CHUNK_PARTICLES)):
         n = min(CHUNK_PARTICLES, config.particles_per_cell - start)
-        acc.add(simulate(shape, config.alpha1_deg[i_alpha], config.speed_m_s[i_speed], n,
+        acc.add(simulate(body, config.alpha1_deg[i_alpha], config.speed_m_s[i_speed], n,
                          seed=derive_seed(seed, chunk), kappa=config.kappa,
                          aspect=config.aspect, wall=config.wall, n_max=config.n_max))
     return acc.finish(config.resolution, derive_seed(seed, REPRESENTATION_KEY),

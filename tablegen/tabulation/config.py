@@ -24,7 +24,12 @@ the ``default`` preset, and the published corundum-on-steel wall law)::
     q = 1.0                           # friction factor exp(q cos gamma), finite
     name = "corundum_on_St3_Lashkov1991"
 
-Unknown keys and invalid values raise :class:`ConfigError` naming the key.
+    [shapes.sand_a]                   # a user's grain, named in grid.shapes (tablegen.tabulation.shape_config)
+    mesh = "grains/sand_a.stl"        # relative to the configuration file; or vertices = [[x, y, z], ...]
+
+``grid.shapes`` names built-in families and user grains; each user grain has its ``[shapes.NAME]`` section and
+each section is named in ``grid.shapes``. Unknown keys and invalid values raise :class:`ConfigError` naming the
+key.
 Presets: ``default`` (the README's main job, a few minutes on 2 cores),
 ``production`` (the table users should run with) and ``paper`` (the study of
 Panfilov & Tsirkunov 2022 at 10⁸ particles per cell; for a cluster).
@@ -38,10 +43,12 @@ import json
 import math
 import tomllib
 from importlib import resources
+from pathlib import Path
 
 from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
 from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
+from direct_model.registry import ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
@@ -55,9 +62,13 @@ class ConfigError(ValueError):
     """An invalid build configuration; the message names the offending key."""
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, eq=False)
 class BuildConfig:
-    """A fully resolved build configuration (every value explicit)."""
+    """A fully resolved build configuration (every value explicit).
+
+    ``grains``: the records (:mod:`direct_model.registry`) of the user's grains of ``shapes``, in their order.
+    Two configurations are equal when their :meth:`to_toml` texts are: the text decides the table.
+    """
 
     alpha1_deg: tuple
     speed_m_s: tuple
@@ -69,10 +80,26 @@ class BuildConfig:
     aspect: AspectRatioLaw
     resolution: TableResolution
     wall: WallMaterial = CORUNDUM_ON_STEEL
+    grains: tuple = ()
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, BuildConfig) and self.to_toml() == other.to_toml()
+
+    def __hash__(self) -> int:
+        return hash(self.to_toml())
 
     @property
     def n_cells(self) -> int:
         return len(self.shapes) * len(self.alpha1_deg) * len(self.speed_m_s)
+
+    def grain(self, name: str) -> ConvexPolyhedron | None:
+        """The record of the user's grain ``name``; None for a built-in family."""
+        return next((g for g in self.grains if g.name == name), None)
+
+    def shape_records(self) -> tuple:
+        """The record of each shape, in the order of ``shapes``: a family's at ``kappa`` and ``aspect``, or the
+        user's grain."""
+        return tuple(self.grain(s) or built_in_shape(s, self.kappa, self.aspect) for s in self.shapes)
 
     def to_toml(self) -> str:
         """The resolved configuration as TOML text (reads back to an equal config)."""
@@ -104,11 +131,35 @@ class BuildConfig:
             f"q = {w.q!r}",
             f"name = {json.dumps(w.name)}",
             "",
+            *(_grain_toml(g) for g in self.grains),
         ])
 
     def sha256(self) -> str:
         """Hash of :meth:`to_toml`: identifies the configuration in files and checkpoints."""
         return hashlib.sha256(self.to_toml().encode()).hexdigest()
+
+
+def _grain_toml(record: ConvexPolyhedron) -> str:
+    """The ``[shapes.NAME]`` section of a user's grain as its canonical hull (vertices and triangles), not as its
+    mesh file or points.
+
+    The text is what the table stores as its configuration (and hashes, and fingerprints), so it must rebuild
+    the table from the table alone: a mesh path would name a file that the table does not hold and that may
+    change, and a rotated, moved or rescaled copy of the file, which gives the same grain and the same cells,
+    would give another text. The canonical hull (exact float reprs), what /shapes holds, reads back as it is
+    (:func:`tablegen.tabulation.grain_files.canonical_grain`): the same record bit for bit, where taking its
+    frame again would move it by round-off.
+    """
+    lines = [f"[shapes.{record.name}]",
+             "vertices = [" + ", ".join("[" + ", ".join(repr(float(x)) for x in v) + "]"
+                                        for v in record.vertices) + "]",
+             "triangles = [" + ", ".join("[" + ", ".join(str(int(i)) for i in t) + "]" for t in record.triangles) + "]"]
+    law = record.aspect
+    if law is not None:
+        lines.append(f"aspect_ratio = {{mean = {law.mean!r}, sd = {law.sd!r}, low = {law.low!r}, high = {law.high!r}}}")
+    if record.both_hands:
+        lines.append("both_hands = true")
+    return "\n".join(lines) + "\n"
 
 
 CONFIG_KEYS = {
@@ -117,6 +168,7 @@ CONFIG_KEYS = {
     "table": {"resolution"},
     "wall": {"k", "p", "q", "name"},
 }
+GRAINS_SECTION = "shapes"      # [shapes.NAME]: the user's grains; their keys are shape_config's
 
 
 def preset_text(name: str) -> str:
@@ -126,8 +178,9 @@ def preset_text(name: str) -> str:
     return resources.files("tablegen.tabulation.presets").joinpath(f"{name}.toml").read_text()
 
 
-def load_config(path=None, preset: str = "default") -> BuildConfig:
-    """Read a configuration file (or the named preset when ``path`` is None)."""
+def load_config(path=None, preset: str = "default", log=None) -> BuildConfig:
+    """Read a configuration file (or the named preset when ``path`` is None); mesh paths are relative to the
+    file's folder. ``log``: called with a warning line (a grain's mesh that is not convex)."""
     if path is None:
         return parse_config(preset_text(preset), f"preset '{preset}'")
     try:
@@ -138,11 +191,15 @@ def load_config(path=None, preset: str = "default") -> BuildConfig:
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{path}: the configuration is not UTF-8 text (byte {exc.start}); TOML files are "
                           f"UTF-8") from None
-    return parse_config(text, str(path))
+    return parse_config(text, str(path), Path(path).parent, log)
 
 
-def parse_config(text: str, source: str = "<config>") -> BuildConfig:
-    """Parse and validate TOML text; defaults come from the ``default`` preset."""
+def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -> BuildConfig:
+    """Parse and validate TOML text; defaults come from the ``default`` preset.
+
+    ``base_dir``: the folder relative mesh paths of ``[shapes.NAME]`` start from (default: the current
+    directory); ``log``: called with a warning line (a grain's mesh that is not convex).
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -168,13 +225,21 @@ def parse_config(text: str, source: str = "<config>") -> BuildConfig:
                           f"factor {wide[0][1] / wide[0][0]:.3g} apart; allowed: at most {MAX_SPEED_RATIO:g} (the "
                           f"runtime's restitution pieces between grid speeds); add speeds between them")
     shapes = grid.get("shapes")
+    sections = data.get(GRAINS_SECTION, {})
     if not isinstance(shapes, list) or not shapes:
-        raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(SHAPES)}; got {shapes!r}")
+        raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(SHAPES)} or the "
+                          f"names of [shapes.NAME] sections; got {shapes!r}")
     for s in shapes:
-        if s not in SHAPES:
-            raise ConfigError(f"{source}: 'grid.shapes' entries must be one of {', '.join(SHAPES)}; got {s!r}")
+        if not isinstance(s, str) or (s not in SHAPES and s not in sections):
+            raise ConfigError(f"{source}: 'grid.shapes' entries must be one of {', '.join(SHAPES)} or a user grain "
+                              f"with its [shapes.NAME] section; got {s!r}, which has no section")
     if len(set(shapes)) != len(shapes):
         raise ConfigError(f"{source}: 'grid.shapes' has duplicates: {shapes!r}")
+    grains = {}
+    if sections:
+        from tablegen.tabulation.shape_config import parse_shape_sections     # here: it imports ConfigError
+        grains = parse_shape_sections(sections, Path.cwd() if base_dir is None else base_dir, source, log,
+                                      used=shapes)
 
     n = _integer(sim.get("particles_per_cell"), "simulation.particles_per_cell", MIN_PARTICLES_PER_CELL, source)
     seed = _integer(sim.get("seed"), "simulation.seed", 0, source)
@@ -212,7 +277,8 @@ def parse_config(text: str, source: str = "<config>") -> BuildConfig:
 
     return BuildConfig(alpha1_deg=tuple(alpha1), speed_m_s=tuple(speeds), shapes=tuple(shapes),
                        particles_per_cell=n, seed=seed, kappa=kappa, n_max=n_max, aspect=aspect,
-                       resolution=resolution, wall=_wall(wall, source))
+                       resolution=resolution, wall=_wall(wall, source),
+                       grains=tuple(grains[s] for s in shapes if s in grains))
 
 
 def _wall(raw: dict, source: str) -> WallMaterial:
@@ -234,10 +300,13 @@ def _wall(raw: dict, source: str) -> WallMaterial:
 
 def _check_keys(data: dict, source: str) -> None:
     for section, value in data.items():
-        if section not in CONFIG_KEYS:
-            raise ConfigError(f"{source}: unknown section '[{section}]'; sections: {', '.join(CONFIG_KEYS)}")
+        if section not in CONFIG_KEYS and section != GRAINS_SECTION:
+            raise ConfigError(f"{source}: unknown section '[{section}]'; sections: {', '.join(CONFIG_KEYS)}, "
+                              f"{GRAINS_SECTION}.NAME")
         if not isinstance(value, dict):
             raise ConfigError(f"{source}: '{section}' must be a table ([{section}])")
+        if section == GRAINS_SECTION:
+            continue                  # its sections' keys: shape_config.parse_shape_sections
         for key in value:
             if key not in CONFIG_KEYS[section]:
                 raise ConfigError(f"{source}: unknown key '{section}.{key}'; allowed in [{section}]: "

@@ -311,4 +311,4 @@ def _assemble(config: BuildConfig, checkpoint: Checkpoint) -> ReboundTable:
         particles_per_cell=config.particles_per_cell, config_text=config.to_toml(),
         config_sha256=config.sha256(), master_seed=config.seed,
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        package_version=package_version(), model_sha256=model_sha256())
+        package_version=package_version(), model_sha256=model_sha256(), records=config.shape_records())

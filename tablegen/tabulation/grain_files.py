@@ -2,8 +2,11 @@
 
 The body is the convex hull of the points (scipy's Qhull); a mesh that is not convex is replaced by its hull,
 with one line through ``log`` saying how much volume the hull adds. The hull is then placed in its canonical
-frame (:func:`direct_model.registry.grain`). Meshes are read with trimesh (the ``build`` extra): STL, OBJ, OFF
-and PLY, and a file of points alone (OBJ or PLY vertices without faces).
+frame (:func:`direct_model.registry.grain`) and settled (:func:`settled`): its vertices rounded to multiples of
+:data:`SETTLE`, vertices and triangles put in an order of their own, so that a moved, turned or rescaled copy of
+a file, whose canonical vertices agree to round-off only, gives the same bits, hence the same table. Meshes are
+read with trimesh (the ``build`` extra): STL, OBJ, OFF and PLY, and a file of points alone (OBJ or PLY vertices
+without faces).
 
 Every problem is one :class:`GrainError` whose message starts with the file (or the config key) and says what
 is wrong: a folder, a missing, empty or unreadable file, NaN or inf, fewer than 4 points off a common plane, a
@@ -16,11 +19,18 @@ from pathlib import Path
 
 import numpy as np
 
-from direct_model.registry import ShapeError, grain
+from direct_model.polyhedron import SORT_DIRECTION
+from direct_model.registry import ShapeError, grain, polyhedron
 
 MESH_SUFFIXES = (".stl", ".obj", ".off", ".ply")
 NOT_CONVEX = 1e-6           # the hull adds more than this fraction of the mesh's volume: the mesh is not convex
 COPLANAR = 1e-9             # points whose spread off their best plane is below this of their size are coplanar
+# the grid (units of a) canonical vertices are rounded to: a power of two (the rounding is exact arithmetic), far
+# above the round-off by which two copies' canonical vertices differ (about 1e-15 for moments 1e-4 apart,
+# direct_model.polyhedron) and far below the frame's tolerance (registry.FRAME_CHECK, 1e-9) and any mesh's
+# precision. Two copies differ only if a coordinate lies within that round-off of a rounding boundary (a chance
+# of about 1e-4 per coordinate); a settled record settles to itself exactly.
+SETTLE = 2.0 ** -36
 
 
 class GrainError(ValueError):
@@ -101,9 +111,44 @@ def grain_from_points(name, points, source, aspect=None, both_hands=False, mesh_
         log(f"{source}: warning: the mesh is not convex; its convex hull, the body used, adds "
             f"{100.0 * (volume / mesh_volume - 1.0):.3g}% to its volume")
     try:
-        return grain(name, vertices, triangles, aspect=aspect, both_hands=both_hands)
+        return settled(grain(name, vertices, triangles, aspect=aspect, both_hands=both_hands))
     except ShapeError as exc:
         raise GrainError(f"{source}: {exc}") from None
+
+
+def canonical_grain(name, vertices, triangles, source, aspect=None, both_hands=False):
+    """The record of a hull given in its canonical frame (a table's stored configuration, :func:`settled` vertices
+    and triangles), taken as it is: GrainError unless it is in a principal frame of unit size
+    (:func:`direct_model.registry.polyhedron`) and convex (every vertex on the hull of the vertices, the
+    triangles enclosing the hull's volume)."""
+    vertices = np.asarray(vertices, dtype=float)
+    hull, _, volume = convex_hull(vertices, source)
+    try:
+        record = polyhedron(name, vertices, triangles, aspect, both_hands)
+    except (ShapeError, ValueError) as exc:
+        raise GrainError(f"{source}: {exc}") from None
+    if len(hull) != len(vertices) or abs(record.volume - volume) > COPLANAR * volume:
+        raise GrainError(f"{source}: the triangles are not the convex hull of the vertices (volume "
+                         f"{record.volume:.17g} against the hull's {volume:.17g}, {len(vertices) - len(hull)} vertices "
+                         f"inside it); give the hull, or the points alone (vertices without triangles)")
+    return record
+
+
+def settled(record):
+    """The canonical record with its vertices rounded to multiples of :data:`SETTLE` and put in ascending order of
+    (their height along SORT_DIRECTION, as canonical_frame orders them, then ξ, η, ζ), its triangles each turned
+    to start at its smallest index (a cyclic turn keeps it counter-clockwise) and in ascending order; mass
+    properties recomputed from these (module doc)."""
+    vertices = np.round(record.vertices / SETTLE) * SETTLE
+    along = sum(vertices[:, i] * SORT_DIRECTION[i] for i in range(3))         # elementwise: no BLAS
+    order = np.lexsort((vertices[:, 2], vertices[:, 1], vertices[:, 0], along))
+    rank = np.empty(len(order), dtype=np.int32)
+    rank[order] = np.arange(len(order), dtype=np.int32)
+    triangles = rank[record.triangles]
+    first = np.argmin(triangles, axis=1)
+    triangles = np.stack([np.roll(t, -k) for t, k in zip(triangles, first)])
+    triangles = triangles[np.lexsort(triangles.T[::-1])]
+    return polyhedron(record.name, vertices[order], triangles, record.aspect, record.both_hands)
 
 
 def grain_from_mesh(name, path, aspect=None, both_hands=False, log=None):

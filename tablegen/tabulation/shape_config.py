@@ -8,13 +8,21 @@
     vertices = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], ...]     # points whose convex hull is the grain
     aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}   # optional: b/a, c/b drawn per particle
     both_hands = true                  # optional: half of the particles are the mirror image (default false)
+    [shapes.sand_c]
+    vertices = [[...], ...]            # with triangles: the grain's canonical hull, taken as it is
+    triangles = [[0, 1, 2], ...]
 
-Exactly one of ``mesh`` and ``vertices``. Without ``aspect_ratio`` the grain keeps the proportions of its file;
-with it, each particle's grain is stretched along η and ζ by the drawn b/a and (b/a)(c/b)
-(:meth:`direct_model.registry.ConvexPolyhedron.stretched`), as the families are.
+Exactly one of ``mesh`` and ``vertices``. ``triangles`` (indices into ``vertices``, counter-clockwise from
+outside) says that the vertices are already the canonical hull (body frame, units of a): what a table's stored
+configuration holds (:meth:`tablegen.tabulation.config.BuildConfig.to_toml`), so that it rebuilds the record
+bit for bit; they must then be a convex hull in a principal frame of unit size, or ConfigError.
 
-:func:`parse_shape_sections` turns the parsed TOML table ``shapes`` into records. It is not yet called by
-:func:`tablegen.tabulation.config.parse_config`: the table build does not take user grains yet.
+Without ``aspect_ratio`` the grain keeps the proportions of its file; with it, each particle's grain is stretched
+along η and ζ by the drawn b/a and (b/a)(c/b) (:meth:`direct_model.registry.ConvexPolyhedron.stretched`), as
+the families are.
+
+:func:`parse_shape_sections` turns the parsed TOML table ``shapes`` into records;
+:func:`tablegen.tabulation.config.parse_config` calls it for the sections of a build configuration.
 """
 
 from __future__ import annotations
@@ -25,18 +33,19 @@ from pathlib import Path
 from direct_model.registry import ShapeError, check_name
 from direct_model.shapes import AspectRatioLaw
 from tablegen.tabulation.config import ConfigError
-from tablegen.tabulation.grain_files import GrainError, grain_from_mesh, grain_from_points
+from tablegen.tabulation.grain_files import GrainError, canonical_grain, grain_from_mesh, grain_from_points
 
-SHAPE_KEYS = ("mesh", "vertices", "aspect_ratio", "both_hands")
+SHAPE_KEYS = ("mesh", "vertices", "triangles", "aspect_ratio", "both_hands")
 ASPECT_KEYS = ("mean", "sd", "low", "high")
 
 
-def parse_shape_sections(shapes, base_dir, source: str, log=None) -> dict:
+def parse_shape_sections(shapes, base_dir, source: str, log=None, used=None) -> dict:
     """Records of the user's grains, by name, from the TOML table ``shapes`` (module doc).
 
     ``base_dir``: the folder the configuration file is in (relative mesh paths start there); ``source``: the
-    configuration's name in messages; ``log``: called with a warning line (a mesh that is not convex).
-    ConfigError naming the key for anything wrong.
+    configuration's name in messages; ``log``: called with a warning line (a mesh that is not convex); ``used``:
+    if given, the shape names of ``grid.shapes``, each section's name must be one of them (checked before any
+    mesh is read). ConfigError naming the key for anything wrong.
     """
     if not isinstance(shapes, dict):
         raise ConfigError(f"{source}: 'shapes' must be a table of [shapes.NAME] sections; got {shapes!r}")
@@ -47,6 +56,11 @@ def parse_shape_sections(shapes, base_dir, source: str, log=None) -> dict:
             check_name(name)
         except ShapeError as exc:
             raise ConfigError(f"{source}: '[{key}]': {exc}") from None
+        if used is not None and name not in used:
+            raise ConfigError(f"{source}: '[{key}]' is not named in 'grid.shapes' ({', '.join(used)}); add "
+                              f"{name!r} there or remove the section")
+    for name, spec in shapes.items():
+        key = f"shapes.{name}"
         if not isinstance(spec, dict):
             raise ConfigError(f"{source}: '{key}' must be a table ([{key}]) with mesh or vertices; got {spec!r}")
         unknown = sorted(set(spec) - set(SHAPE_KEYS))
@@ -55,6 +69,8 @@ def parse_shape_sections(shapes, base_dir, source: str, log=None) -> dict:
         if ("mesh" in spec) == ("vertices" in spec):
             raise ConfigError(f"{source}: '[{key}]' needs exactly one of mesh (a file) and vertices (a list of "
                               f"points); got {'both' if 'mesh' in spec else 'neither'}")
+        if "triangles" in spec and "vertices" not in spec:
+            raise ConfigError(f"{source}: '{key}.triangles' goes with vertices (the canonical hull), not with mesh")
         aspect = _aspect(spec.get("aspect_ratio"), f"{key}.aspect_ratio", source)
         both_hands = spec.get("both_hands", False)
         if not isinstance(both_hands, bool):
@@ -65,6 +81,10 @@ def parse_shape_sections(shapes, base_dir, source: str, log=None) -> dict:
                 if not isinstance(mesh, str) or not mesh.strip():
                     raise ConfigError(f"{source}: '{key}.mesh' must be a file name; got {mesh!r}")
                 records[name] = grain_from_mesh(name, Path(base_dir) / mesh, aspect, both_hands, log)
+            elif "triangles" in spec:
+                points = _points(spec["vertices"], f"{key}.vertices", source)
+                triangles = _triangles(spec["triangles"], len(points), f"{key}.triangles", source)
+                records[name] = canonical_grain(name, points, triangles, f"{source}: '[{key}]'", aspect, both_hands)
             else:
                 points = _points(spec["vertices"], f"{key}.vertices", source)
                 records[name] = grain_from_points(name, points, f"{source}: '{key}.vertices'", aspect, both_hands)
@@ -81,6 +101,17 @@ def _points(value, key, source):
     if not ok:
         raise ConfigError(f"{source}: '{key}' must be a list of [x, y, z] numbers; got {value!r:.200}")
     return [[float(x) for x in p] for p in value]
+
+
+def _triangles(value, n_points, key, source):
+    """A list of [i, j, k] indices into the n_points vertices."""
+    ok = isinstance(value, list) and value and all(
+        isinstance(t, list) and len(t) == 3 and all(isinstance(i, int) and not isinstance(i, bool) and 0 <= i < n_points
+                                                    for i in t) for t in value)
+    if not ok:
+        raise ConfigError(f"{source}: '{key}' must be a list of [i, j, k] vertex indices in 0..{n_points - 1}; "
+                          f"got {value!r:.200}")
+    return value
 
 
 def _aspect(value, key, source):

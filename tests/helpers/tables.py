@@ -1,9 +1,11 @@
 """The configurations of the small tables the session builds once (tests/conftest.py): 2e4 particles per cell,
-all four shapes; and edited copies of a table."""
+all four shapes, and a table of two user grains; and edited copies of a table."""
 
 import shutil
 
 import h5py
+
+from tests.helpers import REPO
 
 
 def edited_copy(source, folder, name, edit=None):
@@ -31,3 +33,34 @@ WIDE_GRAZING_TABLE_CONFIG = _table_config([1.0, 2.0], [150.0, 200.0], seed=14)
 # the law moves fastest with speed (the presets' steps there)
 NEAR_NORMAL_POINT = (84.375, 62.5)
 NEAR_NORMAL_TABLE_CONFIG = _table_config([83.75, 85.0], [50.0, 75.0], seed=13)
+
+
+# a table of two user grains (docs/model.md §9) on a 2 × 2 grid: sand_a the mesh examples/grains/grain_2.obj (17
+# hull vertices, fixed proportions), sand_b the hull of seven points with its own b/a, c/b law, in both hands;
+# written next to its mesh by write_grain_config (the mesh path is relative to the configuration)
+GRAIN_TABLE_CONFIG = """
+[grid]
+alpha1_deg = [30.0, 70.0]
+speed_m_s = [100.0, 200.0]
+shapes = ["sand_a", "sand_b"]
+[simulation]
+particles_per_cell = 3000
+seed = 34
+[shapes.sand_a]
+mesh = "grains/sand_a.obj"
+[shapes.sand_b]
+vertices = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 0.9, 0.1], [0.1, 0.2, 0.7], [0.6, 0.5, 0.5], [0.9, 0.8, 0.3],
+            [0.4, -0.2, 0.4]]
+aspect_ratio = {mean = 0.8, sd = 0.1}
+both_hands = true
+"""
+GRAIN_MESH = REPO / "examples" / "grains" / "grain_2.obj"
+
+
+def write_grain_config(folder, text=GRAIN_TABLE_CONFIG, mesh=GRAIN_MESH):
+    """``text`` as ``folder/grains.toml`` and the mesh as ``folder/grains/sand_a.obj``; the configuration's path."""
+    (folder / "grains").mkdir(exist_ok=True)
+    shutil.copyfile(mesh, folder / "grains" / "sand_a.obj")
+    path = folder / "grains.toml"
+    path.write_text(text)
+    return path
