@@ -46,3 +46,17 @@ def test_every_grain_of_the_config_is_irregular_and_convex(make_grains):
         assert np.all(np.diff(record.inertia) > 1e-3 * record.inertia[0])     # no two moments alike: no symmetry
         half = (record.vertices.max(axis=0) - record.vertices.min(axis=0)) / 2
         assert half.max() == pytest.approx(1.0, rel=1e-15) and half.min() > 0.3
+
+
+def test_the_law_figure_draws_every_shape(tmp_path, capsys):
+    """plot_law.py with 300 particles a shape: a PNG, and a line for each family and each grain of the config."""
+    pytest.importorskip("matplotlib")
+    spec = importlib.util.spec_from_file_location("plot_law", FOLDER / "plot_law.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    out = tmp_path / "law.png"
+    assert module.main(["--n", "300", "--out", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    names = [line.split()[0] for line in capsys.readouterr().out.splitlines()[:-1]]
+    shapes = tomllib.loads((FOLDER / "grains.toml").read_text())["grid"]["shapes"]
+    assert names == ["ellipsoid", "prism", "cut_prism", "tetrahedron"] + [s for s in shapes if s.startswith("grain_")]
