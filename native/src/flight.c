@@ -1,6 +1,6 @@
 /*
  * flight.c: the search for the next contact of a free flight (direct_model.flight: curvature_bound, jerk_bound,
- * safe_step, taylor_root, lowest_points, choose_contact, find_contact); the flight itself is rotation.c's. The same
+ * safe_step, may_reach, taylor_root, lowest_points, choose_contact, find_contact); the flight itself is rotation.c's. The same
  * operations in the same order as the numba kernels (plain products and sums, libm's sqrt).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -68,6 +68,16 @@ static double safe_step(double h, double hdot, double M)
     }
     if (M <= 0.0) return INFINITY;
     return (hdot + sqrt(disc)) / M;
+}
+
+/* 0 only if safe_step(h, hdot, M) is surely above T (> 0, finite): h + hdot T' − ½MT'² > 0 at T' = T(1 + 1e-12)
+ * + 1e-300 beyond its round-off; 1 for NaN */
+static int may_reach(double h, double hdot, double M, double T)
+{
+    if (h < 0.0) h = 0.0;
+    T = T * (1.0 + 1e-12) + 1e-300;
+    double q = h + (hdot - 0.5 * M * T) * T;
+    return !(q > 1e-14 * (h + fabs(hdot) * T + 0.5 * M * T * T));
 }
 
 /* root nearest 0 of h + hdot s + ½hddot s² (Newton's −h/hdot where it has none) */
@@ -169,13 +179,20 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
         }
         double y = y0 + v * t;
         int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2);
-        double hmin = INFINITY;
-        int low = 0;
-        for (int i = 0; i < n; i++)
+        double hmin = INFINITY, h_next = INFINITY; /* the lowest point and the next lowest */
+        int low = -1, second = -1;
+        for (int i = 0; i < n; i++) {
             if (h[i] < hmin) {
+                h_next = hmin;
+                second = low;
                 hmin = h[i];
                 low = i;
+            } else if (h[i] < h_next) {
+                h_next = h[i];
+                second = i;
             }
+        }
+        if (low < 0) low = 0;
         *n_steps = step + 1;
         *t_out = t;
         if (-contact_tol <= hmin && hmin <= contact_tol && choose_contact(n, verts, h, h1, R, set_tol, rc))
@@ -191,8 +208,12 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
             continue;
         }
         if (v > 0.0 && y > Rb) return SEARCH_ESCAPED;
+        /* the smallest and second smallest safe steps are at most T: points that surely take longer are passed */
+        double T = second < 0 ? INFINITY
+                              : py_max(safe_step(h[low], h1[low], M), safe_step(h[second], h1[second], M));
         double tau = INFINITY, tau_other = INFINITY;
         for (int i = 0; i < n; i++) {
+            if (T < INFINITY && !may_reach(h[i], h1[i], M, T)) continue;
             double tau_i = safe_step(h[i], h1[i], M);
             if (tau_i < tau) {
                 tau_other = tau;
