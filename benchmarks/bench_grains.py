@@ -115,9 +115,10 @@ def main(argv=None) -> int:
                   f"{row['collisions_per_rebound']:>6.2f} {row['search_steps_per_rebound']:>7.1f} "
                   f"{row['trapped']:>7d} {row['failed']:>6d}", flush=True)
     target = [r for r in rows if r["vertices"] == TARGET_SIZE and r["shape"].startswith("grain")]
+    verdicts = [f"{r['states']} {r['over_prism']:.2f}x ({'met' if r['over_prism'] <= TARGET_RATIO else 'NOT met'})"
+                for r in target]
     print(f"\nTarget: a {TARGET_SIZE}-vertex grain within {TARGET_RATIO:g}x the prism's cost per rebound: "
-          + "; ".join(f"{r['states']} {r['over_prism']:.2f}x ({'met' if r['over_prism'] <= TARGET_RATIO else 'NOT met'})"
-                      for r in target))
+          + "; ".join(verdicts))
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"machine": info, "states": args.states, "repeats": args.repeats, "seed": SEED, "rows": rows},

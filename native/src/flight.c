@@ -1,7 +1,7 @@
 /*
  * flight.c: the search for the next contact of a free flight (direct_model.flight: curvature_bound, jerk_bound,
- * safe_step, may_reach, taylor_root, lowest_points, choose_contact, find_contact); the flight itself is rotation.c's. The same
- * operations in the same order as the numba kernels (plain products and sums, libm's sqrt).
+ * safe_step, may_reach, taylor_root, lowest_points, choose_contact, find_contact); the flight itself is
+ * rotation.c's. The same operations in the same order as the numba kernels (plain products and sums, libm's sqrt).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
