@@ -46,12 +46,13 @@ vertex at distance ≤ R_b: M = g₂ R_b, M3 = g₃ R_b;
 ellipsoid (|A²g| ≤ a_max σ, σ ≥ a_min): M = a_max² ω² / a_min + a_max g₂,
 M3 = 6 a_max² ω g₂ / a_min + a_max g₃ + 6 a_max³ ω³ / a_min².
 
-A hull of many vertices: only the smallest and second smallest safe steps
-matter, and both are at most T, the larger of the two lowest points' safe
-steps; a point whose h + h'T' − ½MT'² exceeds its round-off (T' = T(1 + 10⁻¹²))
-provably has a safe step above T, so it is passed over without its square root
-and division (:func:`may_reach`): the same steps, the same bits, as a scan of
-every point, at a fraction of the cost for a grain of hundreds of vertices.
+A hull of many vertices (more than :data:`PASS_OVER_ABOVE`): only the smallest
+and second smallest safe steps matter, and both are at most T, the larger of
+the two lowest points' safe steps (:func:`pass_over_bound`); a point whose
+h + h'T' − ½MT'² exceeds its round-off (T' = T(1 + 10⁻¹²)) provably has a safe
+step above T, so it is passed over without its square root and division
+(:func:`may_reach`): the same steps, the same bits, as a scan of every point.
+Below that size the tests cost more than the square roots they save.
 
 The flight's rotation set-up (:func:`direct_model.rotation.rotation_init`) is
 done at the first step that needs the orientation at a later time: a flight
@@ -72,6 +73,7 @@ SEARCH_ESCAPED = 1      # the body can never reach the wall again
 SEARCH_STALLED = 2      # max_steps reached without a decision
 
 HORIZON = 4.0           # the binding point's longer step looks at most this many safe steps ahead
+PASS_OVER_ABOVE = 24    # vertices; up to this many (every family) all safe steps are computed (bench_grains.py)
 
 
 @numba.njit(**JIT)
@@ -128,6 +130,19 @@ def safe_step(h, hdot, M):
     if M <= 0.0:
         return np.inf
     return (hdot + np.sqrt(disc)) / M
+
+
+@numba.njit(**JIT)
+def pass_over_bound(h, h1, n, low, M):
+    """T at least the second smallest safe step of the n points: the larger of the safe steps of point ``low``
+    and of the lowest other point; inf for a single point (module doc)."""
+    second, h_next = -1, np.inf
+    for i in range(n):
+        if i != low and h[i] < h_next:
+            second, h_next = i, h[i]
+    if second < 0:
+        return np.inf
+    return max(safe_step(h[low], h1[low], M), safe_step(h[second], h1[second], M))
 
 
 @numba.njit(**JIT)
@@ -260,14 +275,10 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
             rotation_at(params, t, R, W)
         y = y0 + v * t
         n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2)
-        hmin, low, h_next, second = np.inf, -1, np.inf, -1      # the lowest point and the next lowest
+        hmin, low = np.inf, 0
         for i in range(n):
             if h[i] < hmin:
-                h_next, second = hmin, low
                 hmin, low = h[i], i
-            elif h[i] < h_next:
-                h_next, second = h[i], i
-        low = max(low, 0)
         if -contact_tol <= hmin <= contact_tol and choose_contact(n, verts, h, h1, R, set_tol, rc):
             return SEARCH_CONTACT, t, step + 1
         if hmin < -contact_tol or t_hi < np.inf:
@@ -285,7 +296,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         if v > 0.0 and y > Rb:
             return SEARCH_ESCAPED, t, step + 1
         # the smallest and second smallest safe steps are at most T: points that surely take longer are passed
-        T = np.inf if second < 0 else max(safe_step(h[low], h1[low], M), safe_step(h[second], h1[second], M))
+        T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
         tau, tau_other = np.inf, np.inf
         for i in range(n):
             if T < np.inf and not may_reach(h[i], h1[i], M, T):
