@@ -46,6 +46,14 @@ vertex at distance ≤ R_b: M = g₂ R_b, M3 = g₃ R_b;
 ellipsoid (|A²g| ≤ a_max σ, σ ≥ a_min): M = a_max² ω² / a_min + a_max g₂,
 M3 = 6 a_max² ω g₂ / a_min + a_max g₃ + 6 a_max³ ω³ / a_min².
 
+A hull of many vertices (more than :data:`PASS_OVER_ABOVE`): only the smallest
+and second smallest safe steps matter, and both are at most T, the larger of
+the two lowest points' safe steps (:func:`pass_over_bound`); a point whose
+h + h'T' − ½MT'² exceeds its round-off (T' = T(1 + 10⁻¹²)) provably has a safe
+step above T, so it is passed over without its square root and division
+(:func:`may_reach`): the same steps, the same bits, as a scan of every point.
+Below that size the tests cost more than the square roots they save.
+
 The flight's rotation set-up (:func:`direct_model.rotation.rotation_init`) is
 done at the first step that needs the orientation at a later time: a flight
 decided at its start (a contact at t = 0, an escape) never pays for it.
@@ -65,6 +73,7 @@ SEARCH_ESCAPED = 1      # the body can never reach the wall again
 SEARCH_STALLED = 2      # max_steps reached without a decision
 
 HORIZON = 4.0           # the binding point's longer step looks at most this many safe steps ahead
+PASS_OVER_ABOVE = 24    # vertices; up to this many (every family) all safe steps are computed (bench_grains.py)
 
 
 @numba.njit(**JIT)
@@ -121,6 +130,31 @@ def safe_step(h, hdot, M):
     if M <= 0.0:
         return np.inf
     return (hdot + np.sqrt(disc)) / M
+
+
+@numba.njit(**JIT)
+def pass_over_bound(h, h1, n, low, M):
+    """T at least the second smallest safe step of the n points: the larger of the safe steps of point ``low``
+    and of the lowest other point; inf for a single point (module doc)."""
+    second, h_next = -1, np.inf
+    for i in range(n):
+        if i != low and h[i] < h_next:
+            second, h_next = i, h[i]
+    if second < 0:
+        return np.inf
+    return max(safe_step(h[low], h1[low], M), safe_step(h[second], h1[second], M))
+
+
+@numba.njit(**JIT)
+def may_reach(h, hdot, M, T):
+    """False only if :func:`safe_step` of (h, hdot, M) is surely above T (> 0, finite): then
+    h + hdot·T' − ½MT'² > 0 at T' = T(1 + 10⁻¹²) + 10⁻³⁰⁰ beyond the round-off of its evaluation, so the first
+    root exceeds T', and the computed step (no cancellation in its formula) exceeds T. NaN: True."""
+    if h < 0.0:
+        h = 0.0
+    T = T * (1.0 + 1e-12) + 1e-300
+    q = h + (hdot - 0.5 * M * T) * T
+    return not q > 1e-14 * (h + abs(hdot) * T + 0.5 * M * T * T)
 
 
 @numba.njit(**JIT)
@@ -261,8 +295,12 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
             continue
         if v > 0.0 and y > Rb:
             return SEARCH_ESCAPED, t, step + 1
+        # the smallest and second smallest safe steps are at most T: points that surely take longer are passed
+        T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
         tau, tau_other = np.inf, np.inf
         for i in range(n):
+            if T < np.inf and not may_reach(h[i], h1[i], M, T):
+                continue
             tau_i = safe_step(h[i], h1[i], M)
             if tau_i < tau:
                 tau, tau_other, b = tau_i, tau, i

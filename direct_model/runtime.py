@@ -5,8 +5,8 @@ uniforms the caller passes, the particle's shape from the shapes as arrays
 (:class:`direct_model.shape_arrays.ShapeArrays`) and every other model parameter from one float64 array
 (:func:`model_parameters`, layout P_*), so that a runtime reads the parameters a table was built with and
 calls the model from ``@njit`` code. The P_* array still holds the families' law, κ and factors s, from which a
-runtime builds their arrays (:func:`direct_model.shape_arrays.family_shape_arrays`). It works in the model's frame (wall y = 0, normal +Y; docs/model.md
-§2); :func:`surrogate.kernels.direct_path.direct_rebound` puts a hit in that frame and back.
+runtime builds their arrays (:func:`family_shapes`). It works in the model's frame (wall y = 0, normal +Y;
+docs/model.md §2); :func:`surrogate.kernels.direct_path.direct_rebound` puts a hit in that frame and back.
 
 The uniforms, all in [0, 1): u[0:3] the orientation (Shoemake's uniform quaternion: Haar measure, like the
 batch's normalised Gaussian quaternion), u[3:5] b/a and c/b (inverse CDF of the shape's truncated normal law,

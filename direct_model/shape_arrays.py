@@ -53,8 +53,8 @@ import numba
 import numpy as np
 
 from direct_model.options import JIT
-from direct_model.registry import FRAME_CHECK, MAX_HULL_VERTICES, ConvexPolyhedron, Ellipsoid, built_in_shape, built_in_shapes, \
-    polyhedron
+from direct_model.registry import (FRAME_CHECK, MAX_HULL_VERTICES, ConvexPolyhedron, Ellipsoid, built_in_shape,
+                                   built_in_shapes, polyhedron)
 from direct_model.shapes import DEFAULT_KAPPA, SHAPES, AspectRatioLaw, normal_cdf, second_moment_factor, shape_vertices
 
 KIND_ELLIPSOID, KIND_POLYHEDRON = 0, 1

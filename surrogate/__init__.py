@@ -25,7 +25,7 @@ model answers: :func:`sample_global` with its default ``method="auto"`` picks, p
 valid (|Ω⁻|a/|V⁻| ≤ :data:`SPIN_TOLERANCE`, inside the grid) and the direct model elsewhere; from numba,
 :func:`surrogate.kernels.rebound` (13 uniforms per hit whatever the path) and
 :func:`surrogate.kernels.rebound_path`. The direct model alone: :func:`sample_direct` from NumPy,
-:func:`surrogate.kernels.direct_rebound` from numba with ``table.direct_parameters`` and
+:func:`surrogate.kernels.direct_rebound` from numba with ``table.direct_parameters``, ``table.shape_arrays`` and
 ``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
 
 Every argument of the NumPy API goes through :mod:`surrogate.validation` (``check_random_state``,

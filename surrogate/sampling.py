@@ -216,8 +216,8 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
         shapes = _mix_rows(cdf, n_particles, generator)
     codes = np.ascontiguousarray(table.model_shapes[shapes])
     states = chunk_states(generator, n_particles)
-    direct_rebound_parallel_rng(params, table.shape_arrays, codes, V, as_rows(W, n_particles), as_rows(nrm, n_particles),
-                                as_rows(a, n_particles), states, V_out, Omega_out, status)
+    direct_rebound_parallel_rng(params, table.shape_arrays, codes, V, as_rows(W, n_particles),
+                                as_rows(nrm, n_particles), as_rows(a, n_particles), states, V_out, Omega_out, status)
     return V_out, Omega_out, status
 
 

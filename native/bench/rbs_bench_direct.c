@@ -80,7 +80,8 @@ static double run_piece(int k, const double *params, const rbs_shape_arrays *sha
         int nv = (int)x[PIECE_NV];
         if (k == 0) {
             double V[3], Wo[3];
-            sum += rbs_rebound_model_frame(params, shapes, shape, x[PIECE_MODEL], x[PIECE_MODEL + 1], x[PIECE_MODEL + 2],
+            sum += rbs_rebound_model_frame(params, shapes, shape, x[PIECE_MODEL], x[PIECE_MODEL + 1],
+                                           x[PIECE_MODEL + 2],
                                            x[PIECE_MODEL + 3], x[PIECE_MODEL + 4], x + PIECE_U, V, Wo);
         } else if (k == 1) {
             const double *Wr = x + PIECE_W;

@@ -1,7 +1,8 @@
 /*
  * flight.c: the search for the next contact of a free flight (direct_model.flight: curvature_bound, jerk_bound,
- * safe_step, taylor_root, lowest_points, choose_contact, find_contact); the flight itself is rotation.c's. The same
- * operations in the same order as the numba kernels (plain products and sums, libm's sqrt).
+ * safe_step, pass_over_bound, may_reach, taylor_root, lowest_points, choose_contact, find_contact); the flight
+ * itself is rotation.c's. The same operations in the same order as the numba kernels (plain products and sums,
+ * libm's sqrt).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -14,6 +15,7 @@
 #include "shapes.h"
 
 #define HORIZON 4.0 /* direct_model.flight.HORIZON */
+#define PASS_OVER_ABOVE 24 /* direct_model.flight.PASS_OVER_ABOVE: vertices, fewer: every safe step computed */
 
 /* bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (direct_model.flight._rate_bounds) */
 static void rate_bounds(const double K[3], const double ell[3], const double W[3], double *w, double *wdot,
@@ -68,6 +70,31 @@ static double safe_step(double h, double hdot, double M)
     }
     if (M <= 0.0) return INFINITY;
     return (hdot + sqrt(disc)) / M;
+}
+
+/* T at least the second smallest safe step of the n points: the larger of the safe steps of point low and of the
+ * lowest other point; INFINITY for a single point */
+static double pass_over_bound(const double *h, const double *h1, int n, int low, double M)
+{
+    int second = -1;
+    double h_next = INFINITY;
+    for (int i = 0; i < n; i++)
+        if (i != low && h[i] < h_next) {
+            second = i;
+            h_next = h[i];
+        }
+    if (second < 0) return INFINITY;
+    return py_max(safe_step(h[low], h1[low], M), safe_step(h[second], h1[second], M));
+}
+
+/* 0 only if safe_step(h, hdot, M) is surely above T (> 0, finite): h + hdot T' − ½MT'² > 0 at T' = T(1 + 1e-12)
+ * + 1e-300 beyond its round-off; 1 for NaN */
+static int may_reach(double h, double hdot, double M, double T)
+{
+    if (h < 0.0) h = 0.0;
+    T = T * (1.0 + 1e-12) + 1e-300;
+    double q = h + (hdot - 0.5 * M * T) * T;
+    return !(q > 1e-14 * (h + fabs(hdot) * T + 0.5 * M * T * T));
 }
 
 /* root nearest 0 of h + hdot s + ½hddot s² (Newton's −h/hdot where it has none) */
@@ -191,8 +218,11 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
             continue;
         }
         if (v > 0.0 && y > Rb) return SEARCH_ESCAPED;
+        /* the smallest and second smallest safe steps are at most T: points that surely take longer are passed */
+        double T = n > PASS_OVER_ABOVE ? pass_over_bound(h, h1, n, low, M) : INFINITY;
         double tau = INFINITY, tau_other = INFINITY;
         for (int i = 0; i < n; i++) {
+            if (T < INFINITY && !may_reach(h[i], h1[i], M, T)) continue;
             double tau_i = safe_step(h[i], h1[i], M);
             if (tau_i < tau) {
                 tau_other = tau;

@@ -68,7 +68,8 @@ def inline_direct_rebound(params, shape_arrays, shape, V, omega, n, a, u, scratc
     ex, ez = _frame_axes(V, n, u[U_AXIS])
     # Ω⁻ in (m/s)/a, the model's unit (direct_model.body_rebound): rad/s times a
     status, _, _, vx, vy, vz, wx, wy, wz = rebound_model_frame(
-        params, shape_arrays, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez), u, scratch)
+        params, shape_arrays, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez),
+        u, scratch)
     if status != STATUS_REBOUNDED:
         return (STATUS_TRAPPED if status == STATUS_TRAPPED else STATUS_FAILED), NAN3, NAN3
     return to_global(status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)

@@ -139,8 +139,8 @@ def _lab(R, diagonal):
 def test_each_collision_keeps_the_angular_momentum_about_its_contact_point(particle):
     """Through each collision of a whole rebound, ℓ − r_c × V (per unit mass, ℓ = KΩ lab) is unchanged (the impulse
     acts at r_c), and r_c is on the wall: a vertex of the body at the wall, or the centre of those at the wall
-    (the tie rule), or the ellipsoid's lowest point. ℓ before is the last flight's (torque-free: constant), after is the next flight's; to 1e-9 of
-    |V⁻| a (round-off over a few collisions)."""
+    (the tie rule), or the ellipsoid's lowest point. ℓ before is the last flight's (torque-free: constant),
+    after is the next flight's; to 1e-9 of |V⁻| a (round-off over a few collisions)."""
     shape, ratios, R0, hand = particle
     speed = 200.0
     _, _, status, ncoll, _, hist = run_one(shape, ratios, R0, alpha1=35.0, speed=speed, omega_in=(0.2, -0.1, 0.4),
