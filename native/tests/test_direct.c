@@ -157,15 +157,8 @@ static void make_shapes(test_shapes *s, rbs_rng *rng)
 {
     const double law[4] = {0.8, 0.2, 0.5, 1.0}, cdf[2] = {0.06680720126885804, 0.8413447460685428};
     const double kfac[4] = {0.2, 0.33333333333333337, 0.3309571404654277, 0.2}, semi[3] = {1.0, 0.7, 0.5};
-    rbs_family_shapes f;
-    rbs_family_shapes_init(&f, 0.3, law, cdf, kfac);
-    memcpy(s->kind, f.kind, sizeof f.kind);
-    memcpy(s->vertex_start, f.vertex_start, sizeof f.vertex_start);
-    memcpy(s->vertices, f.vertices, sizeof f.vertices);
-    memcpy(s->second_moments, f.second_moments, sizeof f.second_moments);
-    memcpy(s->aspect, f.aspect, sizeof f.aspect);
-    memcpy(s->aspect_cdf, f.aspect_cdf, sizeof f.aspect_cdf);
-    memcpy(s->both_hands, f.both_hands, sizeof f.both_hands);
+    rbs_family_shapes_fill(s->kind, s->vertex_start, s->vertices, s->second_moments, s->aspect, s->aspect_cdf,
+                           s->both_hands, 0.3, law, cdf, kfac);
     s->kind[4] = KIND_POLYHEDRON;
     s->vertex_start[5] = FAMILY_VERTEX_ROWS + MAX_HULL_VERTICES;
     for (int i = 0; i < MAX_HULL_VERTICES; i++) {
