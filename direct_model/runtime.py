@@ -163,7 +163,10 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
     uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat)
     quaternion_to_matrix(quat, R0)
     law, cdf = shape_arrays.aspect[shape], shape_arrays.aspect_cdf[shape]
-    ratio_ba, ratio_cb = aspect_ratio(law, cdf, u[U_RATIOS]), aspect_ratio(law, cdf, u[U_RATIOS + 1])
+    if np.isnan(law[0]):                    # fixed proportions: no quantile of NaN (C: no FE_INVALID)
+        ratio_ba, ratio_cb = 1.0, 1.0
+    else:
+        ratio_ba, ratio_cb = aspect_ratio(law, cdf, u[U_RATIOS]), aspect_ratio(law, cdf, u[U_RATIOS + 1])
     hand = 1.0 if shape_arrays.both_hands[shape] == 0 or u[U_HAND] < 0.5 else -1.0
     nv = particle_body(shape_arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi)
     kind = shape_arrays.kind[shape]

@@ -74,7 +74,10 @@ int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes
     rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat);
     rbs_quaternion_to_matrix(quat, R0);
     const double *law = shapes->aspect + 4 * shape, *cdf = shapes->aspect_cdf + 2 * shape;
-    double ratio_ba = rbs_aspect_ratio(law, cdf, u[U_RATIOS]), ratio_cb = rbs_aspect_ratio(law, cdf, u[U_RATIOS + 1]);
+    /* fixed proportions (a NaN law): no quantile of NaN, which would raise FE_INVALID in solvers that trap it */
+    int fixed = isnan(law[0]);
+    double ratio_ba = fixed ? 1.0 : rbs_aspect_ratio(law, cdf, u[U_RATIOS]);
+    double ratio_cb = fixed ? 1.0 : rbs_aspect_ratio(law, cdf, u[U_RATIOS + 1]);
     double hand = !shapes->both_hands[shape] || u[U_HAND] < 0.5 ? 1.0 : -1.0;
     int nv = rbs_particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi);
     int kind = shapes->kind[shape];
