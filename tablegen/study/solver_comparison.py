@@ -36,6 +36,7 @@ import numpy as np
 from scipy.stats import ks_2samp
 from sklearn.ensemble import HistGradientBoostingClassifier
 from sklearn.model_selection import GroupShuffleSplit, train_test_split
+from threadpoolctl import threadpool_limits
 
 import surrogate
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
@@ -245,15 +246,19 @@ def _classifier(X, Y, seed: int, groups) -> tuple[float, int]:
         train, test = next(GroupShuffleSplit(n_splits=1, test_size=0.5, random_state=seed)
                            .split(Z, labels, groups=np.asarray(groups)))
         Z_train, Z_test, y_train, y_test = Z[train], Z[test], labels[train], labels[test]
-    model = HistGradientBoostingClassifier(max_iter=200, random_state=seed).fit(Z_train, y_train)
-    return float(model.score(Z_test, y_test)), len(y_test)
+    # one OpenMP thread: on some thousands of rows the threads mostly wait at barriers, and on a busy machine
+    # they spin there against the other jobs (a fit of 12 000 rows took 15-30 s of CPU on 2 loaded cores, about
+    # 1 s on one thread); the figure is then also the same whatever the number of cores
+    with threadpool_limits(1, user_api="openmp"):
+        model = HistGradientBoostingClassifier(max_iter=200, random_state=seed).fit(Z_train, y_train)
+        return float(model.score(Z_test, y_test)), len(y_test)
 
 
 def classifier_accuracy(X: np.ndarray, Y: np.ndarray, seed: int = 0, groups=None) -> float:
     """Held-out accuracy of a classifier telling rows of X from rows of Y (0.5: indistinguishable).
 
-    scikit-learn's HistGradientBoostingClassifier with 200 iterations and a fixed random state, so the figure
-    is reproducible, trained on half of the rows and scored on the other half. Without ``groups``, a
+    scikit-learn's HistGradientBoostingClassifier with 200 iterations, a fixed random state and one thread, so the
+    figure is reproducible, trained on half of the rows and scored on the other half. Without ``groups``, a
     stratified split row by row. ``groups`` (one label per row of X, then of Y): the rows of a group go to
     the same half; give it whenever rows of X and Y share their features in part (the same incident state),
     or the split pulls the accuracy below 0.5 (module doc).

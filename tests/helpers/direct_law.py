@@ -21,7 +21,6 @@ import math
 import numpy as np
 from scipy import stats
 from scipy.spatial.transform import Rotation
-from threadpoolctl import threadpool_limits
 
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, rebound_angles
@@ -120,8 +119,7 @@ def one_law(mine, theirs, comparisons: int) -> dict:
     for V, W in ((V1[ok1][:rows], W1[ok1][:rows]), (V2[ok2][:rows], W2[ok2][:rows])):
         alpha2, beta2, s = rebound_angles(V)
         features.append(np.column_stack([alpha2, beta2, s, W]))
-    with threadpool_limits(1):          # OpenMP's threads spin against numba's and other jobs' on a shared machine
-        accuracy = classifier_accuracy(*features, seed=0)
+    accuracy = classifier_accuracy(*features, seed=0)
     n_test = rows                       # the held-out half of 2·rows
     t1, t2 = np.mean(s1 == STATUS_TRAPPED), np.mean(s2 == STATUS_TRAPPED)
     p = (t1 + t2) / 2
