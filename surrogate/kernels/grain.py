@@ -35,13 +35,22 @@ _KEY_BITS = np.uint64(0x7FFFFFFFFFFFFFFF)      # a key's 63 bits: the top bit cl
 def keyed_uniforms(key, u, direct, out):
     """out[:U_PER_DRAW] = a draw's uniforms ``u`` with the slots the key ``key`` (≥ 0) fixes replaced by its
     keyed uniforms: u[0] (the shape) always; with ``direct`` (the direct path) also the direct model's
-    proportions and hand, u[1 + U_RATIOS], u[2 + U_RATIOS], u[1 + U_HAND]."""
-    out[:] = u[:out.shape[0]]
+    proportions and hand, u[1 + U_RATIOS], u[2 + U_RATIOS], u[1 + U_HAND] (:func:`key_model_uniforms` of
+    u[1:]). ``out`` may be ``u``."""
+    for k in range(out.shape[0]):
+        out[k] = u[k]
     out[0] = grain_uniform(key, SLOT_SHAPE)
     if direct:
-        out[1 + U_RATIOS] = grain_uniform(key, SLOT_RATIO_BA)
-        out[2 + U_RATIOS] = grain_uniform(key, SLOT_RATIO_CB)
-        out[1 + U_HAND] = grain_uniform(key, SLOT_HAND)
+        key_model_uniforms(key, out[1:])
+
+
+@numba.njit(inline="always", **JIT)
+def key_model_uniforms(key, u):
+    """The direct model's uniforms ``u`` (U_PER_REBOUND, :mod:`direct_model.runtime`) of a grain of key ``key``
+    (≥ 0): u[U_RATIOS], u[U_RATIOS + 1] (b/a, c/b) and u[U_HAND] replaced in place by the key's."""
+    u[U_RATIOS] = grain_uniform(key, SLOT_RATIO_BA)
+    u[U_RATIOS + 1] = grain_uniform(key, SLOT_RATIO_CB)
+    u[U_HAND] = grain_uniform(key, SLOT_HAND)
 
 
 @numba.njit(**JIT)
@@ -49,11 +58,13 @@ def keyed_shapes(mix_cdf, shapes, keys):
     """Each row's table shape index as the kernels over many rows take it (``shapes`` of
     :func:`surrogate.kernels.wall_hit.rebound_parallel_rng`): ``shapes[i]`` where given (≥ 0), else the shape
     of key ``keys[i]`` drawn from the mix (:func:`grain_shape`) where it has one (≥ 0), else SHAPE_FROM_MIX.
-    ``shapes`` (N,) or empty, ``keys`` (N,) int64; returns (N,) int64."""
-    out = np.empty(keys.shape[0], dtype=np.int64)
-    for i in range(keys.shape[0]):
+    ``shapes`` and ``keys`` (N,) int64 or empty; returns a new (N,) int64 array, empty if both are."""
+    rows = keys.shape[0] if keys.shape[0] > 0 else shapes.shape[0]
+    out = np.empty(rows, dtype=np.int64)
+    for i in range(rows):
         given = shapes.shape[0] > 0 and shapes[i] != SHAPE_FROM_MIX
-        out[i] = shapes[i] if given else grain_shape(mix_cdf, keys[i]) if keys[i] >= 0 else SHAPE_FROM_MIX
+        keyed = keys.shape[0] > 0 and keys[i] >= 0
+        out[i] = shapes[i] if given else grain_shape(mix_cdf, keys[i]) if keyed else SHAPE_FROM_MIX
     return out
 
 
@@ -95,15 +106,15 @@ def grain_table(shape_arrays, model_shapes, mix_cdf, shapes, keys, shape_out, pr
 
 
 @numba.njit(**JIT)
-def grain_key(seed, ids):
-    """The grain key of each column of ``ids`` (M, N) uint64 under ``seed`` (uint64): splitmix64 chained,
+def grain_key(words):
+    """The grain key of each column of ``words`` (M ≥ 1, N) uint64, the seed then the ids: splitmix64 chained,
     h = splitmix64(seed + γ), then h = splitmix64(h + id + γ) for each id of the column in turn, and the key is h
     with its top bit cleared (an int64 ≥ 0). Returns (N,) int64. Unrelated keys for unrelated ids, the same key
     for the same (seed, ids) everywhere: a solver derives a particle's key from (seed, rank of origin, id)."""
-    keys = np.empty(ids.shape[1], dtype=np.int64)
-    for j in range(ids.shape[1]):
-        h = _splitmix64(seed + _GOLDEN)
-        for m in range(ids.shape[0]):
-            h = _splitmix64(h + ids[m, j] + _GOLDEN)
+    keys = np.empty(words.shape[1], dtype=np.int64)
+    for j in range(words.shape[1]):
+        h = _splitmix64(words[0, j] + _GOLDEN)
+        for m in range(1, words.shape[0]):
+            h = _splitmix64(h + words[m, j] + _GOLDEN)
         keys[j] = np.int64(h & _KEY_BITS)
     return keys
