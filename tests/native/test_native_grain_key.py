@@ -1,7 +1,8 @@
 """Grain keys in C (rbs_rebound_grain, rbs_rebound_grain_rng, rbs_grain_info, rbs_grain_key) give the bits of their
 numba twins (surrogate.kernels.wall_hit.rebound with ``key``, surrogate.grain_of, surrogate.grain_key): 0 ulp over
 the hostile states of test_native_spin (spinning and not, the three methods, both paths), on the families' small
-table with a weighted mix and on the table of user grains (one of random proportions in both hands, one fixed).
+table with a weighted mix, on the table of user grains (one of random proportions in both hands, one fixed) and
+on a table of 64 shapes.
 A key < 0 is refused; the 13 uniforms are checked whatever the key fixes; a keyed hit advances a stream by 13."""
 
 from __future__ import annotations
@@ -40,11 +41,15 @@ def test_grain_key_is_surrogates(native):
     assert native.grain_key(7, 3, 11) == py.grain_key(7, 3, 11)
 
 
-@pytest.fixture(scope="module", params=["small", "grains"])
-def keyed_case(request, native, small_table_path, grain_table_path):
-    """(numba's table, C's table, C mix, its cdf) of the small table (a weighted mix over its four families) or of
-    the user grains' table (equal weights)."""
-    path = small_table_path if request.param == "small" else grain_table_path
+@pytest.fixture(scope="module", params=["small", "grains", "64 shapes"])
+def keyed_case(request, native, small_table_path, grain_table_path, tmp_path_factory):
+    """(numba's table, C's table, C mix, its cdf) with a weighted mix over every shape of the small table (the
+    four families), of the user grains' table, or of a table of 64 shapes (a mix sized by the table, user grains
+    of random and fixed proportions, in one hand and both: tests.helpers.python_side.many_shape_table)."""
+    path = {"small": small_table_path, "grains": grain_table_path}.get(request.param)
+    if path is None:
+        path = tmp_path_factory.mktemp("many") / "many_shapes.h5"
+        py.many_shape_table(small_table_path, path, 64)
     table, c_table = py.load(path), native.table(path)
     weights = dict(zip(table.shapes, np.arange(1.0, len(table.shapes) + 1) / sum(range(1, len(table.shapes) + 1))))
     mix, message = c_table.mix_new(weights=weights)
@@ -67,8 +72,8 @@ def test_grain_info_is_grain_of(keyed_case):
         for name in ("ratio_ba", "ratio_cb", "hand"):
             assert np.float64(grain[name]).tobytes() == np.float64(getattr(grains, name)[i]).tobytes(), (i, name)
         seen_random += not np.isnan(grain["ratio_ba"])
-    assert seen_random > KEYS      # the families' proportions and the grain of random proportions, drawn
-    assert set(grains.shape) == set(table.shapes)
+    assert seen_random > len(keys) // 5     # shapes of random proportions are a third of the weight or more
+    assert len(set(grains.shape)) > 0.8 * len(table.shapes)
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))
