@@ -39,6 +39,7 @@ static void keyed_uniforms(int64_t key, const double *u, int direct, double out[
     }
 }
 
+/* rbs_rebound with the key's uniforms (surrogate.kernels.wall_hit: rebound, _keyed_rebound) */
 int rbs_rebound_grain(const rbs_table *t, const rbs_mix *mix, int64_t key, const double V[3], const double Omega[3],
                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
                       double V_out[3], double Omega_out[3])
@@ -51,7 +52,7 @@ int rbs_rebound_grain(const rbs_table *t, const rbs_mix *mix, int64_t key, const
     }
     double keyed[RBS_U_PER_DRAW];
     keyed_uniforms(key, u, path == RBS_PATH_DIRECT, keyed);
-    return rbs_rebound(t, mix, V, Omega, n, a, keyed, method, interpolation, V_out, Omega_out);
+    return rbs_rebound_along(t, mix, path, V, Omega, n, a, keyed, interpolation, V_out, Omega_out);
 }
 
 int rbs_rebound_grain_rng(const rbs_table *t, const rbs_mix *mix, int64_t key, const double V[3],

@@ -38,7 +38,7 @@ from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
 from surrogate.kernels.direct_path import inline_direct_rebound
 from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
-from surrogate.kernels.grain import NO_KEY, keyed_shapes, keyed_uniforms
+from surrogate.kernels.grain import keyed_shapes, keyed_uniforms
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
 from surrogate.kernels.checks import check_keys, check_shapes
@@ -100,7 +100,7 @@ def rebound_path(data, V, omega, n, a, method):
 
 @numba.njit(**JIT)
 def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True,
-            key=NO_KEY):
+            key=None):
     """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
     3-tuples in the caller's frame.
 
@@ -115,17 +115,25 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
     V, omega, n, a, method : as :func:`rebound_path`.
     u : (U_PER_DRAW,) array of uniforms in [0, 1) (module doc for how each path uses them).
     scaled : the table path's interpolation (:func:`surrogate.kernels.table_path.table_rebound`).
-    key : the particle's grain key, an int ≥ 0 (:mod:`surrogate.kernels.grain`: its shape on either path, and
-        on the direct path its proportions and hand, are the key's, whatever u[0], u[4], u[5], u[6] are; the
-        13 uniforms are still all checked); NO_KEY (−1, the default): none, the draws of u alone.
+    key : None (the default: no key, the draws of u alone; the keyed code is not even compiled) or the
+        particle's grain key, an int ≥ 0 (:mod:`surrogate.kernels.grain`: its shape on either path, and on the
+        direct path its proportions and hand, are the key's, whatever u[0], u[4], u[5], u[6] are; the 13
+        uniforms are still all checked).
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
-    a uniform outside [0, 1) whatever the path, a method not in the three, a key < −1); NaN vectors unless
+    a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0); NaN vectors unless
     rebounded.
     """
     path = rebound_path(data, V, omega, n, a, method)
-    if key == NO_KEY:
-        return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path)
+    if key is not None:
+        return _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path,
+                              key)
+    return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path)
+
+
+@numba.njit(inline="always", **JIT)
+def _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path, key):
+    """:func:`rebound` of a particle of grain key ``key`` along its path ``path``: u with the key's slots."""
     if key < 0 or path == STATUS_INVALID or not uniforms_ok(u):
         return STATUS_INVALID, NAN3, NAN3
     keyed = np.empty(U_PER_DRAW)
@@ -133,7 +141,7 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
     return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, keyed, scaled, path)
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path):
     """:func:`rebound` along its path ``path`` with the uniforms ``u``."""
     if path == PATH_TABLE:

@@ -124,6 +124,7 @@ def test_bad_keys_and_uniforms_are_refused(keyed_case):
         st, v, w = c_table.rebound_grain(mix, key, V, omega, n, 1e-4, u)
         assert st == INVALID and np.isnan(v).all() and np.isnan(w).all()
         assert c_table.grain_info(mix, key) == (ERR_ARGUMENT, None)
+        assert _numba(table, cdf, V, omega, n, 1e-4, u, AUTO, key)[0] == py.STATUS_INVALID
     for k in (0, 4, 5, 6, 12):          # a keyed slot's uniform is replaced, but still checked
         bad = u.copy()
         bad[k] = 1.0

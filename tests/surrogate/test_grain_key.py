@@ -72,7 +72,7 @@ def test_keyed_rows_are_the_single_hit_with_the_key(small_table, method):
     for i in range(M):
         st, v, w = rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                            small_table.model_shapes, cdf, tuple(V[i]), tuple(W[i]), NORMAL, A, u[i],
-                           surrogate.METHODS[method], True, keys[i])
+                           surrogate.METHODS[method], True, None if keys[i] == NO_KEY else keys[i])
         assert st == outputs[2][i] and np.array(v).tobytes() == outputs[0][i].tobytes(), i
         assert np.array(w).tobytes() == outputs[1][i].tobytes(), i
     assert np.mean(outputs[2] == STATUS_REBOUNDED) > 0.5
