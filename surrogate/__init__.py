@@ -28,17 +28,22 @@ valid (|Ω⁻|a/|V⁻| ≤ :data:`SPIN_TOLERANCE`, inside the grid) and the dire
 :func:`surrogate.kernels.direct_rebound` from numba with ``table.direct_parameters``, ``table.shape_arrays`` and
 ``U_PER_REBOUND`` uniforms per call (docs/model.md §10).
 
+A particle that keeps its grain from one wall hit to the next: give it a grain key (``grain_key=`` of
+:func:`sample_global` and :func:`sample_direct`; :func:`grain_key` derives keys from a seed and ids,
+:func:`grain_of` says which grain a key is; :mod:`surrogate.grains`).
+
 Every argument of the NumPy API goes through :mod:`surrogate.validation` (``check_random_state``,
 ``check_shape``, ``mix_cdf``, ...), which a caller may use too.
 """
 
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import U_PER_REBOUND
+from surrogate.grains import Grains, grain_key, grain_of
 from surrogate.kernels import SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.sampling import LocalDraws, sample_direct, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 from surrogate.validation import METHODS, check_random_state, mix_cdf
 
-__all__ = ["LocalDraws", "METHODS", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
+__all__ = ["Grains", "LocalDraws", "METHODS", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
            "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "fill_uniforms",
-           "load", "mix_cdf", "sample_direct", "sample_global", "sample_local", "seed_state"]
+           "grain_key", "grain_of", "load", "mix_cdf", "sample_direct", "sample_global", "sample_local", "seed_state"]

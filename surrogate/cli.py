@@ -29,13 +29,27 @@ BYTES_PER_DRAW = 300
 
 def _mix(args):
     """(the ``shape`` argument of the NumPy API, the label of the samples) from --shape or --mix; the values are
-    checked by :func:`surrogate.validation.check_shape`, as the API checks them."""
+    checked by :func:`surrogate.validation.check_shape`, as the API checks them. --mix is four weights (ellipsoid,
+    prism, cut_prism, tetrahedron) or name=weight pairs (any shape of the table, user grains included)."""
     if args.mix is None:
         return args.shape or "ellipsoid", args.shape or "ellipsoid"
+    items = [item.strip() for item in args.mix.split(",")]
+    if all("=" in item for item in items):
+        weights = {}
+        for item in items:
+            name, _, text = item.partition("=")
+            try:
+                weights[name.strip()] = float(text)
+            except ValueError:
+                raise ValueError(f"--mix weight of {name.strip()!r} must be a number; got {text!r}") from None
+        if len(weights) < len(items):
+            raise ValueError(f"--mix names each shape at most once; got {args.mix!r}")
+        return weights, "mix:" + ",".join(f"{name}={w:g}" for name, w in weights.items())
     try:
-        weights = [float(w) for w in args.mix.split(",")]
+        weights = [float(w) for w in items]
     except ValueError:
-        raise ValueError(f"--mix must be {len(SHAPE_NAMES)} comma-separated numbers; got {args.mix!r}") from None
+        raise ValueError(f"--mix must be {len(SHAPE_NAMES)} comma-separated numbers (ellipsoid, prism, cut_prism, "
+                         f"tetrahedron) or name=weight pairs (prism=0.5,tetrahedron=0.5); got {args.mix!r}") from None
     return weights, "mix:" + ",".join(f"{w:g}" for w in weights)
 
 
@@ -45,7 +59,9 @@ def _draw(table, args, shape, omega):
     The lab frame (wall y = 0, normal +Y, V⁻ in the XY plane) is the impact frame of that state, so the local
     draws are lab-frame vectors. The path is that of :func:`surrogate.kernels.rebound_path`, the same for
     every draw of one incident state; the table's draws are those of ``sample_local``, the direct model's
-    those of ``sample_global``."""
+    those of ``sample_global``. With --grain-key every draw is the grain of that key (one grain over random
+    orientations): on the table path its shape, drawn by ``sample_local`` with the key's shape alone (the table
+    holds that shape's law over its random proportions), on the direct path its shape, proportions and hand."""
     import surrogate
     from surrogate.kernels import PATH_DIRECT, PATH_TABLE, rebound_path
     from surrogate.validation import check_method
@@ -56,12 +72,15 @@ def _draw(table, args, shape, omega):
     spin = tuple(float(w) * speed / half_size for w in omega)
     path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, check_method(args.method))
             if alpha1_is_physical(args.alpha1) and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
+    keyed = args.grain_key is not None
     if path != PATH_DIRECT:
-        draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, shape, random_state=args.seed,
-                                       clamp=args.clamp)
+        local_shape = surrogate.grain_of(table, [args.grain_key], shape).shape[0] if keyed else shape
+        draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, local_shape,
+                                       random_state=args.seed, clamp=args.clamp)
         return draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio), PATH_TABLE
     V_out, Omega_out, status = surrogate.sample_global(table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size,
-                                                       shape, random_state=args.seed, omega=spin, method="direct")
+                                                       shape, random_state=args.seed, omega=spin, method="direct",
+                                                       grain_key=np.full(args.n, args.grain_key) if keyed else None)
     alpha2, beta2, v = rebound_angles(V_out)
     draws = surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
                                  omega=Omega_out * (half_size / speed), status=status)
@@ -70,6 +89,7 @@ def _draw(table, args, shape, omega):
 
 def _sample(args) -> int:
     import surrogate
+    from surrogate.kernels import PATH_DIRECT
     from surrogate.validation import check_omega, check_shape
 
     if args.out is not None:
@@ -81,17 +101,29 @@ def _sample(args) -> int:
     check_shape(table, shape)
     draws, velocity, path = _draw(table, args, shape, omega)
     speed = args.speed
+    grain, fixed = {}, {}
+    if args.grain_key is not None:
+        kept = surrogate.grain_of(table, [args.grain_key], shape)
+        if path == PATH_DIRECT:        # what the direct path fixes (NaN: fixed proportions, one hand)
+            fixed = {k: float(v[0]) for k, v in zip(("ratio_ba", "ratio_cb", "hand"), kept[1:]) if not np.isnan(v[0])}
+        grain = {"grain_key": args.grain_key, "grain_shape": kept.shape[0],
+                 **{f"grain_{k}": v for k, v in fixed.items()}}
     samples = SampleSet(velocity=velocity, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
                         status=draws.status, alpha1=args.alpha1, speed=speed, shape=label, seed=args.seed,
                         producer="surrogate sample",
                         provenance={"table": str(args.table), "table_config_sha256": table.config_sha256,
                                     "clamp": bool(args.clamp), "method": args.method, "omega_in": omega,
-                                    "path": "direct model" if path else "table"})
+                                    "path": "direct model" if path else "table", **grain})
     counts = ", ".join(f"{name} {int(np.sum(draws.status == code))}" for code, name in STATUS_NAMES.items())
     spin = "" if not np.any(omega) else f", Omega- a/|V-| = ({', '.join(f'{w:g}' for w in omega)})"
     print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s{spin}, {label}: {counts}")
     print(f"  answered by the table {0 if path else args.n}, by the direct model {args.n if path else 0} "
           f"(method {args.method}); failed {int(np.sum(draws.status == STATUS_FAILED))}")
+    if grain:
+        labels = {"ratio_ba": "b/a", "ratio_cb": "c/b", "hand": "hand"}
+        kept = (", ".join(f"{labels[k]} {v:.4g}" for k, v in fixed.items()) + ", kept on every hit") if fixed else \
+            "fixed proportions" if path == PATH_DIRECT else "proportions from the shape's law (table path)"
+        print(f"  one grain, key {args.grain_key}: {grain['grain_shape']}, {kept}")
     ok = samples.rebounded
     for name, values in (("alpha2 (deg)", np.degrees(draws.alpha2[ok])), ("beta2 (deg)", np.degrees(draws.beta2[ok])),
                          ("|V+|/|V-|", draws.speed_ratio[ok]), ("Omega_z a/|V-|", draws.omega[ok, 2])):
@@ -156,7 +188,10 @@ def main(argv=None) -> int:
     group.add_argument("--shape", metavar="NAME", help=f"a shape of the table: one of {', '.join(SHAPE_NAMES)} or "
                                                        f"a user grain it holds (tablegen info lists them; default "
                                                        f"ellipsoid)")
-    group.add_argument("--mix", metavar="W1,W2,W3,W4", help="weights of ellipsoid, prism, cut_prism, tetrahedron")
+    group.add_argument("--mix", metavar="W1,W2,W3,W4|NAME=W,...",
+                       help="weights of ellipsoid, prism, cut_prism, tetrahedron, or name=weight pairs of any of "
+                            "the table's shapes (user grains included), e.g. prism=0.5,tetrahedron=0.5; weights "
+                            ">= 0 summing to 1")
     sample.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of draws, >= 1")
     sample.add_argument("--seed", type=seed_argument, default=None, help="random seed in [0, 2**63)")
     sample.add_argument("--omega", type=float, nargs=3, default=(0.0, 0.0, 0.0), metavar=("WX", "WY", "WZ"),
@@ -166,6 +201,10 @@ def main(argv=None) -> int:
                         help="auto (default): the table where it is valid (|Omega-|a/|V-| <= the spin tolerance, "
                              "inside the grid), the direct model elsewhere; table: always the table (Omega- "
                              "ignored); direct: always the direct model")
+    sample.add_argument("--grain-key", type=seed_argument, default=None, metavar="K",
+                        help="a grain key in [0, 2**63): every draw is that one grain over random orientations "
+                             "(its shape from the mix by the key; on the direct path its proportions and hand "
+                             "too), as a particle of that key hits every time")
     sample.add_argument("--clamp", action="store_true",
                         help="with --method table: outside the table's range (but physical), use the law at the "
                              "nearest grid edge")

@@ -42,14 +42,16 @@ import numpy as np
 
 from data_schema.table import STATE_NAMES
 from surrogate.kernels.direct_path import direct_rebound_parallel_rng
+from surrogate.kernels.grain import keyed_shapes
 from surrogate.kernels.locate import mix_shapes
 from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
 from surrogate.kernels.wall_hit import METHOD_DIRECT, METHOD_TABLE, rebound_parallel_rng
 from surrogate.table import SurrogateTable
-from surrogate.validation import (as_rows, check_direct_parameters, check_direct_paths, check_half_size,
-                                  check_incident, check_interpolation, check_local_states, check_method, check_omega,
-                                  check_out, check_random_state, check_shape, check_vectors)
+from surrogate.validation import (as_rows, check_direct_parameters, check_direct_paths, check_grain_key,
+                                  check_half_size, check_incident, check_interpolation, check_local_states,
+                                  check_method, check_omega, check_out, check_random_state, check_shape,
+                                  check_vectors)
 
 
 class LocalDraws(NamedTuple):
@@ -94,7 +96,7 @@ def _incident(table: SurrogateTable, velocity, normal, half_size, omega) -> tupl
 
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
                   clamp: bool = False, interpolation: str = "scaled", out=None, *, omega=None, method: str = "auto",
-                  return_path: bool = False):
+                  return_path: bool = False, grain_key=None):
     """Reflected velocities and spins of particles hitting walls, in the global frame: every hit answered, by
     the table where it is valid and by the direct model elsewhere.
 
@@ -136,6 +138,13 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         for every hit. With Ω⁻ zero and every state in the grid, ``"auto"`` gives ``"table"``'s bits.
     return_path : also return which path answered each hit (0 the table, 1 the direct model;
         :data:`surrogate.kernels.PATH_TABLE`, :data:`surrogate.kernels.PATH_DIRECT`).
+    grain_key : None (default: every hit a new grain drawn from the stream) or (N,) integers in [0, 2**63), one
+        per particle, kept for its life (:func:`surrogate.grain_key` derives them): the particle hits as the same
+        grain every time. Its shape is the key's on either path (a shape given per particle wins); on the direct
+        path its proportions b/a, c/b and its hand are the key's too, while the table path draws them from the
+        shape's law, which the table holds over random proportions (:func:`surrogate.grain_of` gives a key's
+        grain). The orientation at impact and the table's draw stay random per hit; the stream advances as
+        without keys. None gives the bits of a call without the keyword.
 
     Returns
     -------
@@ -152,6 +161,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # the grid's range is an error only where the table must answer every hit
     check_incident(table, V, nrm, a, grid=not clamp and code == METHOD_TABLE)
     cdf, shapes = check_shape(table, shape, n_particles)
+    keys = check_grain_key(grain_key, n_particles)
     if code == METHOD_DIRECT and table.direct_parameters is not None:
         _check_direct_shapes(table, cdf, shapes)
     scaled = check_interpolation(interpolation)
@@ -163,7 +173,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
     params = np.zeros(0) if table.direct_parameters is None else table.direct_parameters
     states = chunk_states(check_random_state(random_state), n_particles)
-    rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, V, W,
+    rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
                          as_rows(nrm, n_particles),
                          as_rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
     if old_table:
@@ -174,7 +184,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
 
 
 def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None, *,
-                  omega=None, out=None):
+                  omega=None, out=None, grain_key=None):
     """Reflected velocities and spins of particles hitting walls, from the direct model alone, in the caller's
     frame (docs/model.md §10): for any hit to be computed by the model itself, a spinning one or one off the
     table's grid (:func:`sample_global`'s ``method="auto"`` does this where the table does not apply).
@@ -196,6 +206,9 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
         body starts touching the wall (as in the tables), otherwise the flight in from a clear start is
         simulated.
     out : None or (V_out, Omega_out, status) arrays to fill (as :func:`sample_global`'s).
+    grain_key : None or (N,) integers in [0, 2**63), one per particle (as :func:`sample_global`'s): a keyed
+        particle's shape (unless given per particle), proportions and hand are its key's
+        (:func:`surrogate.grain_of`), its orientation random per hit. The stream advances as without keys.
 
     Returns
     -------
@@ -210,13 +223,16 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     check_incident(table, V, nrm, a, grid=False)
     cdf, shapes = check_shape(table, shape, n_particles)
     _check_direct_shapes(table, cdf, shapes)
+    keys = check_grain_key(grain_key, n_particles)
     V_out, Omega_out, status = check_out(out, n_particles, (V, nrm, a, W))
     generator = check_random_state(random_state)
     if shapes.size == 0:
-        shapes = _mix_rows(cdf, n_particles, generator)
+        shapes = _mix_rows(cdf, n_particles, generator)      # drawn with keys too: the stream advances alike
+        if keys.size:
+            shapes = keyed_shapes(cdf, np.zeros(0, dtype=np.int64), keys)
     codes = np.ascontiguousarray(table.model_shapes[shapes])
     states = chunk_states(generator, n_particles)
-    direct_rebound_parallel_rng(params, table.shape_arrays, codes, V, as_rows(W, n_particles),
+    direct_rebound_parallel_rng(params, table.shape_arrays, codes, keys, V, as_rows(W, n_particles),
                                 as_rows(nrm, n_particles), as_rows(a, n_particles), states, V_out, Omega_out, status)
     return V_out, Omega_out, status
 

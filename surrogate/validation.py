@@ -212,6 +212,29 @@ def mix_cdf(table, shape) -> np.ndarray:
 
 # -- options -----------------------------------------------------------------------------------------
 
+def check_grain_key(grain_key, n: int) -> np.ndarray:
+    """The grain keys as the kernels take them: (n,) int64 (:mod:`surrogate.kernels.grain`), or (0,) for None
+    (no keys). ``grain_key`` is one integer ≥ 0 per particle ((n,); an integer scalar for all n), below 2**63;
+    a float, bool or object array, a negative or too large value, another length is a ValueError naming it."""
+    if grain_key is None:
+        return np.zeros(0, dtype=np.int64)
+    if isinstance(grain_key, (bool, float, np.bool_, np.floating)):     # a scalar: name its value
+        raise ValueError(f"The 'grain_key' parameter must be integers in [0, 2**63), one per particle; got "
+                         f"{grain_key!r} ({type(grain_key).__name__}).")
+    keys = np.asarray(grain_key)
+    if keys.dtype.kind not in "iu":
+        raise ValueError(f"The 'grain_key' parameter must be integers in [0, 2**63), one per particle; got an array "
+                         f"of dtype {keys.dtype} (a float, bool or object key is refused, not rounded).")
+    if keys.ndim == 0:
+        keys = np.full(n, keys, dtype=keys.dtype)
+    if keys.shape != (n,):
+        raise ValueError(f"The 'grain_key' parameter must be one key per particle, shape ({n},); got {keys.shape}.")
+    bad = np.flatnonzero(keys < 0) if keys.dtype.kind == "i" else np.flatnonzero(keys > np.iinfo(np.int64).max)
+    if bad.size:
+        raise ValueError(f"The 'grain_key' at index {bad[0]} must be in [0, 2**63); got {keys[bad[0]]}.")
+    return np.ascontiguousarray(keys, dtype=np.int64)
+
+
 def check_method(method) -> int:
     """The kernels' code (METHOD_*) of a method name: "auto", "table" or "direct"."""
     if not isinstance(method, str) or method not in METHODS:

@@ -16,6 +16,8 @@ program rebound_example
   real(c_double) :: Vs(3, n_many), ns(3, n_many), a(n_many), Vs_out(3, n_many), Ws_out(3, n_many)
   integer(c_signed_char) :: status(n_many)
   integer(c_int) :: code, st, i, answered_by
+  integer(c_int64_t) :: key
+  type(rbs_grain) :: grain
 
   if (command_argument_count() < 1) then
     print '(a)', "usage: rbs_example_fortran TABLE.h5"
@@ -55,6 +57,18 @@ program rebound_example
   st = rbs_rebound_rng(table, mix, V, Omega, n, 5e-5_c_double, rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out)
   print '(a, i0, a, i0, a, 3f10.3)', "spinning: path ", answered_by, ", status ", st, "  V+ =", V_out
   if (answered_by /= RBS_PATH_DIRECT) stop 6
+
+  ! a particle of its own grain: its key from (seed, rank, id); every hit of it is the same grain, spinning or not
+  key = rbs_grain_key(1_c_int64_t, 0_c_int64_t, 42_c_int64_t)
+  if (rbs_grain_info(table, mix, key, grain) /= RBS_OK) stop 8
+  print '(a, i0, a, i0, a, 3f8.4)', "grain: key ", key, ", shape ", grain%shape, ", b/a c/b hand", &
+      grain%ratio_ba, grain%ratio_cb, grain%hand
+  do i = 1, 2
+    st = rbs_rebound_grain_rng(table, mix, key, V, Omega, n, 5e-5_c_double, rng, RBS_AUTO, RBS_SCALED, V_out, &
+                               Omega_out)
+    print '(a, i0, a, 3f10.3)', "grain hit: status ", st, "  V+ =", V_out
+    if (st == RBS_INVALID) stop 9
+  end do
 
   ! many particles in one call (the faster path)
   do i = 1, n_many

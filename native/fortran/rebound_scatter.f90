@@ -36,6 +36,13 @@ module rebound_scatter
     integer(c_int64_t) :: s(4)
   end type rbs_rng
 
+  ! one grain of a table's mix (rbs_grain, rbs_grain_info): its table shape index (0-based), its direct-model
+  ! shape (-1: none), the b/a, c/b and hand the direct path gives it (NaN where the key does not draw them)
+  type, bind(c) :: rbs_grain
+    integer(c_int) :: shape, direct_shape
+    real(c_double) :: ratio_ba, ratio_cb, hand
+  end type rbs_grain
+
   interface
     integer(c_int) function rbs_table_open(path, table, message, message_size) bind(c, name="rbs_table_open")
       import :: c_int, c_char, c_ptr, c_size_t
@@ -197,6 +204,47 @@ module rebound_scatter
       real(c_double), intent(in) :: u(RBS_U_PER_REBOUND)
       real(c_double), intent(out) :: V_out(3), Omega_out(3)
     end function rbs_direct_rebound
+
+    ! grain keys (1.2): a particle of key >= 0 hits every wall as the same grain (rebound_scatter.h, "Grain keys")
+    integer(c_int) function rbs_rebound_grain(table, mix, key, V, Omega, n, a, u, method, interpolation, V_out, &
+        Omega_out) bind(c, name="rbs_rebound_grain")
+      import :: c_int, c_int64_t, c_ptr, c_double, rbs_mix, RBS_U_PER_DRAW
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      integer(c_int64_t), value :: key
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      real(c_double), intent(in) :: u(RBS_U_PER_DRAW)
+      integer(c_int), value :: method, interpolation
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_rebound_grain
+
+    integer(c_int) function rbs_rebound_grain_rng(table, mix, key, V, Omega, n, a, rng, method, interpolation, &
+        V_out, Omega_out) bind(c, name="rbs_rebound_grain_rng")
+      import :: c_int, c_int64_t, c_ptr, c_double, rbs_mix, rbs_rng
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      integer(c_int64_t), value :: key
+      real(c_double), intent(in) :: V(3), Omega(3), n(3)
+      real(c_double), value :: a
+      type(rbs_rng), intent(inout) :: rng
+      integer(c_int), value :: method, interpolation
+      real(c_double), intent(out) :: V_out(3), Omega_out(3)
+    end function rbs_rebound_grain_rng
+
+    integer(c_int) function rbs_grain_info(table, mix, key, grain) bind(c, name="rbs_grain_info")
+      import :: c_int, c_int64_t, c_ptr, rbs_mix, rbs_grain
+      type(c_ptr), value :: table
+      type(rbs_mix), intent(in) :: mix
+      integer(c_int64_t), value :: key
+      type(rbs_grain), intent(out) :: grain
+    end function rbs_grain_info
+
+    ! seed and ids are uint64 in C: values >= 2**63 are negative here
+    integer(c_int64_t) function rbs_grain_key(seed, id1, id2) bind(c, name="rbs_grain_key")
+      import :: c_int64_t
+      integer(c_int64_t), value :: seed, id1, id2
+    end function rbs_grain_key
 
     ! rbs_rebound_rng under its 0.x name, kept for programs written against 0.x
     integer(c_int) function rbs_rebound_spin(table, mix, V, Omega, n, a, rng, method, interpolation, V_out, &

@@ -23,7 +23,9 @@
  * Version 1.0 renamed the draws of 0.x; rbs_rebound_spin and rbs_rebound_path keep working with their 0.x
  * arguments (end of this header). Version 1.1 reads tables of any number of shapes (format 3.4: the families and
  * the user's own grains, each stored as data; rbs_table_shape_info) and adds the mixes sized by the table
- * (rbs_mix_new_*); every 1.0 program compiles and runs unchanged on tables of at most 4 shapes.
+ * (rbs_mix_new_*); every 1.0 program compiles and runs unchanged on tables of at most 4 shapes. Version 1.2 adds
+ * grain keys (rbs_rebound_grain, "Grain keys" below): a particle that keeps its grain from one hit to the next;
+ * every 1.0 and 1.1 call keeps its arguments and its bits.
  *
  * Frames and units
  * ----------------
@@ -88,7 +90,7 @@ extern "C" {
 #endif
 
 #define RBS_VERSION_MAJOR 1
-#define RBS_VERSION_MINOR 1
+#define RBS_VERSION_MINOR 2
 #define RBS_VERSION_PATCH 0
 
 #define RBS_U_PER_DRAW 13       /* uniforms per draw (surrogate.U_PER_DRAW) */
@@ -320,6 +322,51 @@ int rbs_rebound_rng(const rbs_table *table, const rbs_mix *mix, const double V[3
  * not finite and > 0, Ω⁻ not finite). */
 int rbs_rebound_path(const rbs_table *table, const double V[3], const double Omega[3], const double n[3],
                      double a, int method);
+
+/* ---------------------------------------------------------------- grain keys */
+
+/* A grain key: an int64 >= 0 per particle, its own for life (rbs_grain_key derives one from a seed and the
+ * particle's ids), so that the particle hits every wall as the same grain (surrogate.kernels.grain). The random
+ * properties of the grain are pure functions of (key, the shape mix): the shape from the mix, and, for a shape of
+ * random proportions, b/a and c/b, and for a shape drawn in both hands, its hand; each is drawn from a uniform of
+ * the key (splitmix64 of the key and the property's slot) instead of from u. Everything else (the orientation
+ * at impact, the table's law, the impact frame) stays random per hit from u. Which path honours what: the table
+ * holds each shape's law over its random proportions and hands, so under the table path a key fixes the shape
+ * only; under the direct path it fixes the shape, the proportions and the hand (rbs_grain_info gives them). */
+
+/* One grain of a table's mix (rbs_grain_info). */
+typedef struct rbs_grain {
+    int shape;              /* the table's shape index (rbs_table_shape_name gives its name) */
+    int direct_shape;       /* its shape for rbs_direct_rebound (rbs_shape_info.direct_shape); −1 for none */
+    double ratio_ba;        /* b/a and c/b the direct path gives this grain on every hit; NaN for a shape of */
+    double ratio_cb;        /*   fixed proportions or without direct shape (the table path: the shape's law) */
+    double hand;            /* +1 or −1 (the mirror image) on the direct path; NaN for a shape of one hand */
+} rbs_grain;
+
+/* rbs_rebound for a particle of grain key `key` (surrogate.kernels.wall_hit.rebound with its `key`): the same
+ * path, with u[0] (the shape) replaced by the key's uniform on either path and, on the direct path, u[4], u[5]
+ * (b/a, c/b) and u[6] (the hand; u[1 + k] is the direct model's u[k]) by the key's. The hit still takes
+ * RBS_U_PER_DRAW uniforms, all checked in [0, 1), so streams stay aligned keyed or not. A key < 0 (or what
+ * rbs_rebound refuses) gives RBS_INVALID and NaN outputs. Thread-safe. */
+int rbs_rebound_grain(const rbs_table *table, const rbs_mix *mix, int64_t key, const double V[3],
+                      const double Omega[3], const double n[3], double a, const double u[RBS_U_PER_DRAW], int method,
+                      int interpolation, double V_out[3], double Omega_out[3]);
+
+/* rbs_rebound_grain with its RBS_U_PER_DRAW uniforms drawn from `rng` (rbs_rng_fill), which advances by them
+ * whatever the path, the key and the result; a NULL or all-zero rng gives RBS_INVALID. */
+int rbs_rebound_grain_rng(const rbs_table *table, const rbs_mix *mix, int64_t key, const double V[3],
+                          const double Omega[3], const double n[3], double a, rbs_rng *rng, int method,
+                          int interpolation, double V_out[3], double Omega_out[3]);
+
+/* The grain of key `key` in the mix `mix` of `table` (surrogate.kernels.grain: grain_shape, grain_properties;
+ * surrogate.grain_of from Python): its shape, and the proportions and hand the direct path gives it. Returns RBS_OK,
+ * or RBS_ERR_ARGUMENT (nothing written) for a NULL pointer, a mix of another table's shape count or key < 0. */
+int rbs_grain_info(const rbs_table *table, const rbs_mix *mix, int64_t key, rbs_grain *grain);
+
+/* A grain key from a seed and two ids, e.g. (the run's seed, the rank a particle was born on, its number there):
+ * splitmix64 chained, the top bit cleared, so a key >= 0 (surrogate.kernels.grain.grain_key; surrogate.grain_key
+ * from Python with the same numbers). The same numbers give the same key on every machine, rank count and run. */
+int64_t rbs_grain_key(uint64_t seed, uint64_t id1, uint64_t id2);
 
 /* ---------------------------------------------------------------- the table path */
 

@@ -41,6 +41,12 @@ static inline uint64_t rbs_splitmix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
+/* a uniform in [0, 1) that depends on the grain key and the slot only (surrogate.kernels.rng.grain_uniform) */
+static inline double rbs_grain_uniform(uint64_t key, uint64_t slot)
+{
+    return rbs_uniform_of(rbs_splitmix64(rbs_splitmix64(key + RBS_GOLDEN) + (slot + 1) * RBS_GOLDEN));
+}
+
 /* a state that is not NULL and not all zero (xoshiro256+'s fixed point: all-zero words give 0 forever) */
 static inline int rbs_rng_ok(const rbs_rng *rng)
 {

@@ -1,6 +1,7 @@
 /*
- * wall_hit.c: every wall hit answered, spinning or not (surrogate.kernels.wall_hit: rebound_path, rebound): the
- * path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound along it.
+ * wall_hit.c: every wall hit answered, spinning or not (surrogate.kernels.wall_hit: rebound_path, rebound,
+ * _rebound_along): the path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound
+ * along it.
  *
  * A hit consumes RBS_U_PER_DRAW uniforms whatever path answers it, so a stream stays aligned. The table path
  * is rbs_table_rebound with those uniforms; the direct path draws the shape from the mix with u[0] as the
@@ -55,7 +56,14 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3
                         const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
                         double V_out[3], double Omega_out[3])
 {
-    int path = rbs_rebound_path(t, V, Omega, n, a, method);
+    return rbs_rebound_along(t, mix, rbs_rebound_path(t, V, Omega, n, a, method), V, Omega, n, a, u, interpolation,
+                             V_out, Omega_out);
+}
+
+int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const double V[3], const double Omega[3],
+                      const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
+                      double Omega_out[3])
+{
     if (path == RBS_INVALID || !u || !V_out || !Omega_out || !rbs_table_arguments_ok(t, mix, interpolation)
         || !rbs_uniforms_ok(u, 1)) {
         nan_out(V_out);

@@ -18,6 +18,8 @@ xoshiro256+ state. Where each part lives:
                  particle), :func:`rebound_parallel_rng` (many, all threads), :func:`rebound_path` (which path
                  answers a hit: the table where it is valid, the direct model elsewhere); METHOD_*, PATH_*,
                  SPIN_TOLERANCE
+``grain``        grain keys: a particle's shape, proportions and hand from its key (:func:`keyed_uniforms`,
+                 :func:`grain_properties`, :func:`grain_key`); NO_KEY
 ``block``        the block form of the stages' records, field-major over BLOCK particles
 ``pipeline``     many particles on one thread, the stages' block forms scheduled: :func:`table_rebound_many`,
                  :func:`table_rebound_many_rng`

@@ -154,6 +154,18 @@ def check_shapes(shapes, rows, n_shapes):
 
 
 @numba.njit(**JIT)
+def check_keys(keys, rows):
+    """ValueError unless ``keys`` is empty (no grain keys) or holds one key per row, each ≥ 0 or NO_KEY (−1,
+    none): :mod:`surrogate.kernels.grain`."""
+    if keys.shape[0] != 0 and keys.shape[0] != rows:
+        raise ValueError(shape_error("keys", keys.shape, "(" + str(rows) + ",) or (0,)"))
+    for i in range(keys.shape[0]):
+        if keys[i] < -1:
+            raise ValueError("'keys' must hold grain keys >= 0 or -1 (none); row " + str(i) + " holds "
+                             + str(keys[i]))
+
+
+@numba.njit(**JIT)
 def check_local_rows(alpha1, speed, out, status):
     """ValueError naming the first array of a local-frame call that has not one row per incident state."""
     rows = alpha1.shape[0]

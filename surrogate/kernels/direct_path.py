@@ -17,7 +17,9 @@ import numpy as np
 
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_model_frame
+from surrogate.kernels.checks import check_keys
 from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, particle_ok, to_global
+from surrogate.kernels.grain import key_model_uniforms
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
 
@@ -83,18 +85,25 @@ def _frame_axes(V, n, u_axis):
 
 
 @numba.njit(parallel=True, **JIT)
-def direct_rebound_parallel_rng(params, shape_arrays, shape, V, omega, n, a, states, V_out, Omega_out, status):
+def direct_rebound_parallel_rng(params, shape_arrays, shape, keys, V, omega, n, a, states, V_out, Omega_out,
+                                status):
     """:func:`direct_rebound` for every row i of shape (N,) indices into ``shape_arrays``, V, omega, n (N, 3) and
     a (N,), on all
     threads: chunk j of CHUNK_ROWS rows draws its uniforms, U_PER_REBOUND per row in row order, from a copy of
     the xoshiro256+ state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the results do not
-    depend on the number of threads. Outputs V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,)."""
+    depend on the number of threads. ``keys``: (N,) int64 grain keys (≥ 0; NO_KEY −1: none) or empty (none):
+    a keyed row's proportions and hand are its key's (:func:`surrogate.kernels.grain.key_model_uniforms`; its
+    shape is the caller's ``shape[i]``, :func:`surrogate.kernels.grain.grain_shape` for a grain of the mix).
+    Outputs V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,)."""
+    check_keys(keys, V.shape[0])
     for j in numba.prange(states.shape[0]):
         state = states[j].copy()
         u = np.empty(U_PER_REBOUND)
         scratch = np.empty(SCRATCH_SIZE)
         for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
             fill_uniforms(state, u)
+            if keys.shape[0] > 0 and keys[i] >= 0:
+                key_model_uniforms(keys[i], u)
             st, V_new, Omega_new = inline_direct_rebound(params, shape_arrays, shape[i], (V[i, 0], V[i, 1], V[i, 2]),
                                                          (omega[i, 0], omega[i, 1], omega[i, 2]),
                                                          (n[i, 0], n[i, 1], n[i, 2]), a[i], u, scratch)

@@ -138,6 +138,17 @@ def _splitmix64(x):
 
 
 @numba.njit(inline="always", cache=True, nogil=True)
+def grain_uniform(key, slot):
+    """A uniform in [0, 1) (53 bits) that depends on the grain key and the slot only, not on any stream.
+
+    splitmix64 of the key, then splitmix64 of that plus (slot + 1)·γ: keys that differ by a multiple of γ
+    still give unrelated uniforms. ``key`` a non-negative int64, ``slot`` a small non-negative integer.
+    """
+    x = _splitmix64(np.uint64(key) + _GOLDEN) + np.uint64(slot + 1) * _GOLDEN
+    return np.float64(np.int64(_splitmix64(x) >> np.uint64(11))) * _53_BITS
+
+
+@numba.njit(inline="always", cache=True, nogil=True)
 def seed_lanes(state, lanes):
     """Seed L = len(lanes) // 4 xoshiro256+ lanes from ``state`` ((4,) uint64, advanced one step).
 

@@ -19,7 +19,9 @@ its index in the direct model's shapes (``model_shapes``, into ``shape_arrays``)
 its U_PER_REBOUND uniforms (u[1 + k]
 is the model's u[k]; the axis at normal impact is u[7]). :func:`rebound_parallel_rng` also takes one shape per
 particle (``shapes``, the table's shape index, or SHAPE_FROM_MIX): a particle given its shape still consumes its
-u[0], on either path (:func:`surrogate.kernels.locate.row_shape`).
+u[0], on either path (:func:`surrogate.kernels.locate.row_shape`). A particle of a grain key (``key``,
+``keys``) hits as its own grain: its shape from the key on either path, its proportions and hand too on the
+direct path (:mod:`surrogate.kernels.grain`).
 
 Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
 gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a
@@ -34,10 +36,12 @@ import numpy as np
 from data_schema.samples import STATUS_INVALID
 from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
 from surrogate.kernels.direct_path import inline_direct_rebound
+from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
+from surrogate.kernels.grain import keyed_shapes, keyed_uniforms
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
-from surrogate.kernels.checks import check_shapes
+from surrogate.kernels.checks import check_keys, check_shapes
 from surrogate.kernels.options import JIT
 from surrogate.kernels.pipeline import no_uniforms, run_blocks, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS
@@ -95,7 +99,8 @@ def rebound_path(data, V, omega, n, a, method):
 
 
 @numba.njit(**JIT)
-def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True):
+def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True,
+            key=None):
     """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
     3-tuples in the caller's frame.
 
@@ -110,11 +115,35 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
     V, omega, n, a, method : as :func:`rebound_path`.
     u : (U_PER_DRAW,) array of uniforms in [0, 1) (module doc for how each path uses them).
     scaled : the table path's interpolation (:func:`surrogate.kernels.table_path.table_rebound`).
+    key : None (the default: no key, the draws of u alone; the keyed code is not even compiled) or the
+        particle's grain key, an int ≥ 0 (:mod:`surrogate.kernels.grain`: its shape on either path, and on the
+        direct path its proportions and hand, are the key's, whatever u[0], u[4], u[5], u[6] are; the 13
+        uniforms are still all checked).
 
     Returns STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
-    a uniform outside [0, 1) whatever the path, a method not in the three); NaN vectors unless rebounded.
+    a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0); NaN vectors unless
+    rebounded.
     """
     path = rebound_path(data, V, omega, n, a, method)
+    if key is not None:
+        return _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path,
+                              key)
+    return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path)
+
+
+@numba.njit(inline="always", **JIT)
+def _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path, key):
+    """:func:`rebound` of a particle of grain key ``key`` along its path ``path``: u with the key's slots."""
+    if key < 0 or path == STATUS_INVALID or not uniforms_ok(u):
+        return STATUS_INVALID, NAN3, NAN3
+    keyed = np.empty(U_PER_DRAW)
+    keyed_uniforms(key, u, path == PATH_DIRECT, keyed)
+    return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, keyed, scaled, path)
+
+
+@numba.njit(inline="always", **JIT)
+def _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path):
+    """:func:`rebound` along its path ``path`` with the uniforms ``u``."""
     if path == PATH_TABLE:
         return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
@@ -149,14 +178,17 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 
 @numba.njit(parallel=True, **JIT)
-def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, V, omega, n, a, states, method,
-                         V_out, Omega_out, status, path, scaled=True):
+def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
+                         method, V_out, Omega_out, status, path, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
     a (N,), on all threads; the path of each row into ``path`` (N,).
 
     ``shapes``: (N,) int64, each row's shape (its index in the table, or SHAPE_FROM_MIX to draw it from
     ``mix_cdf``), or empty, every row's from the mix (:func:`surrogate.kernels.locate.row_shape`); ValueError
-    for another length or an index outside the table's shapes.
+    for another length or an index outside the table's shapes. ``keys``: (N,) int64, each row's grain key
+    (≥ 0, or NO_KEY), or empty, no keys: a keyed row's results are :func:`rebound`'s with its ``key``
+    (:func:`surrogate.kernels.grain.keyed_shapes`; on the direct path its proportions and hand too); ValueError
+    for another length or a key < −1.
 
     The uniforms are those :func:`surrogate.kernels.parallel.table_rebound_parallel_rng` draws: chunk j's rows
     (CHUNK_ROWS rows) from a copy of ``states[j]``, U_PER_DRAW per row. Where the table answers every row
@@ -171,6 +203,9 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
     check_shapes(shapes, V.shape[0], mix_cdf.shape[0])
+    check_keys(keys, V.shape[0])
+    keyed = keys.shape[0] > 0
+    row_shapes = keyed_shapes(mix_cdf, shapes, keys)     # a copy of shapes without keys
     rows = V.shape[0]
     last_omega = omega.shape[0] - 1
     for j in numba.prange(states.shape[0]):
@@ -183,8 +218,8 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
         for i in range(lo, hi):
             n_table += path[i] == PATH_TABLE
         if n_table > 0:
-            run_blocks(data, mix_cdf, shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), states[j].copy(),
-                       V_out[lo:hi], Omega_out[lo:hi], status[lo:hi], scaled)
+            run_blocks(data, mix_cdf, row_shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(),
+                       states[j].copy(), V_out[lo:hi], Omega_out[lo:hi], status[lo:hi], scaled)
         if n_table < hi - lo:
             u = table_rebound_uniforms(states[j].copy(), hi - lo)
             scratch = np.empty(SCRATCH_SIZE)
@@ -194,7 +229,9 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
                 w = min(i, last_omega)
                 st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
                 if path[i] == PATH_DIRECT:
-                    shape = shapes[i] if shapes.shape[0] > 0 else SHAPE_FROM_MIX
+                    shape = row_shapes[i] if row_shapes.shape[0] > 0 else SHAPE_FROM_MIX
+                    if keyed and keys[i] >= 0:
+                        keyed_uniforms(keys[i], u[i - lo], True, u[i - lo])
                     st, V_new, Omega_new = _direct_path(
                         params, shape_arrays, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
                         (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo],

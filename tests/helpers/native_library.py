@@ -120,6 +120,13 @@ class ShapeArrays(ctypes.Structure):
         return cls(len(arrays.kind), *(getattr(arrays, name).ctypes.data for name in cls.FIELDS))
 
 
+class Grain(ctypes.Structure):
+    """rbs_grain (rbs_grain_info)."""
+
+    _fields_ = [("shape", ctypes.c_int), ("direct_shape", ctypes.c_int), ("ratio_ba", ctypes.c_double),
+                ("ratio_cb", ctypes.c_double), ("hand", ctypes.c_double)]
+
+
 class Info(ctypes.Structure):
     _fields_ = [("n_shapes", ctypes.c_int), ("n_alpha1", ctypes.c_int), ("n_speed", ctypes.c_int),
                 ("n_clusters", ctypes.c_int), ("n_levels", ctypes.c_int), ("n_dictionary", ctypes.c_int),
@@ -276,6 +283,31 @@ class NativeTable:
                                              _ptr(V_out), _ptr(W_out))
         return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
 
+    def rebound_grain(self, mix, key: int, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
+        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_rebound_grain."""
+        V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
+        V_out, W_out = np.empty(3), np.empty(3)
+        status = self.lib.c.rbs_rebound_grain(self.handle, _mix_ref(mix), ctypes.c_int64(key), _ptr(V), _ptr(Omega),
+                                              _ptr(n), ctypes.c_double(a), _ptr(u), method, interpolation,
+                                              _ptr(V_out), _ptr(W_out))
+        return status, V_out, W_out
+
+    def rebound_grain_rng(self, mix, key: int, V, Omega, n, a, state: np.ndarray, method=AUTO, interpolation=SCALED):
+        """(status, V⁺, Ω⁺, advanced state) of rbs_rebound_grain_rng."""
+        V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
+        rng = _rng(state)
+        V_out, W_out = np.empty(3), np.empty(3)
+        status = self.lib.c.rbs_rebound_grain_rng(self.handle, _mix_ref(mix), ctypes.c_int64(key), _ptr(V),
+                                                  _ptr(Omega), _ptr(n), ctypes.c_double(a), ctypes.byref(rng), method,
+                                                  interpolation, _ptr(V_out), _ptr(W_out))
+        return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
+
+    def grain_info(self, mix, key: int):
+        """(code, rbs_grain as a dict or None) of rbs_grain_info."""
+        grain = Grain()
+        code = self.lib.c.rbs_grain_info(self.handle, _mix_ref(mix), ctypes.c_int64(key), ctypes.byref(grain))
+        return code, ({name: getattr(grain, name) for name, _ in Grain._fields_} if code == OK else None)
+
     def rebound_path(self, V, Omega, n, a, method=AUTO):
         V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
         return self.lib.c.rbs_rebound_path(self.handle, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a), method)
@@ -347,6 +379,15 @@ class Native:
         for kept in ("rbs_rebound_rng", "rbs_rebound_spin"):     # rbs_rebound_spin: its 0.x name
             getattr(c, kept).argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, ctypes.POINTER(Rng), i, i, vp, vp]
             getattr(c, kept).restype = i
+        c.rbs_rebound_grain.argtypes = [vp, ctypes.POINTER(Mix), ctypes.c_int64, vp, vp, vp, d, vp, i, i, vp, vp]
+        c.rbs_rebound_grain.restype = i
+        c.rbs_rebound_grain_rng.argtypes = [vp, ctypes.POINTER(Mix), ctypes.c_int64, vp, vp, vp, d, ctypes.POINTER(Rng),
+                                            i, i, vp, vp]
+        c.rbs_rebound_grain_rng.restype = i
+        c.rbs_grain_info.argtypes = [vp, ctypes.POINTER(Mix), ctypes.c_int64, ctypes.POINTER(Grain)]
+        c.rbs_grain_info.restype = i
+        c.rbs_grain_key.argtypes = [ctypes.c_uint64, ctypes.c_uint64, ctypes.c_uint64]
+        c.rbs_grain_key.restype = ctypes.c_int64
         c.rbs_rebound_path.argtypes = [vp, vp, vp, vp, d, i]
         c.rbs_rebound_path.restype = i
         c.rbs_rng_seed.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64]
@@ -397,6 +438,9 @@ class Native:
         rng = _rng(state)
         x = self.c.rbs_rng_uniform(ctypes.byref(rng))
         return x, np.array(list(rng.s), dtype=np.uint64)
+
+    def grain_key(self, seed: int, id1: int, id2: int) -> int:
+        return self.c.rbs_grain_key(ctypes.c_uint64(seed), ctypes.c_uint64(id1), ctypes.c_uint64(id2))
 
     def table_rebound_uniforms(self, state: np.ndarray, count: int):
         rng, u = _rng(state), np.empty((count, U_PER_DRAW))

@@ -19,8 +19,8 @@ import surrogate
 from direct_model import runtime as direct_runtime     # the parameter layout (P_*, U_*, N_PARAMS)
 from data_schema.samples import STATUS_FAILED, angles_to_velocity
 from direct_model.rotation import ROT_PARAMS_SIZE, carlson_rf, carlson_rj, rotation_at, rotation_init
-from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, load, mix_cdf, \
-    seed_state
+from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DRAW, fill_uniforms, grain_key, \
+    grain_of, load, mix_cdf, seed_state
 from surrogate.kernels import draw_local, table_rebound, table_rebound_many, table_rebound_many_rng, table_rebound_uniforms
 from surrogate.kernels.direct_path import direct_rebound
 from direct_model.collision import collide

@@ -221,7 +221,8 @@ def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table
     with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
         rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                              small_table.model_shapes,
-                             surrogate.mix_cdf(small_table, "mix"), np.zeros(0, np.int64), V, np.zeros((1, 3)),
+                             surrogate.mix_cdf(small_table, "mix"), np.zeros(0, np.int64), np.zeros(0, np.int64), V,
+                             np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3,
                              *outputs)
 
@@ -241,7 +242,7 @@ def test_the_many_hit_kernel_refuses_shape_indices_outside_the_table(small_table
     with pytest.raises(ValueError, match=message):
         rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                              small_table.model_shapes,
-                             surrogate.mix_cdf(small_table, "mix"), shapes, V, np.zeros((1, 3)),
+                             surrogate.mix_cdf(small_table, "mix"), shapes, np.zeros(0, np.int64), V, np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 0,
                              *outputs)
 
@@ -353,8 +354,8 @@ def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, me
 
     def run(cdf, rows):
         outputs = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, np.int8), np.empty(m, np.int8)
-        rebound_parallel_rng(data, params, small_table.shape_arrays, model_shapes, cdf, rows, V, W,
-                             np.tile(NORMAL, (m, 1)), np.full(m, A),
+        rebound_parallel_rng(data, params, small_table.shape_arrays, model_shapes, cdf, rows, np.zeros(0, np.int64), V,
+                             W, np.tile(NORMAL, (m, 1)), np.full(m, A),
                              chunk_states(np.random.default_rng(11), m), method, *outputs)
         return outputs
 
