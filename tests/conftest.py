@@ -1,10 +1,14 @@
 """Shared fixtures: small tables built once per test session (2e4 particles per cell, all four shapes), and the
-long subprocesses that tests only wait for, started when the session starts (tests.helpers.background)."""
+long subprocesses that tests only wait for (builds, fresh installs, runs under other CPU settings), started when the
+session starts (tests.helpers.background)."""
+
+import os
 
 import pytest
 
 from tablegen import build_table, load_config, parse_config
-from tests.helpers import background, cpu_dispatch
+from tests.helpers import REPO, background, cpu_dispatch
+from tests.helpers.native_library import build as native_build_in
 from tests.helpers.plain_install import install_and_draw
 from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG, SMALL_TABLE_CONFIG,
                                   WIDE_GRAZING_TABLE_CONFIG, write_grain_config)
@@ -59,9 +63,15 @@ def near_normal_table(tmp_path_factory):
     return surrogate.load(_build(tmp_path_factory, "near_normal", NEAR_NORMAL_TABLE_CONFIG))
 
 
+# a rank of the 2-rank solver cases waiting in a collective yields its core instead of polling: the cases run beside
+# the tests and the background worker on 2 cores (a code_saturne 2-rank case took 113 s polling against two busy
+# loops, 57 s yielding; the hits are the same)
+os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
+
 # fixtures whose subprocesses run next to the tests from the session's start, in this order (the order their
 # tests come in); each is started only when a selected test uses it
-STARTED_WITH_THE_SESSION = ("dispatch_children", "forced_rebuilds", "plain_install")
+STARTED_WITH_THE_SESSION = ("saturne_build_job", "native_build_job", "native_sanitized_job", "native_baseline_job",
+                            "openfoam_build_job", "dispatch_children", "forced_rebuilds", "plain_install")
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -91,3 +101,44 @@ def forced_rebuilds(tmp_path_factory):
 def plain_install(small_table_path, tmp_path_factory):
     """The future of tests/test_install.py's fresh install and draw (tests.helpers.plain_install.install_and_draw)."""
     return background.submit(install_and_draw, small_table_path, tmp_path_factory.mktemp("install"))
+
+
+def _integration_build(name):
+    return background.submit(background.run, ["bash", str(REPO / "integrations" / name / "build.sh")], cwd=REPO,
+                             timeout=1200)
+
+
+@pytest.fixture(scope="session")
+def saturne_build_job():
+    """The future of integrations/code_saturne/build.sh's finished process (tests/code_saturne's cs_build)."""
+    return _integration_build("code_saturne")
+
+
+@pytest.fixture(scope="session")
+def openfoam_build_job():
+    """The future of integrations/openfoam/build.sh's finished process (tests/openfoam's openfoam_build)."""
+    return _integration_build("openfoam")
+
+
+@pytest.fixture(scope="session")
+def native_build_job(tmp_path_factory):
+    """The future of native/'s Release build with the C and Fortran examples and the bench program
+    (tests/native/conftest.py's native_build; BuildError on failure)."""
+    return background.submit(native_build_in, tmp_path_factory.mktemp("native_build"),
+                             {"RBS_BUILD_EXAMPLES": "ON", "RBS_BUILD_FORTRAN": "ON", "RBS_BUILD_BENCH": "ON"})
+
+
+@pytest.fixture(scope="session")
+def native_sanitized_job(tmp_path_factory):
+    """The future of native/ built with -fsanitize=address,undefined: the static library and the C test programs."""
+    return background.submit(native_build_in, tmp_path_factory.mktemp("native_sanitized"),
+                             {"RBS_SANITIZE": "ON", "RBS_BUILD_TESTS": "ON", "RBS_BUILD_SHARED": "OFF",
+                              "CMAKE_BUILD_TYPE": "RelWithDebInfo"})
+
+
+@pytest.fixture(scope="session")
+def native_baseline_job(tmp_path_factory):
+    """The future of native/'s shared library built for the x86-64 baseline only (no multi-versioning: fma() from
+    the C library)."""
+    return background.submit(native_build_in, tmp_path_factory.mktemp("native_baseline"),
+                             {"CMAKE_C_FLAGS": "-DRBS_NO_CLONES", "RBS_BUILD_STATIC": "OFF"})

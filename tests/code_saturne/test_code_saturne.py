@@ -27,6 +27,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.helpers import background
+
 REPO = Path(__file__).resolve().parents[2]
 CS_DIR = REPO / "integrations" / "code_saturne"
 CASE = CS_DIR / "cases" / "channelRebound"
@@ -50,19 +52,16 @@ def _cache() -> Path:
 
 def _run(cmd, cwd, env=None, timeout=900) -> subprocess.CompletedProcess:
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
-    if proc.returncode != 0:
-        pytest.fail(f"{' '.join(map(str, cmd))} failed ({proc.returncode}):\n{proc.stdout[-4000:]}\n"
-                    f"{proc.stderr[-4000:]}")
-    return proc
+    return background.succeeded(proc)
 
 
 @pytest.fixture(scope="session")
-def cs_build():
-    """install-deps.sh's outputs checked, then the C runtime built (build.sh)."""
+def cs_build(saturne_build_job):
+    """install-deps.sh's outputs checked, then the C runtime built (build.sh, started with the session)."""
     missing = [tool for tool in ("code_saturne", "mpirun", "gfortran") if shutil.which(tool) is None]
     if missing:
         pytest.fail(f"code_saturne is missing ({', '.join(missing)} not on PATH): {INSTALL_HINT}")
-    _run(["bash", str(CS_DIR / "build.sh")], cwd=REPO)
+    background.succeeded(saturne_build_job.result())
     lib = _cache() / "native-install" / "lib" / "librebound_scatter.so"
     assert lib.is_file()
     return lib

@@ -12,6 +12,8 @@ from __future__ import annotations
 import subprocess
 from concurrent.futures import Future, ThreadPoolExecutor
 
+import pytest
+
 _WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tests-background")
 _RUNNING: set = set()
 
@@ -32,6 +34,14 @@ def run(command, timeout=None, **kwargs) -> subprocess.CompletedProcess:
             if process.poll() is None:
                 process.kill()
     return subprocess.CompletedProcess(command, process.returncode, stdout, stderr)
+
+
+def succeeded(process: subprocess.CompletedProcess) -> subprocess.CompletedProcess:
+    """``process`` if it exited with 0; otherwise the calling test fails with the command and its output's end."""
+    if process.returncode != 0:
+        pytest.fail(f"{' '.join(map(str, process.args))} failed ({process.returncode}):\n{process.stdout[-4000:]}\n"
+                    f"{process.stderr[-4000:]}")
+    return process
 
 
 def stop() -> None:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tests.helpers import REPO
+from tests.helpers import REPO, background
 
 NATIVE = REPO / "native"
 INSTALL_HINT = ("run native/install-deps.sh (as root on Debian/Ubuntu it installs gcc, g++, cmake, libhdf5-dev, "
@@ -46,7 +46,8 @@ def missing_tools(fortran: bool = True, cxx: bool = True) -> list:
 
 
 def run(command, cwd=None, env=None, timeout=600) -> subprocess.CompletedProcess:
-    return subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    # background.run: a build started with the session is killed with it (tests.helpers.background.stop)
+    return background.run(command, cwd=cwd, env=env, timeout=timeout)
 
 
 def build(folder: Path, options: dict, targets=None) -> Path:

@@ -1,4 +1,5 @@
-"""Fixtures of the native tests: the library built once per session with CMake, and a table.
+"""Fixtures of the native tests: the library built once per session with CMake (the builds start with the
+session, tests/conftest.py), and a table.
 
 The builds never skip: a missing tool (cmake, a C, C++ or Fortran compiler, HDF5's development files)
 fails every test that needs it, with a message saying to run native/install-deps.sh.
@@ -6,9 +7,11 @@ fails every test that needs it, with a message saying to run native/install-deps
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from tests.helpers.native_library import INSTALL_HINT, BuildError, Native, build, missing_tools
+from tests.helpers.native_library import INSTALL_HINT, BuildError, Native, missing_tools
 
 
 def _require_tools(fortran=True, cxx=True):
@@ -17,39 +20,34 @@ def _require_tools(fortran=True, cxx=True):
         pytest.fail(f"the native tests need {', '.join(missing)}: {INSTALL_HINT}", pytrace=False)
 
 
+def _built(job) -> Path:
+    """The folder of a build started with the session (tests/conftest.py), or the test fails with its output."""
+    try:
+        return job.result()
+    except BuildError as exc:
+        pytest.fail(str(exc), pytrace=False)
+
+
 @pytest.fixture(scope="session")
-def native_build(tmp_path_factory):
+def native_build(native_build_job):
     """native/ configured and built (Release, -Werror): shared and static libraries, the C and Fortran
     examples, the bench program."""
     _require_tools()
-    folder = tmp_path_factory.mktemp("native_build")
-    try:
-        return build(folder, {"RBS_BUILD_EXAMPLES": "ON", "RBS_BUILD_FORTRAN": "ON", "RBS_BUILD_BENCH": "ON"})
-    except BuildError as exc:
-        pytest.fail(str(exc), pytrace=False)
+    return _built(native_build_job)
 
 
 @pytest.fixture(scope="session")
-def native_sanitized(tmp_path_factory):
+def native_sanitized(native_sanitized_job):
     """native/ built with -fsanitize=address,undefined: the static library and the C test programs."""
     _require_tools(fortran=False, cxx=False)
-    folder = tmp_path_factory.mktemp("native_sanitized")
-    try:
-        return build(folder, {"RBS_SANITIZE": "ON", "RBS_BUILD_TESTS": "ON", "RBS_BUILD_SHARED": "OFF",
-                              "CMAKE_BUILD_TYPE": "RelWithDebInfo"})
-    except BuildError as exc:
-        pytest.fail(str(exc), pytrace=False)
+    return _built(native_sanitized_job)
 
 
 @pytest.fixture(scope="session")
-def native_baseline(tmp_path_factory):
+def native_baseline(native_baseline_job):
     """The shared library built for the x86-64 baseline only (no multi-versioning: fma() from the C library)."""
     _require_tools(fortran=False, cxx=False)
-    folder = tmp_path_factory.mktemp("native_baseline")
-    try:
-        return Native(build(folder, {"CMAKE_C_FLAGS": "-DRBS_NO_CLONES", "RBS_BUILD_STATIC": "OFF"}))
-    except BuildError as exc:
-        pytest.fail(str(exc), pytrace=False)
+    return Native(_built(native_baseline_job))
 
 
 @pytest.fixture(scope="session")

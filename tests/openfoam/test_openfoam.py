@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.helpers import background
+
 REPO = Path(__file__).resolve().parents[2]
 OPENFOAM_DIR = REPO / "integrations" / "openfoam"
 CASE = OPENFOAM_DIR / "cases" / "hopperRebound"
@@ -51,10 +53,7 @@ def _cache() -> Path:
 
 def _run(cmd, cwd, env=None, timeout=600) -> subprocess.CompletedProcess:
     proc = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
-    if proc.returncode != 0:
-        pytest.fail(f"{' '.join(map(str, cmd))} failed ({proc.returncode}):\n{proc.stdout[-4000:]}\n"
-                    f"{proc.stderr[-4000:]}")
-    return proc
+    return background.succeeded(proc)
 
 
 def _timings(case: Path) -> dict:
@@ -75,15 +74,16 @@ def _cpu_seconds(case: Path) -> float:
 
 
 @pytest.fixture(scope="session")
-def openfoam_build():
-    """install-deps.sh's outputs checked, then the C runtime and the adapter built (build.sh)."""
+def openfoam_build(openfoam_build_job):
+    """install-deps.sh's outputs checked, then the C runtime and the adapter built (build.sh, started with the
+    session)."""
     missing = [tool for tool in (SOLVER, "blockMesh", "decomposePar", "mpirun") if shutil.which(tool) is None]
     tree = _cache() / "OpenFOAM-v1912"
     if missing:
         pytest.fail(f"OpenFOAM is missing ({', '.join(missing)} not on PATH): {INSTALL_HINT}")
     if not (tree / "src" / "lagrangian" / "intermediate" / "lnInclude").is_dir():
         pytest.fail(f"the OpenFOAM v1912 headers are missing ({tree}): {INSTALL_HINT}")
-    proc = _run(["bash", str(OPENFOAM_DIR / "build.sh")], cwd=REPO)
+    proc = background.succeeded(openfoam_build_job.result())
     lib = _cache() / "lib" / "libstochasticRebound.so"
     assert lib.is_file(), proc.stdout
     return {"lib": lib, "log": proc.stdout}
