@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tablegen.study.hit_records import (HIT_COLUMNS, parse_header, rank_files, read_hit_files, solver_hits,
+from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, parse_header, rank_files, read_hit_files, solver_hits,
                                         summary_counts)
 
 OPENFOAM = ("# stochasticRebound hits: seed 7, stream 1, table /t/a.h5, mix weights (prism 0.25, tetrahedron 0.75), "
@@ -12,13 +12,14 @@ SATURNE = ("# code_saturne rebound-scatter hits: seed 7, stream 0, table /t/a.h5
            "tetrahedron:0.75), halfSizeFactor 0.5, interpolation nearest, method auto, spin tolerance 0.001")
 
 
-def _write(path, header, rows):
-    lines = [header, "# free text", ",".join(HIT_COLUMNS)]
+def _write(path, header, rows, columns=HIT_COLUMNS):
+    lines = [header, "# free text", ",".join(columns)]
     for k in range(rows):
         values = dict.fromkeys(HIT_COLUMNS, "0.5")
         values.update(rank="1", patch=f"wall{k}", origProc="-1", origId=str(k), status="0", path=str(k % 2),
-                      Vx=str(k), Vy="-3", Vz="0.25")
-        lines.append(",".join(values[c] for c in HIT_COLUMNS))
+                      Vx=str(k), Vy="-3", Vz="0.25", key=str(1000 + k), shape="prism" if k % 2 else "tetrahedron",
+                      hand="-1" if k % 2 else "nan")
+        lines.append(",".join(values[c] for c in columns))
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -29,8 +30,31 @@ def test_both_headers_give_the_same_settings(title, header):
     assert settings["shape"] == {"prism": 0.25, "tetrahedron": 0.75}
     assert (settings["seed"], settings["table"], settings["method"], settings["spin_tolerance"]) == (
         7, "/t/a.h5", "auto", 0.001)
+    # written before grain keys: a new grain per hit
+    assert (settings["grain"], settings["grain_seed"]) == ("perHit", None)
     with pytest.raises(ValueError, match="not a other hits header"):
         parse_header(header, "other")
+
+
+@pytest.mark.parametrize("grain, seed", [("kept (key seed 42)", 42), ("perHit", None)])
+def test_the_header_names_the_grain_mode_and_the_keys_seed(grain, seed):
+    settings = parse_header(OPENFOAM + f", grain {grain}", "stochasticRebound")
+    assert (settings["grain"], settings["grain_seed"]) == (grain.split()[0], seed)
+    for bad in (", grain sometimes", ", grain kept", ", grain perHit (key seed 42)"):
+        with pytest.raises(ValueError, match="not a stochasticRebound hits header"):
+            parse_header(OPENFOAM + bad, "stochasticRebound")
+
+
+def test_the_grain_columns_and_a_file_written_before_them(tmp_path):
+    _write(tmp_path / "hits_0.csv", OPENFOAM + ", grain kept (key seed 7)", 2)
+    _write(tmp_path / "hits_1.csv", OPENFOAM, 2, columns=HIT_COLUMNS[:-len(GRAIN_COLUMNS)])
+    cols, headers = read_hit_files(rank_files(tmp_path), "stochasticRebound")
+    assert [h["grain"] for h in headers] == ["kept", "perHit"]
+    assert cols["key"].dtype == np.int64 and cols["key"].tolist() == [1000, 1001, -1, -1]
+    assert cols["shape"].tolist() == ["tetrahedron", "prism", "", ""]
+    assert cols["ratio_ba"][:2].tolist() == [0.5, 0.5] and np.isnan(cols["ratio_ba"][2:]).all()
+    assert np.isnan(cols["hand"][[0, 2, 3]]).all() and cols["hand"][1] == -1
+    assert cols["V"][:, 0].tolist() == [0, 1, 0, 1]
 
 
 def test_files_read_in_rank_order_with_vectors_and_types(tmp_path):
@@ -50,7 +74,7 @@ def test_a_file_of_another_layout_is_named(tmp_path):
     _write(tmp_path / "hits_0.csv", OPENFOAM, 1)
     text = (tmp_path / "hits_0.csv").read_text()
     (tmp_path / "hits_0.csv").write_text(text + "1,2,3\n")
-    with pytest.raises(ValueError, match=r"hits_0.csv, line 5: 3 fields, not 29"):
+    with pytest.raises(ValueError, match=r"hits_0.csv, line 5: 3 fields, not 34"):
         read_hit_files(rank_files(tmp_path), "stochasticRebound")
     (tmp_path / "hits_0.csv").write_text(text.replace("Winx", "Wx0"))
     with pytest.raises(ValueError, match="line 3 is not the hits columns"):
