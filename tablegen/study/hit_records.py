@@ -4,7 +4,8 @@ The OpenFOAM adapter (integrations/openfoam) and the code_saturne user sources (
 write one CSV file per rank, ``hits_<rank>.csv``:
 
 * line 1, the run's settings: ``# <title> hits: seed S, stream K, table PATH, mix MIX, halfSizeFactor F,
-  interpolation I, method M, spin tolerance T, grain G (key seed K)``, MIX a shape name, ``mix`` or ``weights (name w, ...)``
+  interpolation I, method M, spin tolerance T, grain G (key seed K)``, MIX a shape name, ``mix`` or
+  ``weights (name w, ...)``
   (OpenFOAM writes ``name w``, code_saturne ``name:w``), G ``kept`` (a particle hits as one grain, its key
   fixed for life from the seed K and its ids, docs/model.md §11) or ``perHit`` (a new grain from the mix at
   every hit, without ``(key seed K)``; files written before grain keys have no ``, grain G`` and drew per hit);
@@ -32,7 +33,8 @@ import numpy as np
 
 from tablegen.study.solver_comparison import SolverHits
 
-__all__ = ["GRAIN_COLUMNS", "HIT_COLUMNS", "parse_header", "rank_files", "read_hit_files", "solver_hits", "summary_counts"]
+__all__ = ["GRAIN_COLUMNS", "HIT_COLUMNS", "parse_header", "rank_files", "read_hit_files", "solver_hits",
+           "summary_counts"]
 
 _HIT_COLUMNS_BEFORE_GRAINS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,nx,ny,nz,Uwx,Uwy,Uwz,"
                               "status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0").split(",")
@@ -116,9 +118,11 @@ def rank_files(folder: Path) -> list:
 
 
 def solver_hits(hits: dict, settings: dict) -> SolverHits:
-    """The columns of :func:`read_hit_files` as a :class:`SolverHits` (``settings``: a file's header)."""
+    """The columns of :func:`read_hit_files` as a :class:`SolverHits` (``settings``: a file's header), with the
+    particles' grain keys under ``grain kept``."""
     return SolverHits(V=hits["V"], Omega=hits["Win"], n=hits["n"], a=hits["a"], shape=settings["shape"],
-                      V_out=hits["Vout"], Omega_out=hits["Wout"], status=hits["status"], path=hits["path"])
+                      V_out=hits["Vout"], Omega_out=hits["Wout"], status=hits["status"], path=hits["path"],
+                      grain_key=hits["key"] if settings["grain"] == "kept" else None)
 
 
 def summary_counts(block: str) -> dict:

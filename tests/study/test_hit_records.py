@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, parse_header, rank_files, read_hit_files, solver_hits,
-                                        summary_counts)
+from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, parse_header, rank_files, read_hit_files,
+                                        solver_hits, summary_counts)
 
 OPENFOAM = ("# stochasticRebound hits: seed 7, stream 1, table /t/a.h5, mix weights (prism 0.25, tetrahedron 0.75), "
             "halfSizeFactor 0.5, interpolation nearest, method auto, spin tolerance 0.001")
@@ -55,6 +55,10 @@ def test_the_grain_columns_and_a_file_written_before_them(tmp_path):
     assert cols["ratio_ba"][:2].tolist() == [0.5, 0.5] and np.isnan(cols["ratio_ba"][2:]).all()
     assert np.isnan(cols["hand"][[0, 2, 3]]).all() and cols["hand"][1] == -1
     assert cols["V"][:, 0].tolist() == [0, 1, 0, 1]
+    # the comparison draws a kept grain's hits as its grain, and every hit afresh otherwise
+    kept, kept_headers = read_hit_files(rank_files(tmp_path)[:1], "stochasticRebound")
+    assert solver_hits(kept, kept_headers[0]).grain_key.tolist() == [1000, 1001]
+    assert solver_hits(cols, headers[1]).grain_key is None
 
 
 def test_files_read_in_rank_order_with_vectors_and_types(tmp_path):
