@@ -31,10 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
+import surrogate
+from surrogate.kernels import PATH_DIRECT
 from tablegen.study.solver_comparison import SolverHits
 
-__all__ = ["GRAIN_COLUMNS", "HIT_COLUMNS", "parse_header", "rank_files", "read_hit_files", "solver_hits",
-           "summary_counts"]
+__all__ = ["GRAIN_COLUMNS", "HIT_COLUMNS", "grain_mismatches", "parse_header", "rank_files", "read_hit_files",
+           "solver_hits", "summary_counts"]
 
 _HIT_COLUMNS_BEFORE_GRAINS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,nx,ny,nz,Uwx,Uwy,Uwz,"
                               "status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0").split(",")
@@ -123,6 +125,25 @@ def solver_hits(hits: dict, settings: dict) -> SolverHits:
     return SolverHits(V=hits["V"], Omega=hits["Win"], n=hits["n"], a=hits["a"], shape=settings["shape"],
                       V_out=hits["Vout"], Omega_out=hits["Wout"], status=hits["status"], path=hits["path"],
                       grain_key=hits["key"] if settings["grain"] == "kept" else None)
+
+
+def grain_mismatches(hits: dict, settings: dict, table) -> dict:
+    """How many hits of a grain-kept run do not carry their key's grain: the grain :func:`surrogate.grain_of`
+    gives the recorded key in the run's mix (``settings["shape"]``) of ``table`` (the loaded table the run drew
+    from). Counts: ``key`` (a key < 0), and of the others ``shape`` (another shape name), ``direct`` (on the
+    direct path, a b/a, c/b or hand other than the key's, to the bit, NaN equal to NaN); ``table`` (off the
+    direct path, a proportion or hand recorded: the table path draws them from the shape's law). All zero:
+    every hit carried its particle's grain."""
+    keys = hits["key"]
+    valid = keys >= 0
+    grains = surrogate.grain_of(table, np.where(valid, keys, 0), settings["shape"])
+    direct = hits["path"] == PATH_DIRECT
+    recorded = np.column_stack([hits["ratio_ba"], hits["ratio_cb"], hits["hand"]])
+    expected = np.column_stack([grains.ratio_ba, grains.ratio_cb, grains.hand])
+    same = (recorded == expected) | (np.isnan(recorded) & np.isnan(expected))
+    return {"key": int(np.sum(~valid)), "shape": int(np.sum(valid & (hits["shape"] != grains.shape))),
+            "direct": int(np.sum(valid & direct & ~same.all(axis=1))),
+            "table": int(np.sum(~direct & ~np.isnan(recorded).all(axis=1)))}
 
 
 def summary_counts(block: str) -> dict:

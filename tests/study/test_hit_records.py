@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, parse_header, rank_files, read_hit_files,
-                                        solver_hits, summary_counts)
+from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, grain_mismatches, parse_header, rank_files,
+                                        read_hit_files, solver_hits, summary_counts)
 
 OPENFOAM = ("# stochasticRebound hits: seed 7, stream 1, table /t/a.h5, mix weights (prism 0.25, tetrahedron 0.75), "
             "halfSizeFactor 0.5, interpolation nearest, method auto, spin tolerance 0.001")
@@ -103,3 +103,28 @@ def test_summary_counts():
                       "failed": 7, "invalid": 0, "outside": 12, "direct_us": 4.5}
     with pytest.raises(ValueError, match="no count '- trapped'"):
         summary_counts(block.replace("- trapped", "- kept"))
+
+
+def test_grain_mismatches_finds_each_kind_of_wrong_grain(small_table):
+    """The columns a grain-kept run writes (its key's shape, and b/a, c/b, hand on the direct path only) give
+    no mismatch; one wrong entry of each kind is counted once."""
+    import surrogate
+    from surrogate.kernels import PATH_DIRECT, PATH_TABLE
+
+    keys = surrogate.grain_key(3, 0, np.arange(40))
+    grains = surrogate.grain_of(small_table, keys, "mix")
+    path = np.where(np.arange(40) % 2, PATH_DIRECT, PATH_TABLE)
+    direct = path == PATH_DIRECT
+    hits = {"key": keys.copy(), "shape": grains.shape.copy(), "path": path}
+    for name in ("ratio_ba", "ratio_cb", "hand"):
+        hits[name] = np.where(direct, getattr(grains, name), np.nan)
+    assert np.isfinite(hits["ratio_ba"][direct]).any(), "the mix has a shape of random proportions"
+    settings = {"shape": "mix"}
+    assert grain_mismatches(hits, settings, small_table) == {"key": 0, "shape": 0, "direct": 0, "table": 0}
+    other = {"prism": "tetrahedron"}.get(hits["shape"][0], "prism")
+    finite = np.flatnonzero(direct & np.isfinite(hits["ratio_ba"]))[0]
+    hits["shape"][0] = other
+    hits["ratio_ba"][finite] = np.nextafter(hits["ratio_ba"][finite], 2)      # one ulp off
+    hits["hand"][2] = 1.0                                                      # a table-path hit
+    hits["key"][4] = -1
+    assert grain_mismatches(hits, settings, small_table) == {"key": 1, "shape": 1, "direct": 1, "table": 1}
