@@ -289,7 +289,7 @@ def _check_grains(case: Path, table: Path) -> dict:
     to surrogate.grain_key's, and the grain of that key: the shape surrogate.grain_of gives it on every hit, and
     on the direct path its b/a, c/b and hand to the bit (NaN on the table path). Returns the parcels' rows."""
     hits, headers = compare_rebounds.read_hits(case)
-    assert {(h["grain"], h["grain_seed"]) for h in headers} == {("kept", headers[0]["seed"])}
+    assert {(h["grain"], h["grain_seed"]) for h in headers} == {("kept", headers[0]["grain_seed"])}
     keys = grain_key(headers[0]["grain_seed"], hits["origProc"], hits["origId"])
     np.testing.assert_array_equal(hits["key"], keys)
     mismatches = grain_mismatches(hits, headers[0], load(table))
@@ -315,10 +315,46 @@ def test_each_parcel_hits_as_one_grain_on_one_and_two_ranks(serial_case, paralle
     runs: a function of the ids, the same on both (_check_grains), not of the decomposition."""
     serial_rows = _check_grains(serial_case, case_table)
     rows = _check_grains(parallel_case, case_table)
-    hits, _ = compare_rebounds.read_hits(parallel_case)
+    hits, headers = compare_rebounds.read_hits(parallel_case)
+    assert headers[0]["grain_seed"] == headers[0]["seed"], "grainSeed defaults to seed"
     on_both = [parcel for parcel, i in rows.items() if len(set(hits["rank"][i].tolist())) == 2]
     assert len(on_both) > 100, len(on_both)
     assert {p[0] for p in serial_rows} == {0} and {p[0] for p in rows} == {1}
+
+
+def test_a_parcel_keeps_its_grain_over_a_restart(openfoam_build, case_table, tmp_path_factory):
+    """The case run to 2.5 ms, then restarted from its written time to 5 ms with another seed (new streams)
+    and grainSeed the first run's: the parcels (their ids are written with the cloud and read back) hit
+    after the restart as the grains they were before it."""
+    def first_half(case):
+        control = case / "system" / "controlDict"
+        text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.0025;", control.read_text())
+        control.write_text(re.sub(r"\nwriteInterval\s+[^;]+;", "\nwriteInterval   0.0025;", text))
+
+    case = _run_case(tmp_path_factory, "restart", case_table, edit=first_half)
+    before, before_headers = compare_rebounds.read_hits(case)
+    control = case / "system" / "controlDict"
+    text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.005;", control.read_text())
+    control.write_text(re.sub(r"\nstartFrom\s+[^;]+;", "\nstartFrom       latestTime;", text))
+    seed = before_headers[0]["seed"]
+    _set_coeff(case, "seed", str(seed + 1))
+    _insert_coeff(case, f"grainSeed {seed};")
+    script = (f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {{ [ -f \"$WM_PROJECT_DIR/etc/controlDict\" ] || "
+              f"export WM_PROJECT_DIR=/usr/share/openfoam; }} && {SOLVER} > log.restart 2>&1")
+    _run(["bash", "-c", script], cwd=case)
+    assert "Starting time loop" in (case / "log.restart").read_text()
+    after, after_headers = compare_rebounds.read_hits(case)
+    assert (after_headers[0]["seed"], after_headers[0]["grain_seed"]) == (seed + 1, seed)
+    assert after["time"].min() > 0.0025 and before["time"].max() <= 0.0025
+    _check_grains(case, case_table)
+    # the same parcels on both sides of the restart, each with its key and shape
+    key_before = dict(zip(zip(before["origProc"].tolist(), before["origId"].tolist()), before["key"].tolist()))
+    both = [(p, k) for p, k in zip(zip(after["origProc"].tolist(), after["origId"].tolist()), after["key"].tolist())
+            if p in key_before]
+    assert len({p for p, _ in both}) > 1000
+    assert all(key_before[p] == k for p, k in both)
+    # new streams: no first uniform of the restart repeats one of the first run
+    assert len(np.intersect1d(before["u0"], after["u0"])) == 0
 
 
 def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(openfoam_build, case_table,
