@@ -14,12 +14,12 @@ Copyright (C) 2026 the rebound-scatter authors. License: GPL-2.0-or-later
 
 from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load
 from surrogate.kernels import PATH_DIRECT, PATH_TABLE
-from tablegen.study.hit_records import rank_files, read_hit_files, solver_hits, summary_counts
+from tablegen.study.hit_records import grain_mismatches, rank_files, read_hit_files, solver_hits, summary_counts
 from tablegen.study.solver_comparison import compare_hits, path_rule
 
 __all__ = ["PATH_DIRECT", "PATH_TABLE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED", "STATUS_TRAPPED",
-           "build_table_from_text", "compare_hits", "load", "path_rule", "rank_files", "read_hit_files",
-           "solver_hits", "summary_counts"]
+           "build_table_from_text", "compare_hits", "grain_mismatches", "load", "path_rule", "rank_files",
+           "read_hit_files", "solver_hits", "summary_counts"]
 
 
 def build_table_from_text(config_text: str, path, **kwargs):

@@ -2,26 +2,28 @@
 
 Every import of the project's packages by integrations/openfoam and
 tests/openfoam goes through this module, so a refactoring of the packages
-re-points these few lines only. Public API only: ``surrogate.load``, ``surrogate.STATUS_*``, the
-solver-neutral comparison of a solver's hits with surrogate (``tablegen.study.solver_comparison``, BSD-3:
-the statistics live there), the hit records' reader (``tablegen.study.hit_records``, BSD-3: the layout both
-adapters write; this integration only finds OpenFOAM's files) and, to build a table,
+re-points these few lines only. Public API only: ``surrogate.load``, ``surrogate.grain_key``,
+``surrogate.STATUS_*``, the solver-neutral comparison of a solver's hits with surrogate
+(``tablegen.study.solver_comparison``, BSD-3: the statistics live there), the hit records' reader and the check
+of their grains (``tablegen.study.hit_records``, BSD-3: the layout both adapters write; this integration only
+finds OpenFOAM's files) and, to build a table,
 ``tablegen.build_table(tablegen.parse_config(text), path)``.
 
 Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 (see LICENSE in this folder).
 """
 
-from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, load
+from surrogate import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, grain_key, load
 from surrogate.kernels import PATH_DIRECT, PATH_TABLE
-from tablegen.study.hit_records import HIT_COLUMNS, rank_files, read_hit_files, solver_hits, summary_counts
+from tablegen.study.hit_records import (HIT_COLUMNS, grain_mismatches, rank_files, read_hit_files, solver_hits,
+                                        summary_counts)
 from tablegen.study.solver_comparison import (SolverHits, agreement, compare_hits, impact_states, incident_states,
                                               path_rule, specular_answers, surrogate_answers)
 
 __all__ = ["HIT_COLUMNS", "PATH_DIRECT", "PATH_TABLE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
-           "STATUS_TRAPPED", "SolverHits", "agreement", "build_table_from_text", "compare_hits", "impact_states",
-           "incident_states", "load", "path_rule", "rank_files", "read_hit_files", "solver_hits", "specular_answers",
-           "summary_counts", "surrogate_answers"]
+           "STATUS_TRAPPED", "SolverHits", "agreement", "build_table_from_text", "compare_hits", "grain_key",
+           "grain_mismatches", "impact_states", "incident_states", "load", "path_rule", "rank_files",
+           "read_hit_files", "solver_hits", "specular_answers", "summary_counts", "surrogate_answers"]
 
 
 def build_table_from_text(config_text: str, path, **kwargs):

@@ -70,6 +70,11 @@ class SolverHits:
     status : (N,) ``surrogate.STATUS_*``.
     path : (N,) the path that answered: ``surrogate.kernels.PATH_TABLE`` or ``PATH_DIRECT``
         (``STATUS_INVALID`` for a hit nothing answered).
+    grain_key : None (every hit drew a new grain from ``shape``) or (N,) the grain key of each hit's particle
+        (:func:`surrogate.grain_key`, integers in [0, 2**63)): the particle hit as the grain of its key in
+        ``shape``, and :func:`surrogate_answers` draws it so (docs/model.md §11). Where particles keep their
+        grain, the hits at an incident state are not the mix's: the grains that hit more often, or slower,
+        are over-represented there, so the reference must hold the same grains.
     """
 
     V: np.ndarray
@@ -81,6 +86,7 @@ class SolverHits:
     Omega_out: np.ndarray
     status: np.ndarray
     path: np.ndarray
+    grain_key: np.ndarray | None = None
 
     def __post_init__(self):
         count = len(np.asarray(self.status))
@@ -99,6 +105,12 @@ class SolverHits:
                 raise ValueError(f"SolverHits.shape must be a name, a mix or one name per hit ({count}); "
                                  f"got shape {names.shape}.")
             object.__setattr__(self, "shape", names)
+        if self.grain_key is not None:
+            keys = np.asarray(self.grain_key)
+            if keys.shape != (count,) or keys.dtype.kind not in "iu" or (keys.size and keys.min() < 0):
+                raise ValueError(f"SolverHits.grain_key must be None or one integer >= 0 per hit ({count}); "
+                                 f"got {keys.dtype} of shape {keys.shape}.")
+            object.__setattr__(self, "grain_key", keys.astype(np.int64))
 
     def __len__(self) -> int:
         return len(self.status)
@@ -106,7 +118,7 @@ class SolverHits:
     def take(self, rows) -> SolverHits:
         """The hits at ``rows`` (a boolean mask or indices)."""
         per_hit = {f.name: getattr(self, f.name)[rows] for f in fields(self)
-                   if f.name != "shape" or isinstance(self.shape, np.ndarray)}
+                   if isinstance(getattr(self, f.name), np.ndarray)}
         return replace(self, **per_hit)
 
 
@@ -321,7 +333,8 @@ def surrogate_answers(table, hits: SolverHits, seed: int = 1, interpolation: str
     :func:`surrogate.sample_global` with ``method="table"`` (``clamp=True``, as the runtime at a grid's
     edge), the direct model's by ``method="direct"`` with their Ω⁻; ``"table"``: every hit by the table,
     Ω⁻ ignored (what a solver that does not pass Ω⁻ would get); ``"direct"``: every hit by the direct model. Invalid hits stay NaN and invalid.
-    ``table``: the loaded table the solver drew from (:func:`surrogate.load`); ``seed``: the draws'.
+    ``table``: the loaded table the solver drew from (:func:`surrogate.load`); ``seed``: the draws'. With
+    ``hits.grain_key``, each hit is drawn as its particle's grain (``sample_global``'s ``grain_key``).
     """
     if method not in (None, *PATHS):
         raise ValueError(f"The 'method' parameter must be None (the solver's path), 'table' or 'direct'; "
@@ -336,7 +349,8 @@ def surrogate_answers(table, hits: SolverHits, seed: int = 1, interpolation: str
             if len(rows):
                 V_out[rows], Omega_out[rows], status[rows] = surrogate.sample_global(
                     table, hits.V[rows], hits.n[rows], hits.a[rows], shape=shape, random_state=rng, clamp=True,
-                    interpolation=interpolation, omega=hits.Omega[rows] if name == "direct" else None, method=name)
+                    interpolation=interpolation, omega=hits.Omega[rows] if name == "direct" else None, method=name,
+                    grain_key=None if hits.grain_key is None else hits.grain_key[rows])
     return replace(hits, V_out=V_out, Omega_out=Omega_out, status=status, path=taken)
 
 

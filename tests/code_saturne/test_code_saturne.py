@@ -6,8 +6,9 @@ case's user sources and the adapter with `code_saturne compile`), and checks: th
 well-formed and agree with the solver's log; every rebound leaves the wall; the paths follow the rule of
 method auto; the solver's rebounds follow surrogate's law at the same incident states, path by path (the
 solver-neutral comparison tablegen.study.solver_comparison, called through compare_saturne_rebounds.py); each
-rank draws its own stream; trapped particles are deposited or removed; a bad setup stops the solver with
-one clear message; and the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
+rank draws its own stream; each particle hits as one grain (grain kept) and the grains follow the mix's
+weights; trapped particles are deposited or removed; a bad setup stops the solver with one clear message; and
+the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
 
 These tests need code_saturne: they fail (they are not skipped) when it is missing, with a message naming
 integrations/code_saturne/install-deps.sh.
@@ -38,7 +39,8 @@ sys.path.insert(0, str(CS_DIR))
 import compare_saturne_rebounds  # noqa: E402
 import make_channel_table  # noqa: E402
 from read_hits import read_cpu_seconds, read_hits, read_summary  # noqa: E402
-from saturne_api import PATH_DIRECT, PATH_TABLE, STATUS_REBOUNDED, build_table_from_text  # noqa: E402
+from saturne_api import (PATH_DIRECT, PATH_TABLE, STATUS_REBOUNDED, build_table_from_text,  # noqa: E402
+                         grain_mismatches, load)
 
 INSTALL_HINT = ("run `bash integrations/code_saturne/install-deps.sh` (as root on Debian bookworm: it installs "
                 "Debian's code_saturne 6.0 with its headers and Open MPI) and then "
@@ -316,8 +318,22 @@ def trapping_table(tmp_path_factory):
 
 @pytest.mark.parametrize("policy", ["deposit", "remove"])
 def test_trapped_particles_are_deposited_or_removed(policy, cs_build, trapping_table, tmp_path_factory):
-    case = _run_case(tmp_path_factory, f"cs_trapped_{policy}", trapping_table,
-                     edit=lambda c: _set(c, "trapped", policy))
+    """Trapped particles are deposited or removed; the deposit run keeps each particle's grain (the default),
+    the remove run draws a new grain per hit (grain = perHit: no key, no shape recorded), and both trap as
+    surrogate does."""
+    grain = "kept" if policy == "deposit" else "perHit"
+
+    def edit(case):
+        _set(case, "trapped", policy)
+        _set(case, "grain", grain)
+
+    case = _run_case(tmp_path_factory, f"cs_trapped_{policy}", trapping_table, edit=edit)
+    hits, headers = read_hits(case / "RESU")
+    assert [h["grain"] for h in headers] == [grain]
+    if grain == "perHit":
+        assert (hits["key"] == -1).all() and set(hits["shape"].tolist()) == {""} and np.isnan(hits["ratio_ba"]).all()
+    else:
+        assert (hits["key"] >= 0).all() and set(hits["shape"].tolist()) <= {"prism", "tetrahedron"}
     info = read_summary((case / "RESU" / "run_solver.log").read_text())
     assert info["trapped"] > 200, info
     lagr = _lagrangian_log(case)
@@ -340,6 +356,39 @@ def test_trapped_particles_are_deposited_or_removed(policy, cs_build, trapping_t
     assert min(a.not_rebounded[0] for a in comparison.agreement.values()) > 0, comparison.lines()
 
 
+def _grains(case: Path, table: Path) -> dict:
+    """The hits of a grain-kept run by grain key (6.0's particles carry no id: the key, from the particle's
+    random value, stands for the particle), checked: every hit carries its key's grain in the run's mix
+    (surrogate.grain_of: the shape, and on the direct path b/a, c/b and the hand to the bit; NaN on the table
+    path)."""
+    hits, headers = read_hits(case / "RESU")
+    assert {(h["grain"], h["grain_seed"]) for h in headers} == {("kept", headers[0]["seed"])}
+    mismatches = grain_mismatches(hits, headers[0], load(table))
+    assert mismatches == {"key": 0, "shape": 0, "direct": 0, "table": 0}, mismatches
+    assert np.sum(hits["path"] == PATH_DIRECT) > 1000
+    rows: dict = {}
+    for i, key in enumerate(hits["key"].tolist()):
+        rows.setdefault(key, []).append(i)
+    return {key: np.array(i) for key, i in rows.items()}
+
+
+def test_each_particle_hits_as_one_grain_of_the_mix(serial_case, parallel_case, case_table):
+    """grain kept (the default): a particle's key comes from its random value (drawn at injection, carried
+    from rank to rank), so on 2 ranks particles that hit walls on both ranks keep one key; and over the
+    particles the shapes follow the weights 0.7/0.3: about 2500 keys (one per particle, at most the injected
+    number), the prisms' fraction within 3.29 standard deviations, sqrt(0.21/n), of 0.7 (two-sided 1e-3)."""
+    for case in (serial_case, parallel_case):
+        rows = _grains(case, case_table)
+        hits, _ = read_hits(case / "RESU")
+        assert 0.8 * INJECTED < len(rows) <= INJECTED, len(rows)
+        shapes = np.array([hits["shape"][i[0]] for i in rows.values()], dtype=object)
+        assert set(shapes.tolist()) == {"prism", "tetrahedron"}
+        n = len(shapes)
+        assert abs(np.mean(shapes == "prism") - 0.7) < 3.29 * np.sqrt(0.21 / n), np.mean(shapes == "prism")
+    on_both = [key for key, i in rows.items() if len(set(hits["rank"][i].tolist())) == 2]
+    assert len(on_both) > 50, len(on_both)
+
+
 # ----------------------------------------------------------------------------- bad setup
 
 @pytest.mark.parametrize("edits, words", [
@@ -349,8 +398,9 @@ def test_trapped_particles_are_deposited_or_removed(policy, cs_build, trapping_t
     ({"seed": "12abc"}, ["seed must be an integer", "\"12abc\""]),
     ({"method": "tabel"}, ["method must be auto, table or direct, not \"tabel\""]),
     ({"interpolaton": "scaled"}, ["unknown key \"interpolaton\""]),
+    ({"grain": "once"}, ["grain must be kept or perHit, not \"once\""]),
 ], ids=["missing table", "unknown shape", "negative seed", "seed not a number", "unknown method",
-        "misspelled key"])
+        "misspelled key", "unknown grain mode"])
 def test_bad_setup_is_one_clear_error_from_the_solver(cs_build, case_table, tmp_path_factory, edits, words):
     case = _copy_case(tmp_path_factory, "cs_bad_setup")
     for key, value in edits.items():

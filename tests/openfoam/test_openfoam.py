@@ -6,8 +6,9 @@ outputs of install-deps.sh), runs the case hopperRebound serially and on 2
 MPI ranks with method auto, and checks the hit counts per path, the
 rebounds the table answered and those the direct model answered against
 surrogate on the same incident states (the BSD statistics of
-tablegen.study.solver_comparison, called through compare_rebounds), the random streams per rank, a moving wall, OpenFOAM's erosion model
-beside ours, and times the runs against standardWallInteraction.
+tablegen.study.solver_comparison, called through compare_rebounds), the random streams per rank, the grain
+each parcel keeps from hit to hit (grain kept), a moving wall, OpenFOAM's erosion model beside ours, and times
+the runs against standardWallInteraction.
 
 These tests need OpenFOAM: they fail (they are not skipped) when it is
 missing, with a message naming integrations/openfoam/install-deps.sh.
@@ -27,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy import stats
 
 from tests.helpers import background
 
@@ -40,7 +42,7 @@ sys.path.insert(0, str(OPENFOAM_DIR))
 
 import compare_rebounds  # noqa: E402
 import make_case_table  # noqa: E402
-from rbs_api import build_table_from_text, summary_counts  # noqa: E402
+from rbs_api import build_table_from_text, grain_key, grain_mismatches, load, summary_counts  # noqa: E402
 
 INSTALL_HINT = ("run `bash integrations/openfoam/install-deps.sh` (as root on Debian bookworm: it installs "
                 "Debian's OpenFOAM v1912 and Open MPI, unpacks the v1912 headers from the source package "
@@ -274,6 +276,87 @@ def test_each_rank_draws_its_own_stream(parallel_case, serial_case):
     assert serial["u0"][0] == u0[0][0] and serial["u0"][0] != u0[1][0]
 
 
+def _parcels(hits: dict) -> dict:
+    """Row indices of the hits per parcel, keyed by its birth ids (origProc, origId)."""
+    rows: dict = {}
+    for i, parcel in enumerate(zip(hits["origProc"].tolist(), hits["origId"].tolist())):
+        rows.setdefault(parcel, []).append(i)
+    return {parcel: np.array(i) for parcel, i in rows.items()}
+
+
+def _check_grains(case: Path, table: Path) -> dict:
+    """Every hit of a grain-kept run carries its parcel's key, rbs_grain_key(grainSeed, origProc, origId) equal
+    to surrogate.grain_key's, and the grain of that key: the shape surrogate.grain_of gives it on every hit, and
+    on the direct path its b/a, c/b and hand to the bit (NaN on the table path). Returns the parcels' rows."""
+    hits, headers = compare_rebounds.read_hits(case)
+    assert {(h["grain"], h["grain_seed"]) for h in headers} == {("kept", headers[0]["grain_seed"])}
+    keys = grain_key(headers[0]["grain_seed"], hits["origProc"], hits["origId"])
+    np.testing.assert_array_equal(hits["key"], keys)
+    mismatches = grain_mismatches(hits, headers[0], load(table))
+    assert mismatches == {"key": 0, "shape": 0, "direct": 0, "table": 0}, mismatches
+    direct = hits["path"] == compare_rebounds.PATH_DIRECT
+    assert direct.sum() > 1000
+    rows = _parcels(hits)
+    # ... so each parcel hits as one grain: one key, one shape, and one b/a, c/b on the direct path
+    for parcel, i in rows.items():
+        assert len(set(hits["key"][i].tolist())) == 1 and len(set(hits["shape"][i].tolist())) == 1, parcel
+        on_direct = i[direct[i]]
+        proportions = np.column_stack([hits["ratio_ba"][on_direct], hits["ratio_cb"][on_direct]])
+        # NaN equal to NaN: a shape of fixed proportions records none
+        np.testing.assert_array_equal(proportions, proportions[:1].repeat(len(on_direct), axis=0), err_msg=str(parcel))
+    return rows
+
+
+def test_each_parcel_hits_as_one_grain_on_one_and_two_ranks(serial_case, parallel_case, case_table):
+    """grain kept (the default): a parcel's key is a function of its birth ids only, so it keeps its grain from
+    hit to hit, and from rank to rank: on 2 ranks some 600 parcels hit walls on both ranks, with one key. The
+    serial and the 2-rank run number their parcels on the rank that injects them (rank 0 serially, rank 1 on 2
+    ranks, where the injection point lies), so one injected parcel has other ids, and another key, in the two
+    runs: a function of the ids, the same on both (_check_grains), not of the decomposition."""
+    serial_rows = _check_grains(serial_case, case_table)
+    rows = _check_grains(parallel_case, case_table)
+    hits, headers = compare_rebounds.read_hits(parallel_case)
+    assert headers[0]["grain_seed"] == headers[0]["seed"], "grainSeed defaults to seed"
+    on_both = [parcel for parcel, i in rows.items() if len(set(hits["rank"][i].tolist())) == 2]
+    assert len(on_both) > 100, len(on_both)
+    assert {p[0] for p in serial_rows} == {0} and {p[0] for p in rows} == {1}
+
+
+def test_a_parcel_keeps_its_grain_over_a_restart(openfoam_build, case_table, tmp_path_factory):
+    """The case run to 2.5 ms, then restarted from its written time to 5 ms with another seed (new streams)
+    and grainSeed the first run's: the parcels (their ids are written with the cloud and read back) hit
+    after the restart as the grains they were before it."""
+    def first_half(case):
+        control = case / "system" / "controlDict"
+        text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.0025;", control.read_text())
+        control.write_text(re.sub(r"\nwriteInterval\s+[^;]+;", "\nwriteInterval   0.0025;", text))
+
+    case = _run_case(tmp_path_factory, "restart", case_table, edit=first_half)
+    before, before_headers = compare_rebounds.read_hits(case)
+    control = case / "system" / "controlDict"
+    text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.005;", control.read_text())
+    control.write_text(re.sub(r"\nstartFrom\s+[^;]+;", "\nstartFrom       latestTime;", text))
+    seed = before_headers[0]["seed"]
+    _set_coeff(case, "seed", str(seed + 1))
+    _insert_coeff(case, f"grainSeed {seed};")
+    script = (f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {{ [ -f \"$WM_PROJECT_DIR/etc/controlDict\" ] || "
+              f"export WM_PROJECT_DIR=/usr/share/openfoam; }} && {SOLVER} > log.restart 2>&1")
+    _run(["bash", "-c", script], cwd=case)
+    assert "Starting time loop" in (case / "log.restart").read_text()
+    after, after_headers = compare_rebounds.read_hits(case)
+    assert (after_headers[0]["seed"], after_headers[0]["grain_seed"]) == (seed + 1, seed)
+    assert after["time"].min() > 0.0025 and before["time"].max() <= 0.0025
+    _check_grains(case, case_table)
+    # the same parcels on both sides of the restart, each with its key and shape
+    key_before = dict(zip(zip(before["origProc"].tolist(), before["origId"].tolist()), before["key"].tolist()))
+    both = [(p, k) for p, k in zip(zip(after["origProc"].tolist(), after["origId"].tolist()), after["key"].tolist())
+            if p in key_before]
+    assert len({p for p, _ in both}) > 1000
+    assert all(key_before[p] == k for p, k in both)
+    # new streams: no first uniform of the restart repeats one of the first run
+    assert len(np.intersect1d(before["u0"], after["u0"])) == 0
+
+
 def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(openfoam_build, case_table,
                                                                      tmp_path_factory):
     def moving_walls(case):
@@ -299,20 +382,43 @@ def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(openfoam_bui
     assert res["comparison"].ok, res
 
 
-def test_a_table_of_64_shapes_draws_in_the_adapter(openfoam_build, case_table, tmp_path_factory):
+@pytest.fixture(scope="session")
+def many_shapes(openfoam_build, case_table, tmp_path_factory):
     """The case's table with 63 user grains beside its prism (format 3.4; the grains share the prism's cells:
-    tests.helpers.python_side.many_shape_table): the adapter loads it, its mix sized by the table takes the 64
-    shapes with equal weights (shape mix), and every hit takes a path: the table, or the direct model, which
-    answers the prism's hits and the grains' alike, so that no hit is invalid."""
+    tests.helpers.python_side.many_shape_table), and the case run on it with shape mix (equal weights)."""
     from tests.helpers.python_side import many_shape_table
     table = tmp_path_factory.mktemp("many_shapes_table") / "many_shapes.h5"
     many_shape_table(case_table, table, 64)
-    case = _run_case(tmp_path_factory, "many_shapes", table, edit=lambda c: _set_coeff(c, "shape", "mix"))
+    return table, _run_case(tmp_path_factory, "many_shapes", table, edit=lambda c: _set_coeff(c, "shape", "mix"))
+
+
+def test_a_table_of_64_shapes_draws_in_the_adapter(many_shapes):
+    """The adapter loads the table of 64 shapes, its mix sized by the table takes them with equal weights
+    (shape mix), and every hit takes a path: the table, or the direct model, which answers the prism's hits and
+    the grains' alike, so that no hit is invalid."""
+    _, case = many_shapes
     log = (case / f"log.{SOLVER}").read_text()
     assert "Stochastic rebound (mix)" in log
     info = _cloud_info(log)
     assert info["hits"] == info["table"] + info["direct"] and info["table"] > 1000, info
     assert info["direct"] > 0 and info["invalid"] == 0, info
+
+
+def test_the_parcels_grains_follow_the_mix_weights(many_shapes):
+    """Each parcel hits as one grain of the 64-shape mix, and over the parcels the shapes follow the mix's equal
+    weights: about 7000 parcels, some 110 per shape; Pearson's chi-square of the counts against n/64 each, with
+    63 degrees of freedom, has mean 63 and sd 11 and stays below its 0.999 quantile (103.4) but for one run in a
+    thousand (the run is fixed by its seeds: this one passes or fails for good)."""
+    table, case = many_shapes
+    rows = _check_grains(case, table)
+    hits, _ = compare_rebounds.read_hits(case)
+    shapes = np.array([hits["shape"][i[0]] for i in rows.values()], dtype=object)
+    names = load(table).shapes
+    assert len(names) == 64 and len(shapes) > 5000
+    counts = np.array([np.sum(shapes == name) for name in names])
+    expected = len(shapes) / len(names)
+    chi2 = float(np.sum((counts - expected) ** 2 / expected))
+    assert chi2 < stats.chi2.ppf(0.999, len(names) - 1), (chi2, counts)
 
 
 @pytest.fixture(scope="session")
@@ -373,8 +479,21 @@ def trapping_table(tmp_path_factory):
 
 @pytest.mark.parametrize("policy", ["stick", "remove"])
 def test_trapped_parcels_stick_or_are_removed(policy, openfoam_build, trapping_table, tmp_path_factory):
-    case = _run_case(tmp_path_factory, f"trapped_{policy}", trapping_table,
-                     edit=lambda c: _set_coeff(c, "trapped", policy))
+    """Trapped parcels stick or are removed; the stick run keeps each parcel's grain (the default), the remove
+    run draws a new grain per hit (grain perHit: no key, no shape recorded), and both trap as the sampler does."""
+    grain = "kept" if policy == "stick" else "perHit"
+
+    def edit(case):
+        _set_coeff(case, "trapped", policy)
+        _insert_coeff(case, f"grain {grain};")
+
+    case = _run_case(tmp_path_factory, f"trapped_{policy}", trapping_table, edit=edit)
+    hits, headers = compare_rebounds.read_hits(case)
+    assert [h["grain"] for h in headers] == [grain]
+    if grain == "perHit":
+        assert (hits["key"] == -1).all() and set(hits["shape"].tolist()) == {""} and np.isnan(hits["ratio_ba"]).all()
+    else:
+        assert (hits["key"] >= 0).all() and set(hits["shape"].tolist()) == {"prism"}
     log = (case / f"log.{SOLVER}").read_text()
     info, parcels = _cloud_info(log), _cloud_parcels(log)
     assert info["trapped"] > 200, info
@@ -447,6 +566,7 @@ def _insert_coeff(case: Path, entry: str) -> None:
     (lambda c: _insert_coeff(c, "weights { prism 1; }"), ["shape and weights are both given"]),
     (lambda c: _set_coeff(c, "maxHitRecords", "-1"), ["maxHitRecords must be >= 0, not -1"]),
     (lambda c: _insert_coeff(c, "method tabel;"), ["method must be auto, table or direct, not tabel"]),
+    (lambda c: _insert_coeff(c, "grain once;"), ["grain must be kept or perHit, not once"]),
 ])
 def test_dictionary_contradictions_and_unknown_entries_are_fatal(openfoam_build, case_table, tmp_path_factory,
                                                                  edit, words):

@@ -113,8 +113,27 @@ def test_per_hit_shapes_are_redrawn_shape_by_shape(small_table):
     np.testing.assert_array_equal(answers.V_out[::2], prism[0])
 
 
+def test_grain_keys_are_drawn_as_the_particles_grains(small_table):
+    """Hits of keyed particles (grain kept): surrogate answers each as its particle's grain, the bits of
+    sample_global with the same keys; the keys' shapes differ from the unkeyed draw's."""
+    hits = _hits(small_table, seed=9, spinning=False)
+    keys = surrogate.grain_key(5, 0, np.arange(N_HITS) // 3)        # three hits per particle
+    keyed = sc.SolverHits(**{**vars(hits), "grain_key": keys})
+    answers = sc.surrogate_answers(small_table, keyed, seed=1)
+    reference = surrogate.sample_global(small_table, hits.V, hits.n, A, shape="mix", method="table", clamp=True,
+                                        random_state=np.random.default_rng(1), grain_key=keys)
+    assert np.all(hits.path == PATH_TABLE)
+    np.testing.assert_array_equal(answers.V_out, reference[0])
+    assert not np.array_equal(answers.V_out, sc.surrogate_answers(small_table, hits, seed=1).V_out)
+    # take keeps the keys row for row, and a record without them stays without
+    np.testing.assert_array_equal(keyed.take(slice(3, 9)).grain_key, keys[3:9])
+    assert hits.take(slice(3, 9)).grain_key is None
+
+
 @pytest.mark.parametrize("field, value", [("V", np.zeros((3, 3))), ("a", np.zeros((N_HITS, 1))),
-                                          ("shape", np.array(["prism"] * 3, dtype=object))])
+                                          ("shape", np.array(["prism"] * 3, dtype=object)),
+                                          ("grain_key", np.arange(3)), ("grain_key", np.full(N_HITS, -1)),
+                                          ("grain_key", np.zeros(N_HITS))])
 def test_a_record_without_one_row_per_hit_is_refused(hits, field, value):
     with pytest.raises(ValueError, match=f"SolverHits.{field} must"):
         sc.SolverHits(**{**vars(hits), field: value})

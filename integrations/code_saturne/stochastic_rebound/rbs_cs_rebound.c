@@ -78,6 +78,8 @@ typedef struct {
   int         method;                       /* RBS_AUTO, RBS_TABLE, RBS_DIRECT */
   int         interpolation;                /* RBS_SCALED, RBS_STOCHASTIC */
   int         remove_trapped;               /* 0: deposited, 1: removed */
+  int         keep_grain;                   /* 1: kept, 0: a new grain per hit */
+  uint64_t    grain_seed;                   /* the keys' seed */
   long long   max_hit_records;
 } rbs_cs_settings_t;
 
@@ -113,7 +115,8 @@ _thread_cpu_seconds(void)
 
 static const char *_keys[] = {"table", "shape", "weights", "seed", "method",
                               "interpolation", "trapped", "half_size_factor",
-                              "hits", "max_hit_records"};
+                              "hits", "max_hit_records", "grain",
+                              "grain_seed"};
 #define RBS_CS_N_KEYS (sizeof(_keys)/sizeof(_keys[0]))
 
 /* A copy of `src` into `dst` (size RBS_CS_LINE): it fits, lines being shorter */
@@ -199,7 +202,7 @@ _read_settings_file(const char *path, char values[][RBS_CS_LINE], int given[])
                 "rebound-scatter settings %s, line %d: unknown key \"%s\"; "
                 "the keys are table, shape, weights, seed, method, "
                 "interpolation, trapped, half_size_factor, hits, "
-                "max_hit_records", path, line_no, key);
+                "max_hit_records, grain, grain_seed", path, line_no, key);
     if (given[i])
       bft_error(__FILE__, __LINE__, 0,
                 "rebound-scatter settings %s, line %d: \"%s\" is given twice",
@@ -343,6 +346,19 @@ _read_settings(void)
                                       trapped_names, trapped_codes, 2,
                                       "deposit or remove");
 
+  /* grain kept: a particle's key from its random value (module doc of
+     docs/code_saturne.md); perHit: a new grain from the mix at every hit */
+  static const char *const grain_names[] = {"kept", "perHit"};
+  static const int grain_codes[] = {1, 0};
+  const char *grain = _value(values, given, "grain");
+  _set.keep_grain = _parse_choice("grain", grain ? grain : "kept",
+                                  grain_names, grain_codes, 2,
+                                  "kept or perHit");
+  const char *grain_seed = _value(values, given, "grain_seed");
+  _set.grain_seed = (grain_seed == NULL) ? _set.seed
+    : (uint64_t)_parse_integer("grain_seed", grain_seed, 0,
+                               9223372036854775807LL);
+
   const char *factor = _value(values, given, "half_size_factor");
   _set.half_size_factor = 1.0;
   if (factor != NULL) {
@@ -422,10 +438,15 @@ _open_hits(int rank)
   fprintf(_hits,
           "%s seed %llu, stream %d, "
           "table %s, mix %s, halfSizeFactor %.17g, interpolation %s, "
-          "method %s, spin tolerance %g\n",
+          "method %s, spin tolerance %g, grain ",
           ours, (unsigned long long)_set.seed, rank, table, _set.mix_name,
           _set.half_size_factor, _name(_set.interpolation, im, ic, 2),
           _name(_set.method, m, mc, 3), RBS_SPIN_TOLERANCE);
+  if (_set.keep_grain)
+    fprintf(_hits, "kept (key seed %llu)\n",
+            (unsigned long long)_set.grain_seed);
+  else
+    fprintf(_hits, "perHit\n");
   fprintf(_hits,
           "# V: incident velocity relative to the wall (at rest), Win: "
           "incident angular velocity (0: code_saturne 6.0's particles carry "
@@ -433,29 +454,50 @@ _open_hits(int rank)
           "boundary zone, origProc/origId: -1 (6.0's particles carry no "
           "persistent id), path: 0 table, 1 direct model, -1 invalid, "
           "Vout/Wout: rebound velocity and angular velocity, spin_ratio: "
-          "|Win| a/|V|, u0: first uniform of the draw\n");
+          "|Win| a/|V|, u0: first uniform of the draw, key: the particle's "
+          "grain key (from its random value; -1: a new grain per hit), "
+          "shape: its shape (empty: drawn per hit), ratio_ba/ratio_cb/hand: "
+          "its b/a, c/b and hand on the direct path (nan: the table path or "
+          "not random)\n");
   fprintf(_hits,
           "time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,"
           "nx,ny,nz,Uwx,Uwy,Uwz,status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,"
-          "spin_ratio,u0\n");
+          "spin_ratio,u0,key,shape,ratio_ba,ratio_cb,hand\n");
 }
 
 static void
 _record_hit(int b_zone_id, double d, double a, const double V[3],
-            const double n[3], int status, int path, const double Vout[3],
-            const double Wout[3], double u0)
+            const double n[3], int status, int path, int64_t key,
+            const double Vout[3], const double Wout[3], double u0)
 {
   if (_hits == NULL || _n_recorded >= _set.max_hit_records)
     return;
   _n_recorded++;
   const cs_zone_t *z = cs_boundary_zone_by_id(b_zone_id);
+
+  /* The grain: its shape under grain kept (empty for a new grain per hit),
+     and b/a, c/b and the hand where the direct path fixed them (NaN on the
+     table path, which draws them from the shape's law) */
+  const char *shape = "";
+  double ratio_ba = NAN, ratio_cb = NAN, hand = NAN;
+  rbs_grain grain;
+  if (key >= 0 && rbs_grain_info(_table, _mix, key, &grain) == RBS_OK) {
+    shape = rbs_table_shape_name(_table, grain.shape);
+    if (path == RBS_PATH_DIRECT) {
+      ratio_ba = grain.ratio_ba;
+      ratio_cb = grain.ratio_cb;
+      hand = grain.hand;
+    }
+  }
   fprintf(_hits,
           "%.9g,%d,%s,-1,-1,%.9g,%.9g,%.17g,%.17g,%.17g,0,0,0,"
           "%.17g,%.17g,%.17g,0,0,0,%d,%d,"
-          "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,0,%.17g\n",
+          "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,0,%.17g,"
+          "%lld,%s,%.17g,%.17g,%g\n",
           cs_glob_time_step->t_cur, cs_glob_rank_id < 0 ? 0 : cs_glob_rank_id,
           z->name, d, a, V[0], V[1], V[2], n[0], n[1], n[2], status, path,
-          Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2], u0);
+          Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2], u0,
+          (long long)key, shape, ratio_ba, ratio_cb, hand);
 }
 
 /*----------------------------------------------------------------------------
@@ -494,13 +536,17 @@ rbs_cs_initialize(void)
   bft_printf("\n  rebound-scatter: table %s (%d shapes, alpha1 %g-%g deg, "
              "|V| %g-%g m/s)\n"
              "    mix %s, a = %g*d/2, trapped particles %s, method %s "
-             "(spin tolerance %g), seed %llu (rank r draws stream r)%s%s\n",
+             "(spin tolerance %g), seed %llu (rank r draws stream r), "
+             "grain %s%s%s\n",
              _set.table_path, rbs_table_n_shapes(_table), _alpha1_lo,
              _alpha1_hi, _speed_lo, _speed_hi, _set.mix_name,
              _set.half_size_factor,
              _set.remove_trapped ? "removed" : "deposited",
              _name(_set.method, m, mc, 3), RBS_SPIN_TOLERANCE,
              (unsigned long long)_set.seed,
+             _set.keep_grain ? "kept (a particle's key from grain_seed and "
+                               "its random value)"
+                             : "perHit (a new grain from the mix at every hit)",
              _hits != NULL ? ", hits in " : "", _set.hits_dir);
 }
 
@@ -628,9 +674,24 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
   double t0 = 0, Vout[3], Wout[3];
   if (path == RBS_PATH_DIRECT)
     t0 = cs_timer_wtime();
-  const int status = rbs_rebound_rng(_table, _mix, V, Omega, n, a, &_rng,
-                                     _set.method, _set.interpolation,
-                                     Vout, Wout);
+  /* grain kept: the key of the particle's random value (drawn at its
+     injection, carried from rank to rank and through a restart file: 6.0's
+     one persistent mark of a particle); perHit: a new grain per hit */
+  int64_t key = -1;
+  int status;
+  if (_set.keep_grain) {
+    const double random = cs_lagr_particle_get_real(particle, p_am,
+                                                    CS_LAGR_RANDOM_VALUE);
+    uint64_t bits;
+    memcpy(&bits, &random, sizeof(bits));
+    key = rbs_grain_key(_set.grain_seed, bits, 0);
+    status = rbs_rebound_grain_rng(_table, _mix, key, V, Omega, n, a, &_rng,
+                                   _set.method, _set.interpolation, Vout,
+                                   Wout);
+  }
+  else
+    status = rbs_rebound_rng(_table, _mix, V, Omega, n, a, &_rng,
+                             _set.method, _set.interpolation, Vout, Wout);
   if (path == RBS_PATH_DIRECT) {
     _count.direct_seconds += cs_timer_wtime() - t0;
     _count.direct_path++;
@@ -724,6 +785,6 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
     *tracking_state = CS_LAGR_PART_TO_SYNC;
   }
 
-  _record_hit(b_zone_id, d, a, V, n, status, path, Vout, Wout, u0);
+  _record_hit(b_zone_id, d, a, V, n, status, path, key, Vout, Wout, u0);
   _count.cpu_seconds += _thread_cpu_seconds() - cpu0;
 }

@@ -184,6 +184,7 @@ void Foam::StochasticRebound<CloudType>::recordHit
     double a,
     int status,
     int path,
+    int64_t key,
     const double Vout[3],
     const double Wout[3],
     scalar spinRatio,
@@ -196,6 +197,24 @@ void Foam::StochasticRebound<CloudType>::recordHit
         return;
     }
     ++s.nRecorded;
+
+    // The grain: its shape under grain kept (empty for a new grain per
+    // hit), and b/a, c/b and the hand where the direct path fixed them
+    // (NaN on the table path, which draws them from the shape's law)
+    const char* shape = "";
+    double ratioBa = NAN, ratioCb = NAN, hand = NAN;
+    rbs_grain grain;
+    if (key >= 0 && rbs_grain_info(table_.get(), mix_.get(), key, &grain) == RBS_OK)
+    {
+        shape = rbs_table_shape_name(table_.get(), grain.shape);
+        if (path == RBS_PATH_DIRECT)
+        {
+            ratioBa = grain.ratio_ba;
+            ratioCb = grain.ratio_cb;
+            hand = grain.hand;
+        }
+    }
+
     char line[1024];
     std::snprintf
     (
@@ -203,14 +222,16 @@ void Foam::StochasticRebound<CloudType>::recordHit
         "%.9g,%d,%s,%d,%d,%.9g,%.9g,"
         "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
         "%.9g,%.9g,%.9g,"
-        "%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.17g\n",
+        "%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.9g,%.17g,"
+        "%lld,%s,%.17g,%.17g,%g\n",
         this->owner().mesh().time().value(),
         int(Pstream::myProcNo()), pp.name().c_str(),
         int(p.origProc()), int(p.origId()), p.d(), a,
         V[0], V[1], V[2], Omega[0], Omega[1], Omega[2], n[0], n[1], n[2],
         Uwall.x(), Uwall.y(), Uwall.z(),
         status, path, Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2],
-        spinRatio, u0
+        spinRatio, u0, static_cast<long long>(key), shape, ratioBa, ratioCb,
+        hand
     );
     s.hits << line;
 }
@@ -238,6 +259,8 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     seed_(0),
     interpolation_(RBS_SCALED),
     method_(RBS_AUTO),
+    keepGrain_(true),
+    grainSeed_(0),
     alpha1Lo_(0),
     alpha1Hi_(0),
     speedLo_(0),
@@ -262,7 +285,7 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     static const wordList known
     ({
         "table", "shape", "weights", "halfSizeFactor", "trapped", "seed",
-        "interpolation", "method", "writeHits", "maxHitRecords",
+        "interpolation", "method", "grain", "grainSeed", "writeHits", "maxHitRecords",
         "U", "writePrecision", "writeToFile", "useUserTime", "defaultCoeffs"
     });
     for (const word& key : coeffs.toc())
@@ -336,6 +359,18 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
             << exit(FatalIOError);
     }
 
+    const word grainMode(coeffs.getOrDefault<word>("grain", "kept"));
+    if (grainMode == "perHit")
+    {
+        keepGrain_ = false;
+    }
+    else if (grainMode != "kept")
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "grain must be kept or perHit, not " << grainMode
+            << exit(FatalIOError);
+    }
+
     const label seed = coeffs.getOrDefault<label>("seed", 1);
     if (seed < 0)
     {
@@ -343,6 +378,17 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
             << "seed must be >= 0, not " << seed << exit(FatalIOError);
     }
     seed_ = uint64_t(seed);
+
+    // The keys' own seed, so that a restart may draw new streams (another
+    // seed) while every parcel keeps its grain
+    const label grainSeed = coeffs.getOrDefault<label>("grainSeed", seed);
+    if (grainSeed < 0)
+    {
+        FatalIOErrorInFunction(coeffs)
+            << "grainSeed must be >= 0, not " << grainSeed
+            << exit(FatalIOError);
+    }
+    grainSeed_ = uint64_t(grainSeed);
 
     openTable(coeffs);
 
@@ -371,16 +417,24 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
             << mixName_.c_str() << ", halfSizeFactor " << halfSizeFactor_
             << ", interpolation " << interp.c_str() << ", method "
             << method.c_str() << ", spin tolerance " << RBS_SPIN_TOLERANCE
-            << "\n"
+            << ", grain " << grainMode.c_str();
+        if (keepGrain_)
+        {
+            state_->hits << " (key seed " << grainSeed_ << ")";
+        }
+        state_->hits << "\n"
             << "# V: incident velocity relative to the wall, Win: incident"
                " angular velocity (colliding parcels, else 0), n: unit normal"
                " into the gas, Uw: wall velocity, path: 0 table, 1 direct"
                " model, -1 invalid, Vout/Wout: rebound velocity (relative to"
                " the wall) and angular velocity, spin_ratio: |Win| a/|V|,"
-               " u0: first uniform of the draw\n"
+               " u0: first uniform of the draw, key: the parcel's grain key"
+               " (-1: a new grain per hit), shape: its shape (empty: drawn"
+               " per hit), ratio_ba/ratio_cb/hand: its b/a, c/b and hand on"
+               " the direct path (nan: the table path or not random)\n"
             << "time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,"
                "nx,ny,nz,Uwx,Uwy,Uwz,status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,"
-               "spin_ratio,u0\n";
+               "spin_ratio,u0,key,shape,ratio_ba,ratio_cb,hand\n";
     }
 
     const rbs_table* t = table_.get();
@@ -393,7 +447,18 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
         << ", interpolation " << interp << ", method " << method
         << " (spin tolerance " << RBS_SPIN_TOLERANCE << ")"
         << ", seed " << seed_
-        << " (rank r draws stream r)" << endl;
+        << " (rank r draws stream r)" << nl
+        << "        grain " << grainMode
+        << (
+               keepGrain_
+             ? " (a parcel's key from grainSeed, origProc, origId; grainSeed "
+             : " (a new grain from the mix at every hit"
+           );
+    if (keepGrain_)
+    {
+        Info<< grainSeed_;
+    }
+    Info<< ")" << endl;
 }
 
 
@@ -413,6 +478,8 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     seed_(pim.seed_),
     interpolation_(pim.interpolation_),
     method_(pim.method_),
+    keepGrain_(pim.keepGrain_),
+    grainSeed_(pim.grainSeed_),
     alpha1Lo_(pim.alpha1Lo_),
     alpha1Hi_(pim.alpha1Hi_),
     speedLo_(pim.speedLo_),
@@ -478,10 +545,25 @@ bool Foam::StochasticRebound<CloudType>::correct
     {
         t0 = std::chrono::steady_clock::now();
     }
-    const int status = rbs_rebound
-    (
-        table, mix_.get(), V, Omega, n, a, u, method_, interpolation_, Vout, Wout
-    );
+    // grain kept: the parcel's ids, born with it, carried across ranks and
+    // restarts, give its key (rbs_rebound_grain_rng's draw, with u kept for
+    // the record); perHit: rbs_rebound, a new grain per hit
+    const int64_t key =
+        keepGrain_
+      ? rbs_grain_key(grainSeed_, uint64_t(p.origProc()), uint64_t(p.origId()))
+      : -1;
+    const int status =
+        keepGrain_
+      ? rbs_rebound_grain
+        (
+            table, mix_.get(), key, V, Omega, n, a, u, method_,
+            interpolation_, Vout, Wout
+        )
+      : rbs_rebound
+        (
+            table, mix_.get(), V, Omega, n, a, u, method_, interpolation_,
+            Vout, Wout
+        );
     if (path == RBS_PATH_DIRECT)
     {
         c.directSeconds += std::chrono::duration<double>
@@ -574,8 +656,8 @@ bool Foam::StochasticRebound<CloudType>::correct
     {
         recordHit
         (
-            p, pp, V, Omega, n, Uwall, a, status, path, Vout, Wout, spinRatio,
-            u[0]
+            p, pp, V, Omega, n, Uwall, a, status, path, key, Vout, Wout,
+            spinRatio, u[0]
         );
     }
 
