@@ -53,7 +53,28 @@ def _mix(args):
     return weights, "mix:" + ",".join(f"{w:g}" for w in weights)
 
 
-def _draw(table, args, shape, omega):
+def _grain_keys(path: str, n: int) -> np.ndarray:
+    """(n,) int64 grain keys from the text file ``path`` (--grain-keys): whole numbers in [0, 2**63) separated by
+    white space, one per draw; an unreadable file, another count or a bad entry is a ValueError naming it."""
+    try:
+        tokens = Path(path).read_text().split()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"--grain-keys {path}: cannot read it ({getattr(exc, 'strerror', None) or exc}).") from None
+    keys = np.empty(len(tokens), dtype=np.int64)
+    for i, token in enumerate(tokens):
+        try:
+            key = int(token)
+        except ValueError:
+            key = -1
+        if not 0 <= key < 2 ** 63:
+            raise ValueError(f"--grain-keys {path}: entry {i + 1} is {token!r}, not a whole number in [0, 2**63).")
+        keys[i] = key
+    if len(keys) != n:
+        raise ValueError(f"--grain-keys {path}: {len(keys)} keys, but -n asks for {n} draws (one key each).")
+    return keys
+
+
+def _draw(table, args, shape, omega, keys=None):
     """(draws in the local frame, V⁺ in m/s lab frame, the path of the draws) at the incident state of ``args``.
 
     The lab frame (wall y = 0, normal +Y, V⁻ in the XY plane) is the impact frame of that state, so the local
@@ -61,7 +82,9 @@ def _draw(table, args, shape, omega):
     every draw of one incident state; the table's draws are those of ``sample_local``, the direct model's
     those of ``sample_global``. With --grain-key every draw is the grain of that key (one grain over random
     orientations): on the table path its shape, drawn by ``sample_local`` with the key's shape alone (the table
-    holds that shape's law over its random proportions), on the direct path its shape, proportions and hand."""
+    holds that shape's law over its random proportions), on the direct path its shape, proportions and hand.
+    With ``keys`` ((n,) int64, --grain-keys: one grain per draw), the draws of ``sample_global`` with those keys
+    on either path."""
     import surrogate
     from surrogate.kernels import PATH_DIRECT, PATH_TABLE, rebound_path
     from surrogate.validation import check_method
@@ -73,18 +96,20 @@ def _draw(table, args, shape, omega):
     path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, check_method(args.method))
             if alpha1_is_physical(args.alpha1) and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
     keyed = args.grain_key is not None
-    if path != PATH_DIRECT:
+    if path != PATH_DIRECT and keys is None:
         local_shape = surrogate.grain_of(table, [args.grain_key], shape).shape[0] if keyed else shape
         draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, local_shape,
                                        random_state=args.seed, clamp=args.clamp)
         return draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio), PATH_TABLE
-    V_out, Omega_out, status = surrogate.sample_global(table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size,
-                                                       shape, random_state=args.seed, omega=spin, method="direct",
-                                                       grain_key=np.full(args.n, args.grain_key) if keyed else None)
+    if keys is None and keyed:
+        keys = np.full(args.n, args.grain_key)
+    V_out, Omega_out, status = surrogate.sample_global(
+        table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape, random_state=args.seed, omega=spin,
+        method="direct" if path == PATH_DIRECT else "table", clamp=args.clamp, grain_key=keys)
     alpha2, beta2, v = rebound_angles(V_out)
     draws = surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
                                  omega=Omega_out * (half_size / speed), status=status)
-    return draws, V_out, PATH_DIRECT
+    return draws, V_out, path
 
 
 def _sample(args) -> int:
@@ -97,9 +122,10 @@ def _sample(args) -> int:
     check_memory(args.n, BYTES_PER_DRAW, "-n")
     shape, label = _mix(args)
     omega = check_omega(args.omega, 1)[0]         # Ω⁻ a/|V⁻|, lab frame
+    keys = None if args.grain_keys is None else _grain_keys(args.grain_keys, args.n)
     table = surrogate.load(args.table)
     check_shape(table, shape)
-    draws, velocity, path = _draw(table, args, shape, omega)
+    draws, velocity, path = _draw(table, args, shape, omega, keys)
     speed = args.speed
     grain, fixed = {}, {}
     if args.grain_key is not None:
@@ -108,6 +134,10 @@ def _sample(args) -> int:
             fixed = {k: float(v[0]) for k, v in zip(("ratio_ba", "ratio_cb", "hand"), kept[1:]) if not np.isnan(v[0])}
         grain = {"grain_key": args.grain_key, "grain_shape": kept.shape[0],
                  **{f"grain_{k}": v for k, v in fixed.items()}}
+    if keys is not None:
+        names, counts = np.unique(surrogate.grain_of(table, keys, shape).shape, return_counts=True)
+        grain = {"grain_keys": str(args.grain_keys),
+                 "grain_shapes": ", ".join(f"{name} {count}" for name, count in zip(names, counts))}
     samples = SampleSet(velocity=velocity, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
                         status=draws.status, alpha1=args.alpha1, speed=speed, shape=label, seed=args.seed,
                         producer="surrogate sample",
@@ -119,7 +149,9 @@ def _sample(args) -> int:
     print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s{spin}, {label}: {counts}")
     print(f"  answered by the table {0 if path else args.n}, by the direct model {args.n if path else 0} "
           f"(method {args.method}); failed {int(np.sum(draws.status == STATUS_FAILED))}")
-    if grain:
+    if keys is not None:
+        print(f"  {args.n} grains, one per draw, from {args.grain_keys}: {grain['grain_shapes']}")
+    elif grain:
         labels = {"ratio_ba": "b/a", "ratio_cb": "c/b", "hand": "hand"}
         kept = (", ".join(f"{labels[k]} {v:.4g}" for k, v in fixed.items()) + ", kept on every hit") if fixed else \
             "fixed proportions" if path == PATH_DIRECT else "proportions from the shape's law (table path)"
@@ -201,10 +233,14 @@ def main(argv=None) -> int:
                         help="auto (default): the table where it is valid (|Omega-|a/|V-| <= the spin tolerance, "
                              "inside the grid), the direct model elsewhere; table: always the table (Omega- "
                              "ignored); direct: always the direct model")
-    sample.add_argument("--grain-key", type=seed_argument, default=None, metavar="K",
-                        help="a grain key in [0, 2**63): every draw is that one grain over random orientations "
-                             "(its shape from the mix by the key; on the direct path its proportions and hand "
-                             "too), as a particle of that key hits every time")
+    keyed = sample.add_mutually_exclusive_group()
+    keyed.add_argument("--grain-key", type=seed_argument, default=None, metavar="K",
+                       help="a grain key in [0, 2**63): every draw is that one grain over random orientations "
+                            "(its shape from the mix by the key; on the direct path its proportions and hand "
+                            "too), as a particle of that key hits every time")
+    keyed.add_argument("--grain-keys", default=None, metavar="FILE",
+                       help="a text file of N grain keys in [0, 2**63), one per draw (white space between): draw "
+                            "i is the grain of key i (sample_global's grain_key)")
     sample.add_argument("--clamp", action="store_true",
                         help="with --method table: outside the table's range (but physical), use the law at the "
                              "nearest grid edge")

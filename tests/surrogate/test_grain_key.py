@@ -278,3 +278,49 @@ def test_cli_bad_grain_key_or_mix_is_one_line(small_table_path, capsys, argv, wo
     from tests.helpers.cli import user_error
     user_error(main, ["sample", "--table", str(small_table_path), "--alpha1", "45", "--speed", "100", "-n", "5"]
                + argv, capsys, *words)
+
+
+def test_cli_draws_one_grain_per_draw_from_a_file_of_keys(small_table_path, small_table, tmp_path, capsys):
+    """surrogate sample --grain-keys FILE: draw i is the grain of key i, as sample_global draws it with those keys,
+    on the table path and on the direct path; the shapes' counts are printed and kept in the provenance."""
+    from data_schema.samples import read_samples
+    from surrogate.cli import main
+    from tests.helpers.cli import run_cli
+    n = 300
+    keys = np.arange(n, dtype=np.int64) * 1_000_003 + 11
+    path = tmp_path / "keys.txt"
+    path.write_text("\n".join(map(str, keys[:150])) + "\n" + " ".join(map(str, keys[150:])))
+    names, counts = np.unique(surrogate.grain_of(small_table, keys, MIX).shape, return_counts=True)
+    shapes = ", ".join(f"{name} {count}" for name, count in zip(names, counts))
+    named = ",".join(f"{k}={v}" for k, v in MIX.items())
+    a1 = math.radians(45.0)          # as the command line computes V⁻
+    V = np.tile([100.0 * math.cos(a1), -100.0 * math.sin(a1), 0.0], (n, 1))
+    for method in ("table", "direct"):
+        out = tmp_path / f"{method}.h5"
+        code, err, text = run_cli(main, ["sample", "--table", str(small_table_path), "--alpha1", "45", "--speed",
+                                         "100", "-n", str(n), "--seed", "5", "--mix", named, "--grain-keys",
+                                         str(path), "--method", method, "--out", str(out)], capsys)
+        assert code == 0, err
+        assert f"{n} grains, one per draw, from {path}: {shapes}" in text
+        samples = read_samples(out)
+        assert samples.provenance["grain_shapes"] == shapes
+        expected = surrogate.sample_global(small_table, V, NORMAL, 1.0, MIX, random_state=5, method=method,
+                                           grain_key=keys)
+        assert samples.velocity.tobytes() == expected[0].tobytes()
+
+
+@pytest.mark.parametrize("content, words", [
+    ("1 2", ["2 keys", "-n asks for 5"]),
+    ("1 2 3 -4 5", ["entry 4", "'-4'", "[0, 2**63)"]),
+    ("1 2 3 4.0 5", ["entry 4", "'4.0'"]),
+    (f"1 2 3 4 {2 ** 63}", ["entry 5", str(2 ** 63)]),
+    (None, ["cannot read"]),
+])
+def test_cli_bad_file_of_keys_is_one_line(small_table_path, tmp_path, capsys, content, words):
+    from surrogate.cli import main
+    from tests.helpers.cli import user_error
+    path = tmp_path / "keys.txt"
+    if content is not None:
+        path.write_text(content)
+    user_error(main, ["sample", "--table", str(small_table_path), "--alpha1", "45", "--speed", "100", "-n", "5",
+                      "--grain-keys", str(path)], capsys, "--grain-keys", *words)
