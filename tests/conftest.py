@@ -63,9 +63,8 @@ def near_normal_table(tmp_path_factory):
     return surrogate.load(_build(tmp_path_factory, "near_normal", NEAR_NORMAL_TABLE_CONFIG))
 
 
-# a rank of the 2-rank solver cases waiting in a collective yields its core instead of polling: the cases run beside
-# the tests and the background worker on 2 cores (a code_saturne 2-rank case took 113 s polling against two busy
-# loops, 57 s yielding; the hits are the same)
+# a rank of the 2-rank solver cases waiting in a collective yields its core instead of polling it away from the tests
+# and the background worker beside it (docs/design/test_time.md)
 os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 
 # fixtures whose subprocesses run next to the tests from the session's start, in this order (the order their

@@ -258,9 +258,8 @@ def _classifier(X, Y, seed: int, groups) -> tuple[float, int]:
         train, test = next(GroupShuffleSplit(n_splits=1, test_size=0.5, random_state=seed)
                            .split(Z, labels, groups=np.asarray(groups)))
         Z_train, Z_test, y_train, y_test = Z[train], Z[test], labels[train], labels[test]
-    # one OpenMP thread: on some thousands of rows the threads mostly wait at barriers, and on a busy machine
-    # they spin there against the other jobs (a fit of 12 000 rows took 15-30 s of CPU on 2 loaded cores, about
-    # 1 s on one thread); the figure is then also the same whatever the number of cores
+    # one OpenMP thread: on some thousands of rows the threads mostly spin at barriers against the machine's other
+    # jobs (docs/design/test_time.md), and the figure is the same whatever the number of cores
     with threadpool_limits(1, user_api="openmp"):
         model = HistGradientBoostingClassifier(max_iter=200, random_state=seed).fit(Z_train, y_train)
         return float(model.score(Z_test, y_test)), len(y_test)

@@ -44,12 +44,9 @@ cs_user_parameters(cs_domain_t  *domain)
   domain->time_step->dt_ref = 2.e-5;
   domain->time_step->nt_max = 200;
 
-  /* the fluid's iteration log every 100 steps (and the first ones): on 2 MPI
-     ranks a logged step sums the flow rates of every boundary type over the
-     ranks, some 450 global sums, 6 in 7 of the run's. Each sum waits for the
-     other rank to get a core: on a busy machine (load 8 on 2 cores) the run
-     on 2 ranks took 170 s logging every step, 39 s so. lagrangian.log keeps
-     a row per step. */
+  /* the fluid's iteration log every 100 steps (and the first ones): a logged
+     step makes most of the run's global sums over the ranks, each waiting
+     for the other rank to get a core. lagrangian.log keeps a row per step. */
   cs_glob_log_frequency = 100;
 }
 
