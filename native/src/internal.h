@@ -156,7 +156,7 @@ static inline const double *rbs_mix_cdf(const rbs_mix *mix)
     return mix->n_shapes <= RBS_MAX_SHAPES ? mix->cdf : ((const rbs_mix_block *)(const void *)mix)->cdf;
 }
 
-/* wall_hit.c: rbs_rebound along the path `path` its rbs_rebound_path gave (surrogate.kernels.wall_hit._rebound_along):
+/* wall_hit.c: rbs_rebound along the path `path` its rbs_rebound_path gave (surrogate.kernels.wall_hit.rebound_typed):
  * RBS_INVALID and NaN for path RBS_INVALID or what rbs_rebound refuses; rbs_rebound_grain passes the key's uniforms */
 int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const double V[3], const double Omega[3],
                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],

@@ -1,6 +1,6 @@
 /*
  * wall_hit.c: every wall hit answered, spinning or not (surrogate.kernels.wall_hit: rebound_path, rebound,
- * _rebound_along): the path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound
+ * rebound_typed): the path of a hit (the table where its law is valid, the direct model elsewhere) and the rebound
  * along it.
  *
  * A hit consumes RBS_U_PER_DRAW uniforms whatever path answers it, so a stream stays aligned. The table path

@@ -8,6 +8,8 @@ Per hit the model frame is built as the table's draws build theirs
 :func:`direct_model.runtime.rebound_model_frame` runs the whole rebound, and V⁺, Ω⁺ come back in the
 caller's frame. Units: V in m/s, Ω in rad/s, a in m. The model parameters and the shapes come from the table
 (``table.direct_parameters``, ``table.shape_arrays``), so a table and its direct model never disagree.
+:func:`direct_rebound` converts its arguments to one set of types and calls :func:`direct_rebound_typed`, which
+every kernel of the direct path calls: the model is compiled once per process whatever types the callers pass.
 """
 
 import math
@@ -18,7 +20,7 @@ import numpy as np
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_model_frame
 from surrogate.kernels.checks import check_keys
-from surrogate.kernels.frame import NAN3, dot, impact_frame, moves_into_wall, particle_ok, to_global
+from surrogate.kernels.frame import NAN3, dot, float3, impact_frame, moves_into_wall, particle_ok, to_global
 from surrogate.kernels.grain import key_model_uniforms
 from surrogate.kernels.options import JIT
 from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
@@ -47,7 +49,8 @@ def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
     (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID with NaN vectors for
     an input outside the ranges above.
     """
-    return inline_direct_rebound(params, shape_arrays, shape, V, omega, n, a, u, np.empty(SCRATCH_SIZE))
+    return direct_rebound_typed(params, shape_arrays, np.int64(shape), float3(V), float3(omega), float3(n), float(a), u,
+                                np.empty(SCRATCH_SIZE))
 
 
 @numba.njit(inline="always", **JIT)
@@ -61,10 +64,10 @@ def _valid(shape_arrays, shape, V, omega, n, a, u):
     return ok
 
 
-@numba.njit(inline="always", **JIT)
-def inline_direct_rebound(params, shape_arrays, shape, V, omega, n, a, u, scratch):
-    """:func:`direct_rebound` with its scratch space given, inlined into its caller (the parallel kernel, and
-    the call that answers any hit, :func:`surrogate.kernels.wall_hit.rebound`)."""
+@numba.njit(**JIT)
+def direct_rebound_typed(params, shape_arrays, shape, V, omega, n, a, u, scratch):
+    """:func:`direct_rebound` with its scratch space given: ``shape`` an int64, V, omega and n 3-tuples of float64,
+    a a float64, ``scratch`` (SCRATCH_SIZE,) float64 (module doc)."""
     if not _valid(shape_arrays, shape, V, omega, n, a, u):
         return STATUS_INVALID, NAN3, NAN3
     ex, ez = _frame_axes(V, n, u[U_AXIS])
@@ -104,9 +107,8 @@ def direct_rebound_parallel_rng(params, shape_arrays, shape, keys, V, omega, n, 
             fill_uniforms(state, u)
             if keys.shape[0] > 0 and keys[i] >= 0:
                 key_model_uniforms(keys[i], u)
-            st, V_new, Omega_new = inline_direct_rebound(params, shape_arrays, shape[i], (V[i, 0], V[i, 1], V[i, 2]),
-                                                         (omega[i, 0], omega[i, 1], omega[i, 2]),
-                                                         (n[i, 0], n[i, 1], n[i, 2]), a[i], u, scratch)
+            st, V_new, Omega_new = direct_rebound_typed(params, shape_arrays, np.int64(shape[i]), float3(V[i]),
+                                                        float3(omega[i]), float3(n[i]), float(a[i]), u, scratch)
             status[i] = st
             for k in range(3):
                 V_out[i, k] = V_new[k]

@@ -78,6 +78,12 @@ NAN3 = (np.nan, np.nan, np.nan)     # the V⁺ and Ω⁺ of a draw that did not 
 
 
 @numba.njit(inline="always", **JIT)
+def float3(x):
+    """A 3-vector (3-tuple or (3,) array) as a 3-tuple of float64."""
+    return float(x[0]), float(x[1]), float(x[2])
+
+
+@numba.njit(inline="always", **JIT)
 def moves_into_wall(V, n):
     """V·n < 0 and V finite: a particle that hits the wall (else STATUS_INVALID at once)."""
     return dot(V, n) < 0.0 and math.isfinite(V[0] + V[1] + V[2])

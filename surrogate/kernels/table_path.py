@@ -1,6 +1,10 @@
 """The table path, one particle: in the global frame :func:`table_rebound` (for a solver's per-hit loop); in
 the local frame :func:`draw_local`.
 
+Each public kernel converts its arguments to one set of types (3-tuples and scalars of float64, ``scaled`` a
+bool) and calls its ``_typed`` twin, which holds the work: whatever types the callers pass, the work is compiled
+once per process (docs/design/test_time.md).
+
 The impact frame (:func:`surrogate.kernels.frame.impact_frame`), then one draw
 (:mod:`surrogate.kernels.draw`: locate, gather, arithmetic) and the way back
 to the global frame. V⁻ in m/s in, V⁺ in m/s and Ω⁺ in rad/s out.
@@ -13,7 +17,7 @@ import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
 from surrogate.kernels.draw import draw_in_cell, draw_velocity
-from surrogate.kernels.frame import (NAN3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
+from surrogate.kernels.frame import (NAN3, float3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
                                      uniforms_ok)
 from surrogate.kernels.locate import hint, locate
 from surrogate.kernels.options import JIT, KERNEL
@@ -49,13 +53,12 @@ def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
     ``V[i]`` creates no array view, so the loop does no reference counting
     (numba's atomic counts on views: docs/design/sampler_cost.md).
     """
-    return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
+    return table_rebound_typed(data, mix_cdf, float3(V), float3(n), float(a), u, scaled != 0)
 
 
-@numba.njit(inline="always", **JIT)
-def inline_table_rebound(data, mix_cdf, V, n, a, u, scaled):
-    """:func:`table_rebound`, inlined into its caller (the call that answers any hit,
-    :func:`surrogate.kernels.wall_hit.rebound`)."""
+@numba.njit(**KERNEL)
+def table_rebound_typed(data, mix_cdf, V, n, a, u, scaled):
+    """:func:`table_rebound` with V and n 3-tuples of float64, a a float64 and ``scaled`` a bool (module doc)."""
     if not moves_into_wall(V, n):
         return STATUS_INVALID, NAN3, NAN3
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
@@ -82,6 +85,12 @@ def draw_local(data, mix_cdf, alpha1, speed, u, scaled=True):
     and > 0, a uniform outside [0, 1), or a draw that is not a finite rebound
     leaving the wall (as rbs_draw_local).
     """
+    return draw_local_typed(data, mix_cdf, float(alpha1), float(speed), u, scaled != 0)
+
+
+@numba.njit(**KERNEL)
+def draw_local_typed(data, mix_cdf, alpha1, speed, u, scaled):
+    """:func:`draw_local` with α1 and |V⁻| float64 and ``scaled`` a bool (module doc)."""
     if not local_ok(alpha1, speed):
         return STATUS_INVALID, np.nan, np.nan, np.nan, np.nan, np.nan, np.nan
     status, vx, vy, vz, wx, wy, wz = draw_velocity(data, mix_cdf, alpha1, speed, u, scaled)

@@ -23,6 +23,9 @@ u[0], on either path (:func:`surrogate.kernels.locate.row_shape`). A particle of
 ``keys``) hits as its own grain: its shape from the key on either path, its proportions and hand too on the
 direct path (:mod:`surrogate.kernels.grain`).
 
+Like the table path's kernels (:mod:`surrogate.kernels.table_path`), :func:`rebound` and
+:func:`rebound_parallel_rng` convert their arguments and call their ``_typed`` twins, compiled once per process.
+
 Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
 gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a
 contact search failed; NaN vectors), STATUS_INVALID (NaN vectors).
@@ -35,9 +38,9 @@ import numpy as np
 
 from data_schema.samples import STATUS_INVALID
 from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
-from surrogate.kernels.direct_path import inline_direct_rebound
+from surrogate.kernels.direct_path import direct_rebound_typed
 from surrogate.kernels.draw import U_PER_DRAW
-from surrogate.kernels.frame import NAN3, dot, incidence, incidence_angle, particle_ok, uniforms_ok
+from surrogate.kernels.frame import NAN3, dot, float3, incidence, incidence_angle, particle_ok, uniforms_ok
 from surrogate.kernels.grain import keyed_shapes, keyed_uniforms
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
@@ -45,7 +48,7 @@ from surrogate.kernels.checks import check_keys, check_shapes
 from surrogate.kernels.options import JIT
 from surrogate.kernels.pipeline import no_uniforms, run_blocks, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS
-from surrogate.kernels.table_path import inline_table_rebound
+from surrogate.kernels.table_path import table_rebound_typed
 
 METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
 PATH_TABLE, PATH_DIRECT = 0, 1
@@ -124,11 +127,12 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
     a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0); NaN vectors unless
     rebounded.
     """
-    path = rebound_path(data, V, omega, n, a, method)
+    V, omega, n, a, scaled = float3(V), float3(omega), float3(n), float(a), scaled != 0
+    path = rebound_path(data, V, omega, n, a, np.int64(method))
     if key is not None:
         return _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path,
-                              key)
-    return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path)
+                              np.int64(key))
+    return rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path)
 
 
 @numba.njit(inline="always", **JIT)
@@ -138,14 +142,15 @@ def _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, 
         return STATUS_INVALID, NAN3, NAN3
     keyed = np.empty(U_PER_DRAW)
     keyed_uniforms(key, u, path == PATH_DIRECT, keyed)
-    return _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, keyed, scaled, path)
+    return rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, keyed, scaled, path)
 
 
-@numba.njit(inline="always", **JIT)
-def _rebound_along(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path):
-    """:func:`rebound` along its path ``path`` with the uniforms ``u``."""
+@numba.njit(**JIT)
+def rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path):
+    """:func:`rebound` along its path ``path`` with the uniforms ``u``: V, omega and n 3-tuples of float64, a a
+    float64, ``scaled`` a bool (module doc)."""
     if path == PATH_TABLE:
-        return inline_table_rebound(data, mix_cdf, V, n, a, u, scaled)
+        return table_rebound_typed(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
         return _direct_path(params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u,
                             np.empty(SCRATCH_SIZE))
@@ -160,8 +165,8 @@ def _direct_path(params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n
         return STATUS_INVALID, NAN3, NAN3
     if shape == SHAPE_FROM_MIX:
         shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
-    return inline_direct_rebound(params, shape_arrays, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND],
-                                 scratch)
+    return direct_rebound_typed(params, shape_arrays, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND],
+                                scratch)
 
 
 @numba.njit(**JIT)
@@ -177,7 +182,7 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
                              (n[i, 0], n[i, 1], n[i, 2]), a[i])
 
 
-@numba.njit(parallel=True, **JIT)
+@numba.njit(**JIT)
 def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
                          method, V_out, Omega_out, status, path, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
@@ -200,6 +205,15 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     and path STATUS_INVALID under METHOD_AUTO, the method's path under the others. A method code outside
     the three is a ValueError.
     """
+    # a private copy of the mix (a few numbers): writable or not, the caller's mix compiles the same kernel
+    rebound_parallel_rng_typed(data, params, shape_arrays, model_shapes, mix_cdf.copy(), shapes, keys, V, omega, n, a,
+                               states, np.int64(method), V_out, Omega_out, status, path, scaled != 0)
+
+
+@numba.njit(parallel=True, **JIT)
+def rebound_parallel_rng_typed(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
+                               method, V_out, Omega_out, status, path, scaled):
+    """:func:`rebound_parallel_rng` with a writable mix, ``method`` an int64 and ``scaled`` a bool (module doc)."""
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
     check_shapes(shapes, V.shape[0], mix_cdf.shape[0])

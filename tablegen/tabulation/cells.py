@@ -9,6 +9,8 @@ with the direct model (:data:`tablegen.tabulation.driver.MODEL_SOURCES`).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from data_schema.table import CellTable
@@ -43,6 +45,16 @@ def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> s
     """The cell's name in messages: shape, α1 and speed."""
     return (f"cell (shape={shape}, alpha1={config.alpha1_deg[i_alpha]:g} deg, "
             f"speed={config.speed_m_s[i_speed]:g} m/s)")
+
+
+def compile_cell_kernels(config: BuildConfig) -> None:
+    """Compile the model's kernels in this process, on one particle, into numba's on-disk cache: worker processes
+    started afterwards load them instead of each compiling them at once (about a minute per worker)."""
+    shape = config.shapes[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # the one particle's warnings are the cells' own, given there
+        simulate(config.grain(shape) or shape, config.alpha1_deg[0], config.speed_m_s[0], 1, seed=0,
+                 kappa=config.kappa, aspect=config.aspect, wall=config.wall, n_max=config.n_max)
 
 
 def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> CellTable:

@@ -36,7 +36,7 @@ from data_schema.output import check_free_space, check_memory, check_output, rem
 from data_schema.table import CELL_DATASETS, TABLE_FILE_TYPE, TABLE_VERSION, CellTable, ReboundTable, write_table
 from direct_model.shapes import second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL     # cells.py's simulate uses these
-from tablegen.tabulation.cells import cell_label, compute_cell
+from tablegen.tabulation.cells import cell_label, compile_cell_kernels, compute_cell
 from tablegen.tabulation.config import BuildConfig
 from tablegen.progress import progress_bar
 
@@ -224,6 +224,8 @@ def _run_local(config, tasks, checkpoint, workers, bar) -> None:
     if not tasks:
         return
     workers = worker_count(workers, len(tasks))
+    if workers > 1:
+        compile_cell_kernels(config)
     threads = max(1, (os.cpu_count() or 1) // workers)
     # spawn, not fork: forking a process whose numba kernels already ran on OpenMP threads is unsafe
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
