@@ -64,7 +64,7 @@ def draw_local_parallel(data, mix_cdf, alpha1, speed, u, out, status, scaled=Tru
     check_uniforms(u, alpha1.shape[0], "alpha1")
     for j in numba.prange(n_chunks(alpha1.shape[0])):
         lo, hi = _chunk(j, alpha1.shape[0])
-        _draw_local_chunk(data, mix_cdf, alpha1, speed, u[lo:hi], out, status, scaled, lo, hi)
+        _draw_local_chunk(data, mix_cdf, alpha1, speed, u, 0, out, status, scaled, lo, hi)
 
 
 @numba.njit(parallel=True, **JIT)
@@ -75,14 +75,15 @@ def draw_local_parallel_rng(data, mix_cdf, alpha1, speed, states, out, status, s
     check_states(states, alpha1.shape[0])
     for j in numba.prange(states.shape[0]):
         lo, hi = _chunk(j, alpha1.shape[0])
-        _draw_local_chunk(data, mix_cdf, alpha1, speed, table_rebound_uniforms(states[j].copy(), hi - lo), out, status,
-                          scaled, lo, hi)
+        _draw_local_chunk(data, mix_cdf, alpha1, speed, table_rebound_uniforms(states[j].copy(), hi - lo), lo, out,
+                          status, scaled, lo, hi)
 
 
 @numba.njit(inline="always", **JIT)
-def _draw_local_chunk(data, mix_cdf, alpha1, speed, u, out, status, scaled, lo, hi):
-    """:func:`draw_local` on rows [lo, hi) with the uniforms ``u`` of those rows."""
+def _draw_local_chunk(data, mix_cdf, alpha1, speed, u, first, out, status, scaled, lo, hi):
+    """:func:`draw_local` on rows [lo, hi), row i with the uniforms ``u[i - first]`` (a row of the whole array: a
+    slice of ``u`` would compile :func:`draw_local` again for its layout)."""
     for i in range(lo, hi):
-        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i - lo], scaled)
+        st, a2, b2, s, wx, wy, wz = draw_local(data, mix_cdf, alpha1[i], speed[i], u[i - first], scaled)
         status[i] = st
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = a2, b2, s, wx, wy, wz
