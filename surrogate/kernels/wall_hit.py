@@ -23,8 +23,8 @@ u[0], on either path (:func:`surrogate.kernels.locate.row_shape`). A particle of
 ``keys``) hits as its own grain: its shape from the key on either path, its proportions and hand too on the
 direct path (:mod:`surrogate.kernels.grain`).
 
-Like the table path's kernels (:mod:`surrogate.kernels.table_path`), :func:`rebound` and
-:func:`rebound_parallel_rng` convert their arguments and call their ``_typed`` twins, compiled once per process.
+Like the table path's kernels (:mod:`surrogate.kernels.table_path`), :func:`rebound` converts its arguments and
+calls its ``_typed`` twin, compiled once per process.
 
 Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
 gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a
@@ -182,7 +182,7 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
                              (n[i, 0], n[i, 1], n[i, 2]), a[i])
 
 
-@numba.njit(**JIT)
+@numba.njit(parallel=True, **JIT)
 def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
                          method, V_out, Omega_out, status, path, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
@@ -205,15 +205,6 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     and path STATUS_INVALID under METHOD_AUTO, the method's path under the others. A method code outside
     the three is a ValueError.
     """
-    # a private copy of the mix (a few numbers): writable or not, the caller's mix compiles the same kernel
-    rebound_parallel_rng_typed(data, params, shape_arrays, model_shapes, mix_cdf.copy(), shapes, keys, V, omega, n, a,
-                               states, np.int64(method), V_out, Omega_out, status, path, scaled != 0)
-
-
-@numba.njit(parallel=True, **JIT)
-def rebound_parallel_rng_typed(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
-                               method, V_out, Omega_out, status, path, scaled):
-    """:func:`rebound_parallel_rng` with a writable mix, ``method`` an int64 and ``scaled`` a bool (module doc)."""
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
     check_shapes(shapes, V.shape[0], mix_cdf.shape[0])

@@ -44,7 +44,7 @@ def test_no_key_gives_the_bits_of_a_call_without_keys(small_table, method):
     rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                          small_table.model_shapes, surrogate.mix_cdf(small_table, MIX), np.zeros(0, np.int64),
                          np.full(M, NO_KEY), V, W, np.tile(NORMAL, (M, 1)), np.full(M, A),
-                         chunk_states(np.random.default_rng(3), M), surrogate.METHODS[method], *outputs)
+                         chunk_states(np.random.default_rng(3), M), surrogate.METHODS[method], *outputs, True)
     assert _bits(plain) == _bits(outputs)
     if method == "auto":
         assert {PATH_TABLE, PATH_DIRECT} <= set(plain[3])
@@ -66,7 +66,7 @@ def test_keyed_rows_are_the_single_hit_with_the_key(small_table, method):
     outputs = np.empty((M, 3)), np.empty((M, 3)), np.empty(M, np.int8), np.empty(M, np.int8)
     rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                          small_table.model_shapes, cdf, np.zeros(0, np.int64), keys, V, W, np.tile(NORMAL, (M, 1)),
-                         np.full(M, A), states, surrogate.METHODS[method], *outputs)
+                         np.full(M, A), states, surrogate.METHODS[method], *outputs, True)
     u = np.concatenate([table_rebound_uniforms(states[j].copy(), min(CHUNK_ROWS, M - j * CHUNK_ROWS))
                         for j in range(len(states))])
     for i in range(M):

@@ -224,7 +224,7 @@ def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table
                              surrogate.mix_cdf(small_table, "mix"), np.zeros(0, np.int64), np.zeros(0, np.int64), V,
                              np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3,
-                             *outputs)
+                             *outputs, True)
 
 
 @pytest.mark.parametrize("shapes, message", [
@@ -244,7 +244,7 @@ def test_the_many_hit_kernel_refuses_shape_indices_outside_the_table(small_table
                              small_table.model_shapes,
                              surrogate.mix_cdf(small_table, "mix"), shapes, np.zeros(0, np.int64), V, np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 0,
-                             *outputs)
+                             *outputs, True)
 
 
 def test_auto_sends_states_outside_the_grid_to_the_model_and_table_keeps_its_errors(small_table):
@@ -356,7 +356,7 @@ def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, me
         outputs = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, np.int8), np.empty(m, np.int8)
         rebound_parallel_rng(data, params, small_table.shape_arrays, model_shapes, cdf, rows, np.zeros(0, np.int64), V,
                              W, np.tile(NORMAL, (m, 1)), np.full(m, A),
-                             chunk_states(np.random.default_rng(11), m), method, *outputs)
+                             chunk_states(np.random.default_rng(11), m), method, *outputs, True)
         return outputs
 
     mix = surrogate.mix_cdf(small_table, {"prism": 0.5, "tetrahedron": 0.5})
