@@ -67,8 +67,9 @@ def near_normal_table(tmp_path_factory):
 # and the background worker beside it (docs/design/test_time.md)
 os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 
-# fixtures whose subprocesses run next to the tests from the session's start, in this order (the order their
-# tests come in); each is started only when a selected test uses it
+# fixtures whose subprocesses run next to the tests from the session's start, in this order: the builds first, in
+# the order their tests come in (they need no table), then the runs on the session's small table; each is started
+# only when a selected test uses it
 STARTED_WITH_THE_SESSION = ("saturne_build_job", "native_build_job", "native_sanitized_job", "native_baseline_job",
                             "openfoam_build_job", "dispatch_children", "forced_rebuilds", "plain_install")
 

@@ -107,8 +107,10 @@ def direct_rebound_parallel_rng(params, shape_arrays, shape, keys, V, omega, n, 
             fill_uniforms(state, u)
             if keys.shape[0] > 0 and keys[i] >= 0:
                 key_model_uniforms(keys[i], u)
-            st, V_new, Omega_new = direct_rebound_typed(params, shape_arrays, np.int64(shape[i]), float3(V[i]),
-                                                        float3(omega[i]), float3(n[i]), float(a[i]), u, scratch)
+            st, V_new, Omega_new = direct_rebound_typed(params, shape_arrays, np.int64(shape[i]),
+                                                        (V[i, 0], V[i, 1], V[i, 2]),
+                                                        (omega[i, 0], omega[i, 1], omega[i, 2]),
+                                                        (n[i, 0], n[i, 1], n[i, 2]), float(a[i]), u, scratch)
             status[i] = st
             for k in range(3):
                 V_out[i, k] = V_new[k]

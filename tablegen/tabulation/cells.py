@@ -49,7 +49,7 @@ def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> s
 
 def compile_cell_kernels(config: BuildConfig) -> None:
     """Compile the model's kernels in this process, on one particle, into numba's on-disk cache: worker processes
-    started afterwards load them instead of each compiling them at once (about a minute per worker)."""
+    started afterwards load them instead of each compiling them at the same moment."""
     shape = config.shapes[0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # the one particle's warnings are the cells' own, given there
