@@ -194,8 +194,10 @@ def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall,
         semi = np.empty(3)
         R0 = np.empty((3, 3))
         for i in range(block * n // n_blocks, (block + 1) * n // n_blocks):
-            nv = particle_body(shape_arrays, shapes[i], ratios[i, 0], ratios[i, 1], float(hands[i]), verts, K, semi)
-            kind = shape_arrays.kind[shapes[i]]
+            # int64 shape and kind, as the runtime passes them: one compilation of the model for both
+            shape = np.int64(shapes[i])
+            nv = particle_body(shape_arrays, shape, ratios[i, 0], ratios[i, 1], float(hands[i]), verts, K, semi)
+            kind = np.int64(shape_arrays.kind[shape])
             quaternion_to_matrix(quats[i], R0)
             status, failure, ncoll, steps, multi, erot = body_rebound(
                 kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, wall, n_max,

@@ -169,7 +169,7 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
         ratio_ba, ratio_cb = aspect_ratio(law, cdf, u[U_RATIOS]), aspect_ratio(law, cdf, u[U_RATIOS + 1])
     hand = 1.0 if shape_arrays.both_hands[shape] == 0 or u[U_HAND] < 0.5 else -1.0
     nv = particle_body(shape_arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi)
-    kind = shape_arrays.kind[shape]
+    kind = np.int64(shape_arrays.kind[shape])
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
     status, _, n_coll, n_steps, _, _ = body_rebound(

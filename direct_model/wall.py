@@ -60,8 +60,11 @@ class WallMaterial:
             raise ValueError(f"The wall law parameter 'q' must be finite; got {self.q!r}.")
 
     def as_array(self) -> np.ndarray:
-        """The coefficients (k, p, q) as the float64 array the kernels take."""
-        return np.array([self.k, self.p, self.q], dtype=np.float64)
+        """The coefficients (k, p, q) as the float64 array the kernels take, read-only as the slice of the model's
+        parameters that the runtime passes (a writable one would compile the kernels a second time)."""
+        coefficients = np.array([self.k, self.p, self.q], dtype=np.float64)
+        coefficients.setflags(write=False)
+        return coefficients
 
 
 CORUNDUM_ON_STEEL = WallMaterial()

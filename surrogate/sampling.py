@@ -51,7 +51,7 @@ from surrogate.table import SurrogateTable
 from surrogate.validation import (as_rows, check_direct_parameters, check_direct_paths, check_grain_key,
                                   check_half_size, check_incident, check_interpolation, check_local_states,
                                   check_method, check_omega, check_out, check_random_state, check_shape,
-                                  check_vectors)
+                                  check_vectors, read_only)
 
 
 class LocalDraws(NamedTuple):
@@ -171,7 +171,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # needs the model
     V_out, Omega_out, status, path = (check_out(None, n_particles, (), 4) if old_table
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
-    params = np.zeros(0) if table.direct_parameters is None else table.direct_parameters
+    params = read_only(np.zeros(0)) if table.direct_parameters is None else check_direct_parameters(table)
     states = chunk_states(check_random_state(random_state), n_particles)
     rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
                          as_rows(nrm, n_particles),

@@ -367,7 +367,15 @@ def check_direct_parameters(table) -> np.ndarray:
     if table.direct_parameters is None:
         raise ValueError(f"The table {table.path} does not record the direct model's second-moment factors (built "
                          f"at kappa != 0.3 before tables recorded them); rebuild it with this version.")
-    return table.direct_parameters
+    return read_only(table.direct_parameters)
+
+
+def read_only(array: np.ndarray) -> np.ndarray:
+    """A read-only, C-contiguous view of ``array`` (a copy if it is not contiguous; ``array`` is left as it is):
+    the kernels are compiled for the loaded table's read-only arrays, and a writable one would compile them again."""
+    view = np.ascontiguousarray(array).view()
+    view.setflags(write=False)
+    return view
 
 
 def check_direct_paths(table, path: np.ndarray, V, W, a) -> None:

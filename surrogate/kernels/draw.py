@@ -57,13 +57,13 @@ from surrogate.kernels.arithmetic import NAN6, arithmetic
 from surrogate.kernels.fastmath import sincos
 from surrogate.kernels.gather import gather, is_trapped
 from surrogate.kernels.locate import component, hint, locate
-from surrogate.kernels.options import JIT
+from surrogate.kernels.options import JIT, KERNEL
 
 
 U_PER_DRAW = 13
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**KERNEL)
 def draw_in_cell(data, cell, cos_alpha1, sin_alpha1, u, scaled):
     """:func:`draw_velocity` once its cell (:func:`locate`) is known and its reads hinted; α1 given by its
     cosine and sine. A trapped draw reads nothing more."""
