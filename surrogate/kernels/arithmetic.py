@@ -21,7 +21,7 @@ from surrogate.kernels.block import BLOCK, field, put3
 from surrogate.kernels.fastmath import fma, sincos
 from surrogate.kernels.frame import FRAME_OK, frame_at, is_valid, to_global
 from surrogate.kernels.gather import gathered_at
-from surrogate.kernels.options import JIT
+from surrogate.kernels.options import JIT, KERNEL
 
 
 @numba.njit(inline="always", **JIT)
@@ -187,7 +187,7 @@ OUT_STATUS, OUT_V, OUT_OMEGA = 0, 1, 4      # status, V⁺ (m/s), Ω⁺ (rad/s),
 OUT_FIELDS = 7
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**KERNEL)
 def arithmetic_block(g, fr, out, V_out, Omega_out, status, start, m, scaled):
     """Stage 3 for the m particles of a gathered block (gathered records ``g``, frame records ``fr``): the
     draws (SIMD), back in the global frame, stored in rows start … start + m − 1 of the caller's arrays."""

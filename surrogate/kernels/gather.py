@@ -18,7 +18,7 @@ from surrogate.kernels.layout import (CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CE
                                       ROW_SCALE, ROW_SHAPE, ROW_SLOPE)
 from surrogate.kernels.locate import I_DRAWN, I_ROW, cell_at, level_offset
 from surrogate.kernels.memory import load, load15
-from surrogate.kernels.options import JIT
+from surrogate.kernels.options import JIT, KERNEL
 
 
 @numba.njit(inline="always", **JIT)
@@ -133,7 +133,7 @@ def gathered_at(g, b):
             fields6(g, G_SHIFT, b), field(g, G_F_TARGET, b), field(g, G_F_GRID, b))
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**KERNEL)
 def gather_block(data, ub, m, fr, index, weights, g):
     """Stage 2 for the m particles of a located block (uniforms ``ub``, frame records ``fr``, cell records
     ``index``, ``weights``): their gathered records into ``g``."""

@@ -19,7 +19,7 @@ from surrogate.kernels.frame import FRAME_ALPHA1, FRAME_SPEED, frame_block, is_v
 from surrogate.kernels.layout import (AXIS_GRID, AXIS_INV_STEP, AXIS_ORIGIN, FLOAT32_PER_CACHE_LINE, ROW_ALIAS,
                                       ROW_ALIAS_PROB, ROW_SIZE)
 from surrogate.kernels.memory import load, prefetch
-from surrogate.kernels.options import JIT
+from surrogate.kernels.options import JIT, KERNEL
 
 
 @numba.njit(inline="always", **JIT)
@@ -186,7 +186,7 @@ def cell_at(index, weights, b):
             field(weights, W_V, b), field(index, I_IV, b))
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**KERNEL)
 def locate_block(data, mix_cdf, shapes, V, n, a, ub, given, start, m, fr, index, weights):
     """Stage 1 for the m rows from ``start`` (their uniforms ``ub``, checked if ``given``; their shapes
     :func:`row_shape`): the frame records ``fr`` (:func:`surrogate.kernels.frame.frame_block`), the cells, and
@@ -224,7 +224,7 @@ def _no_cell(index, weights, b):
     weights[W_A * BLOCK + b], weights[W_V * BLOCK + b] = 0.0, 0.0
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**KERNEL)
 def resolve_block(data, ub, m, fr, index):
     """Stage 1, a block later: each particle's component (the alias table read on the row hinted in
     :func:`locate_block`), and cache hints for its row (the same lines again unless the alias table

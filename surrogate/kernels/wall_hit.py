@@ -209,39 +209,49 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
     check_shapes(shapes, V.shape[0], mix_cdf.shape[0])
     check_keys(keys, V.shape[0])
-    keyed = keys.shape[0] > 0
     row_shapes = keyed_shapes(mix_cdf, shapes, keys)     # a copy of shapes without keys
     rows = V.shape[0]
-    last_omega = omega.shape[0] - 1
     for j in numba.prange(states.shape[0]):
-        lo, hi = j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows)
-        if method == METHOD_AUTO:
-            _auto_paths(data, V, omega, n, a, lo, hi, path)
-        else:
-            path[lo:hi] = PATH_TABLE if method == METHOD_TABLE else PATH_DIRECT
-        n_table = 0
-        for i in range(lo, hi):
-            n_table += path[i] == PATH_TABLE
-        if n_table > 0:
-            run_blocks(data, mix_cdf, row_shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(),
-                       states[j].copy(), V_out[lo:hi], Omega_out[lo:hi], status[lo:hi], scaled)
-        if n_table < hi - lo:
-            u = table_rebound_uniforms(states[j].copy(), hi - lo)
-            scratch = np.empty(SCRATCH_SIZE)
-            for i in range(lo, hi):
-                if path[i] == PATH_TABLE:
-                    continue
-                w = min(i, last_omega)
-                st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
-                if path[i] == PATH_DIRECT:
-                    shape = row_shapes[i] if row_shapes.shape[0] > 0 else SHAPE_FROM_MIX
-                    if keyed and keys[i] >= 0:
-                        keyed_uniforms(keys[i], u[i - lo], True, u[i - lo])
-                    st, V_new, Omega_new = _direct_path(
-                        params, shape_arrays, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
-                        (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo],
-                        scratch)
-                status[i] = st
-                for k in range(3):
-                    V_out[i, k] = V_new[k]
-                    Omega_out[i, k] = Omega_new[k]
+        _rebound_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a,
+                       states[j], method, V_out, Omega_out, status, path, scaled, j * CHUNK_ROWS,
+                       min((j + 1) * CHUNK_ROWS, rows))
+
+
+@numba.njit(**JIT)
+def _rebound_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state,
+                   method, V_out, Omega_out, status, path, scaled, lo, hi):
+    """Rows lo:hi of :func:`rebound_parallel_rng` (one chunk, its uniforms from a copy of ``state``). Compiled on
+    its own and called from the parallel loop, so that numba's parallel passes see one call, not the chunk's
+    whole work (docs/design/test_time.md)."""
+    if method == METHOD_AUTO:
+        _auto_paths(data, V, omega, n, a, lo, hi, path)
+    else:
+        path[lo:hi] = PATH_TABLE if method == METHOD_TABLE else PATH_DIRECT
+    n_table = 0
+    for i in range(lo, hi):
+        n_table += path[i] == PATH_TABLE
+    if n_table > 0:
+        run_blocks(data, mix_cdf, row_shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), state.copy(),
+                   V_out[lo:hi], Omega_out[lo:hi], status[lo:hi], scaled)
+    if n_table == hi - lo:
+        return
+    keyed = keys.shape[0] > 0
+    last_omega = omega.shape[0] - 1
+    u = table_rebound_uniforms(state.copy(), hi - lo)
+    scratch = np.empty(SCRATCH_SIZE)
+    for i in range(lo, hi):
+        if path[i] == PATH_TABLE:
+            continue
+        w = min(i, last_omega)
+        st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
+        if path[i] == PATH_DIRECT:
+            shape = row_shapes[i] if row_shapes.shape[0] > 0 else SHAPE_FROM_MIX
+            if keyed and keys[i] >= 0:
+                keyed_uniforms(keys[i], u[i - lo], True, u[i - lo])
+            st, V_new, Omega_new = _direct_path(
+                params, shape_arrays, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
+                (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo], scratch)
+        status[i] = st
+        for k in range(3):
+            V_out[i, k] = V_new[k]
+            Omega_out[i, k] = Omega_new[k]
