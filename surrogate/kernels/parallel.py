@@ -48,10 +48,11 @@ def _chunk(j, n_rows):
     return j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, n_rows)
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**JIT)
 def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, scaled, lo, hi):
     """:func:`surrogate.kernels.pipeline.table_rebound_many` on rows [lo, hi) with the uniforms ``u`` of those rows,
-    or :func:`surrogate.kernels.pipeline.table_rebound_many_rng` with ``state``."""
+    or :func:`surrogate.kernels.pipeline.table_rebound_many_rng` with ``state``. Called, not inlined: numba's
+    parallel passes then see one call in the loop, not the chunk's work (docs/design/test_time.md)."""
     run_blocks(data, mix_cdf, no_shapes(), V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], Omega_out[lo:hi],
                status[lo:hi], scaled)
 

@@ -212,17 +212,17 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     row_shapes = keyed_shapes(mix_cdf, shapes, keys)     # a copy of shapes without keys
     rows = V.shape[0]
     for j in numba.prange(states.shape[0]):
-        _rebound_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a,
+        _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a,
                        states[j], method, V_out, Omega_out, status, path, scaled, j * CHUNK_ROWS,
                        min((j + 1) * CHUNK_ROWS, rows))
 
 
 @numba.njit(**JIT)
-def _rebound_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state,
+def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state,
                    method, V_out, Omega_out, status, path, scaled, lo, hi):
-    """Rows lo:hi of :func:`rebound_parallel_rng` (one chunk, its uniforms from a copy of ``state``). Compiled on
-    its own and called from the parallel loop, so that numba's parallel passes see one call, not the chunk's
-    whole work (docs/design/test_time.md)."""
+    """Rows [lo, hi) of :func:`rebound_parallel_rng` along their paths (one chunk, its uniforms from a copy of
+    ``state``). Called, not inlined: numba's parallel passes then see one call in the loop, not the chunk's work
+    (docs/design/test_time.md)."""
     if method == METHOD_AUTO:
         _auto_paths(data, V, omega, n, a, lo, hi, path)
     else:
