@@ -43,6 +43,7 @@ import numpy as np
 from data_schema.table import STATE_NAMES
 from surrogate.kernels.direct_path import direct_rebound_parallel_rng
 from surrogate.kernels.grain import keyed_shapes
+from surrogate.kernels.layout import frozen
 from surrogate.kernels.locate import mix_shapes
 from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
@@ -51,7 +52,7 @@ from surrogate.table import SurrogateTable
 from surrogate.validation import (as_rows, check_direct_parameters, check_direct_paths, check_grain_key,
                                   check_half_size, check_incident, check_interpolation, check_local_states,
                                   check_method, check_omega, check_out, check_random_state, check_shape,
-                                  check_vectors, read_only)
+                                  check_vectors)
 
 
 class LocalDraws(NamedTuple):
@@ -171,7 +172,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # needs the model
     V_out, Omega_out, status, path = (check_out(None, n_particles, (), 4) if old_table
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
-    params = read_only(np.zeros(0)) if table.direct_parameters is None else check_direct_parameters(table)
+    params = frozen(np.zeros(0)) if table.direct_parameters is None else check_direct_parameters(table)
     states = chunk_states(check_random_state(random_state), n_particles)
     rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
                          as_rows(nrm, n_particles),

@@ -27,6 +27,7 @@ from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTS
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
                                       FAULT_VELOCITY_ZERO, SPEED_MAX, SPEED_MIN, SPIN_SCALE_MAX, first_faults)
 from surrogate.kernels.frame import NORMAL_TOLERANCE
+from surrogate.kernels.layout import frozen
 from surrogate.kernels.wall_hit import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT
 
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
@@ -367,15 +368,7 @@ def check_direct_parameters(table) -> np.ndarray:
     if table.direct_parameters is None:
         raise ValueError(f"The table {table.path} does not record the direct model's second-moment factors (built "
                          f"at kappa != 0.3 before tables recorded them); rebuild it with this version.")
-    return read_only(table.direct_parameters)
-
-
-def read_only(array: np.ndarray) -> np.ndarray:
-    """A read-only, C-contiguous view of ``array`` (a copy if it is not contiguous; ``array`` is left as it is):
-    the kernels are compiled for the loaded table's read-only arrays, and a writable one would compile them again."""
-    view = np.ascontiguousarray(array).view()
-    view.setflags(write=False)
-    return view
+    return frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
 
 
 def check_direct_paths(table, path: np.ndarray, V, W, a) -> None:

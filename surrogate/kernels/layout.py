@@ -191,9 +191,11 @@ def cell_records(p_trapped: np.ndarray, mean: np.ndarray, std: np.ndarray) -> np
 
 
 def frozen(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.setflags(write=False)
-    return a
+    """A read-only, C-contiguous view of ``a`` (a copy if it is not contiguous; ``a`` itself is left as it is): the
+    kernels are compiled for read-only arrays, and a writable one would compile them a second time."""
+    view = np.ascontiguousarray(a).view()
+    view.setflags(write=False)
+    return view
 
 
 def kernel_data(table: ReboundTable) -> KernelData:
