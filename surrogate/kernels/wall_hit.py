@@ -212,14 +212,13 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     row_shapes = keyed_shapes(mix_cdf, shapes, keys)     # a copy of shapes without keys
     rows = V.shape[0]
     for j in numba.prange(states.shape[0]):
-        _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a,
-                       states[j], method, V_out, Omega_out, status, path, scaled, j * CHUNK_ROWS,
-                       min((j + 1) * CHUNK_ROWS, rows))
+        _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, states[j],
+                    method, V_out, Omega_out, status, path, scaled, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
 
 
 @numba.njit(**JIT)
-def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state,
-                   method, V_out, Omega_out, status, path, scaled, lo, hi):
+def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state, method,
+                V_out, Omega_out, status, path, scaled, lo, hi):
     """Rows [lo, hi) of :func:`rebound_parallel_rng` along their paths (one chunk, its uniforms from a copy of
     ``state``). Called, not inlined: numba's parallel passes then see one call in the loop, not the chunk's work
     (docs/design/test_time.md)."""

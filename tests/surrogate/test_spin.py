@@ -20,8 +20,8 @@ import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED
 from direct_model.runtime import P_MAX_STEPS, U_PER_REBOUND
 from surrogate.kernels import (CHUNK_ROWS, METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
-                               SPIN_TOLERANCE, chunk_states, direct_rebound, rebound_path, rebound,
-                               table_rebound, table_rebound_uniforms)
+                               SPIN_TOLERANCE, chunk_states, direct_rebound, direct_rebound_parallel_rng, rebound_path,
+                               rebound, rebound_parallel_rng, table_rebound, table_rebound_uniforms)
 
 KS_C = math.sqrt(-math.log(1e-3 / 2) / 2)      # c(α = 1e-3) (module doc)
 A = 1e-3                                       # half-size, m
@@ -215,7 +215,6 @@ def test_bad_method_names_the_allowed_ones(small_table):
 
 
 def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table):
-    from surrogate.kernels import rebound_parallel_rng
     V = np.array(_in_grid(3, 1))
     outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
     with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
@@ -236,7 +235,6 @@ def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table
 def test_the_many_hit_kernel_refuses_shape_indices_outside_the_table(small_table, shapes, message):
     """A per-particle shape index outside the table's shapes would read outside the table: a ValueError before
     the parallel loop."""
-    from surrogate.kernels import rebound_parallel_rng
     V = np.array(_in_grid(3, 1))
     outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
     with pytest.raises(ValueError, match=message):
@@ -275,6 +273,21 @@ def test_failed_rebounds_are_status_2_and_never_dropped(small_table):
     assert np.all(path[failed] == PATH_DIRECT) and np.all(np.isin(status[path == PATH_TABLE], (0, 1)))
     assert np.all(np.isnan(V_out[failed])) and np.all(np.isnan(W_out[failed]))
     assert np.all(np.isfinite(V_out[status == STATUS_REBOUNDED]))
+
+
+def test_a_writable_copy_of_the_parameters_reaches_the_kernel_read_only(small_table):
+    """A table whose parameters a caller replaced by a writable copy: sample_global and sample_direct hand the
+    kernels a read-only view, the type they are compiled for (a writable one would compile them again), and
+    leave the caller's copy writable."""
+    params = small_table.direct_parameters.copy()
+    table = dataclasses.replace(small_table, direct_parameters=params)
+    V = _in_grid(20, 12)
+    W = _spinning(V, 0.3, 13)
+    surrogate.sample_global(table, V, NORMAL, A, "mix", random_state=4, omega=W)
+    surrogate.sample_direct(table, V, NORMAL, A, "mix", random_state=4, omega=W)
+    assert params.flags.writeable
+    assert all(not signature[1].mutable for signature in rebound_parallel_rng.signatures)
+    assert all(not signature[0].mutable for signature in direct_rebound_parallel_rng.signatures)
 
 
 def test_a_table_without_the_model_s_parameters_fails_only_where_the_model_is_needed(small_table):
@@ -345,7 +358,6 @@ def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, me
     gets the bits the one-shape mix of k gives it, a row given -1 those of the mix, and every row still
     consumes its u[0] (the other rows' bits do not move). 2 chunks and a part, so the chunks' slices are
     taken."""
-    from surrogate.kernels import rebound_parallel_rng
     m = 2 * CHUNK_ROWS + 50
     V = _in_grid(m, 8)
     W = _spinning(V, 0.3, 9) if method == METHOD_DIRECT else np.zeros((1, 3))
