@@ -172,7 +172,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     # needs the model
     V_out, Omega_out, status, path = (check_out(None, n_particles, (), 4) if old_table
                                       else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
-    params = frozen(np.zeros(0)) if table.direct_parameters is None else check_direct_parameters(table)
+    params = frozen(np.zeros(0) if table.direct_parameters is None else table.direct_parameters)
     states = chunk_states(check_random_state(random_state), n_particles)
     rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
                          as_rows(nrm, n_particles),
