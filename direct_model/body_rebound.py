@@ -112,10 +112,12 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
     dW = work[_K + 12:_K + 15]
     Wt = work[_K + 15:_K + 18]          # angular velocity during the search
 
-    Kinv[:] = 1.0 / K
-    R[:] = R0
-    V[:] = V0
-    W[:] = W0
+    # element by element: an array assigned to a slice would compile numba's shape-mismatch message (seconds)
+    for i in range(3):
+        Kinv[i] = 1.0 / K[i]
+        V[i], W[i] = V0[i], W0[i]
+        for j in range(3):
+            R[i, j] = R0[i, j]
 
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
         n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2)
@@ -134,9 +136,10 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         if n_flights < history.shape[0]:
             row = history[n_flights]
             row[0], row[1] = t_abs, y
-            row[2:5] = V
-            row[5:8] = W
-            row[8:17] = R.ravel()
+            for i in range(3):
+                row[2 + i], row[5 + i] = V[i], W[i]
+                for j in range(3):
+                    row[8 + 3 * i + j] = R[i, j]
         n_flights += 1
         lab_tensor(R, K, K_lab)
         for i in range(3):
@@ -144,7 +147,8 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         e_rot = 0.5 * (W[0] * ell[0] + W[1] * ell[1] + W[2] * ell[2])
         M = curvature_bound(kind, semi, Rb, K, ell, W)
         M3 = jerk_bound(kind, semi, Rb, K, ell, W)
-        Wt[:] = W
+        for i in range(3):
+            Wt[i] = W[i]
         code, t, steps = find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
                                       contact_tol, set_tol, max_steps, R, Wt, h, h1, h2, rc)
         n_steps += steps
@@ -159,7 +163,8 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
             break
         y += V[1] * t
         t_abs += t
-        W[:] = Wt
+        for i in range(3):
+            W[i] = Wt[i]
         lab_tensor(R, Kinv, Kinv_lab)
         outcome = collide(V, W, rc, Kinv_lab, wall, dV, dW)
         if outcome != COLLISION_OK and outcome != COLLISION_MULTIPLE_ROOTS:

@@ -231,7 +231,8 @@ def _kmeans(x, u, max_iterations):
     nearest = np.full(n, np.inf)
     chosen = min(int(u[0] * n), n - 1)
     for c in range(k):
-        centres[c] = x[chosen]
+        for j in range(d):      # not centres[c] = x[chosen]: that compiles numba's shape-mismatch message
+            centres[c, j] = x[chosen, j]
         total = 0.0
         for i in range(n):
             dist = 0.0

@@ -61,9 +61,11 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
     draw_local_parallel(small_table.kernel_data, cdf, np.degrees(a1), speed, U, out, status)
     np.testing.assert_array_equal(status, local.status)
     np.testing.assert_array_equal(out, np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega]))
+    # wrong shapes in C-contiguous arrays, the layout of the call above: no compilation for another layout
     for args, message in (((speed[:-1], U, out, status), f"'speed' has shape \\({m - 1},\\); needed \\({m},\\)"),
-                          ((speed, U[:, :-1], out, status), f"'u' has shape \\({m}, 12\\); needed \\({m}, 13\\)"),
-                          ((speed, U, out[:, :5], status), f"'out' has shape \\({m}, 5\\); needed \\({m}, 6\\)")):
+                          ((speed, U[:, :-1].copy(), out, status),
+                           f"'u' has shape \\({m}, 12\\); needed \\({m}, 13\\)"),
+                          ((speed, U, np.empty((m, 5)), status), f"'out' has shape \\({m}, 5\\); needed \\({m}, 6\\)")):
         with pytest.raises(ValueError, match=message):
             draw_local_parallel(small_table.kernel_data, cdf, np.degrees(a1), *args)
     with pytest.raises(ValueError, match=f"'status' has shape \\({m - 1},\\); needed \\({m},\\): one row per "
@@ -199,10 +201,10 @@ def test_block_kernel_takes_strided_rows_and_rejects_short_arrays(small_table):
         table_rebound_many_rng(data, cdf, V, n, a, seed_state(3), *copied[:2], copied[2][:-1])
     with pytest.raises(ValueError, match="'u' has shape \\(67, 12\\); needed \\(67, 13\\)"):
         table_rebound_many(data, cdf, V, n, a, np.zeros((m, U_PER_DRAW - 1)), *copied)
-    # the parallel kernels check before their loop
+    # the parallel kernels check before their loop (contiguous V and n: the layout the other tests compile)
     with pytest.raises(ValueError, match="'Omega_out' has shape \\(65, 3\\); needed \\(67, 3\\)"):
-        table_rebound_parallel_rng(data, cdf, V, n, a, chunk_states(np.random.default_rng(3), m), copied[0], copied[1][:-2],
-                          copied[2])
+        table_rebound_parallel_rng(data, cdf, V.copy(), n.copy(), a, chunk_states(np.random.default_rng(3), m),
+                                   copied[0], copied[1][:-2], copied[2])
 
 
 def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
