@@ -1,4 +1,4 @@
-"""Command line of the runtime side: ``surrogate sample`` and ``surrogate info``.
+"""Command line of the runtime side: ``surrogate sample``, ``surrogate info`` and ``surrogate compile``.
 
 Reads files through :mod:`data_schema` only (the runtime never imports tablegen).
 A user error ends the command with one line on stderr and exit status 2
@@ -201,6 +201,21 @@ def _info(args) -> int:
     return 0
 
 
+def _compile(args) -> int:
+    import surrogate
+    from surrogate.compilation import compile_kernels
+    table = surrogate.load(args.table)
+    print(f"compiling the runtime's kernels into numba's cache for this CPU (with {table.path}'s types)", flush=True)
+    def report(name, seconds, compiled):
+        print(f"  {name}: {seconds:.1f} s, " + (f"{compiled} functions compiled" if compiled else "from the cache"),
+              flush=True)
+
+    done = compile_kernels(table, report)
+    print(f"done: {len(done)} kernels in {sum(d[1] for d in done):.1f} s, {sum(d[2] for d in done)} functions "
+          f"compiled; later processes load them from the cache")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = CommandParser(prog="surrogate", description="Runtime rebound sampler.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -249,8 +264,14 @@ def main(argv=None) -> int:
                         help="replace an existing --out file if it is a samples file (never the table)")
     info = sub.add_parser("info", help="describe a table or a rebound-samples file")
     info.add_argument("file")
+    compile_ = sub.add_parser("compile", help="compile every kernel of the runtime into numba's cache",
+                              description="Call every kernel of the runtime once on a few particles of TABLE, so "
+                                          "that numba compiles them into its cache for this CPU (about 3 minutes "
+                                          "on a fresh install) and no later draw waits for it. Any table will "
+                                          "do: the compiled code depends on the argument types only.")
+    compile_.add_argument("--table", required=True, metavar="TABLE.h5")
     args = parser.parse_args(argv)
-    commands = {"sample": _sample, "info": _info}
+    commands = {"sample": _sample, "info": _info, "compile": _compile}
     return run(f"surrogate {args.command}", commands[args.command], args)
 
 

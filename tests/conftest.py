@@ -3,6 +3,7 @@ long subprocesses that tests only wait for (builds, fresh installs, runs under o
 session starts (tests.helpers.background)."""
 
 import os
+import sys
 
 import pytest
 
@@ -67,11 +68,40 @@ def near_normal_table(tmp_path_factory):
 # and the background worker beside it (docs/design/test_time.md)
 os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 
-# fixtures whose subprocesses run next to the tests from the session's start, in this order: the builds first, in
-# the order their tests come in (they need no table), then the runs on the session's small table; each is started
-# only when a selected test uses it
-STARTED_WITH_THE_SESSION = ("saturne_build_job", "native_build_job", "native_sanitized_job", "native_baseline_job",
-                            "openfoam_build_job", "dispatch_children", "forced_rebuilds", "plain_install")
+# fixtures whose subprocesses run next to the tests from the session's start, in this order: the native builds
+# first (they need no table), then the compilation of the runtime's kernels on the session's small table (the test
+# process builds it meanwhile), then the solvers' builds and the runs on the small table; each is started only when
+# a selected test uses it
+STARTED_WITH_THE_SESSION = ("native_build_job", "native_sanitized_job", "native_baseline_job", "compiled_kernels",
+                            "saturne_build_job", "openfoam_build_job", "dispatch_children", "forced_rebuilds",
+                            "plain_install")
+# the folders of tests/ whose modules use none of those, in the order the test process takes them: the runtime's
+# kernels are called most in the last ones, which come when compiled_kernels has put them in numba's cache ("" is
+# tests/ itself)
+FOLDER_ORDER = ("data_schema", "direct_model", "tabulation", "openfoam", "code_saturne", "native", "study",
+                "surrogate", "")
+
+
+def pytest_collection_modifyitems(items):
+    """The modules that use none of STARTED_WITH_THE_SESSION first, by FOLDER_ORDER; then the others by the last
+    of them they use, in the worker's order: the test process does the rest of the suite meanwhile instead of
+    waiting (docs/design/test_time.md)."""
+    def module(item):
+        return item.nodeid.split("::")[0]
+
+    last_used = {}
+    for item in items:
+        used = [STARTED_WITH_THE_SESSION.index(name) for name in item.fixturenames if name in STARTED_WITH_THE_SESSION]
+        last_used[module(item)] = max([last_used.get(module(item), -1), *used])
+
+    def rank(item):
+        if last_used[module(item)] >= 0:
+            return 1, last_used[module(item)]
+        parts = module(item).split("/")
+        folder = parts[1] if len(parts) > 2 else ""
+        return 0, FOLDER_ORDER.index(folder) if folder in FOLDER_ORDER else len(FOLDER_ORDER)
+
+    items.sort(key=rank)
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -82,6 +112,15 @@ def _start_subprocesses(request):
             request.getfixturevalue(name)
     yield
     background.stop()
+
+
+@pytest.fixture(scope="session")
+def compiled_kernels(small_table_path):
+    """The future of ``surrogate compile`` on the session's small table, twice (tests/surrogate/test_compilation.py):
+    the first run puts the runtime's kernels in numba's cache before the tests that call them most; the second, a
+    new process, finds each there."""
+    command = [sys.executable, "-m", "surrogate.cli", "compile", "--table", str(small_table_path)]
+    return background.submit(lambda: tuple(background.run(command, cwd=REPO, timeout=1200) for _ in range(2)))
 
 
 @pytest.fixture(scope="session")
