@@ -70,11 +70,11 @@ os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 
 # fixtures whose subprocesses run next to the tests from the session's start, in this order: the native builds
 # first (they need no table), then the compilation of the runtime's kernels on the session's small table (the test
-# process builds it meanwhile), then the solvers' builds and the runs on the small table; each is started only when
-# a selected test uses it
+# process builds it meanwhile), then the solvers' builds, the runs on the small table and the OpenFOAM runs; each is
+# started only when a selected test uses it
 STARTED_WITH_THE_SESSION = ("native_build_job", "native_sanitized_job", "native_baseline_job", "compiled_kernels",
                             "saturne_build_job", "openfoam_build_job", "dispatch_children", "forced_rebuilds",
-                            "plain_install")
+                            "openfoam_runs", "plain_install")
 # the folders of tests/ whose modules use none of those, in the order the test process takes them: the runtime's
 # kernels are called most in the last ones, which come when compiled_kernels has put them in numba's cache ("" is
 # tests/ itself)
@@ -140,6 +140,15 @@ def forced_rebuilds(tmp_path_factory):
 def plain_install(small_table_path, tmp_path_factory):
     """The future of tests/test_install.py's fresh install and draw (tests.helpers.plain_install.install_and_draw)."""
     return background.submit(install_and_draw, small_table_path, tmp_path_factory.mktemp("install"))
+
+
+@pytest.fixture(scope="session")
+def openfoam_runs(tmp_path_factory):
+    """The future of tests/openfoam/cases.py's runs (a GPL-3 program, run as one): (its finished process, the
+    folder of its tables and runs)."""
+    folder = tmp_path_factory.mktemp("openfoam_runs")
+    command = [sys.executable, "-m", "tests.openfoam.cases", str(folder)]
+    return background.submit(lambda: (background.run(command, cwd=REPO, timeout=1800), folder))
 
 
 def _integration_build(name):

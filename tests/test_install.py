@@ -1,5 +1,5 @@
-"""The plain install is the runtime alone: a fresh virtual environment with ``pip install .`` draws from a table,
-the same draws as the development install, without the build extra."""
+"""The plain install is the runtime alone: a fresh virtual environment with ``pip install .`` draws from a table
+and runs the direct model, the same draws as the development install, without the build extra."""
 
 import json
 import re
@@ -30,9 +30,14 @@ def test_plain_install_draws_from_a_table(small_table_path, plain_install):
     assert fresh["missing"] == list(RUNTIME_ONLY), "the plain install brought more than the runtime"
     assert 'pip install "rebound-scatter[build]"' in fresh["refused"]
     table = surrogate.load(small_table_path)
-    V = np.tile([120.0, -80.0, 10.0], (200, 1))
-    V_out, Omega_out, status = surrogate.sample_global(table, V, [0.0, 1.0, 0.0], 5e-5, shape="mix", random_state=7)
-    assert (status == 0).sum() > 150
+    local = surrogate.sample_local(table, np.full(200, 33.7), np.full(200, 144.6), "mix", random_state=7)
+    V_out, Omega_out, status = surrogate.sample_direct(table, np.tile([120.0, -80.0, 10.0], (50, 1)),
+                                                       [0.0, 1.0, 0.0], 5e-5, "prism", random_state=7,
+                                                       omega=[0.0, 0.0, 2e5])
+    assert (local.status == 0).sum() > 150 and (status == 0).sum() > 40
+    np.testing.assert_array_equal(np.array(fresh["local"], dtype=float),
+                                  np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega,
+                                                   local.status]))
     np.testing.assert_array_equal(np.array(fresh["status"]), status)
     np.testing.assert_array_equal(np.array(fresh["V"], dtype=float), V_out)
     np.testing.assert_array_equal(np.array(fresh["Omega"], dtype=float), Omega_out)

@@ -9,12 +9,14 @@ with the direct model (:data:`tablegen.tabulation.driver.MODEL_SOURCES`).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
 
 from data_schema.table import CellTable
 from tablegen.tabulation.config import BuildConfig
+from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL
 from tablegen.tabulation.tabulate import CellAccumulator
 from direct_model.shapes import SHAPES
 from direct_model.simulate import simulate
@@ -48,13 +50,16 @@ def cell_label(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> s
 
 
 def compile_cell_kernels(config: BuildConfig) -> None:
-    """Compile the model's kernels in this process, on one particle, into numba's on-disk cache: worker processes
-    started afterwards load them instead of each compiling them at the same moment."""
-    shape = config.shapes[0]
+    """Compile a cell's kernels (the model's and the representation's) in this process, on the first cell with the
+    fewest particles a cell may have, into numba's on-disk cache: worker processes started afterwards load them
+    instead of each compiling them at the same moment."""
+    smallest = dataclasses.replace(config, particles_per_cell=MIN_PARTICLES_PER_CELL)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")      # the one particle's warnings are the cells' own, given there
-        simulate(config.grain(shape) or shape, config.alpha1_deg[0], config.speed_m_s[0], 1, seed=0,
-                 kappa=config.kappa, aspect=config.aspect, wall=config.wall, n_max=config.n_max)
+        warnings.simplefilter("ignore")      # the cell's warnings are the cells' own, given there
+        try:
+            compute_cell(smallest, config.shapes[0], 0, 0)
+        except ValueError:                   # too few rebounds among so few particles: the workers compile the rest
+            pass
 
 
 def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> CellTable:

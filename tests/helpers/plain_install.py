@@ -13,20 +13,25 @@ from tests.helpers import REPO, background
 PYPROJECT = tomllib.loads((REPO / "pyproject.toml").read_text())
 RUNTIME_ONLY = ("scipy", "sklearn", "threadpoolctl", "tqdm", "matplotlib", "dask")     # modules it must not bring
 
+# the runtime's two halves, each run: the table's draws and the direct model's on spinning particles (not
+# sample_global, which would compile both for 80 s more and, without spin, run the table's alone)
 DRAW = """
 import importlib.util, json, sys
 import numpy as np
 import surrogate
 table = surrogate.load(sys.argv[1])
-V = np.tile([120.0, -80.0, 10.0], (200, 1))
-V_out, Omega_out, status = surrogate.sample_global(table, V, [0.0, 1.0, 0.0], 5e-5, shape="mix", random_state=7)
+local = surrogate.sample_local(table, np.full(200, 33.7), np.full(200, 144.6), "mix", random_state=7)
+V_out, Omega_out, status = surrogate.sample_direct(table, np.tile([120.0, -80.0, 10.0], (50, 1)), [0.0, 1.0, 0.0],
+                                                   5e-5, "prism", random_state=7, omega=[0.0, 0.0, 2e5])
 missing = [m for m in sys.argv[2:] if importlib.util.find_spec(m) is None]
 try:
     import tablegen
     refused = ""
 except ImportError as error:
     refused = str(error)
-print(json.dumps({"V": V_out.tolist(), "Omega": Omega_out.tolist(), "status": status.tolist(), "missing": missing,
+print(json.dumps({"local": np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega,
+                                           local.status]).tolist(),
+                  "V": V_out.tolist(), "Omega": Omega_out.tolist(), "status": status.tolist(), "missing": missing,
                   "refused": refused, "where": surrogate.__file__}))
 """
 

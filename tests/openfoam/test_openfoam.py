@@ -3,7 +3,8 @@
 Builds the C runtime and the stochasticRebound patch interaction model
 against Debian's OpenFOAM v1912 (integrations/openfoam/build.sh, on the
 outputs of install-deps.sh), runs the case hopperRebound serially and on 2
-MPI ranks with method auto, and checks the hit counts per path, the
+MPI ranks with method auto (these runs and the others of tests/openfoam/cases.py are made beside the tests,
+from the session's start), and checks the hit counts per path, the
 rebounds the table answered and those the direct model answered against
 surrogate on the same incident states (the BSD statistics of
 tablegen.study.solver_comparison, called through compare_rebounds), the random streams per rank, the grain
@@ -34,15 +35,15 @@ from tests.helpers import background
 
 REPO = Path(__file__).resolve().parents[2]
 OPENFOAM_DIR = REPO / "integrations" / "openfoam"
-CASE = OPENFOAM_DIR / "cases" / "hopperRebound"
 SOLVER = "icoUncoupledKinematicParcelFoam"
 HITS = Path("postProcessing/lagrangian/kinematicCloud/stochasticRebound")
 
 sys.path.insert(0, str(OPENFOAM_DIR))
 
 import compare_rebounds  # noqa: E402
-import make_case_table  # noqa: E402
-from rbs_api import build_table_from_text, grain_key, grain_mismatches, load, summary_counts  # noqa: E402
+from rbs_api import grain_key, grain_mismatches, load, summary_counts  # noqa: E402
+
+from tests.openfoam import cases  # noqa: E402
 
 INSTALL_HINT = ("run `bash integrations/openfoam/install-deps.sh` (as root on Debian bookworm: it installs "
                 "Debian's OpenFOAM v1912 and Open MPI, unpacks the v1912 headers from the source package "
@@ -70,6 +71,15 @@ def _cloud_info(log: str) -> dict:
                 spin_max=float(spin.group(2)) if spin else None)
 
 
+def _cloud_parcels(log: str) -> dict:
+    """Parcels in the system, added and escaped (through open patches) at the last time step."""
+    block = log[log.rindex("Current number of parcels"):]
+    def number(label):
+        return int(float(re.search(re.escape(label) + r"\s*=\s*([-0-9.eE+]+)", block).group(1)))
+    return {"current": number("Current number of parcels"), "added": number("- parcels added"),
+            "escaped": number("- escape")}
+
+
 def _cpu_seconds(case: Path) -> float:
     """The solver's ExecutionTime (CPU seconds of rank 0) at its last time step."""
     return float(re.findall(r"ExecutionTime = ([0-9.eE+-]+) s", (case / f"log.{SOLVER}").read_text())[-1])
@@ -92,63 +102,35 @@ def openfoam_build(openfoam_build_job):
 
 
 @pytest.fixture(scope="session")
-def case_table(tmp_path_factory):
-    """The case's table (make_case_table.py's configuration), built once."""
-    path = tmp_path_factory.mktemp("openfoam_table") / "rebound_table.h5"
-    build_table_from_text(make_case_table.CASE_TABLE_CONFIG, path)
-    return path
+def runs_folder(openfoam_build, openfoam_runs):
+    """The folder of tests/openfoam/cases.py's tables and runs, made beside the tests (tests/conftest.py's
+    openfoam_runs, after the adapter's build)."""
+    done, folder = openfoam_runs.result()
+    background.succeeded(done)
+    return folder
 
 
-# The case's grid with n_max = 2: a particle that would touch the wall a third time counts as trapped,
-# so a good part of the near-normal hits are trapped and both trapped policies can be seen at work.
-# A coarse grid is enough: both sides of the comparison draw from the same table.
-TRAPPING_TABLE_CONFIG = """\
-[grid]
-alpha1_deg = [1.0, 7.5, 30.0, 60.0, 90.0]
-speed_m_s = [50.0, 150.0]
-shapes = ["prism"]
-[simulation]
-particles_per_cell = 5000
-seed = 20261124
-n_max = 2
-"""
-
-
-def _set_coeff(case: Path, key: str, value: str) -> None:
-    props = case / "constant" / "kinematicCloudProperties"
-    text, n = re.subn(rf"(\n        {key}\s+)[^;]+;", rf"\g<1>{value};", props.read_text(), count=1)
-    assert n == 1, key
-    props.write_text(text)
-
-
-def _cloud_parcels(log: str) -> dict:
-    """Parcels in the system, added and escaped (through open patches) at the last time step."""
-    block = log[log.rindex("Current number of parcels"):]
-    def number(label):
-        return int(float(re.search(re.escape(label) + r"\s*=\s*([-0-9.eE+]+)", block).group(1)))
-    return {"current": number("Current number of parcels"), "added": number("- parcels added"),
-            "escaped": number("- escape")}
-
-
-def _run_case(tmp_path_factory, name, table, np_=1, model="stochasticRebound", edit=None) -> Path:
-    case = tmp_path_factory.mktemp(name) / "hopperRebound"
-    shutil.copytree(CASE, case, ignore=shutil.ignore_patterns("log.*", "processor*", "postProcessing",
-                                                              "rebound_table.h5"))
-    if edit:
-        edit(case)
-    env = dict(os.environ, RBS_OPENFOAM_DIR=str(OPENFOAM_DIR), RBS_TABLE=str(table))
-    _run(["bash", "./Allrun", "-np", str(np_), "-model", model], cwd=case, env=env)
+def _case(folder: Path, name: str) -> Path:
+    """The case ``name`` of cases.CASES as its run left it (a run that failed fails the test, with its output)."""
+    case, done = cases.read_runs(folder)[name]
+    background.succeeded(done)
     return case
 
 
 @pytest.fixture(scope="session")
-def serial_case(openfoam_build, case_table, tmp_path_factory):
-    return _run_case(tmp_path_factory, "serial", case_table)
+def case_table(runs_folder):
+    """The case's table (make_case_table.py's configuration)."""
+    return runs_folder / cases.TABLES["case"]
 
 
 @pytest.fixture(scope="session")
-def parallel_case(openfoam_build, case_table, tmp_path_factory):
-    return _run_case(tmp_path_factory, "parallel", case_table, np_=2)
+def serial_case(runs_folder):
+    return _case(runs_folder, "serial")
+
+
+@pytest.fixture(scope="session")
+def parallel_case(runs_folder):
+    return _case(runs_folder, "parallel")
 
 
 # ----------------------------------------------------------------------------- build
@@ -322,23 +304,18 @@ def test_each_parcel_hits_as_one_grain_on_one_and_two_ranks(serial_case, paralle
     assert {p[0] for p in serial_rows} == {0} and {p[0] for p in rows} == {1}
 
 
-def test_a_parcel_keeps_its_grain_over_a_restart(openfoam_build, case_table, tmp_path_factory):
-    """The case run to 2.5 ms, then restarted from its written time to 5 ms with another seed (new streams)
-    and grainSeed the first run's: the parcels (their ids are written with the cloud and read back) hit
-    after the restart as the grains they were before it."""
-    def first_half(case):
-        control = case / "system" / "controlDict"
-        text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.0025;", control.read_text())
-        control.write_text(re.sub(r"\nwriteInterval\s+[^;]+;", "\nwriteInterval   0.0025;", text))
-
-    case = _run_case(tmp_path_factory, "restart", case_table, edit=first_half)
+def test_a_parcel_keeps_its_grain_over_a_restart(runs_folder, case_table):
+    """The case run to 2.5 ms (cases.CASES["restart"]), then restarted from its written time to 5 ms with another
+    seed (new streams) and grainSeed the first run's: the parcels (their ids are written with the cloud and read
+    back) hit after the restart as the grains they were before it."""
+    case = _case(runs_folder, "restart")
     before, before_headers = compare_rebounds.read_hits(case)
     control = case / "system" / "controlDict"
     text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.005;", control.read_text())
     control.write_text(re.sub(r"\nstartFrom\s+[^;]+;", "\nstartFrom       latestTime;", text))
     seed = before_headers[0]["seed"]
-    _set_coeff(case, "seed", str(seed + 1))
-    _insert_coeff(case, f"grainSeed {seed};")
+    cases.set_coeff(case, "seed", str(seed + 1))
+    cases.insert_coeff(case, f"grainSeed {seed};")
     script = (f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {{ [ -f \"$WM_PROJECT_DIR/etc/controlDict\" ] || "
               f"export WM_PROJECT_DIR=/usr/share/openfoam; }} && {SOLVER} > log.restart 2>&1")
     _run(["bash", "-c", script], cwd=case)
@@ -357,19 +334,9 @@ def test_a_parcel_keeps_its_grain_over_a_restart(openfoam_build, case_table, tmp
     assert len(np.intersect1d(before["u0"], after["u0"])) == 0
 
 
-def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(openfoam_build, case_table,
-                                                                     tmp_path_factory):
-    def moving_walls(case):
-        # the side and funnel walls slide along z (tangential to all of them) at 20 m/s
-        u = case / "0.orig" / "U"
-        text = u.read_text()
-        text = text.replace("    walls\n    {\n        type            noSlip;\n    }",
-                            "    walls\n    {\n        type            fixedValue;\n"
-                            "        value           uniform (0 0 20);\n    }")
-        assert "uniform (0 0 20)" in text
-        u.write_text(text)
-
-    case = _run_case(tmp_path_factory, "moving", case_table, edit=moving_walls)
+def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(runs_folder):
+    """The side and funnel walls slide along z at 20 m/s (cases.CASES["moving"])."""
+    case = _case(runs_folder, "moving")
     hits, _ = compare_rebounds.read_hits(case)
     on_walls = hits["patch"] == "walls"
     assert on_walls.sum() > 1000
@@ -383,13 +350,10 @@ def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(openfoam_bui
 
 
 @pytest.fixture(scope="session")
-def many_shapes(openfoam_build, case_table, tmp_path_factory):
+def many_shapes(runs_folder):
     """The case's table with 63 user grains beside its prism (format 3.4; the grains share the prism's cells:
     tests.helpers.python_side.many_shape_table), and the case run on it with shape mix (equal weights)."""
-    from tests.helpers.python_side import many_shape_table
-    table = tmp_path_factory.mktemp("many_shapes_table") / "many_shapes.h5"
-    many_shape_table(case_table, table, 64)
-    return table, _run_case(tmp_path_factory, "many_shapes", table, edit=lambda c: _set_coeff(c, "shape", "mix"))
+    return runs_folder / cases.TABLES["many_shapes"], _case(runs_folder, "many_shapes")
 
 
 def test_a_table_of_64_shapes_draws_in_the_adapter(many_shapes):
@@ -422,10 +386,9 @@ def test_the_parcels_grains_follow_the_mix_weights(many_shapes):
 
 
 @pytest.fixture(scope="session")
-def standard_cases(openfoam_build, case_table, tmp_path_factory):
+def standard_cases(runs_folder):
     """The case with OpenFOAM's specular bounce (standardWallInteraction), serially and on 2 ranks."""
-    return {np_: _run_case(tmp_path_factory, f"standard{np_}", case_table, np_=np_, model="standardWallInteraction")
-            for np_ in (1, 2)}
+    return {np_: _case(runs_folder, f"standard{np_}") for np_ in (1, 2)}
 
 
 def test_run_times_against_standard_wall_interaction(serial_case, parallel_case, standard_cases, capsys):
@@ -471,23 +434,17 @@ def test_erosion_beside_the_rebound_models(serial_case, standard_cases, tmp_path
 
 
 @pytest.fixture(scope="session")
-def trapping_table(tmp_path_factory):
-    path = tmp_path_factory.mktemp("openfoam_trapping_table") / "rebound_table_nmax2.h5"
-    build_table_from_text(TRAPPING_TABLE_CONFIG, path)
-    return path
+def trapping_table(runs_folder):
+    """The case's grid with n_max = 2 (cases.TRAPPING_TABLE_CONFIG)."""
+    return runs_folder / cases.TABLES["trapping"]
 
 
 @pytest.mark.parametrize("policy", ["stick", "remove"])
-def test_trapped_parcels_stick_or_are_removed(policy, openfoam_build, trapping_table, tmp_path_factory):
+def test_trapped_parcels_stick_or_are_removed(policy, runs_folder, trapping_table):
     """Trapped parcels stick or are removed; the stick run keeps each parcel's grain (the default), the remove
     run draws a new grain per hit (grain perHit: no key, no shape recorded), and both trap as the sampler does."""
     grain = "kept" if policy == "stick" else "perHit"
-
-    def edit(case):
-        _set_coeff(case, "trapped", policy)
-        _insert_coeff(case, f"grain {grain};")
-
-    case = _run_case(tmp_path_factory, f"trapped_{policy}", trapping_table, edit=edit)
+    case = _case(runs_folder, f"trapped_{policy}")
     hits, headers = compare_rebounds.read_hits(case)
     assert [h["grain"] for h in headers] == [grain]
     if grain == "perHit":
@@ -553,31 +510,20 @@ def test_mppic_cloud_selects_and_runs_the_model(openfoam_build, case_table, tmp_
     assert info["spin_mean"] is None and info["direct"] == info["outside"], info
 
 
-def _insert_coeff(case: Path, entry: str) -> None:
-    """Add ``entry`` to stochasticReboundCoeffs, after its table."""
-    props = case / "constant" / "kinematicCloudProperties"
-    text, n = re.subn(r"(\n        table\s+[^;]+;)", rf"\g<1>\n        {entry}", props.read_text(), count=1)
-    assert n == 1
-    props.write_text(text)
-
-
 @pytest.mark.parametrize("edit, words", [
-    (lambda c: _insert_coeff(c, "interpolaton stochastic;"), ["unknown entry interpolaton", "interpolation"]),
-    (lambda c: _insert_coeff(c, "weights { prism 1; }"), ["shape and weights are both given"]),
-    (lambda c: _set_coeff(c, "maxHitRecords", "-1"), ["maxHitRecords must be >= 0, not -1"]),
-    (lambda c: _insert_coeff(c, "method tabel;"), ["method must be auto, table or direct, not tabel"]),
-    (lambda c: _insert_coeff(c, "grain once;"), ["grain must be kept or perHit, not once"]),
+    (lambda c: cases.insert_coeff(c, "interpolaton stochastic;"), ["unknown entry interpolaton", "interpolation"]),
+    (lambda c: cases.insert_coeff(c, "weights { prism 1; }"), ["shape and weights are both given"]),
+    (lambda c: cases.set_coeff(c, "maxHitRecords", "-1"), ["maxHitRecords must be >= 0, not -1"]),
+    (lambda c: cases.insert_coeff(c, "method tabel;"), ["method must be auto, table or direct, not tabel"]),
+    (lambda c: cases.insert_coeff(c, "grain once;"), ["grain must be kept or perHit, not once"]),
 ])
 def test_dictionary_contradictions_and_unknown_entries_are_fatal(openfoam_build, case_table, tmp_path_factory,
                                                                  edit, words):
     """A misspelled entry silently fell back to its default, shape was ignored under weights, and
     maxHitRecords -1 wrote nothing: each is now a FatalIOError naming the entry, before any time step."""
-    case = tmp_path_factory.mktemp("bad_dictionary") / "hopperRebound"
-    shutil.copytree(CASE, case, ignore=shutil.ignore_patterns("log.*", "processor*", "postProcessing",
-                                                              "rebound_table.h5"))
+    case = cases.copy_case(tmp_path_factory.mktemp("bad_dictionary"))
     edit(case)
-    env = dict(os.environ, RBS_OPENFOAM_DIR=str(OPENFOAM_DIR), RBS_TABLE=str(case_table))
-    proc = subprocess.run(["bash", "./Allrun"], cwd=case, env=env, capture_output=True, text=True, timeout=600)
+    proc = cases.run_allrun(case, case_table)
     log = (case / f"log.{SOLVER}").read_text()
     assert proc.returncode != 0 and "FOAM FATAL IO ERROR" in log, log[-3000:]
     assert "stochasticReboundCoeffs" in log and "Time = " not in log.split("FOAM FATAL IO ERROR")[0]
