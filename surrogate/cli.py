@@ -25,6 +25,9 @@ from data_schema.table import TABLE_FILE_TYPE
 
 # memory per draw: the local draws, the lab-frame vectors and the file made in memory
 BYTES_PER_DRAW = 300
+COMPILE_DESCRIPTION = ("Call every kernel of the runtime once on a few particles of TABLE, so that numba compiles "
+                       "them into its cache for this CPU (about 3 minutes on a fresh install) and no later draw "
+                       "waits for it. Any table will do: the compiled code depends on the argument types only.")
 
 
 def _mix(args):
@@ -265,10 +268,7 @@ def main(argv=None) -> int:
     info = sub.add_parser("info", help="describe a table or a rebound-samples file")
     info.add_argument("file")
     compile_ = sub.add_parser("compile", help="compile every kernel of the runtime into numba's cache",
-                              description="Call every kernel of the runtime once on a few particles of TABLE, so "
-                                          "that numba compiles them into its cache for this CPU (about 3 minutes "
-                                          "on a fresh install) and no later draw waits for it. Any table will "
-                                          "do: the compiled code depends on the argument types only.")
+                              description=COMPILE_DESCRIPTION)
     compile_.add_argument("--table", required=True, metavar="TABLE.h5")
     args = parser.parse_args(argv)
     commands = {"sample": _sample, "info": _info, "compile": _compile}

@@ -18,3 +18,12 @@ def test_a_second_process_finds_every_kernel_in_the_cache(compiled_kernels):
     assert {m.group(2) for m in line.finditer(second.stdout)} == {"from the cache"}, second.stdout
     assert second.stdout.splitlines()[-1].startswith(f"done: {len(TABLE_KERNELS + DIRECT_KERNELS)} kernels in ")
     assert " 0 functions compiled;" in second.stdout.splitlines()[-1], second.stdout
+
+
+def test_a_bad_table_is_one_line_and_exit_2(tmp_path, capsys):
+    from surrogate.cli import main
+    (tmp_path / "notes.txt").write_text("not a table\n")
+    for path in (tmp_path / "missing.h5", tmp_path / "notes.txt", tmp_path):
+        assert main(["compile", "--table", str(path)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("surrogate compile: error: ") and str(path) in err[0], err
