@@ -23,6 +23,7 @@ from direct_model.shape_arrays import family_shape_arrays
 from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL
 from direct_model.wall import CORUNDUM_ON_STEEL
+from surrogate.compilation import TABLE_KERNELS, compile_kernels
 from surrogate.kernels import direct_rebound
 
 from tests.helpers.direct_law import A, kernel_in_frame, ks_bound, random_frame
@@ -151,6 +152,8 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
     assert old_table.direct_parameters is None
     with pytest.raises(ValueError, match=r"^The table .* does not record the direct model's second-moment factors"):
         surrogate.sample_direct(old_table, [[100.0, -100.0, 0.0]], [0.0, 1.0, 0.0], A)
+    # surrogate compile on it: the table's kernels, not the model's, which it cannot run
+    assert [name for name, *_ in compile_kernels(old_table)] == list(TABLE_KERNELS)
 
 
 @pytest.mark.parametrize("change", [
