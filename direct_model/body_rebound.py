@@ -112,7 +112,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
     dW = work[_K + 12:_K + 15]
     Wt = work[_K + 15:_K + 18]          # angular velocity during the search
 
-    # element by element: an array assigned to a slice would compile numba's shape-mismatch message (seconds)
+    # element by element: an array assigned to a slice would compile numba's shape-mismatch message
     for i in range(3):
         Kinv[i] = 1.0 / K[i]
         V[i], W[i] = V0[i], W0[i]

@@ -1,9 +1,9 @@
 """The runtime's kernels compiled ahead of the first draw: :func:`compile_kernels` (``surrogate compile``).
 
 numba compiles a kernel at its first call and keeps the machine code in its cache (``__pycache__`` beside the
-sources, or ``NUMBA_CACHE_DIR``), for this CPU: the first :func:`surrogate.sample_global` of a fresh install
-takes about 100 s, the same call in any later process about a second. Compiling once after installing (in a
-container's build, before a solver's first run on many ranks) means that no run waits for it. The compiled code
+sources, or ``NUMBA_CACHE_DIR``), for this CPU: the first call of a fresh install waits for the compilation, later
+processes load the code. Compiling once after installing (in a container's build, before a solver's first run on
+many ranks) means that no run waits for it. The compiled code
 depends on the argument types only, not on the table's contents, so any table compiles them all.
 """
 
@@ -40,10 +40,10 @@ def _calls(table: SurrogateTable) -> list:
     alpha1, speed = np.full(ROWS, 45.0), np.full(ROWS, 100.0)
     # the direct model's kernels need its parameters (tables of format 3.3 on) and a shape it answers
     answerable = [k for k in range(len(table.shapes)) if table.model_shapes[k] >= 0]
-    spin = table.direct_parameters is not None and bool(answerable)
-    shape = table.shapes[answerable[0]] if spin and len(answerable) < len(table.shapes) else "mix"
+    direct = table.direct_parameters is not None and bool(answerable)
+    shape = table.shapes[answerable[0]] if direct and len(answerable) < len(table.shapes) else "mix"
     # half the particles spinning: method auto takes both paths
-    omega = np.where(np.arange(ROWS)[:, None] < ROWS // 2, 0.0, 1e4) * np.array([0.0, 0.0, 1.0]) if spin else None
+    omega = np.where(np.arange(ROWS)[:, None] < ROWS // 2, 0.0, 1e4) * np.array([0.0, 0.0, 1.0]) if direct else None
     calls = [
         ("sample_global", lambda: sample_global(table, V, n, a, shape, 0, omega=omega)),
         ("sample_local", lambda: sample_local(table, alpha1, speed, "mix", 0)),
@@ -57,7 +57,7 @@ def _calls(table: SurrogateTable) -> list:
             data, cdf, V, n, a, kernels.chunk_states(np.random.default_rng(0), ROWS), *outputs)),
         ("draw_local_parallel", lambda: kernels.draw_local_parallel(data, cdf, alpha1, speed, u, local, status)),
     ]
-    if spin:
+    if direct:
         params, shapes = table.direct_parameters, table.shape_arrays
         code = int(table.model_shapes[answerable[0]])
         calls += [

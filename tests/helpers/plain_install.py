@@ -14,7 +14,7 @@ PYPROJECT = tomllib.loads((REPO / "pyproject.toml").read_text())
 RUNTIME_ONLY = ("scipy", "sklearn", "threadpoolctl", "tqdm", "matplotlib", "dask")     # modules it must not bring
 
 # the runtime's two halves, each run: the table's draws and the direct model's on spinning particles (not
-# sample_global, which would compile both for 80 s more and, without spin, run the table's alone)
+# sample_global, which compiles both halves into one kernel and, without spin, runs the table's alone)
 DRAW = """
 import importlib.util, json, sys
 import numpy as np
