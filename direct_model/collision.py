@@ -20,7 +20,8 @@ that matrix's determinant is a cubic P(λ) with P(0) = −Δv_c < 0 and leading
 coefficient > 0 (the Schur complement of G), so a positive root always exists.
 The cubic's critical points split (0, ∞) into monotone pieces; the smallest
 positive root is bracketed in the first piece where P changes sign and polished
-by Newton's method safeguarded with bisection, to machine precision. Three
+by Newton's method safeguarded with bisection, to machine precision, from the
+root of P's second-order expansion at the bracket's lower end. Three
 positive roots (a sign pattern decidable from P at the critical points) are
 reported with :data:`COLLISION_MULTIPLE_ROOTS`; the smallest is taken.
 
@@ -55,16 +56,35 @@ def _cubic_slope(c1, c2, c3, x):
 
 
 @numba.njit(**JIT)
+def _first_guess(c0, c1, c2, c3, lo):
+    """A first guess of the root above ``lo`` (P(lo) ≤ 0, P rising after lo): the root of P's second-order
+    expansion at lo, P(lo) + P'(lo)d + ½P''(lo)d² (P(lo + d) = c3 d³ ≥ 0 there, so it is above the root), or a
+    Newton step from lo where that has none; inf if neither exists."""
+    p = _cubic(c0, c1, c2, c3, lo)
+    slope = _cubic_slope(c1, c2, c3, lo)
+    curvature = 6.0 * c3 * lo + 2.0 * c2
+    disc = slope * slope - 2.0 * p * curvature
+    if disc >= 0.0 and slope + np.sqrt(disc) > 0.0:
+        return lo - 2.0 * p / (slope + np.sqrt(disc))
+    return lo - p / slope if slope > 0.0 else np.inf
+
+
+@numba.njit(**JIT)
 def _bracketed_root(c0, c1, c2, c3, lo, hi):
     """Root of the cubic in [lo, hi] where it rises from ≤ 0 to ≥ 0 (monotone piece).
 
-    Newton steps, replaced by bisection whenever they leave the bracket.
-    Returns (root, converged).
+    Newton steps from :func:`_first_guess` (the bracket's midpoint if the guess is outside it), replaced by
+    bisection whenever they leave the bracket, until P(x) is within the rounding of its evaluation (lo ≥ 0:
+    |P(x)| ≤ 10⁻¹⁵ Σ|c_i| x^i, above the 6 rounding errors of Horner's scheme), the Newton step or the
+    bracket below 4·10⁻¹⁶ relative. Returns (root, converged).
     """
-    x = 0.5 * (lo + hi)
+    x = _first_guess(c0, c1, c2, c3, lo)
+    if not lo < x < hi:
+        x = 0.5 * (lo + hi)
+    a0, a1, a2, a3 = 1e-15 * abs(c0), 1e-15 * abs(c1), 1e-15 * abs(c2), 1e-15 * abs(c3)
     for _ in range(_MAX_ROOT_ITERATIONS):
         fx = _cubic(c0, c1, c2, c3, x)
-        if fx == 0.0:
+        if abs(fx) <= _cubic(a0, a1, a2, a3, x):
             return x, True
         if fx < 0.0:
             lo = x

@@ -1,7 +1,7 @@
 /*
  * collision.c: one impulsive collision of a rigid body with the wall y = 0 (direct_model.collision: collide,
- * smallest_positive_root, _bracketed_root, _cubic, _cubic_slope, _form). The same operations in the same order
- * as the numba kernels: plain products and sums (no fma), libm's sqrt, exp and pow.
+ * smallest_positive_root, _first_guess, _bracketed_root, _cubic, _cubic_slope, _form). The same operations in the
+ * same order as the numba kernels: plain products and sums (no fma), libm's sqrt, exp and pow.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -23,14 +23,31 @@ static inline double cubic_slope(double c1, double c2, double c3, double x)
     return (3.0 * c3 * x + 2.0 * c2) * x + c1;
 }
 
-/* root of the cubic in [lo, hi] where it rises from <= 0 to >= 0: Newton steps, bisection whenever they leave
- * the bracket; returns 1 if converged */
+/* a first guess of the root above lo (P(lo) <= 0, P rising after lo): the root of P's second-order expansion at
+ * lo, P(lo) + P'(lo) d + P''(lo) d^2 / 2 (P(lo + d) = c3 d^3 >= 0 there, so it is above the root), or a Newton
+ * step from lo where that has none; inf if neither exists */
+static double first_guess(double c0, double c1, double c2, double c3, double lo)
+{
+    double p = cubic(c0, c1, c2, c3, lo);
+    double slope = cubic_slope(c1, c2, c3, lo);
+    double curvature = 6.0 * c3 * lo + 2.0 * c2;
+    double disc = slope * slope - 2.0 * p * curvature;
+    if (disc >= 0.0 && slope + sqrt(disc) > 0.0) return lo - 2.0 * p / (slope + sqrt(disc));
+    return slope > 0.0 ? lo - p / slope : INFINITY;
+}
+
+/* root of the cubic in [lo, hi] where it rises from <= 0 to >= 0: Newton steps from first_guess (the bracket's
+ * midpoint if the guess is outside it), bisection whenever they leave the bracket, until P(x) is within the
+ * rounding of its evaluation (|P(x)| <= 1e-15 sum |c_i| x^i, lo >= 0), the step or the bracket below 4e-16
+ * relative; returns 1 if converged */
 static int bracketed_root(double c0, double c1, double c2, double c3, double lo, double hi, double *root)
 {
-    double x = 0.5 * (lo + hi);
+    double x = first_guess(c0, c1, c2, c3, lo);
+    if (!(lo < x && x < hi)) x = 0.5 * (lo + hi);
+    double a0 = 1e-15 * fabs(c0), a1 = 1e-15 * fabs(c1), a2 = 1e-15 * fabs(c2), a3 = 1e-15 * fabs(c3);
     for (int i = 0; i < MAX_ROOT_ITERATIONS; i++) {
         double fx = cubic(c0, c1, c2, c3, x);
-        if (fx == 0.0) {
+        if (fabs(fx) <= cubic(a0, a1, a2, a3, x)) {
             *root = x;
             return 1;
         }
