@@ -291,15 +291,23 @@ def _row_moments(x):
     return mean, std
 
 
-def _group_quantiles(x: np.ndarray, group: np.ndarray, counts: np.ndarray, levels: int) -> np.ndarray:
-    """(G, levels + 1) quantile functions of x per group at p = i/levels (linear in the order statistics)."""
-    order = np.lexsort((x, group))
+@numba.njit(cache=True, nogil=True)
+def _sort_segments(x, starts, counts):
+    """Sorts each segment x[starts[g]:starts[g] + counts[g]] in place."""
+    for g in range(len(starts)):
+        x[starts[g]:starts[g] + counts[g]].sort()
+
+
+def _group_quantiles(x: np.ndarray, by_group: np.ndarray, counts: np.ndarray, levels: int) -> np.ndarray:
+    """(G, levels + 1) quantile functions of x per group at p = i/levels (linear in the order statistics);
+    ``by_group`` orders the rows by group (a stable argsort of the groups), ``counts`` the rows per group."""
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    xs = x[by_group]
+    _sort_segments(xs, starts, counts)      # the groups' values in order: what sorting by (group, x) gives
     pos = np.linspace(0.0, 1.0, levels + 1)[None, :] * (counts[:, None] - 1)
     lo = np.floor(pos).astype(np.int64)
     hi = np.minimum(lo + 1, counts[:, None] - 1)
     f = pos - lo
-    xs = x[order]
     return xs[starts[:, None] + lo] * (1.0 - f) + xs[starts[:, None] + hi] * f
 
 
@@ -474,6 +482,7 @@ def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolutio
     shape_id = np.zeros((r.clusters, N_CHAIN), dtype=np.uint8)
     slope = np.zeros((r.clusters, N_SLOPES))
     dictionary = np.empty((N_CHAIN, r.dictionary_size, r.levels + 1))
+    by_group = np.argsort(group, kind="stable")
     for k in range(N_CHAIN):
         residual = z[:, k]
         if k:
@@ -481,7 +490,7 @@ def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolutio
             b = _group_slopes(A, residual, group, counts.astype(np.float64))
             slope[:G, slope_index(k, 0):slope_index(k, 0) + k] = b
             residual = _residual(residual, A, b, group)
-        q = _group_quantiles(residual, group, counts, r.levels)
+        q = _group_quantiles(residual, by_group, counts, r.levels)
         loc[:G, k], scl[:G, k] = _row_moments(q)
         # a cluster of one value (a few samples) has no shape: scale 0 and shape 0
         spread = scl[:G, k] > SPREAD_TOL * max(scale[k], 1e-300)
