@@ -17,7 +17,7 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.output import check_memory, check_output
 from data_schema.samples import ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, write_samples
 from tablegen.tabulation.config import PRESETS
-from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES
+from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw
 from direct_model.simulate import DEFAULT_N_MAX
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 from tablegen.study.report import DEFAULT_N as REPORT_DEFAULT_N
@@ -38,8 +38,9 @@ def _build_parser() -> argparse.ArgumentParser:
                      help=f"particle shape: {', '.join(SHAPES)}, {MIX} (the families' equal-weight mix), or a user "
                           f"grain of --config")
     sim.add_argument("--config", metavar="FILE",
-                     help="TOML build configuration whose [shapes.NAME] section defines the grain --shape names "
-                          "(only the grains are taken from it)")
+                     help="TOML build configuration: its [shapes.NAME] sections define the grains --shape may name, "
+                          "and its model (kappa, the b/a and c/b law, n_max, the wall law) replaces the defaults "
+                          "below, so that the particles are a table cell's; a flag given still wins")
     sim.add_argument("--alpha1", type=float, required=True, metavar="DEG", help=f"incidence angle from the wall, {ALPHA1_RANGE_TEXT}")
     sim.add_argument("--speed", type=float, required=True, metavar="M_PER_S", help="incident speed |V-| in m/s, > 0")
     sim.add_argument("-n", type=count_argument, required=True, metavar="N", help="number of particles, >= 1")
@@ -47,18 +48,19 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="random seed in [0, 2**63) (default: fresh, printed)")
     sim.add_argument("--omega", type=float, nargs=3, default=(0.0, 0.0, 0.0), metavar=("WX", "WY", "WZ"),
                      help="incident angular velocity Omega- a/|V-|, lab frame (default 0 0 0)")
-    sim.add_argument("--kappa", type=float, default=DEFAULT_KAPPA,
-                     help="cut_prism corner truncation, [0, 1) (default %(default)s)")
-    sim.add_argument("--n-max", type=int, default=DEFAULT_N_MAX,
-                     help="collisions before a particle is trapped (default %(default)s)")
+    sim.add_argument("--kappa", type=float, metavar="KAPPA",
+                     help=f"cut_prism corner truncation, [0, 1) (default {DEFAULT_KAPPA}, or --config's)")
+    sim.add_argument("--n-max", type=int, metavar="N_MAX",
+                     help=f"collisions before a particle is trapped (default {DEFAULT_N_MAX}, or --config's)")
     law = CORUNDUM_ON_STEEL
-    sim.add_argument("--wall-k", type=float, default=law.k, metavar="K",
-                     help="wall law: restitution rate constant k, (m/s)^-p, > 0 (default %(default)s)")
-    sim.add_argument("--wall-p", type=float, default=law.p, metavar="P",
-                     help="wall law: restitution speed exponent p, > 0 (default %(default)s)")
-    sim.add_argument("--wall-q", type=float, default=law.q, metavar="Q",
-                     help=f"wall law: friction factor exp(q cos gamma), finite (default %(default)s; the three "
-                          f"defaults are the law {law.name}; another is recorded as '{CUSTOM_WALL}')")
+    sim.add_argument("--wall-k", type=float, metavar="K",
+                     help=f"wall law: restitution rate constant k, (m/s)^-p, > 0 (default {law.k}, or --config's)")
+    sim.add_argument("--wall-p", type=float, metavar="P",
+                     help=f"wall law: restitution speed exponent p, > 0 (default {law.p}, or --config's)")
+    sim.add_argument("--wall-q", type=float, metavar="Q",
+                     help=f"wall law: friction factor exp(q cos gamma), finite (default {law.q}, or --config's; "
+                          f"the three defaults are the law {law.name}; a law changed by a flag is recorded as "
+                          f"'{CUSTOM_WALL}')")
     sim.add_argument("--out", metavar="FILE.h5", help="write the per-particle samples (HDF5, docs/format.md)")
     sim.add_argument("--overwrite", action="store_true",
                      help="replace an existing --out file if it is a samples file (nothing else is replaced)")
@@ -133,26 +135,36 @@ def _simulate(args) -> int:
     if args.out is not None:
         check_output(args.out, SAMPLES_FILE_TYPE, args.overwrite)
     check_memory(args.n, BYTES_PER_PARTICLE, "-n")
-    samples = simulate(_shape(args), args.alpha1, args.speed, args.n, seed=args.seed, omega_in=args.omega,
-                       kappa=args.kappa, n_max=args.n_max, wall=_wall(args), progress=_progress(args))
+    config, kappa, aspect, n_max, wall = _model(args)
+    samples = simulate(_shape(args, config), args.alpha1, args.speed, args.n, seed=args.seed, omega_in=args.omega,
+                       kappa=kappa, aspect=aspect, n_max=n_max, wall=wall, progress=_progress(args))
     print(format_summary(samples, summarize(samples)))
     if args.out is not None:
         print(f"samples written to {write_samples(args.out, samples, overwrite=args.overwrite)}")
     return 0
 
 
-def _shape(args):
-    """--shape: a family's name or the mix, or the record of a user grain of --config; ValueError naming it."""
-    if args.config is None:
-        if args.shape not in SHAPES + (MIX,):
-            raise ValueError(f"--shape must be one of {', '.join(SHAPES + (MIX,))}, or a user grain with --config "
-                             f"FILE defining its [shapes.NAME] section; got {args.shape!r}")
-        return args.shape
-    from tablegen.tabulation.config import load_config
+def _model(args):
+    """(the --config configuration or None, kappa, the b/a and c/b law, n_max, the wall law) that simulate runs:
+    --config's model, else the model's defaults; the --kappa, --n-max and --wall-* flags given replace them."""
+    config, kappa, aspect, n_max, wall = None, DEFAULT_KAPPA, AspectRatioLaw(), DEFAULT_N_MAX, CORUNDUM_ON_STEEL
+    if args.config is not None:
+        from tablegen.tabulation.config import load_config
 
-    config = load_config(args.config, log=lambda line: print(line, file=sys.stderr))
+        config = load_config(args.config, log=lambda line: print(line, file=sys.stderr))
+        kappa, aspect, n_max, wall = config.kappa, config.aspect, config.n_max, config.wall
+    return (config, kappa if args.kappa is None else args.kappa, aspect,
+            n_max if args.n_max is None else args.n_max, _wall(args, wall))
+
+
+def _shape(args, config):
+    """--shape: a family's name or the mix, or the record of a user grain of ``config`` (--config's, or None);
+    ValueError naming it."""
     if args.shape in SHAPES + (MIX,):
         return args.shape
+    if config is None:
+        raise ValueError(f"--shape must be one of {', '.join(SHAPES + (MIX,))}, or a user grain with --config "
+                         f"FILE defining its [shapes.NAME] section; got {args.shape!r}")
     record = config.grain(args.shape)
     if record is None:
         names = ", ".join(g.name for g in config.grains) or "none"
@@ -161,10 +173,11 @@ def _shape(args):
     return record
 
 
-def _wall(args) -> WallMaterial:
-    """The wall law of --wall-k/-p/-q: the default law, or a custom one; ValueError naming the flag."""
-    values = {"k": args.wall_k, "p": args.wall_p, "q": args.wall_q}
-    law = CORUNDUM_ON_STEEL
+def _wall(args, law: WallMaterial) -> WallMaterial:
+    """The wall law: ``law`` (the default or --config's) with what --wall-k/-p/-q change, a custom law if they
+    change it; ValueError naming the flag."""
+    given = {"k": args.wall_k, "p": args.wall_p, "q": args.wall_q}
+    values = {key: getattr(law, key) if value is None else value for key, value in given.items()}
     if values == {"k": law.k, "p": law.p, "q": law.q}:
         return law
     for key, value in values.items():

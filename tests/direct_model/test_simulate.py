@@ -161,6 +161,32 @@ def test_cli_wall_law(tmp_path):
     assert back.provenance["wall_law"] == "custom" and back.provenance["wall_k"] == 0.2
 
 
+def test_cli_takes_the_model_of_a_config(tmp_path):
+    """--config gives simulate the configuration's model (kappa, the b/a and c/b law, n_max, the wall law) instead
+    of the defaults, so that its particles are a table cell's; a flag given still replaces its part."""
+    from direct_model.wall import WallMaterial
+    config = tmp_path / "c.toml"
+    config.write_text('[grid]\nalpha1_deg = [45.0]\nspeed_m_s = [200.0]\nshapes = ["cut_prism"]\n'
+                      '[simulation]\nkappa = 0.1\nn_max = 3\naspect_ratio = {mean = 0.6, sd = 0.1, low = 0.4, '
+                      'high = 0.9}\n[wall]\nk = 0.2\np = 0.5\nq = 0.4\nname = "a_wall"\n')
+    aspect = AspectRatioLaw(mean=0.6, sd=0.1, low=0.4, high=0.9)
+    argv = ["simulate", "--shape", "cut_prism", "--alpha1", "45", "--speed", "200", "-n", "300", "--seed", "4",
+            "--config", str(config), "--no-progress"]
+    out, flagged = tmp_path / "s.h5", tmp_path / "f.h5"
+    assert tablegen_main(argv + ["--out", str(out)]) == 0
+    assert tablegen_main(argv + ["--n-max", "1000", "--wall-q", "1.0", "--out", str(flagged)]) == 0
+    wall = WallMaterial(k=0.2, p=0.5, q=0.4, name="a_wall")
+    cell = simulate("cut_prism", 45.0, 200.0, 300, seed=4, kappa=0.1, aspect=aspect, n_max=3, wall=wall)
+    back = read_samples(out)
+    assert back.velocity.tobytes() == cell.velocity.tobytes() and np.array_equal(back.status, cell.status)
+    assert back.provenance["wall_law"] == "a_wall" and back.provenance["n_max"] == 3
+    # n_max = 3 traps some of these particles; the flags' n_max = 1000 and q = 1.0 are what runs then
+    custom = WallMaterial(k=0.2, p=0.5, q=1.0, name="custom")
+    again = simulate("cut_prism", 45.0, 200.0, 300, seed=4, kappa=0.1, aspect=aspect, n_max=1000, wall=custom)
+    assert read_samples(flagged).velocity.tobytes() == again.velocity.tobytes()
+    assert (cell.status != STATUS_REBOUNDED).any() and read_samples(flagged).provenance["wall_law"] == "custom"
+
+
 def test_failures_are_counted_with_their_reason():
     """A one-step search budget cannot follow a flight: those particles fail, with the reason."""
     from data_schema.samples import FAILURE_SEARCH_BUDGET
