@@ -45,3 +45,4 @@ def test_bench_direct_runtime_quick(native_build, small_table_path, tmp_path, ca
             assert row[piece] > 0, piece
     printed = capsys.readouterr().out
     assert "C outputs equal numba's bits on every row: yes" in printed and "Where C's time goes" in printed
+    assert "at the 'spinning' states:" in printed and "averaged over hopperRebound's hits, per shape: ellipsoid" in printed
