@@ -97,9 +97,14 @@ def _build_parser() -> argparse.ArgumentParser:
                         help="draw from a table, at its grid alpha1 and its grid speed nearest 200 m/s")
     source.add_argument("--direct", action="store_true", help="run the direct model at 200 m/s")
     report.add_argument("-o", "--out", required=True, metavar="FOLDER", help="output folder (must not exist)")
+    report.add_argument("--config", metavar="FILE",
+                        help="with --direct: a TOML build configuration whose grid shapes (its user grains too) and "
+                             "model (kappa, the b/a and c/b law, n_max, the wall law) are run, as its table's cells "
+                             "would be")
     report.add_argument("--shapes", nargs="+", metavar="NAME",
                         help=f"shapes to report, and 'mix' for the equal-weight mix (default: all): with --direct "
-                             f"among {', '.join(SHAPES + (MIX,))}; with --table the table's (its user grains too)")
+                             f"among {', '.join(SHAPES + (MIX,))} or --config's grid shapes; with --table the table's "
+                             f"(its user grains too)")
     report.add_argument("-n", type=count_argument, default=REPORT_DEFAULT_N, metavar="N",
                         help="particles (--direct) or draws (--table) per shape and alpha1, >= 1 "
                              "(default %(default)s)")
@@ -144,14 +149,21 @@ def _simulate(args) -> int:
     return 0
 
 
+def _config(args):
+    """The build configuration of --config, or None without it; its warnings on stderr."""
+    if args.config is None:
+        return None
+    from tablegen.tabulation.config import load_config
+
+    return load_config(args.config, log=lambda line: print(line, file=sys.stderr))
+
+
 def _model(args):
     """(the --config configuration or None, kappa, the b/a and c/b law, n_max, the wall law) that simulate runs:
     --config's model, else the model's defaults; the --kappa, --n-max and --wall-* flags given replace them."""
-    config, kappa, aspect, n_max, wall = None, DEFAULT_KAPPA, AspectRatioLaw(), DEFAULT_N_MAX, CORUNDUM_ON_STEEL
-    if args.config is not None:
-        from tablegen.tabulation.config import load_config
-
-        config = load_config(args.config, log=lambda line: print(line, file=sys.stderr))
+    config = _config(args)
+    kappa, aspect, n_max, wall = DEFAULT_KAPPA, AspectRatioLaw(), DEFAULT_N_MAX, CORUNDUM_ON_STEEL
+    if config is not None:
         kappa, aspect, n_max, wall = config.kappa, config.aspect, config.n_max, config.wall
     return (config, kappa if args.kappa is None else args.kappa, aspect,
             n_max if args.n_max is None else args.n_max, _wall(args, wall))
@@ -235,13 +247,18 @@ def _report(args) -> int:
     seed = check_seed(args.seed)
     check_output(args.out, REPORT_KIND, args.overwrite, folder=True)
     require_matplotlib()
+    if args.config is not None and not args.direct:
+        raise ValueError(f"--config {args.config} goes with --direct: a table (--table) holds its own model")
     if args.direct:
-        shapes = args.shapes or SHAPES + (MIX,)
-        unknown = [s for s in shapes if s not in SHAPES + (MIX,)]
+        config = _config(args)
+        available = (SHAPES if config is None else config.shapes) + (MIX,)
+        shapes = args.shapes or available
+        unknown = [s for s in shapes if s not in available]
         if unknown:
-            raise ValueError(f"--shapes with --direct must be among {', '.join(SHAPES + (MIX,))}; got {unknown[0]!r} "
-                             f"(a user grain: report it from a table of it, --table)")
-        data = direct_data(shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args))
+            raise ValueError(f"--shapes with --direct must be among {', '.join(available)}; got {unknown[0]!r}"
+                             + (" (a user grain: name it in the grid of a --config FILE)" if config is None else ""))
+        data = direct_data(shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args),
+                           config=config)
     else:
         data = table_data(args.table, args.shapes, args.alpha1, args.n, seed)
     path = write_report(data, args.out, overwrite=args.overwrite)

@@ -99,33 +99,43 @@ def _with_mix(parts: dict, shapes, alpha1, mix_of) -> dict:
 
 
 def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0,
-                progress: bool = False) -> ReportData:
+                progress: bool = False, config=None) -> ReportData:
     """Run the direct model at 200 m/s, Ω⁻ = 0, for each shape and α1 (deg); ``n`` particles each.
 
     Every run uses the same ``seed`` (common random numbers: the same
-    orientations and aspect ratios at every point). The mix pools the four
-    shapes' runs; it has no run of its own.
+    orientations and aspect ratios at every point). The mix pools the
+    available shapes' runs; it has no run of its own. ``config`` (a
+    :class:`tablegen.tabulation.config.BuildConfig`, or None): the shapes of its grid, its user grains among them,
+    are the available ones and its model (kappa, the b/a and c/b law, n_max, the wall law) is run, as its table's
+    cells are; None: the four families with the model's defaults.
     """
     from direct_model.simulate import simulate
 
+    available = SHAPES if config is None else config.shapes
+    model = {} if config is None else {"kappa": config.kappa, "aspect": config.aspect, "n_max": config.n_max,
+                                       "wall": config.wall}
     alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
-    mix_of = _constituents(shapes, SHAPES)
+    mix_of = _constituents(shapes, available)
     bar = progress_bar(progress, len(mix_of) * len(alpha1) * n, "particle", "report runs")
     parts = {}
     for shape in mix_of:
+        body = shape if config is None else config.grain(shape) or shape
         for a in alpha1:
-            parts[shape, a] = from_sample_set(simulate(shape, a, PAPER_SPEED, n, seed=seed))
+            parts[shape, a] = from_sample_set(simulate(body, a, PAPER_SPEED, n, seed=seed, **model))
             if bar is not None:
                 bar.update(n)
     if bar is not None:
         bar.close()
+    source = "direct model (`direct_model.simulate.simulate`)"
+    if config is not None:
+        source += f" with the model of a build configuration (grid shapes {', '.join(available)})"
     return ReportData(
-        source="direct model (`direct_model.simulate.simulate`)", speed=PAPER_SPEED, alpha1=alpha1,
-        shapes=_ordered(shapes, SHAPES), mix_of=SHAPES, n=n, seed=seed,
+        source=source, speed=PAPER_SPEED, alpha1=alpha1,
+        shapes=_ordered(shapes, available), mix_of=tuple(available), n=n, seed=seed,
         counts_note=f"Counted over the {n} simulated particles per shape.",
         e_rot_method="exact: E_Ω⁺ = ½ Ω⁺·JΩ⁺ with each particle's own inertia tensor and orientation "
                      "(docs/model.md §5.4).",
-        points=_with_mix(parts, shapes, alpha1, SHAPES))
+        points=_with_mix(parts, shapes, alpha1, available))
 
 
 def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> ReportData:
