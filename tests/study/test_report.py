@@ -161,17 +161,17 @@ def test_cli_direct_reports_the_grains_of_a_config(tmp_path, capsys):
     config_path = write_grain_config(tmp_path)
     out = tmp_path / "report"
     argv = ["report", "--direct", "--config", str(config_path), "-o", str(out), "--shapes", "sand_b", "mix", "-n",
-            "200", "--seed", "3", "--alpha1", "30,90", "--no-progress"]
+            "200", "--seed", "3", "--alpha1", "90", "--no-progress"]
     assert tablegen_main(argv) == 0
     index = (out / "index.md").read_text(encoding="utf-8")
     assert "| sand_b |" in index and "| mix |" in index and "grid shapes sand_a, sand_b" in index
     config = load_config(config_path)
-    data = direct_data(["sand_b", "mix"], (30.0, 90.0), n=200, seed=3, config=config)
+    data = direct_data(["sand_b", "mix"], (90.0,), n=200, seed=3, config=config)
     grain = simulate(config.grain("sand_b"), 90.0, 200.0, 200, seed=3, kappa=config.kappa, aspect=config.aspect,
                      n_max=config.n_max, wall=config.wall)
     assert np.array_equal(data.points["sand_b", 90.0].alpha2, grain.alpha2[grain.rebounded])
     assert data.mix_of == ("sand_a", "sand_b")
-    assert data.points["mix", 30.0].alpha2.size > data.points["sand_b", 30.0].alpha2.size
+    assert data.points["mix", 90.0].alpha2.size > data.points["sand_b", 90.0].alpha2.size
     user_error(tablegen_main, argv[:4] + ["-o", str(tmp_path / "r2"), "--shapes", "prism"], capsys,
                "--shapes", "'prism'", "sand_a, sand_b, mix")
     user_error(tablegen_main, ["report", "--table", "t.h5", "--config", str(config_path), "-o", str(tmp_path / "r3")],
