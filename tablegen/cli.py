@@ -162,11 +162,10 @@ def _model(args):
     """(the --config configuration or None, kappa, the b/a and c/b law, n_max, the wall law) that simulate runs:
     --config's model, else the model's defaults; the --kappa, --n-max and --wall-* flags given replace them."""
     config = _config(args)
-    kappa, aspect, n_max, wall = DEFAULT_KAPPA, AspectRatioLaw(), DEFAULT_N_MAX, CORUNDUM_ON_STEEL
-    if config is not None:
-        kappa, aspect, n_max, wall = config.kappa, config.aspect, config.n_max, config.wall
-    return (config, kappa if args.kappa is None else args.kappa, aspect,
-            n_max if args.n_max is None else args.n_max, _wall(args, wall))
+    model = (config.model() if config is not None else
+             {"kappa": DEFAULT_KAPPA, "aspect": AspectRatioLaw(), "n_max": DEFAULT_N_MAX, "wall": CORUNDUM_ON_STEEL})
+    return (config, model["kappa"] if args.kappa is None else args.kappa, model["aspect"],
+            model["n_max"] if args.n_max is None else args.n_max, _wall(args, model["wall"]))
 
 
 def _shape(args, config):

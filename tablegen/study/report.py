@@ -112,8 +112,7 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
     from direct_model.simulate import simulate
 
     available = SHAPES if config is None else config.shapes
-    model = {} if config is None else {"kappa": config.kappa, "aspect": config.aspect, "n_max": config.n_max,
-                                       "wall": config.wall}
+    model = {} if config is None else config.model()
     alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
     mix_of = _constituents(shapes, available)
     bar = progress_bar(progress, len(mix_of) * len(alpha1) * n, "particle", "report runs")

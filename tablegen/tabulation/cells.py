@@ -71,7 +71,6 @@ def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) ->
     for chunk, start in enumerate(range(0, config.particles_per_cell, CHUNK_PARTICLES)):
         n = min(CHUNK_PARTICLES, config.particles_per_cell - start)
         acc.add(simulate(body, config.alpha1_deg[i_alpha], config.speed_m_s[i_speed], n,
-                         seed=derive_seed(seed, chunk), kappa=config.kappa,
-                         aspect=config.aspect, wall=config.wall, n_max=config.n_max))
+                         seed=derive_seed(seed, chunk), **config.model()))
     return acc.finish(config.resolution, derive_seed(seed, REPRESENTATION_KEY),
                       cell_label(config, shape, i_alpha, i_speed))

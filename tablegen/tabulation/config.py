@@ -96,6 +96,10 @@ class BuildConfig:
         """The record of the user's grain ``name``; None for a built-in family."""
         return next((g for g in self.grains if g.name == name), None)
 
+    def model(self) -> dict:
+        """The direct model's settings a cell runs with, as keywords of ``direct_model.simulate.simulate``."""
+        return {"kappa": self.kappa, "aspect": self.aspect, "n_max": self.n_max, "wall": self.wall}
+
     def shape_records(self) -> tuple:
         """The record of each shape, in the order of ``shapes``: a family's at ``kappa`` and ``aspect``, or the
         user's grain."""
