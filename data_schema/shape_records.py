@@ -1,15 +1,17 @@
 """The shapes a table holds, as data (group ``/shapes`` since table format 3.4; docs/format.md, "Shapes").
 
 One row per shape of ``grid/shapes``, in its order; the records are those of :mod:`direct_model.registry`
-(the four families, :func:`direct_model.registry.built_in_shapes`, and the user's own grains,
+(the built-in families, :data:`direct_model.registry.FAMILIES`, and the user's own grains,
 :func:`direct_model.registry.grain`). Everything is in the body frame Oξηζ (centre of mass at the origin,
 principal axes along ξ, η, ζ) and in units of a, the largest half-extent along a principal axis, at
 b/a = c/b = 1 (the body before a particle's random stretch by the ``aspect`` law).
 
 This module is the only place that writes or reads these arrays (the C twin: native/src/shape_records.c). Every
 dataset carries the Fletcher-32 checksum, so a flipped bit fails to load naming the dataset; ``name`` is the
-checksummed copy of ``grid/shapes``, and a built-in family's record must be the family's at the table's κ and
-aspect-ratio law (the attributes of group ``grid``, themselves copied in ``grid/law``). Tables before 3.4 hold
+checksummed copy of ``grid/shapes``, and the record of one of the paper's four families (whose bodies the runtimes
+also make from code, :data:`direct_model.shapes.SHAPES`) must be the family's at the table's κ and aspect-ratio law
+(the attributes of group ``grid``, themselves copied in ``grid/law``). Any other shape, a later family's as a user
+grain's, is read from its stored record alone. Tables before 3.4 hold
 the families only: :func:`family_records` synthesises their records from those attributes.
 """
 
@@ -189,9 +191,9 @@ def check_shape_datasets(arrays: dict, names, refuse) -> None:
 
 
 def records_from_arrays(arrays: dict, names, kappa: float, aspect: tuple, refuse) -> tuple:
-    """The registry records of checked /shapes datasets (:func:`check_shape_datasets`). A built-in family's row must
-    be the family's record at κ and the aspect-ratio law ``aspect`` bit for bit; a user grain's record is rebuilt
-    from its vertices and triangles (:func:`direct_model.registry.polyhedron`), whose mass properties must give
+    """The registry records of checked /shapes datasets (:func:`check_shape_datasets`). A row of the paper's four
+    families must be the family's record at κ and the aspect-ratio law ``aspect`` bit for bit; any other polyhedron's
+    record (a user grain's, a later family's) is rebuilt from its vertices and triangles (:func:`direct_model.registry.polyhedron`), whose mass properties must give
     the stored inertia bit for bit. ``refuse`` names the first row that does not."""
     records = []
     for i, name in enumerate(names):

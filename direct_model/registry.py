@@ -1,4 +1,4 @@
-"""Shapes as data (docs/model.md §3 and §9): the record of a shape, and the four families as records.
+"""Shapes as data (docs/model.md §3 and §9): the record of a shape, and the registry of the built-in families.
 
 A shape is a named record, one of two kinds:
 
@@ -12,8 +12,9 @@ for every shape. A record may carry a law that scales it at random per particle 
 §3): a particle's body is :meth:`stretched` by the law's draws. ``both_hands`` draws the mirror image (ζ → −ζ)
 for half of the particles (the family tetrahedron; a user's grain only when asked).
 
-The families are :func:`built_in_shape` records whose stretched bodies are those of :mod:`direct_model.shapes`
-(the tests check their mass properties against it). Plain numpy: the runtime may build and read records.
+The built-in families are the entries of :data:`FAMILIES`, made into records by :func:`built_in_shape`; the
+stretched bodies of the paper's four are those of :mod:`direct_model.shapes` (the tests check their mass properties
+against it). Plain numpy: the runtime may build and read records.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from typing import Callable
 
 import numpy as np
 
@@ -45,8 +47,8 @@ def check_name(name) -> str:
     if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
         raise ShapeError(f"a shape name must be 1-64 letters, digits or underscores, starting with a letter; "
                          f"got {name!r}")
-    if name in SHAPES or name == MIX:
-        raise ShapeError(f"the shape name {name!r} is a built-in's; built-in names: {', '.join(SHAPES)}, {MIX}")
+    if name in FAMILIES or name == MIX:
+        raise ShapeError(f"the shape name {name!r} is a built-in's; built-in names: {', '.join(FAMILIES)}, {MIX}")
     return name
 
 
@@ -184,36 +186,69 @@ def _faces_to_triangles(vertices, normals):
     return np.array(triangles, dtype=np.int32)
 
 
-def _unit_body(name, kappa):
-    """The family's body at b/a = c/b = 1 (cubic symmetry) and its faces' outward normals."""
-    vertices = np.unique(shape_vertices(name, 1.0, 1.0, 1.0, kappa=kappa), axis=0)   # κ = 0 repeats corners
-    axes = np.vstack([np.eye(3), -np.eye(3)])
-    corners = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
-    if name == "prism":
-        normals = axes
-    elif name == "cut_prism":
-        normals = np.vstack([axes, corners])
-    else:                                         # tetrahedron: each face faces away from the opposite vertex
-        normals = -vertices
-    return vertices, normals
+_AXES = np.vstack([np.eye(3), -np.eye(3)])
+_CORNERS = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+
+
+def _prism_body(kappa):
+    return shape_vertices("prism"), _AXES
+
+
+def _cut_prism_body(kappa):
+    return shape_vertices("cut_prism", kappa=kappa), np.vstack([_AXES, _CORNERS])
+
+
+def _tetrahedron_body(kappa):
+    vertices = shape_vertices("tetrahedron")
+    return vertices, -np.unique(vertices, axis=0)      # each face faces away from the opposite vertex
+
+
+@dataclasses.dataclass(frozen=True)
+class Family:
+    """A built-in family (docs/model.md §3): how :func:`built_in_shape` makes its record.
+
+    ``body(kappa)`` gives the body at b/a = c/b = 1 in units of a, in its principal frame: its vertices (n, 3;
+    repeats allowed) and the outward normals of its faces (f, 3, any length); None for the ellipsoid, the one
+    smooth family (a table stores no semi-axes for another). docs/design/grains.md, "A new built-in family".
+    ``both_hands``: half of the particles are the mirror image; ``uses_kappa``: κ shapes the body (the record
+    keeps it in ``parameters``).
+    """
+
+    body: Callable | None
+    both_hands: bool = False
+    uses_kappa: bool = False
+
+
+# The built-in families by name: a new family is an entry here (its record is then stored in every table that
+# holds it, which is where the runtimes read it). The first four are the paper's, with the codes 0-3 of
+# direct_model.shapes.SHAPES that old tables, "mix" and the C and Fortran enums know them by.
+FAMILIES = {
+    "ellipsoid": Family(None),
+    "prism": Family(_prism_body),
+    "cut_prism": Family(_cut_prism_body, uses_kappa=True),
+    "tetrahedron": Family(_tetrahedron_body, both_hands=True),
+}
 
 
 def built_in_shape(name: str, kappa: float = DEFAULT_KAPPA, aspect: AspectRatioLaw | None = AspectRatioLaw()):
-    """The record of a family of docs/model.md §3 at b/a = c/b = 1, with its aspect-ratio law.
+    """The record of the family ``name`` of :data:`FAMILIES` at b/a = c/b = 1, with its aspect-ratio law.
 
-    Stretching it by (b/a, c/b) (:meth:`ConvexPolyhedron.stretched`) gives the body of
-    :func:`direct_model.shapes.shape_vertices` at a = 1 and those ratios. ValueError for an unknown name or κ.
+    Stretching it by (b/a, c/b) (:meth:`ConvexPolyhedron.stretched`) gives the particle's body; for the paper's
+    four, the body of :func:`direct_model.shapes.shape_vertices` at a = 1 and those ratios. ValueError for an
+    unknown name or κ.
     """
-    if name not in SHAPES:
-        raise ValueError(f"The 'shape' parameter must be one of {', '.join(SHAPES)}; got {name!r}.")
-    if name == "ellipsoid":
+    family = FAMILIES.get(name)
+    if family is None:
+        raise ValueError(f"The 'shape' parameter must be one of {', '.join(FAMILIES)}; got {name!r}.")
+    if family.body is None:
         return Ellipsoid(name, aspect=aspect)
     kappa = check_kappa(kappa)
-    vertices, normals = _unit_body(name, kappa)
-    return polyhedron(name, vertices, _faces_to_triangles(vertices, normals), aspect=aspect,
-                      both_hands=name == "tetrahedron", parameters={"kappa": kappa} if name == "cut_prism" else {})
+    vertices, normals = family.body(kappa)
+    vertices = np.unique(np.asarray(vertices, dtype=float), axis=0)      # κ = 0 repeats the cut prism's corners
+    return polyhedron(name, vertices, _faces_to_triangles(vertices, np.asarray(normals, dtype=float)), aspect=aspect,
+                      both_hands=family.both_hands, parameters={"kappa": kappa} if family.uses_kappa else {})
 
 
 def built_in_shapes(kappa: float = DEFAULT_KAPPA, aspect: AspectRatioLaw | None = AspectRatioLaw()) -> dict:
-    """The four families as records, by name, in the order of :data:`direct_model.shapes.SHAPES`."""
+    """The paper's four families as records, by name, in the order of :data:`direct_model.shapes.SHAPES`."""
     return {name: built_in_shape(name, kappa, aspect) for name in SHAPES}

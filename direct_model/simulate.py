@@ -18,10 +18,10 @@ import numpy as np
 from data_schema.common import package_version
 from data_schema.samples import ALPHA1_RANGE_TEXT, SampleSet, alpha1_is_physical
 from direct_model.body_rebound import body_rebound_batch
-from direct_model.registry import ConvexPolyhedron, Ellipsoid
+from direct_model.registry import FAMILIES, ConvexPolyhedron, Ellipsoid, built_in_shape
 from direct_model.shape_arrays import family_shape_arrays, shape_arrays
 from direct_model.shapes import (
-    DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, second_moment_factors, shape_code,
+    DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, second_moment_factors,
 )
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
@@ -111,10 +111,10 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
 
     Parameters
     ----------
-    shape : ``"ellipsoid"``, ``"prism"``, ``"cut_prism"``, ``"tetrahedron"`` or
-        ``"mix"`` (each particle's shape drawn from the four with weight ¼); or a shape's
-        record (:mod:`direct_model.registry`, a user's grain say), stretched per particle by its own
-        law (``aspect`` and ``kappa`` are the families'), in both hands if it says so.
+    shape : a built-in family's name (``"ellipsoid"``, ``"prism"``, ``"cut_prism"``, ``"tetrahedron"``: any
+        of :data:`direct_model.registry.FAMILIES`) or ``"mix"`` (each particle's shape drawn from the paper's
+        four with weight ¼); or a shape's record (:mod:`direct_model.registry`, a user's grain say), stretched
+        per particle by its own law (``aspect`` and ``kappa`` are the families'), in both hands if it says so.
     alpha1 : incidence angle from the wall, degrees, in (0, 90].
     speed : incident speed |V⁻|, m/s, > 0 (the default wall law is validated
         for 50–300 m/s; outside it a warning is issued).
@@ -137,8 +137,9 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
     per-particle extras (shape code, hand, b/a, c/b, E_Ω⁺/E_V⁻, search steps).
     """
     record = shape if isinstance(shape, (Ellipsoid, ConvexPolyhedron)) else None
-    if record is None and shape != MIX:
-        shape_code(shape)
+    if record is None and shape != MIX and shape not in FAMILIES:
+        raise ValueError(f"The 'shape' parameter must be one of {', '.join(FAMILIES)}, {MIX!r} or a shape's record; "
+                         f"got {shape!r}.")
     alpha1 = check_alpha1(alpha1)
     speed = check_speed(speed)
     n = _check_count("n", n, 1)
@@ -157,6 +158,8 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
 
     V0 = incident_velocity(alpha1, speed)
     W0 = omega_arr * speed                      # (m/s)/a
+    if record is None and shape not in SHAPES + (MIX,):
+        record = built_in_shape(shape, kappa, aspect)       # a family after the paper's four: its record
     if record is None:
         arrays = family_shape_arrays(kappa, aspect, second_moment_factors(kappa))
         code, name, law = (-1 if shape == MIX else SHAPES.index(shape)), shape, aspect

@@ -51,23 +51,23 @@ class SurrogateTable:
     def shape_arrays(self) -> ShapeArrays:
         """The direct model's shapes as the kernels take them (:class:`direct_model.shape_arrays.ShapeArrays`):
         the four families in code order at the κ, aspect-ratio law and factors s of :attr:`direct_parameters`,
-        then the table's user grains in table order; no shape for a table without those parameters."""
+        then the table's other polyhedra (its user grains, and families after the paper's four) in table order; no shape for a table without those parameters."""
         if self.direct_parameters is None:
             return from_stored(np.zeros(0), [0], np.zeros((0, 3)), [0], np.zeros((0, 3)), np.zeros((0, 3)),
                                np.zeros((0, 4)), np.zeros(0))
-        return family_shapes(self.direct_parameters, self._grains)
+        return family_shapes(self.direct_parameters, self._stored_polyhedra)
 
     @functools.cached_property
     def model_shapes(self) -> np.ndarray:
         """Each of the table's shapes, in the table's order, as its index in :attr:`shape_arrays`: a family's code
-        (:data:`direct_model.shapes.SHAPES`), 4 + k for the table's k-th user grain, −1 for a table without the
+        (:data:`direct_model.shapes.SHAPES`), 4 + k for the table's k-th other polyhedron, −1 for a table without the
         direct model's parameters (the direct path then answers STATUS_INVALID): read-only int64 (n_shapes,),
         as :func:`surrogate.kernels.rebound` takes it."""
         if self.direct_parameters is None:
             return frozen(np.full(len(self.shapes), -1, dtype=np.int64))
-        grains = iter(range(len(SHAPES), len(SHAPES) + len(self._grains)))
+        others = iter(range(len(SHAPES), len(SHAPES) + len(self._stored_polyhedra)))
         return frozen(np.array([SHAPES.index(r.name) if r.name in SHAPES
-                                else next(grains) if isinstance(r, ConvexPolyhedron) else -1 for r in self.records],
+                                else next(others) if isinstance(r, ConvexPolyhedron) else -1 for r in self.records],
                                dtype=np.int64))
 
     @functools.cached_property
@@ -77,9 +77,10 @@ class SurrogateTable:
         return {name: frozen(values) for name, values in shape_datasets(self.records).items()}
 
     @property
-    def _grains(self) -> tuple:
-        """The table's user grains (polyhedra that are no family), in table order; a smooth body that is no family
-        has no semi-axes on file, and the direct path refuses it (:attr:`model_shapes` −1)."""
+    def _stored_polyhedra(self) -> tuple:
+        """The table's polyhedra other than the paper's four families (user grains, later families), in table
+        order: the direct model takes them from their stored records. A smooth body other than the ellipsoid has no
+        semi-axes on file, and the direct path refuses it (:attr:`model_shapes` −1)."""
         return tuple(r for r in self.records if r.name not in SHAPES and isinstance(r, ConvexPolyhedron))
 
     @property

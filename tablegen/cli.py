@@ -17,7 +17,8 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.output import check_memory, check_output
 from data_schema.samples import ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, write_samples
 from tablegen.tabulation.config import PRESETS
-from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw
+from direct_model.registry import FAMILIES
+from direct_model.shapes import DEFAULT_KAPPA, MIX, AspectRatioLaw
 from direct_model.simulate import DEFAULT_N_MAX
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 from tablegen.study.report import DEFAULT_N as REPORT_DEFAULT_N
@@ -35,8 +36,8 @@ def _build_parser() -> argparse.ArgumentParser:
                          description="Simulate n rebounds at one incident state (lab frame: wall y = 0, "
                                      "V- = |V-|(cos a1, -sin a1, 0)) and print a summary.")
     sim.add_argument("--shape", required=True, metavar="NAME",
-                     help=f"particle shape: {', '.join(SHAPES)}, {MIX} (the families' equal-weight mix), or a user "
-                          f"grain of --config")
+                     help=f"particle shape: {', '.join(FAMILIES)}, {MIX} (the paper's four families' equal-weight "
+                          f"mix), or a user grain of --config")
     sim.add_argument("--config", metavar="FILE",
                      help="TOML build configuration: its [shapes.NAME] sections define the grains --shape may name, "
                           "and its model (kappa, the b/a and c/b law, n_max, the wall law) replaces the defaults "
@@ -103,7 +104,7 @@ def _build_parser() -> argparse.ArgumentParser:
                              "would be")
     report.add_argument("--shapes", nargs="+", metavar="NAME",
                         help=f"shapes to report, and 'mix' for the equal-weight mix (default: all): with --direct "
-                             f"among {', '.join(SHAPES + (MIX,))} or --config's grid shapes; with --table the table's "
+                             f"among {', '.join((*FAMILIES, MIX))} or --config's grid shapes; with --table the table's "
                              f"(its user grains too)")
     report.add_argument("-n", type=count_argument, default=REPORT_DEFAULT_N, metavar="N",
                         help="particles (--direct) or draws (--table) per shape and alpha1, >= 1 "
@@ -171,15 +172,15 @@ def _model(args):
 def _shape(args, config):
     """--shape: a family's name or the mix, or the record of a user grain of ``config`` (--config's, or None);
     ValueError naming it."""
-    if args.shape in SHAPES + (MIX,):
+    if args.shape in FAMILIES or args.shape == MIX:
         return args.shape
     if config is None:
-        raise ValueError(f"--shape must be one of {', '.join(SHAPES + (MIX,))}, or a user grain with --config "
+        raise ValueError(f"--shape must be one of {', '.join((*FAMILIES, MIX))}, or a user grain with --config "
                          f"FILE defining its [shapes.NAME] section; got {args.shape!r}")
     record = config.grain(args.shape)
     if record is None:
         names = ", ".join(g.name for g in config.grains) or "none"
-        raise ValueError(f"--shape {args.shape!r} is neither a built-in shape ({', '.join(SHAPES + (MIX,))}) nor a "
+        raise ValueError(f"--shape {args.shape!r} is neither a built-in shape ({', '.join((*FAMILIES, MIX))}) nor a "
                          f"user grain of {args.config} (its grains: {names})")
     return record
 
@@ -250,7 +251,7 @@ def _report(args) -> int:
         raise ValueError(f"--config {args.config} goes with --direct: a table (--table) holds its own model")
     if args.direct:
         config = _config(args)
-        available = (SHAPES if config is None else config.shapes) + (MIX,)
+        available = (tuple(FAMILIES) if config is None else config.shapes) + (MIX,)
         shapes = args.shapes or available
         unknown = [s for s in shapes if s not in available]
         if unknown:

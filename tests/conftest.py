@@ -9,6 +9,7 @@ import pytest
 
 from tablegen import build_table, load_config, parse_config
 from tests.helpers import REPO, background, cpu_dispatch
+from tests.helpers.families import OCTAHEDRON_TABLE_CONFIG, octahedron_entered
 from tests.helpers.native_library import build as native_build_in
 from tests.helpers.plain_install import install_and_draw
 from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG, SMALL_TABLE_CONFIG,
@@ -34,6 +35,16 @@ def grain_table_path(tmp_path_factory):
     folder = tmp_path_factory.mktemp("grain_table")
     path = folder / "grains.h5"
     build_table(load_config(write_grain_config(folder)), path)
+    return path
+
+
+@pytest.fixture(scope="session")
+def octahedron_table_path(tmp_path_factory):
+    """A table of the prism and of a family entered by the tests alone (tests/helpers/families.py), built in this
+    process with the entry in the registry; the entry is gone after the build."""
+    path = tmp_path_factory.mktemp("family_entry") / "octahedron.h5"
+    with octahedron_entered():
+        build_table(parse_config(OCTAHEDRON_TABLE_CONFIG), path, workers=1)
     return path
 
 

@@ -155,14 +155,15 @@ typedef struct rbs_mix {
 typedef struct rbs_shape_info {
     const char *name;           /* valid until rbs_table_close */
     int kind;                   /* RBS_SMOOTH (the ellipsoid) or RBS_POLYHEDRON */
-    int family;                 /* RBS_ELLIPSOID .. RBS_TETRAHEDRON for a built-in family, −1 for a user's grain */
+    int family;                 /* RBS_ELLIPSOID .. RBS_TETRAHEDRON for the paper's four families, −1 for any other
+                                 * shape (a user's grain, a family added to the registry after them) */
     int n_vertices;             /* hull vertices (4 to 256), 0 for a smooth body */
     const double *vertices;     /* n_vertices × 3, row-major, valid until rbs_table_close; NULL if none */
     double inertia[3];          /* principal J/m along ξ, η, ζ, units of a² */
     double aspect[4];           /* the law of b/a and c/b: mean, sd, low, high; NaN: fixed proportions */
     int both_hands;             /* 1: half of the particles are the mirror image (ζ → −ζ) */
     int direct_shape;           /* its `shape` for rbs_direct_rebound: the family's code, 4 + k for the table's
-                                 * k-th user grain; −1 for a table without the direct model's parameters */
+                                 * k-th other polyhedron; −1 for a table without the direct model's parameters */
 } rbs_shape_info;
 
 /* One xoshiro256+ state (four 64-bit words, not all zero): one per thread / MPI rank / stream. */
@@ -420,7 +421,8 @@ int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg
  * the impulse model itself (docs/model.md), flights and collisions simulated, where the table's law does not
  * apply (a spinning particle, say). The same bits as the numba kernel for the same uniforms.
  *   shape    RBS_ELLIPSOID, RBS_PRISM, RBS_CUT_PRISM or RBS_TETRAHEDRON (any of the four, whatever
- *            shapes the table holds), or 4 + k for the table's k-th user grain in table order
+ *            shapes the table holds), or 4 + k for the table's k-th other polyhedron (a user grain, a later
+ *            family) in table order
  *            (rbs_shape_info.direct_shape gives it for each of the table's shapes)
  *   V        incident velocity V⁻, m/s (finite, must move into the wall: V·n < 0)
  *   Omega    incident angular velocity Ω⁻, rad/s (finite); exactly zero: the body starts touching the

@@ -81,7 +81,7 @@
  * them and their checksum, then freed: the runtime needs the vertices, not the surface. */
 typedef struct rbs_shape_records {
     int8_t *kind;               /* (n) RBS_SMOOTH or RBS_POLYHEDRON */
-    int *family;                /* (n) RBS_ELLIPSOID .. RBS_TETRAHEDRON, or −1 for a user's grain */
+    int *family;                /* (n) RBS_ELLIPSOID .. RBS_TETRAHEDRON, or −1 for any other shape */
     int64_t *vertex_start;      /* (n + 1) shape i's vertices are rows vertex_start[i] .. vertex_start[i+1] − 1 */
     double *vertices;           /* (vertex_start[n], 3) body frame, units of a, at b/a = c/b = 1 */
     double *inertia;            /* (n, 3) principal J/m, units of a² */
@@ -112,7 +112,7 @@ struct rbs_table {
     int has_direct;                                 /* the table records the direct model's parameters */
     double direct_parameters[N_PARAMS];             /* surrogate.table.SurrogateTable.direct_parameters (P_*) */
     /* the direct model's shapes (surrogate.table.SurrogateTable.shape_arrays): the four families in code order,
-     * from the parameters, then the table's user grains in table order; model_shape[i] is the index there of the
+     * from the parameters, then the table's other polyhedra in table order; model_shape[i] is the index there of the
      * table's shape i (shape_records.c: rbs_direct_shapes_build; NULL without direct parameters) */
     rbs_shape_arrays direct_shapes;
     int *model_shape;

@@ -49,7 +49,7 @@ static int compare_rows(const void *a, const void *b)
     return 0;
 }
 
-/* The family's body at b/a = c/b = 1 (direct_model.registry._unit_body): its distinct vertices, sorted, into out
+/* The family's body at b/a = c/b = 1 (direct_model.registry.built_in_shape): its distinct vertices, sorted, into out
  * (at most MAX_VERTICES rows); returns their number, 0 for the ellipsoid. */
 static int family_vertices(int family, double kappa, double *out)
 {

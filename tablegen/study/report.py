@@ -32,6 +32,7 @@ import numpy as np
 from data_schema.common import package_version
 from data_schema.output import atomic_folder
 from data_schema.samples import STATUS_REBOUNDED
+from direct_model.registry import FAMILIES
 from direct_model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_factor
 from tablegen.progress import progress_bar
 from tablegen.study.figures import require_matplotlib, write_figures
@@ -107,18 +108,18 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
     available shapes' runs; it has no run of its own. ``config`` (a
     :class:`tablegen.tabulation.config.BuildConfig`, or None): the shapes of its grid, its user grains among them,
     are the available ones and its model (kappa, the b/a and c/b law, n_max, the wall law) is run, as its table's
-    cells are; None: the four families with the model's defaults.
+    cells are; None: the built-in families with the model's defaults.
     """
     from direct_model.simulate import simulate
 
-    available = SHAPES if config is None else config.shapes
+    available = tuple(FAMILIES) if config is None else config.shapes
     model = {} if config is None else config.model()
     alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
     mix_of = _constituents(shapes, available)
     bar = progress_bar(progress, len(mix_of) * len(alpha1) * n, "particle", "report runs")
     parts = {}
     for shape in mix_of:
-        body = shape if config is None else config.grain(shape) or shape
+        body = shape if config is None else config.body(shape)
         for a in alpha1:
             parts[shape, a] = from_sample_set(simulate(body, a, PAPER_SPEED, n, seed=seed, **model))
             if bar is not None:

@@ -48,7 +48,7 @@ from pathlib import Path
 from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
 from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
-from direct_model.registry import ConvexPolyhedron, built_in_shape
+from direct_model.registry import FAMILIES, ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
@@ -66,8 +66,10 @@ class ConfigError(ValueError):
 class BuildConfig:
     """A fully resolved build configuration (every value explicit).
 
-    ``grains``: the records (:mod:`direct_model.registry`) of the user's grains of ``shapes``, in their order.
-    Two configurations are equal when their :meth:`to_toml` texts are: the text decides the table.
+    ``grains``: the records (:mod:`direct_model.registry`) of the user's grains of ``shapes``, in their order;
+    ``families``: the records of its families after the paper's four (:data:`direct_model.registry.FAMILIES`),
+    made when the text was parsed, so that every cell simulates the record its table stores. Two configurations
+    are equal when their :meth:`to_toml` texts are: the text decides the table.
     """
 
     alpha1_deg: tuple
@@ -81,6 +83,7 @@ class BuildConfig:
     resolution: TableResolution
     wall: WallMaterial = CORUNDUM_ON_STEEL
     grains: tuple = ()
+    families: tuple = ()
 
     def __eq__(self, other) -> bool:
         return isinstance(other, BuildConfig) and self.to_toml() == other.to_toml()
@@ -96,6 +99,12 @@ class BuildConfig:
         """The record of the user's grain ``name``; None for a built-in family."""
         return next((g for g in self.grains if g.name == name), None)
 
+    def body(self, name: str):
+        """What a cell of shape ``name`` simulates (``direct_model.simulate.simulate``'s ``shape``): the record
+        of a user grain or of a later family, the name of one of the paper's four (their bits come from
+        :mod:`direct_model.shapes`)."""
+        return self.grain(name) or next((f for f in self.families if f.name == name), name)
+
     def model(self) -> dict:
         """The direct model's settings a cell runs with, as keywords of ``direct_model.simulate.simulate``."""
         return {"kappa": self.kappa, "aspect": self.aspect, "n_max": self.n_max, "wall": self.wall}
@@ -103,7 +112,8 @@ class BuildConfig:
     def shape_records(self) -> tuple:
         """The record of each shape, in the order of ``shapes``: a family's at ``kappa`` and ``aspect``, or the
         user's grain."""
-        return tuple(self.grain(s) or built_in_shape(s, self.kappa, self.aspect) for s in self.shapes)
+        bodies = [self.body(s) for s in self.shapes]
+        return tuple(built_in_shape(b, self.kappa, self.aspect) if isinstance(b, str) else b for b in bodies)
 
     def to_toml(self) -> str:
         """The resolved configuration as TOML text (reads back to an equal config)."""
@@ -231,11 +241,11 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
     shapes = grid.get("shapes")
     sections = data.get(GRAINS_SECTION, {})
     if not isinstance(shapes, list) or not shapes:
-        raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(SHAPES)} or the "
+        raise ConfigError(f"{source}: 'grid.shapes' must be a non-empty list of {', '.join(FAMILIES)} or the "
                           f"names of [shapes.NAME] sections; got {shapes!r}")
     for s in shapes:
-        if not isinstance(s, str) or (s not in SHAPES and s not in sections):
-            raise ConfigError(f"{source}: 'grid.shapes' entries must be one of {', '.join(SHAPES)} or a user grain "
+        if not isinstance(s, str) or (s not in FAMILIES and s not in sections):
+            raise ConfigError(f"{source}: 'grid.shapes' entries must be one of {', '.join(FAMILIES)} or a user grain "
                               f"with its [shapes.NAME] section; got {s!r}, which has no section")
     if len(set(shapes)) != len(shapes):
         raise ConfigError(f"{source}: 'grid.shapes' has duplicates: {shapes!r}")
@@ -282,7 +292,9 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
     return BuildConfig(alpha1_deg=tuple(alpha1), speed_m_s=tuple(speeds), shapes=tuple(shapes),
                        particles_per_cell=n, seed=seed, kappa=kappa, n_max=n_max, aspect=aspect,
                        resolution=resolution, wall=_wall(wall, source),
-                       grains=tuple(grains[s] for s in shapes if s in grains))
+                       grains=tuple(grains[s] for s in shapes if s in grains),
+                       families=tuple(built_in_shape(s, kappa, aspect) for s in shapes
+                                      if s in FAMILIES and s not in SHAPES))
 
 
 def _wall(raw: dict, source: str) -> WallMaterial:

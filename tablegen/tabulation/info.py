@@ -9,8 +9,7 @@ import numpy as np
 
 from data_schema.samples import STATUS_NAMES
 from data_schema.table import ReboundTable, table_fingerprint
-from direct_model.registry import ConvexPolyhedron
-from direct_model.shapes import SHAPES
+from direct_model.registry import FAMILIES, ConvexPolyhedron
 
 STEP_DECIMALS = 9       # grid steps equal to this many decimals count as one step (round-off of {start, stop, step})
 
@@ -31,7 +30,7 @@ def _shape(record) -> str:
     law = record.aspect
     scaled = (f"b/a, c/b ~ N({law.mean:g}, {law.sd:g}) in [{law.low:g}, {law.high:g}]" if law is not None
               else "fixed proportions")
-    built_in = "built-in" if record.name in SHAPES else "user grain"
+    built_in = "built-in" if record.name in FAMILIES else "user grain"
     return f"{record.name:<16} {built_in}, {kind}; {scaled}{'; both hands' if record.both_hands else ''}"
 
 
