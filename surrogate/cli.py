@@ -235,9 +235,8 @@ def main(argv=None) -> int:
                         help="incident speed |V-| in m/s, > 0 (with --method table: in the table's range, unless "
                              "--clamp)")
     group = sample.add_mutually_exclusive_group()
-    group.add_argument("--shape", metavar="NAME", help=f"a shape of the table: one of {', '.join(SHAPE_NAMES)} or "
-                                                       f"a user grain it holds (tablegen info lists them; default "
-                                                       f"ellipsoid)")
+    group.add_argument("--shape", metavar="NAME", help="a shape the table holds: a built-in family or a user grain "
+                                                       "(tablegen info lists them; default ellipsoid)")
     group.add_argument("--mix", metavar="W1,W2,W3,W4|NAME=W,...",
                        help="weights of ellipsoid, prism, cut_prism, tetrahedron, or name=weight pairs of any of "
                             "the table's shapes (user grains included), e.g. prism=0.5,tetrahedron=0.5; weights "

@@ -6,9 +6,9 @@ Usage (from the repository root)::
         --table production=production.h5 -o docs/VALIDATION.md [--n 20000] [--workers 2]
 
 For each table, at the on-grid points and off-grid midpoints of
-:func:`tablegen.study.validation.matrix_points`, for each shape and the equal-weight
-mix, n states are drawn from the table and n from the direct model (an
-independent seed) and compared (:func:`tablegen.study.validation.compare_point`).
+:func:`tablegen.study.validation.matrix_points`, for each shape the table holds (families and
+user grains) and their equal-weight mix, n states are drawn from the table and n from the
+direct model it was built with (an independent seed) and compared (:func:`tablegen.study.validation.compare_point`).
 The document states the targets, the statistical precision of each figure for
 the sample sizes used, a summary per table and every row. Comparisons run in
 worker processes; each has its own seed, so the document does not depend on
@@ -59,12 +59,13 @@ def _run(task) -> dict:
 def run_matrix(tables: dict, n: int, workers: int) -> list:
     """Rows of the matrix for {name: path}, in a fixed order."""
     import surrogate
-    from tablegen.study.validation import SHAPES_AND_MIX, matrix_points
+    from direct_model.shapes import MIX
+    from tablegen.study.validation import matrix_points
     tasks = []
     for name, path in tables.items():
         table = surrogate.load(path)
         for where, alpha1, speed in matrix_points(table):
-            for shape in SHAPES_AND_MIX:
+            for shape in (*table.shapes, MIX):
                 tasks.append((name, str(path), where, shape, alpha1, speed, n, SEED + 2 * len(tasks)))
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_worker_init) as pool:

@@ -20,7 +20,8 @@ from data_schema.table import STATE_NAMES, read_table
 from surrogate.kernels.layout import ROW_LOC, ROW_REGIME, ROW_SCALE, ROW_SHAPE, ROW_SLOPE
 from tablegen.study.solver_comparison import classifier_accuracy
 from tablegen.study.validation import (
-    SPEED_TARGETS, compare, direct_states, grid_points, matrix_points, midpoints, table_states,
+    SPEED_TARGETS, compare, compare_point, direct_states, grid_points, matrix_points, midpoints, table_model,
+    table_states,
 )
 from tablegen.study.validation_report import document, precision
 
@@ -42,6 +43,37 @@ def test_marginals_match_the_direct_model_on_the_grid(small_table, shape, alpha1
     # means agree within 5 standard errors of the difference (two samples of ~2e4)
     se = np.sqrt(result["std_table"] ** 2 / len(T) + result["std_direct"] ** 2 / len(D))
     assert np.all(np.abs(result["mean_table"] - result["mean_direct"]) < 5 * se + 1e-12)
+
+
+# A table of user grains (tests/conftest.py, grain_table_path: N = 3000 particles per cell) is validated as the
+# families' tables are: compare_point runs the direct model the table was built with on the table's own records,
+# and its mix over the table's shapes. With n = m = 10⁴ draws on each side, the 99.9 % quantile of the KS statistic
+# is 1.95·√(1/N + 1/n + 1/m) = 0.045, and a mean differs by its build noise too: SE = σ √(1/N + 1/n + 1/m), 1.6 times
+# the two-sample SE that compare_point reports, so 5 of those SE are 8 two-sample SE. Measured (seed 5):
+# KS 0.020–0.032, 1.8–4.5 two-sample SE.
+GRAIN_N, GRAIN_DRAWS = 3000, 10_000
+
+
+@pytest.mark.parametrize("shape, alpha1, speed", [("sand_a", 30.0, 100.0), ("sand_b", 70.0, 200.0),
+                                                  ("mix", 30.0, 100.0)])
+def test_a_grain_table_is_validated_against_its_own_model_and_records(grain_table_path, shape, alpha1, speed):
+    import surrogate
+
+    table = surrogate.load(grain_table_path)
+    row = compare_point(table, shape, alpha1, speed, GRAIN_DRAWS, seed=5)
+    assert row["n_direct"] > 0.9 * GRAIN_DRAWS and row["n_table"] > 0.9 * GRAIN_DRAWS
+    assert max(row["ks"].values()) <= 1.95 * np.sqrt(1 / GRAIN_N + 2 / GRAIN_DRAWS)
+    assert row["mean_error_se"] < 5 * np.sqrt((1 / GRAIN_N + 2 / GRAIN_DRAWS) / (2 / GRAIN_DRAWS))
+
+
+def test_the_direct_side_is_the_model_the_table_was_built_with(grain_table_path):
+    import surrogate
+    from tablegen import load_config
+
+    config = load_config(grain_table_path.parent / "grains.toml")
+    model = table_model(surrogate.load(grain_table_path))
+    assert (model["kappa"], model["aspect"], model["n_max"]) == (config.kappa, config.aspect, config.n_max)
+    assert model["wall"].as_array().tobytes() == config.wall.as_array().tobytes()
 
 
 # Off grid: both α1 and |V⁻| between grid points, with the default preset's α1
