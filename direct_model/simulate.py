@@ -137,7 +137,7 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
     per-particle extras (shape code, hand, b/a, c/b, E_Ω⁺/E_V⁻, search steps).
     """
     record = shape if isinstance(shape, (Ellipsoid, ConvexPolyhedron)) else None
-    if record is None and shape != MIX and shape not in FAMILIES:
+    if record is None and not (isinstance(shape, str) and (shape == MIX or shape in FAMILIES)):
         raise ValueError(f"The 'shape' parameter must be one of {', '.join(FAMILIES)}, {MIX!r} or a shape's record; "
                          f"got {shape!r}.")
     alpha1 = check_alpha1(alpha1)
