@@ -64,8 +64,10 @@ def _first_guess(c0, c1, c2, c3, lo):
     slope = _cubic_slope(c1, c2, c3, lo)
     curvature = 6.0 * c3 * lo + 2.0 * c2
     disc = slope * slope - 2.0 * p * curvature
-    if disc >= 0.0 and slope + np.sqrt(disc) > 0.0:
-        return lo - 2.0 * p / (slope + np.sqrt(disc))
+    if disc >= 0.0:
+        denominator = slope + np.sqrt(disc)
+        if denominator > 0.0:
+            return lo - 2.0 * p / denominator
     return lo - p / slope if slope > 0.0 else np.inf
 
 

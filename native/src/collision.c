@@ -32,7 +32,10 @@ static double first_guess(double c0, double c1, double c2, double c3, double lo)
     double slope = cubic_slope(c1, c2, c3, lo);
     double curvature = 6.0 * c3 * lo + 2.0 * c2;
     double disc = slope * slope - 2.0 * p * curvature;
-    if (disc >= 0.0 && slope + sqrt(disc) > 0.0) return lo - 2.0 * p / (slope + sqrt(disc));
+    if (disc >= 0.0) {
+        double denominator = slope + sqrt(disc);
+        if (denominator > 0.0) return lo - 2.0 * p / denominator;
+    }
     return slope > 0.0 ? lo - p / slope : INFINITY;
 }
 
