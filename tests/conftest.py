@@ -9,11 +9,11 @@ import pytest
 
 from tablegen import build_table, load_config, parse_config
 from tests.helpers import REPO, background, cpu_dispatch
-from tests.helpers.families import OCTAHEDRON_TABLE_CONFIG, octahedron_entered
+from tests.helpers.families import octahedron_entered
 from tests.helpers.native_library import build as native_build_in
 from tests.helpers.plain_install import install_and_draw
-from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG, SMALL_TABLE_CONFIG,
-                                  WIDE_GRAZING_TABLE_CONFIG, write_grain_config)
+from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OCTAHEDRON_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG,
+                                  SMALL_TABLE_CONFIG, WIDE_GRAZING_TABLE_CONFIG, write_grain_config)
 
 
 def _build(tmp_path_factory, name, config_text):

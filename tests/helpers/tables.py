@@ -1,6 +1,7 @@
 """The configurations of the small tables the session builds once (tests/conftest.py): 2e4 particles per cell,
-all four shapes, and a table of two user grains; and edited copies of a table."""
+all four shapes, a table of two user grains and one of a family entered by the tests; and edited copies of a table."""
 
+import json
 import shutil
 
 import h5py
@@ -18,9 +19,10 @@ def edited_copy(source, folder, name, edit=None):
     return path
 
 
-def _table_config(alpha1_deg, speed_m_s, seed):
-    return (f"[grid]\nalpha1_deg = {list(alpha1_deg)}\nspeed_m_s = {list(speed_m_s)}\n"
-            f"[simulation]\nparticles_per_cell = 20000\nseed = {seed}\n")
+def _table_config(alpha1_deg, speed_m_s, seed, shapes=None, particles_per_cell=20000):
+    grid_shapes = "" if shapes is None else f"shapes = {json.dumps(list(shapes))}\n"
+    return (f"[grid]\nalpha1_deg = {list(alpha1_deg)}\nspeed_m_s = {list(speed_m_s)}\n{grid_shapes}"
+            f"[simulation]\nparticles_per_cell = {particles_per_cell}\nseed = {seed}\n")
 
 
 SMALL_TABLE_CONFIG = _table_config([30.0, 60.0, 90.0], [50.0, 150.0, 250.0], seed=11)
@@ -33,6 +35,9 @@ WIDE_GRAZING_TABLE_CONFIG = _table_config([1.0, 2.0], [150.0, 200.0], seed=14)
 # the law moves fastest with speed (the presets' steps there)
 NEAR_NORMAL_POINT = (84.375, 62.5)
 NEAR_NORMAL_TABLE_CONFIG = _table_config([83.75, 85.0], [50.0, 75.0], seed=13)
+# the prism and a family entered by the tests alone (tests/helpers/families.py) on a 2 × 2 grid
+OCTAHEDRON_TABLE_CONFIG = _table_config([30.0, 70.0], [100.0, 200.0], seed=45, shapes=["prism", "octahedron"],
+                                        particles_per_cell=3000)
 
 
 # a table of two user grains (docs/model.md §9) on a 2 × 2 grid: sand_a the mesh examples/grains/grain_2.obj (17
