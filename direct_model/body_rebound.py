@@ -28,7 +28,7 @@ from data_schema.samples import (
     FAILURE_COLLISION_SOLVER, FAILURE_NONE, FAILURE_NOT_APPROACHING, FAILURE_SEARCH_BUDGET,
     STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED,
 )
-from direct_model.options import JIT, NO_ALLOCATION
+from direct_model.options import JIT, KERNEL
 from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
 from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, jerk_bound,
                                   lowest_points)
@@ -51,7 +51,7 @@ WORK_SIZE = _K + 18
 _BLOCKS = 1024                     # parallel work units of body_rebound_batch (scratch allocated per block)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def quaternion_to_matrix(q, R):
     """Rotation matrix of the quaternion q = (w, x, y, z) (normalised here) into R."""
     n = np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
@@ -61,7 +61,7 @@ def quaternion_to_matrix(q, R):
     R[2, 0], R[2, 1], R[2, 2] = 2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def lab_tensor(R, diag, out):
     """out = R diag(diag) Rᵀ: a body-frame principal tensor in the lab frame."""
     for i in range(3):
@@ -69,7 +69,7 @@ def lab_tensor(R, diag, out):
             out[i, j] = R[i, 0] * diag[0] * R[j, 0] + R[i, 1] * diag[1] * R[j, 1] + R[i, 2] * diag[2] * R[j, 2]
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_tol, set_tol, max_steps, V, W,
                  history, work):
     """Simulate one particle's rebound.

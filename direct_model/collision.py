@@ -34,7 +34,7 @@ momentum about the contact point, KΩ − r_c × V_p, is unchanged.
 import numba
 import numpy as np
 
-from direct_model.options import NO_ALLOCATION
+from direct_model.options import KERNEL
 from direct_model.wall import friction_factor, restitution
 
 COLLISION_OK = 0
@@ -45,17 +45,17 @@ COLLISION_FAILED = 3              # root finder did not converge, nothing change
 _MAX_ROOT_ITERATIONS = 200
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _cubic(c0, c1, c2, c3, x):
     return ((c3 * x + c2) * x + c1) * x + c0
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _cubic_slope(c1, c2, c3, x):
     return (3.0 * c3 * x + 2.0 * c2) * x + c1
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _first_guess(c0, c1, c2, c3, lo):
     """A first guess of the root above ``lo`` (P(lo) ≤ 0, P rising after lo): the root of P's second-order
     expansion at lo, P(lo) + P'(lo)d + ½P''(lo)d² (P(lo + d) = c3 d³ ≥ 0 there, so it is above the root), or a
@@ -71,7 +71,7 @@ def _first_guess(c0, c1, c2, c3, lo):
     return lo - p / slope if slope > 0.0 else np.inf
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _bracketed_root(c0, c1, c2, c3, lo, hi):
     """Root of the cubic in [lo, hi] where it rises from ≤ 0 to ≥ 0 (monotone piece).
 
@@ -105,7 +105,7 @@ def _bracketed_root(c0, c1, c2, c3, lo, hi):
     return x, False
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def smallest_positive_root(c0, c1, c2, c3):
     """Smallest positive root of c3 λ³ + c2 λ² + c1 λ + c0 with c0 < 0 < c3.
 
@@ -137,7 +137,7 @@ def smallest_positive_root(c0, c1, c2, c3):
     return root, False, ok
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _form(A, p, q):
     """pᵀ A q for a 3×3 array A and 3-tuples p, q."""
     acc = 0.0
@@ -147,7 +147,7 @@ def _form(A, p, q):
     return acc
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def collide(V, W, r, Kinv, wall, dV, dW):
     """Apply one collision at contact point ``r`` (relative to the centre of mass).
 

@@ -64,7 +64,7 @@ import math
 import numba
 import numpy as np
 
-from direct_model.options import NO_ALLOCATION
+from direct_model.options import KERNEL
 from direct_model.rotation import rotation_at, rotation_init
 from direct_model.shape_arrays import KIND_ELLIPSOID
 
@@ -76,7 +76,7 @@ HORIZON = 4.0           # the binding point's longer step looks at most this man
 PASS_OVER_ABOVE = 24    # vertices; up to this many (every family) all safe steps are computed (bench_grains.py)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rate_bounds(K, ell, W):
     """Bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (module doc)."""
     kmin = min(K[0], min(K[1], K[2]))
@@ -88,7 +88,7 @@ def _rate_bounds(K, ell, W):
     return w, wdot, (kmax - kmin) * w * wdot / kmin
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def curvature_bound(kind, semi, Rb, K, ell, W):
     """Bound M on |h''| of any candidate point's height during a flight (module doc).
 
@@ -103,7 +103,7 @@ def curvature_bound(kind, semi, Rb, K, ell, W):
     return (wdot + w * w) * Rb
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def jerk_bound(kind, semi, Rb, K, ell, W):
     """Bound M3 on |h'''| of any candidate point's height during a flight (module doc)."""
     w, wdot, wddot = _rate_bounds(K, ell, W)
@@ -116,7 +116,7 @@ def jerk_bound(kind, semi, Rb, K, ell, W):
     return g3 * Rb
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def safe_step(h, hdot, M):
     """First τ ≥ 0 where h + hdot·τ − ½Mτ² reaches 0 (h < 0 taken as 0; M of any sign); inf if never."""
     if h < 0.0:
@@ -132,7 +132,7 @@ def safe_step(h, hdot, M):
     return (hdot + np.sqrt(disc)) / M
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def pass_over_bound(h, h1, n, low, M):
     """T at least the second smallest safe step of the n points: the larger of the safe steps of point ``low``
     and of the lowest other point; inf for a single point (module doc)."""
@@ -145,7 +145,7 @@ def pass_over_bound(h, h1, n, low, M):
     return max(safe_step(h[low], h1[low], M), safe_step(h[second], h1[second], M))
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def may_reach(h, hdot, M, T):
     """False only if :func:`safe_step` of (h, hdot, M) is surely above T (> 0, finite): then
     h + hdot·T' − ½MT'² > 0 at T' = T(1 + 10⁻¹²) + 10⁻³⁰⁰ beyond the round-off of its evaluation, so the first
@@ -157,7 +157,7 @@ def may_reach(h, hdot, M, T):
     return not q > 1e-14 * (h + abs(hdot) * T + 0.5 * M * T * T)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def taylor_root(h, hdot, hddot):
     """Root nearest 0 of h + hdot·s + ½hddot·s² (Newton's −h/hdot where it has none)."""
     disc = hdot * hdot - 2.0 * h * hddot
@@ -166,7 +166,7 @@ def taylor_root(h, hdot, hddot):
     return -2.0 * h / (hdot + math.copysign(np.sqrt(disc), hdot))
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2):
     """Heights ``h[i]``, rates ``h1[i]`` and curvatures ``h2[i]`` of the candidate lowest points.
 
@@ -206,7 +206,7 @@ def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2):
     return nv
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def choose_contact(n, verts, h, h1, R, set_tol, rc):
     """Contact point among touching candidates (docs/model.md §4); False if none approaches.
 
@@ -238,7 +238,7 @@ def choose_contact(n, verts, h, h1, R, set_tol, rc):
     return True
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
                  max_steps, R, W, h, h1, h2, rc):
     """Advance a flight from its start (t = 0) to the next collision or to escape.

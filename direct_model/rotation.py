@@ -120,7 +120,7 @@ import math
 
 import numba
 
-from direct_model.options import NO_ALLOCATION
+from direct_model.options import KERNEL
 
 # --------------------------------------------------------------------------------------
 # Layout of the parameter array
@@ -179,7 +179,7 @@ _RF_TOL_INV = 1.0 / 0.025
 # --------------------------------------------------------------------------------------
 # Carlson's symmetric elliptic integrals (Carlson, Numer. Algorithms 10 (1995) 13-26)
 # --------------------------------------------------------------------------------------
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _carlson_rc1(e):
     """Carlson's R_C(1, 1 + e) for e > -1 (DLMF 19.2.17-19.2.19).
 
@@ -196,7 +196,7 @@ def _carlson_rc1(e):
     return math.atanh(s) / s
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rf_series(e2, e3):
     """Series of R_F (DLMF 19.36.1 continued to degree 9, A^(-1/2) factored out).
 
@@ -211,7 +211,7 @@ def _rf_series(e2, e3):
             + e3 * e3 * (3.0 / 104.0 - e2 * (15.0 / 272.0) + e3 * (5.0 / 304.0)))
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rj_series(e2, e3, e4, e5):
     """Series of R_J (DLMF 19.36.2 continued to degree 11, A^(-3/2) factored out).
 
@@ -236,7 +236,7 @@ def _rj_series(e2, e3, e4, e5):
                           + e4 * (-3.0 / 28.0 + e2 * (9.0 / 40.0)) + e5 * (9.0 / 184.0)))
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rf_tail(x, y, z, a, fac, qx, qy, qmax):
     """Duplication steps of R_F(x, y, z) until the spread ``fac qmax`` (``qmax`` already
     divided by the tolerance) falls below ``a``, then the series; ``qx = A_0 - x_0``,
@@ -259,7 +259,7 @@ def _rf_tail(x, y, z, a, fac, qx, qy, qmax):
     return _rf_series(dx * dy - dz * dz, dx * dy * dz) / math.sqrt(a)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def carlson_rf(x, y, z):
     """Carlson's R_F(x, y, z) = 1/2 int_0^inf dt / sqrt((t+x)(t+y)(t+z)).
 
@@ -274,7 +274,7 @@ def carlson_rf(x, y, z):
     return _rf_tail(x, y, z, a, 1.0, qx, qy, qmax)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rf_amp(x, sx, y, sy):
     """R_F(x, y, 1) with ``sx = sqrt(x)``, ``sy = sqrt(y)`` known: the first duplication
     step takes no square root."""
@@ -287,7 +287,7 @@ def _rf_amp(x, sx, y, sy):
                     0.25 * (a + lam), 0.25, qx, qy, qmax)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rj_tail(x, y, z, p, delta, a, fac, acc, qx, qy, qz, qmax):
     """Duplication steps of R_J (Carlson 1995, Algorithm 3, with the R_C corrections
     ``6 sum 4^-m R_C(1, 1 + e_m) / d_m``, ``e_m = 4^{-3m} delta / d_m^2``) until the spread
@@ -320,7 +320,7 @@ def _rj_tail(x, y, z, p, delta, a, fac, acc, qx, qy, qz, qmax):
     return fac * _rj_series(e2, e3, e4, e5) / (a * math.sqrt(a)) + 6.0 * acc
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def carlson_rj(x, y, z, p):
     """Carlson's R_J(x, y, z, p) = 3/2 int_0^inf dt / ((t+p) sqrt((t+x)(t+y)(t+z))).
 
@@ -338,7 +338,7 @@ def carlson_rj(x, y, z, p):
     return _rj_tail(x, y, z, p, delta, a, 1.0, 0.0, qx, qy, qz, qmax)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _rj_amp(x, sx, y, sy, p, delta):
     """R_J(x, y, 1, p) with ``sx = sqrt(x)``, ``sy = sqrt(y)`` and
     ``delta = (p - x)(p - y)(p - 1) >= 0`` given (in closed form by the caller, free of
@@ -359,7 +359,7 @@ def _rj_amp(x, sx, y, sy, p, delta):
 # --------------------------------------------------------------------------------------
 # Double-double helpers (Dekker 1971) for the distance to the separatrix
 # --------------------------------------------------------------------------------------
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _two_sum(a, b):
     """s + e == a + b exactly, s = fl(a + b) (Knuth)."""
     s = a + b
@@ -367,7 +367,7 @@ def _two_sum(a, b):
     return s, (a - (s - bb)) + (b - bb)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _two_prod(a, b):
     """p + e == a * b exactly, p = fl(a * b) (Dekker, Veltkamp splitting, no FMA)."""
     p = a * b
@@ -380,7 +380,7 @@ def _two_prod(a, b):
     return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _dd_mul(ah, al, bh, bl):
     """Product of two double-double numbers (relative error ~ 1e-32)."""
     p, e = _two_prod(ah, bh)
@@ -389,7 +389,7 @@ def _dd_mul(ah, al, bh, bl):
     return s, e - (s - p)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _separatrix_distance(i_lo, i_mid, i_hi, m_lo, m_hi):
     """H = (I_hi - I_mid) I_lo m_hi^2 - (I_mid - I_lo) I_hi m_lo^2 in double-double.
 
@@ -411,7 +411,7 @@ def _separatrix_distance(i_lo, i_mid, i_hi, m_lo, m_hi):
 # --------------------------------------------------------------------------------------
 # Jacobi elliptic functions and the phase integral
 # --------------------------------------------------------------------------------------
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _landen_sncndn(w, params):
     """sn, cn, dn of ``u = w prod(1 + k_n)`` by climbing the stored Landen chain.
 
@@ -458,7 +458,7 @@ def _landen_sncndn(w, params):
     return s * rw, c * rw, d / v
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _pi_minus_f(s, c, d, beta):
     """Pi(phi; -beta | k) - F(phi | k) = -beta/3 sn^3 R_J(cn^2, dn^2, 1, 1 + beta sn^2).
 
@@ -471,7 +471,7 @@ def _pi_minus_f(s, c, d, beta):
     return -beta / 3.0 * s * s * s * carlson_rj(c * c, d * d, 1.0, 1.0 + beta * s * s)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _pi_large_beta(s, c, d, gamma, sqd):
     """Pi(phi; -beta | k) for beta > 1 (form 2), a sum of two terms of one sign.
 
@@ -488,7 +488,7 @@ def _pi_large_beta(s, c, d, gamma, sqd):
     return pi3
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _gp_amp(params, s, c, d, ur):
     """Periodic part ``G_p`` of the phase integral at ``sin phi = s``, ``cos phi = c >= 0``,
     ``Delta = d``, ``phi = am u_r``, ``u_r`` in ``[-K, K]`` (see :func:`_phase_state`)::
@@ -516,7 +516,7 @@ def _gp_amp(params, s, c, d, ur):
     return gp
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _phase_state(params, u):
     """sn(u), cn(u), dn(u) and the periodic part ``G_p(u)`` of the phase integral.
 
@@ -551,7 +551,7 @@ def _phase_state(params, u):
     return s, c, d, gp
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _unit_momentum(params, s, c, d):
     """Unit body angular momentum n = m / |m| in the working frame from sn, cn, dn."""
     m0 = params[_I_A + 0] * c
@@ -561,7 +561,7 @@ def _unit_momentum(params, s, c, d):
     return m0 * inv, m1 * inv, m2 * inv
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _ez_to_n(n0, n1, n2):
     """Rotation B (row-major entries) about e_z x n taking e_z to the unit vector n.
 
@@ -578,7 +578,7 @@ def _ez_to_n(n0, n1, n2):
 # --------------------------------------------------------------------------------------
 # Set-up
 # --------------------------------------------------------------------------------------
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _is_steady(m0, m1, m2, k0, k1, k2):
     """True if (m0, m1, m2) is an eigenvector of diag(k0, k1, k2) (exact comparison)."""
     if m0 != 0.0 and m1 != 0.0 and k0 != k1:
@@ -590,7 +590,7 @@ def _is_steady(m0, m1, m2, k0, k1, k2):
     return True
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _landen_agm(k, kp, eta, params):
     """Store the descending Landen moduli; return K(k) = pi/2 prod(1 + k_n) and
     ``(Pi(-eta | k) - K(k)) / K(k)`` (complete integrals, ``0 <= eta``).
@@ -646,14 +646,14 @@ def _landen_agm(k, kp, eta, params):
     return 0.5 * math.pi * prod, -0.5 * eta / (1.0 + eta) * qsum
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _landen_chain(k, kp, params):
     """Store the descending Landen moduli and return K(k) = pi/2 prod(1 + k_n)
     (:func:`_landen_agm`)."""
     return _landen_agm(k, kp, 0.0, params)[0]
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _store_r0(R0, params):
     """C = R0 (static and steady modes)."""
     for r in range(3):
@@ -661,7 +661,7 @@ def _store_r0(R0, params):
             params[_I_C + 3 * r + c] = R0[r, c]
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def rotation_init(K, R0, ell, params):
     """Precompute torque-free motion.
 
@@ -824,7 +824,7 @@ def rotation_init(K, R0, ell, params):
 # --------------------------------------------------------------------------------------
 # Evaluation
 # --------------------------------------------------------------------------------------
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def rotation_at(params, t, R_out, omega_out):
     """Fill R_out (3x3, body->lab) and omega_out (3, lab-frame angular velocity) at time t.
 

@@ -22,7 +22,7 @@ import math
 import numba
 import numpy as np
 
-from direct_model.options import NO_ALLOCATION
+from direct_model.options import KERNEL
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, body_rebound
 from direct_model.registry import MAX_HULL_VERTICES
 from direct_model.shape_arrays import ShapeArrays, bounding_radius, family_shape_arrays, particle_body
@@ -84,7 +84,7 @@ def family_shapes(params, grains=()) -> ShapeArrays:
     return family_shape_arrays(float(params[P_KAPPA]), law, params[P_KFAC:P_KFAC + len(SHAPES)], grains)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def normal_quantile(p):
     """Φ⁻¹(p) for p in (0, 1): Wichura's AS 241 (PPND16), relative error about 1e-16; log and sqrt only."""
     q = p - 0.5
@@ -116,7 +116,7 @@ def normal_quantile(p):
     return -x if q < 0.0 else x
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def aspect_ratio(law, cdf, u):
     """The quantile at u ∈ [0, 1) of the aspect-ratio law ``law`` = (mean, sd, low, high) whose CDF bounds are
     ``cdf`` = (Φ_low, Φ_high) (:class:`direct_model.shape_arrays.ShapeArrays`' aspect and aspect_cdf rows):
@@ -126,7 +126,7 @@ def aspect_ratio(law, cdf, u):
     return min(max(x, law[2]), law[3])
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def uniform_quaternion(u0, u1, u2, q):
     """q = a unit quaternion uniform on S³ (Shoemake 1992) from three uniforms: Haar-uniform rotations."""
     s, c = math.sqrt(1.0 - u0), math.sqrt(u0)
@@ -134,7 +134,7 @@ def uniform_quaternion(u0, u1, u2, q):
     q[2], q[3] = c * math.sin(2.0 * math.pi * u2), c * math.cos(2.0 * math.pi * u2)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scratch):
     """One particle's whole rebound (docs/model.md §5) in the model frame, its random inputs from ``u``.
 

@@ -52,7 +52,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from direct_model.options import NO_ALLOCATION
+from direct_model.options import KERNEL
 from direct_model.registry import (FRAME_CHECK, MAX_HULL_VERTICES, ConvexPolyhedron, Ellipsoid, built_in_shape,
                                    built_in_shapes, polyhedron)
 from direct_model.shapes import DEFAULT_KAPPA, SHAPES, AspectRatioLaw, normal_cdf, second_moment_factor, shape_vertices
@@ -240,7 +240,7 @@ def shape_records(arrays: ShapeArrays, names) -> dict:
     return records
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi):
     """One particle's body from shape ``shape`` of ``shapes`` (:class:`ShapeArrays`, module doc); returns nv.
 
@@ -277,7 +277,7 @@ def particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi):
     return nv
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def _half_extents(unit, lo, nv):
     """(max − min)/2 of rows lo to lo + nv of ``unit`` along each axis."""
     lo0, lo1, lo2 = unit[lo, 0], unit[lo, 1], unit[lo, 2]
@@ -289,7 +289,7 @@ def _half_extents(unit, lo, nv):
     return 0.5 * (hi0 - lo0), 0.5 * (hi1 - lo1), 0.5 * (hi2 - lo2)
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def bounding_radius(kind, semi, verts, nv):
     """Radius of the smallest centroid-centred sphere holding the body (units of a): the largest semi-axis of
     an ellipsoid, the farthest vertex of a polyhedron."""

@@ -27,7 +27,7 @@ import dataclasses
 import numba
 import numpy as np
 
-from direct_model.options import NO_ALLOCATION
+from direct_model.options import KERNEL
 
 
 @dataclasses.dataclass(frozen=True)
@@ -70,13 +70,13 @@ class WallMaterial:
 CORUNDUM_ON_STEEL = WallMaterial()
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def restitution(wall, contact_speed, sin_impact):
     """Normal restitution a_nc of the contact point; ``contact_speed`` in m/s."""
     return 1.0 - (1.0 - np.exp(-wall[0] * contact_speed ** wall[1])) * sin_impact
 
 
-@numba.njit(**NO_ALLOCATION)
+@numba.njit(**KERNEL)
 def friction_factor(wall, cos_gamma):
     """Friction factor C_f = exp(q cos γ)."""
     return np.exp(wall[2] * cos_gamma)
