@@ -388,8 +388,8 @@ def split(row: dict, costs: dict, total_us: float) -> dict:
 
 def random_states(m: int, spin: tuple, seed: int, alpha1_deg: tuple = (5.0, 90.0),
                   speed_m_s: tuple = (50.0, 300.0)) -> dict:
-    """m incident states (module doc), |Ω⁻|a/|V⁻|, α1 (degrees) and |V⁻| (m/s) uniform in the given ranges, Ω⁻ in
-    a random direction: V (m, 3) m/s, n (m, 3) unit normals, a (m,) = 1 m, Ω (m, 3) rad/s."""
+    """m incident states (module doc), |Ω⁻|a/|V⁻|, α1 (degrees) and |V⁻| (m/s) uniform in the given ranges,
+    Ω⁻ in a random direction: V (m, 3) m/s, n (m, 3) unit normals, a (m,) = 1 m, Ω (m, 3) rad/s."""
     rng = np.random.default_rng(seed)
     alpha1 = np.radians(rng.uniform(*alpha1_deg, m))
     speed = rng.uniform(*speed_m_s, m)
@@ -536,7 +536,8 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
             bench_runtime(params, shapes, warm, "warm-up", code, 1)
         print(f"\nRun-time kernels, one thread, best of {repeats}: numba (surrogate.kernels.direct_rebound)"
               + (" and C (rbs_direct_rebound)" if native else "") + f"; states: {states} random per row with Ω⁻ = 0 "
-              f"('random, 0') or spinning ('random, spin'; 'spinning': |Ω⁻|a/|V⁻| 0.02–0.8, α1 20–70°, 100–250 m/s), "
+              f"('random, 0') or spinning ('random, spin'; 'spinning': |Ω⁻|a/|V⁻| 0.02–0.8, α1 20–70°, "
+              f"100–250 m/s), "
               f"and {len(sets['hopper']['a'])} hopperRebound hits "
               f"({hits_path.name}, {np.mean(np.any(sets['hopper']['omega'] != 0, axis=1)):.0%} spinning) run with "
               "each shape ('hopper')")

@@ -9,8 +9,7 @@ reproducible.
 
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
-# The kernels on a rebound's path (the free flight, the search, the collision, the body) allocate nothing, so they
-# are compiled without numba's reference counting (_nrt=False), which would add an atomic increment and decrement
-# for most array arguments of every call (numba issue 2345): 1.13-1.2 times the rebounds per second, the same bits
-# (docs/design/contact_search.md). An allocation in one of them fails to compile.
+# The kernels on a rebound's path allocate nothing: without numba's reference counting (_nrt=False) a call costs
+# no atomic increment and decrement per array argument (numba issue 2345; docs/design/contact_search.md), and an
+# allocation in one of them fails to compile.
 KERNEL = dict(JIT, _nrt=False)

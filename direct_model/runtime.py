@@ -76,12 +76,24 @@ def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: Wal
     return p
 
 
+def model_settings(params) -> dict:
+    """The settings a parameter array holds (the inverse of :func:`model_parameters` but for the factors s), as
+    keywords of :func:`direct_model.simulate.simulate`: κ, the b/a and c/b law, n_max, the wall law and the
+    search's tolerances (units of a) and step budget."""
+    return {"kappa": float(params[P_KAPPA]),
+            "aspect": AspectRatioLaw(*map(float, params[P_ASPECT_MEAN:P_ASPECT_HIGH + 1])),
+            "n_max": int(params[P_N_MAX]),
+            "wall": WallMaterial(*map(float, params[P_WALL:P_WALL + 3]), name="from the model's parameters"),
+            "contact_tol": float(params[P_CONTACT_TOL]), "set_tol": float(params[P_SET_TOL]),
+            "max_steps": int(params[P_MAX_STEPS])}
+
+
 def family_shapes(params, grains=()) -> ShapeArrays:
     """The four families' shape arrays at the κ, aspect-ratio law and factors s of a parameter array
-    (:func:`model_parameters`), in shape-code order, then the records ``grains`` (a table's user grains): what
-    a runtime builds from a table."""
-    law = AspectRatioLaw(*map(float, params[P_ASPECT_MEAN:P_ASPECT_HIGH + 1]))
-    return family_shape_arrays(float(params[P_KAPPA]), law, params[P_KFAC:P_KFAC + len(SHAPES)], grains)
+    (:func:`model_parameters`), in shape-code order, then the records ``grains`` (a table's other polyhedra):
+    what a runtime builds from a table."""
+    settings = model_settings(params)
+    return family_shape_arrays(settings["kappa"], settings["aspect"], params[P_KFAC:P_KFAC + len(SHAPES)], grains)
 
 
 @numba.njit(**KERNEL)

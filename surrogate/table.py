@@ -51,7 +51,8 @@ class SurrogateTable:
     def shape_arrays(self) -> ShapeArrays:
         """The direct model's shapes as the kernels take them (:class:`direct_model.shape_arrays.ShapeArrays`):
         the four families in code order at the κ, aspect-ratio law and factors s of :attr:`direct_parameters`,
-        then the table's other polyhedra (its user grains, and families after the paper's four) in table order; no shape for a table without those parameters."""
+        then the table's other polyhedra (its user grains, and families after the paper's four) in table order;
+        no shape for a table without those parameters."""
         if self.direct_parameters is None:
             return from_stored(np.zeros(0), [0], np.zeros((0, 3)), [0], np.zeros((0, 3)), np.zeros((0, 3)),
                                np.zeros((0, 4)), np.zeros(0))

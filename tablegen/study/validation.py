@@ -23,11 +23,9 @@ from scipy.stats import ks_2samp
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED
 from data_schema.table import STATE_NAMES
-from direct_model.runtime import (P_ASPECT_HIGH, P_ASPECT_MEAN, P_CONTACT_TOL, P_KAPPA, P_MAX_STEPS, P_N_MAX,
-                                  P_SET_TOL, P_WALL)
-from direct_model.shapes import MIX, SHAPES, AspectRatioLaw
+from direct_model.runtime import model_settings
+from direct_model.shapes import MIX, SHAPES
 from direct_model.simulate import simulate
-from direct_model.wall import WallMaterial
 from tablegen.tabulation.cells import derive_seed
 from tablegen.study.solver_comparison import classifier_accuracy
 
@@ -52,27 +50,23 @@ def direct_states(shape, alpha1: float, speed: float, n: int, seed: int, **model
 def table_model(table) -> dict:
     """The direct model ``table`` (:func:`surrogate.load`) was built with, as keywords of
     :func:`direct_model.simulate.simulate`: κ, the b/a and c/b law, n_max, the wall law and the search's
-    tolerances, from its direct parameters; ValueError for a table that does not record them."""
-    p = table.direct_parameters
-    if p is None:
+    tolerances, from its direct parameters (:func:`direct_model.runtime.model_settings`); ValueError for a table
+    that does not record them."""
+    if table.direct_parameters is None:
         raise ValueError(f"the table {table.path} does not record its direct model's parameters (built at a kappa "
                          f"other than 0.3 before format 3.2): rebuild it to validate it")
-    return {"kappa": float(p[P_KAPPA]), "aspect": AspectRatioLaw(*map(float, p[P_ASPECT_MEAN:P_ASPECT_HIGH + 1])),
-            "n_max": int(p[P_N_MAX]), "wall": WallMaterial(*map(float, p[P_WALL:P_WALL + 3]), name="the table's"),
-            "contact_tol": float(p[P_CONTACT_TOL]), "set_tol": float(p[P_SET_TOL]), "max_steps": int(p[P_MAX_STEPS])}
+    return model_settings(table.direct_parameters)
 
 
 def table_direct_states(table, shape: str, alpha1: float, speed: float, n: int, seed: int) -> np.ndarray:
     """(m, 6) rebounded states of the direct model ``table`` was built with (:func:`table_model`) for its shape
     ``shape``: one of the paper's four families by name, any other (a user's grain, a later family) by the
     record the table holds, ``"mix"`` each particle's shape drawn with equal weights among the table's shapes
-    (as its mix draws them; a table of the four families: simulate's own mix)."""
+    (as its mix draws them)."""
     model = table_model(table)
     records = dict(zip(table.shapes, table.records))
     if shape != MIX:
         return direct_states(shape if shape in SHAPES else records[shape], alpha1, speed, n, seed, **model)
-    if sorted(table.shapes) == sorted(SHAPES):
-        return direct_states(MIX, alpha1, speed, n, seed, **model)
     counts = np.random.default_rng(seed).multinomial(n, np.full(len(table.shapes), 1.0 / len(table.shapes)))
     parts = [direct_states(s if s in SHAPES else records[s], alpha1, speed, int(c), derive_seed(seed, k), **model)
              for k, (s, c) in enumerate(zip(table.shapes, counts)) if c]

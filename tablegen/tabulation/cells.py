@@ -63,9 +63,9 @@ def compile_cell_kernels(config: BuildConfig) -> None:
 
 
 def compute_cell(config: BuildConfig, shape: str, i_alpha: int, i_speed: int) -> CellTable:
-    """Simulate one cell and build its stored representation (runs in a worker): one of the paper's four families by
-    its name, a user's grain or a later family by its record (:meth:`BuildConfig.body`; a grain's own law of b/a and c/b, if any,
-    instead of the families')."""
+    """Simulate one cell and build its stored representation (runs in a worker): one of the paper's four
+    families by its name, a user's grain or a later family by its record (:meth:`BuildConfig.body`; a grain's
+    own law of b/a and c/b, if any, instead of the families')."""
     seed = cell_seed(config.seed, shape, i_alpha, i_speed)
     body = config.body(shape)
     acc = CellAccumulator()

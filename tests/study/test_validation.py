@@ -46,10 +46,11 @@ def test_marginals_match_the_direct_model_on_the_grid(small_table, shape, alpha1
 
 
 # A table of user grains (tests/conftest.py, grain_table_path: N = 3000 particles per cell) is validated as the
-# families' tables are: compare_point runs the direct model the table was built with on the table's own records,
-# and its mix over the table's shapes. With n = m = 10⁴ draws on each side, the 99.9 % quantile of the KS statistic
-# is 1.95·√(1/N + 1/n + 1/m) = 0.045, and a mean differs by its build noise too: SE = σ √(1/N + 1/n + 1/m), 1.6 times
-# the two-sample SE that compare_point reports, so 5 of those SE are 8 two-sample SE. Measured (seed 5):
+# families' tables are: compare_point runs the direct model the table was built with on the table's own
+# records, and its mix over the table's shapes. With n = m = 10⁴ draws on each side, the 99.9 % quantile of the KS
+# statistic is 1.95·√(1/N + 1/n + 1/m) = 0.045, and a mean differs by its build noise too: SE = σ √(1/N + 1/n +
+# 1/m), 1.6 times the two-sample SE that compare_point reports, so 5 of those SE are 8 two-sample SE. Measured
+# (seed 5):
 # KS 0.020–0.032, 1.8–4.5 two-sample SE.
 GRAIN_N, GRAIN_DRAWS = 3000, 10_000
 
@@ -67,13 +68,22 @@ def test_a_grain_table_is_validated_against_its_own_model_and_records(grain_tabl
 
 
 def test_the_direct_side_is_the_model_the_table_was_built_with(grain_table_path):
+    """table_model reads the table's own parameters, not the defaults: a table whose direct parameters are
+    changed gives those back."""
     import surrogate
-    from tablegen import load_config
+    from direct_model.runtime import model_parameters
+    from direct_model.shapes import AspectRatioLaw
+    from direct_model.wall import WallMaterial
 
-    config = load_config(grain_table_path.parent / "grains.toml")
-    model = table_model(surrogate.load(grain_table_path))
-    assert (model["kappa"], model["aspect"], model["n_max"]) == (config.kappa, config.aspect, config.n_max)
-    assert model["wall"].as_array().tobytes() == config.wall.as_array().tobytes()
+    table = surrogate.load(grain_table_path)
+    own = dict(kappa=0.2, aspect=AspectRatioLaw(0.7, 0.1, 0.6, 0.9), n_max=50,
+               wall=WallMaterial(0.2, 0.5, 0.8, "test"), contact_tol=1e-9, set_tol=1e-8, max_steps=1000)
+    other = dataclasses.replace(table, direct_parameters=model_parameters(
+        own["aspect"], own["kappa"], own["n_max"], own["wall"], own["contact_tol"], own["set_tol"], own["max_steps"],
+        table.direct_parameters[-4:]))
+    model = table_model(other)
+    assert model["wall"].as_array().tobytes() == own.pop("wall").as_array().tobytes()
+    assert {k: model[k] for k in own} == own
 
 
 # Off grid: both α1 and |V⁻| between grid points, with the default preset's α1
