@@ -129,6 +129,7 @@ _MODE_STATIC = 0.0  # ell == 0: R = R0, omega = 0
 _MODE_STEADY = 1.0  # constant omega about a principal direction
 _MODE_GENERAL = 2.0  # elliptic solution, 0 < k' <= 1
 _MODE_SEPARATRIX = 3.0  # elliptic solution on the separatrix, k' == 0
+_MODE_THETA = 4.0  # Jacobi's theta series, nome q <= e^_THETA_LNQ_MAX, away from a steady spin
 
 _NLEV_MAX = 24  # Landen levels; k' = 1e-9 needs 7, k' = 5e-324 needs 12
 _LANDEN_KTOL = 1e-9  # stop once k_n < this: sn(w|k_n) = sin w + O(k_n^2)
@@ -164,6 +165,22 @@ _I_KN = 45  # _NLEV_MAX entries: k_n, n = 1..N
 _I_OMKN = _I_KN + _NLEV_MAX  # _NLEV_MAX entries: 1 - k_n
 
 ROT_PARAMS_SIZE = _I_OMKN + _NLEV_MAX
+# the theta mode keeps its series in the Landen chain's slots
+_TH_TERMS = 8  # at most; q <= 0.2 needs 6
+_I_TH_N = _I_KN  # number of terms
+_I_TH_NUV = _I_KN + 1  # dv/dt, v = pi u / (2 K)
+_I_TH_V0 = _I_KN + 2  # v at t = 0
+_I_TH_CRE = _I_KN + 3  # e^{-i psi_raw(0)}: real and imaginary parts
+_I_TH_CIM = _I_KN + 4
+_I_TH_M0 = _I_KN + 5  # coefficients of cos((2n+1) v) in m_0
+_I_TH_M1 = _I_TH_M0 + _TH_TERMS  # of sin((2n+1) v) in m_1
+_I_TH_M2 = _I_TH_M1 + _TH_TERMS  # of cos(2n v) in m_2
+_I_TH_WR = _I_TH_M2 + _TH_TERMS  # of cos(2n v) in Re w
+_I_TH_WI = _I_TH_WR + _TH_TERMS  # of sin(2n v) in Im w
+_THETA_LNQ_MAX = -1.6094379124341003  # ln 0.2: larger nomes (k^2 > 0.97) take the Landen path
+_THETA_LNRHO_MAX = -0.6931471805599453  # ln 0.5: see _theta_init
+_THETA_TOL = 1e-17  # the first term left out of every series is below this
+_THETA_K2_MIN = 1e-4  # closer to a steady spin (k -> 0) the theta phases lose digits: the Landen path
 """Length of the float64 parameter array filled by :func:`rotation_init` (93)."""
 
 _SNAP = 16.0 * 2.220446049250313e-16  # relative size of rounding noise in R0^T ell
@@ -561,6 +578,139 @@ def _unit_momentum(params, s, c, d):
     return m0 * inv, m1 * inv, m2 * inv
 
 
+# --------------------------------------------------------------------------------------
+# Jacobi's theta series (the theta mode)
+# --------------------------------------------------------------------------------------
+@numba.njit(**KERNEL)
+def _agm_k(kp):
+    """K(k) = pi / (2 AGM(1, k')) for 0 < k' <= 1 (DLMF 19.8.5); the last mean after
+    ``|a - g| <= 1e-9 a`` is exact to ~1e-19."""
+    a = 1.0
+    g = kp
+    while abs(a - g) > 1e-9 * a:  # written so that a NaN ends the loop too
+        a_next = 0.5 * (a + g)
+        g = math.sqrt(a * g)
+        a = a_next
+    return math.pi / (a + g)
+
+
+@numba.njit(**KERNEL)
+def _theta_init(params, k, kp, beta, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0):
+    """Set up the theta mode (module docstring, item 6); False, and nothing to be read
+    left behind, if the state needs the Landen path (``q > 0.2`` or ``rho > 1/2``).
+
+    With ``lq = ln q = -pi K'/K`` and ``rho = q e^{2 alpha~}`` the series' terms are at
+    most ``q^{n^2 - n} rho^n``; ``rho`` -> 1 for a body spinning close to the circulated
+    axis, where ``w`` passes near a zero and its phase loses ``eps / (1 - rho)^2``.
+    """
+    kk = _agm_k(kp)
+    lq = -math.pi * _agm_k(k) / kk
+    if not lq <= _THETA_LNQ_MAX:
+        return False
+    k2 = k * k
+    hw = 0.5 * math.pi / kk
+    at2 = 2.0 * hw * math.sqrt(beta) * carlson_rf(k2, k2 * (1.0 + beta), k2 + beta)
+    if not lq + at2 <= _THETA_LNRHO_MAX:
+        return False
+    q = math.exp(lq)
+    e = math.exp(at2)
+    s4 = math.exp(0.25 * lq)
+    f0 = 2.0 * a0 * s4 / math.sqrt(k)
+    f1 = 2.0 * a1 * s4 / (math.sqrt(k) * math.sqrt(kp))
+    params[_I_TH_M0] = f0
+    params[_I_TH_M1] = f1
+    params[_I_TH_M2] = a2
+    params[_I_TH_WR] = 1.0
+    params[_I_TH_WI] = 0.0
+    qo = q  # q^(2n - 1)
+    qn = 1.0  # q^(n^2)
+    qd = 1.0  # q^(n (n + 1))
+    cp = 1.0  # q^(n^2) e^(n at2)
+    cm = 1.0  # q^(n^2) e^(-n at2)
+    sgn = 1.0
+    zn = 0.0
+    zd = 1.0
+    n = 1
+    while True:
+        qn *= qo
+        cp *= qo * e
+        cm *= qo / e
+        qd *= qo * q
+        if not cp > _THETA_TOL:
+            break
+        if n == _TH_TERMS:
+            return False
+        sgn = -sgn
+        wr = sgn * (cp + cm)
+        wi = -sgn * (cp - cm)
+        params[_I_TH_M0 + n] = f0 * qd
+        params[_I_TH_M1 + n] = sgn * f1 * qd
+        params[_I_TH_M2 + n] = 2.0 * a2 * qn
+        params[_I_TH_WR + n] = wr
+        params[_I_TH_WI + n] = wi
+        zn += n * wi
+        zd += wr
+        qo *= q * q
+        n += 1
+    # Z(i alpha) = i z, z = (pi/K) sum n WI_n / sum WR_n; D/P_a of the rate of phi_E
+    z = math.pi / kk * zn / zd
+    pa = math.sqrt(beta * (k2 + beta) * (1.0 + beta))
+    params[_I_LIN] = lmag / j0 + lmag * (j0 - j1) * d20 / (j0 * j0 * d21) * z / pa
+    params[_I_TH_N] = n
+    params[_I_TH_NUV] = nu * hw
+    params[_I_TH_V0] = u0 * hw
+    params[_I_TH_CRE] = 1.0
+    params[_I_TH_CIM] = 0.0
+    return True
+
+
+@numba.njit(**KERNEL)
+def _theta_state(params, t):
+    """The working-frame ``m`` (up to a positive factor) and ``(cos psi, sin psi)`` at
+    time ``t`` in the theta mode (module docstring, item 6).
+
+    The multiple angles come from one sine-cosine pair by complex recurrence.
+    ``e^{i psi} = e^{i lin t} (w / |w|) ((m_0 - i m_1) / |(m_0, m_1)|) e^{-i psi_raw(0)}``.
+    """
+    v = params[_I_TH_NUV] * t + params[_I_TH_V0]
+    c1 = math.cos(v)
+    s1 = math.sin(v)
+    c2 = c1 * c1 - s1 * s1
+    s2 = 2.0 * s1 * c1
+    co = c1  # cos, sin of (2n + 1) v
+    so = s1
+    ce = 1.0  # cos, sin of 2n v
+    se = 0.0
+    m0 = 0.0
+    m1 = 0.0
+    m2 = 0.0
+    wr = 0.0
+    wi = 0.0
+    for i in range(int(params[_I_TH_N])):
+        m0 += params[_I_TH_M0 + i] * co
+        m1 += params[_I_TH_M1 + i] * so
+        m2 += params[_I_TH_M2 + i] * ce
+        wr += params[_I_TH_WR + i] * ce
+        wi += params[_I_TH_WI + i] * se
+        co_next = co * c2 - so * s2
+        so = so * c2 + co * s2
+        co = co_next
+        ce_next = ce * c2 - se * s2
+        se = se * c2 + ce * s2
+        ce = ce_next
+    a = params[_I_LIN] * t
+    ca = math.cos(a)
+    sa = math.sin(a)
+    r = 1.0 / math.sqrt((wr * wr + wi * wi) * (m0 * m0 + m1 * m1))
+    xr = wr * m0 + wi * m1  # w (m_0 - i m_1)
+    xi = wi * m0 - wr * m1
+    yr = (xr * ca - xi * sa) * r
+    yi = (xr * sa + xi * ca) * r
+    cre = params[_I_TH_CRE]
+    cim = params[_I_TH_CIM]
+    return m0, m1, m2, yr * cre - yi * cim, yr * cim + yi * cre
+
+
 @numba.njit(**KERNEL)
 def _ez_to_n(n0, n1, n2):
     """Rotation B (row-major entries) about e_z x n taking e_z to the unit vector n.
@@ -770,47 +920,56 @@ def rotation_init(K, R0, ell, params):
         params[_I_MODE] = _MODE_SEPARATRIX
         params[_I_LIN] = lmag / j2
         u0 = math.asinh(sf / cf)
-        params[_I_U0] = u0
-        s, c, d, gval = _phase_state(params, u0)
+    elif k2 == 0.0:  # axisymmetric (J_0 = J_1): F(phi | 0) = phi
+        u0 = math.atan2(sf, cf)
     else:
-        params[_I_MODE] = _MODE_GENERAL
-        # the R_J term: Pi - F with eta = beta (form 1) or Pi(-gamma) - F (form 2)
-        form2 = beta > 1.0
-        eta = gamma if form2 else beta
-        params[_I_FORM2] = 1.0 if form2 else 0.0
-        params[_I_ETA] = eta
-        params[_I_DCOEF] = eta * (1.0 + eta) * (eta + k2)
-        params[_I_CPI] = lmag * gamma / 3.0 if form2 else -lmag * beta / 3.0
-        params[_I_SQD] = sqd
-        params[_I_LSQD] = lmag / sqd
-        kcomp, pik = _landen_agm(math.sqrt(k2), math.sqrt(kp2), eta, params)
-        params[_I_TWOK] = 2.0 * kcomp
-        params[_I_INV2K] = 0.5 / kcomp
-        if k2 == 0.0:  # axisymmetric (J_0 = J_1): F(phi | 0) = phi
-            u0 = math.atan2(sf, cf)
-        else:
-            d = math.sqrt(cf * cf + kp2 * sf * sf)  # dn(u_0)
-            u0 = sf * _rf_amp(cf * cf, cf, d * d, d)
-        # mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar
-        # G(K) = L Pi(-beta) - a_2 T(pi/2) with Pi(-beta) - K = pik K (form 1) or
-        # Pi(-beta) = K - Pi(-gamma) + pi / (2 sqd) (form 2)
-        g_quarter = -a2 * 0.5 * math.pi / gfac  # -a_2 T(pi/2)
-        if form2:
-            g_quarter += lmag * (0.5 * math.pi / sqd - pik * kcomp)
-            foff = g_quarter / kcomp  # f_bar
-            params[_I_LIN] = lmag / j2 + kappa * foff
-        else:
-            foff = lmag * pik - a2 * 0.5 * math.pi / (gfac * kcomp)  # f_bar - L
-            params[_I_LIN] = lmag / j0 + kappa * foff
-        params[_I_FOFF] = foff
-        params[_I_U0] = u0
+        d = math.sqrt(cf * cf + kp2 * sf * sf)  # dn(u_0)
+        u0 = sf * _rf_amp(cf * cf, cf, d * d, d)
+    params[_I_U0] = u0
+    if kp2 != 0.0 and k2 >= _THETA_K2_MIN and _theta_init(params, math.sqrt(k2), math.sqrt(kp2), beta, lmag, j0, j1,
+                                                 d20, d21, nu, params[_I_A + 0], params[_I_A + 1], a2, u0):
+        params[_I_MODE] = _MODE_THETA
+        m0, m1, m2, cr, ci = _theta_state(params, 0.0)
+        params[_I_TH_CRE] = cr  # then psi(0) = 0 and R(0) = R0 up to rounding
+        params[_I_TH_CIM] = -ci
+        inv = 1.0 / math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+        n0 = m0 * inv
+        n1 = m1 * inv
+        n2 = m2 * inv
+    else:
+        if kp2 != 0.0:
+            params[_I_MODE] = _MODE_GENERAL
+            # the R_J term: Pi - F with eta = beta (form 1) or Pi(-gamma) - F (form 2)
+            form2 = beta > 1.0
+            eta = gamma if form2 else beta
+            params[_I_FORM2] = 1.0 if form2 else 0.0
+            params[_I_ETA] = eta
+            params[_I_DCOEF] = eta * (1.0 + eta) * (eta + k2)
+            params[_I_CPI] = lmag * gamma / 3.0 if form2 else -lmag * beta / 3.0
+            params[_I_SQD] = sqd
+            params[_I_LSQD] = lmag / sqd
+            kcomp, pik = _landen_agm(math.sqrt(k2), math.sqrt(kp2), eta, params)
+            params[_I_TWOK] = 2.0 * kcomp
+            params[_I_INV2K] = 0.5 / kcomp
+            # mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar
+            # G(K) = L Pi(-beta) - a_2 T(pi/2) with Pi(-beta) - K = pik K (form 1) or
+            # Pi(-beta) = K - Pi(-gamma) + pi / (2 sqd) (form 2)
+            g_quarter = -a2 * 0.5 * math.pi / gfac  # -a_2 T(pi/2)
+            if form2:
+                g_quarter += lmag * (0.5 * math.pi / sqd - pik * kcomp)
+                foff = g_quarter / kcomp  # f_bar
+                params[_I_LIN] = lmag / j2 + kappa * foff
+            else:
+                foff = lmag * pik - a2 * 0.5 * math.pi / (gfac * kcomp)  # f_bar - L
+                params[_I_LIN] = lmag / j0 + kappa * foff
+            params[_I_FOFF] = foff
         # G_p and n at u_0 as rotation_at evaluates them (not from sf, cf, d): then
         # psi(0) = 0 and R(0) = R0 exactly up to rounding
         s, c, d, gval = _phase_state(params, u0)
-    params[_I_G0] = gval
+        params[_I_G0] = gval
+        n0, n1, n2 = _unit_momentum(params, s, c, d)
 
     # ---- C = R0 Q B(n(0)): makes R(0) = R0 exactly up to rounding
-    n0, n1, n2 = _unit_momentum(params, s, c, d)
     b00, b01, b02, b10, b11, b12, b20, b21, b22 = _ez_to_n(n0, n1, n2)
     for r in range(3):
         q0 = sg0 * R0[r, o0]
@@ -870,12 +1029,19 @@ def rotation_at(params, t, R_out, omega_out):
         omega_out[2] = w2
         return
 
-    u = params[_I_NU] * t + params[_I_U0]
-    s, c, d, gval = _phase_state(params, u)
-    n0, n1, n2 = _unit_momentum(params, s, c, d)
-    psi = params[_I_LIN] * t + params[_I_KAPNU] * (gval - params[_I_G0])
-    cp = math.cos(psi)
-    sp = math.sin(psi)
+    if mode == _MODE_THETA:
+        m0, m1, m2, cp, sp = _theta_state(params, t)
+        inv = 1.0 / math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+        n0 = m0 * inv
+        n1 = m1 * inv
+        n2 = m2 * inv
+    else:
+        u = params[_I_NU] * t + params[_I_U0]
+        s, c, d, gval = _phase_state(params, u)
+        n0, n1, n2 = _unit_momentum(params, s, c, d)
+        psi = params[_I_LIN] * t + params[_I_KAPNU] * (gval - params[_I_G0])
+        cp = math.cos(psi)
+        sp = math.sin(psi)
     b00, b01, b02, b10, b11, b12, b20, b21, b22 = _ez_to_n(n0, n1, n2)
     # M = Rz(psi) B^T (rows of B^T are the columns of B)
     m00 = cp * b00 - sp * b01

@@ -18,6 +18,7 @@
 #define MODE_STEADY 1.0     /* constant omega about a principal direction */
 #define MODE_GENERAL 2.0    /* elliptic solution, 0 < k' <= 1 */
 #define MODE_SEPARATRIX 3.0 /* elliptic solution on the separatrix, k' == 0 */
+#define MODE_THETA 4.0      /* Jacobi's theta series, nome q <= 0.2, away from a steady spin */
 
 #define NLEV_MAX 24         /* Landen levels; k' = 1e-9 needs 7, k' = 5e-324 needs 12 */
 #define LANDEN_KTOL 1e-9    /* stop once k_n < this: sn(w|k_n) = sin w + O(k_n^2) */
@@ -53,6 +54,25 @@
 #define I_OMKN (I_KN + NLEV_MAX) /* NLEV_MAX entries: 1 - k_n */
 
 _Static_assert(I_OMKN + NLEV_MAX == RBS_ROT_PARAMS_SIZE, "the layout of direct_model.rotation");
+
+/* the theta mode keeps its series in the Landen chain's slots */
+#define TH_TERMS 8               /* at most; q <= 0.2 needs 6 */
+#define I_TH_N I_KN              /* number of terms */
+#define I_TH_NUV (I_KN + 1)      /* dv/dt, v = pi u / (2 K) */
+#define I_TH_V0 (I_KN + 2)       /* v at t = 0 */
+#define I_TH_CRE (I_KN + 3)      /* e^{-i psi_raw(0)}: real and imaginary parts */
+#define I_TH_CIM (I_KN + 4)
+#define I_TH_M0 (I_KN + 5)       /* coefficients of cos((2n+1) v) in m_0 */
+#define I_TH_M1 (I_TH_M0 + TH_TERMS) /* of sin((2n+1) v) in m_1 */
+#define I_TH_M2 (I_TH_M1 + TH_TERMS) /* of cos(2n v) in m_2 */
+#define I_TH_WR (I_TH_M2 + TH_TERMS) /* of cos(2n v) in Re w */
+#define I_TH_WI (I_TH_WR + TH_TERMS) /* of sin(2n v) in Im w */
+#define THETA_LNQ_MAX (-1.6094379124341003)  /* ln 0.2: larger nomes (k^2 > 0.97) take the Landen path */
+#define THETA_LNRHO_MAX (-0.6931471805599453) /* ln 0.5: see rbs_theta_init */
+#define THETA_TOL 1e-17          /* the first term left out of every series is below this */
+#define THETA_K2_MIN 1e-4        /* closer to a steady spin (k -> 0) the theta phases lose digits */
+
+_Static_assert(I_TH_WI + TH_TERMS <= RBS_ROT_PARAMS_SIZE, "the theta series fit the parameter array");
 
 #define SNAP (16.0 * 2.220446049250313e-16) /* relative size of rounding noise in R0^T ell */
 
@@ -362,6 +382,126 @@ static void rbs_unit_momentum(const double *params, double s, double c, double d
     n[2] = m2 * inv;
 }
 
+/* ---------------------------------------------------------------- Jacobi's theta series (the theta mode) */
+
+/* K(k) = pi / (2 AGM(1, k')) for 0 < k' <= 1 (DLMF 19.8.5) */
+static double rbs_agm_k(double kp)
+{
+    double a = 1.0;
+    double g = kp;
+    while (fabs(a - g) > 1e-9 * a) { /* a NaN ends the loop too, as in numba */
+        double a_next = 0.5 * (a + g);
+        g = sqrt(a * g);
+        a = a_next;
+    }
+    return RBS_PI / (a + g);
+}
+
+/* Set up the theta mode (direct_model.rotation._theta_init); 0 if the state needs the Landen path */
+static int rbs_theta_init(double *params, double k, double kp, double beta, double lmag, double j0, double j1,
+                          double d20, double d21, double nu, double a0, double a1, double a2, double u0)
+{
+    double kk = rbs_agm_k(kp);
+    double lq = -RBS_PI * rbs_agm_k(k) / kk;
+    if (!(lq <= THETA_LNQ_MAX)) return 0;
+    double k2 = k * k;
+    double hw = 0.5 * RBS_PI / kk;
+    double at2 = 2.0 * hw * sqrt(beta) * rbs_carlson_rf(k2, k2 * (1.0 + beta), k2 + beta);
+    if (!(lq + at2 <= THETA_LNRHO_MAX)) return 0;
+    double q = exp(lq);
+    double e = exp(at2);
+    double s4 = exp(0.25 * lq);
+    double f0 = 2.0 * a0 * s4 / sqrt(k);
+    double f1 = 2.0 * a1 * s4 / (sqrt(k) * sqrt(kp));
+    params[I_TH_M0] = f0;
+    params[I_TH_M1] = f1;
+    params[I_TH_M2] = a2;
+    params[I_TH_WR] = 1.0;
+    params[I_TH_WI] = 0.0;
+    double qo = q;   /* q^(2n - 1) */
+    double qn = 1.0; /* q^(n^2) */
+    double qd = 1.0; /* q^(n (n + 1)) */
+    double cp = 1.0; /* q^(n^2) e^(n at2) */
+    double cm = 1.0; /* q^(n^2) e^(-n at2) */
+    double sgn = 1.0;
+    double zn = 0.0;
+    double zd = 1.0;
+    int64_t n = 1;
+    for (;;) {
+        qn *= qo;
+        cp *= qo * e;
+        cm *= qo / e;
+        qd *= qo * q;
+        if (!(cp > THETA_TOL)) break;
+        if (n == TH_TERMS) return 0;
+        sgn = -sgn;
+        double wr = sgn * (cp + cm);
+        double wi = -sgn * (cp - cm);
+        params[I_TH_M0 + n] = f0 * qd;
+        params[I_TH_M1 + n] = sgn * f1 * qd;
+        params[I_TH_M2 + n] = 2.0 * a2 * qn;
+        params[I_TH_WR + n] = wr;
+        params[I_TH_WI + n] = wi;
+        zn += (double)n * wi;
+        zd += wr;
+        qo *= q * q;
+        n++;
+    }
+    /* Z(i alpha) = i z, z = (pi/K) sum n WI_n / sum WR_n; D/P_a of the rate of phi_E */
+    double z = RBS_PI / kk * zn / zd;
+    double pa = sqrt(beta * (k2 + beta) * (1.0 + beta));
+    params[I_LIN] = lmag / j0 + lmag * (j0 - j1) * d20 / (j0 * j0 * d21) * z / pa;
+    params[I_TH_N] = (double)n;
+    params[I_TH_NUV] = nu * hw;
+    params[I_TH_V0] = u0 * hw;
+    params[I_TH_CRE] = 1.0;
+    params[I_TH_CIM] = 0.0;
+    return 1;
+}
+
+/* m (up to a positive factor) and (cos psi, sin psi) at time t in the theta mode
+ * (direct_model.rotation._theta_state) */
+static void rbs_theta_state(const double *params, double t, double m[3], double *cpsi, double *spsi)
+{
+    double v = params[I_TH_NUV] * t + params[I_TH_V0];
+    double c1 = cos(v);
+    double s1 = sin(v);
+    double c2 = c1 * c1 - s1 * s1;
+    double s2 = 2.0 * s1 * c1;
+    double co = c1, so = s1; /* cos, sin of (2n + 1) v */
+    double ce = 1.0, se = 0.0; /* cos, sin of 2n v */
+    double m0 = 0.0, m1 = 0.0, m2 = 0.0, wr = 0.0, wi = 0.0;
+    int64_t nterms = rbs_trunc(params[I_TH_N]);
+    for (int64_t i = 0; i < nterms; i++) {
+        m0 += params[I_TH_M0 + i] * co;
+        m1 += params[I_TH_M1 + i] * so;
+        m2 += params[I_TH_M2 + i] * ce;
+        wr += params[I_TH_WR + i] * ce;
+        wi += params[I_TH_WI + i] * se;
+        double co_next = co * c2 - so * s2;
+        so = so * c2 + co * s2;
+        co = co_next;
+        double ce_next = ce * c2 - se * s2;
+        se = se * c2 + ce * s2;
+        ce = ce_next;
+    }
+    double a = params[I_LIN] * t;
+    double ca = cos(a);
+    double sa = sin(a);
+    double r = 1.0 / sqrt((wr * wr + wi * wi) * (m0 * m0 + m1 * m1));
+    double xr = wr * m0 + wi * m1; /* w (m_0 - i m_1) */
+    double xi = wi * m0 - wr * m1;
+    double yr = (xr * ca - xi * sa) * r;
+    double yi = (xr * sa + xi * ca) * r;
+    double cre = params[I_TH_CRE];
+    double cim = params[I_TH_CIM];
+    m[0] = m0;
+    m[1] = m1;
+    m[2] = m2;
+    *cpsi = yr * cre - yi * cim;
+    *spsi = yr * cim + yi * cre;
+}
+
 /* rotation B (row-major) about e_z x n taking e_z to the unit vector n: I + [v]x + [v]x^2 / (1 + n_2) */
 static void rbs_ez_to_n(double n0, double n1, double n2, double b[9])
 {
@@ -535,55 +675,67 @@ void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3
     double h = hypot(cf, sf);
     cf /= h;
     sf /= h;
-    double s, c, d, gval, u0;
+    double s, c, d, gval, u0, n[3];
     if (kp2 == 0.0) {
         params[I_MODE] = MODE_SEPARATRIX;
         params[I_LIN] = lmag / j2;
         u0 = asinh(sf / cf);
-        params[I_U0] = u0;
-        rbs_phase_state(params, u0, &s, &c, &d, &gval);
+    } else if (k2 == 0.0) { /* axisymmetric (J_0 = J_1): F(phi | 0) = phi */
+        u0 = atan2(sf, cf);
     } else {
-        params[I_MODE] = MODE_GENERAL;
-        /* the R_J term: Pi - F with eta = beta (form 1) or Pi(-gamma) - F (form 2) */
-        int form2 = beta > 1.0;
-        double eta = form2 ? gamma : beta;
-        params[I_FORM2] = form2 ? 1.0 : 0.0;
-        params[I_ETA] = eta;
-        params[I_DCOEF] = eta * (1.0 + eta) * (eta + k2);
-        params[I_CPI] = form2 ? lmag * gamma / 3.0 : -lmag * beta / 3.0;
-        params[I_SQD] = sqd;
-        params[I_LSQD] = lmag / sqd;
-        double kcomp, pik;
-        rbs_landen_agm(sqrt(k2), sqrt(kp2), eta, params, &kcomp, &pik);
-        params[I_TWOK] = 2.0 * kcomp;
-        params[I_INV2K] = 0.5 / kcomp;
-        if (k2 == 0.0) { /* axisymmetric (J_0 = J_1): F(phi | 0) = phi */
-            u0 = atan2(sf, cf);
-        } else {
-            d = sqrt(cf * cf + kp2 * sf * sf); /* dn(u_0) */
-            u0 = sf * rbs_rf_amp(cf * cf, cf, d * d, d);
+        d = sqrt(cf * cf + kp2 * sf * sf); /* dn(u_0) */
+        u0 = sf * rbs_rf_amp(cf * cf, cf, d * d, d);
+    }
+    params[I_U0] = u0;
+    if (kp2 != 0.0 && k2 >= THETA_K2_MIN &&
+        rbs_theta_init(params, sqrt(k2), sqrt(kp2), beta, lmag, j0, j1, d20, d21, nu, params[I_A + 0],
+                       params[I_A + 1], a2, u0)) {
+        params[I_MODE] = MODE_THETA;
+        double m[3], cr, ci;
+        rbs_theta_state(params, 0.0, m, &cr, &ci);
+        params[I_TH_CRE] = cr; /* then psi(0) = 0 and R(0) = R0 up to rounding */
+        params[I_TH_CIM] = -ci;
+        double inv = 1.0 / sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        n[0] = m[0] * inv;
+        n[1] = m[1] * inv;
+        n[2] = m[2] * inv;
+    } else {
+        if (kp2 != 0.0) {
+            params[I_MODE] = MODE_GENERAL;
+            /* the R_J term: Pi - F with eta = beta (form 1) or Pi(-gamma) - F (form 2) */
+            int form2 = beta > 1.0;
+            double eta = form2 ? gamma : beta;
+            params[I_FORM2] = form2 ? 1.0 : 0.0;
+            params[I_ETA] = eta;
+            params[I_DCOEF] = eta * (1.0 + eta) * (eta + k2);
+            params[I_CPI] = form2 ? lmag * gamma / 3.0 : -lmag * beta / 3.0;
+            params[I_SQD] = sqd;
+            params[I_LSQD] = lmag / sqd;
+            double kcomp, pik;
+            rbs_landen_agm(sqrt(k2), sqrt(kp2), eta, params, &kcomp, &pik);
+            params[I_TWOK] = 2.0 * kcomp;
+            params[I_INV2K] = 0.5 / kcomp;
+            /* mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar */
+            double g_quarter = -a2 * 0.5 * RBS_PI / gfac; /* -a_2 T(pi/2) */
+            double foff;
+            if (form2) {
+                g_quarter += lmag * (0.5 * RBS_PI / sqd - pik * kcomp);
+                foff = g_quarter / kcomp; /* f_bar */
+                params[I_LIN] = lmag / j2 + kappa * foff;
+            } else {
+                foff = lmag * pik - a2 * 0.5 * RBS_PI / (gfac * kcomp); /* f_bar - L */
+                params[I_LIN] = lmag / j0 + kappa * foff;
+            }
+            params[I_FOFF] = foff;
         }
-        /* mean f_bar = G(K) / K; psi' = L/J_2 + kappa f  =>  mean rate L/J_2 + kappa f_bar */
-        double g_quarter = -a2 * 0.5 * RBS_PI / gfac; /* -a_2 T(pi/2) */
-        double foff;
-        if (form2) {
-            g_quarter += lmag * (0.5 * RBS_PI / sqd - pik * kcomp);
-            foff = g_quarter / kcomp; /* f_bar */
-            params[I_LIN] = lmag / j2 + kappa * foff;
-        } else {
-            foff = lmag * pik - a2 * 0.5 * RBS_PI / (gfac * kcomp); /* f_bar - L */
-            params[I_LIN] = lmag / j0 + kappa * foff;
-        }
-        params[I_FOFF] = foff;
-        params[I_U0] = u0;
         /* G_p and n at u_0 as rbs_rotation_at evaluates them: psi(0) = 0 and R(0) = R0 up to rounding */
         rbs_phase_state(params, u0, &s, &c, &d, &gval);
+        params[I_G0] = gval;
+        rbs_unit_momentum(params, s, c, d, n);
     }
-    params[I_G0] = gval;
 
     /* C = R0 Q B(n(0)): makes R(0) = R0 up to rounding */
-    double n[3], b[9];
-    rbs_unit_momentum(params, s, c, d, n);
+    double b[9];
     rbs_ez_to_n(n[0], n[1], n[2], b);
     for (int r = 0; r < 3; r++) {
         double q0 = sg0 * R0[3 * r + o0];
@@ -642,13 +794,23 @@ void rbs_rotation_at(const double *params, double t, double R_out[9], double ome
         return;
     }
 
-    double u = params[I_NU] * t + params[I_U0];
-    double s, c, d, gval, n[3], b[9];
-    rbs_phase_state(params, u, &s, &c, &d, &gval);
-    rbs_unit_momentum(params, s, c, d, n);
-    double psi = params[I_LIN] * t + params[I_KAPNU] * (gval - params[I_G0]);
-    double cp = cos(psi);
-    double sp = sin(psi);
+    double n[3], b[9], cp, sp;
+    if (mode == MODE_THETA) {
+        double m[3];
+        rbs_theta_state(params, t, m, &cp, &sp);
+        double inv = 1.0 / sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        n[0] = m[0] * inv;
+        n[1] = m[1] * inv;
+        n[2] = m[2] * inv;
+    } else {
+        double u = params[I_NU] * t + params[I_U0];
+        double s, c, d, gval;
+        rbs_phase_state(params, u, &s, &c, &d, &gval);
+        rbs_unit_momentum(params, s, c, d, n);
+        double psi = params[I_LIN] * t + params[I_KAPNU] * (gval - params[I_G0]);
+        cp = cos(psi);
+        sp = sin(psi);
+    }
     rbs_ez_to_n(n[0], n[1], n[2], b);
     /* M = Rz(psi) B^T (rows of B^T are the columns of B) */
     double m00 = cp * b[0] - sp * b[1];

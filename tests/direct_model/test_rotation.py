@@ -397,6 +397,57 @@ def test_matches_long_double_taylor_for_random_bodies():
     assert err < 1e-12
 
 
+def test_random_bodies_take_both_the_theta_and_the_landen_path():
+    """The bodies of the two tests above run through both evaluations of the general motion: Jacobi's
+    theta series and the Landen chain with R_J (nomes above 0.2, k^2 below 1e-4: close to a steady spin
+    or to an axisymmetric body, and bodies that spin close to an axis of a nearly axisymmetric inertia)."""
+    modes = []
+    for seed, hard, n in ((20240611, False, 300), (4321, True, 80)):
+        K, R0, ell = random_bodies(n, np.random.default_rng(seed), hard=hard)
+        for b in range(n):
+            params = np.zeros(ROT_PARAMS_SIZE)
+            rotation_init(K[b], R0[b], ell[b], params)
+            modes.append(params[rot._I_MODE])
+    modes = np.array(modes)
+    print(f"theta mode {np.mean(modes == rot._MODE_THETA):.2f}, Landen path {np.mean(modes == rot._MODE_GENERAL):.2f}")
+    assert np.sum(modes == rot._MODE_THETA) >= 50
+    assert np.sum(modes == rot._MODE_GENERAL) >= 50
+
+
+@pytest.mark.parametrize("axis", [0, 2])
+def test_near_a_steady_spin_both_paths_match_long_double_taylor(axis):
+    """L tilted by 1e-1 to 1e-7 from the smallest (axis 0) or largest (axis 2) principal axis. The theta
+    series' two phases (of w and of m_0 + i m_1) then both turn fast and their difference loses digits
+    as k -> 0 (measured: 1e-13 to 1e-12 at tilts 1e-3 to 1e-7, against 1e-14 for the Landen path), so
+    states with k^2 < 1e-4 take the Landen path. Both stay at the accuracy of the random bodies above
+    (1e-12 over 20 turns; measured at most 1.1e-13 here)."""
+    K = np.array([0.3, 0.5, 0.8])
+    tilts = 10.0 ** -np.arange(1.0, 8.0)
+    n = len(tilts)
+    mdir = np.zeros((n, 3))
+    mdir[:, axis] = 1.0
+    mdir[:, 1] = tilts
+    mdir[:, 2 - axis] = 0.7 * tilts
+    mdir /= np.linalg.norm(mdir, axis=1)[:, None]
+    rng = np.random.default_rng(17 + axis)
+    R0 = np.array([random_rotation(rng) for _ in range(n)])
+    ell = np.einsum("bij,bj->bi", R0, mdir * 3.0)
+    mb = np.array([body_momentum(R0[b], ell[b]) for b in range(n)])
+    tmax = np.full(n, 40.0 * np.pi * 0.5 / 3.0)
+    taus = np.linspace(0.0, 1.0, 6)
+    Rref, mref = taylor_reference(np.tile(K, (n, 1)), R0, mb, tmax, taus)
+    modes = []
+    for b in range(n):
+        params = np.zeros(ROT_PARAMS_SIZE)
+        rotation_init(K, R0[b], ell[b], params)
+        modes.append(params[rot._I_MODE])
+        Rs, ws = evaluate(K, R0[b], ell[b], taus * tmax[b])
+        wref = np.einsum("tij,tj->ti", Rref[b], mref[b] / K)
+        err = max(np.abs(Rs - Rref[b]).max(), (np.linalg.norm(ws - wref, axis=1) / np.linalg.norm(wref, axis=1)).max())
+        assert err < 1e-12, (tilts[b], err)
+    assert modes[0] == rot._MODE_THETA and modes[-1] == rot._MODE_GENERAL, modes
+
+
 # --------------------------------------------------------------------------------------
 # near the separatrix (k -> 1)
 # --------------------------------------------------------------------------------------

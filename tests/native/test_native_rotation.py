@@ -2,7 +2,8 @@
 
 For random and adversarial bodies and states in every mode -- static (ell = 0), steady (ell along a
 principal axis, including the middle one; a sphere; an axisymmetric body spinning in its degenerate
-plane), general (both forms of the third-kind integral, axisymmetric and nearly axisymmetric bodies,
+plane), general (Jacobi's theta series and the Landen chain with both forms of the third-kind integral,
+axisymmetric and nearly axisymmetric bodies,
 inertias and momenta scaled by 1e+-40), the separatrix (exactly, and within the rounding of R0^T ell) and
 states next to it (k' down to 1e-19) -- the whole parameter array of rbs_rotation_init equals that of
 rotation_init bit for bit, and R and omega of rbs_rotation_at equal those of rotation_at at times from 0 to
@@ -119,8 +120,8 @@ def _states(kind, rng, count):
 
 KINDS = ("general", "scaled", "static", "steady_axis", "sphere", "axisymmetric_plane", "axisymmetric",
          "nearly_axisymmetric", "separatrix", "separatrix_rounded", "near_separatrix")
-MODES = {"static": {0.0}, "steady_axis": {1.0}, "sphere": {1.0}, "axisymmetric_plane": {1.0},
-         "separatrix": {3.0}, "near_separatrix": {2.0}}
+MODES = {"general": {2.0, 4.0}, "static": {0.0}, "steady_axis": {1.0}, "sphere": {1.0}, "axisymmetric_plane": {1.0},
+         "axisymmetric": {2.0}, "nearly_axisymmetric": {4.0}, "separatrix": {3.0}, "near_separatrix": {2.0}}
 
 
 def _times(rng, params):
@@ -133,6 +134,8 @@ def _times(rng, params):
         period = params[21] / abs(params[19])
     elif mode == 3.0:
         period = 1.0 / abs(params[19])
+    elif mode == 4.0:
+        period = math.pi / abs(params[46])
     else:
         period = 1.0
     spans = [0.0, 1e-3, 0.5, 1.0, 10.0, 1e3, 1e6, 1e12]
