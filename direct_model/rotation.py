@@ -4,8 +4,8 @@ Closed-form solution in Jacobi elliptic functions, evaluated by jitted plain fun
 over float64 arrays:
 
 * :func:`rotation_init` does the set-up once per flight (sorting of the axes, the
-  elliptic modulus, the Landen chain, complete integrals, the initial phase) and writes
-  everything into a float64 array of length :data:`ROT_PARAMS_SIZE`.
+  elliptic modulus, the theta series or the Landen chain, complete integrals, the initial
+  phase) and writes everything into a float64 array of length :data:`ROT_PARAMS_SIZE`.
 * :func:`rotation_at` evaluates the orientation ``R(t)`` (body -> lab) and the lab-frame
   angular velocity ``omega(t)`` at any time ``t``, working on scalars only (no allocation).
 
@@ -111,6 +111,34 @@ Method
    of ``m`` below ``16 eps L`` (rounding noise of ``R0^T ell``) are ignored for that test
    only.  ``ell = 0`` leaves ``R = R0``.  Axisymmetric bodies otherwise take the general
    path with ``k = 0, beta = 0`` (regular precession, all closed forms).
+
+6. *Theta mode* -- Jacobi's own solution, used when the nome ``q = exp(-pi K'/K) <= 0.2``
+   (``k^2`` below about 0.97), ``k^2 >= 1e-4`` and ``rho <= 1/2`` (below); the other
+   general states take items 3 and 4.  With ``v = pi u / (2K)`` (DLMF 22.2.4-22.2.6, the
+   common divisor ``theta_4(v)`` dropped, as ``n = m / |m|`` does not need it)::
+
+       m ~ (a_0 theta_2(v) / sqrt(k), a_1 theta_1(v) / sqrt(k k'), a_2 theta_3(v)).
+
+   The Euler angle of precession about ``L``, ``phi_E = psi + gamma`` with
+   ``e^{i gamma} = (m_0 + i m_1) / |(m_0, m_1)|``, has ``phi_E' = L/J_0 + D sn^2 / (1 +
+   beta sn^2)``, ``D = L (J_0 - J_1) d_20 / (J_0^2 d_21)``; Jacobi's form of the
+   third-kind integral with the imaginary parameter ``i alpha``, ``sc(alpha | k') =
+   sqrt(beta) / k``, that is ``alpha = sqrt(beta) R_F(k^2, k^2 (1 + beta), k^2 + beta)``,
+   integrates it to::
+
+       phi_E(t) = phi_E(0) + (L/J_0 + D z / P) t + arg w(u) - arg w(u_0),
+       w = theta_4(v + i alpha~),  alpha~ = pi alpha / (2K),  P = sqrt(beta (k^2 + beta) (1 + beta)),
+
+   with ``Z(i alpha) = i z`` (Jacobi's zeta, from the same series at ``v = i alpha~``).
+   The coefficient of ``arg w`` is exactly -1 (``D = -nu P``), so ``e^{i psi} =
+   e^{i lin t} (w/|w|) ((m_0 - i m_1) / |(m_0, m_1)|)`` times the constant that makes
+   ``psi(0) = 0``: no arctangent, no ``R_J``, no Landen climb.  A step costs one
+   sine-cosine pair of ``v`` (the multiple angles by complex recurrence), one of
+   ``lin t``, 2 to 6 terms of five series and three square roots.  ``K`` and ``K'`` come
+   from the AGM.  The series' terms are at most ``q^{n^2 - n} rho^n``, ``rho = q e^{2
+   alpha~} < 1``; they stop below 1e-17.  ``rho`` -> 1 (``alpha`` -> ``K'``) puts ``w`` near
+   a zero, and ``k`` -> 0 (close to a steady spin) makes the two phases turn fast and cancel
+   in ``psi``; both lose digits, hence the bounds above.
 
 The lab angular momentum ``R K R^T omega = L C e_z = R0 Q n(0) L`` and the energy
 ``sum m_i^2 / J_i`` are constant by construction (to rounding).

@@ -1,6 +1,7 @@
 /*
  * rotation.c: torque-free rotation of a rigid body (direct_model.rotation, whose module docstring gives the
- * method: Landau & Lifshitz section 37, the Landen/AGM chain, Carlson's R_F and R_J, Celledoni et al. 2008),
+ * method: Landau & Lifshitz section 37, Jacobi's theta series or the Landen/AGM chain, Carlson's R_F and R_J,
+ * Celledoni et al. 2008),
  * function for function, each expression in numba's order (no contraction, numba's min/max and int(),
  * libm where numba calls it), so the same bits.
  *

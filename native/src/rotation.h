@@ -21,7 +21,8 @@
  *   K       principal values of the inertia tensor per unit mass along body axes 0, 1, 2 (positive)
  *   R0      rotation body -> lab at t = 0, row-major
  *   ell     angular momentum per unit mass in the lab frame (constant), possibly zero
- *   params  output, RBS_ROT_PARAMS_SIZE doubles; the Landen levels beyond the stored count are not written */
+ *   params  output, RBS_ROT_PARAMS_SIZE doubles; the Landen levels or theta terms beyond the stored count are not
+ *           written */
 void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3], double *params);
 
 /* R_out (row-major, body -> lab) and omega_out (lab frame) at time t (direct_model.rotation.rotation_at) */
