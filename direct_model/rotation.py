@@ -193,6 +193,8 @@ _I_KN = 45  # _NLEV_MAX entries: k_n, n = 1..N
 _I_OMKN = _I_KN + _NLEV_MAX  # _NLEV_MAX entries: 1 - k_n
 
 ROT_PARAMS_SIZE = _I_OMKN + _NLEV_MAX
+"""Length of the float64 parameter array filled by :func:`rotation_init` (93)."""
+
 # the theta mode keeps its series in the Landen chain's slots
 _TH_TERMS = 8  # at most; q <= 0.2 needs 6
 _I_TH_N = _I_KN  # number of terms
@@ -209,7 +211,6 @@ _THETA_LNQ_MAX = -1.6094379124341003  # ln 0.2: larger nomes (k^2 > 0.97) take t
 _THETA_LNRHO_MAX = -0.6931471805599453  # ln 0.5: see _theta_init
 _THETA_TOL = 1e-17  # the first term left out of every series is below this
 _THETA_K2_MIN = 1e-4  # closer to a steady spin (k -> 0) the theta phases lose digits: the Landen path
-"""Length of the float64 parameter array filled by :func:`rotation_init` (93)."""
 
 _SNAP = 16.0 * 2.220446049250313e-16  # relative size of rounding noise in R0^T ell
 
@@ -625,11 +626,12 @@ def _agm_k(kp):
 @numba.njit(**KERNEL)
 def _theta_init(params, k, kp, beta, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0):
     """Set up the theta mode (module docstring, item 6); False, and nothing to be read
-    left behind, if the state needs the Landen path (``q > 0.2`` or ``rho > 1/2``).
+    left behind, if the state needs the Landen path (``q > 0.2``, ``rho > 1/2``, or more
+    than ``_TH_TERMS`` terms).
 
     With ``lq = ln q = -pi K'/K`` and ``rho = q e^{2 alpha~}`` the series' terms are at
-    most ``q^{n^2 - n} rho^n``; ``rho`` -> 1 for a body spinning close to the circulated
-    axis, where ``w`` passes near a zero and its phase loses ``eps / (1 - rho)^2``.
+    most ``q^{n^2 - n} rho^n``; ``rho`` -> 1 (``alpha`` -> ``K'``) puts ``w`` near a zero,
+    where its phase loses digits.
     """
     kk = _agm_k(kp)
     lq = -math.pi * _agm_k(k) / kk
@@ -954,8 +956,9 @@ def rotation_init(K, R0, ell, params):
         d = math.sqrt(cf * cf + kp2 * sf * sf)  # dn(u_0)
         u0 = sf * _rf_amp(cf * cf, cf, d * d, d)
     params[_I_U0] = u0
-    if kp2 != 0.0 and k2 >= _THETA_K2_MIN and _theta_init(params, math.sqrt(k2), math.sqrt(kp2), beta, lmag, j0, j1,
-                                                 d20, d21, nu, params[_I_A + 0], params[_I_A + 1], a2, u0):
+    if kp2 != 0.0 and k2 >= _THETA_K2_MIN and _theta_init(
+            params, math.sqrt(k2), math.sqrt(kp2), beta, lmag, j0, j1, d20, d21, nu, params[_I_A + 0],
+            params[_I_A + 1], a2, u0):
         params[_I_MODE] = _MODE_THETA
         m0, m1, m2, cr, ci = _theta_state(params, 0.0)
         params[_I_TH_CRE] = cr  # then psi(0) = 0 and R(0) = R0 up to rounding
