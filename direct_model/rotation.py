@@ -696,8 +696,8 @@ def _theta_init(params, k, kp, beta, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0)
 
 @numba.njit(**KERNEL)
 def _theta_state(params, t):
-    """The working-frame ``m`` (up to a positive factor) and ``(cos psi, sin psi)`` at
-    time ``t`` in the theta mode (module docstring, item 6).
+    """The working-frame unit momentum ``n = m / |m|`` and ``(cos psi, sin psi)`` at time
+    ``t`` in the theta mode (module docstring, item 6).
 
     The multiple angles come from one sine-cosine pair by complex recurrence.
     ``e^{i psi} = e^{i lin t} (w / |w|) ((m_0 - i m_1) / |(m_0, m_1)|) e^{-i psi_raw(0)}``.
@@ -738,7 +738,8 @@ def _theta_state(params, t):
     yi = (xr * sa + xi * ca) * r
     cre = params[_I_TH_CRE]
     cim = params[_I_TH_CIM]
-    return m0, m1, m2, yr * cre - yi * cim, yr * cim + yi * cre
+    inv = 1.0 / math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    return m0 * inv, m1 * inv, m2 * inv, yr * cre - yi * cim, yr * cim + yi * cre
 
 
 @numba.njit(**KERNEL)
@@ -960,13 +961,9 @@ def rotation_init(K, R0, ell, params):
             params, math.sqrt(k2), math.sqrt(kp2), beta, lmag, j0, j1, d20, d21, nu, params[_I_A + 0],
             params[_I_A + 1], a2, u0):
         params[_I_MODE] = _MODE_THETA
-        m0, m1, m2, cr, ci = _theta_state(params, 0.0)
+        n0, n1, n2, cr, ci = _theta_state(params, 0.0)
         params[_I_TH_CRE] = cr  # then psi(0) = 0 and R(0) = R0 up to rounding
         params[_I_TH_CIM] = -ci
-        inv = 1.0 / math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
-        n0 = m0 * inv
-        n1 = m1 * inv
-        n2 = m2 * inv
     else:
         if kp2 != 0.0:
             params[_I_MODE] = _MODE_GENERAL
@@ -1061,11 +1058,7 @@ def rotation_at(params, t, R_out, omega_out):
         return
 
     if mode == _MODE_THETA:
-        m0, m1, m2, cp, sp = _theta_state(params, t)
-        inv = 1.0 / math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
-        n0 = m0 * inv
-        n1 = m1 * inv
-        n2 = m2 * inv
+        n0, n1, n2, cp, sp = _theta_state(params, t)
     else:
         u = params[_I_NU] * t + params[_I_U0]
         s, c, d, gval = _phase_state(params, u)

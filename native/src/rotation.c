@@ -460,9 +460,9 @@ static int rbs_theta_init(double *params, double k, double kp, double beta, doub
     return 1;
 }
 
-/* m (up to a positive factor) and (cos psi, sin psi) at time t in the theta mode
+/* the unit momentum n = m / |m| and (cos psi, sin psi) at time t in the theta mode
  * (direct_model.rotation._theta_state) */
-static void rbs_theta_state(const double *params, double t, double m[3], double *cpsi, double *spsi)
+static void rbs_theta_state(const double *params, double t, double n[3], double *cpsi, double *spsi)
 {
     double v = params[I_TH_NUV] * t + params[I_TH_V0];
     double c1 = cos(v);
@@ -496,9 +496,10 @@ static void rbs_theta_state(const double *params, double t, double m[3], double 
     double yi = (xr * sa + xi * ca) * r;
     double cre = params[I_TH_CRE];
     double cim = params[I_TH_CIM];
-    m[0] = m0;
-    m[1] = m1;
-    m[2] = m2;
+    double inv = 1.0 / sqrt(m0 * m0 + m1 * m1 + m2 * m2);
+    n[0] = m0 * inv;
+    n[1] = m1 * inv;
+    n[2] = m2 * inv;
     *cpsi = yr * cre - yi * cim;
     *spsi = yr * cim + yi * cre;
 }
@@ -692,14 +693,10 @@ void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3
         rbs_theta_init(params, sqrt(k2), sqrt(kp2), beta, lmag, j0, j1, d20, d21, nu, params[I_A + 0],
                        params[I_A + 1], a2, u0)) {
         params[I_MODE] = MODE_THETA;
-        double m[3], cr, ci;
-        rbs_theta_state(params, 0.0, m, &cr, &ci);
+        double cr, ci;
+        rbs_theta_state(params, 0.0, n, &cr, &ci);
         params[I_TH_CRE] = cr; /* then psi(0) = 0 and R(0) = R0 up to rounding */
         params[I_TH_CIM] = -ci;
-        double inv = 1.0 / sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-        n[0] = m[0] * inv;
-        n[1] = m[1] * inv;
-        n[2] = m[2] * inv;
     } else {
         if (kp2 != 0.0) {
             params[I_MODE] = MODE_GENERAL;
@@ -797,12 +794,7 @@ void rbs_rotation_at(const double *params, double t, double R_out[9], double ome
 
     double n[3], b[9], cp, sp;
     if (mode == MODE_THETA) {
-        double m[3];
-        rbs_theta_state(params, t, m, &cp, &sp);
-        double inv = 1.0 / sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-        n[0] = m[0] * inv;
-        n[1] = m[1] * inv;
-        n[2] = m[2] * inv;
+        rbs_theta_state(params, t, n, &cp, &sp);
     } else {
         double u = params[I_NU] * t + params[I_U0];
         double s, c, d, gval;
