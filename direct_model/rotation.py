@@ -283,26 +283,59 @@ def _rj_series(e2, e3, e4, e5):
 
 
 @numba.njit(**KERNEL)
-def _rf_tail(x, y, z, a, fac, qx, qy, qmax):
-    """Duplication steps of R_F(x, y, z) until the spread ``fac qmax`` (``qmax`` already
-    divided by the tolerance) falls below ``a``, then the series; ``qx = A_0 - x_0``,
+def _rf_step(x, y, z, a, fac):
+    """One duplication step of R_F (Carlson 1995, section 2): the arguments, their mean
+    ``a`` and the spread's factor ``fac`` each divided by 4."""
+    sx = math.sqrt(x)
+    sy = math.sqrt(y)
+    sz = math.sqrt(z)
+    lam = sx * (sy + sz) + sy * sz
+    return 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam), fac * 0.25
+
+
+@numba.njit(**KERNEL)
+def _rf_end(a, fac, qx, qy):
+    """R_F from the series once the duplication has stopped: ``qx = A_0 - x_0``,
     ``qy = A_0 - y_0`` and ``fac = 4^-m`` give Carlson's ``X = qx fac / A_m`` etc. free of
     the cancellation in ``A_m - x_m``."""
-    while fac * qmax > a:
-        sx = math.sqrt(x)
-        sy = math.sqrt(y)
-        sz = math.sqrt(z)
-        lam = sx * (sy + sz) + sy * sz
-        x = 0.25 * (x + lam)
-        y = 0.25 * (y + lam)
-        z = 0.25 * (z + lam)
-        a = 0.25 * (a + lam)
-        fac *= 0.25
     f = fac / a
     dx = qx * f
     dy = qy * f
     dz = -(dx + dy)
     return _rf_series(dx * dy - dz * dz, dx * dy * dz) / math.sqrt(a)
+
+
+@numba.njit(**KERNEL)
+def _rf_start(x, y, z):
+    """The state ``(x, y, z, a, fac, qx, qy, qmax)`` of R_F(x, y, z)'s duplication before
+    its first step; ``qmax`` is the spread already divided by the tolerance: the steps
+    go on while ``fac qmax > a``."""
+    a = (x + y + z) / 3.0
+    qx = a - x
+    qy = a - y
+    qmax = max(abs(qx), abs(qy), abs(a - z)) * _RF_TOL_INV
+    return x, y, z, a, 1.0, qx, qy, qmax
+
+
+@numba.njit(**KERNEL)
+def _rf_amp_start(x, sx, y, sy):
+    """:func:`_rf_start` for R_F(x, y, 1) after its first step, which takes no square root
+    with ``sx = sqrt(x)``, ``sy = sqrt(y)`` known."""
+    a = (x + y + 1.0) / 3.0
+    qx = a - x
+    qy = a - y
+    qmax = max(abs(qx), abs(qy), abs(a - 1.0)) * _RF_TOL_INV
+    lam = sx * (sy + 1.0) + sy
+    return 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (1.0 + lam), 0.25 * (a + lam), 0.25, qx, qy, qmax
+
+
+@numba.njit(**KERNEL)
+def _rf_tail(x, y, z, a, fac, qx, qy, qmax):
+    """R_F from a duplication state (:func:`_rf_start`): steps until the spread
+    ``fac qmax`` falls below ``a``, then the series."""
+    while fac * qmax > a:
+        x, y, z, a, fac = _rf_step(x, y, z, a, fac)
+    return _rf_end(a, fac, qx, qy)
 
 
 @numba.njit(**KERNEL)
@@ -313,24 +346,15 @@ def carlson_rf(x, y, z):
     section 2) until the arguments agree to a relative 2.5e-2, then the series DLMF
     19.36.1 continued to degree 9 (truncation < 2e-18).
     """
-    a = (x + y + z) / 3.0
-    qx = a - x
-    qy = a - y
-    qmax = max(abs(qx), abs(qy), abs(a - z)) * _RF_TOL_INV
-    return _rf_tail(x, y, z, a, 1.0, qx, qy, qmax)
+    x, y, z, a, fac, qx, qy, qmax = _rf_start(x, y, z)
+    return _rf_tail(x, y, z, a, fac, qx, qy, qmax)
 
 
 @numba.njit(**KERNEL)
 def _rf_amp(x, sx, y, sy):
-    """R_F(x, y, 1) with ``sx = sqrt(x)``, ``sy = sqrt(y)`` known: the first duplication
-    step takes no square root."""
-    a = (x + y + 1.0) / 3.0
-    qx = a - x
-    qy = a - y
-    qmax = max(abs(qx), abs(qy), abs(a - 1.0)) * _RF_TOL_INV
-    lam = sx * (sy + 1.0) + sy
-    return _rf_tail(0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (1.0 + lam),
-                    0.25 * (a + lam), 0.25, qx, qy, qmax)
+    """R_F(x, y, 1) with ``sx = sqrt(x)``, ``sy = sqrt(y)`` known (:func:`_rf_amp_start`)."""
+    x, y, z, a, fac, qx, qy, qmax = _rf_amp_start(x, sx, y, sy)
+    return _rf_tail(x, y, z, a, fac, qx, qy, qmax)
 
 
 @numba.njit(**KERNEL)
@@ -611,35 +635,66 @@ def _unit_momentum(params, s, c, d):
 # Jacobi's theta series (the theta mode)
 # --------------------------------------------------------------------------------------
 @numba.njit(**KERNEL)
-def _agm_k(kp):
-    """K(k) = pi / (2 AGM(1, k')) for 0 < k' <= 1 (DLMF 19.8.5); the last mean after
-    ``|a - g| <= 1e-9 a`` is exact to ~1e-19."""
-    a = 1.0
-    g = kp
-    while abs(a - g) > 1e-9 * a:  # written so that a NaN ends the loop too
-        a_next = 0.5 * (a + g)
-        g = math.sqrt(a * g)
-        a = a_next
-    return math.pi / (a + g)
+def _agm_open(a, g):
+    """True while the arithmetic-geometric mean of ``(a, g)`` needs another step: once
+    ``|a - g| <= 1e-9 a`` the next mean is exact to ~1e-19 (written so that a NaN ends the
+    steps too)."""
+    return abs(a - g) > 1e-9 * a
 
 
 @numba.njit(**KERNEL)
-def _theta_init(params, k, kp, beta, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0):
-    """Set up the theta mode (module docstring, item 6); False, and nothing to be read
-    left behind, if the state needs the Landen path (``q > 0.2``, ``rho > 1/2``, or more
-    than ``_TH_TERMS`` terms).
+def _theta_elliptic(k, kp, beta, x, sx, y, sy):
+    """The four elliptic quantities of the theta mode's set-up: ``K(k)``, ``K(k')``,
+    ``R_F(k^2, k^2 (1 + beta), k^2 + beta)`` for ``alpha`` and ``R_F(x, y, 1)`` for ``u_0``
+    (:func:`_rf_amp`, ``sx = sqrt(x)``, ``sy = sqrt(y)``).
+
+    ``K = pi / (2 AGM(1, k'))`` (DLMF 19.8.5).  The four chains of square roots (two AGMs,
+    two duplications) are independent; their steps are interleaved so that the CPU runs
+    them side by side.  Each chain stops at its own test and takes the same operations as
+    alone.
+    """
+    a1 = 1.0  # AGM(1, k')
+    g1 = kp
+    a2 = 1.0  # AGM(1, k)
+    g2 = k
+    k2 = k * k
+    xa, ya, za, aa, fa, qxa, qya, qma = _rf_start(k2, k2 * (1.0 + beta), k2 + beta)
+    xu, yu, zu, au, fu, qxu, qyu, qmu = _rf_amp_start(x, sx, y, sy)
+    while True:
+        open1 = _agm_open(a1, g1)
+        open2 = _agm_open(a2, g2)
+        open3 = fa * qma > aa
+        open4 = fu * qmu > au
+        if not (open1 or open2 or open3 or open4):
+            break
+        if open1:
+            a1, g1 = 0.5 * (a1 + g1), math.sqrt(a1 * g1)
+        if open2:
+            a2, g2 = 0.5 * (a2 + g2), math.sqrt(a2 * g2)
+        if open3:
+            xa, ya, za, aa, fa = _rf_step(xa, ya, za, aa, fa)
+        if open4:
+            xu, yu, zu, au, fu = _rf_step(xu, yu, zu, au, fu)
+    return math.pi / (a1 + g1), math.pi / (a2 + g2), _rf_end(aa, fa, qxa, qya), _rf_end(au, fu, qxu, qyu)
+
+
+@numba.njit(**KERNEL)
+def _theta_init(params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0):
+    """Set up the theta mode (module docstring, item 6) from ``kk = K(k)``,
+    ``kkp = K(k')`` and ``rf_alpha`` (:func:`_theta_elliptic`); False, and nothing to be
+    read left behind, if the state needs the Landen path (``q > 0.2``, ``rho > 1/2``, or
+    more than ``_TH_TERMS`` terms).
 
     With ``lq = ln q = -pi K'/K`` and ``rho = q e^{2 alpha~}`` the series' terms are at
     most ``q^{n^2 - n} rho^n``; ``rho`` -> 1 (``alpha`` -> ``K'``) puts ``w`` near a zero,
     where its phase loses digits.
     """
-    kk = _agm_k(kp)
-    lq = -math.pi * _agm_k(k) / kk
+    lq = -math.pi * kkp / kk
     if not lq <= _THETA_LNQ_MAX:
         return False
     k2 = k * k
     hw = 0.5 * math.pi / kk
-    at2 = 2.0 * hw * math.sqrt(beta) * carlson_rf(k2, k2 * (1.0 + beta), k2 + beta)
+    at2 = 2.0 * hw * math.sqrt(beta) * rf_alpha
     if not lq + at2 <= _THETA_LNRHO_MAX:
         return False
     q = math.exp(lq)
@@ -947,6 +1002,7 @@ def rotation_init(K, R0, ell, params):
     h = math.hypot(cf, sf)
     cf /= h
     sf /= h
+    theta = kp2 != 0.0 and k2 >= _THETA_K2_MIN  # a candidate for the theta mode
     if kp2 == 0.0:
         params[_I_MODE] = _MODE_SEPARATRIX
         params[_I_LIN] = lmag / j2
@@ -955,11 +1011,17 @@ def rotation_init(K, R0, ell, params):
         u0 = math.atan2(sf, cf)
     else:
         d = math.sqrt(cf * cf + kp2 * sf * sf)  # dn(u_0)
-        u0 = sf * _rf_amp(cf * cf, cf, d * d, d)
+        if theta:
+            k = math.sqrt(k2)
+            kp = math.sqrt(kp2)
+            kk, kkp, rf_alpha, rf_u0 = _theta_elliptic(k, kp, beta, cf * cf, cf, d * d, d)
+        else:
+            rf_u0 = _rf_amp(cf * cf, cf, d * d, d)
+        u0 = sf * rf_u0
     params[_I_U0] = u0
-    if kp2 != 0.0 and k2 >= _THETA_K2_MIN and _theta_init(
-            params, math.sqrt(k2), math.sqrt(kp2), beta, lmag, j0, j1, d20, d21, nu, params[_I_A + 0],
-            params[_I_A + 1], a2, u0):
+    if theta and _theta_init(
+            params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, nu,
+            params[_I_A + 0], params[_I_A + 1], a2, u0):
         params[_I_MODE] = _MODE_THETA
         n0, n1, n2, cr, ci = _theta_state(params, 0.0)
         params[_I_TH_CRE] = cr  # then psi(0) = 0 and R(0) = R0 up to rounding

@@ -121,47 +121,85 @@ static double rbs_rj_series(double e2, double e3, double e4, double e5)
                           + e4 * (-3.0 / 28.0 + e2 * (9.0 / 40.0)) + e5 * (9.0 / 184.0)));
 }
 
-/* duplication steps of R_F until the spread fac qmax falls below a, then the series (qx = A_0 - x_0,
- * qy = A_0 - y_0 and fac = 4^-m give X = qx fac / A_m free of cancellation) */
-static double rbs_rf_tail(double x, double y, double z, double a, double fac, double qx, double qy, double qmax)
+/* the state of R_F's duplication (direct_model.rotation._rf_start): the arguments x, y, z, their mean a, the
+ * spread's factor fac = 4^-m, qx = A_0 - x_0 and qy = A_0 - y_0 (X = qx fac / A_m free of cancellation) and
+ * qmax, the spread over the tolerance: the steps go on while fac qmax > a */
+typedef struct {
+    double x, y, z, a, fac, qx, qy, qmax;
+} rbs_rf_state;
+
+static rbs_rf_state rbs_rf_start(double x, double y, double z)
 {
-    while (fac * qmax > a) {
-        double sx = sqrt(x);
-        double sy = sqrt(y);
-        double sz = sqrt(z);
-        double lam = sx * (sy + sz) + sy * sz;
-        x = 0.25 * (x + lam);
-        y = 0.25 * (y + lam);
-        z = 0.25 * (z + lam);
-        a = 0.25 * (a + lam);
-        fac *= 0.25;
-    }
-    double f = fac / a;
-    double dx = qx * f;
-    double dy = qy * f;
+    rbs_rf_state st;
+    st.a = (x + y + z) / 3.0;
+    st.qx = st.a - x;
+    st.qy = st.a - y;
+    st.qmax = rbs_fmax_py(rbs_fmax_py(fabs(st.qx), fabs(st.qy)), fabs(st.a - z)) * RF_TOL_INV;
+    st.x = x;
+    st.y = y;
+    st.z = z;
+    st.fac = 1.0;
+    return st;
+}
+
+/* rbs_rf_start for R_F(x, y, 1) after its first step, which takes no square root with sx = sqrt(x), sy = sqrt(y)
+ * known */
+static rbs_rf_state rbs_rf_amp_start(double x, double sx, double y, double sy)
+{
+    rbs_rf_state st;
+    double a = (x + y + 1.0) / 3.0;
+    st.qx = a - x;
+    st.qy = a - y;
+    st.qmax = rbs_fmax_py(rbs_fmax_py(fabs(st.qx), fabs(st.qy)), fabs(a - 1.0)) * RF_TOL_INV;
+    double lam = sx * (sy + 1.0) + sy;
+    st.x = 0.25 * (x + lam);
+    st.y = 0.25 * (y + lam);
+    st.z = 0.25 * (1.0 + lam);
+    st.a = 0.25 * (a + lam);
+    st.fac = 0.25;
+    return st;
+}
+
+/* one duplication step (Carlson 1995, section 2) */
+static void rbs_rf_step(rbs_rf_state *st)
+{
+    double sx = sqrt(st->x);
+    double sy = sqrt(st->y);
+    double sz = sqrt(st->z);
+    double lam = sx * (sy + sz) + sy * sz;
+    st->x = 0.25 * (st->x + lam);
+    st->y = 0.25 * (st->y + lam);
+    st->z = 0.25 * (st->z + lam);
+    st->a = 0.25 * (st->a + lam);
+    st->fac = st->fac * 0.25;
+}
+
+/* R_F from the series once the duplication has stopped */
+static double rbs_rf_end(const rbs_rf_state *st)
+{
+    double f = st->fac / st->a;
+    double dx = st->qx * f;
+    double dy = st->qy * f;
     double dz = -(dx + dy);
-    return rbs_rf_series(dx * dy - dz * dz, dx * dy * dz) / sqrt(a);
+    return rbs_rf_series(dx * dy - dz * dz, dx * dy * dz) / sqrt(st->a);
+}
+
+/* R_F from a duplication state: steps until the spread falls below a, then the series */
+static double rbs_rf_tail(rbs_rf_state st)
+{
+    while (st.fac * st.qmax > st.a) rbs_rf_step(&st);
+    return rbs_rf_end(&st);
 }
 
 double rbs_carlson_rf(double x, double y, double z)
 {
-    double a = (x + y + z) / 3.0;
-    double qx = a - x;
-    double qy = a - y;
-    double qmax = rbs_fmax_py(rbs_fmax_py(fabs(qx), fabs(qy)), fabs(a - z)) * RF_TOL_INV;
-    return rbs_rf_tail(x, y, z, a, 1.0, qx, qy, qmax);
+    return rbs_rf_tail(rbs_rf_start(x, y, z));
 }
 
-/* R_F(x, y, 1) with sx = sqrt(x), sy = sqrt(y) known: the first duplication step takes no square root */
+/* R_F(x, y, 1) with sx = sqrt(x), sy = sqrt(y) known */
 static double rbs_rf_amp(double x, double sx, double y, double sy)
 {
-    double a = (x + y + 1.0) / 3.0;
-    double qx = a - x;
-    double qy = a - y;
-    double qmax = rbs_fmax_py(rbs_fmax_py(fabs(qx), fabs(qy)), fabs(a - 1.0)) * RF_TOL_INV;
-    double lam = sx * (sy + 1.0) + sy;
-    return rbs_rf_tail(0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (1.0 + lam), 0.25 * (a + lam), 0.25, qx, qy,
-                       qmax);
+    return rbs_rf_tail(rbs_rf_amp_start(x, sx, y, sy));
 }
 
 /* duplication steps of R_J with the R_C corrections (Carlson 1995, Algorithm 3), then the series */
@@ -385,29 +423,59 @@ static void rbs_unit_momentum(const double *params, double s, double c, double d
 
 /* ---------------------------------------------------------------- Jacobi's theta series (the theta mode) */
 
-/* K(k) = pi / (2 AGM(1, k')) for 0 < k' <= 1 (DLMF 19.8.5) */
-static double rbs_agm_k(double kp)
+/* 1 while the AGM of (a, g) needs another step (a NaN ends the steps too, as in numba) */
+static int rbs_agm_open(double a, double g)
 {
-    double a = 1.0;
-    double g = kp;
-    while (fabs(a - g) > 1e-9 * a) { /* a NaN ends the loop too, as in numba */
-        double a_next = 0.5 * (a + g);
-        g = sqrt(a * g);
-        a = a_next;
-    }
-    return RBS_PI / (a + g);
+    return fabs(a - g) > 1e-9 * a;
 }
 
-/* Set up the theta mode (direct_model.rotation._theta_init); 0 if the state needs the Landen path */
-static int rbs_theta_init(double *params, double k, double kp, double beta, double lmag, double j0, double j1,
-                          double d20, double d21, double nu, double a0, double a1, double a2, double u0)
+/* K(k), K(k'), R_F(k^2, k^2 (1 + beta), k^2 + beta) for alpha and R_F(x, y, 1) for u_0
+ * (direct_model.rotation._theta_elliptic): four independent chains of square roots, their steps interleaved so
+ * that the CPU runs them side by side, each with its own test and its own operations */
+static void rbs_theta_elliptic(double k, double kp, double beta, double x, double sx, double y, double sy,
+                               double *kk, double *kkp, double *rf_alpha, double *rf_u0)
 {
-    double kk = rbs_agm_k(kp);
-    double lq = -RBS_PI * rbs_agm_k(k) / kk;
+    double a1 = 1.0, g1 = kp; /* AGM(1, k') */
+    double a2 = 1.0, g2 = k;  /* AGM(1, k) */
+    double k2 = k * k;
+    rbs_rf_state ra = rbs_rf_start(k2, k2 * (1.0 + beta), k2 + beta);
+    rbs_rf_state ru = rbs_rf_amp_start(x, sx, y, sy);
+    for (;;) {
+        int open1 = rbs_agm_open(a1, g1);
+        int open2 = rbs_agm_open(a2, g2);
+        int open3 = ra.fac * ra.qmax > ra.a;
+        int open4 = ru.fac * ru.qmax > ru.a;
+        if (!(open1 || open2 || open3 || open4)) break;
+        if (open1) {
+            double a_next = 0.5 * (a1 + g1);
+            g1 = sqrt(a1 * g1);
+            a1 = a_next;
+        }
+        if (open2) {
+            double a_next = 0.5 * (a2 + g2);
+            g2 = sqrt(a2 * g2);
+            a2 = a_next;
+        }
+        if (open3) rbs_rf_step(&ra);
+        if (open4) rbs_rf_step(&ru);
+    }
+    *kk = RBS_PI / (a1 + g1);
+    *kkp = RBS_PI / (a2 + g2);
+    *rf_alpha = rbs_rf_end(&ra);
+    *rf_u0 = rbs_rf_end(&ru);
+}
+
+/* Set up the theta mode from kk = K(k), kkp = K(k') and rf_alpha (direct_model.rotation._theta_init); 0 if the
+ * state needs the Landen path */
+static int rbs_theta_init(double *params, double kk, double kkp, double rf_alpha, double k, double kp, double beta,
+                          double lmag, double j0, double j1, double d20, double d21, double nu, double a0, double a1,
+                          double a2, double u0)
+{
+    double lq = -RBS_PI * kkp / kk;
     if (!(lq <= THETA_LNQ_MAX)) return 0;
     double k2 = k * k;
     double hw = 0.5 * RBS_PI / kk;
-    double at2 = 2.0 * hw * sqrt(beta) * rbs_carlson_rf(k2, k2 * (1.0 + beta), k2 + beta);
+    double at2 = 2.0 * hw * sqrt(beta) * rf_alpha;
     if (!(lq + at2 <= THETA_LNRHO_MAX)) return 0;
     double q = exp(lq);
     double e = exp(at2);
@@ -678,6 +746,8 @@ void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3
     cf /= h;
     sf /= h;
     double s, c, d, gval, u0, n[3];
+    int theta = kp2 != 0.0 && k2 >= THETA_K2_MIN; /* a candidate for the theta mode */
+    double k = 0.0, kp = 0.0, kk = 0.0, kkp = 0.0, rf_alpha = 0.0; /* set and read only if theta */
     if (kp2 == 0.0) {
         params[I_MODE] = MODE_SEPARATRIX;
         params[I_LIN] = lmag / j2;
@@ -686,12 +756,19 @@ void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3
         u0 = atan2(sf, cf);
     } else {
         d = sqrt(cf * cf + kp2 * sf * sf); /* dn(u_0) */
-        u0 = sf * rbs_rf_amp(cf * cf, cf, d * d, d);
+        double rf_u0;
+        if (theta) {
+            k = sqrt(k2);
+            kp = sqrt(kp2);
+            rbs_theta_elliptic(k, kp, beta, cf * cf, cf, d * d, d, &kk, &kkp, &rf_alpha, &rf_u0);
+        } else {
+            rf_u0 = rbs_rf_amp(cf * cf, cf, d * d, d);
+        }
+        u0 = sf * rf_u0;
     }
     params[I_U0] = u0;
-    if (kp2 != 0.0 && k2 >= THETA_K2_MIN &&
-        rbs_theta_init(params, sqrt(k2), sqrt(kp2), beta, lmag, j0, j1, d20, d21, nu, params[I_A + 0],
-                       params[I_A + 1], a2, u0)) {
+    if (theta && rbs_theta_init(params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, nu, params[I_A + 0],
+                                params[I_A + 1], a2, u0)) {
         params[I_MODE] = MODE_THETA;
         double cr, ci;
         rbs_theta_state(params, 0.0, n, &cr, &ci);
