@@ -46,13 +46,14 @@ vertex at distance ≤ R_b: M = g₂ R_b, M3 = g₃ R_b;
 ellipsoid (|A²g| ≤ a_max σ, σ ≥ a_min): M = a_max² ω² / a_min + a_max g₂,
 M3 = 6 a_max² ω g₂ / a_min + a_max g₃ + 6 a_max³ ω³ / a_min².
 
-A hull of many vertices (more than :data:`PASS_OVER_ABOVE`): only the smallest
-and second smallest safe steps matter, and both are at most T, the larger of
-the two lowest points' safe steps (:func:`pass_over_bound`); a point whose
+Only the smallest and second smallest safe steps matter. A point whose
 h + h'T' − ½MT'² exceeds its round-off (T' = T(1 + 10⁻¹²)) provably has a safe
 step above T, so it is passed over without its square root and division
 (:func:`may_reach`): the same steps, the same bits, as a scan of every point.
-Below that size the tests cost more than the square roots they save.
+T is the second smallest safe step of the points before it in the scan, and on
+a hull of many vertices (more than :data:`PASS_OVER_ABOVE`) at most the larger
+of the two lowest points' safe steps (:func:`pass_over_bound`), which costs a
+scan and two safe steps first.
 
 The flight's rotation set-up (:func:`direct_model.rotation.rotation_init`) is
 done at the first step that needs the orientation at a later time: a flight
@@ -73,7 +74,7 @@ SEARCH_ESCAPED = 1      # the body can never reach the wall again
 SEARCH_STALLED = 2      # max_steps reached without a decision
 
 HORIZON = 4.0           # the binding point's longer step looks at most this many safe steps ahead
-PASS_OVER_ABOVE = 24    # vertices; up to this many (every family) all safe steps are computed (bench_grains.py)
+PASS_OVER_ABOVE = 24    # vertices; above this many (no family) the pass over starts from pass_over_bound (bench_grains.py)
 
 
 @numba.njit(**KERNEL)
@@ -299,7 +300,9 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
         tau, tau_other = np.inf, np.inf
         for i in range(n):
-            if T < np.inf and not may_reach(h[i], h1[i], M, T):
+            # a point whose safe step surely exceeds the second smallest so far changes neither
+            bound = min(T, tau_other)
+            if bound < np.inf and not may_reach(h[i], h1[i], M, bound):
                 continue
             tau_i = safe_step(h[i], h1[i], M)
             if tau_i < tau:

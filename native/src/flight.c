@@ -15,7 +15,7 @@
 #include "shapes.h"
 
 #define HORIZON 4.0 /* direct_model.flight.HORIZON */
-#define PASS_OVER_ABOVE 24 /* direct_model.flight.PASS_OVER_ABOVE: vertices, fewer: every safe step computed */
+#define PASS_OVER_ABOVE 24 /* direct_model.flight.PASS_OVER_ABOVE: above this many vertices pass_over_bound starts the pass */
 
 /* bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (direct_model.flight._rate_bounds) */
 static void rate_bounds(const double K[3], const double ell[3], const double W[3], double *w, double *wdot,
@@ -222,7 +222,9 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
         double T = n > PASS_OVER_ABOVE ? pass_over_bound(h, h1, n, low, M) : INFINITY;
         double tau = INFINITY, tau_other = INFINITY;
         for (int i = 0; i < n; i++) {
-            if (T < INFINITY && !may_reach(h[i], h1[i], M, T)) continue;
+            /* a point whose safe step surely exceeds the second smallest so far changes neither */
+            double bound = py_min(T, tau_other);
+            if (bound < INFINITY && !may_reach(h[i], h1[i], M, bound)) continue;
             double tau_i = safe_step(h[i], h1[i], M);
             if (tau_i < tau) {
                 tau_other = tau;
