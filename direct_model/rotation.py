@@ -148,6 +148,7 @@ import math
 
 import numba
 
+from direct_model.elementary import sincos
 from direct_model.options import KERNEL
 
 # --------------------------------------------------------------------------------------
@@ -212,6 +213,7 @@ _THETA_LNRHO_MAX = -0.6931471805599453  # ln 0.5: see _theta_init
 _THETA_TOL = 1e-17  # the first term left out of every series is below this
 _THETA_K2_MIN = 1e-4  # closer to a steady spin (k -> 0) the theta phases lose digits: the Landen path
 
+_PHASE_MAX = 2.0 ** 62  # sincos's domain: int() of the multiple of pi/2 stays within int64
 _SNAP = 16.0 * 2.220446049250313e-16  # relative size of rounding noise in R0^T ell
 
 # Duplication stops once the arguments agree to these relative spreads; the series
@@ -750,6 +752,15 @@ def _theta_init(params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, 
 
 
 @numba.njit(**KERNEL)
+def _phase_sincos(x):
+    """(sin x, cos x) of a phase: :func:`direct_model.elementary.sincos` on its domain ``|x| < 2^62``, libm's
+    beyond (where ulp(x) > 1000 makes the phase meaningless, but numba and C still agree)."""
+    if abs(x) < _PHASE_MAX:
+        return sincos(x)
+    return math.sin(x), math.cos(x)
+
+
+@numba.njit(**KERNEL)
 def _theta_state(params, t):
     """The working-frame unit momentum ``n = m / |m|`` and ``(cos psi, sin psi)`` at time
     ``t`` in the theta mode (module docstring, item 6).
@@ -758,8 +769,7 @@ def _theta_state(params, t):
     ``e^{i psi} = e^{i lin t} (w / |w|) ((m_0 - i m_1) / |(m_0, m_1)|) e^{-i psi_raw(0)}``.
     """
     v = params[_I_TH_NUV] * t + params[_I_TH_V0]
-    c1 = math.cos(v)
-    s1 = math.sin(v)
+    s1, c1 = _phase_sincos(v)
     c2 = c1 * c1 - s1 * s1
     s2 = 2.0 * s1 * c1
     co = c1  # cos, sin of (2n + 1) v
@@ -783,9 +793,7 @@ def _theta_state(params, t):
         ce_next = ce * c2 - se * s2
         se = se * c2 + ce * s2
         ce = ce_next
-    a = params[_I_LIN] * t
-    ca = math.cos(a)
-    sa = math.sin(a)
+    sa, ca = _phase_sincos(params[_I_LIN] * t)
     r = 1.0 / math.sqrt((wr * wr + wi * wi) * (m0 * m0 + m1 * m1))
     xr = wr * m0 + wi * m1  # w (m_0 - i m_1)
     xi = wi * m0 - wr * m1

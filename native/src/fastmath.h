@@ -1,9 +1,9 @@
 /*
- * fastmath.h: the inlined arithmetic of a draw that would otherwise call libm (surrogate.kernels.fastmath),
- * with the same operations in the same order and fma() wherever numba uses its fused multiply-add
- * intrinsic, so the same bits:
+ * fastmath.h: the inlined arithmetic of a draw and of the flight's phases that would otherwise call libm
+ * (surrogate.kernels.fastmath, direct_model.elementary), with the same operations in the same order and fma()
+ * wherever numba uses its fused multiply-add intrinsic, so the same bits:
  *
- *   rbs_sincos            (sin x, cos x), |x| <= 2π: Cody–Waite reduction by π/2, Taylor polynomials
+ *   rbs_sincos            (sin x, cos x): Cody–Waite reduction by π/2, Taylor polynomials
  *   rbs_atan2_q1          atan2(y, x) for x, y >= 0: nearest node atan c + Taylor series of atan z
  *   rbs_restitution_at    exp(−k V^p) between grid speeds from the table's polynomial pieces
  *   rbs_trunc             Python's int(x) of a float as numba compiles it on x86-64
@@ -68,7 +68,7 @@ RBS_INLINE double rbs_fmin_py(double a, double b) { return b < a ? b : a; }
 RBS_INLINE double rbs_fmax_py(double a, double b) { return b > a ? b : a; }
 
 /* The reduced angle's sine s and cosine c and the multiple q of π/2 with x = r + q·π/2, |r| <= π/4
- * (Cody–Waite reduction, Taylor polynomials; surrogate.kernels.fastmath.sincos) */
+ * (Cody–Waite reduction, Taylor polynomials; direct_model.elementary.sincos) */
 RBS_INLINE double rbs_sincos_reduced(double x, double *s, double *c)
 {
     const double S3 = -0x1.5555555555555p-3, S5 = 0x1.1111111111111p-7, S7 = -0x1.a01a01a01a01ap-13,
@@ -87,7 +87,7 @@ RBS_INLINE double rbs_sincos_reduced(double x, double *s, double *c)
     return q;
 }
 
-/* (sin x, cos x) for |x| <= 2π, to a few ulp (surrogate.kernels.fastmath.sincos) */
+/* (sin x, cos x), |x| < 2^62: a few ulp for |x| <= 2π, plus about ulp(x)/2 beyond (direct_model.elementary.sincos) */
 RBS_INLINE void rbs_sincos(double x, double *sin_x, double *cos_x)
 {
     double s, c;

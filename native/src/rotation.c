@@ -528,13 +528,24 @@ static int rbs_theta_init(double *params, double kk, double kkp, double rf_alpha
     return 1;
 }
 
+/* (sin x, cos x) of a phase: rbs_sincos on its domain |x| < 2^62, libm's beyond (direct_model.rotation._phase_sincos) */
+RBS_INLINE void rbs_phase_sincos(double x, double *s, double *c)
+{
+    if (fabs(x) < 0x1p62) {
+        rbs_sincos(x, s, c);
+    } else {
+        *s = sin(x);
+        *c = cos(x);
+    }
+}
+
 /* the unit momentum n = m / |m| and (cos psi, sin psi) at time t in the theta mode
  * (direct_model.rotation._theta_state) */
-static void rbs_theta_state(const double *params, double t, double n[3], double *cpsi, double *spsi)
+RBS_INLINE void rbs_theta_state(const double *params, double t, double n[3], double *cpsi, double *spsi)
 {
     double v = params[I_TH_NUV] * t + params[I_TH_V0];
-    double c1 = cos(v);
-    double s1 = sin(v);
+    double s1, c1;
+    rbs_phase_sincos(v, &s1, &c1);
     double c2 = c1 * c1 - s1 * s1;
     double s2 = 2.0 * s1 * c1;
     double co = c1, so = s1; /* cos, sin of (2n + 1) v */
@@ -554,9 +565,8 @@ static void rbs_theta_state(const double *params, double t, double n[3], double 
         se = se * c2 + ce * s2;
         ce = ce_next;
     }
-    double a = params[I_LIN] * t;
-    double ca = cos(a);
-    double sa = sin(a);
+    double sa, ca;
+    rbs_phase_sincos(params[I_LIN] * t, &sa, &ca);
     double r = 1.0 / sqrt((wr * wr + wi * wi) * (m0 * m0 + m1 * m1));
     double xr = wr * m0 + wi * m1; /* w (m_0 - i m_1) */
     double xi = wi * m0 - wr * m1;
@@ -648,7 +658,8 @@ static void rbs_store_r0(const double R0[9], double *params)
     for (int i = 0; i < 9; i++) params[I_C + i] = R0[i];
 }
 
-void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3], double *params)
+/* RBS_HOT: the x86-64-v3 version has rbs_sincos's fma() as one instruction (the same bits either way) */
+RBS_HOT void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3], double *params)
 {
     for (int i = 0; i < I_KN; i++) params[i] = 0.0;    /* the Landen levels beyond I_NLEV are never read */
     double mb0 = R0[0] * ell[0] + R0[3] * ell[1] + R0[6] * ell[2];
@@ -824,7 +835,7 @@ void rbs_rotation_init(const double K[3], const double R0[9], const double ell[3
 
 /* ---------------------------------------------------------------- evaluation */
 
-void rbs_rotation_at(const double *params, double t, double R_out[9], double omega_out[3])
+RBS_HOT void rbs_rotation_at(const double *params, double t, double R_out[9], double omega_out[3])
 {
     double mode = params[I_MODE];
     if (mode == MODE_STATIC) {

@@ -17,8 +17,8 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from direct_model.elementary import fma, sincos
 from surrogate.kernels.block import BLOCK, field, put3
-from surrogate.kernels.fastmath import fma, sincos
 from surrogate.kernels.frame import FRAME_OK, frame_at, is_valid, to_global
 from surrogate.kernels.gather import gathered_at
 from surrogate.kernels.options import JIT, KERNEL

@@ -53,8 +53,8 @@ import math
 import numba
 
 from data_schema.samples import STATUS_TRAPPED
+from direct_model.elementary import sincos
 from surrogate.kernels.arithmetic import NAN6, arithmetic
-from surrogate.kernels.fastmath import sincos
 from surrogate.kernels.gather import gather, is_trapped
 from surrogate.kernels.locate import component, hint, locate
 from surrogate.kernels.options import JIT, KERNEL

@@ -15,8 +15,9 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
+from direct_model.elementary import fma, sincos
 from surrogate.kernels.block import BLOCK, field, fields3, put3, uniforms
-from surrogate.kernels.fastmath import atan2_first_quadrant, bits, fma, sincos
+from surrogate.kernels.fastmath import atan2_first_quadrant, bits
 from surrogate.kernels.options import JIT
 
 

@@ -11,8 +11,9 @@ block of the pipeline (:mod:`surrogate.kernels.pipeline`).
 import numba
 import numpy as np
 
+from direct_model.elementary import fma
 from surrogate.kernels.block import BLOCK, field, fields6, put3, put6, uniforms
-from surrogate.kernels.fastmath import clamp_index, fma, restitution_at
+from surrogate.kernels.fastmath import clamp_index, restitution_at
 from surrogate.kernels.frame import is_valid
 from surrogate.kernels.layout import (CELL_INV_SD, CELL_MEAN, CELL_P_TRAPPED, CELL_SD, CELL_SIZE, ROW_LOC, ROW_REGIME,
                                       ROW_SCALE, ROW_SHAPE, ROW_SLOPE)
