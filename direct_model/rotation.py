@@ -1007,9 +1007,9 @@ def rotation_init(K, R0, ell, params):
     # ---- initial amplitude phi_0 (cos phi_0 >= 0) and phase u_0 = F(phi_0 | k)
     cf = x * math.sqrt(j1 * d20)
     sf = y * math.sqrt(j0 * d21)
-    h = math.hypot(cf, sf)
-    cf /= h
-    sf /= h
+    hinv = 1.0 / math.sqrt(cf * cf + sf * sf)  # no hypot: |ell| and K within 1e+-100 of 1 (module doc)
+    cf *= hinv
+    sf *= hinv
     theta = kp2 != 0.0 and k2 >= _THETA_K2_MIN  # a candidate for the theta mode
     if kp2 == 0.0:
         params[_I_MODE] = _MODE_SEPARATRIX

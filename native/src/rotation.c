@@ -753,9 +753,9 @@ RBS_HOT void rbs_rotation_init(const double K[3], const double R0[9], const doub
     /* initial amplitude phi_0 (cos phi_0 >= 0) and phase u_0 = F(phi_0 | k) */
     double cf = x * sqrt(j1 * d20);
     double sf = y * sqrt(j0 * d21);
-    double h = hypot(cf, sf);
-    cf /= h;
-    sf /= h;
+    double hinv = 1.0 / sqrt(cf * cf + sf * sf); /* no hypot: |ell| and K within 1e+-100 of 1 (rotation.py) */
+    cf *= hinv;
+    sf *= hinv;
     double s, c, d, gval, u0, n[3];
     int theta = kp2 != 0.0 && k2 >= THETA_K2_MIN; /* a candidate for the theta mode */
     double k = 0.0, kp = 0.0, kk = 0.0, kkp = 0.0, rf_alpha = 0.0; /* set and read only if theta */
