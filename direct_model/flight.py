@@ -74,7 +74,7 @@ SEARCH_ESCAPED = 1      # the body can never reach the wall again
 SEARCH_STALLED = 2      # max_steps reached without a decision
 
 HORIZON = 4.0           # the binding point's longer step looks at most this many safe steps ahead
-PASS_OVER_ABOVE = 24    # vertices; above this many (no family) the pass over starts from pass_over_bound (bench_grains.py)
+PASS_OVER_ABOVE = 24    # vertices; above this many the pass over starts from pass_over_bound (C: 12; the same bits)
 
 
 @numba.njit(**KERNEL)
