@@ -51,7 +51,7 @@ timed alone on the bodies of the first PIECE_ROWS rows (inputs that stay in cach
 rebound: a flight's setup (K in the lab frame, curvature_bound, jerk_bound and rotation_init; counted once per
 flight, an upper count: a flight decided at its first step skips rotation_init), the free flight's orientation
 at one instant (rotation_at; once per search step but a flight's first), the body's lowest points there with
-their rates and curvatures (lowest_points; once per search step), a collision
+their rates and g̈ for the curvatures (lowest_points; once per search step), a collision
 (K⁻¹ in the lab frame and collide); the rest is the body's setup, the search's own logic and the frame.
 The C program times the same pieces in C (rbs_rotation_init, rbs_rotation_at, rbs_lowest_points,
 rbs_collide: the model's internal kernels) on the same inputs, and C's rebound alone
@@ -289,12 +289,12 @@ def _orientations(rot, t):
 
 @numba.njit
 def _lowest_points(shapes, shape, semi, K, R, verts, nv, W):
-    """The candidate lowest points of the body, their heights, rates and curvatures (lowest_points): what every
-    search step computes."""
-    h, h1, h2 = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES)
+    """The candidate lowest points of the body, their heights and rates and what gives their curvatures
+    (lowest_points): what every search step computes."""
+    h, h1, curv = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3)
     kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
-        lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W[i], 1.0, 0.0, h, h1, h2)
+        lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W[i], 1.0, 0.0, h, h1, curv)
 
 
 @numba.njit
@@ -302,12 +302,12 @@ def _collisions(params, shapes, shape, semi, K, R, verts, nv, model, out):
     """One collision per row, the body at rest touching the wall at its lowest point, hit at V⁻ (the first
     collision of a rebound with Ω⁻ = 0): K⁻¹ in the lab frame and collide. out[i] = collide's outcome."""
     Kinv, Kinv_lab = np.empty(3), np.empty((3, 3))
-    h, h1, h2, r = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3)
+    h, h1, curv, r = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES), np.empty(3), np.empty(3)
     V, W, dV, dW = np.empty(3), np.zeros(3), np.empty(3), np.empty(3)
     wall = params[P_WALL:P_WALL + 3]
     kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
-        m = lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W, 0.0, 0.0, h, h1, h2)
+        m = lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W, 0.0, 0.0, h, h1, curv)
         low = 0
         for j in range(m):
             low = j if h[j] < h[low] else low
@@ -567,7 +567,7 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
           "the bounds, rotation_init), counted once per flight (an upper count: a flight decided at its first\n"
           "step skips rotation_init); orient: the free flight's orientation at one instant (rotation_at), once\n"
           "per search step but a flight's first; lowest: the body's lowest points with their rates and\n"
-          "curvatures (lowest_points), once per search step; coll: one collision (K⁻¹ in the lab frame, collide), once per collision. rest: the body's setup,\n"
+          "g̈ for the curvatures (lowest_points), once per search step; coll: one collision (K⁻¹ in the lab frame, collide), once per collision. rest: the body's setup,\n"
           "the search's own logic (the safe and Newton steps, the contact choice), the frame's rotations; the pieces\n"
           "timed alone run hotter in cache than inside a rebound, so rest is uncertain by about ±10 points.\n"
           "trapped %: the share of the time spent on trapped particles (1 − untrapped time / all).")

@@ -41,8 +41,8 @@ HISTORY_COLUMNS = 17
 # layout of the scratch array of :func:`body_rebound`: the candidate points' heights, rates and curvatures first
 _HEIGHTS = 0
 _RATES = _HEIGHTS + MAX_HULL_VERTICES
-_CURVATURES = _RATES + MAX_HULL_VERTICES
-_PARAMS = _CURVATURES + MAX_HULL_VERTICES
+_CURVATURE = _RATES + MAX_HULL_VERTICES
+_PARAMS = _CURVATURE + 3
 _R = _PARAMS + ROT_PARAMS_SIZE
 _K_LAB = _R + 9
 _KINV_LAB = _K_LAB + 9
@@ -100,7 +100,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
     """
     h = work[_HEIGHTS:_HEIGHTS + MAX_HULL_VERTICES]
     h1 = work[_RATES:_RATES + MAX_HULL_VERTICES]
-    h2 = work[_CURVATURES:_CURVATURES + MAX_HULL_VERTICES]
+    curv = work[_CURVATURE:_CURVATURE + 3]
     params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
     R = work[_R:_R + 9].reshape((3, 3))
     K_lab = work[_K_LAB:_K_LAB + 9].reshape((3, 3))
@@ -120,7 +120,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
             R[i, j] = R0[i, j]
 
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
-        n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2)
+        n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv)
         y = -np.inf
         for i in range(n):
             y = max(y, -h[i])         # −min h (h[:n].min() would need numba's runtime)
@@ -152,7 +152,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         for i in range(3):
             Wt[i] = W[i]
         code, t, steps = find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
-                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, h2, rc)
+                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, curv, rc)
         n_steps += steps
         if code == SEARCH_ESCAPED:
             status = STATUS_REBOUNDED

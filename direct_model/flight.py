@@ -168,12 +168,14 @@ def taylor_root(h, hdot, hddot):
 
 
 @numba.njit(**KERNEL)
-def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2):
-    """Heights ``h[i]``, rates ``h1[i]`` and curvatures ``h2[i]`` of the candidate lowest points.
+def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv):
+    """Heights ``h[i]`` and rates ``h1[i]`` of the candidate lowest points, and ``curv`` (3,), from which
+    :func:`curvature` gives any one's curvature h'' (only the binding point's is needed).
 
     ``R``, ``W``: orientation and lab Ω now; ``y``, ``v``: the centre's height and vertical
     velocity. Candidates (body frame): the vertices ``verts[:nv]``, or the ellipsoid's support
-    point, written into ``verts[0]``. Returns the number of candidates (module doc).
+    point, written into ``verts[0]``. ``curv`` receives g̈ (a vertex p has h'' = g̈·p), or the
+    ellipsoid's h'' in ``curv[0]``. Returns the number of candidates (module doc).
     """
     g0, g1, g2 = R[1, 0], R[1, 1], R[1, 2]
     w0 = R[0, 0] * W[0] + R[1, 0] * W[1] + R[2, 0] * W[2]      # ω = Rᵀ Ω
@@ -197,14 +199,22 @@ def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2):
                       + (q0 * a0 + q1 * a1 + q2 * a2))
         h[0] = y - sigma
         h1[0] = v - 0.5 * phi1 / sigma
-        h2[0] = (0.25 * phi1 * phi1 / (sigma * sigma) - 0.5 * phi2) / sigma
+        curv[0] = (0.25 * phi1 * phi1 / (sigma * sigma) - 0.5 * phi2) / sigma
         return 1
     for i in range(nv):
         p0, p1, p2 = verts[i, 0], verts[i, 1], verts[i, 2]
         h[i] = y + (g0 * p0 + g1 * p1 + g2 * p2)
         h1[i] = v + (d0 * p0 + d1 * p1 + d2 * p2)
-        h2[i] = a0 * p0 + a1 * p1 + a2 * p2
+    curv[0], curv[1], curv[2] = a0, a1, a2
     return nv
+
+
+@numba.njit(**KERNEL)
+def curvature(kind, verts, i, curv):
+    """Curvature h'' of candidate point ``i`` from :func:`lowest_points`' ``curv``."""
+    if kind == KIND_ELLIPSOID:
+        return curv[0]
+    return curv[0] * verts[i, 0] + curv[1] * verts[i, 1] + curv[2] * verts[i, 2]
 
 
 @numba.njit(**KERNEL)
@@ -241,7 +251,7 @@ def choose_contact(n, verts, h, h1, R, set_tol, rc):
 
 @numba.njit(**KERNEL)
 def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
-                 max_steps, R, W, h, h1, h2, rc):
+                 max_steps, R, W, h, h1, curv, rc):
     """Advance a flight from its start (t = 0) to the next collision or to escape.
 
     Parameters
@@ -258,8 +268,8 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
     max_steps : step budget of this search.
     R, W : on entry the orientation and lab angular velocity at t = 0; on
         return, at the returned time.
-    h, h1, h2, rc : work arrays; for a contact, rc receives the contact point
-        relative to the centroid (lab frame).
+    h, h1, curv, rc : work arrays (nv, nv, 3, 3 entries; :func:`lowest_points`); for a
+        contact, rc receives the contact point relative to the centroid (lab frame).
 
     Returns
     -------
@@ -275,7 +285,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
                 rotation_init(K, R, ell, params)
             rotation_at(params, t, R, W)
         y = y0 + v * t
-        n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2)
+        n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv)
         hmin, low = np.inf, 0
         for i in range(n):
             if h[i] < hmin:
@@ -291,7 +301,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
                 t_hi = t
             else:
                 t_lo = t
-            t_new = t + taylor_root(h[b], h1[b], h2[b])
+            t_new = t + taylor_root(h[b], h1[b], curvature(kind, verts, b, curv))
             t = t_new if t_lo < t_new < t_hi else 0.5 * (t_lo + t_hi)
             continue
         if v > 0.0 and y > Rb:
@@ -311,8 +321,9 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
                 tau_other = min(tau_other, tau_i)
         if 0.0 < tau < np.inf:
             # b's longer step from its exact curvature, valid up to the horizon (module doc)
+            h2b = curvature(kind, verts, b, curv)  # read again below only with a finite step
             horizon = min(tau_other, HORIZON * tau)
-            tau = max(tau, min(horizon, safe_step(h[b], h1[b], min(M, M3 * horizon / 3.0 - h2[b]))))
+            tau = max(tau, min(horizon, safe_step(h[b], h1[b], min(M, M3 * horizon / 3.0 - h2b))))
         if v > 0.0 and tau >= (Rb - y) / v:
             return SEARCH_ESCAPED, t, step + 1
         if not (0.0 < tau < np.inf):
@@ -320,9 +331,9 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         # second-order Newton step of b where it is safe (module doc): no other point can
         # reach the wall first, and b approaches monotonically
         if h1[b] < 0.0:
-            t_newton = taylor_root(h[b], h1[b], h2[b])
+            t_newton = taylor_root(h[b], h1[b], h2b)
             if tau < t_newton < tau_other and (h1[b] + M * t_newton < 0.0
-                                                or h1[b] + (h2[b] + 0.5 * M3 * t_newton) * t_newton < 0.0):
+                                                or h1[b] + (h2b + 0.5 * M3 * t_newton) * t_newton < 0.0):
                 tau = t_newton
         t_lo = t
         t += tau

@@ -16,8 +16,9 @@
  * wy, wz, the RBS_U_PER_REBOUND uniforms), the pieces of bench_direct.py's time split are timed as its numba
  * loops time them, in µs per call: us_model_frame (rbs_rebound_model_frame alone), us_flight_setup (K in the
  * lab frame, ℓ, rbs_rotation_init, rbs_curvature_bound, rbs_jerk_bound), us_orientation (rbs_rotation_at at t),
- * us_lowest_points (rbs_lowest_points with the rates and curvatures), us_collision (the body at rest touching
- * the wall at its lowest point hit at (vt, vn, 0): K⁻¹ in the lab frame, rbs_collide); each the best of 5 × REPEATS.
+ * us_lowest_points (rbs_lowest_points with the rates and g̈ for the curvatures), us_collision (the body at rest
+ * touching the wall at its lowest point hit at (vt, vn, 0): K⁻¹ in the lab frame, rbs_collide); each the best of
+ * 5 × REPEATS.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -71,7 +72,7 @@ static void principal(const double *params, int shape, const double *semi, doubl
 static double run_piece(int k, const double *params, const rbs_shape_arrays *shapes, int shape, const double *rows,
                         size_t m, double *rot)
 {
-    double sum = 0.0, K[3], Kinv[3], T[9], ell[3], R[9], W[3], h[MAX_VERTICES], h1[MAX_VERTICES], h2[MAX_VERTICES];
+    double sum = 0.0, K[3], Kinv[3], T[9], ell[3], R[9], W[3], h[MAX_VERTICES], h1[MAX_VERTICES], curv[3];
     double verts[3 * MAX_VERTICES];
     int kind = shapes->kind[shape];
     for (size_t i = 0; i < m; i++) {
@@ -96,12 +97,12 @@ static double run_piece(int k, const double *params, const rbs_shape_arrays *sha
             sum += R[0];
         } else if (k == 3) {
             principal(params, shape, semi, K);
-            sum += rbs_lowest_points(kind, verts, nv, semi, K, x + PIECE_R, x + PIECE_W, 1.0, 0.0, h, h1, h2);
+            sum += rbs_lowest_points(kind, verts, nv, semi, K, x + PIECE_R, x + PIECE_W, 1.0, 0.0, h, h1, curv);
         } else {
             double V[3] = {x[PIECE_MODEL], x[PIECE_MODEL + 1], 0.0}, W0[3] = {0.0, 0.0, 0.0}, dV[3], dW[3], r[3];
             const double *Ri = x + PIECE_R;
             principal(params, shape, semi, K);
-            int n = rbs_lowest_points(kind, verts, nv, semi, K, Ri, W0, 0.0, 0.0, h, h1, h2), low = 0;
+            int n = rbs_lowest_points(kind, verts, nv, semi, K, Ri, W0, 0.0, 0.0, h, h1, curv), low = 0;
             for (int j = 0; j < n; j++) low = h[j] < h[low] ? j : low;
             for (int j = 0; j < 3; j++) {
                 r[j] = Ri[3 * j] * verts[3 * low] + Ri[3 * j + 1] * verts[3 * low + 1] + Ri[3 * j + 2] * verts[3 * low + 2];

@@ -46,7 +46,7 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
                      long long *n_collisions, long long *n_steps)
 {
-    double h[MAX_HULL_VERTICES], h1[MAX_HULL_VERTICES], h2[MAX_HULL_VERTICES];
+    double h[MAX_HULL_VERTICES], h1[MAX_HULL_VERTICES], curv[3];
     double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
     double Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
 
@@ -59,7 +59,7 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
 
     double y;
     if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
-        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, h2);
+        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv);
         /* numpy's min: the first NaN, else the smallest */
         double lowest = h[0];
         for (int i = 1; i < n && lowest == lowest; i++)
@@ -79,7 +79,7 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
         double t = 0.0;
         long long steps = 0;
         int code = rbs_find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1], contact_tol, set_tol,
-                                    max_steps, &t, R, Wt, h, h1, h2, rc, &steps);
+                                    max_steps, &t, R, Wt, h, h1, curv, rc, &steps);
         steps_total += steps;
         if (code == SEARCH_ESCAPED) {
             status = RBS_REBOUNDED;

@@ -108,7 +108,7 @@ static double taylor_root(double h, double hdot, double hddot)
 }
 
 int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
-                      const double W[3], double y, double v, double *h, double *h1, double *h2)
+                      const double W[3], double y, double v, double *h, double *h1, double curv[3])
 {
     double g0 = R[3], g1 = R[4], g2 = R[5];
     double w0 = R[0] * W[0] + R[3] * W[1] + R[6] * W[2]; /* ω = Rᵀ Ω */
@@ -134,16 +134,25 @@ int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], con
                              + (q0 * a0 + q1 * a1 + q2 * a2));
         h[0] = y - sigma;
         h1[0] = v - 0.5 * phi1 / sigma;
-        h2[0] = (0.25 * phi1 * phi1 / (sigma * sigma) - 0.5 * phi2) / sigma;
+        curv[0] = (0.25 * phi1 * phi1 / (sigma * sigma) - 0.5 * phi2) / sigma;
         return 1;
     }
     for (int i = 0; i < nv; i++) {
         double p0 = verts[3 * i], p1 = verts[3 * i + 1], p2 = verts[3 * i + 2];
         h[i] = y + (g0 * p0 + g1 * p1 + g2 * p2);
         h1[i] = v + (d0 * p0 + d1 * p1 + d2 * p2);
-        h2[i] = a0 * p0 + a1 * p1 + a2 * p2;
     }
+    curv[0] = a0;
+    curv[1] = a1;
+    curv[2] = a2;
     return nv;
+}
+
+/* curvature h'' of candidate point i from rbs_lowest_points' curv (direct_model.flight.curvature) */
+static double curvature(int kind, const double *verts, int i, const double curv[3])
+{
+    if (kind == KIND_ELLIPSOID) return curv[0];
+    return curv[0] * verts[3 * i] + curv[1] * verts[3 * i + 1] + curv[2] * verts[3 * i + 2];
 }
 
 /* the contact point among touching candidates into rc (lab); 0 if none approaches (the points within set_tol of
@@ -185,7 +194,7 @@ static int choose_contact(int n, const double *verts, const double *h, const dou
 int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], double Rb, const double K[3],
                      const double ell[3], double M, double M3, double *params, double y0, double v, double contact_tol,
                      double set_tol, long long max_steps, double *t_out, double R[9], double W[3], double *h,
-                     double *h1, double *h2, double rc[3], long long *n_steps)
+                     double *h1, double curv[3], double rc[3], long long *n_steps)
 {
     int b = -1;                 /* the binding point of the last step */
     double t = 0.0;
@@ -197,7 +206,7 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
             rbs_rotation_at(params, t, R, W);
         }
         double y = y0 + v * t;
-        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, h2);
+        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv);
         double hmin = INFINITY;
         int low = 0;
         for (int i = 0; i < n; i++)
@@ -215,7 +224,7 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
             if (b < 0) b = low; /* below the wall at the start: no bracket, the budget ends it */
             if (h[b] < 0.0) t_hi = t;
             else t_lo = t;
-            double t_new = t + taylor_root(h[b], h1[b], h2[b]);
+            double t_new = t + taylor_root(h[b], h1[b], curvature(kind, verts, b, curv));
             t = t_lo < t_new && t_new < t_hi ? t_new : 0.5 * (t_lo + t_hi);
             continue;
         }
@@ -236,19 +245,21 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
                 tau_other = py_min(tau_other, tau_i);
             }
         }
+        double h2b = 0.0; /* b's curvature: set with a finite step, before its only reads */
         if (0.0 < tau && tau < INFINITY) {
             /* b's longer step from its exact curvature, valid up to the horizon */
+            h2b = curvature(kind, verts, b, curv);
             double horizon = py_min(tau_other, HORIZON * tau);
-            tau = py_max(tau, py_min(horizon, safe_step(h[b], h1[b], py_min(M, M3 * horizon / 3.0 - h2[b]))));
+            tau = py_max(tau, py_min(horizon, safe_step(h[b], h1[b], py_min(M, M3 * horizon / 3.0 - h2b))));
         }
         if (v > 0.0 && tau >= (Rb - y) / v) return SEARCH_ESCAPED;
         if (!(0.0 < tau && tau < INFINITY)) return SEARCH_STALLED;
         /* second-order Newton step of b where it is safe: no other point can reach the wall first, and b
          * approaches monotonically */
         if (h1[b] < 0.0) {
-            double t_newton = taylor_root(h[b], h1[b], h2[b]);
+            double t_newton = taylor_root(h[b], h1[b], h2b);
             if (tau < t_newton && t_newton < tau_other
-                && (h1[b] + M * t_newton < 0.0 || h1[b] + (h2[b] + 0.5 * M3 * t_newton) * t_newton < 0.0))
+                && (h1[b] + M * t_newton < 0.0 || h1[b] + (h2b + 0.5 * M3 * t_newton) * t_newton < 0.0))
                 tau = t_newton;
         }
         t_lo = t;

@@ -23,21 +23,22 @@ double rbs_curvature_bound(int kind, const double semi[3], double Rb, const doub
 double rbs_jerk_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
                       const double W[3]);
 
-/* Heights h[i] (units of a), rates h1[i] and curvatures h2[i] of the candidate lowest points at orientation R, lab
- * angular velocity W, centre height y and vertical velocity v: every vertex (body frame, verts), or the
- * ellipsoid's support point, written into verts[0..2]; returns their number (direct_model.flight.lowest_points). */
+/* Heights h[i] (units of a) and rates h1[i] of the candidate lowest points at orientation R, lab angular velocity W,
+ * centre height y and vertical velocity v: every vertex (body frame, verts), or the ellipsoid's support point,
+ * written into verts[0..2]; curv receives what gives a point's curvature h'': g̈ (a vertex p has h'' = g̈·p), or the
+ * ellipsoid's h'' in curv[0]. Returns their number (direct_model.flight.lowest_points). */
 int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
-                      const double W[3], double y, double v, double *h, double *h1, double *h2);
+                      const double W[3], double y, double v, double *h, double *h1, double curv[3]);
 
 /* Advance a flight from its start (t = 0) to the next collision or to escape (direct_model.flight.find_contact):
  * K, ell its principal J/m and ℓ = L/m (lab), M, M3 its bounds, params its rotation (filled here by
  * rbs_rotation_init when first needed), y0 and v its centre height (a) at t = 0 and vertical velocity (m/s); R, W
  * on entry at t = 0, on return at the returned time *t; rc the contact point from the centroid (lab) for a
- * contact; h, h1, h2 work space of nv points (at least one). Returns a SEARCH_* code, the search steps taken into
- * *n_steps. */
+ * contact; h, h1 work space of nv points (at least one), curv of 3. Returns a SEARCH_* code, the search steps taken
+ * into *n_steps. */
 int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], double Rb, const double K[3],
                      const double ell[3], double M, double M3, double *params, double y0, double v, double contact_tol,
                      double set_tol, long long max_steps, double *t, double R[9], double W[3], double *h,
-                     double *h1, double *h2, double rc[3], long long *n_steps);
+                     double *h1, double curv[3], double rc[3], long long *n_steps);
 
 #endif /* RBS_FLIGHT_H */
