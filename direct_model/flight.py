@@ -209,7 +209,7 @@ def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv):
     return nv
 
 
-@numba.njit(**KERNEL)
+@numba.njit(inline="always", **KERNEL)
 def curvature(kind, verts, i, curv):
     """Curvature h'' of candidate point ``i`` from :func:`lowest_points`' ``curv``."""
     if kind == KIND_ELLIPSOID:
