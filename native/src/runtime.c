@@ -4,7 +4,7 @@
  * the particle's body from the shape arrays (shapes.c), every other model parameter from the P_* array, then the
  * rebound (body_rebound.c). The same operations in the same order as the numba kernels; libm's sqrt, log, sin
  * and cos. The work space on the stack: the body's vertices, MAX_HULL_VERTICES rows (6 KiB), and
- * rbs_body_rebound's (about 6.5 KiB): 13 KiB in all.
+ * rbs_body_rebound's (heights and rates, about 4.5 KiB): 11 KiB in all.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
