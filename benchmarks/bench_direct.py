@@ -567,7 +567,8 @@ def main_runtime(states: int, repeats: int, hits_path: Path, table_path: Path | 
           "the bounds, rotation_init), counted once per flight (an upper count: a flight decided at its first\n"
           "step skips rotation_init); orient: the free flight's orientation at one instant (rotation_at), once\n"
           "per search step but a flight's first; lowest: the body's lowest points with their rates and\n"
-          "g̈ for the curvatures (lowest_points), once per search step; coll: one collision (K⁻¹ in the lab frame, collide), once per collision. rest: the body's setup,\n"
+          "g̈ for the curvatures (lowest_points), once per search step; coll: one collision (K⁻¹ in the lab\n"
+          "frame, collide), once per collision. rest: the body's setup,\n"
           "the search's own logic (the safe and Newton steps, the contact choice), the frame's rotations; the pieces\n"
           "timed alone run hotter in cache than inside a rebound, so rest is uncertain by about ±10 points.\n"
           "trapped %: the share of the time spent on trapped particles (1 − untrapped time / all).")

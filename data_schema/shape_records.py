@@ -194,7 +194,8 @@ def records_from_arrays(arrays: dict, names, kappa: float, aspect: tuple, refuse
     """The registry records of checked /shapes datasets (:func:`check_shape_datasets`). A row of the paper's four
     families must be the family's record at κ and the aspect-ratio law ``aspect`` bit for bit; any other
     polyhedron's record (a user grain's, a later family's) is rebuilt from its vertices and triangles
-    (:func:`direct_model.registry.polyhedron`), whose mass properties must give the stored inertia bit for bit. ``refuse`` names the first row that does not."""
+    (:func:`direct_model.registry.polyhedron`), whose mass properties must give the stored inertia bit for bit.
+    ``refuse`` names the first row that does not."""
     records = []
     for i, name in enumerate(names):
         if name in SHAPES:

@@ -332,10 +332,15 @@ def _rf_amp_start(x, sx, y, sy):
 
 
 @numba.njit(**KERNEL)
+def _rf_open(a, fac, qmax):
+    """True while R_F's duplication needs another step: the spread ``fac qmax`` is above ``a``."""
+    return fac * qmax > a
+
+
+@numba.njit(**KERNEL)
 def _rf_tail(x, y, z, a, fac, qx, qy, qmax):
-    """R_F from a duplication state (:func:`_rf_start`): steps until the spread
-    ``fac qmax`` falls below ``a``, then the series."""
-    while fac * qmax > a:
+    """R_F from a duplication state (:func:`_rf_start`): steps while :func:`_rf_open`, then the series."""
+    while _rf_open(a, fac, qmax):
         x, y, z, a, fac = _rf_step(x, y, z, a, fac)
     return _rf_end(a, fac, qx, qy)
 
@@ -665,8 +670,8 @@ def _theta_elliptic(k, kp, beta, x, sx, y, sy):
     while True:
         open1 = _agm_open(a1, g1)
         open2 = _agm_open(a2, g2)
-        open3 = fa * qma > aa
-        open4 = fu * qmu > au
+        open3 = _rf_open(aa, fa, qma)
+        open4 = _rf_open(au, fu, qmu)
         if not (open1 or open2 or open3 or open4):
             break
         if open1:

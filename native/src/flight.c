@@ -15,8 +15,8 @@
 #include "shapes.h"
 
 #define HORIZON 4.0 /* direct_model.flight.HORIZON */
-/* above this many vertices pass_over_bound starts the pass: from 12 here, 24 in numba (direct_model.flight.PASS_OVER_ABOVE),
- * where each compiler's scan pays for it (the same bits either way) */
+/* above this many vertices pass_over_bound starts the pass: from 12 here, 24 in numba
+ * (direct_model.flight.PASS_OVER_ABOVE), where each compiler's scan pays for it (the same bits either way) */
 #define PASS_OVER_ABOVE 12
 
 /* bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (direct_model.flight._rate_bounds) */

@@ -184,10 +184,16 @@ static double rbs_rf_end(const rbs_rf_state *st)
     return rbs_rf_series(dx * dy - dz * dz, dx * dy * dz) / sqrt(st->a);
 }
 
-/* R_F from a duplication state: steps until the spread falls below a, then the series */
+/* 1 while the duplication needs another step: the spread fac qmax is above a */
+static int rbs_rf_open(const rbs_rf_state *st)
+{
+    return st->fac * st->qmax > st->a;
+}
+
+/* R_F from a duplication state: steps while rbs_rf_open, then the series */
 static double rbs_rf_tail(rbs_rf_state st)
 {
-    while (st.fac * st.qmax > st.a) rbs_rf_step(&st);
+    while (rbs_rf_open(&st)) rbs_rf_step(&st);
     return rbs_rf_end(&st);
 }
 
@@ -443,8 +449,8 @@ static void rbs_theta_elliptic(double k, double kp, double beta, double x, doubl
     for (;;) {
         int open1 = rbs_agm_open(a1, g1);
         int open2 = rbs_agm_open(a2, g2);
-        int open3 = ra.fac * ra.qmax > ra.a;
-        int open4 = ru.fac * ru.qmax > ru.a;
+        int open3 = rbs_rf_open(&ra);
+        int open4 = rbs_rf_open(&ru);
         if (!(open1 || open2 || open3 || open4)) break;
         if (open1) {
             double a_next = 0.5 * (a1 + g1);
@@ -528,7 +534,8 @@ static int rbs_theta_init(double *params, double kk, double kkp, double rf_alpha
     return 1;
 }
 
-/* (sin x, cos x) of a phase: rbs_sincos on its domain |x| < 2^62, libm's beyond (direct_model.rotation._phase_sincos) */
+/* (sin x, cos x) of a phase: rbs_sincos on its domain |x| < 2^62, libm's beyond
+ * (direct_model.rotation._phase_sincos) */
 RBS_INLINE void rbs_phase_sincos(double x, double *s, double *c)
 {
     if (fabs(x) < 0x1p62) {

@@ -185,8 +185,9 @@ def test_rotation_bit_identical(native, kind):
 def test_states_cover_both_climbs_of_the_landen_chain(native):
     """The states of the test above include both forms of the third-kind integral (beta <= 1 and > 1),
     Landen chains of at most 7 levels (the climb in homogeneous coordinates) and of more (one division per
-    level), and k' from above 1e-9 down to below 1e-18 next to the separatrix. (k' cannot go much lower: |m_lo| stays above 16 eps L, or the state counts as a steady
-    rotation, and |m_hi| - |m_lo| is at least an ulp; both bound |H|, so k'^2, from below.)"""
+    level), and k' from above 1e-9 down to below 1e-18 next to the separatrix. (k' cannot go much lower:
+    |m_lo| stays above 16 eps L, or the state counts as a steady rotation, and |m_hi| - |m_lo| is at least an
+    ulp; both bound |H|, so k'^2, from below.)"""
     levels, forms, k_prime = set(), set(), []
     for kind in ("general", "near_separatrix"):
         rng = np.random.default_rng(KINDS.index(kind) + 2027)

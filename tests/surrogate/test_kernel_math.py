@@ -1,6 +1,6 @@
 """The inlined functions of the sampler kernels and the flight against their closed forms: the fused
-multiply-add and sincos (direct_model.elementary), first-quadrant atan2, the polynomial pieces of the wall's restitution factor exp(−k V^p), and the plain
-load of surrogate.kernels.memory."""
+multiply-add and sincos (direct_model.elementary), first-quadrant atan2, the polynomial pieces of the wall's
+restitution factor exp(−k V^p), and the plain load of surrogate.kernels.memory."""
 
 import math
 
