@@ -77,8 +77,8 @@ static double run_piece(int k, const double *params, const rbs_shape_arrays *sha
     int kind = shapes->kind[shape];
     for (size_t i = 0; i < m; i++) {
         const double *x = rows + i * PIECE_SIZE, *semi = x + PIECE_SEMI;
-        for (int j = 0; j < 3 * MAX_VERTICES; j++) verts[j] = x[PIECE_VERTS + j];
         int nv = (int)x[PIECE_NV];
+        for (int j = 0; j < 3 * (nv > 1 ? nv : 1); j++) verts[j] = x[PIECE_VERTS + j]; /* the ellipsoid: 1 point */
         if (k == 0) {
             double V[3], Wo[3];
             sum += rbs_rebound_model_frame(params, shapes, shape, x[PIECE_MODEL], x[PIECE_MODEL + 1],
