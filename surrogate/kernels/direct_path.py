@@ -10,6 +10,8 @@ caller's frame. Units: V in m/s, Ω in rad/s, a in m. The model parameters and t
 (``table.direct_parameters``, ``table.shape_arrays``), so a table and its direct model never disagree.
 :func:`direct_rebound` converts its arguments to one set of types and calls :func:`direct_rebound_typed`, which
 every kernel of the direct path calls: the model is compiled once per process whatever types the callers pass.
+Both run without numba's reference counting (``KERNEL``), the scratch space of :func:`direct_rebound` in its stack
+frame (:func:`surrogate.kernels.memory.stack_scratch`).
 """
 
 import math
@@ -22,11 +24,12 @@ from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_mo
 from surrogate.kernels.checks import check_keys
 from surrogate.kernels.frame import NAN3, dot, float3, impact_frame, moves_into_wall, particle_ok, to_global
 from surrogate.kernels.grain import key_model_uniforms
-from surrogate.kernels.options import JIT
+from surrogate.kernels.memory import stack_scratch
+from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
 
 
-@numba.njit(**JIT)
+@numba.njit(**KERNEL)
 def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
     """One particle's rebound by the direct model, in the caller's frame: (status, V⁺, Ω⁺) with V⁺ in m/s
     and Ω⁺ in rad/s as 3-tuples.
@@ -50,7 +53,7 @@ def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
     an input outside the ranges above.
     """
     return direct_rebound_typed(params, shape_arrays, np.int64(shape), float3(V), float3(omega), float3(n), float(a), u,
-                                np.empty(SCRATCH_SIZE))
+                                stack_scratch(SCRATCH_SIZE))
 
 
 @numba.njit(inline="always", **JIT)
@@ -64,7 +67,7 @@ def _valid(shape_arrays, shape, V, omega, n, a, u):
     return ok
 
 
-@numba.njit(**JIT)
+@numba.njit(**KERNEL)
 def direct_rebound_typed(params, shape_arrays, shape, V, omega, n, a, u, scratch):
     """:func:`direct_rebound` with its scratch space given: ``shape`` an int64, V, omega and n 3-tuples of float64,
     a a float64, ``scratch`` (SCRATCH_SIZE,) float64 (module doc)."""
@@ -80,7 +83,7 @@ def direct_rebound_typed(params, shape_arrays, shape, V, omega, n, a, u, scratch
     return to_global(status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
 
 
-@numba.njit(**JIT)
+@numba.njit(**KERNEL)
 def _frame_axes(V, n, u_axis):
     """ex and ez of the impact frame (:func:`impact_frame`), as 3-tuples."""
     _, _, _, _, ex, ez = impact_frame(V, n, u_axis)

@@ -14,6 +14,14 @@ waiting for the data nor faulting on any address. The kernels use it to have a
 draw's table reads, or those of a block of particles, in flight at once
 instead of one dependent cache miss after another (docs/design/sampler_cost.md
 has the measurements).
+
+``stack_scratch(size)`` is a (size,) float64 array in the calling kernel's
+stack frame, for a single-hit kernel's scratch space: ``np.empty`` needs numba's
+runtime, and a kernel compiled with it increments and decrements the reference
+count of every array it is passed, on every call (``rebound`` on the table path:
+560 ns a call with the runtime, 150 ns without; docs/model.md §10). The array
+lives until the kernel that called ``stack_scratch`` returns: it is passed
+down, never returned or stored.
 """
 
 import numba
@@ -22,6 +30,7 @@ from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
+from numba.np.arrayobj import populate_array
 
 from surrogate.kernels.options import JIT
 
@@ -83,3 +92,25 @@ def load6(x, at, step):
 def load15(x, at, step):
     """x[at + j·step] for j = 0 … 14, as float64 (the slopes of a component row)."""
     return load6(x, at, step) + load6(x, at + 6 * step, step) + load3(x, at + 12 * step, step)
+
+
+@intrinsic
+def stack_scratch(typingctx, size):
+    """A (``size``,) float64 array, C-contiguous, in the calling kernel's stack frame (module doc); ``size`` a
+    compile-time integer (a literal or a module constant). Its values start undefined, as ``np.empty``'s."""
+    if not (isinstance(size, types.IntegerLiteral) and size.literal_value > 0):
+        return None
+    count = size.literal_value
+    array_type = types.Array(types.float64, 1, "C")
+
+    def codegen(context, builder, signature, args):
+        # alloca_once puts the allocation in the function's entry block: once per call, whatever the loops
+        data = cgutils.alloca_once(builder, context.get_value_type(types.float64), size=count)
+        array = context.make_array(array_type)(context, builder)
+        itemsize = context.get_constant(types.intp, 8)
+        populate_array(array, data=data, shape=[context.get_constant(types.intp, count)], strides=[itemsize],
+                       itemsize=itemsize, meminfo=None)
+        return array._getvalue()
+
+    return array_type(size), codegen
+

@@ -24,7 +24,8 @@ u[0], on either path (:func:`surrogate.kernels.locate.row_shape`). A particle of
 direct path (:mod:`surrogate.kernels.grain`).
 
 Like the table path's kernels (:mod:`surrogate.kernels.table_path`), :func:`rebound` converts its arguments and
-calls its ``_typed`` twin, compiled once per process.
+calls its ``_typed`` twin, compiled once per process. The single-hit kernels run without numba's reference
+counting (``KERNEL``), their scratch space in their stack frame (:func:`surrogate.kernels.memory.stack_scratch`).
 
 Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
 gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a
@@ -44,8 +45,9 @@ from surrogate.kernels.frame import NAN3, dot, float3, incidence, incidence_angl
 from surrogate.kernels.grain import keyed_shapes, keyed_uniforms
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
+from surrogate.kernels.memory import stack_scratch
 from surrogate.kernels.checks import check_keys, check_shapes
-from surrogate.kernels.options import JIT
+from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.pipeline import no_uniforms, run_blocks, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS
 from surrogate.kernels.table_path import table_rebound_typed
@@ -78,7 +80,7 @@ def _auto_path(bounds, V, omega, n, a):
     return np.int8(PATH_TABLE if table else PATH_DIRECT) if valid else np.int8(STATUS_INVALID)
 
 
-@numba.njit(**JIT)
+@numba.njit(**KERNEL)
 def rebound_path(data, V, omega, n, a, method):
     """Which path answers a hit: PATH_TABLE or PATH_DIRECT; STATUS_INVALID for a bad input.
 
@@ -101,7 +103,7 @@ def rebound_path(data, V, omega, n, a, method):
     return PATH_DIRECT if method == METHOD_DIRECT else STATUS_INVALID
 
 
-@numba.njit(**JIT)
+@numba.njit(**KERNEL)
 def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True,
             key=None):
     """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
@@ -140,21 +142,27 @@ def _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, 
     """:func:`rebound` of a particle of grain key ``key`` along its path ``path``: u with the key's slots."""
     if key < 0 or path == STATUS_INVALID or not uniforms_ok(u):
         return STATUS_INVALID, NAN3, NAN3
-    keyed = np.empty(U_PER_DRAW)
+    keyed = stack_scratch(U_PER_DRAW)
     keyed_uniforms(key, u, path == PATH_DIRECT, keyed)
     return rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, keyed, scaled, path)
 
 
-@numba.njit(**JIT)
+@numba.njit(**KERNEL)
 def rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path):
     """:func:`rebound` along its path ``path`` with the uniforms ``u``: V, omega and n 3-tuples of float64, a a
     float64, ``scaled`` a bool (module doc)."""
     if path == PATH_TABLE:
         return table_rebound_typed(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
-        return _direct_path(params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u,
-                            np.empty(SCRATCH_SIZE))
+        return _direct_hit(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u)
     return STATUS_INVALID, NAN3, NAN3
+
+
+@numba.njit(**KERNEL)
+def _direct_hit(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u):
+    """The direct path of :func:`rebound_typed`, its scratch space in this kernel's stack frame."""
+    return _direct_path(params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u,
+                        stack_scratch(SCRATCH_SIZE))
 
 
 @numba.njit(inline="always", **JIT)

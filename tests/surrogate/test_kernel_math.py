@@ -1,6 +1,7 @@
 """The inlined functions of the sampler kernels and the flight against their closed forms: the fused
 multiply-add and sincos (direct_model.elementary), first-quadrant atan2, the polynomial pieces of the wall's
-restitution factor exp(−k V^p), and the plain load of surrogate.kernels.memory."""
+restitution factor exp(−k V^p), the plain load and the stack scratch of surrogate.kernels.memory, and the
+single-hit kernels' compilation without numba's reference counting."""
 
 import math
 
@@ -10,7 +11,8 @@ import pytest
 
 from direct_model.elementary import fma, sincos
 from surrogate.kernels.fastmath import atan2_first_quadrant, restitution_at, restitution_pieces
-from surrogate.kernels.memory import load
+from surrogate import kernels
+from surrogate.kernels.memory import load, stack_scratch
 
 ULP_ONE = np.spacing(1.0)     # 2.2e-16
 
@@ -48,6 +50,34 @@ def test_load_reads_the_element_at_the_index(dtype):
         out = np.empty(len(index), dtype=dtype)
         _load_all(a, index, out)
         np.testing.assert_array_equal(out, a[index.astype(np.int64)])
+
+
+@numba.njit(_nrt=False)
+def _two_scratch_arrays(x):
+    """Fills a (1448,) and a (3,) stack scratch array (1448: the direct model's scratch size) and reads them back."""
+    big, small = stack_scratch(1448), stack_scratch(3)
+    for i in range(big.shape[0]):
+        big[i] = x + i
+    for i in range(small.shape[0]):
+        small[i] = big[i]
+    return big.shape[0], small.shape[0], big[0], big[1447], small[0], small[1], small[2], big.sum()
+
+
+def test_stack_scratch_holds_its_size_without_the_runtime():
+    """Two stack arrays of one kernel compiled without numba's runtime are distinct, of their sizes, and keep what
+    is written into them (a 1448-long array would be an 11.6 KB heap allocation through the runtime otherwise)."""
+    n_big, n_small, first, last, s0, s1, s2, total = _two_scratch_arrays(0.5)
+    assert (n_big, n_small) == (1448, 3)
+    assert (first, last, s0, s1, s2) == (0.5, 1447.5, 0.5, 1.5, 2.5)
+    assert total == sum(0.5 + i for i in range(1448))
+
+
+@pytest.mark.parametrize("name", ["table_rebound", "draw_local", "direct_rebound", "rebound", "rebound_path"])
+def test_single_hit_kernels_run_without_reference_counting(name):
+    """A solver calls these once per hit: compiled with numba's runtime, each would increment and decrement the
+    reference count of every array it is given (the table's, the shapes', the uniforms) on every call, which made
+    ``rebound`` on the table path 2.4 times as slow (docs/model.md §10)."""
+    assert getattr(kernels, name).targetoptions.get("_nrt") is False
 
 
 @numba.njit
