@@ -20,7 +20,8 @@ and prints the cost in ns per reflected state:
     tuples (no array views, so the loop does no reference counting); the loop
     draws the U_PER_DRAW uniforms of each state with
     ``surrogate.fill_uniforms`` (xoshiro256+, caller-owned state) and that
-    cost is included. Variants: ``surrogate.kernels.table_rebound`` on the rows
+    cost is included. Variants: ``surrogate.kernels.rebound`` in the same loop with Ω⁻ = 0 (each hit's path
+    decided; the table answers every state of its grid); ``surrogate.kernels.table_rebound`` on the rows
     ``V[i]``, ``n[i]``, its outputs stored into ``V_out[i]``, ``Omega_out[i]`` (array views); the uniforms
     from numba's ``np.random.random()``; (b') the loop reading pre-drawn
     uniforms; (b-block) a solver that collects its wall hits and calls
@@ -47,7 +48,8 @@ and prints the cost in ns per reflected state:
     hopperRebound's spinning hits: median 0.75, 90 % below 1.16); their count is N_SPIN = min(N, 20000),
     since each costs microseconds.
 
-Then it prints the ratios (c)/(b), (b)/(d), (c)/(b-block), (b-block)/(d), (e)'s auto over table,
+Then it prints the ratios (c)/(b), (b)/(d), (c)/(b-block), (b-block)/(d), rebound over table_rebound,
+(e)'s auto over table,
 spinning and the 50 % mix over table,
 and the runtime's targets, each with 'met' or 'NOT met': (b) ≤ 150 ns per
 state per core, (b-block) ≤ 100 ns and ≤ 3 × (d), a deterministic
@@ -114,8 +116,8 @@ import numpy as np
 
 import surrogate
 from machine import machine_info  # benchmarks/machine.py, next to this script
-from surrogate.kernels import (PATH_DIRECT, U_PER_DRAW, chunk_states, fill_uniforms, seed_state, table_rebound,
-                               table_rebound_many, table_rebound_many_rng, table_rebound_parallel_rng)
+from surrogate.kernels import (PATH_DIRECT, U_PER_DRAW, chunk_states, fill_uniforms, rebound, seed_state,
+                               table_rebound, table_rebound_many, table_rebound_many_rng, table_rebound_parallel_rng)
 
 SEED = 20240601
 HALF_SIZE = 1e-4                    # m, particle half-size a
@@ -202,6 +204,19 @@ def loop_kernel_rng(data, cdf, V, n, a, state, V_out, Omega_out, status):
         fill_uniforms(state, u)
         status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
                                                 (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
+        Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
+
+
+@numba.njit(**JIT)
+def loop_rebound_rng(data, params, shape_arrays, model_shapes, cdf, V, n, a, state, V_out, Omega_out, status):
+    """(b, rebound) The same loop calling rebound, which decides each hit's path (Ω⁻ = 0: the table answers
+    every state of the grid)."""
+    u = np.empty(U_PER_DRAW)
+    for i in range(V.shape[0]):
+        fill_uniforms(state, u)
+        status[i], V_new, W_new = rebound(data, params, shape_arrays, model_shapes, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                                          (0.0, 0.0, 0.0), (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
 
@@ -480,6 +495,8 @@ def main(argv=None) -> int:
     loop_block_given(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), U_block[:m], V_out[:m], Omega_out[:m],
                      status[:m])
     loop_kernel_views(data, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], Omega_out[:m], status[:m])
+    direct = (table.direct_parameters, table.shape_arrays, table.model_shapes)
+    loop_rebound_rng(data, *direct, cdf, V[:m], nrm[:m], a[:m], seed_state(SEED), V_out[:m], Omega_out[:m], status[:m])
     for scaled in (True, False):
         loop_kernel_predrawn(data, cdf, V[:m], nrm[:m], a[:m], U[:m], V_out[:m], Omega_out[:m], status[:m], scaled)
     loop_rng_only(m, seed_state(SEED), np.empty(1))
@@ -518,6 +535,8 @@ def main(argv=None) -> int:
     trapped_api = float(np.mean(api()[2] != 0))
     record("b", "(b) table_rebound in @njit loop, xoshiro256+", 1,
            lambda: loop_kernel_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
+    record("b_rebound", "    variant: rebound (its path decided; no spin)", 1,
+           lambda: loop_rebound_rng(data, *direct, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
     record("b_views", "    variant: table_rebound on array rows (views)", 1,
            lambda: loop_kernel_views(data, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
     record("b_nprandom", "    variant: uniforms from np.random.random()", 1,
@@ -574,6 +593,7 @@ def main(argv=None) -> int:
               "kernel_predrawn_over_bounce": rows["b_predrawn"]["ns_per_state"] / d,
               "kernel_beam_ns": rows["b_beam"]["ns_per_state"], "block_beam_ns": rows["b_block_beam"]["ns_per_state"],
               "api_1thread_over_kernel": rows["a_1"]["ns_per_state"] / b,
+              "rebound_over_kernel": rows["b_rebound"]["ns_per_state"] / b,
               "rng_share_of_kernel": rows["b_rng"]["ns_per_state"] / b,
               "auto_over_table": rows["e_auto"]["ns_per_state"] / rows["e_table"]["ns_per_state"],
               "spinning_over_table": rows["e_spin"]["ns_per_state"] / rows["e_table"]["ns_per_state"],
@@ -599,6 +619,7 @@ def main(argv=None) -> int:
           f"{ratios['block_beam_ns']:11.4g}")
     print(f"  (b')/(d) kernel on pre-drawn uniforms / G-T   {ratios['kernel_predrawn_over_bounce']:12.4g}")
     print(f"  (a, 1 thread)/(b) NumPy API / @njit loop      {ratios['api_1thread_over_kernel']:12.4g}")
+    print(f"  (b, rebound)/(b) rebound / table_rebound      {ratios['rebound_over_kernel']:12.4g}")
     print(f"  RNG share of (b)                              {ratios['rng_share_of_kernel']:12.4g}")
     print(f"  (e) auto / table, no spin (the path decision) {ratios['auto_over_table']:12.4g}   "
           f"in CPU time {ratios['auto_over_table_cpu']:.4g}")

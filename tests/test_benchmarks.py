@@ -23,8 +23,8 @@ def test_bench_sampler_reports_every_figure(small_table_path, tmp_path, capsys):
                                "--min-time", "0.01", "--json", str(out)]) == 0
     figures = json.loads(out.read_text())
     results = figures["results"]
-    for key in ("a_all", "a_1", "a_kernel_1", "b", "b_views", "b_predrawn", "b_block", "b_rng", "c", "d", "e_table",
-                "e_auto", "e_spin", "e_mix"):
+    for key in ("a_all", "a_1", "a_kernel_1", "b", "b_rebound", "b_views", "b_predrawn", "b_block", "b_rng", "c", "d",
+                "e_table", "e_auto", "e_spin", "e_mix"):
         assert results[key]["ns_per_state"] > 0, key
     assert figures["ratios"]["mix_over_table"] == pytest.approx(results["e_mix"]["ns_per_state"]
                                                                 / results["e_table"]["ns_per_state"])
@@ -32,6 +32,7 @@ def test_bench_sampler_reports_every_figure(small_table_path, tmp_path, capsys):
     b, c, d = (results[k]["ns_per_state"] for k in ("b", "c", "d"))
     assert figures["ratios"]["direct_over_kernel"] == pytest.approx(c / b)
     assert figures["ratios"]["kernel_over_bounce"] == pytest.approx(b / d)
+    assert figures["ratios"]["rebound_over_kernel"] == pytest.approx(results["b_rebound"]["ns_per_state"] / b)
     assert 0.0 <= figures["trapped_fraction"]["a"] <= 1.0 and 0.0 <= figures["trapped_fraction"]["b"] <= 1.0
     assert figures["memory_latency"]["table_bytes"] > 0
     printed = capsys.readouterr().out
