@@ -76,7 +76,7 @@ def test_stack_scratch_holds_its_size_without_the_runtime():
 def test_single_hit_kernels_run_without_reference_counting(name):
     """A solver calls these once per hit: compiled with numba's runtime, each would increment and decrement the
     reference count of every array it is given (the table's, the shapes', the uniforms) on every call, which made
-    ``rebound`` on the table path 2.4 times as slow (docs/model.md §10)."""
+    ``rebound`` on the table path take twice ``table_rebound``'s time (docs/runtime.md)."""
     assert getattr(kernels, name).targetoptions.get("_nrt") is False
 
 
