@@ -154,12 +154,12 @@ def rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n
     if path == PATH_TABLE:
         return table_rebound_typed(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
-        return _direct_hit(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u)
+        return _direct_path_on_stack(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u)
     return STATUS_INVALID, NAN3, NAN3
 
 
 @numba.njit(**KERNEL)
-def _direct_hit(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u):
+def _direct_path_on_stack(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u):
     """The direct path of :func:`rebound_typed`, its scratch space in this kernel's stack frame."""
     return _direct_path(params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX, V, omega, n, a, u,
                         stack_scratch(SCRATCH_SIZE))
