@@ -1,8 +1,8 @@
 /*
- * flight.c: the search for the next contact of a free flight (direct_model.flight: curvature_bound, jerk_bound,
- * safe_step, pass_over_bound, may_reach, taylor_root, lowest_points, choose_contact, find_contact); the flight
- * itself is rotation.c's. The same operations in the same order as the numba kernels (plain products and sums,
- * libm's sqrt).
+ * flight.c: the search for the next contact of a free flight (direct_model.flight: safe_step, pass_over_bound,
+ * may_reach, taylor_root, lowest_points, choose_contact, find_contact; curvature_bound and jerk_bound are
+ * flight.h's); the flight itself is rotation.c's. The same operations in the same order as the numba kernels
+ * (plain products and sums, libm's sqrt).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -18,47 +18,6 @@
 /* above this many vertices pass_over_bound starts the pass: from 12 here, 24 in numba
  * (direct_model.flight.PASS_OVER_ABOVE), where each compiler's scan pays for it (the same bits either way) */
 #define PASS_OVER_ABOVE 12
-
-/* bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (direct_model.flight._rate_bounds) */
-static void rate_bounds(const double K[3], const double ell[3], const double W[3], double *w, double *wdot,
-                        double *wddot)
-{
-    double kmin = py_min(K[0], py_min(K[1], K[2]));
-    double kmax = py_max(K[0], py_max(K[1], K[2]));
-    double l2 = ell[0] * ell[0] + ell[1] * ell[1] + ell[2] * ell[2];
-    double two_t = py_max(ell[0] * W[0] + ell[1] * W[1] + ell[2] * W[2], 0.0);
-    *w = py_min(sqrt(l2) / kmin, sqrt(two_t / kmin));
-    *wdot = 0.5 * (kmax - kmin) * *w * *w / kmin;
-    *wddot = (kmax - kmin) * *w * *wdot / kmin;
-}
-
-double rbs_curvature_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
-                           const double W[3])
-{
-    double w, wdot, wddot;
-    rate_bounds(K, ell, W, &w, &wdot, &wddot);
-    if (kind == KIND_ELLIPSOID) {
-        double amax = py_max(semi[0], py_max(semi[1], semi[2]));
-        double amin = py_min(semi[0], py_min(semi[1], semi[2]));
-        return amax * amax * w * w / amin + amax * (wdot + w * w);
-    }
-    return (wdot + w * w) * Rb;
-}
-
-double rbs_jerk_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
-                      const double W[3])
-{
-    double w, wdot, wddot;
-    rate_bounds(K, ell, W, &w, &wdot, &wddot);
-    double g3 = wddot + 3.0 * w * wdot + w * w * w;
-    if (kind == KIND_ELLIPSOID) {
-        double amax = py_max(semi[0], py_max(semi[1], semi[2]));
-        double amin = py_min(semi[0], py_min(semi[1], semi[2]));
-        return 6.0 * amax * amax * w * (wdot + w * w) / amin + amax * g3
-               + 6.0 * amax * amax * amax * w * w * w / (amin * amin);
-    }
-    return g3 * Rb;
-}
 
 /* first τ >= 0 where h + hdot τ − ½Mτ² reaches 0 (h < 0 taken as 0; M of any sign); inf if never */
 static double safe_step(double h, double hdot, double M)

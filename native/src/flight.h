@@ -8,6 +8,12 @@
 #ifndef RBS_FLIGHT_H
 #define RBS_FLIGHT_H
 
+#include <math.h>
+
+#include "internal.h"
+#include "pymath.h"
+#include "shapes.h"
+
 /* search outcomes (direct_model.flight: SEARCH_CONTACT, SEARCH_ESCAPED, SEARCH_STALLED) */
 #define SEARCH_CONTACT 0    /* a point touches the wall (within contact_tol) and approaches it */
 #define SEARCH_ESCAPED 1    /* the body can never reach the wall again */
@@ -16,12 +22,49 @@
 /* The body: kind KIND_ELLIPSOID (semi its semi-axes) or KIND_POLYHEDRON (verts its nv vertices), Rb its bounding
  * radius (shapes.h, rbs_particle_body). */
 
+/* bounds (ω, |ω̇|, |ω̈|) on the angular velocity and its rates during a flight (direct_model.flight._rate_bounds) */
+RBS_INLINE void rbs_rate_bounds(const double K[3], const double ell[3], const double W[3], double *w, double *wdot,
+                                double *wddot)
+{
+    double kmin = py_min(K[0], py_min(K[1], K[2]));
+    double kmax = py_max(K[0], py_max(K[1], K[2]));
+    double l2 = ell[0] * ell[0] + ell[1] * ell[1] + ell[2] * ell[2];
+    double two_t = py_max(ell[0] * W[0] + ell[1] * W[1] + ell[2] * W[2], 0.0);
+    *w = py_min(sqrt(l2) / kmin, sqrt(two_t / kmin));
+    *wdot = 0.5 * (kmax - kmin) * *w * *w / kmin;
+    *wddot = (kmax - kmin) * *w * *wdot / kmin;
+}
+
 /* Bounds M on |h''| and M3 on |h'''| of any candidate point's height during a flight, K principal J/m (a²), ell =
- * L/m and W = Ω (lab) at any instant of it (direct_model.flight.curvature_bound, jerk_bound). */
-double rbs_curvature_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
-                           const double W[3]);
-double rbs_jerk_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
-                      const double W[3]);
+ * L/m and W = Ω (lab) at any instant of it (direct_model.flight.curvature_bound, jerk_bound). Inline: a flight's
+ * set-up takes both, and the compiler computes their rbs_rate_bounds once. */
+RBS_INLINE double rbs_curvature_bound(int kind, const double semi[3], double Rb, const double K[3],
+                                      const double ell[3], const double W[3])
+{
+    double w, wdot, wddot;
+    rbs_rate_bounds(K, ell, W, &w, &wdot, &wddot);
+    if (kind == KIND_ELLIPSOID) {
+        double amax = py_max(semi[0], py_max(semi[1], semi[2]));
+        double amin = py_min(semi[0], py_min(semi[1], semi[2]));
+        return amax * amax * w * w / amin + amax * (wdot + w * w);
+    }
+    return (wdot + w * w) * Rb;
+}
+
+RBS_INLINE double rbs_jerk_bound(int kind, const double semi[3], double Rb, const double K[3], const double ell[3],
+                                 const double W[3])
+{
+    double w, wdot, wddot;
+    rbs_rate_bounds(K, ell, W, &w, &wdot, &wddot);
+    double g3 = wddot + 3.0 * w * wdot + w * w * w;
+    if (kind == KIND_ELLIPSOID) {
+        double amax = py_max(semi[0], py_max(semi[1], semi[2]));
+        double amin = py_min(semi[0], py_min(semi[1], semi[2]));
+        return 6.0 * amax * amax * w * (wdot + w * w) / amin + amax * g3
+               + 6.0 * amax * amax * amax * w * w * w / (amin * amin);
+    }
+    return g3 * Rb;
+}
 
 /* Heights h[i] (units of a) and rates h1[i] of the candidate lowest points at orientation R, lab angular velocity W,
  * centre height y and vertical velocity v: every vertex (body frame, verts), or the ellipsoid's support point,
