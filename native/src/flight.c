@@ -1,8 +1,8 @@
 /*
  * flight.c: the search for the next contact of a free flight (direct_model.flight: safe_step, pass_over_bound,
- * may_reach, taylor_root, lowest_points, choose_contact, find_contact; curvature_bound and jerk_bound are
- * flight.h's); the flight itself is rotation.c's. The same operations in the same order as the numba kernels
- * (plain products and sums, libm's sqrt).
+ * may_reach, taylor_root, lowest_points, choose_contact, find_contact); the bounds it takes are flight.h's, the
+ * flight itself rotation.c's. The same operations in the same order as the numba kernels (plain products and
+ * sums, libm's sqrt).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */

@@ -36,7 +36,7 @@ RBS_INLINE void rbs_rate_bounds(const double K[3], const double ell[3], const do
 }
 
 /* Bounds M on |h''| and M3 on |h'''| of any candidate point's height during a flight, K principal J/m (a²), ell =
- * L/m and W = Ω (lab) at any instant of it (direct_model.flight.curvature_bound, jerk_bound). Inline: a flight's
+ * L/m and W = Ω (lab) at any instant of it (direct_model.flight: curvature_bound, jerk_bound). Inline: a flight's
  * set-up takes both, and the compiler computes their rbs_rate_bounds once. */
 RBS_INLINE double rbs_curvature_bound(int kind, const double semi[3], double Rb, const double K[3],
                                       const double ell[3], const double W[3])
