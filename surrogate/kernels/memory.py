@@ -113,4 +113,3 @@ def stack_scratch(typingctx, size):
         return array._getvalue()
 
     return array_type(size), codegen
-
