@@ -263,7 +263,7 @@ def _bodies(shapes, shape, u_all, semi, K, R, verts, nv):
 
 
 # without numba's reference counts, like the kernels they time: with them, each row's view (verts[i], R[i], ...)
-# costs an atomic increment and decrement that a rebound never pays (lowest_points: 66 ns a call instead of 21)
+# would cost an atomic increment and decrement that a rebound never pays
 PIECE_LOOP = dict(_nrt=False)
 
 

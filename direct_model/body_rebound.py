@@ -38,7 +38,7 @@ from direct_model.shape_arrays import bounding_radius, particle_body
 
 HISTORY_COLUMNS = 17
 
-# layout of the scratch array of :func:`body_rebound`: the candidate points' heights and rates, then g̈ for their curvatures
+# layout of the scratch array of :func:`body_rebound`: the candidate points' heights and rates, then g̈ (curvatures)
 _HEIGHTS = 0
 _RATES = _HEIGHTS + MAX_HULL_VERTICES
 _CURVATURE = _RATES + MAX_HULL_VERTICES

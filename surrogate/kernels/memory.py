@@ -18,10 +18,9 @@ has the measurements).
 ``stack_scratch(size)`` is a (size,) float64 array in the calling kernel's
 stack frame, for a single-hit kernel's scratch space: ``np.empty`` needs numba's
 runtime, and a kernel compiled with it increments and decrements the reference
-count of every array it is passed, on every call (``rebound`` on the table path
-took twice ``table_rebound``'s time with the runtime; docs/runtime.md). The array
-lives until the kernel that called ``stack_scratch`` returns: it is passed
-down, never returned or stored.
+count of every array it is passed, on every call. The array lives until the
+kernel that called ``stack_scratch`` returns: it is passed down, never returned
+or stored.
 """
 
 import numba

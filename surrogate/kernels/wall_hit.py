@@ -24,10 +24,10 @@ u[0], on either path (:func:`surrogate.kernels.locate.row_shape`). A particle of
 direct path (:mod:`surrogate.kernels.grain`).
 
 Like the table path's kernels (:mod:`surrogate.kernels.table_path`), :func:`rebound` converts its arguments to one
-set of types; its ``_typed`` twin, inlined, only picks the path, whose kernels (``table_rebound_typed``, the
-direct path) are compiled once per process (as a call, the twin took 50 ns a hit: the table's arrays passed once
-more). The single-hit kernels run without numba's reference counting (``KERNEL``), their scratch space in their
-stack frame (:func:`surrogate.kernels.memory.stack_scratch`).
+set of types; its ``_typed`` twin, inlined (a call would pass the table's arrays once more), only picks the path,
+whose kernels (``table_rebound_typed``, the direct path) are compiled once per process. The single-hit kernels
+run without numba's reference counting (``KERNEL``), their scratch space in their stack frame
+(:func:`surrogate.kernels.memory.stack_scratch`).
 
 Units and frames: V in m/s, Ω in rad/s, a in m, all in the caller's frame; n the unit wall normal into the
 gas. Statuses: STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct model only: a collision solve or a

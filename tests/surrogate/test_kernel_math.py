@@ -75,8 +75,7 @@ def test_stack_scratch_holds_its_size_without_the_runtime():
 @pytest.mark.parametrize("name", ["table_rebound", "draw_local", "direct_rebound", "rebound", "rebound_path"])
 def test_single_hit_kernels_run_without_reference_counting(name):
     """A solver calls these once per hit: compiled with numba's runtime, each would increment and decrement the
-    reference count of every array it is given (the table's, the shapes', the uniforms) on every call, which made
-    ``rebound`` on the table path take twice ``table_rebound``'s time (docs/runtime.md)."""
+    reference count of every array it is given (the table's, the shapes', the uniforms) on every call."""
     assert getattr(kernels, name).targetoptions.get("_nrt") is False
 
 
