@@ -59,7 +59,7 @@ def _two_scratch_arrays(x):
     for i in range(big.shape[0]):
         big[i] = x + i
     for i in range(small.shape[0]):
-        small[i] = big[i]
+        small[i] = -1.0 - i          # would overwrite big[:3] if the two shared memory
     return big.shape[0], small.shape[0], big[0], big[1447], small[0], small[1], small[2], big.sum()
 
 
@@ -68,7 +68,7 @@ def test_stack_scratch_holds_its_size_without_the_runtime():
     is written into them (a 1448-long array would be an 11.6 KB heap allocation through the runtime otherwise)."""
     n_big, n_small, first, last, s0, s1, s2, total = _two_scratch_arrays(0.5)
     assert (n_big, n_small) == (1448, 3)
-    assert (first, last, s0, s1, s2) == (0.5, 1447.5, 0.5, 1.5, 2.5)
+    assert (first, last, s0, s1, s2) == (0.5, 1447.5, -1.0, -2.0, -3.0)
     assert total == sum(0.5 + i for i in range(1448))
 
 
