@@ -6,7 +6,8 @@ finish). Checkpoints: next to the output ``table.h5`` the build keeps a folder
 ``table.h5.partial/`` holding what produced it (table format version, package
 version, :func:`model_sha256` and the resolved configuration, wall law
 included) and one ``.npz`` file per finished cell, each written to a temporary
-name and renamed. Rerunning the same command computes only the missing cells;
+name and renamed (by the local worker that computed it, or by the driver for
+a Dask worker's cell). Rerunning the same command computes only the missing cells;
 a checkpoint made by another model, package version, table format or
 configuration is refused, so a table never mixes cells of two laws. While a
 build runs it holds a lock on that folder. The table is assembled in memory,
@@ -144,9 +145,7 @@ class Checkpoint:
         return self.cell_path(shape, i_alpha, i_speed).exists()
 
     def save(self, shape: str, i_alpha: int, i_speed: int, cell: CellTable) -> None:
-        buffer = io.BytesIO()
-        np.savez(buffer, **cell.arrays())
-        replace_file(self.cell_path(shape, i_alpha, i_speed), buffer.getvalue())
+        save_cell(self.cell_path(shape, i_alpha, i_speed), cell)
 
     def load(self, shape: str, i_alpha: int, i_speed: int) -> CellTable:
         with np.load(self.cell_path(shape, i_alpha, i_speed)) as data:
@@ -158,6 +157,13 @@ class Checkpoint:
 
     def remove(self) -> None:
         shutil.rmtree(self.path)
+
+
+def save_cell(path: Path, cell: CellTable) -> None:
+    """Write ``cell`` to ``path`` (.npz), under a temporary name first and then renamed onto it."""
+    buffer = io.BytesIO()
+    np.savez(buffer, **cell.arrays())
+    replace_file(path, buffer.getvalue())
 
 
 def build_table(config: BuildConfig, out, workers: int | None = None, scheduler: str | None = None,
@@ -231,20 +237,33 @@ def _run_local(config, tasks, checkpoint, workers, bar) -> None:
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
                                initializer=_worker_init, initargs=(threads,))
     try:
-        futures = {pool.submit(compute_cell, config, *task): task for task in tasks}
+        futures = {pool.submit(_compute_and_save, config, checkpoint.cell_path(*task), *task): task
+                   for task in tasks}
         for future in as_completed(futures):
             task = futures[future]
             try:
-                cell = future.result()
+                future.result()
             except BrokenProcessPool as exc:
                 raise BuildError(f"a worker process died before computing {cell_label(config, *task)} ({exc}); "
                                  f"a script calling build_table with workers must guard its main code with "
                                  f"`if __name__ == \"__main__\":`") from None
             except Exception as exc:
                 raise BuildError(f"{cell_label(config, *task)} failed: {type(exc).__name__}: {exc}") from exc
-            _store(checkpoint, task, cell, bar)
+            if bar is not None:
+                bar.update(1)
     finally:
         _stop(pool)
+
+
+def _compute_and_save(config: BuildConfig, path: Path, shape: str, i_alpha: int, i_speed: int) -> None:
+    """A local worker's task: compute a cell and checkpoint it to ``path`` itself.
+
+    Its reply through the pool's pipe is then a few bytes, which a pipe writes whole or not at all
+    (PIPE_BUF). A 100 kB cell sent back instead could be cut off by :func:`_stop` terminating its worker,
+    and the pool's reader thread would wait forever for the rest (the main process holds the pipe's other
+    end), hanging the interpreter's exit.
+    """
+    save_cell(path, compute_cell(config, shape, i_alpha, i_speed))
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:

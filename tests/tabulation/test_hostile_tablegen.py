@@ -21,6 +21,7 @@ from data_schema.common import DataFormatError
 from data_schema.output import FOLDER_MARKER, OutputError, kind_of, remove_stale_temporaries, write_output
 from data_schema.table import TABLE_FILE_TYPE
 from tablegen.tabulation import driver
+from tablegen.tabulation.cells import compute_cell
 from tablegen.tabulation.driver import Checkpoint, CheckpointError, build_table, model_sha256, worker_count
 from tablegen.tabulation.config import parse_config
 from tablegen.cli import main
@@ -245,6 +246,18 @@ def test_a_signal_stops_the_workers_and_keeps_the_checkpoints(tmp_path, signal_n
     time.sleep(0.5)
     assert not any(_alive(pid) for pid in workers if pid != proc.pid)
     assert len(list(partial.glob("*.npz"))) >= 1 and not out.exists()
+
+
+def test_a_local_worker_saves_its_cell_and_sends_back_nothing(tmp_path):
+    # a cell sent back could be cut off by terminating its worker, and the pool's reader would wait forever
+    config = parse_config(TINY)
+    path = tmp_path / "cell.npz"
+    assert driver._compute_and_save(config, path, "prism", 1, 0) is None
+    with np.load(path) as saved:
+        expected = compute_cell(config, "prism", 1, 0).arrays()
+        assert sorted(saved.files) == sorted(expected)
+        for name, array in expected.items():
+            assert saved[name].dtype == array.dtype and saved[name].tobytes() == array.tobytes(), name
 
 
 def test_a_second_build_of_the_same_output_stops_at_once(tmp_path, capsys):
