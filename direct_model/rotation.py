@@ -113,8 +113,8 @@ Method
    path with ``k = 0, beta = 0`` (regular precession, all closed forms).
 
 6. *Theta mode* -- Jacobi's own solution, used when the nome ``q = exp(-pi K'/K) <= 0.2``
-   (``k^2`` below about 0.97), ``k^2 >= 1e-4`` and ``rho <= 1/2`` (below); the other
-   general states take items 3 and 4.  With ``v = pi u / (2K)`` (DLMF 22.2.4-22.2.6, the
+   (``k^2`` below about 0.97) and ``k^2 >= 1e-4``; the other general states take items 3
+   and 4.  With ``v = pi u / (2K)`` (DLMF 22.2.4-22.2.6, the
    common divisor ``theta_4(v)`` dropped, as ``n = m / |m|`` does not need it)::
 
        m ~ (a_0 theta_2(v) / sqrt(k), a_1 theta_1(v) / sqrt(k k'), a_2 theta_3(v)).
@@ -136,9 +136,26 @@ Method
    sine-cosine pair of ``v`` (the multiple angles by complex recurrence), one of
    ``lin t``, 2 to 6 terms of five series and three square roots.  ``K`` and ``K'`` come
    from the AGM.  The series' terms are at most ``q^{n^2 - n} rho^n``, ``rho = q e^{2
-   alpha~} < 1``; they stop below 1e-17.  ``rho`` -> 1 (``alpha`` -> ``K'``) puts ``w`` near
-   a zero, and ``k`` -> 0 (close to a steady spin) makes the two phases turn fast and cancel
-   in ``psi``; both lose digits, hence the bounds above.
+   alpha~}``; they stop below 1e-17.
+
+   ``alpha`` -> ``K'`` (``rho`` -> 1) puts ``w`` near a zero of ``theta_4``, where its
+   series cancels, and makes ``z`` as sensitive as ``K' - alpha`` is to the rounding of
+   ``alpha``.  So for ``alpha > K'/2``, that is ``beta > k``, ``w`` is taken through
+   ``theta_1`` (the quasi-periodicity ``theta_4(x + pi tau/2) = i q^{-1/4} e^{-ix}
+   theta_1(x)``, DLMF 20.2(iv))::
+
+       theta_4(v + i alpha~) = i q^{-1/4} e^{-a} e^{-iv} theta_1(v - i a),
+       a = pi (K' - alpha) / (2K),  K' - alpha = R_F(beta, k^2 + beta, 1 + beta),
+
+   the last without a subtraction: ``K' - F(phi | k') = F(chi | k')`` for ``tan phi tan
+   chi = 1/k``, here ``tan chi = 1/sqrt(beta)``, and DLMF 19.25.5.  The series of
+   ``theta_1`` in the odd multiples of ``v`` have the coefficients ``q^{n^2 + n} cosh((2n +
+   1) a)`` and ``q^{n^2 + n} sinh((2n + 1) a)`` (both by the addition theorems, without
+   cancellation), ``e^{-iv}`` joins ``lin`` as ``-dv/dt``, and ``z = (pi/2K) (C / S - 1)``
+   from ``theta_1'/theta_1`` at ``-i a``, ``C`` and ``S`` these two series at ``v = 0``
+   with the factors ``2n + 1`` in ``C``.  Either way ``rho`` (reflected ``q e^{2a}``) is at
+   most ``sqrt(q)``.  ``k`` -> 0 (close to a steady spin) makes the two phases turn fast
+   and cancel in ``psi``; they lose digits, hence the bound on ``k^2``.
 
 The lab angular momentum ``R K R^T omega = L C e_z = R0 Q n(0) L`` and the energy
 ``sum m_i^2 / J_i`` are constant by construction (to rounding).
@@ -206,11 +223,11 @@ _I_TH_CIM = _I_KN + 4
 _I_TH_M0 = _I_KN + 5  # coefficients of cos((2n+1) v) in m_0
 _I_TH_M1 = _I_TH_M0 + _TH_TERMS  # of sin((2n+1) v) in m_1
 _I_TH_M2 = _I_TH_M1 + _TH_TERMS  # of cos(2n v) in m_2
-_I_TH_WR = _I_TH_M2 + _TH_TERMS  # of cos(2n v) in Re w
-_I_TH_WI = _I_TH_WR + _TH_TERMS  # of sin(2n v) in Im w
+_I_TH_WR = _I_TH_M2 + _TH_TERMS  # of cos(2n v) in Re w (sin((2n+1) v) reflected)
+_I_TH_WI = _I_TH_WR + _TH_TERMS  # of sin(2n v) in Im w (cos((2n+1) v) reflected)
+_I_TH_REFLECT = _I_TH_WI + _TH_TERMS  # 1.0 if w is taken through theta_1 (beta > k, module doc), else 0.0
 _THETA_LNQ_MAX = -1.6094379124341003  # ln 0.2: larger nomes (k^2 > 0.97) take the Landen path
-_THETA_LNRHO_MAX = -0.6931471805599453  # ln 0.5: see _theta_init
-_THETA_TOL = 1e-17  # the first term left out of every series is below this
+_THETA_TOL = 1e-17  # the first term left out of every series is below this (relative to its first term)
 _THETA_K2_MIN = 1e-4  # closer to a steady spin (k -> 0) the theta phases lose digits: the Landen path
 
 _PHASE_MAX = 2.0 ** 62  # sincos's domain: int() of the multiple of pi/2 stays within int64
@@ -650,10 +667,10 @@ def _agm_open(a, g):
 
 
 @numba.njit(**KERNEL)
-def _theta_elliptic(k, kp, beta, x, sx, y, sy):
+def _theta_elliptic(k, kp, ax, ay, az, x, sx, y, sy):
     """The four elliptic quantities of the theta mode's set-up: ``K(k)``, ``K(k')``,
-    ``R_F(k^2, k^2 (1 + beta), k^2 + beta)`` for ``alpha`` and ``R_F(x, y, 1)`` for ``u_0``
-    (:func:`_rf_amp`, ``sx = sqrt(x)``, ``sy = sqrt(y)``).
+    ``R_F(ax, ay, az)`` for ``alpha`` or ``K' - alpha`` (:func:`_theta_init`) and
+    ``R_F(x, y, 1)`` for ``u_0`` (:func:`_rf_amp`, ``sx = sqrt(x)``, ``sy = sqrt(y)``).
 
     ``K = pi / (2 AGM(1, k'))`` (DLMF 19.8.5).  The four chains of square roots (two AGMs,
     two duplications) are independent; their steps are interleaved so that the CPU runs
@@ -664,8 +681,7 @@ def _theta_elliptic(k, kp, beta, x, sx, y, sy):
     g1 = kp
     a2 = 1.0  # AGM(1, k)
     g2 = k
-    k2 = k * k
-    xa, ya, za, aa, fa, qxa, qya, qma = _rf_start(k2, k2 * (1.0 + beta), k2 + beta)
+    xa, ya, za, aa, fa, qxa, qya, qma = _rf_start(ax, ay, az)
     xu, yu, zu, au, fu, qxu, qyu, qmu = _rf_amp_start(x, sx, y, sy)
     while True:
         open1 = _agm_open(a1, g1)
@@ -686,73 +702,105 @@ def _theta_elliptic(k, kp, beta, x, sx, y, sy):
 
 
 @numba.njit(**KERNEL)
-def _theta_init(params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0):
-    """Set up the theta mode (module docstring, item 6) from ``kk = K(k)``,
-    ``kkp = K(k')`` and ``rf_alpha`` (:func:`_theta_elliptic`); False, and nothing to be
-    read left behind, if the state needs the Landen path (``q > 0.2``, ``rho > 1/2``, or
-    more than ``_TH_TERMS`` terms).
+def _theta_init(params, kk, kkp, rf, k, kp, beta, reflect, lmag, j0, j1, d20, d21, nu, a0, a1, a2, u0):
+    """Set up the theta mode (module docstring, item 6) from ``kk = K(k)``, ``kkp = K(k')``
+    and ``rf`` (:func:`_theta_elliptic`): ``R_F(k^2, k^2 (1 + beta), k^2 + beta)``, so that
+    ``alpha = sqrt(beta) rf``, or with ``reflect`` (``beta > k``, that is ``alpha > K'/2``)
+    ``R_F(beta, k^2 + beta, 1 + beta) = K' - alpha``. False, and nothing to be read left
+    behind, if the state needs the Landen path (``q > 0.2`` or more than ``_TH_TERMS`` terms).
 
-    With ``lq = ln q = -pi K'/K`` and ``rho = q e^{2 alpha~}`` the series' terms are at
-    most ``q^{n^2 - n} rho^n``; ``rho`` -> 1 (``alpha`` -> ``K'``) puts ``w`` near a zero,
-    where its phase loses digits.
+    The terms of ``w``'s series are at most ``q^{n^2 - n} rho^n``, ``rho = q e^{2 alpha~} <=
+    sqrt(q)``; reflected, those of ``theta_1`` relative to its first are at most ``(2n + 1)
+    q^{n^2 + n} cosh((2n + 1) a)``, ``a = pi (K' - alpha) / (2K)``, ``q e^{2a} <= sqrt(q)``.
     """
     lq = -math.pi * kkp / kk
     if not lq <= _THETA_LNQ_MAX:
         return False
     k2 = k * k
     hw = 0.5 * math.pi / kk
-    at2 = 2.0 * hw * math.sqrt(beta) * rf_alpha
-    if not lq + at2 <= _THETA_LNRHO_MAX:
-        return False
     q = math.exp(lq)
-    e = math.exp(at2)
     s4 = math.exp(0.25 * lq)
     f0 = 2.0 * a0 * s4 / math.sqrt(k)
     f1 = 2.0 * a1 * s4 / (math.sqrt(k) * math.sqrt(kp))
     params[_I_TH_M0] = f0
     params[_I_TH_M1] = f1
     params[_I_TH_M2] = a2
-    params[_I_TH_WR] = 1.0
-    params[_I_TH_WI] = 0.0
+    e = 1.0
+    sh = 0.0  # sinh, cosh of (2n + 1) a (reflected)
+    ch = 1.0
+    s2a = 0.0  # sinh, cosh of 2a
+    c2a = 1.0
+    if reflect:
+        a = hw * rf
+        sh = math.sinh(a)
+        ch = math.cosh(a)
+        s2a = 2.0 * sh * ch
+        c2a = 1.0 + 2.0 * sh * sh
+        params[_I_TH_WR] = ch
+        params[_I_TH_WI] = -sh
+    else:
+        e = math.exp(2.0 * hw * math.sqrt(beta) * rf)
+        params[_I_TH_WR] = 1.0
+        params[_I_TH_WI] = 0.0
     qo = q  # q^(2n - 1)
     qn = 1.0  # q^(n^2)
     qd = 1.0  # q^(n (n + 1))
-    cp = 1.0  # q^(n^2) e^(n at2)
+    cp = 1.0  # q^(n^2) e^(n at2), at2 = 2 alpha~ (reflected: the bound above)
     cm = 1.0  # q^(n^2) e^(-n at2)
     sgn = 1.0
-    zn = 0.0
+    zn = 0.0  # sums for Jacobi's zeta (reflected: sum (2n + 1) WR_n and -sum WI_n)
     zd = 1.0
+    if reflect:
+        zn = ch
+        zd = sh
     n = 1
     while True:
         qn *= qo
-        cp *= qo * e
-        cm *= qo / e
         qd *= qo * q
-        if not cp > _THETA_TOL:
+        if reflect:
+            sh, ch = sh * c2a + ch * s2a, ch * c2a + sh * s2a  # no cancellation for small a
+            cp = (2 * n + 1) * qd * ch
+        else:
+            cp *= qo * e
+            cm *= qo / e
+        if not (cp > _THETA_TOL or qn > _THETA_TOL):
             break
         if n == _TH_TERMS:
             return False
         sgn = -sgn
-        wr = sgn * (cp + cm)
-        wi = -sgn * (cp - cm)
+        if reflect:
+            wr = sgn * qd * ch
+            wi = -sgn * qd * sh
+            zn += (2 * n + 1) * wr
+            zd -= wi
+        else:
+            wr = sgn * (cp + cm)
+            wi = -sgn * (cp - cm)
+            zn += n * wi
+            zd += wr
         params[_I_TH_M0 + n] = f0 * qd
         params[_I_TH_M1 + n] = sgn * f1 * qd
         params[_I_TH_M2 + n] = 2.0 * a2 * qn
         params[_I_TH_WR + n] = wr
         params[_I_TH_WI + n] = wi
-        zn += n * wi
-        zd += wr
         qo *= q * q
         n += 1
-    # Z(i alpha) = i z, z = (pi/K) sum n WI_n / sum WR_n; D/P_a of the rate of phi_E
-    z = math.pi / kk * zn / zd
+    # Z(i alpha) = i z; D/P_a of the rate of phi_E
+    if reflect:
+        z = hw * (zn / zd - 1.0)  # from theta_1'/theta_1 at -i a
+    else:
+        z = math.pi / kk * zn / zd  # (pi/K) sum n WI_n / sum WR_n
     pa = math.sqrt(beta * (k2 + beta) * (1.0 + beta))
-    params[_I_LIN] = lmag / j0 + lmag * (j0 - j1) * d20 / (j0 * j0 * d21) * z / pa
-    params[_I_TH_N] = n
+    lin = lmag / j0 + lmag * (j0 - j1) * d20 / (j0 * j0 * d21) * z / pa
     params[_I_TH_NUV] = nu * hw
+    if reflect:
+        lin -= params[_I_TH_NUV]  # w's factor e^{-iv}
+    params[_I_LIN] = lin
+    params[_I_TH_N] = n
     params[_I_TH_V0] = u0 * hw
     params[_I_TH_CRE] = 1.0
     params[_I_TH_CIM] = 0.0
+    params[_I_TH_REFLECT] = 1.0 if reflect else 0.0
     return True
 
 
@@ -771,7 +819,8 @@ def _theta_state(params, t):
     ``t`` in the theta mode (module docstring, item 6).
 
     The multiple angles come from one sine-cosine pair by complex recurrence.
-    ``e^{i psi} = e^{i lin t} (w / |w|) ((m_0 - i m_1) / |(m_0, m_1)|) e^{-i psi_raw(0)}``.
+    ``e^{i psi} = e^{i lin t} (w / |w|) ((m_0 - i m_1) / |(m_0, m_1)|) e^{-i psi_raw(0)}``;
+    reflected, ``w`` is ``theta_1(v - i a)``, its series in the odd multiples of ``v``.
     """
     v = params[_I_TH_NUV] * t + params[_I_TH_V0]
     s1, c1 = _phase_sincos(v)
@@ -786,12 +835,13 @@ def _theta_state(params, t):
     m2 = 0.0
     wr = 0.0
     wi = 0.0
+    odd = params[_I_TH_REFLECT] != 0.0
     for i in range(int(params[_I_TH_N])):
         m0 += params[_I_TH_M0 + i] * co
         m1 += params[_I_TH_M1 + i] * so
         m2 += params[_I_TH_M2 + i] * ce
-        wr += params[_I_TH_WR + i] * ce
-        wi += params[_I_TH_WI + i] * se
+        wr += params[_I_TH_WR + i] * (so if odd else ce)
+        wi += params[_I_TH_WI + i] * (co if odd else se)
         co_next = co * c2 - so * s2
         so = so * c2 + co * s2
         co = co_next
@@ -1027,13 +1077,16 @@ def rotation_init(K, R0, ell, params):
         if theta:
             k = math.sqrt(k2)
             kp = math.sqrt(kp2)
-            kk, kkp, rf_alpha, rf_u0 = _theta_elliptic(k, kp, beta, cf * cf, cf, d * d, d)
+            reflect = beta > k  # alpha > K'/2: w passes near a zero of theta_4, so it is taken through theta_1
+            kk, kkp, rf_shift, rf_u0 = _theta_elliptic(
+                k, kp, beta if reflect else k2, k2 + beta if reflect else k2 * (1.0 + beta),
+                1.0 + beta if reflect else k2 + beta, cf * cf, cf, d * d, d)
         else:
             rf_u0 = _rf_amp(cf * cf, cf, d * d, d)
         u0 = sf * rf_u0
     params[_I_U0] = u0
     if theta and _theta_init(
-            params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, nu,
+            params, kk, kkp, rf_shift, k, kp, beta, reflect, lmag, j0, j1, d20, d21, nu,
             params[_I_A + 0], params[_I_A + 1], a2, u0):
         params[_I_MODE] = _MODE_THETA
         n0, n1, n2, cr, ci = _theta_state(params, 0.0)

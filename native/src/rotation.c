@@ -66,14 +66,14 @@ _Static_assert(I_OMKN + NLEV_MAX == RBS_ROT_PARAMS_SIZE, "the layout of direct_m
 #define I_TH_M0 (I_KN + 5)       /* coefficients of cos((2n+1) v) in m_0 */
 #define I_TH_M1 (I_TH_M0 + TH_TERMS) /* of sin((2n+1) v) in m_1 */
 #define I_TH_M2 (I_TH_M1 + TH_TERMS) /* of cos(2n v) in m_2 */
-#define I_TH_WR (I_TH_M2 + TH_TERMS) /* of cos(2n v) in Re w */
-#define I_TH_WI (I_TH_WR + TH_TERMS) /* of sin(2n v) in Im w */
+#define I_TH_WR (I_TH_M2 + TH_TERMS) /* of cos(2n v) in Re w (sin((2n+1) v) reflected) */
+#define I_TH_WI (I_TH_WR + TH_TERMS) /* of sin(2n v) in Im w (cos((2n+1) v) reflected) */
+#define I_TH_REFLECT (I_TH_WI + TH_TERMS) /* 1.0 if w is taken through theta_1 (beta > k), else 0.0 */
 #define THETA_LNQ_MAX (-1.6094379124341003)  /* ln 0.2: larger nomes (k^2 > 0.97) take the Landen path */
-#define THETA_LNRHO_MAX (-0.6931471805599453) /* ln 0.5: see rbs_theta_init */
-#define THETA_TOL 1e-17          /* the first term left out of every series is below this */
+#define THETA_TOL 1e-17          /* the first term left out of every series is below this (relative) */
 #define THETA_K2_MIN 1e-4        /* closer to a steady spin (k -> 0) the theta phases lose digits */
 
-_Static_assert(I_TH_WI + TH_TERMS <= RBS_ROT_PARAMS_SIZE, "the theta series fit the parameter array");
+_Static_assert(I_TH_REFLECT < RBS_ROT_PARAMS_SIZE, "the theta series fit the parameter array");
 
 #define SNAP (16.0 * 2.220446049250313e-16) /* relative size of rounding noise in R0^T ell */
 
@@ -435,16 +435,15 @@ static int rbs_agm_open(double a, double g)
     return fabs(a - g) > 1e-9 * a;
 }
 
-/* K(k), K(k'), R_F(k^2, k^2 (1 + beta), k^2 + beta) for alpha and R_F(x, y, 1) for u_0
+/* K(k), K(k'), R_F(ax, ay, az) for alpha or K' - alpha and R_F(x, y, 1) for u_0
  * (direct_model.rotation._theta_elliptic): four independent chains of square roots, their steps interleaved so
  * that the CPU runs them side by side, each with its own test and its own operations */
-static void rbs_theta_elliptic(double k, double kp, double beta, double x, double sx, double y, double sy,
-                               double *kk, double *kkp, double *rf_alpha, double *rf_u0)
+static void rbs_theta_elliptic(double k, double kp, double ax, double ay, double az, double x, double sx, double y,
+                               double sy, double *kk, double *kkp, double *rf_shift, double *rf_u0)
 {
     double a1 = 1.0, g1 = kp; /* AGM(1, k') */
     double a2 = 1.0, g2 = k;  /* AGM(1, k) */
-    double k2 = k * k;
-    rbs_rf_state ra = rbs_rf_start(k2, k2 * (1.0 + beta), k2 + beta);
+    rbs_rf_state ra = rbs_rf_start(ax, ay, az);
     rbs_rf_state ru = rbs_rf_amp_start(x, sx, y, sy);
     for (;;) {
         int open1 = rbs_agm_open(a1, g1);
@@ -467,70 +466,105 @@ static void rbs_theta_elliptic(double k, double kp, double beta, double x, doubl
     }
     *kk = RBS_PI / (a1 + g1);
     *kkp = RBS_PI / (a2 + g2);
-    *rf_alpha = rbs_rf_end(&ra);
+    *rf_shift = rbs_rf_end(&ra);
     *rf_u0 = rbs_rf_end(&ru);
 }
 
-/* Set up the theta mode from kk = K(k), kkp = K(k') and rf_alpha (direct_model.rotation._theta_init); 0 if the
- * state needs the Landen path */
-static int rbs_theta_init(double *params, double kk, double kkp, double rf_alpha, double k, double kp, double beta,
-                          double lmag, double j0, double j1, double d20, double d21, double nu, double a0, double a1,
-                          double a2, double u0)
+/* Set up the theta mode from kk = K(k), kkp = K(k') and rf = R_F(k^2, k^2 (1 + beta), k^2 + beta) (alpha =
+ * sqrt(beta) rf) or, reflected (beta > k), rf = R_F(beta, k^2 + beta, 1 + beta) = K' - alpha
+ * (direct_model.rotation._theta_init); 0 if the state needs the Landen path */
+static int rbs_theta_init(double *params, double kk, double kkp, double rf, double k, double kp, double beta,
+                          int reflect, double lmag, double j0, double j1, double d20, double d21, double nu, double a0,
+                          double a1, double a2, double u0)
 {
     double lq = -RBS_PI * kkp / kk;
     if (!(lq <= THETA_LNQ_MAX)) return 0;
     double k2 = k * k;
     double hw = 0.5 * RBS_PI / kk;
-    double at2 = 2.0 * hw * sqrt(beta) * rf_alpha;
-    if (!(lq + at2 <= THETA_LNRHO_MAX)) return 0;
     double q = exp(lq);
-    double e = exp(at2);
     double s4 = exp(0.25 * lq);
     double f0 = 2.0 * a0 * s4 / sqrt(k);
     double f1 = 2.0 * a1 * s4 / (sqrt(k) * sqrt(kp));
     params[I_TH_M0] = f0;
     params[I_TH_M1] = f1;
     params[I_TH_M2] = a2;
-    params[I_TH_WR] = 1.0;
-    params[I_TH_WI] = 0.0;
+    double e = 1.0;
+    double sh = 0.0, ch = 1.0;   /* sinh, cosh of (2n + 1) a (reflected) */
+    double s2a = 0.0, c2a = 1.0; /* sinh, cosh of 2a */
+    if (reflect) {
+        double a = hw * rf;
+        sh = sinh(a);
+        ch = cosh(a);
+        s2a = 2.0 * sh * ch;
+        c2a = 1.0 + 2.0 * sh * sh;
+        params[I_TH_WR] = ch;
+        params[I_TH_WI] = -sh;
+    } else {
+        e = exp(2.0 * hw * sqrt(beta) * rf);
+        params[I_TH_WR] = 1.0;
+        params[I_TH_WI] = 0.0;
+    }
     double qo = q;   /* q^(2n - 1) */
     double qn = 1.0; /* q^(n^2) */
     double qd = 1.0; /* q^(n (n + 1)) */
-    double cp = 1.0; /* q^(n^2) e^(n at2) */
+    double cp = 1.0; /* q^(n^2) e^(n at2), at2 = 2 alpha~ (reflected: the bound of _theta_init) */
     double cm = 1.0; /* q^(n^2) e^(-n at2) */
     double sgn = 1.0;
-    double zn = 0.0;
+    double zn = 0.0; /* sums for Jacobi's zeta (reflected: sum (2n + 1) WR_n and -sum WI_n) */
     double zd = 1.0;
+    if (reflect) {
+        zn = ch;
+        zd = sh;
+    }
     int64_t n = 1;
     for (;;) {
         qn *= qo;
-        cp *= qo * e;
-        cm *= qo / e;
         qd *= qo * q;
-        if (!(cp > THETA_TOL)) break;
+        if (reflect) {
+            double sh_next = sh * c2a + ch * s2a; /* no cancellation for small a */
+            ch = ch * c2a + sh * s2a;
+            sh = sh_next;
+            cp = (double)(2 * n + 1) * qd * ch;
+        } else {
+            cp *= qo * e;
+            cm *= qo / e;
+        }
+        if (!(cp > THETA_TOL || qn > THETA_TOL)) break;
         if (n == TH_TERMS) return 0;
         sgn = -sgn;
-        double wr = sgn * (cp + cm);
-        double wi = -sgn * (cp - cm);
+        double wr, wi;
+        if (reflect) {
+            wr = sgn * qd * ch;
+            wi = -sgn * qd * sh;
+            zn += (double)(2 * n + 1) * wr;
+            zd -= wi;
+        } else {
+            wr = sgn * (cp + cm);
+            wi = -sgn * (cp - cm);
+            zn += (double)n * wi;
+            zd += wr;
+        }
         params[I_TH_M0 + n] = f0 * qd;
         params[I_TH_M1 + n] = sgn * f1 * qd;
         params[I_TH_M2 + n] = 2.0 * a2 * qn;
         params[I_TH_WR + n] = wr;
         params[I_TH_WI + n] = wi;
-        zn += (double)n * wi;
-        zd += wr;
         qo *= q * q;
         n++;
     }
-    /* Z(i alpha) = i z, z = (pi/K) sum n WI_n / sum WR_n; D/P_a of the rate of phi_E */
-    double z = RBS_PI / kk * zn / zd;
+    /* Z(i alpha) = i z; D/P_a of the rate of phi_E */
+    double z = reflect ? hw * (zn / zd - 1.0) /* from theta_1'/theta_1 at -i a */
+                       : RBS_PI / kk * zn / zd; /* (pi/K) sum n WI_n / sum WR_n */
     double pa = sqrt(beta * (k2 + beta) * (1.0 + beta));
-    params[I_LIN] = lmag / j0 + lmag * (j0 - j1) * d20 / (j0 * j0 * d21) * z / pa;
-    params[I_TH_N] = (double)n;
+    double lin = lmag / j0 + lmag * (j0 - j1) * d20 / (j0 * j0 * d21) * z / pa;
     params[I_TH_NUV] = nu * hw;
+    if (reflect) lin -= params[I_TH_NUV]; /* w's factor e^{-iv} */
+    params[I_LIN] = lin;
+    params[I_TH_N] = (double)n;
     params[I_TH_V0] = u0 * hw;
     params[I_TH_CRE] = 1.0;
     params[I_TH_CIM] = 0.0;
+    params[I_TH_REFLECT] = reflect ? 1.0 : 0.0;
     return 1;
 }
 
@@ -558,13 +592,14 @@ RBS_INLINE void rbs_theta_state(const double *params, double t, double n[3], dou
     double co = c1, so = s1; /* cos, sin of (2n + 1) v */
     double ce = 1.0, se = 0.0; /* cos, sin of 2n v */
     double m0 = 0.0, m1 = 0.0, m2 = 0.0, wr = 0.0, wi = 0.0;
+    int odd = params[I_TH_REFLECT] != 0.0; /* reflected: w = theta_1(v - i a), odd multiples of v */
     int64_t nterms = rbs_trunc(params[I_TH_N]);
     for (int64_t i = 0; i < nterms; i++) {
         m0 += params[I_TH_M0 + i] * co;
         m1 += params[I_TH_M1 + i] * so;
         m2 += params[I_TH_M2 + i] * ce;
-        wr += params[I_TH_WR + i] * ce;
-        wi += params[I_TH_WI + i] * se;
+        wr += params[I_TH_WR + i] * (odd ? so : ce);
+        wi += params[I_TH_WI + i] * (odd ? co : se);
         double co_next = co * c2 - so * s2;
         so = so * c2 + co * s2;
         co = co_next;
@@ -765,7 +800,8 @@ RBS_HOT void rbs_rotation_init(const double K[3], const double R0[9], const doub
     sf *= hinv;
     double s, c, d, gval, u0, n[3];
     int theta = kp2 != 0.0 && k2 >= THETA_K2_MIN; /* a candidate for the theta mode */
-    double k = 0.0, kp = 0.0, kk = 0.0, kkp = 0.0, rf_alpha = 0.0; /* set and read only if theta */
+    double k = 0.0, kp = 0.0, kk = 0.0, kkp = 0.0, rf_shift = 0.0; /* set and read only if theta */
+    int reflect = 0;
     if (kp2 == 0.0) {
         params[I_MODE] = MODE_SEPARATRIX;
         params[I_LIN] = lmag / j2;
@@ -778,15 +814,17 @@ RBS_HOT void rbs_rotation_init(const double K[3], const double R0[9], const doub
         if (theta) {
             k = sqrt(k2);
             kp = sqrt(kp2);
-            rbs_theta_elliptic(k, kp, beta, cf * cf, cf, d * d, d, &kk, &kkp, &rf_alpha, &rf_u0);
+            reflect = beta > k; /* alpha > K'/2: w passes near a zero of theta_4, so it is taken through theta_1 */
+            rbs_theta_elliptic(k, kp, reflect ? beta : k2, reflect ? k2 + beta : k2 * (1.0 + beta),
+                               reflect ? 1.0 + beta : k2 + beta, cf * cf, cf, d * d, d, &kk, &kkp, &rf_shift, &rf_u0);
         } else {
             rf_u0 = rbs_rf_amp(cf * cf, cf, d * d, d);
         }
         u0 = sf * rf_u0;
     }
     params[I_U0] = u0;
-    if (theta && rbs_theta_init(params, kk, kkp, rf_alpha, k, kp, beta, lmag, j0, j1, d20, d21, nu, params[I_A + 0],
-                                params[I_A + 1], a2, u0)) {
+    if (theta && rbs_theta_init(params, kk, kkp, rf_shift, k, kp, beta, reflect, lmag, j0, j1, d20, d21, nu,
+                                params[I_A + 0], params[I_A + 1], a2, u0)) {
         params[I_MODE] = MODE_THETA;
         double cr, ci;
         rbs_theta_state(params, 0.0, n, &cr, &ci);

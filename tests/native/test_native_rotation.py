@@ -204,6 +204,19 @@ def test_states_cover_both_climbs_of_the_landen_chain(native):
     assert min(k_prime) < 1e-18 and max(k_prime) > 1e-9
 
 
+def test_states_cover_both_forms_of_the_theta_series(native):
+    """The general states of the bit test above take the theta mode with w through theta_4 (beta <= k) and
+    through theta_1 (beta > k), a hundred or more of each."""
+    rng = np.random.default_rng(KINDS.index("general") + 2027)
+    reflected = []
+    for K, R0, ell in _states("general", rng, STATES_PER_KIND):
+        params = np.full(py.ROT_PARAMS_SIZE, PREFILL)
+        native.rotation_init(K, R0, ell, params)
+        if params[0] == 4.0:
+            reflected.append(params[90])
+    assert reflected.count(0.0) >= 100 and reflected.count(1.0) >= 100, reflected
+
+
 def test_carlson_bit_identical(native):
     """R_F and R_J on random arguments over 1e+-30, with one of x, y, z zero, equal arguments, p near x."""
     rng = np.random.default_rng(7)
