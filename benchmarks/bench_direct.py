@@ -80,9 +80,6 @@ Run from the repository root::
     PYTHONPATH=. python benchmarks/bench_direct.py --json bench.json
     PYTHONPATH=. python benchmarks/bench_direct.py --runtime  # the run-time kernels alone (about 2 min)
     PYTHONPATH=. python benchmarks/bench_direct.py --runtime --no-native    # numba's alone
-
-If the numbers look odd after kernel edits, delete numba's cache files
-(``*.nbi``, ``*.nbc``) and rerun.
 """
 
 from __future__ import annotations

@@ -96,9 +96,6 @@ Run from the repository root::
     PYTHONPATH=. python benchmarks/bench_sampler.py                  # full run (a few minutes)
     PYTHONPATH=. python benchmarks/bench_sampler.py --quick          # smoke run
     PYTHONPATH=. python benchmarks/bench_sampler.py --table table.h5 --json sampler.json
-
-If the numbers look odd after kernel edits, delete numba's cache files
-(``*.nbi``, ``*.nbc``) and rerun.
 """
 
 from __future__ import annotations

@@ -28,6 +28,7 @@ import h5py
 import numba
 import numpy as np
 
+from data_schema import kernel_cache  # noqa: F401  (keys this module's kernels by their sources)
 from data_schema.common import DataFormatError, check_file, write_header
 from data_schema.output import hdf5_bytes, write_output
 

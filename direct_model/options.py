@@ -5,7 +5,10 @@ One dict so that all kernels compile the same way, and its variant for those tha
 module globals that change at run time (tables and parameters are always passed in as arrays).
 ``fastmath`` stays off: the physics tests compare results to round-off and IEEE semantics keep them
 reproducible.
+Importing :mod:`data_schema.kernel_cache` first keys every kernel's cache by the sources it depends on.
 """
+
+from data_schema import kernel_cache  # noqa: F401  (installed before any kernel is decorated)
 
 JIT = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 

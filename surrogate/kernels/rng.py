@@ -32,6 +32,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from data_schema import kernel_cache  # noqa: F401  (keys this module's kernels by their sources)
+
 _53_BITS = 1.0 / 9007199254740992.0      # 2**-53
 CHUNK_ROWS = 1024      # rows of a chunk: the unit of work of the parallel kernels, drawn from one stream
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from data_schema import kernel_cache  # noqa: F401  (keys this module's kernels by their sources)
 from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet, rebound_angles
 from data_schema.table import (
     CHAIN_TO_STATE, FEW_COLLISIONS, INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_CHAIN, N_COLLISION_CLASSES,
