@@ -5,15 +5,17 @@ and its ``incident_states``; default N = 10⁶: α1 10–90°, |V⁻| over the t
 normals, a = 0.1 mm, the four shapes with equal weights), timed five ways in ns per reflected state,
 uniforms included:
 
-* (C-1) C per particle: a C loop calling ``rbs_rng_fill`` (13 uniforms) and ``rbs_table_rebound`` per hit;
-* (C-many) C many-particle call: ``rbs_table_rebound_many_rng`` on all the hits (uniforms from 32 lanes);
-  breakdown: ``rbs_table_rebound_many`` on pre-drawn uniforms, and the 13 uniforms alone;
+* (C-1) C per particle: a C loop calling ``rbs_rng_fill`` (13 uniforms) and ``rbs_rebound`` (``RBS_METHOD_TABLE``,
+  the uniforms given) per hit;
+* (C-many) C many-particle call: ``rbs_draw_many`` on all the hits (uniforms from the rng's 32 lanes);
+  breakdown: ``rbs_draw_many`` on pre-drawn uniforms, and the 13 uniforms alone;
 * (N-1) numba per particle: ``table_rebound`` in an ``@njit`` loop with ``fill_uniforms``
   (bench_sampler's (b));
 * (N-block) numba block kernel: ``table_rebound_many_rng`` (bench_sampler's (b-block));
 * (C-GT) the Grant–Tabakoff sphere bounce of bench_sampler.py written in C, same loop (and numba's,
   bench_sampler's (d), for reference);
-* (C-spin) every hit answered: (C-1)'s loop with ``rbs_rebound_rng`` (method auto) for non-spinning hits,
+* (C-spin) every hit answered: (C-1)'s loop with ``rbs_rebound`` (method auto, uniforms from the rng) for
+  non-spinning hits,
   where the table answers after the path decision (its overhead: (C-spin) − (C-1)), and in µs per hit for
   spinning ones (|Ω⁻| a/|V⁻| = 0.3 about random axes, the first 20 000 states), which the direct model
   answers.
@@ -162,15 +164,15 @@ def main(argv=None) -> int:
         same_bits = bool(np.array_equal(s_c, s_py) and np.array_equal(V_c.view(np.int64), V_py.view(np.int64))
                          and np.array_equal(W_c.view(np.int64), W_py.view(np.int64)))
 
-    rows = [("(C-1)    C per particle: rbs_rng_fill + rbs_table_rebound", c["c_per_particle"]),
-            ("(C-many) C rbs_table_rebound_many_rng, all hits", c["c_many"]),
-            ("         breakdown: rbs_table_rebound_many, uniforms given", c["c_many_given"]),
+    rows = [("(C-1)    C per particle: rbs_rng_fill + rbs_rebound (table)", c["c_per_particle"]),
+            ("(C-many) C rbs_draw_many, all hits, uniforms from the rng", c["c_many"]),
+            ("         breakdown: rbs_draw_many, uniforms given", c["c_many_given"]),
             ("         breakdown: 13 xoshiro256+ uniforms alone", c["c_rng"]),
             ("(N-1)    numba table_rebound in @njit loop", n1),
             ("(N-block) numba table_rebound_many_rng", nb),
             ("(C-GT)   C Grant-Tabakoff sphere bounce", c["c_grant_tabakoff"]),
             ("         numba Grant-Tabakoff bounce (bench_sampler (d))", gt),
-            ("(C-spin) C rbs_rebound_rng, auto, no spin (the table)", c["c_spin_still"])]
+            ("(C-spin) C rbs_rebound from the rng, auto, no spin (table)", c["c_spin_still"])]
     print(f"\n{'case':58s} {'ns/state':>10s}")
     print("-" * 69)
     for label, ns in rows:
@@ -183,8 +185,8 @@ def main(argv=None) -> int:
                "c_many_ns": c["c_many"] <= TARGET_MANY_NS,
                "c_many_over_c_bounce": ratios["c_many_over_c_bounce"] <= TARGET_MANY_OVER_BOUNCE}
     overhead = c["c_spin_still"] - c["c_per_particle"]
-    print(f"\n(C-spin) every hit answered (rbs_rebound_rng, method auto):")
-    print(f"  no spin: {c['c_spin_still']:.1f} ns per hit against {c['c_per_particle']:.1f} for rbs_table_rebound: "
+    print(f"\n(C-spin) every hit answered (rbs_rebound from the rng, method auto):")
+    print(f"  no spin: {c['c_spin_still']:.1f} ns per hit against {c['c_per_particle']:.1f} under RBS_METHOD_TABLE: "
           f"the path decision costs {overhead:+.1f} ns ({c['still_direct']} of {count} states off the table's grid went to "
           f"the direct model)")
     print(f"  spinning, |Omega-| a/|V-| = 0.3: {c['c_spin_spinning_us']:.2f} us per hit over {c['spinning']} hits "

@@ -12,8 +12,10 @@ class DataFormatError(ValueError):
     """A file is not a readable file of the expected layout; the message names it."""
 
 
-def check_file(path, file_type: str, major: int) -> None:
-    """Check that ``path`` is an HDF5 file of ``file_type`` with format major version ``major``.
+def check_file(path, file_type: str, major, other_major=None) -> None:
+    """Check that ``path`` is an HDF5 file of ``file_type`` with format major version ``major`` (an int, or a
+    tuple of the majors accepted). ``other_major(path, major, minor)`` may give the message (without the path)
+    for a file of another major version, or None for the generic one.
 
     Raises
     ------
@@ -42,11 +44,13 @@ def check_file(path, file_type: str, major: int) -> None:
         raise DataFormatError(f"{path}: file_type is {found_type!r}, expected {file_type!r}")
     if version is None or len(version) != 2:
         raise DataFormatError(f"{path}: missing or malformed 'format_version' attribute: {version!r}")
-    if int(version[0]) != major:
-        raise DataFormatError(
-            f"{path}: format version {int(version[0])}.{int(version[1])} is not readable by this "
-            f"version of the package, which reads major version {major}; make the file again with this "
-            f"version (docs/format.md, 'Identification and versions')")
+    majors = major if isinstance(major, tuple) else (major,)
+    if int(version[0]) not in majors:
+        text = other_major(path, int(version[0]), int(version[1])) if other_major is not None else None
+        raise DataFormatError(f"{path}: " + (text or (
+            f"format version {int(version[0])}.{int(version[1])} is not readable by this "
+            f"version of the package, which reads major version {' or '.join(map(str, majors))}; make the file "
+            f"again with this version (docs/format.md, 'Identification and versions')")))
 
 
 def write_header(f: h5py.File, file_type: str, version: tuple[int, int]) -> None:

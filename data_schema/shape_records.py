@@ -1,4 +1,4 @@
-"""The shapes a table holds, as data (group ``/shapes`` since table format 3.4; docs/format.md, "Shapes").
+"""The shapes a table holds, as data (group ``/shapes``; docs/format.md, "Shapes").
 
 One row per shape of ``grid/shapes``, in its order; the records are those of :mod:`direct_model.registry`
 (the built-in families, :data:`direct_model.registry.FAMILIES`, and the user's own grains,
@@ -10,9 +10,9 @@ This module is the only place that writes or reads these arrays (the C twin: nat
 dataset carries the Fletcher-32 checksum, so a flipped bit fails to load naming the dataset; ``name`` is the
 checksummed copy of ``grid/shapes``, and the record of one of the paper's four families (whose bodies the runtimes
 also make from code, :data:`direct_model.shapes.SHAPES`) must be the family's at the table's κ and aspect-ratio law
-(the attributes of group ``grid``, themselves copied in ``grid/law``). Any other shape, a later family's as a user
-grain's, is read from its stored record alone. Tables before 3.4 hold
-the families only: :func:`family_records` synthesises their records from those attributes.
+(the fields of the table's ``model/parameters``). Any other shape, a later family's as a user grain's, is read
+from its stored record alone. :func:`family_records` makes the families' records from κ and the law (a table in
+memory that was given no records).
 """
 
 from __future__ import annotations
@@ -38,8 +38,7 @@ INERTIA_BOUND = 2.0 * VERTEX_BOUND ** 2
 # the most shapes a table may hold: far more than any build makes (each is a direct-model run per grid cell);
 # it keeps every count of the C loader within an int
 MAX_TABLE_SHAPES = 4096
-# shape_codes (grid, since 3.2) of a shape that is not a built-in family (since 3.4): a 3.3 reader refuses the
-# table by the name before it reads the codes
+# grid/shape_codes of a shape that is not a built-in family
 USER_SHAPE_CODE = 255
 
 # name: (dtype, units, meaning) of the datasets of group /shapes, in the order both loaders read and check them
@@ -103,7 +102,8 @@ def write_shape_records(f: h5py.File, records) -> None:
 
 def family_records(names, kappa: float, aspect: tuple) -> tuple:
     """The records of the built-in families ``names`` at the table's κ and aspect-ratio law (mean, sd, low, high):
-    what a table before 3.4 holds. ValueError if a name is not a family's or the law or κ is not valid."""
+    what a table in memory without records holds. ValueError if a name is not a family's or the law or κ is not
+    valid."""
     law = AspectRatioLaw(*aspect)
     return tuple(built_in_shape(name, kappa, law) for name in names)
 
@@ -208,7 +208,7 @@ def records_from_arrays(arrays: dict, names, kappa: float, aspect: tuple, refuse
             for key in ("kind", "vertices", "triangles", "inertia", "aspect", "both_hands"):
                 if not np.array_equal(_row(arrays, key, i).view(np.uint8), expected[key].view(np.uint8)):
                     refuse(f"dataset 'shapes/{key}' of the built-in shape {name!r} differs from the family's record "
-                           f"at the table's kappa and aspect-ratio law (group 'grid')")
+                           f"at the table's kappa and aspect-ratio law (dataset 'model/parameters')")
             records.append(record)
             continue
         row = arrays["aspect"][i]
@@ -221,10 +221,12 @@ def records_from_arrays(arrays: dict, names, kappa: float, aspect: tuple, refuse
             record = polyhedron(name, _row(arrays, "vertices", i), _row(arrays, "triangles", i), law,
                                 bool(arrays["both_hands"][i]))
         except (ShapeError, ValueError) as exc:
-            refuse(f"dataset 'shapes/vertices' of shape {name!r} is not a hull in its principal frame: {exc}")
+            refuse(f"datasets 'shapes/vertices' and 'shapes/triangles' of shape {name!r} are not a hull in its "
+                   f"principal frame: {exc}")
         if not np.array_equal(record.inertia.view(np.uint64), arrays["inertia"][i].view(np.uint64)):
             refuse(f"dataset 'shapes/inertia' of shape {name!r} ({arrays['inertia'][i].tolist()}) differs from the "
-                   f"mass properties of its vertices ({record.inertia.tolist()})")
+                   f"mass properties of its hull, datasets 'shapes/vertices' and 'shapes/triangles' "
+                   f"({record.inertia.tolist()})")
         records.append(record)
     return tuple(records)
 

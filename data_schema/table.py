@@ -2,27 +2,27 @@
 
 Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.md):
 
-    /                      attrs: file_type = "rebound_table", format_version = (3, 4),
+    /                      attrs: file_type = "rebound_table", format_version = (4, 0),
                            created (ISO 8601 UTC), package_version, model_sha256, config (TOML text),
                            config_sha256, master_seed
-    /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings;
-                           attrs: kappa, n_max, particles_per_cell,
-                           restitution_k, restitution_p (the wall's normal-restitution law),
-                           friction_q, wall_law (its friction exponent and name; since 3.1, optional);
-                           aspect_ratio_{mean,sd,low,high}, contact_tol, set_tol, max_steps,
-                           second_moment_factors (the rest of the direct model's parameters; required since
-                           3.3); law and shape_codes, checksummed copies of the attributes (LAW_ATTRIBUTES;
-                           3.2: restitution_k, restitution_p only) and names the law depends on (since 3.2;
-                           since 3.4 shape_codes holds USER_SHAPE_CODE for a shape that is not a family)
-    /shapes                (since 3.4) the definition of every shape the table holds, one row per shape
+    /grid                  alpha1_deg (n_alpha,), speed_m_s (n_speed,), shapes (n_shape,) strings, shape_codes
+                           (the checksummed copy of shapes: each family's code, USER_SHAPE_CODE for another);
+                           attr: particles_per_cell
+    /model/parameters      one row of a compound type: the direct model's parameters by name (MODEL_FIELDS)
+    /wall                  attrs: family (the wall law family, direct_model.wall.WALL_FAMILIES), name (the
+                           wall's label); parameters: one row of a compound type, the family's parameters by name
+    /shapes                the definition of every shape the table holds, one row per shape
                            (data_schema.shape_records: name, kind, vertices, triangles, inertia, aspect law, hands)
     /resolution            attrs: clusters, dictionary_size, levels
     /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
 
-Every numeric dataset carries HDF5's Fletcher-32 checksum (since 3.1), so a
-corrupted file fails to load with an error naming the dataset. What makes a
-table valid (docs/format.md, "What makes a table valid") is checked by
-:func:`check_contract` here and by the C library's loader, alike.
+Every numeric dataset carries HDF5's Fletcher-32 checksum, so a corrupted
+file fails to load with an error naming the dataset; the two parameter rows
+are read by field name. What makes a table valid (docs/format.md, "What
+makes a table valid") is checked by :func:`check_contract` here and by the
+C library's loader, alike. A table of format 3 (before rebound-scatter 1.0)
+is refused with how to rebuild it from the configuration it stores
+(:func:`stored_config`).
 
 Representation of one cell (docs/format.md): the reflected state of the
 rebounded particles, folded by the mirror symmetry Z → −Z to β2 ≥ 0 (Ω_x, Ω_y
@@ -53,7 +53,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import tomllib
+import math
 from pathlib import Path
 
 import h5py
@@ -64,10 +64,13 @@ from data_schema.samples import SHAPE_NAMES
 from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_datasets,
                                        family_records, records_from_arrays, write_shape_records)
 from data_schema.output import hdf5_bytes, write_output
+from direct_model.wall import WALL_FAMILIES, WallMaterial, wall_family
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (3, 4)
-SHAPES_SINCE = 4        # the minor version from which a table holds group /shapes
+TABLE_VERSION = (4, 0)
+# the major versions whose stored configuration `tablegen info --config` reads: 3 (before rebound-scatter 1.0,
+# refused by the readers with how to rebuild it) and this one
+CONFIG_MAJORS = (3, TABLE_VERSION[0])
 
 # grid speeds a table may hold, m/s (docs/format.md, "What makes a table valid"): the direct model's arithmetic
 # fails far outside (1e-100 m/s gives no rebound), and the runtime moves draws between consecutive grid speeds
@@ -89,17 +92,6 @@ STATE_UNITS = ("rad", "rad", "1", "1", "1", "1")
 INDICATRIX_ALPHA2_EDGES = np.linspace(0.0, np.pi, 73)
 INDICATRIX_BETA2_EDGES = np.linspace(-np.pi / 2, np.pi / 2, 73)
 
-
-# the direct model's tolerances every build used before tables recorded them (grid attributes; the defaults
-# of direct_model.simulate, which tablegen never changed)
-BUILT_WITH_TOLERANCES = {"contact_tol": 1e-10, "set_tol": 1e-9, "max_steps": 100_000}
-# s per shape code (J/m = s (b²+c², a²+c², a²+b²)) as builds computed them at κ = 0.3, every preset's κ, before
-# tables recorded them (direct_model.shapes.second_moment_factors(0.3), bit for bit)
-BUILT_WITH_KAPPA = 0.3
-BUILT_WITH_SECOND_MOMENT_FACTORS = (0.2, 0.33333333333333337, 0.3309571404654277, 0.20000000000000004)
-# the aspect-ratio law's attributes, by their key in the configuration's aspect_ratio table
-ASPECT_RATIO_ATTRIBUTES = {"aspect_ratio_mean": "mean", "aspect_ratio_sd": "sd", "aspect_ratio_low": "low",
-                           "aspect_ratio_high": "high"}
 
 
 # chain order of the folded state inside a cluster (module doc)
@@ -156,14 +148,44 @@ class TableResolution:
         }
 
 
-# the checksummed copies of the law's attributes and shape names in group grid (since 3.2)
-LAW_DATASETS = ("law", "shape_codes")
-# the grid attributes grid/law copies, in its order (3.3; a 3.2 table copies the first two): every attribute the
-# runtime reads, the table path's wall law and the direct model's parameters (second_moment_factors: 4 numbers)
-LAW_ATTRIBUTES = ("restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean",
-                  "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol", "max_steps",
-                  "second_moment_factors")
-INTEGER_ATTRIBUTES = ("n_max", "particles_per_cell", "max_steps", "clusters", "dictionary_size", "levels")
+INTEGER_ATTRIBUTES = ("particles_per_cell", "clusters", "dictionary_size", "levels")
+
+# the groups holding the two parameter rows, and their dataset: one row of an HDF5 compound type, chunked (1,)
+# under Fletcher-32, read by field name (a field of another name is ignored; its order does not matter)
+MODEL_GROUP, WALL_GROUP, PARAMETERS = "model", "wall", "parameters"
+WALL_ATTRIBUTES = ("family", "name")        # of group wall: the law family and the wall's label, strings
+N_SECOND_MOMENT_FACTORS = 4                 # s per shape code of the paper's four families
+_INTEGER_RANGE = "an integer in [1, 2**53)"
+
+
+def _in_integer_range(x, row) -> bool:
+    return 1 <= x < 2 ** 53
+
+
+def _finite_positive(x, row) -> bool:
+    return math.isfinite(x) and x > 0.0
+
+
+# the fields of model/parameters (ReboundTable attributes of the same names, the aspect-ratio law's four as
+# aspect_ratio): name -> (dtype, units, its range in words, its check given the value and the row's values). The
+# direct model's parameters (direct_model.runtime.model_parameters); both loaders refuse a value out of range
+# with these words, in this order.
+MODEL_FIELDS = {
+    "kappa": ("<f8", "1", "in [0, 1)", lambda x, row: 0.0 <= x < 1.0),
+    "n_max": ("<i8", "1", _INTEGER_RANGE, _in_integer_range),
+    "aspect_ratio_mean": ("<f8", "1", "finite", lambda x, row: math.isfinite(x)),
+    "aspect_ratio_sd": ("<f8", "1", "finite and > 0", _finite_positive),
+    "aspect_ratio_low": ("<f8", "1", "in (0, 1)", lambda x, row: 0.0 < x < 1.0),
+    "aspect_ratio_high": ("<f8", "1", "in (aspect_ratio_low, 1]", lambda x, row: row["aspect_ratio_low"] < x <= 1.0),
+    "contact_tol": ("<f8", "a", "finite and > 0", _finite_positive),
+    "set_tol": ("<f8", "a", "finite and > 0", _finite_positive),
+    "max_steps": ("<i8", "1", _INTEGER_RANGE, _in_integer_range),
+    "second_moment_factors": (("<f8", (N_SECOND_MOMENT_FACTORS,)), "1",
+                              f"{N_SECOND_MOMENT_FACTORS} numbers in (0, 1), one per shape code",
+                              lambda x, row: 0.0 < x < 1.0),
+}
+ASPECT_RATIO_FIELDS = ("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high")
+MODEL_DTYPE = np.dtype([(name, spec[0]) for name, spec in MODEL_FIELDS.items()])
 
 # name: (dtype, units, meaning) of the per-cell datasets
 CELL_DATASETS = {
@@ -228,19 +250,16 @@ class ReboundTable:
     master_seed: int
     created: str
     package_version: str
-    restitution_k: float                 # normal restitution exp(−k |V_c|^p) of the wall law, (m/s)^(−p)
-    restitution_p: float
-    model_sha256: str = ""               # hash of the direct model's source that computed the cells ("" before 3.1)
-    friction_q: float = float("nan")     # friction factor exp(q cos γ) of the wall law (NaN if not recorded)
-    wall_law: str = ""                   # name of the wall law ("" if not recorded)
-    # the rest of the direct model's parameters (docs/format.md; tables before these were recorded: see
-    # :meth:`from_hdf5`): the aspect-ratio law (mean, sd, low, high) of b/a and c/b, the contact and
-    # contact-set tolerances (units of a), the search-step budget per flight, and s per shape code
-    aspect_ratio: tuple = (float("nan"),) * 4
-    contact_tol: float = BUILT_WITH_TOLERANCES["contact_tol"]
-    set_tol: float = BUILT_WITH_TOLERANCES["set_tol"]
-    max_steps: int = BUILT_WITH_TOLERANCES["max_steps"]
-    second_moment_factors: tuple = (float("nan"),) * 4
+    model_sha256: str                    # hash of the direct model's source that computed the cells
+    wall: WallMaterial                   # the wall the cells were built with (group /wall)
+    # the rest of the direct model's parameters (group /model, MODEL_FIELDS, with kappa and n_max): the
+    # aspect-ratio law (mean, sd, low, high) of b/a and c/b, the contact and contact-set tolerances (units of
+    # a), the search-step budget per flight, and s per shape code
+    aspect_ratio: tuple
+    contact_tol: float
+    set_tol: float
+    max_steps: int
+    second_moment_factors: tuple
     format_version: tuple = TABLE_VERSION    # of the file read (what this package writes for a new table)
     # the registry record (direct_model.registry) of each shape, in the order of ``shapes``; () for the built-in
     # families at ``kappa`` and ``aspect_ratio`` (:meth:`shape_records`)
@@ -263,11 +282,11 @@ class ReboundTable:
         """The registry record of each shape, table order: ``records``, or the families' at κ and the aspect law."""
         return self.records or family_records(self.shapes, self.kappa, self.aspect_ratio)
 
-    def law_values(self) -> np.ndarray:
-        """The attributes of :data:`LAW_ATTRIBUTES` in order, as float64: the content of ``grid/law`` (3.3)."""
-        values = [self.restitution_k, self.restitution_p, self.friction_q, self.kappa, self.n_max,
-                  *self.aspect_ratio, self.contact_tol, self.set_tol, self.max_steps, *self.second_moment_factors]
-        return np.array(values, dtype=np.float64)
+    def model_parameters(self) -> dict:
+        """The direct model's parameters by the names of :data:`MODEL_FIELDS` (the row of ``model/parameters``)."""
+        return {"kappa": self.kappa, "n_max": self.n_max, **dict(zip(ASPECT_RATIO_FIELDS, self.aspect_ratio)),
+                "contact_tol": self.contact_tol, "set_tol": self.set_tol, "max_steps": self.max_steps,
+                "second_moment_factors": tuple(self.second_moment_factors)}
 
     def cell(self, shape: str, i_alpha: int, i_speed: int) -> CellTable:
         """The cell of ``shape`` at grid indices (i_alpha, i_speed)."""
@@ -288,22 +307,20 @@ class ReboundTable:
             values = np.asarray(getattr(self, name), dtype=np.float64)
             grid.create_dataset(name, data=values, fletcher32=True).attrs["units"] = units
         grid.create_dataset("shapes", data=np.array(self.shapes, dtype=h5py.string_dtype()))
-        # checksummed copies of what the law depends on beyond the cell datasets (3.2; every law attribute
-        # since 3.3): a flipped bit of an attribute or a swapped shape name fails to load
-        grid.create_dataset("law", data=self.law_values(), fletcher32=True)
+        # the checksummed copy of the names: two swapped shape names fail to load
         grid.create_dataset("shape_codes", data=shape_codes(self.shapes), fletcher32=True)
-        grid.attrs["kappa"] = self.kappa
-        grid.attrs["n_max"] = self.n_max
         grid.attrs["particles_per_cell"] = self.particles_per_cell
-        grid.attrs["restitution_k"] = self.restitution_k
-        grid.attrs["restitution_p"] = self.restitution_p
-        grid.attrs["friction_q"] = self.friction_q
-        grid.attrs["wall_law"] = self.wall_law
-        for name, value in zip(ASPECT_RATIO_ATTRIBUTES, self.aspect_ratio):
-            grid.attrs[name] = value
-        for name in BUILT_WITH_TOLERANCES:
-            grid.attrs[name] = getattr(self, name)
-        grid.attrs["second_moment_factors"] = np.asarray(self.second_moment_factors, dtype=np.float64)
+        row = np.zeros(1, dtype=MODEL_DTYPE)
+        for name, value in self.model_parameters().items():
+            row[name] = value
+        _write_row(f.create_group(MODEL_GROUP), row, [spec[1] for spec in MODEL_FIELDS.values()],
+                   "the direct model's parameters the cells were built with, by name")
+        family = wall_family(self.wall.family)
+        wall = f.create_group(WALL_GROUP)
+        wall.attrs["family"] = family.name
+        wall.attrs["name"] = self.wall.name
+        _write_row(wall, np.array([tuple(self.wall.as_array())], dtype=[(p.name, "<f8") for p in family.parameters]),
+                   [p.units for p in family.parameters], f"the {family.name} wall law's parameters, by name")
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -320,50 +337,44 @@ class ReboundTable:
     def from_hdf5(cls, f: h5py.File) -> "ReboundTable":
         """Read a table written by :meth:`to_hdf5`; DataFormatError naming what is missing."""
         where = f.filename
-        for group in ("grid", "resolution", "cells"):
+        for group in ("grid", "resolution", "cells", MODEL_GROUP, WALL_GROUP, SHAPES_GROUP):
             if group not in f:
                 raise DataFormatError(f"{where}: missing group '{group}'")
-        for name in ("alpha1_deg", "speed_m_s", "shapes"):
+        for name in ("alpha1_deg", "speed_m_s", "shapes", "shape_codes"):
             if name not in f["grid"]:
                 raise DataFormatError(f"{where}: missing dataset 'grid/{name}'")
         missing = [n for n in CELL_DATASETS if n not in f["cells"]]
         if missing:
             raise DataFormatError(f"{where}: missing dataset(s) {', '.join('cells/' + n for n in missing)}")
         grid = f["grid"]
-        alpha1_deg, speed_m_s = (_read(grid, name) for name in ("alpha1_deg", "speed_m_s"))
+        alpha1_deg, speed_m_s, codes = (_read(grid, name) for name in ("alpha1_deg", "speed_m_s", "shape_codes"))
         cells = {name: _read(f["cells"], name) for name in CELL_DATASETS}
-        law = {name: _read(grid, name) for name in LAW_DATASETS if name in grid}
-        missing = [name for name in LAW_DATASETS if name not in law]
-        if _minor(f) >= 2 and missing:
-            raise DataFormatError(f"{where}: missing dataset(s) {', '.join('grid/' + n for n in missing)} (table "
-                                  f"format 3.2)")
-        minor = _minor(f)
-        if minor >= SHAPES_SINCE and SHAPES_GROUP not in f:
-            raise DataFormatError(f"{where}: missing group '{SHAPES_GROUP}' (table format 3.{SHAPES_SINCE})")
-        shapes = _read_group(f[SHAPES_GROUP]) if SHAPES_GROUP in f else None
+        shapes = _read_group(f[SHAPES_GROUP])
+        model_row, wall_row = (_read_row(f[group]) for group in (MODEL_GROUP, WALL_GROUP))
         try:
             resolution = TableResolution(**{name: _number(f["resolution"], name)
                                             for name in ("clusters", "dictionary_size", "levels")})
+            model = _model_fields(model_row)
             table = cls(
                 alpha1_deg=alpha1_deg, speed_m_s=speed_m_s,
                 shapes=tuple(s.decode() if isinstance(s, bytes) else str(s) for s in grid["shapes"][()]),
-                resolution=resolution, cells=cells, kappa=_number(grid, "kappa"),
-                n_max=_number(grid, "n_max"), particles_per_cell=_number(grid, "particles_per_cell"),
+                resolution=resolution, cells=cells, kappa=model["kappa"],
+                n_max=model["n_max"], particles_per_cell=_number(grid, "particles_per_cell"),
                 config_text=str(f.attrs["config"]), config_sha256=str(f.attrs["config_sha256"]),
                 master_seed=int(f.attrs["master_seed"]), created=str(f.attrs["created"]),
-                package_version=str(f.attrs["package_version"]),
-                model_sha256=str(f.attrs.get("model_sha256", "")),
-                restitution_k=_number(grid, "restitution_k"), restitution_p=_number(grid, "restitution_p"),
-                friction_q=_number(grid, "friction_q") if "friction_q" in grid.attrs or minor >= 3 else float("nan"),
-                wall_law=str(grid.attrs.get("wall_law", "")), format_version=(3, minor),
-                **_direct_model_attributes(f, minor))
+                package_version=str(f.attrs["package_version"]), model_sha256=str(f.attrs["model_sha256"]),
+                wall=_wall(f[WALL_GROUP], wall_row),
+                aspect_ratio=tuple(model[name] for name in ASPECT_RATIO_FIELDS), contact_tol=model["contact_tol"],
+                set_tol=model["set_tol"], max_steps=model["max_steps"],
+                second_moment_factors=model["second_moment_factors"],
+                format_version=tuple(int(x) for x in f.attrs["format_version"]))
         except (OSError, KeyError, TypeError) as exc:
             raise DataFormatError(f"{where}: cannot read the table (truncated or corrupt?): {exc}") from exc
         except ValueError as exc:
             if isinstance(exc, DataFormatError):
                 raise DataFormatError(f"{where}: {exc}") from None
             raise DataFormatError(f"{where}: inconsistent table: {exc}") from exc
-        check_contract(table, where, law, shapes)
+        check_contract(table, where, codes, shapes)
         return dataclasses.replace(table, records=_records(table, shapes, where))
 
 
@@ -372,23 +383,109 @@ def shape_codes(names) -> np.ndarray:
     return np.array([SHAPE_NAMES.index(s) if s in SHAPE_NAMES else USER_SHAPE_CODE for s in names], dtype=np.uint8)
 
 
-def _records(table: ReboundTable, shapes: dict | None, where: str) -> tuple:
-    """The records of a checked table: from its /shapes datasets, or (before 3.4) the families'."""
+def _records(table: ReboundTable, shapes: dict, where: str) -> tuple:
+    """The records of a checked table, from its /shapes datasets."""
     def refuse(text):
         raise DataFormatError(f"{where}: {text}")
 
-    if shapes is not None:
-        return records_from_arrays(shapes, table.shapes, table.kappa, table.aspect_ratio, refuse)
+    return records_from_arrays(shapes, table.shapes, table.kappa, table.aspect_ratio, refuse)
+
+
+def _g(value) -> str:
+    """A value in an error message, as the C loader prints it: an integer as it is, a real as %.17g."""
+    return str(value) if isinstance(value, int) else f"{float(value):.17g}"
+
+
+def _write_row(group: h5py.Group, row: np.ndarray, units, meaning: str) -> None:
+    """``row`` (one row of a compound type) as ``group/parameters``, chunked (1,) under Fletcher-32."""
+    ds = group.create_dataset(PARAMETERS, data=row, chunks=(1,), fletcher32=True)
+    ds.attrs["units"] = ", ".join(units)
+    ds.attrs["meaning"] = meaning
+
+
+def _read_row(group: h5py.Group) -> np.ndarray:
+    """The one row of ``group/parameters`` (a structured array of one element); DataFormatError naming the dataset
+    if it is missing, not one row of a compound type, or cannot be read (the file named but by _read)."""
+    where = f"dataset '{group.name.lstrip('/')}/{PARAMETERS}'"
+    if PARAMETERS not in group:
+        raise DataFormatError(f"{group.file.filename}: missing {where}")
+    ds = group[PARAMETERS]
+    if not isinstance(ds, h5py.Dataset) or ds.dtype.names is None or ds.shape != (1,):
+        raise DataFormatError(f"{group.file.filename}: {where} must hold one row of a compound type, one field "
+                              f"per parameter")
+    return _read(group, PARAMETERS)
+
+
+def _field(row: np.ndarray, dataset: str, name: str, kind: str, count: int | None, fields: str):
+    """Field ``name`` of ``row`` (read from ``dataset``): an int (``kind`` "integer"), a float ("number") or a
+    tuple of ``count`` floats; DataFormatError (no file name) if it is missing or stored as something else."""
+    if name not in row.dtype.names:
+        raise DataFormatError(f"dataset '{dataset}' has no field '{name}'; the fields read: {fields}")
+    stored = row.dtype[name]
+    base, shape = (stored.subdtype if stored.subdtype is not None else (stored, ()))
+    wanted = () if count is None else (count,)
+    if base.kind not in ("iu" if kind == "integer" else "iuf") or shape != wanted:
+        what = f"{count} numbers" if count is not None else f"one {kind}"
+        raise DataFormatError(f"field '{name}' of dataset '{dataset}' must be stored as {what}")
+    value = row[name][0]
+    if count is not None:
+        return tuple(float(x) for x in value)
+    return int(value) if kind == "integer" else float(value)
+
+
+def _model_fields(row: np.ndarray) -> dict:
+    """The fields of ``model/parameters`` by name, each checked against its range (:data:`MODEL_FIELDS`, in
+    order); DataFormatError (no file name) naming a field missing, of another type, or out of range."""
+    dataset = f"{MODEL_GROUP}/{PARAMETERS}"
+    names = ", ".join(MODEL_FIELDS)
+    values = {}
+    for name, (dtype, _, _, _) in MODEL_FIELDS.items():
+        kind = "integer" if np.dtype(dtype).kind == "i" else "number"
+        count = N_SECOND_MOMENT_FACTORS if isinstance(dtype, tuple) else None
+        values[name] = _field(row, dataset, name, kind, count, names)
+    for name, (_, _, allowed, ok) in MODEL_FIELDS.items():
+        value = values[name]
+        for i, x in enumerate(value if isinstance(value, tuple) else (value,)):
+            if not ok(x, values):
+                at = f" at index {i}" if isinstance(value, tuple) else ""
+                raise DataFormatError(f"field '{name}' of dataset '{dataset}' must be {allowed}; got {_g(x)}{at}")
+    return values
+
+
+def _string_attribute(group: h5py.Group, name: str) -> str:
+    """A string attribute of ``group``; DataFormatError (no file name) if it is missing or not a string."""
+    where = f"of group '{group.name.lstrip('/')}'"
+    if name not in group.attrs:
+        raise DataFormatError(f"missing attribute '{name}' {where}")
     try:
-        return family_records(table.shapes, table.kappa, table.aspect_ratio)
-    except ValueError as exc:       # κ and the law are the direct model's parameters: the C loader's words
-        refuse(f"the direct model's parameters are out of range: {exc} (the built-in shapes' records cannot be "
-               f"made from the table's kappa {table.kappa!r} and aspect-ratio law {list(table.aspect_ratio)})")
+        value = group.attrs[name]
+    except (OSError, TypeError, ValueError):
+        value = None
+    if isinstance(value, bytes):
+        value = value.decode(errors="replace")
+    if not isinstance(value, str):
+        raise DataFormatError(f"cannot read the attribute '{name}' {where} as a string")
+    return value
 
 
-def _minor(f: h5py.File) -> int:
-    """The minor format version of an open table (checked a pair by check_file)."""
-    return int(f.attrs["format_version"][1])
+def _wall(group: h5py.Group, row: np.ndarray) -> WallMaterial:
+    """The wall record of group /wall and its parameters' row: its family by name (one of
+    direct_model.wall.WALL_FAMILIES), each of the family's parameters by field name within its range;
+    DataFormatError (no file name) naming the attribute or field otherwise."""
+    family_name, name = (_string_attribute(group, attribute) for attribute in WALL_ATTRIBUTES)
+    try:
+        family = wall_family(family_name)
+    except ValueError:
+        raise DataFormatError(f"the attribute 'family' of group '{WALL_GROUP}' names an unknown wall law family "
+                              f"'{family_name}' (this version knows: {', '.join(WALL_FAMILIES)})") from None
+    dataset = f"{WALL_GROUP}/{PARAMETERS}"
+    fields = f"{', '.join(family.parameter_names)} (the {family.name} wall law)"
+    values = {p.name: _field(row, dataset, p.name, "number", None, fields) for p in family.parameters}
+    for parameter in family.parameters:
+        if not parameter.ok(values[parameter.name]):
+            raise DataFormatError(f"field '{parameter.name}' of dataset '{dataset}' must be {parameter.allowed}; "
+                                  f"got {_g(values[parameter.name])}")
+    return WallMaterial.from_parameters(family.name, values, name)
 
 
 def _number(group: h5py.Group, name: str, count: int | None = 1):
@@ -412,21 +509,16 @@ def _number(group: h5py.Group, name: str, count: int | None = 1):
     return int(values.ravel()[0]) if integer else float(values.ravel()[0])
 
 
-def check_contract(table: ReboundTable, where: str, law: dict, shapes: dict | None = None) -> None:
+def check_contract(table: ReboundTable, where: str, codes, shapes: dict) -> None:
     """DataFormatError naming the file and the value unless ``table`` obeys what makes a table valid beyond its
-    layout (docs/format.md, "What makes a table valid"; the C loader checks the same). ``law`` holds the
-    datasets of :data:`LAW_DATASETS` the file has (3.2), which must equal the attributes and names: the first two
-    of :data:`LAW_ATTRIBUTES` in a 3.2 table, all of them since 3.3. ``shapes`` holds the datasets of group
-    /shapes (3.4; :func:`data_schema.shape_records.check_shape_datasets`); a table without them holds the families
-    only."""
+    layout (docs/format.md, "What makes a table valid"; the C loader checks the same). ``codes`` is the dataset
+    ``grid/shape_codes``, which must be the codes of the names; ``shapes`` holds the datasets of group /shapes
+    (:func:`data_schema.shape_records.check_shape_datasets`). The two parameter rows were checked as they were
+    read (:func:`_model_fields`, :func:`_wall`)."""
     def refuse(text):
         raise DataFormatError(f"{where}: {text}")
 
-    if shapes is not None:
-        check_shape_datasets(shapes, table.shapes, refuse)
-    elif not all(name in SHAPE_NAMES for name in table.shapes) or len(set(table.shapes)) != len(table.shapes):
-        refuse(f"dataset 'grid/shapes' must name distinct shapes among {', '.join(SHAPE_NAMES)} (a table before "
-               f"format 3.{SHAPES_SINCE}); got {list(table.shapes)}")
+    check_shape_datasets(shapes, table.shapes, refuse)
     alpha1, speed = np.asarray(table.alpha1_deg, dtype=np.float64), np.asarray(table.speed_m_s, dtype=np.float64)
     if not (np.all((alpha1 > 0.0) & (alpha1 <= 90.0)) and np.all(np.diff(alpha1) > 0.0)):
         refuse(f"dataset 'grid/alpha1_deg' must be strictly increasing in (0, 90] deg; got {alpha1.tolist()}")
@@ -436,23 +528,9 @@ def check_contract(table: ReboundTable, where: str, law: dict, shapes: dict | No
     if np.any(speed[1:] > MAX_SPEED_RATIO * speed[:-1]):
         refuse(f"dataset 'grid/speed_m_s' has consecutive speeds more than a factor {MAX_SPEED_RATIO:g} apart; got "
                f"{speed.tolist()}")
-    for name in ("restitution_k", "restitution_p"):
-        value = getattr(table, name)
-        if not (np.isfinite(value) and value > 0.0):
-            refuse(f"the attribute '{name}' of group 'grid' must be finite and > 0; got {float(value)!r}")
-    if "law" in law:
-        copied = table.law_values() if table.format_version[1] >= 3 else table.law_values()[:2]
-        found = np.asarray(law["law"], dtype=np.float64).ravel()
-        if found.shape != copied.shape:
-            refuse(f"dataset 'grid/law' has shape {np.shape(law['law'])}, expected ({len(copied)},)")
-        differ = np.flatnonzero(found.view(np.uint64) != copied.view(np.uint64))
-        if differ.size:
-            names = list(LAW_ATTRIBUTES[:-1]) + [f"second_moment_factors[{k}]" for k in range(4)]
-            refuse(f"the attribute {names[differ[0]]} of group 'grid' ({copied[differ[0]]!r}) differs from its "
-                   f"checksummed copy in 'grid/law' ({found[differ[0]]!r})")
-    if "shape_codes" in law and np.ravel(law["shape_codes"]).tolist() != shape_codes(table.shapes).tolist():
+    if np.ravel(codes).tolist() != shape_codes(table.shapes).tolist():
         refuse(f"dataset 'grid/shapes' {list(table.shapes)} differs from its checksummed copy 'grid/shape_codes' "
-               f"{np.ravel(law['shape_codes']).tolist()}")
+               f"{np.ravel(codes).tolist()}")
     cells, m = table.cells, table.resolution.dictionary_size
     bound = CELL_VALUE_BOUND
     rules = (("cluster_weight", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
@@ -502,29 +580,6 @@ def check_dictionary(dictionary: np.ndarray, levels: int, refuse) -> None:
                f"non-decreasing")
 
 
-def _direct_model_attributes(f: h5py.File, minor: int) -> dict:
-    """The direct model's parameters of a table (ReboundTable fields). Tables that did not record them were built
-    with the aspect-ratio law of their configuration, the tolerances BUILT_WITH_TOLERANCES and, at κ = 0.3,
-    BUILT_WITH_SECOND_MOMENT_FACTORS (NaN at another κ: not known without the build's code). Since 3.3 every one
-    is required."""
-    grid = f["grid"]
-    recorded = minor >= 3 or all(name in grid.attrs for name in ASPECT_RATIO_ATTRIBUTES)
-    if recorded:
-        aspect = tuple(_number(grid, name) for name in ASPECT_RATIO_ATTRIBUTES)
-    else:
-        law = tomllib.loads(str(f.attrs["config"])).get("simulation", {}).get("aspect_ratio", {})
-        aspect = tuple(float(law.get(key, "nan")) for key in ASPECT_RATIO_ATTRIBUTES.values())
-    if minor >= 3 or "second_moment_factors" in grid.attrs:
-        kfac = _number(grid, "second_moment_factors", None)
-    elif _number(grid, "kappa") == BUILT_WITH_KAPPA:
-        kfac = BUILT_WITH_SECOND_MOMENT_FACTORS
-    else:
-        kfac = (float("nan"),) * len(BUILT_WITH_SECOND_MOMENT_FACTORS)
-    return dict(aspect_ratio=aspect, second_moment_factors=kfac,
-                **{name: _number(grid, name) if minor >= 3 or name in grid.attrs else default
-                   for name, default in BUILT_WITH_TOLERANCES.items()})
-
-
 def _read_group(group: h5py.Group) -> dict:
     """Every dataset of :data:`SHAPE_DATASETS` in ``group``, converted to its dtype; DataFormatError naming one
     that is missing, of another class (strings, integers, floats: as the C loader's H5Tget_class) or cannot be
@@ -553,15 +608,17 @@ def _read(group: h5py.Group, name: str) -> np.ndarray:
 # root attributes the fingerprint covers: the layout and the build's recipe (docs/format.md, "Fingerprint"); not
 # created, package_version or model_sha256, which say when and by which code, not what the table holds
 FINGERPRINT_ROOT_ATTRIBUTES = ("file_type", "format_version", "config", "config_sha256", "master_seed")
-FINGERPRINT_GROUPS = ("grid", "resolution", "cells", SHAPES_GROUP)     # those the table has (shapes: 3.4)
+FINGERPRINT_GROUPS = ("grid", MODEL_GROUP, WALL_GROUP, "resolution", "cells", SHAPES_GROUP)
 
 
 def table_fingerprint(path) -> str:
     """SHA-256 of what a table holds (docs/format.md, "Fingerprint"), hex: the root attributes of
     :data:`FINGERPRINT_ROOT_ATTRIBUTES`, then for each group of :data:`FINGERPRINT_GROUPS` its attributes and
     its datasets in the order of their names, each hashed as its name, dtype, shape and little-endian bytes
-    (strings as UTF-8). Datasets' ``units`` and ``meaning`` attributes are descriptions and are left out; the
-    checksums and HDF5's chunking do not enter. A config and a seed give one fingerprint whatever built them."""
+    (strings as UTF-8); a compound dataset (the parameter rows) as each of its fields in the order of their names,
+    ``group/dataset.field``, so the fields' order in the file does not enter. Datasets' ``units`` and
+    ``meaning`` attributes are descriptions and are left out; the checksums and HDF5's chunking do not enter. A
+    config and a seed give one fingerprint whatever built them."""
     digest = hashlib.sha256()
 
     def feed(name: str, value) -> None:
@@ -575,7 +632,7 @@ def table_fingerprint(path) -> str:
         for part in (name.encode(), kind.encode(), repr(values.shape).encode(), len(data).to_bytes(8, "little"), data):
             digest.update(part + b"\0")
 
-    check_file(path, TABLE_FILE_TYPE, TABLE_VERSION[0])
+    check_table_file(path)
     with h5py.File(path, "r") as f:
         for name in FINGERPRINT_ROOT_ATTRIBUTES:
             feed(f"@{name}", f.attrs[name])
@@ -583,7 +640,12 @@ def table_fingerprint(path) -> str:
             for name in sorted(f[group].attrs):
                 feed(f"{group}@{name}", f[group].attrs[name])
             for name in sorted(f[group]):
-                feed(f"{group}/{name}", _read(f[group], name))
+                values = _read(f[group], name)
+                for field in (sorted(values.dtype.names) if values.dtype.names else [None]):
+                    if field is None:
+                        feed(f"{group}/{name}", values)
+                    else:
+                        feed(f"{group}/{name}.{field}", values[field])
     return digest.hexdigest()
 
 
@@ -599,9 +661,41 @@ def write_table(path, table: ReboundTable, overwrite: bool = False) -> Path:
     return write_output(path, hdf5_bytes(write), TABLE_FILE_TYPE, overwrite)
 
 
+def _older_table(path, major: int, minor: int) -> str | None:
+    """The message (without the path) refusing a table of format 3, written before rebound-scatter 1.0: how to
+    rebuild it from the configuration it stores. None for another major version (check_file's message)."""
+    if major != 3:
+        return None
+    return (f"table format {major}.{minor} was written before rebound-scatter 1.0, which reads format "
+            f"{TABLE_VERSION[0]}; rebuild it from the configuration it stores: tablegen info --config {path} > "
+            f"TABLE.toml && tablegen build --config TABLE.toml -o NEW.h5")
+
+
+def check_table_file(path) -> None:
+    """:func:`data_schema.check_file` for a table: a table of format 3 is refused with how to rebuild it."""
+    check_file(path, TABLE_FILE_TYPE, TABLE_VERSION[0], other_major=_older_table)
+
+
+def stored_config(path) -> str:
+    """The build configuration (TOML text) a table of format 3 or 4 stores, its root attribute ``config``, read
+    without the rest of the table: ``tablegen build --config`` rebuilds the table from it (user grains are stored
+    as their hulls, not as mesh paths). DataFormatError naming the file if it is not such a table."""
+    check_file(path, TABLE_FILE_TYPE, CONFIG_MAJORS)
+    try:
+        with h5py.File(path, "r") as f:
+            text = f.attrs.get("config")
+    except OSError as exc:
+        raise DataFormatError(f"{path}: cannot read the table (truncated or corrupt?): {exc}") from exc
+    if isinstance(text, bytes):
+        text = text.decode(errors="replace")
+    if not isinstance(text, str) or not text.strip():
+        raise DataFormatError(f"{path}: the table stores no build configuration (root attribute 'config')")
+    return text
+
+
 def read_table(path) -> ReboundTable:
-    """Read a rebound table, after :func:`data_schema.check_file`."""
-    check_file(path, TABLE_FILE_TYPE, TABLE_VERSION[0])
+    """Read a rebound table, after :func:`check_table_file`."""
+    check_table_file(path)
     try:
         with h5py.File(path, "r") as f:
             return ReboundTable.from_hdf5(f)

@@ -18,11 +18,20 @@ Two empirical coefficients close the impulse model:
 The published law is k = 0.1, p = 0.61, q = 1 (:data:`CORUNDUM_ON_STEEL`).
 Another particle/wall pair of the same functional family is another
 :class:`WallMaterial`; the kernels receive it as the array :meth:`as_array`.
+
+A wall is a named record of a law *family* (:data:`WALL_FAMILIES`): the
+family names the law's form and its parameters, in the order the kernels read
+them, with their units and ranges; a record holds the family's name, its
+parameters' values and the wall's label. The law above is the family
+``exponential`` (k, p, q), the only one so far. A table stores the record as
+its group ``/wall`` (docs/format.md), read back by field name.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+from collections.abc import Callable, Mapping
 
 import numba
 import numpy as np
@@ -31,8 +40,73 @@ from direct_model.options import KERNEL
 
 
 @dataclasses.dataclass(frozen=True)
+class WallParameter:
+    """One parameter of a wall law family: its name (a field of the table's ``wall/parameters``), units, meaning,
+    and its range as words (what an error says) and as a check."""
+
+    name: str
+    units: str
+    meaning: str
+    allowed: str                    # the range in words: "finite and > 0"
+    ok: Callable[[float], bool]     # whether a value is in that range
+
+    def check(self, value) -> float:
+        """``value`` as a float; ValueError naming the parameter and its range if it is outside."""
+        number = float(value)
+        if not self.ok(number):
+            raise ValueError(f"The wall law parameter '{self.name}' must be {self.allowed}; got {value!r}.")
+        return number
+
+
+@dataclasses.dataclass(frozen=True)
+class WallFamily:
+    """A wall law family: its name, its law in words and its parameters in the order the kernels read them
+    (:meth:`WallMaterial.as_array`)."""
+
+    name: str
+    law: str
+    parameters: tuple
+
+    @property
+    def parameter_names(self) -> tuple:
+        return tuple(p.name for p in self.parameters)
+
+    def check(self, values: Mapping) -> tuple:
+        """The values of ``values`` (a mapping by parameter name) in the family's order, as floats; ValueError
+        naming a parameter that is missing or out of its range (in the family's order)."""
+        missing = [name for name in self.parameter_names if name not in values]
+        if missing:
+            raise ValueError(f"The {self.name} wall law needs the parameters {', '.join(self.parameter_names)}; "
+                             f"'{missing[0]}' is missing.")
+        return tuple(p.check(values[p.name]) for p in self.parameters)
+
+
+def _finite_positive(x: float) -> bool:
+    return math.isfinite(x) and x > 0.0
+
+
+EXPONENTIAL = "exponential"
+# every wall law family, by name; an entry here (and its twin in native/src/loader.c, WALL_FAMILIES) is a family
+WALL_FAMILIES = {
+    EXPONENTIAL: WallFamily(
+        EXPONENTIAL, "a_nc = 1 − [1 − exp(−k |V_c⁻|^p)] |v_c⁻|/|V_c⁻|, C_f = exp(q cos γ) (docs/model.md §4)",
+        (WallParameter("k", "(m/s)^-p", "restitution rate constant", "finite and > 0", _finite_positive),
+         WallParameter("p", "1", "restitution speed exponent", "finite and > 0", _finite_positive),
+         WallParameter("q", "1", "friction exponent scale in C_f = exp(q cos γ)", "finite", math.isfinite))),
+}
+
+
+def wall_family(name: str) -> WallFamily:
+    """The family named ``name``; ValueError naming it and the families known."""
+    family = WALL_FAMILIES.get(name) if isinstance(name, str) else None
+    if family is None:
+        raise ValueError(f"unknown wall law family {name!r}; the families: {', '.join(WALL_FAMILIES)}")
+    return family
+
+
+@dataclasses.dataclass(frozen=True)
 class WallMaterial:
-    """Coefficients of the restitution and friction laws (see module doc).
+    """A wall: the record of one wall law (see module doc), here of the ``exponential`` family.
 
     Attributes
     ----------
@@ -44,25 +118,38 @@ class WallMaterial:
         Friction exponent scale in C_f = exp(q cos γ); finite.
     name : str
         Label stored with results.
+    family : str
+        The law family (:data:`WALL_FAMILIES`) whose parameters k, p, q are.
     """
 
     k: float = 0.1
     p: float = 0.61
     q: float = 1.0
     name: str = "corundum_on_St3_Lashkov1991"
+    family: str = EXPONENTIAL
 
     def __post_init__(self):
-        for key in ("k", "p"):
-            value = getattr(self, key)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"The wall law parameter '{key}' must be finite and > 0; got {value!r}.")
-        if not np.isfinite(self.q):
-            raise ValueError(f"The wall law parameter 'q' must be finite; got {self.q!r}.")
+        if self.family != EXPONENTIAL:      # the record's fields are the exponential family's
+            raise ValueError(f"a WallMaterial holds a wall of the {EXPONENTIAL} family (k, p, q); "
+                             f"{wall_family(self.family).name!r} has the parameters "
+                             f"{', '.join(wall_family(self.family).parameter_names)}")
+        wall_family(self.family).check(self.parameters())
+
+    def parameters(self) -> dict:
+        """The family's parameters by name, in the family's order: {"k": .., "p": .., "q": ..}."""
+        return {name: getattr(self, name) for name in wall_family(self.family).parameter_names}
+
+    @classmethod
+    def from_parameters(cls, family: str, parameters: Mapping, name: str) -> "WallMaterial":
+        """The wall of ``family`` with ``parameters`` by name (others ignored) and label ``name``; ValueError
+        naming an unknown family, a missing parameter or one out of its range."""
+        values = wall_family(family).check(parameters)
+        return cls(*values, name=name, family=family)
 
     def as_array(self) -> np.ndarray:
         """The coefficients (k, p, q) as the float64 array the kernels take, read-only as the slice of the model's
         parameters that the runtime passes (a writable one would compile the kernels a second time)."""
-        coefficients = np.array([self.k, self.p, self.q], dtype=np.float64)
+        coefficients = np.array(list(self.parameters().values()), dtype=np.float64)
         coefficients.setflags(write=False)
         return coefficients
 

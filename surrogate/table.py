@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 
 import numpy as np
 
@@ -37,14 +36,12 @@ class SurrogateTable:
     particles_per_cell: int
     n_max: int
     config_sha256: str
-    restitution_k: float       # the wall's normal restitution exp(−k V^p) the table was built with, (m/s)^(−p)
-    restitution_p: float
+    wall: WallMaterial         # the wall the table was built with (its group /wall): its law family, parameters, name
     kernel_data: KernelData
-    # the parameters of the direct model the table was built with, as the kernels take them
-    # (:func:`direct_model.runtime.model_parameters`); None if the table does not record them
+    # the parameters of the direct model the table was built with (its group /model and the wall), as the
+    # kernels take them (:func:`direct_model.runtime.model_parameters`); None: a table without a direct path
     direct_parameters: np.ndarray | None = None
-    # the registry record (direct_model.registry) of each shape, table order, as the table holds it (format 3.4)
-    # or, for an older table, the families' at its κ and aspect-ratio law
+    # the registry record (direct_model.registry) of each shape, table order, as the table holds it (group /shapes)
     records: tuple = ()
 
     @functools.cached_property
@@ -101,22 +98,15 @@ class SurrogateTable:
         speed = np.asarray(table.speed_m_s, dtype=np.float64)
         return cls(path=path, shapes=tuple(table.shapes), alpha1_deg=frozen(np.asarray(table.alpha1_deg, float)),
                    speed_m_s=frozen(speed), particles_per_cell=table.particles_per_cell, n_max=table.n_max,
-                   config_sha256=table.config_sha256, restitution_k=table.restitution_k,
-                   restitution_p=table.restitution_p, kernel_data=data,
+                   config_sha256=table.config_sha256, wall=table.wall, kernel_data=data,
                    direct_parameters=_read_direct_parameters(table, path), records=table.shape_records())
 
 
-def _read_direct_parameters(table: ReboundTable, path: str) -> np.ndarray | None:
-    """``SurrogateTable.direct_parameters`` from the file's attributes, or None if the table does not record its
-    second-moment factors (built at κ ≠ 0.3 before tables recorded them); DataFormatError naming a value out
-    of range."""
-    if not np.all(np.isfinite(table.second_moment_factors)):
-        return None
-    # tables without friction_q (before 3.1) were built before the wall law was configurable: q = 1
-    q = table.friction_q if math.isfinite(table.friction_q) else 1.0
+def _read_direct_parameters(table: ReboundTable, path: str) -> np.ndarray:
+    """``SurrogateTable.direct_parameters`` from the table's groups /model and /wall (their ranges checked as they
+    were read); DataFormatError naming a value out of range."""
     try:
-        return model_parameters(AspectRatioLaw(*table.aspect_ratio), table.kappa, table.n_max,
-                                WallMaterial(table.restitution_k, table.restitution_p, q, table.wall_law),
+        return model_parameters(AspectRatioLaw(*table.aspect_ratio), table.kappa, table.n_max, table.wall,
                                 table.contact_tol, table.set_tol, table.max_steps, table.second_moment_factors)
     except ValueError as exc:
         raise DataFormatError(f"{path}: the direct model's parameters are out of range: {exc}") from None

@@ -85,7 +85,14 @@ def _build_parser() -> argparse.ArgumentParser:
     build.add_argument("--print-config", action="store_true",
                        help="print the resolved configuration and exit without building")
 
-    info = sub.add_parser("info", help="describe a rebound table")
+    info = sub.add_parser("info", help="describe a rebound table",
+                          description="Describe a rebound table; with --config, print the build configuration it "
+                                      "stores (any table of format 3 or 4), from which tablegen build --config "
+                                      "rebuilds it.")
+    info.add_argument("--config", action="store_true",
+                      help="print the stored build configuration (TOML) and nothing else: rebuild a table with "
+                           "tablegen info --config TABLE.h5 > TABLE.toml && tablegen build --config TABLE.toml "
+                           "-o NEW.h5")
     info.add_argument("table", metavar="TABLE.h5")
 
     report = sub.add_parser("report", help="write the paper's study (figures and index.md) to a folder",
@@ -232,9 +239,13 @@ def _build_interrupted(args) -> str | None:
 
 
 def _info(args) -> int:
-    from data_schema.table import read_table
+    from data_schema.table import read_table, stored_config
     from tablegen.tabulation.info import describe_table
 
+    if args.config:
+        text = stored_config(args.table)
+        print(text, end="" if text.endswith("\n") else "\n")
+        return 0
     print(describe_table(read_table(args.table), Path(args.table)))
     return 0
 

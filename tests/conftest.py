@@ -181,10 +181,12 @@ def openfoam_build_job():
 
 @pytest.fixture(scope="session")
 def native_build_job(tmp_path_factory):
-    """The future of native/'s Release build with the C and Fortran examples and the bench program
-    (tests/native/conftest.py's native_build; BuildError on failure)."""
+    """The future of native/'s Release build with the C and Fortran examples, the bench program and the test-only
+    library of the internal functions, librebound_scatter_testing.so (tests/native/conftest.py's native_build;
+    BuildError on failure)."""
     return background.submit(native_build_in, tmp_path_factory.mktemp("native_build"),
-                             {"RBS_BUILD_EXAMPLES": "ON", "RBS_BUILD_FORTRAN": "ON", "RBS_BUILD_BENCH": "ON"})
+                             {"RBS_BUILD_EXAMPLES": "ON", "RBS_BUILD_FORTRAN": "ON", "RBS_BUILD_BENCH": "ON",
+                              "RBS_BUILD_TESTS": "ON"})
 
 
 @pytest.fixture(scope="session")

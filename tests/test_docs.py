@@ -7,14 +7,16 @@ from pathlib import Path
 import pytest
 
 from data_schema import samples, table
+from direct_model.wall import WALL_FAMILIES
 from tablegen.tabulation.config import CONFIG_KEYS
 
 FORMAT_DOC = (Path(__file__).resolve().parents[1] / "docs" / "format.md").read_text()
 NAMES = ([samples.SAMPLES_FILE_TYPE, "file_type", "format_version", "samples"]
          + list(samples.REQUIRED_DATASETS) + list(samples.OPTIONAL_DATASETS) + list(samples.REQUIRED_ATTRS)
          + [table.TABLE_FILE_TYPE, "created", "package_version", "config", "config_sha256", "master_seed",
-            "grid/alpha1_deg", "grid/speed_m_s", "grid/shapes", "kappa", "n_max", "particles_per_cell",
-            "restitution_k", "restitution_p"]
+            "grid/alpha1_deg", "grid/speed_m_s", "grid/shapes", "grid/shape_codes", "particles_per_cell",
+            "model/parameters", "wall/parameters", "family", "name"]
+         + list(table.MODEL_FIELDS) + list(WALL_FAMILIES) + [p.name for f in WALL_FAMILIES.values() for p in f.parameters]
          + [f.name for f in dataclasses.fields(table.TableResolution)]
          + list(table.CELL_DATASETS))
 

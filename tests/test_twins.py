@@ -93,3 +93,40 @@ def test_twins_are_named_alike(files, twin):
     if twin.startswith("surrogate.kernels.") and files != ["internal.h"]:
         stem = twin.rsplit(".", 1)[1]
         assert any(Path(f).stem == stem for f in files), f"{files} is the twin of {twin}: name one {stem}.c or .h"
+
+
+# Offsets and codes written by hand on both sides of the language boundary: (Python module, the C sources that
+# mirror it, the names, a Python name's C spelling). Every such name of the module must have its twin, of equal
+# value, so that a slot moved on one side only fails here rather than as wrong bits somewhere else.
+MIRRORED = [
+    ("direct_model.rotation", ["rotation.c"], re.compile(r"_(I_\w+|MODE_\w+|NLEV_MAX|TH_TERMS)"), lambda n: n[1:]),
+    ("direct_model.runtime", ["runtime.h", "shapes.h"], re.compile(r"P_\w+|U_(?!PER)\w+|N_PARAMS"), lambda n: n),
+    ("surrogate.kernels.layout", ["internal.h"], re.compile(r"(ROW|CELL|AXIS)_\w+"), lambda n: n),
+    ("direct_model.collision", ["collision.h"], re.compile(r"COLLISION_\w+"), lambda n: n),
+    ("direct_model.flight", ["flight.h"], re.compile(r"SEARCH_\w+"), lambda n: n),
+]
+# "#define NAME value" with the value a number or a parenthesised sum of numbers and names
+_DEFINE = re.compile(r"^#define (\w+) +\(?(-?[\w.]+(?: \+ \w+)*)\)?(?=\s|$)", flags=re.M)
+
+
+def _defines(files) -> dict:
+    """The numeric #defines of native/src's ``files``, sums of earlier names evaluated."""
+    found = [(name, value.split(" + ")) for f in files
+             for name, value in _DEFINE.findall((ROOT / "native" / "src" / f).read_text())]
+    values, changed = {}, True
+    while changed:
+        changed = False
+        for name, terms in found:
+            if name not in values and all(t in values or re.fullmatch(r"-?[\d.]+", t) for t in terms):
+                values[name] = sum(values[t] if t in values else float(t) for t in terms)
+                changed = True
+    return values
+
+
+@pytest.mark.parametrize("module, files, names, spelled", MIRRORED, ids=[m[0] for m in MIRRORED])
+def test_mirrored_offsets_are_equal(module, files, names, spelled):
+    python = {spelled(n): v for n, v in vars(importlib.import_module(module)).items()
+              if names.fullmatch(n) and isinstance(v, (int, float))}
+    c = _defines(files)
+    assert len(python) >= 3
+    assert {n: c.get(n) for n in python} == python

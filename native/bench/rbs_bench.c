@@ -5,17 +5,18 @@
  *
  * STATES.bin: int64 count, then V (count, 3), n (count, 3), a (count) as float64 (row-major). Times, best
  * of REPEATS, in ns per reflected state, printed as one JSON object:
- *   c_per_particle   a solver's loop: rbs_rng_fill (13 uniforms) and rbs_table_rebound per particle
- *   c_many           rbs_table_rebound_many_rng on all the states (uniforms from 32 xoshiro256+ lanes)
- *   c_many_given     rbs_table_rebound_many on pre-drawn uniforms (their drawing not timed)
+ *   c_per_particle   a solver's loop: rbs_rng_fill (13 uniforms) and rbs_rebound (RBS_METHOD_TABLE, the uniforms
+ *                    given) per particle
+ *   c_many           rbs_draw_many on all the states, uniforms from the rng (32 xoshiro256+ lanes)
+ *   c_many_given     rbs_draw_many on pre-drawn uniforms (their drawing not timed)
  *   c_rng            the 13 uniforms per state alone (rbs_rng_fill)
  *   c_grant_tabakoff the deterministic Grant–Tabakoff sphere bounce, same loop (bench_sampler.py's (d))
- *   c_spin_still     c_per_particle's loop with rbs_rebound_rng (RBS_AUTO, Ω⁻ = 0): the path decision's cost
+ *   c_spin_still     rbs_rebound with the uniforms from the rng (RBS_METHOD_AUTO, Ω⁻ = 0): the path decision's cost
  * and, under "cpu", the thread CPU time per state of each best run (steadier when other work shares the CPU);
- * then, in µs per hit, c_spin_spinning_us: rbs_rebound_rng (RBS_AUTO) on the first SPINNING states with
+ * then, in µs per hit, c_spin_spinning_us: rbs_rebound (RBS_METHOD_AUTO, rng) on the first SPINNING states with
  * |Ω⁻| a/|V⁻| = 0.3 about random axes (the direct model answers them), one timed run.
  *
- * With OUT.bin, the results of the first rbs_table_rebound_many_rng call (V_out, Omega_out as float64
+ * With OUT.bin, the results of the first rbs_draw_many call from the rng (V_out, Omega_out as float64
  * (count, 3), status as int8) are written there, for a comparison of the bits.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -109,8 +110,15 @@ int main(int argc, char **argv)
     rbs_rng_fill(&rng, U, RBS_U_PER_DRAW * N);
 
     double best[6] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY}, cpu[6] = {0.0};
-    const double still[3] = {0.0, 0.0, 0.0};
     double checksum = 0.0;
+    rbs_options table_path = RBS_OPTIONS_INIT;
+    table_path.method = RBS_METHOD_TABLE;
+    rbs_hits hits = RBS_HITS_INIT;           /* every state; from the rng, or the uniforms U */
+    hits.count = N, hits.V = V, hits.n = n, hits.a = a;
+    rbs_results results = RBS_RESULTS_INIT;
+    results.V = V_out, results.Omega = Omega_out, results.status = status;
+    rbs_hit hit = RBS_HIT_INIT;             /* Ω⁻ = 0 */
+    rbs_result result = RBS_RESULT_INIT;
     for (int r = 0; r < repeats + 1; r++) {         /* run 0 is the warm-up */
         double t0, dt, c0;
         /* (1) per particle: uniforms and one call per hit */
@@ -120,8 +128,17 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < N; i++) {
             double u[RBS_U_PER_DRAW];
             rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
-            status[i] = (signed char)rbs_table_rebound(table, mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
-                                                       V_out + 3 * i, Omega_out + 3 * i);
+            for (int k = 0; k < 3; k++) {
+                hit.V[k] = V[3 * i + k];
+                hit.n[k] = n[3 * i + k];
+            }
+            hit.a = a[i];
+            hit.u = u;
+            status[i] = (signed char)rbs_rebound(table, mix, &hit, &table_path, &result);
+            for (int k = 0; k < 3; k++) {
+                V_out[3 * i + k] = result.V[k];
+                Omega_out[3 * i + k] = result.Omega[k];
+            }
         }
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[0], &cpu[0]);
@@ -130,7 +147,9 @@ int main(int argc, char **argv)
         rbs_rng_seed(&rng, seed);
         t0 = now();
         c0 = cpu_now();
-        rbs_table_rebound_many_rng(table, mix, N, V, n, a, &rng, RBS_SCALED, V_out, Omega_out, status);
+        hits.u = NULL;
+        hits.rng = &rng;
+        rbs_draw_many(table, mix, &hits, NULL, &results);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[1], &cpu[1]);
         checksum += V_out[0];
@@ -146,7 +165,9 @@ int main(int argc, char **argv)
         /* (3) many particles, uniforms given */
         t0 = now();
         c0 = cpu_now();
-        rbs_table_rebound_many(table, mix, N, V, n, a, U, RBS_SCALED, V_out, Omega_out, status);
+        hits.u = U;
+        hits.rng = NULL;
+        rbs_draw_many(table, mix, &hits, NULL, &results);
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[2], &cpu[2]);
         checksum += V_out[0];
@@ -170,22 +191,40 @@ int main(int argc, char **argv)
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[4], &cpu[4]);
         checksum += V_out[0];
-        /* (6) per particle through rbs_rebound_rng, no spin: the table answers, after the path decision */
+        /* (6) per particle through rbs_rebound, uniforms from the rng, no spin: the table answers, after the path
+         * decision */
         rbs_rng_seed(&rng, seed);
+        hit.u = NULL;
+        hit.rng = &rng;
         t0 = now();
         c0 = cpu_now();
-        for (size_t i = 0; i < N; i++)
-            status[i] = (signed char)rbs_rebound_rng(table, mix, V + 3 * i, still, n + 3 * i, a[i], &rng, RBS_AUTO,
-                                                     RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+        for (size_t i = 0; i < N; i++) {
+            for (int k = 0; k < 3; k++) {
+                hit.V[k] = V[3 * i + k];
+                hit.n[k] = n[3 * i + k];
+            }
+            hit.a = a[i];
+            status[i] = (signed char)rbs_rebound(table, mix, &hit, NULL, &result);
+            for (int k = 0; k < 3; k++) {
+                V_out[3 * i + k] = result.V[k];
+                Omega_out[3 * i + k] = result.Omega[k];
+            }
+        }
         dt = now() - t0;
         keep(r, dt, cpu_now() - c0, &best[5], &cpu[5]);
         checksum += V_out[0];
     }
     size_t trapped = 0;
-    for (size_t i = 0; i < N; i++) trapped += status[i] != RBS_REBOUNDED;
+    for (size_t i = 0; i < N; i++) trapped += status[i] != RBS_OK;
     size_t still_direct = 0;
-    for (size_t i = 0; i < N; i++) still_direct += rbs_rebound_path(table, V + 3 * i, still, n + 3 * i, a[i], RBS_AUTO)
-                                                   == RBS_PATH_DIRECT;
+    for (size_t i = 0; i < N; i++) {
+        for (int k = 0; k < 3; k++) {
+            hit.V[k] = V[3 * i + k];
+            hit.n[k] = n[3 * i + k];
+        }
+        hit.a = a[i];
+        still_direct += rbs_rebound_path(table, &hit, NULL) == RBS_PATH_DIRECT;
+    }
     /* spinning hits: |Ω⁻| a/|V⁻| = 0.3 about random axes; the direct model answers */
     enum { SPINNING = 20000 };
     size_t n_spin = N < SPINNING ? N : SPINNING, spin_direct = 0;
@@ -197,14 +236,28 @@ int main(int argc, char **argv)
             for (int k = 0; k < 3; k++) w[k] = 2.0 * rbs_rng_uniform(&rng) - 1.0;
             ww = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
         } while (ww > 1.0 || ww < 1e-3);
-        for (int k = 0; k < 3; k++) Omega[3 * i + k] = 0.3 * speed / a[i] * w[k] / ww;
-        spin_direct += rbs_rebound_path(table, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], RBS_AUTO) == RBS_PATH_DIRECT;
+        for (int k = 0; k < 3; k++) {
+            Omega[3 * i + k] = 0.3 * speed / a[i] * w[k] / ww;
+            hit.V[k] = V[3 * i + k];
+            hit.Omega[k] = Omega[3 * i + k];
+            hit.n[k] = n[3 * i + k];
+        }
+        hit.a = a[i];
+        spin_direct += rbs_rebound_path(table, &hit, NULL) == RBS_PATH_DIRECT;
     }
     rbs_rng_seed(&rng, seed);
+    hit.u = NULL;
+    hit.rng = &rng;
     double t0 = now();
-    for (size_t i = 0; i < n_spin; i++)
-        status[i] = (signed char)rbs_rebound_rng(table, mix, V + 3 * i, Omega + 3 * i, n + 3 * i, a[i], &rng,
-                                                 RBS_AUTO, RBS_SCALED, V_out + 3 * i, Omega_out + 3 * i);
+    for (size_t i = 0; i < n_spin; i++) {
+        for (int k = 0; k < 3; k++) {
+            hit.V[k] = V[3 * i + k];
+            hit.Omega[k] = Omega[3 * i + k];
+            hit.n[k] = n[3 * i + k];
+        }
+        hit.a = a[i];
+        status[i] = (signed char)rbs_rebound(table, mix, &hit, NULL, &result);
+    }
     double spinning_us = (now() - t0) / (double)n_spin * 1e6;
     size_t spin_failed = 0;
     for (size_t i = 0; i < n_spin; i++) spin_failed += status[i] == RBS_FAILED;

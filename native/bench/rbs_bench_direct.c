@@ -30,8 +30,9 @@
 #include "bench_io.h"
 #include "rebound_scatter.h"
 
-#include "collision.h"   /* the model's internal kernels, for the time split */
+#include "collision.h"   /* the model's internal kernels, for the time split, and the direct path alone */
 #include "flight.h"
+#include "paths.h"
 #include "rotation.h"
 #include "runtime.h"
 #include "shapes.h"

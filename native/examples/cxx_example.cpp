@@ -19,7 +19,7 @@ int main(int argc, char **argv)
     char message[1024];
     rbs_table *raw = nullptr;
     if (int code = rbs_table_open(argv[1], &raw, message, sizeof message); code != RBS_OK) {
-        std::fprintf(stderr, "%s (%s)\n", message, rbs_error_string(code));
+        std::fprintf(stderr, "%s (%s)\n", message, rbs_status_string(code));
         return 1;
     }
     std::unique_ptr<rbs_table, decltype(&rbs_table_close)> table(raw, &rbs_table_close);
@@ -36,15 +36,36 @@ int main(int argc, char **argv)
         V[3 * i + 1] = -60.0 - static_cast<double>(i);
         n[3 * i + 1] = 1.0;
     }
-    rbs_table_rebound_many_rng(table.get(), mix.get(), count, V.data(), n.data(), a.data(), &rng, RBS_SCALED,
-                               V_out.data(), Omega_out.data(), status.data());
+    // many hits from the table, uniforms from rng
+    rbs_hits hits = RBS_HITS_INIT;
+    hits.count = count;
+    hits.V = V.data();
+    hits.n = n.data();
+    hits.a = a.data();
+    hits.rng = &rng;
+    rbs_results results = RBS_RESULTS_INIT;
+    results.V = V_out.data();
+    results.Omega = Omega_out.data();
+    results.status = status.data();
+    rbs_options options = RBS_OPTIONS_INIT;
+    options.interpolation = RBS_INTERPOLATION_STOCHASTIC;
+    if (rbs_draw_many(table.get(), mix.get(), &hits, &options, &results) != RBS_OK) return 1;
+    // one more hit, uniforms given
     std::array<double, RBS_U_PER_DRAW> u{};
     rbs_rng_fill(&rng, u.data(), u.size());
-    double one[3], spin[3];
-    int st = rbs_table_rebound(table.get(), mix.get(), V.data(), n.data(), 1e-4, u.data(), RBS_STOCHASTIC, one, spin);
+    rbs_hit hit = RBS_HIT_INIT;
+    for (int k = 0; k < 3; k++) {
+        hit.V[k] = V[k];
+        hit.n[k] = n[k];
+    }
+    hit.a = 1e-4;
+    hit.u = u.data();
+    rbs_result result = RBS_RESULT_INIT;
+    int st = rbs_rebound(table.get(), mix.get(), &hit, &options, &result);
     std::size_t rebounded = 0;
-    for (signed char s : status) rebounded += s == RBS_REBOUNDED;
-    std::printf("C++: %zu of %zu rebounded over %d shapes; one more: status %d; library %s\n", rebounded, count,
-                rbs_table_n_shapes(table.get()), st, rbs_version());
+    for (signed char s : status) rebounded += s == RBS_OK;
+    std::printf("C++: %zu of %zu rebounded over %d shapes; one more: status %d (%s); library %s (%d)\n", rebounded,
+                count, rbs_table_n_shapes(table.get()), st, rbs_status_string(st), rbs_version(),
+                rbs_version_number());
     return rebounded > 0 ? 0 : 1;
 }

@@ -23,7 +23,7 @@ int main(int argc, char **argv)
     rbs_table *table = NULL;
     int code = rbs_table_open(argv[1], &table, message, sizeof message);
     if (code != RBS_OK) {
-        fprintf(stderr, "error %d (%s): %s\n", code, rbs_error_string(code), message);
+        fprintf(stderr, "error %d (%s): %s\n", code, rbs_status_string(code), message);
         return 1;
     }
     rbs_mix *mix = rbs_mix_new_equal(table);    /* the table's shapes, however many, with equal weights */
@@ -36,24 +36,26 @@ int main(int argc, char **argv)
     rbs_rng rng;
     rbs_rng_seed(&rng, 1);                      /* == surrogate.seed_state(1) */
 
+    rbs_hit hit = RBS_HIT_INIT;                 /* sets hit.size; no grain key, uniforms from hit.rng */
     const double V[3] = {120.0, -80.0, 10.0};   /* m/s, moving into the wall */
-    const double n[3] = {0.0, 1.0, 0.0};        /* unit wall normal into the gas */
-    const double a = 5e-5;                      /* m, half-size */
     const double speed = sqrt(V[0] * V[0] + V[1] * V[1] + V[2] * V[2]);
-    /* rad/s: no spin, then |Omega-| a/|V-| = 0.3 about the wall normal (the table's law no longer holds) */
-    const double Omegas[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.3 * speed / a, 0.0}};
+    for (int k = 0; k < 3; k++) hit.V[k] = V[k];
+    hit.n[1] = 1.0;                             /* unit wall normal into the gas */
+    hit.a = 5e-5;                               /* m, half-size */
+    hit.rng = &rng;
     int rebounded = 0;
     for (int i = 0; i < count; i++) {
-        const double *Omega = Omegas[i % 2];
-        double V_out[3], Omega_out[3];
-        /* RBS_AUTO: the table where its law is valid, the direct model for the other hits */
-        int path = rbs_rebound_path(table, V, Omega, n, a, RBS_AUTO);
-        int status = rbs_rebound_rng(table, mix, V, Omega, n, a, &rng, RBS_AUTO, RBS_SCALED, V_out, Omega_out);
-        printf("%d Omega- = (%g, %g, %g) rad/s, %s: status %2d  V+ = (%9.3f, %9.3f, %9.3f) m/s  "
-               "Omega+ = (%11.1f, %11.1f, %11.1f) rad/s\n", i, Omega[0], Omega[1], Omega[2],
-               path == RBS_PATH_TABLE ? "table" : "direct model", status, V_out[0], V_out[1], V_out[2],
-               Omega_out[0], Omega_out[1], Omega_out[2]);
-        rebounded += status == RBS_REBOUNDED;
+        /* rad/s: no spin, then |Omega-| a/|V-| = 0.3 about the wall normal (the table's law no longer holds) */
+        hit.Omega[1] = i % 2 ? 0.3 * speed / hit.a : 0.0;
+        rbs_result result = RBS_RESULT_INIT;
+        /* NULL options, RBS_METHOD_AUTO: the table where its law is valid, the direct model for the other hits */
+        int status = rbs_rebound(table, mix, &hit, NULL, &result);
+        printf("%d Omega- = (%g, %g, %g) rad/s, %s, shape %s: status %2d  V+ = (%9.3f, %9.3f, %9.3f) m/s  "
+               "Omega+ = (%11.1f, %11.1f, %11.1f) rad/s\n", i, hit.Omega[0], hit.Omega[1], hit.Omega[2],
+               result.path == RBS_PATH_TABLE ? "table" : "direct model",
+               result.shape >= 0 ? rbs_table_shape_name(table, result.shape) : "-", status, result.V[0], result.V[1],
+               result.V[2], result.Omega[0], result.Omega[1], result.Omega[2]);
+        rebounded += status == RBS_OK;
     }
     printf("%d of %d rebounded\n", rebounded, count);
     rbs_mix_free(mix);

@@ -112,16 +112,16 @@ RBS_INLINE void rbs_mirrored(double u, double x[6])
 }
 
 /* The results of a block of RBS_BLOCK particles (pipeline.c), field-major: status, V⁺ (m/s), Ω⁺ (rad/s) */
-typedef struct rbs_results {
+typedef struct rbs_block_results {
     double status[RBS_BLOCK], V[3][RBS_BLOCK], W[3][RBS_BLOCK];
-} rbs_results;
+} rbs_block_results;
 
 /* Stage 3 for a gathered block (surrogate.kernels.arithmetic.arithmetic_block): the arithmetic of every
  * draw, branch-free (rbs_draw_in_cell and rbs_to_global with selects), then the outputs of its m rows from
  * `start`; u11 the mirror uniforms u[11] */
 RBS_INLINE void rbs_arithmetic_block(const rbs_gathered *k, const rbs_frames *f, const rbs_cells *c,
-                                     const double u11[RBS_BLOCK], int scaled, rbs_results *r, size_t start, size_t m,
-                                     double *V_out, double *Omega_out, signed char *status)
+                                     const double u11[RBS_BLOCK], int scaled, rbs_block_results *r, size_t start,
+                                     size_t m, double *V_out, double *Omega_out, signed char *status)
 {
     for (size_t b = 0; b < RBS_BLOCK; b++) {
         double q[6], slope[15], state[6], moved[6], x[6];
@@ -166,7 +166,7 @@ RBS_INLINE void rbs_arithmetic_block(const rbs_gathered *k, const rbs_frames *f,
         /* rbs_to_global's status */
         int ok = f->ok[b] != 0.0, trapped = k->trapped[b] > 0.5;
         int rebounded = ok & (trapped == 0) & rbs_drawn_ok(x) & rbs_rebound_ok(v, o, n);
-        r->status[b] = rebounded ? (double)RBS_REBOUNDED : ok & trapped ? (double)RBS_TRAPPED : (double)RBS_INVALID;
+        r->status[b] = rebounded ? (double)RBS_OK : ok & trapped ? (double)RBS_TRAPPED : (double)RBS_INVALID;
         for (int j = 0; j < 3; j++) {
             r->V[j][b] = rebounded ? v[j] : NAN;
             r->W[j][b] = rebounded ? o[j] : NAN;

@@ -82,7 +82,7 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
                                     max_steps, &t, R, Wt, h, h1, curv, rc, &steps);
         steps_total += steps;
         if (code == SEARCH_ESCAPED) {
-            status = RBS_REBOUNDED;
+            status = RBS_OK;
             break;
         }
         if (code == SEARCH_STALLED) break;

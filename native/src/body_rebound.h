@@ -17,7 +17,7 @@ void rbs_quaternion_to_matrix(const double q[4], double R[9]);
  * written into verts[0..2], so at least one row), its half-extents semi, principal J/m K (a²) and bounding
  * radius Rb; R0 body → lab at the start, V0 (m/s) and W0 ((m/s)/a) incident, wall = (k, p, q), n_max collisions
  * allowed, contact_tol and set_tol (units of a), max_steps per flight; V, W receive the state after the last
- * collision. Returns RBS_REBOUNDED, RBS_TRAPPED or RBS_FAILED; the collisions and search steps into
+ * collision. Returns RBS_OK (rebounded), RBS_TRAPPED or RBS_FAILED; the collisions and search steps into
  * *n_collisions, *n_steps. */
 int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
                      const double R0[9], const double V0[3], const double W0[3], const double wall[3], long long n_max,

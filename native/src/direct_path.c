@@ -1,13 +1,16 @@
 /*
  * direct_path.c: the direct model at run time in the caller's frame (surrogate.kernels.direct_path:
- * direct_rebound, _valid): the checks of the inputs, the impact frame of the hit (frame.h, the
- * sampler's), the rebound in the model's frame (runtime.c), V⁺ and Ω⁺ back in the caller's frame (rbs_to_global).
+ * direct_rebound, _valid), the direct path of rbs_rebound: the checks of the inputs, the impact frame of the hit
+ * (frame.h, the sampler's), the rebound in the model's frame (runtime.c), V⁺ and Ω⁺ back in the caller's frame
+ * (rbs_to_global).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
+#include <limits.h>
 #include <math.h>
 
 #include "frame.h"
+#include "paths.h"
 #include "runtime.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
@@ -27,10 +30,11 @@ static int valid(const rbs_shape_arrays *shapes, int shape, const double *V, con
     return ok;
 }
 
-RBS_HOT int rbs_direct_rebound(const rbs_table *t, int shape, const double V[3], const double Omega[3],
-                               const double n[3], double a, const double u[RBS_U_PER_REBOUND], double V_out[3],
-                               double Omega_out[3])
+RBS_HOT int rbs_direct_hit(const rbs_table *t, int shape, const double V[3], const double Omega[3], const double n[3],
+                           double a, const double u[RBS_U_PER_REBOUND], double V_out[3], double Omega_out[3],
+                           int *n_collisions)
 {
+    *n_collisions = -1;
     if (!t || !t->has_direct || !V || !Omega || !n || !u || !V_out || !Omega_out
         || !valid(&t->direct_shapes, shape, V, Omega, n, a, u)) {
         nan_out(V_out);
@@ -42,15 +46,27 @@ RBS_HOT int rbs_direct_rebound(const rbs_table *t, int shape, const double V[3],
     const double *ex = f.ex, *ez = f.ez;
     /* Ω⁻ in (m/s)/a, the model's unit: rad/s times a */
     double x[6];
-    int status = rbs_rebound_model_frame(
+    long long collisions = -1;
+    int status = rbs_rebound_model_frame_counted(
         t->direct_parameters, &t->direct_shapes, shape, rbs_dot(V[0], V[1], V[2], ex[0], ex[1], ex[2]),
         rbs_dot(V[0], V[1], V[2], n[0], n[1], n[2]), a * rbs_dot(Omega[0], Omega[1], Omega[2], ex[0], ex[1], ex[2]),
         a * rbs_dot(Omega[0], Omega[1], Omega[2], n[0], n[1], n[2]),
-        a * rbs_dot(Omega[0], Omega[1], Omega[2], ez[0], ez[1], ez[2]), u, x, x + 3);
-    if (status != RBS_REBOUNDED) {
+        a * rbs_dot(Omega[0], Omega[1], Omega[2], ez[0], ez[1], ez[2]), u, x, x + 3, &collisions);
+    if (status != RBS_OK) {
         nan_out(V_out);
         nan_out(Omega_out);
-        return status == RBS_TRAPPED ? RBS_TRAPPED : RBS_FAILED;
+        status = status == RBS_TRAPPED ? RBS_TRAPPED : RBS_FAILED;
+    } else {
+        status = rbs_to_global(status, 1, x, 1.0, a, ex, n, ez, V_out, Omega_out);
     }
-    return rbs_to_global(status, 1, x, 1.0, a, ex, n, ez, V_out, Omega_out);
+    /* the count as an int: at most n_max (an integer below 2^53 by the loader's check) plus one, clamped */
+    *n_collisions = status == RBS_INVALID ? -1 : collisions > INT_MAX ? INT_MAX : (int)collisions;
+    return status;
+}
+
+int rbs_direct_rebound(const rbs_table *t, int shape, const double V[3], const double Omega[3], const double n[3],
+                       double a, const double u[RBS_U_PER_REBOUND], double V_out[3], double Omega_out[3])
+{
+    int n_collisions;
+    return rbs_direct_hit(t, shape, V, Omega, n, a, u, V_out, Omega_out, &n_collisions);
 }

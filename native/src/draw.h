@@ -45,7 +45,7 @@ RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double
         rbs_to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, x);
     }
     rbs_mirrored(u[11], x);
-    return rbs_drawn_ok(x) ? RBS_REBOUNDED : RBS_INVALID;
+    return rbs_drawn_ok(x) ? RBS_OK : RBS_INVALID;
 }
 
 #endif /* RBS_DRAW_H */

@@ -1,5 +1,5 @@
 /*
- * error.c: error strings, the version, messages.
+ * error.c: status strings, the version, messages.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -8,17 +8,20 @@
 
 #include "internal.h"
 
-const char *rbs_error_string(int code)
+const char *rbs_status_string(int status)
 {
-    switch (code) {
-    case RBS_OK: return "success";
+    switch (status) {
+    case RBS_OK: return "success (a hit: rebounded)";
+    case RBS_TRAPPED: return "trapped: still colliding after n_max collisions, or drawn trapped from the table";
+    case RBS_FAILED: return "failed: a collision solve or a contact search of the direct model failed";
+    case RBS_INVALID: return "invalid argument (a NULL pointer, a record too small, an unknown name or method, "
+                             "bad weights, a hit's input out of range)";
     case RBS_ERR_IO: return "the file does not exist or cannot be opened";
     case RBS_ERR_FORMAT: return "not a readable rebound table (not HDF5, truncated, corrupt, another file type, "
                                 "missing or malformed data)";
     case RBS_ERR_VERSION: return "a rebound table of another major format version";
-    case RBS_ERR_ARGUMENT: return "invalid argument";
     case RBS_ERR_MEMORY: return "out of memory";
-    default: return "unknown error code";
+    default: return "unknown status";
     }
 }
 
@@ -28,6 +31,11 @@ const char *rbs_error_string(int code)
 const char *rbs_version(void)
 {
     return RBS_STR(RBS_VERSION_MAJOR) "." RBS_STR(RBS_VERSION_MINOR) "." RBS_STR(RBS_VERSION_PATCH);
+}
+
+int rbs_version_number(void)
+{
+    return RBS_VERSION_NUMBER;
 }
 
 void rbs_message(char *message, size_t message_size, const char *format, ...)

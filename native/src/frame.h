@@ -161,11 +161,11 @@ RBS_INLINE int rbs_to_global(int status, int ok, const double x[6], double speed
     double w = speed / a;
     for (int k = 0; k < 3; k++) V[k] = speed * rbs_dot(x[0], x[1], x[2], ex[k], n[k], ez[k]);
     for (int k = 0; k < 3; k++) W[k] = w * rbs_dot(x[3], x[4], x[5], ex[k], n[k], ez[k]);
-    ok &= status != RBS_REBOUNDED || rbs_rebound_ok(V, W, n);
+    ok &= status != RBS_OK || rbs_rebound_ok(V, W, n);
     status = ok ? status : RBS_INVALID;
     for (int k = 0; k < 3; k++) {
-        V_out[k] = status == RBS_REBOUNDED ? V[k] : NAN;
-        Omega_out[k] = status == RBS_REBOUNDED ? W[k] : NAN;
+        V_out[k] = status == RBS_OK ? V[k] : NAN;
+        Omega_out[k] = status == RBS_OK ? W[k] : NAN;
     }
     return status;
 }
@@ -197,7 +197,7 @@ RBS_INLINE void rbs_frame_block(const double *V, const double *n, const double *
         double n0 = k->n[0][b], n1 = k->n[1][b], n2 = k->n[2][b];
         double vn = rbs_dot(V0, V1, V2, n0, n1, n2);
         k->valid[b] = rbs_moves_into_wall(V0, V1, V2, n0, n1, n2) ? 1.0 : 0.0;
-        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_table_rebound_many) */
+        /* uniforms drawn from the lanes are in [0, 1): checked only when `given` (rbs_draw_many with hits.u) */
         k->ok[b] = rbs_particle_ok(n0, n1, n2, k->a[b]) & (!given || rbs_uniforms_ok(&u[0][b], RBS_BLOCK)) ? 1.0 : 0.0;
         double tx = fma(-vn, n0, V0), ty = fma(-vn, n1, V1), tz = fma(-vn, n2, V2);
         double vt = sqrt(fma(tx, tx, fma(ty, ty, tz * tz)));

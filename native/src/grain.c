@@ -8,10 +8,10 @@
 #include <math.h>
 #include <string.h>
 
-#include "frame.h"
 #include "locate.h"
+#include "paths.h"
+#include "records.h"
 #include "rng_internal.h"
-#include "table_arguments.h"
 
 /* the slots of a grain's keyed uniforms (surrogate.kernels.grain: SLOT_SHAPE, SLOT_RATIO_BA, SLOT_RATIO_CB,
  * SLOT_HAND) */
@@ -19,16 +19,7 @@ enum { SLOT_SHAPE = 0, SLOT_RATIO_BA = 1, SLOT_RATIO_CB = 2, SLOT_HAND = 3 };
 
 #define KEY_BITS 0x7FFFFFFFFFFFFFFFull    /* a key's 63 bits: the top bit cleared (surrogate.kernels.grain._KEY_BITS) */
 
-/* NaN into the outputs a caller gave (any may be NULL) */
-static void nan_out(double *x)
-{
-    if (x)
-        for (int k = 0; k < 3; k++) x[k] = NAN;
-}
-
-/* out = u with the slots key fixes replaced: u[0] always, with `direct` the direct model's proportions and hand
- * (surrogate.kernels.grain.keyed_uniforms) */
-static void keyed_uniforms(int64_t key, const double *u, int direct, double out[RBS_U_PER_DRAW])
+void rbs_keyed_uniforms(int64_t key, const double u[RBS_U_PER_DRAW], int direct, double out[RBS_U_PER_DRAW])
 {
     memcpy(out, u, RBS_U_PER_DRAW * sizeof(double));
     out[0] = rbs_grain_uniform((uint64_t)key, SLOT_SHAPE);
@@ -39,39 +30,13 @@ static void keyed_uniforms(int64_t key, const double *u, int direct, double out[
     }
 }
 
-/* rbs_rebound with the key's uniforms (surrogate.kernels.wall_hit: rebound, _keyed_rebound) */
-int rbs_rebound_grain(const rbs_table *t, const rbs_mix *mix, int64_t key, const double V[3], const double Omega[3],
-                      const double n[3], double a, const double u[RBS_U_PER_DRAW], int method, int interpolation,
-                      double V_out[3], double Omega_out[3])
-{
-    int path = rbs_rebound_path(t, V, Omega, n, a, method);
-    if (key < 0 || path == RBS_INVALID || !u || !rbs_uniforms_ok(u, 1)) {
-        nan_out(V_out);
-        nan_out(Omega_out);
-        return RBS_INVALID;
-    }
-    double keyed[RBS_U_PER_DRAW];
-    keyed_uniforms(key, u, path == RBS_PATH_DIRECT, keyed);
-    return rbs_rebound_along(t, mix, path, V, Omega, n, a, keyed, interpolation, V_out, Omega_out);
-}
-
-int rbs_rebound_grain_rng(const rbs_table *t, const rbs_mix *mix, int64_t key, const double V[3],
-                          const double Omega[3], const double n[3], double a, rbs_rng *rng, int method,
-                          int interpolation, double V_out[3], double Omega_out[3])
-{
-    double u[RBS_U_PER_DRAW];
-    rbs_rng_fill(rng, u, RBS_U_PER_DRAW);       /* NaN (refused) for a NULL or all-zero rng */
-    return rbs_rebound_grain(t, mix, key, V, Omega, n, a, u, method, interpolation, V_out, Omega_out);
-}
-
 int rbs_grain_info(const rbs_table *t, const rbs_mix *mix, int64_t key, rbs_grain *grain)
 {
-    if (!t || !mix || !grain || mix->n_shapes != t->n_shapes || key < 0)
-        return RBS_ERR_ARGUMENT;
+    if (!t || !mix || mix->table != t || !RBS_RECORD_OK(grain, rbs_grain) || key < 0)
+        return RBS_INVALID;
     int shape = (int)rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, rbs_grain_uniform((uint64_t)key, SLOT_SHAPE));
     int direct_shape = t->model_shape ? t->model_shape[shape] : -1;
     grain->shape = shape;
-    grain->direct_shape = direct_shape;
     grain->ratio_ba = grain->ratio_cb = grain->hand = NAN;
     if (direct_shape < 0)
         return RBS_OK;

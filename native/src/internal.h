@@ -72,13 +72,13 @@
 #define WEIGHT_SUM_TOLERANCE 1e-9   /* |Σ cluster_weight − 1| per cell */
 #define CELL_VALUE_BOUND 1e6        /* |value| of cluster_loc, cluster_scale, cluster_slope, mean, std */
 #define DICTIONARY_BOUND_TOLERANCE 1e-6     /* relative, on the bound √L of a shape_dictionary knot */
-#define LAW_SIZE 16                 /* numbers in grid/law since 3.3 (data_schema.table.LAW_ATTRIBUTES) */
-#define SHAPES_SINCE 4              /* the minor version from which a table holds group /shapes (data_schema.table) */
 #define USER_SHAPE_CODE 255         /* grid/shape_codes of a shape that is no family (data_schema.shape_records) */
+#define RBS_WALL_NAME_SIZE 256      /* bytes kept of the wall's name (attribute name of group wall), with its NUL */
+#define RBS_WALL_MAX_PARAMETERS 8   /* the most parameters of a wall law family (loader.c: WALL_FAMILIES) */
 
-/* The shapes of a table as data (data_schema.shape_records: group /shapes since 3.4; the families' records,
- * synthesised, before), table order; shape_records.c reads, checks and frees them. Triangles are read to check
- * them and their checksum, then freed: the runtime needs the vertices, not the surface. */
+/* The shapes of a table as data (data_schema.shape_records: group /shapes), table order; shape_records.c reads,
+ * checks and frees them. Triangles are read to check them and their checksum, then freed: the runtime needs the
+ * vertices, not the surface. */
 typedef struct rbs_shape_records {
     int8_t *kind;               /* (n) RBS_SMOOTH or RBS_POLYHEDRON */
     int *family;                /* (n) RBS_ELLIPSOID .. RBS_TETRAHEDRON, or −1 for any other shape */
@@ -94,7 +94,14 @@ struct rbs_table {
     int n_shapes, n_alpha1, n_speed, n_clusters, n_levels, n_dictionary, n_pieces;
     int format_major, format_minor;
     long long particles_per_cell, n_max;
-    double restitution_k, restitution_p;
+    double restitution_k, restitution_p;            /* the exponential wall law's k, p: the restitution pieces */
+    /* the wall (group wall, read by loader.c; rbs_table_wall): its family's name and parameter names (static, of
+     * WALL_FAMILIES), its name, its parameters' values in the family's order */
+    const char *wall_family;
+    const char *const *wall_parameter_names;
+    int n_wall_parameters;
+    char wall_name[RBS_WALL_NAME_SIZE];
+    double wall_parameters[RBS_WALL_MAX_PARAMETERS];
     char (*shape_names)[RBS_SHAPE_NAME_SIZE];       /* (n_shapes) names, grid/shapes */
     rbs_shape_records shapes;
     double *alpha1_deg, *speed_m_s;                 /* the grids */
@@ -135,34 +142,21 @@ typedef struct rbs_raw_cells {
     float *indicatrix_3d;       /* (cells, 72, 72): likewise */
 } rbs_raw_cells;
 
-/* old_tables.c: what a table before format 3.3 may leave out, as data_schema.table._direct_model_attributes
- * reads it. The aspect-ratio law (mean, sd, low, high) from the build configuration's TOML text (NaN for what
- * it does not give); the tolerances every build used; s per shape code at κ = 0.3 (NaN at another κ). */
-void rbs_config_aspect(const char *config, double aspect[4]);
-void rbs_built_with_tolerances(double *contact_tol, double *set_tol, long long *max_steps);
-void rbs_built_with_second_moment_factors(double kappa, double kfac[RBS_N_FAMILIES]);
-
-/* A mix of rbs_mix_new_*: the 1.0 value as its head (n_shapes; cdf too when n_shapes <= RBS_MAX_SHAPES), then
- * the whole cdf. The draws reach it from the head's address (a pointer to a struct's first member converts back
- * to the struct, C11 6.7.2.1). */
-typedef struct rbs_mix_block {
-    rbs_mix head;
+/* A shape mix (rbs_mix_new_*, mix.c): the table it was made from (a mix of another table is refused), its shape
+ * count and cumulative weights in the table's shape order (surrogate.mix_cdf). */
+struct rbs_mix {
+    const rbs_table *table;
+    int n_shapes;
     double cdf[];
-} rbs_mix_block;
+};
 
-/* the cumulative weights of a mix, value or block (n_shapes of them) */
+/* the cumulative weights of a mix (n_shapes of them) */
 static inline const double *rbs_mix_cdf(const rbs_mix *mix)
 {
-    return mix->n_shapes <= RBS_MAX_SHAPES ? mix->cdf : ((const rbs_mix_block *)(const void *)mix)->cdf;
+    return mix->cdf;
 }
 
-/* wall_hit.c: rbs_rebound along the path `path` its rbs_rebound_path gave (surrogate.kernels.wall_hit.rebound_typed):
- * RBS_INVALID and NaN for path RBS_INVALID or what rbs_rebound refuses; rbs_rebound_grain passes the key's uniforms */
-int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const double V[3], const double Omega[3],
-                      const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
-                      double Omega_out[3]);
-
-/* shape_records.c: free what a table's shape records hold (loader.h reads them) */
+/* shape_records.c: free what a table's shape records hold (rbs_shape_records_load reads them) */
 void rbs_shape_records_free(rbs_shape_records *records);
 
 /* shape_records.c: t->direct_shapes and t->model_shape from the direct parameters and the shape records

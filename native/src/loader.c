@@ -1,8 +1,10 @@
 /*
- * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), and the
- * accessors of a loaded table. The kernel arrays are derived in layout.c; the shapes (group shapes, format 3.4)
- * are read by shape_records.c, with the helpers loader.h declares; what tables before format 3.3 leave out is
- * read by old_tables.c.
+ * loader.c: opening a table file (HDF5), the checks of data_schema (check_file, read_table), closing it (what a
+ * loaded table tells about itself: table_info.c). The wall (group wall: its law family by name, WALL_FAMILIES) and
+ * the direct model's parameters (group model) are read here, each one row of a compound type read by field name;
+ * the kernel arrays are derived in layout.c; the shapes (group shapes) are read by shape_records.c; both read with
+ * the helpers of hdf5_read.c (which calls neither). A table of format 3 (before rebound-scatter 1.0) is refused
+ * with how to rebuild it (data_schema.table.check_table_file).
  *
  * Every error names the file and what is wrong with it; HDF5's own error printing is switched off
  * around each HDF5 call that may fail (H5E_BEGIN_TRY), so the library prints nothing.
@@ -12,39 +14,18 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
-#include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
-#include "loader.h"
+#include "hdf5_read.h"
+#include "shape_records.h"
 
 #define TABLE_FILE_TYPE "rebound_table"
 
-int rbs_fail(loader *ld, int code, const char *format, ...)
-{
-    if (ld->code != RBS_OK) return ld->code;
-    ld->code = code;
-    if (ld->message && ld->message_size > 0) {
-        char detail[512];
-        va_list args;
-        va_start(args, format);
-        vsnprintf(detail, sizeof detail, format, args);
-        va_end(args);
-        snprintf(ld->message, ld->message_size, "%s: %s", ld->path, detail);
-    }
-    return code;
-}
-
 /* ------------------------------------------------------------------------- HDF5 helpers */
-
-int rbs_link_exists(hid_t where, const char *name)
-{
-    htri_t found = 0;
-    H5E_BEGIN_TRY { found = H5Lexists(where, name, H5P_DEFAULT); } H5E_END_TRY;
-    return found > 0;
-}
 
 static int attribute_exists(hid_t where, const char *name)
 {
@@ -116,14 +97,6 @@ static int read_numeric_attribute(hid_t where, const char *name, hid_t memtype, 
     return status;
 }
 
-static int read_double_attribute(loader *ld, hid_t where, const char *group, const char *name, double *out)
-{
-    if (!attribute_exists(where, name)) return rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
-    if (read_numeric_attribute(where, name, H5T_NATIVE_DOUBLE, out, 1, 0) != 0)
-        return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group '%s' as one number", name, group);
-    return RBS_OK;
-}
-
 static int read_integer_attribute(loader *ld, hid_t where, const char *group, const char *name, long long *out)
 {
     if (!attribute_exists(where, name)) return rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group '%s'", name, group);
@@ -143,71 +116,6 @@ static hid_t open_group(loader *ld, hid_t file, const char *name)
     H5E_BEGIN_TRY { group = H5Gopen2(file, name, H5P_DEFAULT); } H5E_END_TRY;
     if (group < 0) rbs_fail(ld, RBS_ERR_FORMAT, "'%s' is not a readable group (truncated or corrupt?)", name);
     return group;
-}
-
-/* The shape of dataset `name` in `group`: its rank into *rank and dims (up to 8); 0 on success. */
-int rbs_dataset_shape(loader *ld, hid_t group, const char *group_name, const char *name, int *rank,
-                      hsize_t dims[8])
-{
-    hid_t ds = -1, space = -1;
-    int r = -1;
-    if (!rbs_link_exists(group, name)) return rbs_fail(ld, RBS_ERR_FORMAT, "missing dataset '%s/%s'", group_name, name);
-    H5E_BEGIN_TRY {
-        ds = H5Dopen2(group, name, H5P_DEFAULT);
-        if (ds >= 0) space = H5Dget_space(ds);
-        if (space >= 0) r = H5Sget_simple_extent_ndims(space);
-        if (r >= 0 && r <= 8) H5Sget_simple_extent_dims(space, dims, NULL);
-    } H5E_END_TRY;
-    if (space >= 0) H5Sclose(space);
-    if (ds >= 0) H5Dclose(ds);
-    if (r < 0 || r > 8) return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated or corrupt?)", group_name, name);
-    *rank = r;
-    return RBS_OK;
-}
-
-/* Read dataset `name` whole as `memtype` into a new buffer of `count` elements of `size` bytes, after
- * checking its shape is `rank` × `dims`. */
-void *rbs_read_dataset(loader *ld, hid_t group, const char *group_name, const char *name, hid_t memtype,
-                       size_t size, int rank, const hsize_t *dims)
-{
-    int found_rank = 0;
-    hsize_t found[8];
-    if (rbs_dataset_shape(ld, group, group_name, name, &found_rank, found) != RBS_OK) return NULL;
-    int same = found_rank == rank;
-    size_t count = 1;
-    for (int i = 0; same && i < rank; i++) {
-        same = found[i] == dims[i];
-        count *= (size_t)dims[i];
-    }
-    if (!same) {
-        char want[160] = "(", got[160] = "(";
-        for (int i = 0; i < rank; i++)
-            snprintf(want + strlen(want), sizeof want - strlen(want), "%s%llu", i ? ", " : "", (unsigned long long)dims[i]);
-        for (int i = 0; i < found_rank; i++)
-            snprintf(got + strlen(got), sizeof got - strlen(got), "%s%llu", i ? ", " : "", (unsigned long long)found[i]);
-        strcat(want, ")");
-        strcat(got, ")");
-        rbs_fail(ld, RBS_ERR_FORMAT, "dataset '%s/%s' has shape %s, expected %s", group_name, name, got, want);
-        return NULL;
-    }
-    void *buffer = malloc(count ? count * size : 1);
-    if (!buffer) {
-        rbs_fail(ld, RBS_ERR_MEMORY, "out of memory reading dataset '%s/%s' (%zu elements)", group_name, name, count);
-        return NULL;
-    }
-    herr_t status = -1;
-    hid_t ds = -1;
-    H5E_BEGIN_TRY {
-        ds = H5Dopen2(group, name, H5P_DEFAULT);
-        if (ds >= 0) status = H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer);
-    } H5E_END_TRY;
-    if (ds >= 0) H5Dclose(ds);
-    if (status < 0) {
-        free(buffer);
-        rbs_fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/%s' (truncated, corrupt or failed checksum?)", group_name, name);
-        return NULL;
-    }
-    return buffer;
 }
 
 /* The shape names (a 1-D dataset of strings, 1 to RBS_TABLE_MAX_SHAPES of them) into the table. */
@@ -354,10 +262,17 @@ static hid_t check_file(loader *ld, rbs_table *t)
         H5Fclose(file);
         return -1;
     }
-    if (version[0] != RBS_TABLE_MAJOR) {
+    if (version[0] == 3) {      /* data_schema.table._older_table, word for word */
+        rbs_fail(ld, RBS_ERR_VERSION, "table format %lld.%lld was written before rebound-scatter 1.0, which reads format "
+                 "%d; rebuild it from the configuration it stores: tablegen info --config %s > TABLE.toml && tablegen "
+                 "build --config TABLE.toml -o NEW.h5", version[0], version[1], RBS_TABLE_FORMAT_MAJOR, ld->path);
+        H5Fclose(file);
+        return -1;
+    }
+    if (version[0] != RBS_TABLE_FORMAT_MAJOR) {
         rbs_fail(ld, RBS_ERR_VERSION, "format version %lld.%lld is not readable by this version of the library, which "
              "reads major version %d; make the file again with a matching version of tablegen "
-             "(docs/format.md, 'Identification and versions')", version[0], version[1], RBS_TABLE_MAJOR);
+             "(docs/format.md, 'Identification and versions')", version[0], version[1], RBS_TABLE_FORMAT_MAJOR);
         H5Fclose(file);
         return -1;
     }
@@ -387,106 +302,11 @@ static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dim
     }
 }
 
-/* A table before format 3.4 holds the built-in families only: its names distinct, each a family's
- * (data_schema.table.check_contract; since 3.4 shape_records.c checks the names). */
-static int check_family_names(loader *ld, const rbs_table *t)
+/* The checksummed copy grid/shape_codes equals the names' codes (each family's code, USER_SHAPE_CODE for another
+ * shape; data_schema.table.check_contract, shape_codes). */
+static int check_shape_codes(loader *ld, hid_t grid, const rbs_table *t)
 {
-    if (t->format_minor >= SHAPES_SINCE) return RBS_OK;
-    for (int i = 0; i < t->n_shapes; i++) {
-        int found = rbs_shape_code(t->shape_names[i]) >= 0;
-        for (int j = 0; j < i; j++) found &= strcmp(t->shape_names[i], t->shape_names[j]) != 0;
-        if (!found)
-            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/shapes' must name distinct shapes among ellipsoid, prism, "
-                            "cut_prism, tetrahedron (a table before format 3.%d); got '%s' at index %d", SHAPES_SINCE,
-                            t->shape_names[i], i);
-    }
-    return RBS_OK;
-}
-
-/* The second-moment factors attribute of group grid: 1 to 8 numbers into kfac, their count into *n_kfac. */
-static int read_second_moment_factors(loader *ld, hid_t grid, double kfac[8], int *n_kfac)
-{
-    hid_t attr = -1, space = -1;
-    hssize_t count = -1;
-    if (!attribute_exists(grid, "second_moment_factors"))
-        return rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute 'second_moment_factors' of group 'grid'");
-    H5E_BEGIN_TRY {
-        attr = H5Aopen(grid, "second_moment_factors", H5P_DEFAULT);
-        if (attr >= 0) space = H5Aget_space(attr);
-        if (space >= 0) count = H5Sget_simple_extent_npoints(space);
-    } H5E_END_TRY;
-    if (space >= 0) H5Sclose(space);
-    if (attr >= 0) H5Aclose(attr);
-    if (count < 1 || count > 8
-        || read_numeric_attribute(grid, "second_moment_factors", H5T_NATIVE_DOUBLE, kfac, count, 0) != 0)
-        return rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the attribute 'second_moment_factors' of group 'grid' as 1 to 8 "
-                    "numbers");
-    *n_kfac = (int)count;
-    return RBS_OK;
-}
-
-/* the attributes grid/law copies, in its order (data_schema.table.LAW_ATTRIBUTES; the last holds 4 numbers) */
-static const char *const LAW_ATTRIBUTES[] = {
-    "restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean", "aspect_ratio_sd",
-    "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol", "max_steps", "second_moment_factors"};
-#define N_LAW_ATTRIBUTES (sizeof LAW_ATTRIBUTES / sizeof LAW_ATTRIBUTES[0])
-
-/* The attributes of LAW_ATTRIBUTES as grid/law holds them (data_schema.table.ReboundTable.law_values): every
- * one required, integers (n_max, max_steps) converted to double. */
-static int law_values(loader *ld, hid_t grid, double values[LAW_SIZE])
-{
-    int n = 0;
-    for (size_t i = 0; i + 1 < N_LAW_ATTRIBUTES; i++) {
-        const char *name = LAW_ATTRIBUTES[i];
-        if (strcmp(name, "n_max") == 0 || strcmp(name, "max_steps") == 0) {
-            long long integer = 0;
-            if (read_integer_attribute(ld, grid, "grid", name, &integer) != RBS_OK) return ld->code;
-            values[n++] = (double)integer;
-        } else if (read_double_attribute(ld, grid, "grid", name, &values[n++]) != RBS_OK) {
-            return ld->code;
-        }
-    }
-    double kfac[8];
-    int n_kfac = 0;
-    if (read_second_moment_factors(ld, grid, kfac, &n_kfac) != RBS_OK) return ld->code;
-    if (n + n_kfac != LAW_SIZE)
-        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%d,), expected (%d,) (the attribute "
-                    "'second_moment_factors' of group 'grid' holds %d numbers, not %d)", LAW_SIZE, n + n_kfac, n_kfac,
-                    LAW_SIZE - n);
-    memcpy(values + n, kfac, (size_t)n_kfac * sizeof(double));
-    return RBS_OK;
-}
-
-/* Since 3.2: the checksummed copies grid/law and grid/shape_codes equal the attributes (restitution_k,
- * restitution_p in 3.2; every one of LAW_ATTRIBUTES since 3.3) and the names (each family's code, USER_SHAPE_CODE
- * for another shape), bit for bit (data_schema.table.check_contract, shape_codes). */
-static int check_law_copies(loader *ld, hid_t grid, const rbs_table *t)
-{
-    if (t->format_minor < 2) return RBS_OK;
-    double attributes[LAW_SIZE] = {t->restitution_k, t->restitution_p};
-    const int size = t->format_minor >= 3 ? LAW_SIZE : 2;
-    if (size == LAW_SIZE && law_values(ld, grid, attributes) != RBS_OK) return ld->code;
-    int rank = 0;
-    hsize_t dims[8];
-    if (rbs_dataset_shape(ld, grid, "grid", "law", &rank, dims) != RBS_OK) return ld->code;
-    if (rank != 1 || dims[0] != (hsize_t)size)
-        return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'grid/law' has shape (%llu%s), expected (%d,)",
-                    rank ? (unsigned long long)dims[0] : 0ULL, rank == 1 ? "," : ", ...", size);
-    const hsize_t n_law = (hsize_t)size, shapes = (hsize_t)t->n_shapes;
-    double *law = rbs_read_dataset(ld, grid, "grid", "law", H5T_NATIVE_DOUBLE, sizeof(double), 1, &n_law);
-    if (!law) return ld->code;
-    int differ = -1;
-    for (int i = 0; differ < 0 && i < size; i++)
-        if (memcmp(&law[i], &attributes[i], sizeof(double)) != 0) differ = i;
-    if (differ >= 0) {
-        char name[64];
-        if (differ < (int)N_LAW_ATTRIBUTES - 1) snprintf(name, sizeof name, "%s", LAW_ATTRIBUTES[differ]);
-        else snprintf(name, sizeof name, "second_moment_factors[%d]", differ - ((int)N_LAW_ATTRIBUTES - 1));
-        rbs_fail(ld, RBS_ERR_FORMAT, "the attribute %s of group 'grid' (%.17g) differs from its checksummed copy in "
-             "'grid/law' (%.17g)", name, attributes[differ], law[differ]);
-    }
-    free(law);
-    if (differ >= 0) return ld->code;
+    const hsize_t shapes = (hsize_t)t->n_shapes;
     uint8_t *codes = rbs_read_dataset(ld, grid, "grid", "shape_codes", H5T_NATIVE_UINT8, 1, 1, &shapes);
     if (!codes) return ld->code;
     int same = 1;
@@ -570,113 +390,267 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
     return RBS_OK;
 }
 
-/* ------------------------------------------------------------------------- the direct model's parameters */
+/* ------------------------------------------------------------------------- the parameter rows: model and wall */
 
-/* The attributes of the direct model (data_schema.table._direct_model_attributes: every one required since
- * 3.3, the fallbacks of old_tables.c before) into aspect, kfac (*n_kfac of them), the tolerances and q. */
-static int direct_attributes(loader *ld, hid_t file, hid_t grid, const rbs_table *t, double kappa, double aspect[4],
-                             double kfac[8], int *n_kfac, double *contact_tol, double *set_tol, long long *max_steps,
-                             double *q)
+/* how a field of a parameter row is stored and read: a real (an HDF5 integer or float, read as double), an integer
+ * (an HDF5 integer, read as long long) or an array of `count` reals (data_schema.table._field) */
+enum { FIELD_REAL, FIELD_INTEGER, FIELD_ARRAY };
+
+typedef struct row_field {
+    const char *name;
+    int kind;
+    int count;                  /* the reals of an array field */
+    size_t offset;              /* of its value in the struct read */
+} row_field;
+
+/* whether HDF5 type `type` is stored as field `f` wants it */
+static int field_type_ok(hid_t type, const row_field *f)
 {
-    static const char *const aspect_names[4] = {"aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low",
-                                                "aspect_ratio_high"};
-    const int required = t->format_minor >= 3;
-    int recorded = 1;
-    for (int k = 0; k < 4; k++) {
-        aspect[k] = NAN;
-        recorded &= attribute_exists(grid, aspect_names[k]);
+    H5T_class_t cls = H5Tget_class(type);
+    if (f->kind == FIELD_INTEGER) return cls == H5T_INTEGER;
+    if (f->kind == FIELD_REAL) return cls == H5T_INTEGER || cls == H5T_FLOAT;
+    if (cls != H5T_ARRAY || H5Tget_array_ndims(type) != 1) return 0;
+    hsize_t dims[1] = {0};
+    hid_t base = H5Tget_super(type);
+    H5T_class_t base_cls = base >= 0 ? H5Tget_class(base) : H5T_NO_CLASS;
+    if (base >= 0) H5Tclose(base);
+    return H5Tget_array_dims2(type, dims) == 1 && dims[0] == (hsize_t)f->count
+           && (base_cls == H5T_INTEGER || base_cls == H5T_FLOAT);
+}
+
+/* The one row of `group_name`/parameters (a compound type) read by field name into `out` (a struct of `size`
+ * bytes laid out as `fields` say): H5Dread converts the file's fields by name into an in-memory compound type of
+ * the fields wanted (their order in the file does not matter, others are ignored). Refused, naming the dataset,
+ * as data_schema.table._read_row and _field refuse it: missing, not one row of a compound type, a field missing
+ * (`names`: the fields read, for the message) or stored as another type, or unreadable. */
+static int read_row(loader *ld, hid_t group, const char *group_name, const row_field *fields, int n_fields,
+                    const char *names, void *out, size_t size)
+{
+    hid_t ds = -1, type = -1, space = -1, memtype = -1;
+    int rank = -1, ok = 0;
+    hsize_t dims[1] = {0};
+    if (!rbs_link_exists(group, "parameters"))
+        return rbs_fail(ld, RBS_ERR_FORMAT, "missing dataset '%s/parameters'", group_name);
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(group, "parameters", H5P_DEFAULT);
+        if (ds >= 0) type = H5Dget_type(ds);
+        if (ds >= 0) space = H5Dget_space(ds);
+        if (space >= 0) rank = H5Sget_simple_extent_ndims(space);
+        if (rank == 1) H5Sget_simple_extent_dims(space, dims, NULL);
+        if (type >= 0 && H5Tget_class(type) == H5T_COMPOUND && rank == 1 && dims[0] == 1) ok = 1;
+    } H5E_END_TRY;
+    if (!ok) {
+        rbs_fail(ld, RBS_ERR_FORMAT, "dataset '%s/parameters' must hold one row of a compound type, one field per "
+                 "parameter", group_name);
+        goto done;
     }
-    if (recorded || required) {
-        for (int k = 0; k < 4; k++)
-            if (read_double_attribute(ld, grid, "grid", aspect_names[k], &aspect[k]) != RBS_OK) return ld->code;
-    } else {
-        const size_t size = 1 << 20;
-        char *config = malloc(size);
-        if (!config) return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory reading the root attribute 'config'");
-        if (read_string_attribute(file, "config", config, size) == 0) rbs_config_aspect(config, aspect);
-        free(config);
+    memtype = H5Tcreate(H5T_COMPOUND, size);
+    for (int i = 0; i < n_fields && ld->code == RBS_OK; i++) {
+        const row_field *f = &fields[i];
+        int index = -1, type_ok = 0;
+        H5E_BEGIN_TRY {
+            index = H5Tget_member_index(type, f->name);
+            if (index >= 0) {
+                hid_t member = H5Tget_member_type(type, (unsigned)index);
+                if (member >= 0) {
+                    type_ok = field_type_ok(member, f);
+                    H5Tclose(member);
+                }
+            }
+        } H5E_END_TRY;
+        if (index < 0) {
+            rbs_fail(ld, RBS_ERR_FORMAT, "dataset '%s/parameters' has no field '%s'; the fields read: %s", group_name,
+                     f->name, names);
+        } else if (!type_ok) {
+            if (f->kind == FIELD_ARRAY)
+                rbs_fail(ld, RBS_ERR_FORMAT, "field '%s' of dataset '%s/parameters' must be stored as %d numbers",
+                         f->name, group_name, f->count);
+            else
+                rbs_fail(ld, RBS_ERR_FORMAT, "field '%s' of dataset '%s/parameters' must be stored as one %s", f->name,
+                         group_name, f->kind == FIELD_INTEGER ? "integer" : "number");
+        } else if (f->kind == FIELD_ARRAY) {
+            hsize_t count = (hsize_t)f->count;
+            hid_t array = H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, &count);
+            H5Tinsert(memtype, f->name, f->offset, array);
+            H5Tclose(array);
+        } else {
+            H5Tinsert(memtype, f->name, f->offset, f->kind == FIELD_INTEGER ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE);
+        }
     }
-    *n_kfac = RBS_N_FAMILIES;
-    if (required || attribute_exists(grid, "second_moment_factors")) {
-        if (read_second_moment_factors(ld, grid, kfac, n_kfac) != RBS_OK) return ld->code;
-    } else {
-        rbs_built_with_second_moment_factors(kappa, kfac);
-    }
-    rbs_built_with_tolerances(contact_tol, set_tol, max_steps);
-    *q = NAN;
-    if (((required || attribute_exists(grid, "contact_tol")) && read_double_attribute(ld, grid, "grid", "contact_tol", contact_tol))
-        || ((required || attribute_exists(grid, "set_tol")) && read_double_attribute(ld, grid, "grid", "set_tol", set_tol))
-        || ((required || attribute_exists(grid, "max_steps")) && read_integer_attribute(ld, grid, "grid", "max_steps", max_steps))
-        || ((required || attribute_exists(grid, "friction_q")) && read_double_attribute(ld, grid, "grid", "friction_q", q)))
-        return ld->code;
+    if (ld->code != RBS_OK) goto done;
+    herr_t read = -1;
+    H5E_BEGIN_TRY { read = H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, out); } H5E_END_TRY;
+    if (read < 0)
+        rbs_fail(ld, RBS_ERR_FORMAT, "cannot read dataset '%s/parameters' (truncated, corrupt or failed checksum?)",
+                 group_name);
+done:
+    if (memtype >= 0) H5Tclose(memtype);
+    if (space >= 0) H5Sclose(space);
+    if (type >= 0) H5Tclose(type);
+    if (ds >= 0) H5Dclose(ds);
+    return ld->code;
+}
+
+/* the row model/parameters (data_schema.table.MODEL_FIELDS): the direct model's parameters by name */
+typedef struct model_row {
+    double kappa;
+    long long n_max;
+    double aspect[4];           /* aspect_ratio_mean, _sd, _low, _high */
+    double contact_tol, set_tol;
+    long long max_steps;
+    double kfac[RBS_N_FAMILIES];    /* second_moment_factors */
+} model_row;
+
+static const row_field MODEL_FIELDS[] = {
+    {"kappa", FIELD_REAL, 1, offsetof(model_row, kappa)},
+    {"n_max", FIELD_INTEGER, 1, offsetof(model_row, n_max)},
+    {"aspect_ratio_mean", FIELD_REAL, 1, offsetof(model_row, aspect) + 0 * sizeof(double)},
+    {"aspect_ratio_sd", FIELD_REAL, 1, offsetof(model_row, aspect) + 1 * sizeof(double)},
+    {"aspect_ratio_low", FIELD_REAL, 1, offsetof(model_row, aspect) + 2 * sizeof(double)},
+    {"aspect_ratio_high", FIELD_REAL, 1, offsetof(model_row, aspect) + 3 * sizeof(double)},
+    {"contact_tol", FIELD_REAL, 1, offsetof(model_row, contact_tol)},
+    {"set_tol", FIELD_REAL, 1, offsetof(model_row, set_tol)},
+    {"max_steps", FIELD_INTEGER, 1, offsetof(model_row, max_steps)},
+    {"second_moment_factors", FIELD_ARRAY, RBS_N_FAMILIES, offsetof(model_row, kfac)},
+};
+#define N_MODEL_FIELDS ((int)(sizeof MODEL_FIELDS / sizeof MODEL_FIELDS[0]))
+
+#define TWO_TO_53 9007199254740992LL
+
+/* The direct model's parameters (group model) by name, each in its range (data_schema.table._model_fields: the
+ * fields' presence and types in order, then their ranges in order, with the same words). */
+static int read_model(loader *ld, hid_t file, model_row *m)
+{
+    hid_t group = open_group(ld, file, "model");
+    if (group < 0) return ld->code;
+    char names[512] = "";
+    for (int i = 0; i < N_MODEL_FIELDS; i++)
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "", MODEL_FIELDS[i].name);
+    int code = read_row(ld, group, "model", MODEL_FIELDS, N_MODEL_FIELDS, names, m, sizeof *m);
+    H5Gclose(group);
+    if (code != RBS_OK) return code;
+#define MODEL_FAIL(field, allowed, format, value)                                                                  \
+    rbs_fail(ld, RBS_ERR_FORMAT, "field '" field "' of dataset 'model/parameters' must be " allowed "; got " format, \
+             value)
+    if (!(m->kappa >= 0.0 && m->kappa < 1.0)) return MODEL_FAIL("kappa", "in [0, 1)", "%.17g", m->kappa);
+    if (!(m->n_max >= 1 && m->n_max < TWO_TO_53))
+        return MODEL_FAIL("n_max", "an integer in [1, 2**53)", "%lld", m->n_max);
+    if (!isfinite(m->aspect[0])) return MODEL_FAIL("aspect_ratio_mean", "finite", "%.17g", m->aspect[0]);
+    if (!(isfinite(m->aspect[1]) && m->aspect[1] > 0.0))
+        return MODEL_FAIL("aspect_ratio_sd", "finite and > 0", "%.17g", m->aspect[1]);
+    if (!(m->aspect[2] > 0.0 && m->aspect[2] < 1.0))
+        return MODEL_FAIL("aspect_ratio_low", "in (0, 1)", "%.17g", m->aspect[2]);
+    if (!(m->aspect[2] < m->aspect[3] && m->aspect[3] <= 1.0))
+        return MODEL_FAIL("aspect_ratio_high", "in (aspect_ratio_low, 1]", "%.17g", m->aspect[3]);
+    if (!(isfinite(m->contact_tol) && m->contact_tol > 0.0))
+        return MODEL_FAIL("contact_tol", "finite and > 0", "%.17g", m->contact_tol);
+    if (!(isfinite(m->set_tol) && m->set_tol > 0.0))
+        return MODEL_FAIL("set_tol", "finite and > 0", "%.17g", m->set_tol);
+    if (!(m->max_steps >= 1 && m->max_steps < TWO_TO_53))
+        return MODEL_FAIL("max_steps", "an integer in [1, 2**53)", "%lld", m->max_steps);
+#undef MODEL_FAIL
+    for (int k = 0; k < RBS_N_FAMILIES; k++)
+        if (!(m->kfac[k] > 0.0 && m->kfac[k] < 1.0))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "field 'second_moment_factors' of dataset 'model/parameters' must be %d "
+                            "numbers in (0, 1), one per shape code; got %.17g at index %d", RBS_N_FAMILIES, m->kfac[k], k);
     return RBS_OK;
 }
 
-#define OUT_OF_RANGE "the direct model's parameters are out of range: "
+/* The wall law families (direct_model.wall.WALL_FAMILIES, its twin: the same names, parameters in the order the
+ * kernels read them, and ranges in the same words). */
+typedef struct wall_family {
+    const char *name;
+    int n_parameters;
+    const char *const *parameters;
+    const char *const *allowed;
+    int (*const *ok)(double);
+} wall_family;
 
-/* The direct model's parameters (surrogate.table.SurrogateTable.direct_parameters): none (has_direct = 0) if the table does
- * not record its second-moment factors, else the P_* array of direct_model.runtime.model_parameters after
- * the same range checks in the same order (RBS_ERR_FORMAT naming the value). The aspect-ratio law and the
- * second-moment factors read (NaN where unknown) into aspect and family_kfac, for the shapes' records. */
-static int read_direct_parameters(loader *ld, hid_t file, hid_t grid, rbs_table *t, double kappa,
-                                  double aspect[4], double family_kfac[RBS_N_FAMILIES])
+static int finite_and_positive(double x) { return isfinite(x) && x > 0.0; }
+static int finite(double x) { return isfinite(x); }
+
+static const char *const EXPONENTIAL_PARAMETERS[] = {"k", "p", "q"};
+static const char *const EXPONENTIAL_ALLOWED[] = {"finite and > 0", "finite and > 0", "finite"};
+static int (*const EXPONENTIAL_OK[])(double) = {finite_and_positive, finite_and_positive, finite};
+static const wall_family WALL_FAMILIES[] = {
+    {"exponential", 3, EXPONENTIAL_PARAMETERS, EXPONENTIAL_ALLOWED, EXPONENTIAL_OK},
+};
+#define N_WALL_FAMILIES ((int)(sizeof WALL_FAMILIES / sizeof WALL_FAMILIES[0]))
+
+/* The wall (group wall, data_schema.table._wall): its attributes family and name (strings), the family one of
+ * WALL_FAMILIES, its parameters by field name within their ranges; into t (wall_*, and the exponential family's
+ * k, p as restitution_k, _p for the restitution pieces). */
+static int read_wall(loader *ld, hid_t file, rbs_table *t)
 {
-    double kfac[8], contact_tol, set_tol, q;
-    long long max_steps = 0;
-    int n_kfac = 0;
-    if (direct_attributes(ld, file, grid, t, kappa, aspect, kfac, &n_kfac, &contact_tol, &set_tol, &max_steps, &q) != RBS_OK)
-        return ld->code;
-    for (int k = 0; k < RBS_N_FAMILIES; k++) family_kfac[k] = n_kfac == RBS_N_FAMILIES ? kfac[k] : NAN;
-    for (int k = 0; k < n_kfac; k++)
-        if (!isfinite(kfac[k])) return RBS_OK;
-    /* tables without friction_q (before 3.1) were built before the wall law was configurable: q = 1 */
-    if (!isfinite(q)) q = 1.0;
-    double mean = aspect[0], sd = aspect[1], low = aspect[2], high = aspect[3];
-    if (!(0.0 < low && low < high && high <= 1.0))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio bounds must satisfy 0 < low < high <= 1; got "
-                    "low=%.17g, high=%.17g.", low, high);
-    if (!(sd > 0.0 && isfinite(sd)))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'sd' must be finite and > 0; got %.17g.", sd);
-    if (!isfinite(mean))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The aspect-ratio 'mean' must be finite; got %.17g.", mean);
-    if (!(0.0 <= kappa && kappa < 1.0))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'kappa' parameter must be in [0, 1); got %.17g.", kappa);
-    const long long two53 = 9007199254740992LL;
-    if (!(t->n_max >= 1 && t->n_max < two53))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'n_max' parameter must be an integer in [1, 2**53); got %lld.",
-                    t->n_max);
-    if (!(max_steps >= 1 && max_steps < two53))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'max_steps' parameter must be an integer in [1, 2**53); got "
-                    "%lld.", max_steps);
-    if (!(isfinite(contact_tol) && contact_tol > 0.0))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'contact_tol' parameter must be finite and > 0 (units of a); "
-                    "got %.17g.", contact_tol);
-    if (!(isfinite(set_tol) && set_tol > 0.0))
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'set_tol' parameter must be finite and > 0 (units of a); got "
-                    "%.17g.", set_tol);
-    int kfac_ok = n_kfac == RBS_N_FAMILIES;
-    for (int k = 0; kfac_ok && k < n_kfac; k++) kfac_ok = kfac[k] > 0.0 && kfac[k] < 1.0;
-    if (!kfac_ok)
-        return rbs_fail(ld, RBS_ERR_FORMAT, OUT_OF_RANGE "The 'second_moment_factors' parameter must be %d numbers in (0, "
-                    "1), one per shape code; got %d numbers, the first %.17g.", RBS_N_FAMILIES, n_kfac, kfac[0]);
+    hid_t group = open_group(ld, file, "wall");
+    if (group < 0) return ld->code;
+    char family_name[RBS_WALL_NAME_SIZE];
+    const wall_family *family = NULL;
+    static const char *const attributes[2] = {"family", "name"};
+    char *values[2] = {family_name, t->wall_name};
+    for (int i = 0; i < 2 && ld->code == RBS_OK; i++) {
+        if (!attribute_exists(group, attributes[i]))
+            rbs_fail(ld, RBS_ERR_FORMAT, "missing attribute '%s' of group 'wall'", attributes[i]);
+        else if (read_string_attribute(group, attributes[i], values[i], RBS_WALL_NAME_SIZE) != 0)
+            rbs_fail(ld, RBS_ERR_FORMAT, "cannot read the attribute '%s' of group 'wall' as a string", attributes[i]);
+    }
+    for (int i = 0; ld->code == RBS_OK && !family && i < N_WALL_FAMILIES; i++)
+        if (strcmp(family_name, WALL_FAMILIES[i].name) == 0) family = &WALL_FAMILIES[i];
+    if (ld->code == RBS_OK && !family) {
+        char known[256] = "";
+        for (int i = 0; i < N_WALL_FAMILIES; i++)
+            snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", i ? ", " : "", WALL_FAMILIES[i].name);
+        rbs_fail(ld, RBS_ERR_FORMAT, "the attribute 'family' of group 'wall' names an unknown wall law family '%s' (this "
+                 "version knows: %s)", family_name, known);
+    }
+    if (ld->code == RBS_OK) {
+        row_field fields[RBS_WALL_MAX_PARAMETERS];
+        char names[512] = "";
+        for (int i = 0; i < family->n_parameters; i++) {
+            fields[i] = (row_field){family->parameters[i], FIELD_REAL, 1, (size_t)i * sizeof(double)};
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "", family->parameters[i]);
+        }
+        snprintf(names + strlen(names), sizeof names - strlen(names), " (the %s wall law)", family->name);
+        read_row(ld, group, "wall", fields, family->n_parameters, names, t->wall_parameters,
+                 (size_t)family->n_parameters * sizeof(double));
+    }
+    H5Gclose(group);
+    for (int i = 0; ld->code == RBS_OK && i < family->n_parameters; i++)
+        if (!family->ok[i](t->wall_parameters[i]))
+            rbs_fail(ld, RBS_ERR_FORMAT, "field '%s' of dataset 'wall/parameters' must be %s; got %.17g",
+                     family->parameters[i], family->allowed[i], t->wall_parameters[i]);
+    if (ld->code != RBS_OK) return ld->code;
+    t->wall_family = family->name;
+    t->wall_parameter_names = family->parameters;
+    t->n_wall_parameters = family->n_parameters;
+    t->restitution_k = t->wall_parameters[0];      /* the exponential family's k, p: exp(−k V^p) */
+    t->restitution_p = t->wall_parameters[1];
+    return RBS_OK;
+}
+
+/* The direct model's parameters (surrogate.table.SurrogateTable.direct_parameters): the P_* array of
+ * direct_model.runtime.model_parameters from the model's row and the wall's parameters, in range (read_model,
+ * read_wall). */
+static void direct_parameters(rbs_table *t, const model_row *m)
+{
     double *p = t->direct_parameters;
+    double mean = m->aspect[0], sd = m->aspect[1], low = m->aspect[2], high = m->aspect[3];
     p[P_ASPECT_MEAN] = mean;
     p[P_ASPECT_SD] = sd;
     p[P_ASPECT_LOW] = low;
     p[P_ASPECT_HIGH] = high;
     p[P_CDF_LOW] = rbs_normal_cdf((low - mean) / sd);
     p[P_CDF_HIGH] = rbs_normal_cdf((high - mean) / sd);
-    p[P_KAPPA] = kappa;
-    p[P_N_MAX] = (double)t->n_max;
-    p[P_WALL] = t->restitution_k;
-    p[P_WALL + 1] = t->restitution_p;
-    p[P_WALL + 2] = q;
-    p[P_CONTACT_TOL] = contact_tol;
-    p[P_SET_TOL] = set_tol;
-    p[P_MAX_STEPS] = (double)max_steps;
-    for (int k = 0; k < RBS_N_FAMILIES; k++) p[P_KFAC + k] = kfac[k];
+    p[P_KAPPA] = m->kappa;
+    p[P_N_MAX] = (double)m->n_max;
+    /* the wall's parameters in the order the kernels read them (the exponential family's k, p, q) */
+    for (int k = 0; k < P_CONTACT_TOL - P_WALL && k < t->n_wall_parameters; k++) p[P_WALL + k] = t->wall_parameters[k];
+    p[P_CONTACT_TOL] = m->contact_tol;
+    p[P_SET_TOL] = m->set_tol;
+    p[P_MAX_STEPS] = (double)m->max_steps;
+    for (int k = 0; k < RBS_N_FAMILIES; k++) p[P_KFAC + k] = m->kfac[k];
+    t->n_max = m->n_max;
     t->has_direct = 1;
-    return RBS_OK;
 }
 
 static void free_raw(rbs_raw_cells *raw)
@@ -743,33 +717,27 @@ static int load(loader *ld, rbs_table *t)
     t->n_levels = (int)L + 1;
 
     /* attributes data_schema reads (provenance: present, not used here) */
-    for (int i = 0; i < 5; i++) {
-        static const char *const names[] = {"created", "package_version", "config", "config_sha256", "master_seed"};
+    for (int i = 0; i < 6; i++) {
+        static const char *const names[] = {"created", "package_version", "model_sha256", "config", "config_sha256",
+                                            "master_seed"};
         if (!attribute_exists(file, names[i])) {
             rbs_fail(ld, RBS_ERR_FORMAT, "missing root attribute '%s'", names[i]);
             goto done;
         }
     }
-    double kappa;
-    if (read_double_attribute(ld, grid, "grid", "kappa", &kappa) != RBS_OK
-        || read_double_attribute(ld, grid, "grid", "restitution_k", &t->restitution_k) != RBS_OK
-        || read_double_attribute(ld, grid, "grid", "restitution_p", &t->restitution_p) != RBS_OK
-        || read_integer_attribute(ld, grid, "grid", "particles_per_cell", &t->particles_per_cell) != RBS_OK
-        || read_integer_attribute(ld, grid, "grid", "n_max", &t->n_max) != RBS_OK)
+    /* the direct model's parameters and the wall, each one row read by field name */
+    model_row model;
+    if (read_integer_attribute(ld, grid, "grid", "particles_per_cell", &t->particles_per_cell) != RBS_OK
+        || read_model(ld, file, &model) != RBS_OK || read_wall(ld, file, t) != RBS_OK)
         goto done;
-    if (!(isfinite(t->restitution_k) && t->restitution_k > 0.0 && isfinite(t->restitution_p) && t->restitution_p > 0.0)) {
-        rbs_fail(ld, RBS_ERR_FORMAT, "the wall law attributes of group 'grid' must be finite and > 0: restitution_k = %g, "
-             "restitution_p = %g", t->restitution_k, t->restitution_p);
-        goto done;
-    }
+    direct_parameters(t, &model);
     if (read_shapes(ld, grid, t) != RBS_OK) goto done;
-    if (check_family_names(ld, t) != RBS_OK) goto done;
     t->alpha1_deg = read_grid(ld, grid, "alpha1_deg", 0.0, 1, 90.0, 0.0, "deg", &t->n_alpha1);
     if (!t->alpha1_deg) goto done;
     t->speed_m_s = read_grid(ld, grid, "speed_m_s", SPEED_GRID_MIN, 0, SPEED_GRID_MAX, MAX_SPEED_RATIO, "m/s",
                              &t->n_speed);
     if (!t->speed_m_s) goto done;
-    if (check_law_copies(ld, grid, t) != RBS_OK) goto done;
+    if (check_shape_codes(ld, grid, t) != RBS_OK) goto done;
 
     const hsize_t lead[3] = {(hsize_t)t->n_shapes, (hsize_t)t->n_alpha1, (hsize_t)t->n_speed};
     const size_t n_cells = (size_t)t->n_shapes * (size_t)t->n_alpha1 * (size_t)t->n_speed;
@@ -819,13 +787,9 @@ static int load(loader *ld, rbs_table *t)
         if (code == RBS_ERR_MEMORY) rbs_fail(ld, code, "out of memory deriving the kernel arrays");
         else if (code != RBS_OK) rbs_fail(ld, code, "the derived kernel array %s is not finite (inconsistent table)", what);
     }
-    if (ld->code == RBS_OK) {
-        double aspect[4], kfac[RBS_N_FAMILIES];
-        if (read_direct_parameters(ld, file, grid, t, kappa, aspect, kfac) == RBS_OK
-            && rbs_shape_records_load(ld, file, t, kappa, aspect, kfac) == RBS_OK && t->has_direct
-            && rbs_direct_shapes_build(t) != RBS_OK)
-            rbs_fail(ld, RBS_ERR_MEMORY, "out of memory building the direct model's shapes");
-    }
+    if (ld->code == RBS_OK && rbs_shape_records_load(ld, file, t, model.kappa, model.aspect) == RBS_OK
+        && rbs_direct_shapes_build(t) != RBS_OK)
+        rbs_fail(ld, RBS_ERR_MEMORY, "out of memory building the direct model's shapes");
 
 done:
     free_raw(&raw);
@@ -842,9 +806,9 @@ int rbs_table_open(const char *path, rbs_table **table, char *message, size_t me
 {
     loader ld = {path ? path : "(null)", message, message_size, RBS_OK};
     if (message && message_size > 0) message[0] = '\0';
-    if (!table) return rbs_fail(&ld, RBS_ERR_ARGUMENT, "no place for the table (table is NULL)");
+    if (!table) return rbs_fail(&ld, RBS_INVALID, "no place for the table (table is NULL)");
     *table = NULL;
-    if (!path) return rbs_fail(&ld, RBS_ERR_ARGUMENT, "no path given");
+    if (!path) return rbs_fail(&ld, RBS_INVALID, "no path given");
     rbs_table *t = calloc(1, sizeof *t);
     if (!t) return rbs_fail(&ld, RBS_ERR_MEMORY, "out of memory");
     t->path = malloc(strlen(path) + 1);
@@ -887,88 +851,4 @@ int rbs_table_n_shapes(const rbs_table *t) { return t ? t->n_shapes : 0; }
 const char *rbs_table_shape_name(const rbs_table *t, int i)
 {
     return t && i >= 0 && i < t->n_shapes ? t->shape_names[i] : NULL;
-}
-
-int rbs_table_shape_info(const rbs_table *t, int i, rbs_shape_info *info)
-{
-    if (!t || !info || i < 0 || i >= t->n_shapes) return RBS_ERR_ARGUMENT;
-    const rbs_shape_records *r = &t->shapes;
-    info->name = t->shape_names[i];
-    info->kind = r->kind[i];
-    info->family = r->family[i];
-    info->n_vertices = (int)(r->vertex_start[i + 1] - r->vertex_start[i]);
-    info->vertices = info->n_vertices ? r->vertices + 3 * r->vertex_start[i] : NULL;
-    memcpy(info->inertia, r->inertia + 3 * i, sizeof info->inertia);
-    memcpy(info->aspect, r->aspect + 4 * i, sizeof info->aspect);
-    info->both_hands = r->both_hands[i];
-    info->direct_shape = t->model_shape ? t->model_shape[i] : -1;
-    return RBS_OK;
-}
-
-void rbs_table_alpha1_range(const rbs_table *t, double *lo, double *hi)
-{
-    if (lo) *lo = t ? t->alpha1_deg[0] : NAN;
-    if (hi) *hi = t ? t->alpha1_deg[t->n_alpha1 - 1] : NAN;
-}
-
-void rbs_table_speed_range(const rbs_table *t, double *lo, double *hi)
-{
-    if (lo) *lo = t ? t->speed_m_s[0] : NAN;
-    if (hi) *hi = t ? t->speed_m_s[t->n_speed - 1] : NAN;
-}
-
-const double *rbs_table_alpha1_grid(const rbs_table *t, int *count)
-{
-    if (count) *count = t ? t->n_alpha1 : 0;
-    return t ? t->alpha1_deg : NULL;
-}
-
-const double *rbs_table_speed_grid(const rbs_table *t, int *count)
-{
-    if (count) *count = t ? t->n_speed : 0;
-    return t ? t->speed_m_s : NULL;
-}
-
-void rbs_table_info_get(const rbs_table *t, rbs_table_info *info)
-{
-    if (!info) return;
-    memset(info, 0, sizeof *info);
-    if (!t) return;
-    info->n_shapes = t->n_shapes;
-    info->n_alpha1 = t->n_alpha1;
-    info->n_speed = t->n_speed;
-    info->n_clusters = t->n_clusters;
-    info->n_levels = t->n_levels;
-    info->n_dictionary = t->n_dictionary;
-    info->n_pieces = t->n_pieces;
-    info->format_major = t->format_major;
-    info->format_minor = t->format_minor;
-    info->particles_per_cell = t->particles_per_cell;
-    info->n_max = t->n_max;
-    info->restitution_k = t->restitution_k;
-    info->restitution_p = t->restitution_p;
-    info->kernel_bytes = (t->alpha1_axis_len + t->speed_axis_len + t->cells_len + (size_t)t->n_speed
-                          + t->restitution_pieces_len) * sizeof(double)
-                         + (t->clusters_len + t->dictionary_len) * sizeof(float);
-}
-
-int rbs_table_kernel_array(const rbs_table *t, const char *name, const void **data, size_t *count, int *dtype)
-{
-    const void *p = NULL;
-    size_t n = 0;
-    int type = RBS_FLOAT64;
-    if (!t || !name) return RBS_ERR_ARGUMENT;
-    if (strcmp(name, "alpha1_axis") == 0) { p = t->alpha1_axis; n = t->alpha1_axis_len; }
-    else if (strcmp(name, "speed_axis") == 0) { p = t->speed_axis; n = t->speed_axis_len; }
-    else if (strcmp(name, "cells") == 0) { p = t->cells; n = t->cells_len; }
-    else if (strcmp(name, "clusters") == 0) { p = t->clusters; n = t->clusters_len; type = RBS_FLOAT32; }
-    else if (strcmp(name, "dictionary") == 0) { p = t->dictionary; n = t->dictionary_len; type = RBS_FLOAT32; }
-    else if (strcmp(name, "speed_restitution") == 0) { p = t->speed_restitution; n = (size_t)t->n_speed; }
-    else if (strcmp(name, "restitution_pieces") == 0) { p = t->restitution_pieces; n = t->restitution_pieces_len; }
-    else if (strcmp(name, "direct_parameters") == 0 && t->has_direct) { p = t->direct_parameters; n = N_PARAMS; }
-    else return RBS_ERR_ARGUMENT;
-    if (data) *data = p;
-    if (count) *count = n;
-    if (dtype) *dtype = type;
-    return RBS_OK;
 }

@@ -52,6 +52,7 @@ RBS_INLINE void rbs_locate(const double *axis, int64_t axis_len, int64_t n, doub
 /* The cell a draw reads (surrogate.kernels.locate.locate): shape from u[0] and the mix, grid intervals and weights,
  * the neighbour (ia, iv) drawn with those weights from u[1], u[2] (stochastic interpolation). */
 typedef struct rbs_cell {
+    int64_t shape;      /* the table shape drawn from the mix */
     int64_t drawn;      /* number of cell (shape, ia, iv) */
     int64_t below;      /* number of cell (shape, ja, iv): the lower α1 neighbour at the drawn speed */
     int64_t jv, iv;     /* speed interval, drawn speed index */
@@ -71,6 +72,7 @@ RBS_INLINE rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_sha
 {
     rbs_cell c;
     int64_t shape = rbs_mix_shape(cdf, n_shapes, u[0]), ja;
+    c.shape = shape;
     rbs_locate(t->alpha1_axis, (int64_t)t->alpha1_axis_len, t->n_alpha1, alpha1, &ja, &c.wa);
     rbs_locate(t->speed_axis, (int64_t)t->speed_axis_len, t->n_speed, speed, &c.jv, &c.wv);
     int64_t ia = ja + (int64_t)(u[1] < c.wa);

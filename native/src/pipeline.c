@@ -1,13 +1,13 @@
 /*
- * pipeline.c: many particles on one thread, the table path (surrogate.kernels.pipeline: table_rebound_many,
- * table_rebound_many_rng).
+ * pipeline.c: many particles on one thread, the table path (rbs_draw_many; surrogate.kernels.pipeline:
+ * table_rebound_many, table_rebound_many_rng).
  *
  * Rows go through a pipeline of blocks of RBS_BLOCK particles, so that one block's table reads are in
  * flight while the blocks before it are computed. This file only schedules: while block k is located
  * (rbs_locate_block, locate.h), block k - 1 has its components resolved (rbs_resolve_block) and block
  * k - 2 is gathered (rbs_gather_block, gather.h) and drawn (rbs_arithmetic_block, arithmetic.h). Each
  * stage's block form does the operations of the per-particle code in the same order, so
- * rbs_table_rebound_many gives rbs_table_rebound's bits row by row. rbs_table_rebound_many_rng draws each
+ * rbs_draw_many gives the table path's bits row by row. Without uniforms given, rbs_draw_many draws each
  * block's uniforms from RBS_BLOCK xoshiro256+ lanes as it enters (surrogate.kernels.rng.fill_lanes).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "arithmetic.h"
+#include "records.h"
 #include "rng_internal.h"
 #include "table_arguments.h"
 
@@ -29,7 +30,7 @@ typedef struct block {
     rbs_frames frames;
     rbs_cells cells;
     rbs_gathered gathered;
-    rbs_results results;
+    rbs_block_results results;
 } block;
 
 RBS_HOT static void run_blocks(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V, const double *n,
@@ -79,29 +80,24 @@ static void all_invalid(size_t count, double *V_out, double *Omega_out, signed c
     }
 }
 
-/* a table, a mix of its shape count, a known interpolation, no NULL array (with count > 0); else every row invalid */
-static int arguments(const rbs_table *t, const rbs_mix *mix, int interpolation, size_t count, const double *V,
-                     const double *n, const double *a, const void *uniforms, double *V_out, double *Omega_out,
-                     signed char *status)
+int rbs_draw_many(const rbs_table *t, const rbs_mix *mix, const rbs_hits *hits, const rbs_options *options,
+                  rbs_results *results)
 {
-    int arrays = count == 0 || (V && n && a && uniforms && V_out && Omega_out && status);
-    if (arrays && rbs_table_arguments_ok(t, mix, interpolation)) return 1;
-    all_invalid(count, V_out, Omega_out, status);
-    return 0;
-}
-
-void rbs_table_rebound_many(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V,
-                            const double *n, const double *a, const double *u, int interpolation, double *V_out,
-                            double *Omega_out, signed char *status)
-{
-    if (arguments(t, mix, interpolation, count, V, n, a, u, V_out, Omega_out, status))
-        run_blocks(t, mix, count, V, n, a, u, NULL, interpolation == RBS_SCALED, V_out, Omega_out, status);
-}
-
-void rbs_table_rebound_many_rng(const rbs_table *t, const rbs_mix *mix, size_t count, const double *V,
-                                const double *n, const double *a, rbs_rng *rng, int interpolation, double *V_out,
-                                double *Omega_out, signed char *status)
-{
-    if (arguments(t, rbs_rng_ok(rng) ? mix : NULL, interpolation, count, V, n, a, rng, V_out, Omega_out, status))
-        run_blocks(t, mix, count, V, n, a, NULL, rng, interpolation == RBS_SCALED, V_out, Omega_out, status);
+    if (!RBS_RECORD_OK(results, rbs_results) || !RBS_RECORD_OK(hits, rbs_hits))
+        return RBS_INVALID;     /* no outputs, or no count: nothing written */
+    const size_t count = hits->count;
+    double *V_out = results->V, *Omega_out = results->Omega;
+    signed char *status = results->status;
+    int method, interpolation;
+    int ok = rbs_options_read(options, &method, &interpolation)
+             && (method == RBS_METHOD_AUTO || method == RBS_METHOD_TABLE)
+             && rbs_table_arguments_ok(t, mix, interpolation) && (hits->u || rbs_rng_ok(hits->rng))
+             && (count == 0 || (hits->V && hits->n && hits->a && V_out && Omega_out && status));
+    if (!ok) {
+        all_invalid(count, V_out, Omega_out, status);
+        return RBS_INVALID;
+    }
+    run_blocks(t, mix, count, hits->V, hits->n, hits->a, hits->u, hits->u ? NULL : hits->rng,
+               interpolation == RBS_INTERPOLATION_SCALED, V_out, Omega_out, status);
+    return RBS_OK;
 }

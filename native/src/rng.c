@@ -136,7 +136,7 @@ RBS_HOT void rbs_lanes_fill(uint64_t lanes[4 * RBS_BLOCK], double *u)
     }
 }
 
-void rbs_table_rebound_uniforms(rbs_rng *rng, size_t count, double *u)
+void rbs_draw_many_uniforms(rbs_rng *rng, size_t count, double *u)
 {
     uint64_t lanes[4 * RBS_BLOCK];
     double ub[RBS_BLOCK * RBS_U_PER_DRAW];

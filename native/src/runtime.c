@@ -70,6 +70,14 @@ void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4])
 int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes, int shape, double vt, double vn,
                             double wx, double wy, double wz, const double *u, double V[3], double W[3])
 {
+    long long n_collisions;
+    return rbs_rebound_model_frame_counted(params, shapes, shape, vt, vn, wx, wy, wz, u, V, W, &n_collisions);
+}
+
+int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays *shapes, int shape, double vt,
+                                    double vn, double wx, double wy, double wz, const double *u, double V[3],
+                                    double W[3], long long *n_collisions)
+{
     double quat[4], R0[9], verts[3 * MAX_HULL_VERTICES], K[3], semi[3];
     rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat);
     rbs_quaternion_to_matrix(quat, R0);
@@ -83,9 +91,9 @@ int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes
     int kind = shapes->kind[shape];
     double Rb = rbs_bounding_radius(kind, semi, verts, nv);
     const double V0[3] = {vt, vn, 0.0}, W0[3] = {wx, wy, wz};
-    long long n_collisions, n_steps;
+    long long n_steps;
     /* n_max and max_steps as numba's int() of the float64 parameters */
     return rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL, rbs_trunc(params[P_N_MAX]),
                             params[P_CONTACT_TOL], params[P_SET_TOL], rbs_trunc(params[P_MAX_STEPS]), V, W,
-                            &n_collisions, &n_steps);
+                            n_collisions, &n_steps);
 }

@@ -26,7 +26,8 @@
 #define P_KFAC 14           /* second-moment factor s per shape code, 14..17 */
 #define N_PARAMS (P_KFAC + RBS_N_FAMILIES)     /* one factor per family code, as direct_model.runtime derives it */
 
-/* the uniforms of one rebound (direct_model.runtime: U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS) */
+/* the uniforms of one rebound (direct_model.runtime: U_PER_REBOUND; U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS) */
+#define RBS_U_PER_REBOUND 7
 #define U_ORIENTATION 0
 #define U_RATIOS 3
 #define U_HAND 5
@@ -46,9 +47,14 @@ void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4]);
 /* One particle's whole rebound in the model's frame (direct_model.runtime.rebound_model_frame): params the
  * P_* array, shape the index of the particle's shape in `shapes` (0 .. shapes->n_shapes − 1), incident velocity
  * (vt, vn, 0) m/s (vn < 0), angular velocity (wx, wy, wz) in (m/s)/a (all zero: the body starts touching the
- * wall), u RBS_U_PER_REBOUND uniforms. V⁺ (m/s) into V and Ω⁺ ((m/s)/a) into W; returns RBS_REBOUNDED,
+ * wall), u RBS_U_PER_REBOUND uniforms. V⁺ (m/s) into V and Ω⁺ ((m/s)/a) into W; returns RBS_OK (rebounded),
  * RBS_TRAPPED or RBS_FAILED. */
 int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes, int shape, double vt, double vn,
                             double wx, double wy, double wz, const double *u, double V[3], double W[3]);
+
+/* rbs_rebound_model_frame, the collisions of the rebound into *n_collisions (up to the trap) */
+int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays *shapes, int shape, double vt,
+                                    double vn, double wx, double wy, double wz, const double *u, double V[3],
+                                    double W[3], long long *n_collisions);
 
 #endif /* RBS_RUNTIME_H */

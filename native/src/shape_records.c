@@ -1,14 +1,15 @@
 /*
- * shape_records.c: the shapes a table holds, as data (data_schema.shape_records): group /shapes of a table of
- * format 3.4 read and checked as check_shape_datasets and records_from_arrays check it, in the same order; the
- * families' records synthesised for an older table (data_schema.shape_records.family_records). The only place
- * the C library reads these arrays.
+ * shape_records.c: the shapes a table holds, as data (data_schema.shape_records): group /shapes of a table read
+ * and checked as check_shape_datasets and records_from_arrays check it, in the same order. The only place the C
+ * library reads these arrays.
  *
- * A built-in family's row must be the family's record at the table's κ and aspect-ratio law: kind, vertices (the
- * body of direct_model.registry.built_in_shape: rbs_body_vertices at b/a = c/b = 1, rows sorted and repeated
- * corners dropped, as numpy.unique), law and hands are compared bit for bit here; the Python loader, which has
- * the registry's surface and mass properties, also compares the triangles and inertia, and rebuilds a user's
- * grain's inertia from its vertices.
+ * A built-in family's row must be the family's record at the table's κ and aspect-ratio law, bit for bit: kind,
+ * vertices (the body of direct_model.registry.built_in_shape: rbs_body_vertices at b/a = c/b = 1, rows sorted and
+ * repeated corners dropped, as numpy.unique), triangles (the fans of its faces, registry._faces_to_triangles),
+ * inertia (the mass properties of that surface, direct_model.polyhedron.mass_properties; the ellipsoid's 2/5),
+ * law and hands; a user polyhedron's record is rebuilt from its vertices and triangles as registry.polyhedron
+ * does (a closed surface in its principal frame), and its mass properties must give its stored inertia bit for
+ * bit. polyhedron.c computes both as Python does, so both loaders give one verdict on every table.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -17,8 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "loader.h"
+#include "polyhedron.h"
 #include "runtime.h"
+#include "shape_records.h"
 #include "shapes.h"
 
 #define MIN_HULL_VERTICES 4         /* data_schema.shape_records.MIN_HULL_VERTICES */
@@ -27,6 +29,7 @@
 #define VERTEX_BOUND (1.5 * (1.0 + FRAME_CHECK))            /* data_schema.shape_records.VERTEX_BOUND */
 #define INERTIA_BOUND (2.0 * VERTEX_BOUND * VERTEX_BOUND)   /* data_schema.shape_records.INERTIA_BOUND */
 #define NAME_MAX_LENGTH (RBS_SHAPE_NAME_SIZE - 1)
+#define MAX_FAMILY_NORMALS 14       /* the cut prism's faces: 6 sides and 8 corners */
 
 void rbs_shape_records_free(rbs_shape_records *r)
 {
@@ -63,47 +66,78 @@ static int family_vertices(int family, double kappa, double *out)
     return kept;
 }
 
+/* The outward normals of the family's faces (direct_model.registry: _prism_body, _cut_prism_body,
+ * _tetrahedron_body) into normals (at most MAX_FAMILY_NORMALS rows); their number. `body`: the family's distinct
+ * vertices, sorted (family_vertices). */
+static int family_normals(int family, const double *body, int n_body, double *normals)
+{
+    static const double axes[6][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0},
+                                      {-1.0, -0.0, -0.0}, {-0.0, -1.0, -0.0}, {-0.0, -0.0, -1.0}};
+    if (family == RBS_TETRAHEDRON) {                    /* each face faces away from the opposite vertex */
+        for (int k = 0; k < 3 * n_body; k++) normals[k] = -body[k];
+        return n_body;
+    }
+    memcpy(normals, axes, sizeof axes);
+    int n = 6;
+    if (family == RBS_CUT_PRISM)                        /* and the eight corners' cuts */
+        for (int i = 0; i < 8; i++) {
+            normals[3 * n] = i & 4 ? 1.0 : -1.0;
+            normals[3 * n + 1] = i & 2 ? 1.0 : -1.0;
+            normals[3 * n + 2] = i & 1 ? 1.0 : -1.0;
+            n++;
+        }
+    return n;
+}
+
+/* numpy's max (min) of a running maximum (minimum) and one more value: NaN once any value is NaN */
+static double numpy_max(double m, double x) { return isnan(m) || isnan(x) ? NAN : x > m ? x : m; }
+static double numpy_min(double m, double x) { return isnan(m) || isnan(x) ? NAN : x < m ? x : m; }
+
+/* What direct_model.registry.polyhedron makes of a hull given in its principal frame, units of a: its principal
+ * J/m into inertia, 0; or -1 and, into `why`, the words of its ValueError (no volume) or ShapeError (not a
+ * principal frame of unit size, too flat). Its checks as it writes them (a comparison with NaN is false). */
+static int hull_inertia(const double *vertices, int n_vertices, const int32_t *triangles, int n_triangles,
+                        double inertia[3], char *why, size_t size)
+{
+    rbs_mass_properties props;
+    if (rbs_hull_mass_properties(vertices, n_vertices, triangles, n_triangles, &props) != 0) {
+        snprintf(why, size, "the triangles enclose no volume (volume %.17g): not a closed outward surface",
+                 props.volume);
+        return -1;
+    }
+    double half[3], largest = -INFINITY, thinnest = INFINITY, centre = 0.0, off = 0.0;
+    for (int c = 0; c < 3; c++) {
+        double lo = vertices[c], hi = vertices[c];          /* finite (checked) */
+        for (int i = 1; i < n_vertices; i++) {
+            lo = fmin(lo, vertices[3 * i + c]);
+            hi = fmax(hi, vertices[3 * i + c]);
+        }
+        half[c] = (hi - lo) / 2.0;
+        largest = numpy_max(largest, half[c]);
+        thinnest = numpy_min(thinnest, half[c]);
+        centre = numpy_max(centre, fabs(props.centroid[c]));
+        for (int d = 0; d < 3; d++)     /* inertia − diag(diag(inertia)) */
+            off = numpy_max(off, fabs(props.inertia[c][d] - (c == d ? props.inertia[c][d] : 0.0)));
+    }
+    if (fabs(largest - 1.0) > FRAME_CHECK || centre > FRAME_CHECK || off > FRAME_CHECK) {
+        snprintf(why, size, "the vertices are not in a principal frame of unit size (centre of mass [%.17g, %.17g, "
+                 "%.17g], products of inertia up to %.3g, largest half-extent %.17g); build the record with grain()",
+                 props.centroid[0], props.centroid[1], props.centroid[2], off, largest);
+        return -1;
+    }
+    if (thinnest < MIN_THICKNESS) {
+        snprintf(why, size, "the hull is flat: its thinnest half-extent is %.3g of its largest; allowed: >= %g",
+                 thinnest, MIN_THICKNESS);
+        return -1;
+    }
+    for (int k = 0; k < 3; k++) inertia[k] = props.inertia[k][k];
+    return 0;
+}
+
 /* the law (mean, sd, low, high) is one direct_model.shapes.AspectRatioLaw takes */
 static int law_ok(const double *law)
 {
     return isfinite(law[0]) && isfinite(law[1]) && law[1] > 0.0 && 0.0 < law[2] && law[2] < law[3] && law[3] <= 1.0;
-}
-
-static int allocate(loader *ld, rbs_shape_records *r, int n, int64_t n_vertices)
-{
-    r->kind = calloc((size_t)n, sizeof *r->kind);
-    r->family = calloc((size_t)n, sizeof *r->family);
-    r->vertex_start = calloc((size_t)n + 1, sizeof *r->vertex_start);
-    r->vertices = calloc((size_t)n_vertices * 3 + 1, sizeof *r->vertices);
-    r->inertia = calloc((size_t)n * 3, sizeof *r->inertia);
-    r->aspect = calloc((size_t)n * 4, sizeof *r->aspect);
-    r->both_hands = calloc((size_t)n, sizeof *r->both_hands);
-    if (!r->kind || !r->family || !r->vertex_start || !r->vertices || !r->inertia || !r->aspect || !r->both_hands)
-        return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory for the shapes' records");
-    return RBS_OK;
-}
-
-/* A table before 3.4: the families' records at κ and the aspect-ratio law (data_schema.shape_records.family_records);
- * their inertia J/m = s (b² + c², a² + c², a² + b²) = 2 s at b/a = c/b = 1, s the table's second-moment factor. */
-static int synthesise(loader *ld, rbs_table *t, double kappa, const double aspect[4], const double kfac[RBS_N_FAMILIES])
-{
-    if (!law_ok(aspect) || !(kappa >= 0.0 && kappa < 1.0))
-        return rbs_fail(ld, RBS_ERR_FORMAT, "the direct model's parameters are out of range: the built-in shapes' "
-                        "records cannot be made from the table's kappa %.17g and aspect-ratio law (%.17g, %.17g, "
-                        "%.17g, %.17g)", kappa, aspect[0], aspect[1], aspect[2], aspect[3]);
-    rbs_shape_records *r = &t->shapes;
-    if (allocate(ld, r, t->n_shapes, (int64_t)t->n_shapes * MAX_VERTICES) != RBS_OK) return ld->code;
-    for (int i = 0; i < t->n_shapes; i++) {
-        int family = rbs_shape_code(t->shape_names[i]);     /* a family's: checked by the loader */
-        int n = family_vertices(family, kappa, r->vertices + 3 * r->vertex_start[i]);
-        r->vertex_start[i + 1] = r->vertex_start[i] + n;
-        r->family[i] = family;
-        r->kind[i] = family == RBS_ELLIPSOID ? RBS_SMOOTH : RBS_POLYHEDRON;
-        for (int k = 0; k < 3; k++) r->inertia[3 * i + k] = 2.0 * kfac[family];
-        memcpy(r->aspect + 4 * i, aspect, 4 * sizeof(double));
-        r->both_hands[i] = family == RBS_TETRAHEDRON;
-    }
-    return RBS_OK;
 }
 
 /* Dataset `name` of group shapes, of HDF5 class `cls` (a string, integer or float: data_schema.table._read_group's
@@ -236,39 +270,64 @@ static int check_records(loader *ld, rbs_table *t, const char *names, const int3
         if (r->both_hands[i] > 1)
             return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/both_hands' holds %d at element %d; its values must be "
                             "0 or 1", (int)r->both_hands[i], i);
-    /* a built-in name carries the family's record (records_from_arrays) */
+    /* each row's record, in table order (records_from_arrays): a built-in name carries the family's record; a user
+     * polyhedron's is rebuilt from its hull, whose mass properties must give its stored inertia */
     for (int i = 0; i < n; i++) {
-        int family = r->family[i];
-        if (family < 0) continue;
-        if (!law_ok(aspect) || !(kappa >= 0.0 && kappa < 1.0))
+        const char *name = t->shape_names[i];
+        const int family = r->family[i];
+        const int64_t v0 = r->vertex_start[i], nv = r->vertex_start[i + 1] - v0;
+        const int64_t t0 = triangle_start[i], nt = triangle_start[i + 1] - t0;
+        char why[384];
+        if (family < 0) {
+            double inertia[3];
+            if (r->kind[i] != RBS_POLYHEDRON) continue;     /* a smooth body: its semi-axes come from its inertia */
+            if (hull_inertia(r->vertices + 3 * v0, (int)nv, triangles + 3 * t0, (int)nt, inertia, why, sizeof why) != 0)
+                return rbs_fail(ld, RBS_ERR_FORMAT, "datasets 'shapes/vertices' and 'shapes/triangles' of shape '%s' "
+                                "are not a hull in its principal frame: %s", name, why);
+            const double *stored = r->inertia + 3 * i;
+            if (memcmp(inertia, stored, sizeof inertia) != 0)
+                return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/inertia' of shape '%s' ([%.17g, %.17g, %.17g]) "
+                                "differs from the mass properties of its hull, datasets 'shapes/vertices' and "
+                                "'shapes/triangles' ([%.17g, %.17g, %.17g])", name, stored[0], stored[1], stored[2],
+                                inertia[0], inertia[1], inertia[2]);
+            continue;
+        }
+        /* the family's record (direct_model.registry.built_in_shape; the ellipsoid takes no κ) */
+        if (!law_ok(aspect) || (family != RBS_ELLIPSOID && !(kappa >= 0.0 && kappa < 1.0)))
             return rbs_fail(ld, RBS_ERR_FORMAT, "the built-in shape '%s' cannot be made at the table's kappa %.17g and "
-                            "aspect-ratio law (%.17g, %.17g, %.17g, %.17g)", t->shape_names[i], kappa, aspect[0],
-                            aspect[1], aspect[2], aspect[3]);
-        double body[3 * MAX_VERTICES];
-        int nv = family_vertices(family, kappa, body);
+                            "aspect-ratio law (%.17g, %.17g, %.17g, %.17g)", name, kappa, aspect[0], aspect[1],
+                            aspect[2], aspect[3]);
+        double body[3 * MAX_VERTICES], normals[3 * MAX_FAMILY_NORMALS], inertia[3] = {2.0 / 5.0, 2.0 / 5.0, 2.0 / 5.0};
+        int32_t surface[3 * MAX_HULL_TRIANGLES];
+        int n_body = family_vertices(family, kappa, body), n_surface = 0;
+        if (family != RBS_ELLIPSOID) {
+            n_surface = rbs_faces_to_triangles(body, n_body, normals, family_normals(family, body, n_body, normals),
+                                               surface, MAX_HULL_TRIANGLES);
+            if (n_surface < 0) snprintf(why, sizeof why, "its faces give more than %d triangles", MAX_HULL_TRIANGLES);
+            if (n_surface < 0 || hull_inertia(body, n_body, surface, n_surface, inertia, why, sizeof why) != 0)
+                return rbs_fail(ld, RBS_ERR_FORMAT, "the built-in shape '%s' cannot be made at the table's kappa %.17g "
+                                "and aspect-ratio law (%.17g, %.17g, %.17g, %.17g): %s", name, kappa, aspect[0],
+                                aspect[1], aspect[2], aspect[3], why);
+        }
         const char *differs = NULL;
         if (r->kind[i] != (family == RBS_ELLIPSOID ? RBS_SMOOTH : RBS_POLYHEDRON)) differs = "kind";
-        else if (r->vertex_start[i + 1] - r->vertex_start[i] != nv
-                 || memcmp(r->vertices + 3 * r->vertex_start[i], body, (size_t)nv * 3 * sizeof(double)) != 0)
+        else if (nv != n_body || memcmp(r->vertices + 3 * v0, body, (size_t)n_body * 3 * sizeof(double)) != 0)
             differs = "vertices";
+        else if (nt != n_surface || memcmp(triangles + 3 * t0, surface, (size_t)n_surface * 3 * sizeof(int32_t)) != 0)
+            differs = "triangles";
+        else if (memcmp(r->inertia + 3 * i, inertia, sizeof inertia) != 0) differs = "inertia";
         else if (memcmp(r->aspect + 4 * i, aspect, 4 * sizeof(double)) != 0) differs = "aspect";
         else if (r->both_hands[i] != (family == RBS_TETRAHEDRON)) differs = "both_hands";
         if (differs)
             return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/%s' of the built-in shape '%s' differs from the "
-                            "family's record at the table's kappa and aspect-ratio law (group 'grid')", differs,
-                            t->shape_names[i]);
+                            "family's record at the table's kappa and aspect-ratio law (dataset 'model/parameters')", differs, name);
     }
     return RBS_OK;
 }
 
-int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, const double aspect[4],
-                           const double kfac[RBS_N_FAMILIES])
+int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, const double aspect[4])
 {
-    if (!rbs_link_exists(file, "shapes")) {
-        if (t->format_minor >= SHAPES_SINCE)
-            return rbs_fail(ld, RBS_ERR_FORMAT, "missing group 'shapes' (table format 3.%d)", SHAPES_SINCE);
-        return synthesise(ld, t, kappa, aspect, kfac);
-    }
+    if (!rbs_link_exists(file, "shapes")) return rbs_fail(ld, RBS_ERR_FORMAT, "missing group 'shapes'");
     hid_t group = -1, name_type = -1;
     H5E_BEGIN_TRY { group = H5Gopen2(file, "shapes", H5P_DEFAULT); } H5E_END_TRY;
     if (group < 0) return rbs_fail(ld, RBS_ERR_FORMAT, "'shapes' is not a readable group (truncated or corrupt?)");

@@ -13,6 +13,13 @@
 #include "rebound_scatter.h"
 
 #define RBS_N_FAMILIES 4    /* the built-in families, codes RBS_ELLIPSOID .. RBS_TETRAHEDRON (direct_model.shapes.SHAPES) */
+/* the short names the library's sources use for the public enumerators of families and kinds (rebound_scatter.h) */
+#define RBS_ELLIPSOID RBS_FAMILY_ELLIPSOID
+#define RBS_PRISM RBS_FAMILY_PRISM
+#define RBS_CUT_PRISM RBS_FAMILY_CUT_PRISM
+#define RBS_TETRAHEDRON RBS_FAMILY_TETRAHEDRON
+#define RBS_SMOOTH RBS_KIND_SMOOTH
+#define RBS_POLYHEDRON RBS_KIND_POLYHEDRON
 #define MAX_VERTICES 24             /* direct_model.shapes.MAX_VERTICES: the cut prism's */
 #define MAX_HULL_VERTICES 256       /* direct_model.registry.MAX_HULL_VERTICES: the most a shape has */
 #define KIND_ELLIPSOID 0            /* direct_model.shape_arrays.KIND_ELLIPSOID */

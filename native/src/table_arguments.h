@@ -9,11 +9,11 @@
 
 #include "internal.h"
 
-/* a table, a mix of its shape count, a known interpolation */
+/* a table, a mix made from it, a known interpolation */
 static inline int rbs_table_arguments_ok(const rbs_table *t, const rbs_mix *mix, int interpolation)
 {
-    return t != NULL && mix != NULL && mix->n_shapes == t->n_shapes
-           && (interpolation == RBS_SCALED || interpolation == RBS_STOCHASTIC);
+    return t != NULL && mix != NULL && mix->table == t
+           && (interpolation == RBS_INTERPOLATION_SCALED || interpolation == RBS_INTERPOLATION_STOCHASTIC);
 }
 
 #endif /* RBS_TABLE_ARGUMENTS_H */

@@ -1,5 +1,6 @@
 /*
- * table_path.c: one particle by the table's law (surrogate.kernels.table_path: table_rebound, draw_local):
+ * table_path.c: one particle by the table's law (surrogate.kernels.table_path: table_rebound, draw_local; the
+ * table path of rbs_rebound, and rbs_draw_local):
  * validity, impact frame, grid look-up, cache hints, the draw in its cell, back to the global frame.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -9,6 +10,8 @@
 #include "draw.h"
 #include "frame.h"
 #include "locate.h"
+#include "paths.h"
+#include "records.h"
 #include "table_arguments.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
@@ -18,9 +21,11 @@ static void nan_out(double *x, int count)
         for (int k = 0; k < count; k++) x[k] = NAN;
 }
 
-RBS_HOT int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
-                              const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
+RBS_HOT int rbs_table_hit(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
+                          const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
+                          int *shape)
 {
+    *shape = -1;
     if (!V || !n || !u || !V_out || !Omega_out || !rbs_table_arguments_ok(t, mix, interpolation)
         || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])) {
         nan_out(V_out, 3);
@@ -33,9 +38,19 @@ RBS_HOT int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const doub
     rbs_impact_frame(Vi, ni, u[12], &f);
     rbs_cell cell = rbs_cell_of(t, rbs_mix_cdf(mix), mix->n_shapes, f.alpha1, f.speed, u);
     rbs_hint_draw(t, cell.drawn, u);
-    int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, interpolation == RBS_SCALED, x);
+    int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, interpolation == RBS_INTERPOLATION_SCALED,
+                                  x);
     int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);
-    return rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
+    status = rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
+    *shape = status == RBS_INVALID ? -1 : (int)cell.shape;
+    return status;
+}
+
+int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
+                      const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
+{
+    int shape;
+    return rbs_table_hit(t, mix, V, n, a, u, interpolation, V_out, Omega_out, &shape);
 }
 
 /* a local incident state a draw takes (surrogate.kernels.table_path.local_ok): α1 in (0, 90] deg, |V⁻| finite
@@ -46,9 +61,11 @@ static inline int local_ok(double alpha1_deg, double speed_m_s)
 }
 
 RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
-                   const double u[RBS_U_PER_DRAW], int interpolation, double out[RBS_LOCAL_SIZE])
+                           const double u[RBS_U_PER_DRAW], const rbs_options *options, double out[RBS_LOCAL_SIZE])
 {
-    if (!u || !out || !rbs_table_arguments_ok(t, mix, interpolation) || !local_ok(alpha1_deg, speed_m_s)) {
+    int method, interpolation;      /* the method is not read */
+    if (!u || !out || !rbs_options_read(options, &method, &interpolation)
+        || !rbs_table_arguments_ok(t, mix, interpolation) || !local_ok(alpha1_deg, speed_m_s)) {
         nan_out(out, RBS_LOCAL_SIZE);
         return RBS_INVALID;
     }
@@ -56,11 +73,11 @@ RBS_HOT int rbs_draw_local(const rbs_table *t, const rbs_mix *mix, double alpha1
     rbs_hint_draw(t, cell.drawn, u);
     double sin_a1, cos_a1, x[6];
     rbs_sincos(alpha1_deg * RBS_DEG_TO_RAD, &sin_a1, &cos_a1);
-    int status = rbs_draw_in_cell(t, &cell, cos_a1, sin_a1, u, interpolation == RBS_SCALED, x);
+    int status = rbs_draw_in_cell(t, &cell, cos_a1, sin_a1, u, interpolation == RBS_INTERPOLATION_SCALED, x);
     static const double wall_normal[3] = {0.0, 1.0, 0.0};
-    int ok = rbs_uniforms_ok(u, 1) & (status != RBS_REBOUNDED || rbs_rebound_ok(x, x + 3, wall_normal));
+    int ok = rbs_uniforms_ok(u, 1) & (status != RBS_OK || rbs_rebound_ok(x, x + 3, wall_normal));
     status = ok ? status : RBS_INVALID;
-    if (status != RBS_REBOUNDED) {
+    if (status != RBS_OK) {
         nan_out(out, RBS_LOCAL_SIZE);
         return status;
     }

@@ -23,6 +23,7 @@
 #include "body_rebound.h"
 #include "check.h"
 #include "collision.h"
+#include "paths.h"
 #include "rebound_scatter.h"
 #include "rotation.h"
 #include "runtime.h"
@@ -202,9 +203,9 @@ static void rebounds(rbs_rng *rng)
         long long n_coll, n_steps;
         int status = rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, 1000, 1e-10, 1e-9, 100000, V, W,
                                       &n_coll, &n_steps);
-        CHECK(status == RBS_REBOUNDED || status == RBS_TRAPPED || status == RBS_FAILED, "status %d", status);
+        CHECK(status == RBS_OK || status == RBS_TRAPPED || status == RBS_FAILED, "status %d", status);
         if (status >= 0 && status < 3) counts[status]++;
-        if (status != RBS_REBOUNDED) continue;
+        if (status != RBS_OK) continue;
         /* the final orientation is not returned: ΩᵀKΩ >= K_min |Ω|² bounds the final energy from below */
         lab(R0, K, K0);
         apply(K0, W0, KW0);
@@ -229,7 +230,16 @@ static void hostile(const rbs_table *table, const rbs_table *without)
     const double V[3] = {100.0, -100.0, 0.0}, Omega[3] = {0.0, 0.0, 0.0}, n[3] = {0.0, 1.0, 0.0};
     const double u[RBS_U_PER_REBOUND] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
     double Vo[3], Wo[3];
-    CHECK(rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, Wo) == RBS_REBOUNDED, "a good call");
+    CHECK(rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, Wo) == RBS_OK, "a good call");
+    {   /* rbs_direct_hit: the same bits, and the collisions of the rebound */
+        double Vh[3], Wh[3];
+        int n_collisions = -2;
+        CHECK(rbs_direct_hit(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vh, Wh, &n_collisions) == RBS_OK
+              && memcmp(Vh, Vo, sizeof Vh) == 0 && memcmp(Wh, Wo, sizeof Wh) == 0 && n_collisions >= 1,
+              "rbs_direct_hit: %d collisions", n_collisions);
+        CHECK(rbs_direct_hit(table, -1, V, Omega, n, 1e-3, u, Vh, Wh, &n_collisions) == RBS_INVALID
+              && n_collisions == -1, "rbs_direct_hit of no shape");
+    }
 #define INVALID(...)                                                                                    \
     do {                                                                                                \
         Vo[0] = Vo[1] = Vo[2] = Wo[0] = Wo[1] = Wo[2] = 0.0;                                            \
@@ -287,9 +297,9 @@ static void hostile(const rbs_table *table, const rbs_table *without)
                     int status = rbs_direct_rebound(table, shape, Vx, spin ? Ox : Omega, n, sizes[j], u, Vo, Wo);
                     int finite = isfinite(Vo[0]) && isfinite(Vo[1]) && isfinite(Vo[2]) && isfinite(Wo[0])
                                  && isfinite(Wo[1]) && isfinite(Wo[2]);
-                    CHECK(status == RBS_INVALID || status == RBS_REBOUNDED || status == RBS_TRAPPED || status == RBS_FAILED,
+                    CHECK(status == RBS_INVALID || status == RBS_OK || status == RBS_TRAPPED || status == RBS_FAILED,
                           "status %d", status);
-                    CHECK(status == RBS_REBOUNDED ? finite : all_nan(Vo) && all_nan(Wo), "outputs of status %d", status);
+                    CHECK(status == RBS_OK ? finite : all_nan(Vo) && all_nan(Wo), "outputs of status %d", status);
                 }
             }
     printf("hostile inputs: RBS_INVALID with NaN outputs\n");

@@ -5,9 +5,9 @@
  *   rbs_test_threads TABLE.h5 THREADS ROWS
  *
  * Thread t draws ROWS incident states and their rebounds from stream t of seed 7
- * (rbs_rng_seed_stream), with rbs_table_rebound per particle, with rbs_table_rebound_many_rng and with
- * rbs_rebound_rng (every other hit spinning, |Ω⁻| a/|V⁻| = 0.5: the direct model answers it); then the main thread redoes
- * every stream alone and compares the bits.
+ * (rbs_rng_seed_stream), with rbs_rebound per particle (RBS_METHOD_TABLE, uniforms given), with rbs_draw_many
+ * (uniforms from the rng) and with rbs_rebound (uniforms from the rng, every other hit spinning, |Ω⁻| a/|V⁻| = 0.5:
+ * the direct model answers it); then the main thread redoes every stream alone and compares the bits.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -49,21 +49,39 @@ static void *draw(void *argument)
         a[i] = 1e-4;
     }
     if (w->start) pthread_barrier_wait(w->start);
+    rbs_options table_path = RBS_OPTIONS_INIT;
+    table_path.method = RBS_METHOD_TABLE;
+    rbs_hit hit = RBS_HIT_INIT;
+    rbs_result result = RBS_RESULT_INIT;
     for (size_t i = 0; i < N; i++) {
         double u[RBS_U_PER_DRAW];
         rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
-        w->status[i] = (signed char)rbs_table_rebound(w->table, w->mix, V + 3 * i, n + 3 * i, a[i], u, RBS_SCALED,
-                                                w->V_out + 3 * i, w->Omega_out + 3 * i);
+        memcpy(hit.V, V + 3 * i, sizeof hit.V);
+        memcpy(hit.n, n + 3 * i, sizeof hit.n);
+        hit.a = a[i];
+        hit.u = u;
+        w->status[i] = (signed char)rbs_rebound(w->table, w->mix, &hit, &table_path, &result);
+        memcpy(w->V_out + 3 * i, result.V, sizeof result.V);
+        memcpy(w->Omega_out + 3 * i, result.Omega, sizeof result.Omega);
     }
-    rbs_table_rebound_many_rng(w->table, w->mix, N, V, n, a, &rng, RBS_SCALED, w->V_out + 3 * N, w->Omega_out + 3 * N,
-                         w->status + N);
+    rbs_hits hits = RBS_HITS_INIT;
+    rbs_results results = RBS_RESULTS_INIT;
+    hits.count = N, hits.V = V, hits.n = n, hits.a = a, hits.rng = &rng;
+    results.V = w->V_out + 3 * N, results.Omega = w->Omega_out + 3 * N, results.status = w->status + N;
+    rbs_draw_many(w->table, w->mix, &hits, NULL, &results);
+    hit.u = NULL;
+    hit.rng = &rng;
     for (size_t i = 0; i < N; i++) {
         const double *v = V + 3 * i;
         double w_i = i % 2 ? 0.5 * sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / a[i] : 0.0;
         const double Omega[3] = {0.6 * w_i, 0.0, 0.8 * w_i};
-        w->status[2 * N + i] = (signed char)rbs_rebound_rng(w->table, w->mix, v, Omega, n + 3 * i, a[i], &rng,
-                                                            RBS_AUTO, RBS_SCALED, w->V_out + 3 * (2 * N + i),
-                                                            w->Omega_out + 3 * (2 * N + i));
+        memcpy(hit.V, v, sizeof hit.V);
+        memcpy(hit.Omega, Omega, sizeof hit.Omega);
+        memcpy(hit.n, n + 3 * i, sizeof hit.n);
+        hit.a = a[i];
+        w->status[2 * N + i] = (signed char)rbs_rebound(w->table, w->mix, &hit, NULL, &result);
+        memcpy(w->V_out + 3 * (2 * N + i), result.V, sizeof result.V);
+        memcpy(w->Omega_out + 3 * (2 * N + i), result.Omega, sizeof result.Omega);
     }
     free(V);
     free(n);
@@ -99,14 +117,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", message);
         return 1;
     }
-    rbs_mix mix;
-    rbs_mix_equal(table, &mix);
+    rbs_mix *mix = rbs_mix_new_equal(table);
+    if (!mix) {
+        fprintf(stderr, "out of memory\n");
+        return 1;
+    }
     pthread_t *ids = malloc((size_t)threads * sizeof *ids);
     work *jobs = malloc((size_t)threads * sizeof *jobs);
     pthread_barrier_t start;
     pthread_barrier_init(&start, NULL, (unsigned)threads);
     for (int t = 0; t < threads; t++) {
-        jobs[t] = make_work(table, &mix, (uint64_t)t, rows);
+        jobs[t] = make_work(table, mix, (uint64_t)t, rows);
         jobs[t].start = &start;
         pthread_create(&ids[t], NULL, draw, &jobs[t]);
     }
@@ -115,7 +136,7 @@ int main(int argc, char **argv)
     int differ = 0;
     size_t rebounded = 0;
     for (int t = 0; t < threads; t++) {
-        work alone = make_work(table, &mix, (uint64_t)t, rows);
+        work alone = make_work(table, mix, (uint64_t)t, rows);
         draw(&alone);
         if (memcmp(alone.V_out, jobs[t].V_out, 9 * rows * sizeof(double)) != 0
             || memcmp(alone.Omega_out, jobs[t].Omega_out, 9 * rows * sizeof(double)) != 0
@@ -123,7 +144,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "stream %d: the threaded draws differ from the draws of one thread\n", t);
             differ++;
         }
-        for (size_t i = 0; i < 3 * rows; i++) rebounded += alone.status[i] == RBS_REBOUNDED;
+        for (size_t i = 0; i < 3 * rows; i++) rebounded += alone.status[i] == RBS_OK;
         free_work(&alone);
         free_work(&jobs[t]);
     }
@@ -131,6 +152,7 @@ int main(int argc, char **argv)
            rebounded, differ);
     free(ids);
     free(jobs);
+    rbs_mix_free(mix);
     rbs_table_close(table);
     return differ == 0 && rebounded > 0 ? 0 : 1;
 }

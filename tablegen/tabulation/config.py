@@ -51,15 +51,13 @@ from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_fo
 from direct_model.registry import FAMILIES, ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from tablegen.tabulation.config_error import ConfigError
+from tablegen.tabulation.shape_config import parse_shape_sections
 
 PRESETS = ("default", "production", "paper")
 MAX_GRID_POINTS = 1000      # per axis: far beyond any useful table, small enough to check before allocating
 MAX_SEED = 2 ** 63          # seeds are 63-bit (numpy SeedSequence entropy, HDF5 uint64 attribute)
 GRID_ROUNDING = 1e-9        # a {start, stop, step} grid keeps a stop that round-off puts just past it
-
-
-class ConfigError(ValueError):
-    """An invalid build configuration; the message names the offending key."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -251,7 +249,6 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
         raise ConfigError(f"{source}: 'grid.shapes' has duplicates: {shapes!r}")
     grains = {}
     if sections:
-        from tablegen.tabulation.shape_config import parse_shape_sections     # here: it imports ConfigError
         grains = parse_shape_sections(sections, Path.cwd() if base_dir is None else base_dir, source, log,
                                       used=shapes)
 

@@ -324,9 +324,7 @@ def _assemble(config: BuildConfig, checkpoint: Checkpoint) -> ReboundTable:
     return ReboundTable(
         alpha1_deg=np.array(config.alpha1_deg), speed_m_s=np.array(config.speed_m_s), shapes=config.shapes,
         resolution=config.resolution, cells=cells, kappa=config.kappa, n_max=config.n_max,
-        restitution_k=config.wall.k, restitution_p=config.wall.p, friction_q=config.wall.q,
-        wall_law=config.wall.name,
-        aspect_ratio=(config.aspect.mean, config.aspect.sd, config.aspect.low, config.aspect.high),
+        wall=config.wall, aspect_ratio=(config.aspect.mean, config.aspect.sd, config.aspect.low, config.aspect.high),
         contact_tol=DEFAULT_CONTACT_TOL, set_tol=DEFAULT_SET_TOL, max_steps=DEFAULT_MAX_STEPS,
         second_moment_factors=tuple(second_moment_factors(config.kappa)),
         particles_per_cell=config.particles_per_cell, config_text=config.to_toml(),

@@ -51,8 +51,8 @@ def describe_table(table: ReboundTable, path: Path | None = None) -> str:
         f"speed (m/s):  {_grid(table.speed_m_s)}",
         f"shapes: {len(table.shapes)} (cut_prism kappa = {table.kappa:g}); n_max = {table.n_max}",
         *(f"  {_shape(record)}" for record in table.shape_records()),
-        f"wall law: {table.wall_law or 'not recorded'} (k = {table.restitution_k:g}, p = {table.restitution_p:g}, "
-        f"q = {table.friction_q:g})",
+        f"wall: {table.wall.name} ({table.wall.family} law: "
+        + ", ".join(f"{name} = {value:g}" for name, value in table.wall.parameters().items()) + ")",
         f"cells: {total.size}, {table.particles_per_cell} particles each",
         "resolution: " + ", ".join(f"{f.name} {getattr(table.resolution, f.name)}"
                                    for f in dataclasses.fields(table.resolution)),

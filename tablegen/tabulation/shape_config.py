@@ -32,7 +32,7 @@ from pathlib import Path
 
 from direct_model.registry import ShapeError, check_name
 from direct_model.shapes import AspectRatioLaw
-from tablegen.tabulation.config import ConfigError
+from tablegen.tabulation.config_error import ConfigError
 from tablegen.tabulation.grain_files import GrainError, canonical_grain, grain_from_mesh, grain_from_points
 
 SHAPE_KEYS = ("mesh", "vertices", "triangles", "aspect_ratio", "both_hands")

@@ -6,7 +6,7 @@ import h5py
 import numpy as np
 import pytest
 
-from data_schema.table import table_fingerprint
+from data_schema.table import read_table, table_fingerprint
 from tests.helpers.tables import edited_copy
 
 
@@ -26,12 +26,17 @@ def test_build_time_host_and_descriptions_do_not_enter(small_table_path, fingerp
 
 
 def test_every_dataset_and_law_attribute_enters(small_table_path, fingerprint, tmp_path):
-    """One element of every dataset (the shapes' records of format 3.4 too), one bit of every grid and resolution
-    attribute, the root's recipe: each change gives another fingerprint."""
+    """One element of every dataset (the shapes' records too), every field of the parameter rows of groups model
+    and wall, one bit of every grid, resolution and wall attribute, the root's recipe: each change gives another
+    fingerprint."""
     with h5py.File(small_table_path, "r") as f:
         datasets = [f"{group}/{name}" for group in ("grid", "cells", "shapes") for name in f[group]]
-        attributes = [(group, name) for group in ("grid", "resolution") for name in f[group].attrs]
-    assert len(datasets) == 27 and "shapes/vertices" in datasets and ("grid", "kappa") in attributes and ("grid", "aspect_ratio_sd") in attributes
+        fields = [(f"{group}/parameters", name) for group in ("model", "wall")
+                  for name in f[group]["parameters"].dtype.names]
+        attributes = [(group, name) for group in ("grid", "resolution", "wall") for name in f[group].attrs]
+    assert len(datasets) == 26 and "shapes/vertices" in datasets and "grid/shape_codes" in datasets
+    assert len(fields) == 13 and ("model/parameters", "aspect_ratio_sd") in fields and ("wall/parameters", "q") in fields
+    assert ("wall", "family") in attributes and ("wall", "name") in attributes and ("grid", "particles_per_cell") in attributes
     seen = {fingerprint}
 
     def change_dataset(name):
@@ -42,15 +47,42 @@ def test_every_dataset_and_law_attribute_enters(small_table_path, fingerprint, t
             f[name][...] = values
         return edit
 
+    def change_field(name, field):
+        def edit(f):
+            values = f[name][()]
+            values[field] = values[field] * 0.5 + 1
+            f[name][...] = values
+        return edit
+
     def change_attribute(group, name):
         def edit(f):
             value = np.asarray(f[group].attrs[name])
             f[group].attrs[name] = "another" if value.dtype.kind in "OSU" else value + 1
         return edit
 
-    edits = [change_dataset(name) for name in datasets] + [change_attribute(*pair) for pair in attributes]
+    edits = [change_dataset(name) for name in datasets] + [change_field(*pair) for pair in fields]
+    edits += [change_attribute(*pair) for pair in attributes]
     edits += [lambda f: f.attrs.__setitem__("master_seed", np.uint64(12)),
               lambda f: f.attrs.__setitem__("config", str(f.attrs["config"]) + "\n")]
     for i, edit in enumerate(edits):
         seen.add(table_fingerprint(edited_copy(small_table_path, tmp_path, f"edit_{i}.h5", edit)))
     assert len(seen) == len(edits) + 1
+
+
+def test_the_fields_order_in_a_parameter_row_does_not_enter(small_table_path, fingerprint, tmp_path):
+    """The parameter rows are read by field name: the same values in another field order give the same table and
+    the same fingerprint."""
+    def reorder(f):
+        for group in ("model", "wall"):
+            row = f[group]["parameters"][()]
+            names = list(reversed(row.dtype.names))
+            turned = np.zeros(1, dtype=[(n, row.dtype[n]) for n in names])
+            for n in names:
+                turned[n] = row[n]
+            del f[group]["parameters"]
+            f[group].create_dataset("parameters", data=turned, chunks=(1,), fletcher32=True)
+
+    path = edited_copy(small_table_path, tmp_path, "reordered.h5", reorder)
+    assert table_fingerprint(path) == fingerprint
+    before, after = read_table(small_table_path), read_table(path)
+    assert after.wall == before.wall and after.model_parameters() == before.model_parameters()

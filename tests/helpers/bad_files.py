@@ -9,7 +9,7 @@ import numpy as np
 
 from tests.helpers import python_side as py
 from tests.helpers.native_library import ERR_FORMAT, ERR_IO, ERR_VERSION, OK
-from tests.helpers.tables import edited_copy
+from tests.helpers.tables import edited_copy, format_3_copy
 
 
 def _replace(f, name, values, **options):
@@ -90,15 +90,15 @@ def bad_tables(good, folder) -> list:
             f.attrs["format_version"] = np.array([major, minor], dtype=np.int64)
         return edit
 
-    cases.append((edited_copy(good, folder, "v4.h5", version(4, 0)), ERR_VERSION, "4.0"))
+    cases.append((edited_copy(good, folder, "v5.h5", version(5, 0)), ERR_VERSION, "5.0"))
     cases.append((edited_copy(good, folder, "v2.h5", version(2, 1)), ERR_VERSION, "2.1"))
-    cases.append((edited_copy(good, folder, "v3_9.h5", version(3, 9)), OK, ""))
-
-    def format_3_1(f):      # a table written before 3.2: no checksummed copies of the law's attributes
-        version(3, 1)(f)
-        del f["grid/law"], f["grid/shape_codes"], f["shapes"]
-
-    cases.append((edited_copy(good, folder, "v3_1.h5", format_3_1), OK, ""))
+    cases.append((edited_copy(good, folder, "v4_9.h5", version(4, 9)), OK, ""))
+    # a table of format 3 (before rebound-scatter 1.0): refused, saying how to rebuild it
+    old = format_3_copy(good, folder, "v3_4.h5")
+    cases.append((old, ERR_VERSION, f"table format 3.4 was written before rebound-scatter 1.0, which reads format 4; "
+                                    f"rebuild it from the configuration it stores: tablegen info --config {old} > "
+                                    f"TABLE.toml && tablegen build --config TABLE.toml -o NEW.h5"))
+    cases.append((edited_copy(good, folder, "v3_1.h5", version(3, 1)), ERR_VERSION, "table format 3.1 was written"))
     cases.append((edited_copy(good, folder, "no_version.h5", lambda f: f.attrs.__delitem__("format_version")),
                   ERR_FORMAT, "format_version"))
     cases.append((edited_copy(good, folder, "no_mean.h5", lambda f: f["cells"].__delitem__("mean")), ERR_FORMAT,
@@ -109,13 +109,12 @@ def bad_tables(good, folder) -> list:
                   "resolution"))
     cases.append((edited_copy(good, folder, "wrong_shape.h5",
                         lambda f: _replace(f, "cells/std", f["cells/std"][()][..., :5])), ERR_FORMAT, "cells/std"))
-    cases.append((edited_copy(good, folder, "no_wall_law.h5", lambda f: f["grid"].attrs.__delitem__("restitution_k")),
-                  ERR_FORMAT, "restitution_k"))
-    cases.append((edited_copy(good, folder, "no_kappa.h5", lambda f: f["grid"].attrs.__delitem__("kappa")), ERR_FORMAT,
-                  "kappa"))
+    cases.append((edited_copy(good, folder, "no_wall_row.h5", lambda f: f["wall"].__delitem__("parameters")),
+                  ERR_FORMAT, "wall/parameters"))
+    cases.append((edited_copy(good, folder, "no_kappa.h5", _row_edit("model", drop="kappa")), ERR_FORMAT, "kappa"))
     cases.append((edited_copy(good, folder, "no_config.h5", lambda f: f.attrs.__delitem__("config")), ERR_FORMAT, "config"))
-    cases.append((edited_copy(good, folder, "no_law_copy.h5", lambda f: f["grid"].__delitem__("law")), ERR_FORMAT,
-                  "grid/law"))
+    cases.append((edited_copy(good, folder, "no_codes.h5", lambda f: f["grid"].__delitem__("shape_codes")), ERR_FORMAT,
+                  "grid/shape_codes"))
     cases.append((edited_copy(good, folder, "nan_std.h5", _set("cells/std", (0, 0, 0, 2), np.nan)), ERR_FORMAT, "cells/std"))
     cases.append((edited_copy(good, folder, "negative_std.h5", _set("cells/std", (0, 0, 0, 2), -0.01)), ERR_FORMAT,
                   "cells/std"))
@@ -157,17 +156,90 @@ def bad_tables(good, folder) -> list:
         _replace(f, "grid/shapes", np.array(names, dtype=h5py.string_dtype()))
 
     cases.append((edited_copy(good, folder, "swapped_shapes.h5", swapped), ERR_FORMAT, "grid/shapes"))
-    for name, value in (("restitution_p", 0.0), ("restitution_p", -0.61), ("restitution_k", np.nan)):
-        cases.append((edited_copy(good, folder, f"{name}_{value}.h5", _attribute("grid", name, value)), ERR_FORMAT, name))
-
-    def flipped_p(f):       # one flipped bit of restitution_p (0.61 → 1.22) changed the law and loaded
-        f["grid"].attrs["restitution_p"] = _flip_bit(float(f["grid"].attrs["restitution_p"]), 52)
-
-    cases.append((edited_copy(good, folder, "flipped_p.h5", flipped_p), ERR_FORMAT, "grid/law"))
+    for name, value in (("p", 0.0), ("p", -0.61), ("k", np.nan)):
+        cases.append((edited_copy(good, folder, f"wall_{name}_{value}.h5", _row_edit("wall", **{name: value})),
+                      ERR_FORMAT, f"field '{name}' of dataset 'wall/parameters'"))
     checksum = edited_copy(good, folder, "checksum.h5")
     _corrupt_checksummed(checksum)
     cases.append((checksum, ERR_FORMAT, "cells/cluster_loc"))
-    for name in ("cells/indicatrix_2d", "cells/indicatrix_3d", "cells/collision_counts", "grid/law"):
+    # a flipped bit of a parameter row (of p: 0.61 → 1.22 would change the law) fails its checksum
+    for name in ("cells/indicatrix_2d", "cells/indicatrix_3d", "cells/collision_counts", "grid/shape_codes",
+                 "wall/parameters", "model/parameters"):
         path = _corrupt_chunk(edited_copy(good, folder, f"checksum_{name.replace('/', '_')}.h5"), name)
         cases.append((path, ERR_FORMAT, name))
     return cases
+
+
+def _row_edit(group, drop=None, dtype=None, **values):
+    """An edit of ``group/parameters`` (one compound row): field ``drop`` left out, fields of ``dtype`` (a
+    {name: dtype}) stored as that type, the fields of ``values`` set; rewritten chunked (1,) under Fletcher-32."""
+    def edit(f):
+        row = f[group]["parameters"][()]
+        types = {name: row.dtype[name] for name in row.dtype.names if name != drop}
+        types.update(dtype or {})
+        new = np.zeros(1, dtype=[(name, t) for name, t in types.items()])
+        for name in types:
+            new[name] = values.get(name, row[name]) if np.dtype(types[name]).kind not in "OSU" else b"0.61"
+        del f[group]["parameters"]
+        f[group].create_dataset("parameters", data=new, chunks=(1,), fletcher32=True)
+    return edit
+
+
+def _replace_row(group, data):
+    def edit(f):
+        del f[group]["parameters"]
+        f[group].create_dataset("parameters", data=data)
+    return edit
+
+
+def parameter_row_cases(good, folder) -> list:
+    """(path, expected C code, the message after "PATH: ") for each fault of the rows /wall/parameters and
+    /model/parameters and of the wall's attributes: the two loaders give the same message, word for word."""
+    folder.mkdir(parents=True, exist_ok=True)
+    wall, model = "dataset 'wall/parameters'", "dataset 'model/parameters'"
+    model_fields = ("kappa, n_max, aspect_ratio_mean, aspect_ratio_sd, aspect_ratio_low, aspect_ratio_high, "
+                    "contact_tol, set_tol, max_steps, second_moment_factors")
+    specs = [
+        ("no_wall", lambda f: f.__delitem__("wall"), "missing group 'wall'"),
+        ("no_model", lambda f: f.__delitem__("model"), "missing group 'model'"),
+        ("no_wall_row", lambda f: f["wall"].__delitem__("parameters"), f"missing {wall}"),
+        ("no_family", lambda f: f["wall"].attrs.__delitem__("family"), "missing attribute 'family' of group 'wall'"),
+        ("no_wall_name", lambda f: f["wall"].attrs.__delitem__("name"), "missing attribute 'name' of group 'wall'"),
+        ("numeric_family", _attribute("wall", "family", 3.0),
+         "cannot read the attribute 'family' of group 'wall' as a string"),
+        ("unknown_family", _attribute("wall", "family", "linear"),
+         "the attribute 'family' of group 'wall' names an unknown wall law family 'linear' (this version knows: "
+         "exponential)"),
+        ("no_q", _row_edit("wall", drop="q"), f"{wall} has no field 'q'; the fields read: k, p, q (the exponential "
+                                              f"wall law)"),
+        ("p_zero", _row_edit("wall", p=0.0), f"field 'p' of {wall} must be finite and > 0; got 0"),
+        ("p_negative", _row_edit("wall", p=-0.61),
+         f"field 'p' of {wall} must be finite and > 0; got -0.60999999999999999"),
+        ("k_nan", _row_edit("wall", k=np.nan), f"field 'k' of {wall} must be finite and > 0; got nan"),
+        ("q_inf", _row_edit("wall", q=np.inf), f"field 'q' of {wall} must be finite; got inf"),
+        ("p_string", _row_edit("wall", dtype={"p": "S8"}), f"field 'p' of {wall} must be stored as one number"),
+        ("wall_not_compound", _replace_row("wall", np.array([0.1, 0.61, 1.0])),
+         f"{wall} must hold one row of a compound type, one field per parameter"),
+        ("wall_two_rows", _replace_row("wall", np.zeros(2, dtype=[("k", "<f8"), ("p", "<f8"), ("q", "<f8")])),
+         f"{wall} must hold one row of a compound type, one field per parameter"),
+        ("no_kappa", _row_edit("model", drop="kappa"), f"{model} has no field 'kappa'; the fields read: {model_fields}"),
+        ("kappa_one", _row_edit("model", kappa=1.0), f"field 'kappa' of {model} must be in [0, 1); got 1"),
+        ("n_max_real", _row_edit("model", dtype={"n_max": "<f8"}), f"field 'n_max' of {model} must be stored as one "
+                                                                   f"integer"),
+        ("n_max_zero", _row_edit("model", n_max=0), f"field 'n_max' of {model} must be an integer in [1, 2**53); got 0"),
+        ("sd_zero", _row_edit("model", aspect_ratio_sd=0.0), f"field 'aspect_ratio_sd' of {model} must be finite and "
+                                                             f"> 0; got 0"),
+        ("high_below_low", _row_edit("model", aspect_ratio_high=0.4),
+         f"field 'aspect_ratio_high' of {model} must be in (aspect_ratio_low, 1]; got 0.40000000000000002"),
+        ("contact_tol_zero", _row_edit("model", contact_tol=0.0), f"field 'contact_tol' of {model} must be finite and "
+                                                                  f"> 0; got 0"),
+        ("max_steps_zero", _row_edit("model", max_steps=0), f"field 'max_steps' of {model} must be an integer in "
+                                                            f"[1, 2**53); got 0"),
+        ("kfac_three", _row_edit("model", dtype={"second_moment_factors": ("<f8", (3,))},
+                                 second_moment_factors=[0.2, 0.3, 0.3]),
+         f"field 'second_moment_factors' of {model} must be stored as 4 numbers"),
+        ("kfac_out", _row_edit("model", second_moment_factors=[0.2, 0.33, 1.5, 0.2]),
+         f"field 'second_moment_factors' of {model} must be 4 numbers in (0, 1), one per shape code; got 1.5 at "
+         f"index 2"),
+    ]
+    return [(edited_copy(good, folder, f"row_{name}.h5", edit), ERR_FORMAT, message) for name, edit, message in specs]

@@ -1,8 +1,14 @@
 """Building the native library with CMake and driving it through ctypes (the tests' side of it).
 
-:func:`build` configures and builds ``native/`` into a folder; :class:`Native` loads the shared library
-and wraps the functions the tests call, on NumPy arrays. Nothing here imports the Python packages: the
-Python side of every comparison comes through :mod:`tests.helpers.python_side`.
+:func:`build` configures and builds ``native/`` into a folder; :class:`Native` loads the public shared library
+(``librebound_scatter.so``: the names of native/include/rebound_scatter.h and nothing else) and wraps the functions
+the tests call, on NumPy arrays; ``Native.internal`` is a second handle, on the test-only library of the same
+sources (``librebound_scatter_testing.so``, built with RBS_BUILD_TESTS), for the internal functions the tests
+compare piece by piece (the direct model's kernels, the free flight, the table path and the direct path alone).
+The records of the header (rbs_hit, rbs_options, rbs_result, ...) are mirrored as ctypes Structures below, each
+created with its ``size`` set to its ctypes.sizeof, as the header's RBS_*_INIT set it (test_native_api.py checks
+the layouts against the header). Nothing here imports the Python packages: the Python side of every comparison
+comes through :mod:`tests.helpers.python_side`.
 """
 
 from __future__ import annotations
@@ -10,7 +16,6 @@ from __future__ import annotations
 import ctypes
 import os
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -18,16 +23,40 @@ import numpy as np
 from tests.helpers import REPO, background
 
 NATIVE = REPO / "native"
+HEADER = NATIVE / "include" / "rebound_scatter.h"
 INSTALL_HINT = ("run native/install-deps.sh (as root on Debian/Ubuntu it installs gcc, g++, cmake, libhdf5-dev, "
                 "gfortran and pkg-config; elsewhere it prints what to install)")
 
-U_PER_DRAW = 13
-MAX_SHAPES = 4
-SCALED, STOCHASTIC = 0, 1
-AUTO, TABLE, DIRECT = 0, 1, 2           # RBS_AUTO, RBS_TABLE, RBS_DIRECT
-PATH_TABLE, PATH_DIRECT = 0, 1          # RBS_PATH_TABLE, RBS_PATH_DIRECT
-INVALID = -1                            # RBS_INVALID
-OK, ERR_IO, ERR_FORMAT, ERR_VERSION, ERR_ARGUMENT, ERR_MEMORY = range(6)
+U_PER_DRAW = 13                         # RBS_U_PER_DRAW
+BLOCK = 32                              # RBS_BLOCK
+LOCAL_SIZE = 6                          # RBS_LOCAL_SIZE
+NO_KEY = -1                             # RBS_NO_KEY
+VERSION_NUMBER = 1_000_000              # RBS_VERSION_NUMBER of 1.0.0
+
+# rbs_status: one status space (the hits' codes are surrogate's STATUS_*)
+OK, TRAPPED, FAILED = 0, 1, 2
+INVALID, ERR_IO, ERR_FORMAT, ERR_VERSION, ERR_MEMORY = -1, -2, -3, -4, -5
+STATUSES = {"RBS_OK": OK, "RBS_TRAPPED": TRAPPED, "RBS_FAILED": FAILED, "RBS_INVALID": INVALID,
+            "RBS_ERR_IO": ERR_IO, "RBS_ERR_FORMAT": ERR_FORMAT, "RBS_ERR_VERSION": ERR_VERSION,
+            "RBS_ERR_MEMORY": ERR_MEMORY}
+# rbs_method, rbs_path, rbs_interpolation, rbs_family, rbs_kind, rbs_dtype
+METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
+PATH_NONE, PATH_TABLE, PATH_DIRECT = -1, 0, 1
+INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC = 0, 1
+FAMILY_NONE, FAMILY_ELLIPSOID, FAMILY_PRISM, FAMILY_CUT_PRISM, FAMILY_TETRAHEDRON = -1, 0, 1, 2, 3
+KIND_SMOOTH, KIND_POLYHEDRON = 0, 1
+DTYPE_FLOAT64, DTYPE_FLOAT32 = 0, 1
+ENUMS = {"rbs_status": STATUSES,
+         "rbs_method": {"RBS_METHOD_AUTO": METHOD_AUTO, "RBS_METHOD_TABLE": METHOD_TABLE,
+                        "RBS_METHOD_DIRECT": METHOD_DIRECT},
+         "rbs_path": {"RBS_PATH_NONE": PATH_NONE, "RBS_PATH_TABLE": PATH_TABLE, "RBS_PATH_DIRECT": PATH_DIRECT},
+         "rbs_interpolation": {"RBS_INTERPOLATION_SCALED": INTERPOLATION_SCALED,
+                               "RBS_INTERPOLATION_STOCHASTIC": INTERPOLATION_STOCHASTIC},
+         "rbs_family": {"RBS_FAMILY_NONE": FAMILY_NONE, "RBS_FAMILY_ELLIPSOID": FAMILY_ELLIPSOID,
+                        "RBS_FAMILY_PRISM": FAMILY_PRISM, "RBS_FAMILY_CUT_PRISM": FAMILY_CUT_PRISM,
+                        "RBS_FAMILY_TETRAHEDRON": FAMILY_TETRAHEDRON},
+         "rbs_kind": {"RBS_KIND_SMOOTH": KIND_SMOOTH, "RBS_KIND_POLYHEDRON": KIND_POLYHEDRON},
+         "rbs_dtype": {"RBS_DTYPE_FLOAT64": DTYPE_FLOAT64, "RBS_DTYPE_FLOAT32": DTYPE_FLOAT32}}
 
 
 class BuildError(RuntimeError):
@@ -45,7 +74,7 @@ def missing_tools(fortran: bool = True, cxx: bool = True) -> list:
     return missing
 
 
-def run(command, cwd=None, env=None, timeout=600) -> subprocess.CompletedProcess:
+def run(command, cwd=None, env=None, timeout=600):
     # background.run: a build started with the session is killed with it (tests.helpers.background.stop)
     return background.run(command, cwd=cwd, env=env, timeout=timeout)
 
@@ -55,7 +84,8 @@ def build(folder: Path, options: dict, targets=None) -> Path:
     BuildError with CMake's output (and the install hint) on failure."""
     folder.mkdir(parents=True, exist_ok=True)
     configure = ["cmake", "-S", str(NATIVE), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release", "-DRBS_WERROR=ON"]
-    configure += [f"-D{k}={v}" for k, v in options.items()]
+    # RBS_BUILD_TESTS: the test library too (librebound_scatter_testing.so, every internal function exported)
+    configure += [f"-D{k}={v}" for k, v in {"RBS_BUILD_TESTS": "ON", **options}.items()]
     done = run(configure)
     if done.returncode != 0:
         raise BuildError(f"CMake could not configure native/ ({INSTALL_HINT}):\n{done.stdout[-3000:]}\n"
@@ -69,47 +99,128 @@ def build(folder: Path, options: dict, targets=None) -> Path:
     return folder
 
 
-_d = ctypes.POINTER(ctypes.c_double)
+# ---------------------------------------------------------------- the header's records
 
-
-class Mix(ctypes.Structure):
-    _fields_ = [("n_shapes", ctypes.c_int), ("cdf", ctypes.c_double * MAX_SHAPES)]
-
-
-class ShapeInfo(ctypes.Structure):
-    _fields_ = [("name", ctypes.c_char_p), ("kind", ctypes.c_int), ("family", ctypes.c_int),
-                ("n_vertices", ctypes.c_int), ("vertices", ctypes.POINTER(ctypes.c_double)),
-                ("inertia", ctypes.c_double * 3), ("aspect", ctypes.c_double * 4), ("both_hands", ctypes.c_int),
-                ("direct_shape", ctypes.c_int)]
-
-
-class OwnedMix:
-    """A mix of rbs_mix_new_* (sized by the table), freed with rbs_mix_free on garbage collection."""
-
-    def __init__(self, lib, pointer):
-        self.lib, self.pointer = lib, pointer
-
-    @property
-    def n_shapes(self) -> int:
-        return self.pointer.contents.n_shapes
-
-    def __del__(self):
-        if self.pointer:
-            self.lib.c.rbs_mix_free(self.pointer)
-            self.pointer = None
-
-
-def _mix_ref(mix):
-    """What a draw takes for a mix: the pointer of an :class:`OwnedMix`, or a value :class:`Mix` by reference."""
-    return mix.pointer if isinstance(mix, OwnedMix) else ctypes.byref(mix)
+_d3 = ctypes.c_double * 3
+_vp = ctypes.c_void_p
 
 
 class Rng(ctypes.Structure):
+    """rbs_rng: one xoshiro256+ state."""
+
     _fields_ = [("s", ctypes.c_uint64 * 4)]
 
 
+class Record(ctypes.Structure):
+    """A record of the header that begins with ``size_t size``: created with its size set to its own ctypes.sizeof
+    (what the header's RBS_*_INIT does), unless ``size`` is given."""
+
+    _fields_ = [("size", ctypes.c_size_t)]
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        if not args and "size" not in kwargs:
+            self.size = ctypes.sizeof(type(self))
+
+    @classmethod
+    def grown(cls, extra: int = 24):
+        """The record as a later header might declare it: ``extra`` bytes of new fields at its end (``later``)."""
+        return type(f"{cls.__name__}Grown", (cls,), {"_fields_": [("later", ctypes.c_uint8 * extra)]})
+
+
+class Hit(Record):
+    """rbs_hit (RBS_HIT_INIT: no grain key)."""
+
+    _fields_ = [("V", _d3), ("Omega", _d3), ("n", _d3), ("a", ctypes.c_double), ("grain_key", ctypes.c_int64),
+                ("u", ctypes.POINTER(ctypes.c_double)), ("rng", ctypes.POINTER(Rng))]
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("grain_key", NO_KEY)
+        super().__init__(*args, **kwargs)
+
+
+class Options(Record):
+    """rbs_options (RBS_OPTIONS_INIT: auto, scaled)."""
+
+    _fields_ = [("method", ctypes.c_int), ("interpolation", ctypes.c_int)]
+
+
+class Result(Record):
+    """rbs_result (RBS_RESULT_INIT)."""
+
+    _fields_ = [("status", ctypes.c_int), ("path", ctypes.c_int), ("shape", ctypes.c_int),
+                ("n_collisions", ctypes.c_int), ("V", _d3), ("Omega", _d3)]
+
+    def __init__(self, *args, **kwargs):
+        for name, value in (("status", INVALID), ("path", PATH_NONE), ("shape", -1), ("n_collisions", -1)):
+            kwargs.setdefault(name, value)
+        super().__init__(*args, **kwargs)
+
+
+class Hits(Record):
+    """rbs_hits."""
+
+    _fields_ = [("count", ctypes.c_size_t), ("V", _vp), ("n", _vp), ("a", _vp), ("u", _vp), ("rng", _vp)]
+
+
+class Results(Record):
+    """rbs_results."""
+
+    _fields_ = [("V", _vp), ("Omega", _vp), ("status", _vp)]
+
+
+class TableInfo(Record):
+    """rbs_table_info."""
+
+    _fields_ = [(name, ctypes.c_int) for name in ("n_shapes", "n_alpha1", "n_speed", "n_clusters", "n_levels",
+                                                    "n_dictionary", "n_pieces", "format_major", "format_minor")] + \
+        [("particles_per_cell", ctypes.c_longlong), ("n_max", ctypes.c_longlong),
+         ("alpha1_min_deg", ctypes.c_double), ("alpha1_max_deg", ctypes.c_double),
+         ("speed_min_m_s", ctypes.c_double), ("speed_max_m_s", ctypes.c_double), ("kernel_bytes", ctypes.c_size_t)]
+
+
+class ShapeInfo(Record):
+    """rbs_shape_info."""
+
+    _fields_ = [("name", ctypes.c_char_p), ("kind", ctypes.c_int), ("family", ctypes.c_int),
+                ("n_vertices", ctypes.c_int), ("vertices", ctypes.POINTER(ctypes.c_double)),
+                ("inertia", _d3), ("aspect", ctypes.c_double * 4), ("both_hands", ctypes.c_int)]
+
+
+class WallInfo(Record):
+    """rbs_wall_info."""
+
+    _fields_ = [("family", ctypes.c_char_p), ("name", ctypes.c_char_p), ("n_parameters", ctypes.c_int),
+                ("parameter_names", ctypes.POINTER(ctypes.c_char_p)),
+                ("parameter_values", ctypes.POINTER(ctypes.c_double))]
+
+
+class Grain(Record):
+    """rbs_grain (RBS_GRAIN_INIT: shape −1)."""
+
+    _fields_ = [("shape", ctypes.c_int), ("ratio_ba", ctypes.c_double), ("ratio_cb", ctypes.c_double),
+                ("hand", ctypes.c_double)]
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("shape", -1)
+        super().__init__(*args, **kwargs)
+
+
+RECORDS = {"rbs_hit": Hit, "rbs_options": Options, "rbs_result": Result, "rbs_hits": Hits, "rbs_results": Results,
+           "rbs_table_info": TableInfo, "rbs_shape_info": ShapeInfo, "rbs_wall_info": WallInfo, "rbs_grain": Grain}
+
+
+def fields(record) -> list:
+    """The field names of a record class, ``size`` first, as the header declares them."""
+    names = []
+    for klass in reversed(record.__mro__):
+        names += [name for name, _ in vars(klass).get("_fields_", [])]
+    return names
+
+
 class ShapeArrays(ctypes.Structure):
-    """rbs_shape_arrays (native/src/shapes.h): pointers into a direct_model.shape_arrays.ShapeArrays' arrays."""
+    """rbs_shape_arrays (native/src/shapes.h, internal): pointers into a direct_model.shape_arrays.ShapeArrays'
+    arrays."""
 
     FIELDS = ("kind", "vertex_start", "vertices", "second_moments", "aspect", "aspect_cdf", "both_hands")
     _fields_ = [("n_shapes", ctypes.c_int)] + [(name, ctypes.c_void_p) for name in FIELDS]
@@ -121,38 +232,81 @@ class ShapeArrays(ctypes.Structure):
         return cls(len(arrays.kind), *(getattr(arrays, name).ctypes.data for name in cls.FIELDS))
 
 
-class Grain(ctypes.Structure):
-    """rbs_grain (rbs_grain_info)."""
-
-    _fields_ = [("shape", ctypes.c_int), ("direct_shape", ctypes.c_int), ("ratio_ba", ctypes.c_double),
-                ("ratio_cb", ctypes.c_double), ("hand", ctypes.c_double)]
+# ---------------------------------------------------------------- helpers of the calls
 
 
-class Info(ctypes.Structure):
-    _fields_ = [("n_shapes", ctypes.c_int), ("n_alpha1", ctypes.c_int), ("n_speed", ctypes.c_int),
-                ("n_clusters", ctypes.c_int), ("n_levels", ctypes.c_int), ("n_dictionary", ctypes.c_int),
-                ("n_pieces", ctypes.c_int), ("format_major", ctypes.c_int), ("format_minor", ctypes.c_int),
-                ("particles_per_cell", ctypes.c_longlong), ("n_max", ctypes.c_longlong),
-                ("restitution_k", ctypes.c_double), ("restitution_p", ctypes.c_double),
-                ("kernel_bytes", ctypes.c_size_t)]
+def ref(x):
+    """What a pointer argument takes: None (NULL), an address (an int), or a ctypes object by reference (which keeps
+    the object alive for the call, a temporary record too)."""
+    if x is None or isinstance(x, int):
+        return x
+    return ctypes.byref(x)
+
+
+def address(x) -> int | None:
+    """The address of a ctypes object for a pointer field of a record (the caller keeps the object alive)."""
+    return None if x is None else ctypes.addressof(x)
 
 
 def _rng(state) -> Rng:
     return Rng((ctypes.c_uint64 * 4)(*[int(x) for x in state]))
 
 
+def _state(rng: Rng) -> np.ndarray:
+    return np.array(list(rng.s), dtype=np.uint64)
+
+
 def _ptr(a: np.ndarray):
-    return a.ctypes.data_as(ctypes.c_void_p)
+    return a.ctypes.data
+
+
+def _f64(x) -> np.ndarray:
+    return np.ascontiguousarray(x, dtype=np.float64)
+
+
+def options(method=METHOD_AUTO, interpolation=INTERPOLATION_SCALED, record=Options) -> Options:
+    return record(method=method, interpolation=interpolation)
+
+
+def hit(V, Omega, n, a, u=None, rng: Rng | None = None, key: int = NO_KEY, record=Hit):
+    """An rbs_hit (or a ``record`` of its layout grown) and the arrays it points to (keep them while C reads)."""
+    h = record(V=_d3(*_f64(V)), Omega=_d3(*_f64(Omega)), n=_d3(*_f64(n)), a=float(a), grain_key=int(key))
+    kept = None
+    if u is not None:
+        kept = _f64(u)
+        h.u = kept.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    if rng is not None:
+        h.rng = ctypes.pointer(rng)
+    return h, kept
+
+
+class OwnedMix:
+    """An rbs_mix of rbs_mix_new_*, freed with rbs_mix_free on garbage collection (it keeps its table object
+    alive, so that the table is not closed by the collector first)."""
+
+    def __init__(self, table: "NativeTable", pointer: int):
+        self.table, self.pointer = table, pointer
+
+    def __del__(self):
+        if self.pointer:
+            self.table.lib.c.rbs_mix_free(self.pointer)
+            self.pointer = None
+
+
+def _mix_ref(mix):
+    return mix.pointer if isinstance(mix, OwnedMix) else mix
 
 
 class NativeTable:
     """An open rbs_table (closed by :meth:`close` or on garbage collection)."""
 
-    def __init__(self, lib: "Native", handle):
-        self.lib, self.handle = lib, handle
+    def __init__(self, lib: "Native", handle: int, path):
+        self.lib, self.handle, self.path = lib, handle, Path(path)
+        self._single = {}
 
     def close(self):
         if self.handle:
+            self._single.clear()
             self.lib.c.rbs_table_close(self.handle)
             self.handle = None
 
@@ -164,256 +318,288 @@ class NativeTable:
         c = self.lib.c
         return tuple(c.rbs_table_shape_name(self.handle, i).decode() for i in range(c.rbs_table_n_shapes(self.handle)))
 
-    def info(self) -> Info:
-        info = Info()
-        self.lib.c.rbs_table_info_get(self.handle, ctypes.byref(info))
+    def info(self) -> TableInfo:
+        info = TableInfo()
+        assert self.lib.c.rbs_table_info_get(self.handle, ref(info)) == OK
         return info
+
+    def ranges(self):
+        """((α1 first, last) deg, (|V⁻| first, last) m/s) of rbs_table_info."""
+        info = self.info()
+        return (info.alpha1_min_deg, info.alpha1_max_deg), (info.speed_min_m_s, info.speed_max_m_s)
+
+    def grids(self):
+        """(α1 grid, |V⁻| grid) of rbs_table_alpha1_grid, rbs_table_speed_grid, copied."""
+        out = []
+        for function in (self.lib.c.rbs_table_alpha1_grid, self.lib.c.rbs_table_speed_grid):
+            count = ctypes.c_int(-1)
+            data = function(self.handle, ctypes.byref(count))
+            out.append(np.ctypeslib.as_array(data, shape=(count.value,)).copy())
+        return tuple(out)
 
     def kernel_array(self, name: str) -> np.ndarray:
         data, count, dtype = ctypes.c_void_p(), ctypes.c_size_t(), ctypes.c_int()
         code = self.lib.c.rbs_table_kernel_array(self.handle, name.encode(), ctypes.byref(data), ctypes.byref(count),
                                                  ctypes.byref(dtype))
         if code != OK:
+            assert code == INVALID, code
             raise KeyError(name)
-        ctype = ctypes.c_double if dtype.value == 0 else ctypes.c_float
+        ctype = {DTYPE_FLOAT64: ctypes.c_double, DTYPE_FLOAT32: ctypes.c_float}[dtype.value]
         array = np.ctypeslib.as_array(ctypes.cast(data, ctypes.POINTER(ctype)), shape=(count.value,))
         return array.copy()
 
-    def ranges(self):
-        lo, hi, vlo, vhi = (ctypes.c_double() for _ in range(4))
-        self.lib.c.rbs_table_alpha1_range(self.handle, ctypes.byref(lo), ctypes.byref(hi))
-        self.lib.c.rbs_table_speed_range(self.handle, ctypes.byref(vlo), ctypes.byref(vhi))
-        return (lo.value, hi.value), (vlo.value, vhi.value)
+    def shape_info(self, i: int) -> dict | None:
+        """rbs_table_shape_info of shape i as a dict (vertices copied), or None (RBS_INVALID)."""
+        info = ShapeInfo()
+        code = self.lib.c.rbs_table_shape_info(self.handle, i, ref(info))
+        if code != OK:
+            assert code == INVALID, code
+            return None
+        n = info.n_vertices
+        vertices = (np.ctypeslib.as_array(info.vertices, shape=(n, 3)).copy() if n else np.zeros((0, 3)))
+        assert n or not info.vertices
+        return {"name": info.name.decode(), "kind": info.kind, "family": info.family, "vertices": vertices,
+                "inertia": np.array(info.inertia[:]), "aspect": np.array(info.aspect[:]),
+                "both_hands": info.both_hands}
+
+    def wall(self) -> dict:
+        """rbs_table_wall as a dict: family, name, parameters {name: value}."""
+        info = WallInfo()
+        assert self.lib.c.rbs_table_wall(self.handle, ref(info)) == OK
+        names = [info.parameter_names[i].decode() for i in range(info.n_parameters)]
+        values = [info.parameter_values[i] for i in range(info.n_parameters)]
+        return {"family": info.family.decode(), "name": info.name.decode(), "parameters": dict(zip(names, values)),
+                "n_parameters": info.n_parameters}
 
     # -- mixes
-    def mix_equal(self) -> Mix:
-        mix = Mix()
-        assert self.lib.c.rbs_mix_equal(self.handle, ctypes.byref(mix)) == OK
-        return mix
-
-    def mix_from_weights(self, weights: dict):
-        mix, message = Mix(), ctypes.create_string_buffer(1024)
-        names = (ctypes.c_char_p * max(1, len(weights)))(*[k.encode() for k in weights])
-        values = np.ascontiguousarray(list(weights.values()) or [0.0], dtype=np.float64)
-        code = self.lib.c.rbs_mix_from_weights(self.handle, len(weights), names, _ptr(values), ctypes.byref(mix),
-                                               message, len(message))
-        return code, mix, message.value.decode()
-
-    def mix_from_shape(self, name: str):
-        mix, message = Mix(), ctypes.create_string_buffer(1024)
-        code = self.lib.c.rbs_mix_from_shape(self.handle, name.encode(), ctypes.byref(mix), message, len(message))
-        return code, mix, message.value.decode()
-
     def mix_new(self, shape="mix", weights: dict | None = None):
         """(OwnedMix or None, message): rbs_mix_new_from_weights with ``weights``, else rbs_mix_new_from_shape
-        (``"mix"``: rbs_mix_new_equal)."""
+        (``"mix"`` there gives the equal mix; ``shape=None``: rbs_mix_new_equal)."""
         c, message = self.lib.c, ctypes.create_string_buffer(1024)
         if weights is not None:
             names = (ctypes.c_char_p * max(1, len(weights)))(*[k.encode() for k in weights])
             values = np.ascontiguousarray(list(weights.values()) or [0.0], dtype=np.float64)
             pointer = c.rbs_mix_new_from_weights(self.handle, len(weights), names, _ptr(values), message,
                                                  len(message))
-        elif shape == "mix":
+        elif shape is None:
             pointer = c.rbs_mix_new_equal(self.handle)
         else:
             pointer = c.rbs_mix_new_from_shape(self.handle, shape.encode(), message, len(message))
-        return (OwnedMix(self.lib, pointer) if pointer else None), message.value.decode()
+        return (OwnedMix(self, pointer) if pointer else None), message.value.decode()
 
-    def shape_info(self, i: int) -> dict | None:
-        """rbs_table_shape_info of shape i as a dict (vertices copied), or None (RBS_ERR_ARGUMENT)."""
-        info = ShapeInfo()
-        if self.lib.c.rbs_table_shape_info(self.handle, i, ctypes.byref(info)) != OK:
-            return None
-        n = info.n_vertices
-        vertices = (np.ctypeslib.as_array(info.vertices, shape=(n, 3)).copy() if n else np.zeros((0, 3)))
-        return {"name": info.name.decode(), "kind": info.kind, "family": info.family, "vertices": vertices,
-                "inertia": np.array(info.inertia[:]), "aspect": np.array(info.aspect[:]),
-                "both_hands": info.both_hands, "direct_shape": info.direct_shape}
+    def mix(self, spec="mix") -> OwnedMix:
+        """The mix of a spec as surrogate.mix_cdf takes it: a dict of weights, a shape's name, or "mix" (the equal
+        mix, rbs_mix_new_equal); fails the test if the library refuses it."""
+        mix, message = self.mix_new(weights=spec) if isinstance(spec, dict) else \
+            self.mix_new(None if spec == "mix" else spec)
+        assert mix is not None, message
+        return mix
 
-    # -- draws
-    def table_rebound(self, mix, V, n, a, u, interpolation=SCALED):
-        V, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, u))
-        V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_table_rebound(self.handle, _mix_ref(mix), _ptr(V), _ptr(n), ctypes.c_double(a),
-                                              _ptr(u), interpolation, _ptr(V_out), _ptr(W_out))
-        return status, V_out, W_out
-
-    def table_rebound_many(self, mix, V, n, a, u, interpolation=SCALED):
-        V, n, a, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a, u))
-        count = V.shape[0]
-        assert n.shape == (count, 3) and a.shape == (count,) and u.shape == (count, U_PER_DRAW)
-        V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        self.lib.c.rbs_table_rebound_many(self.handle, _mix_ref(mix), ctypes.c_size_t(count), _ptr(V), _ptr(n),
-                                          _ptr(a), _ptr(u), interpolation, _ptr(V_out), _ptr(W_out), _ptr(status))
-        return status, V_out, W_out
-
-    def table_rebound_many_rng(self, mix, V, n, a, state: np.ndarray, interpolation=SCALED):
-        """Returns (status, V_out, W_out, advanced state)."""
-        V, n, a = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, a))
-        count = V.shape[0]
-        rng = _rng(state)
-        V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
-        self.lib.c.rbs_table_rebound_many_rng(self.handle, _mix_ref(mix), ctypes.c_size_t(count), _ptr(V),
-                                              _ptr(n), _ptr(a), ctypes.byref(rng), interpolation, _ptr(V_out),
-                                              _ptr(W_out), _ptr(status))
-        return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
-
-    def direct_rebound(self, shape: int, V, Omega, n, a: float, u):
-        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_direct_rebound for one particle (shape code, 7 uniforms)."""
-        V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
-        V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_direct_rebound(self.handle, shape, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a),
-                                               _ptr(u), _ptr(V_out), _ptr(W_out))
-        return status, V_out, W_out
-
-    def rebound(self, mix, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
-        V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
-        V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound(self.handle, _mix_ref(mix), _ptr(V), _ptr(Omega), _ptr(n),
-                                        ctypes.c_double(a), _ptr(u), method, interpolation, _ptr(V_out), _ptr(W_out))
-        return status, V_out, W_out
-
-    def rebound_rng(self, mix, V, Omega, n, a, state: np.ndarray, method=AUTO, interpolation=SCALED,
-                    symbol="rbs_rebound_rng"):
-        """Returns (status, V_out, W_out, advanced state); ``symbol`` "rbs_rebound_spin" calls the 0.x name."""
-        V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
-        rng = _rng(state)
-        V_out, W_out = np.empty(3), np.empty(3)
-        status = getattr(self.lib.c, symbol)(self.handle, _mix_ref(mix), _ptr(V), _ptr(Omega), _ptr(n),
-                                             ctypes.c_double(a), ctypes.byref(rng), method, interpolation,
-                                             _ptr(V_out), _ptr(W_out))
-        return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
-
-    def rebound_grain(self, mix, key: int, V, Omega, n, a, u, method=AUTO, interpolation=SCALED):
-        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_rebound_grain."""
-        V, Omega, n, u = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n, u))
-        V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound_grain(self.handle, _mix_ref(mix), ctypes.c_int64(key), _ptr(V), _ptr(Omega),
-                                              _ptr(n), ctypes.c_double(a), _ptr(u), method, interpolation,
-                                              _ptr(V_out), _ptr(W_out))
-        return status, V_out, W_out
-
-    def rebound_grain_rng(self, mix, key: int, V, Omega, n, a, state: np.ndarray, method=AUTO, interpolation=SCALED):
-        """(status, V⁺, Ω⁺, advanced state) of rbs_rebound_grain_rng."""
-        V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
-        rng = _rng(state)
-        V_out, W_out = np.empty(3), np.empty(3)
-        status = self.lib.c.rbs_rebound_grain_rng(self.handle, _mix_ref(mix), ctypes.c_int64(key), _ptr(V),
-                                                  _ptr(Omega), _ptr(n), ctypes.c_double(a), ctypes.byref(rng), method,
-                                                  interpolation, _ptr(V_out), _ptr(W_out))
-        return status, V_out, W_out, np.array(list(rng.s), dtype=np.uint64)
+    def single(self, shape: int) -> OwnedMix:
+        """The mix of the table's shape ``shape`` alone (kept)."""
+        if shape not in self._single:
+            self._single[shape] = self.mix(self.shapes[shape])
+        return self._single[shape]
 
     def grain_info(self, mix, key: int):
         """(code, rbs_grain as a dict or None) of rbs_grain_info."""
         grain = Grain()
-        code = self.lib.c.rbs_grain_info(self.handle, _mix_ref(mix), ctypes.c_int64(key), ctypes.byref(grain))
-        return code, ({name: getattr(grain, name) for name, _ in Grain._fields_} if code == OK else None)
+        code = self.lib.c.rbs_grain_info(self.handle, _mix_ref(mix), ctypes.c_int64(key), ref(grain))
+        return code, ({name: getattr(grain, name) for name in ("shape", "ratio_ba", "ratio_cb", "hand")}
+                      if code == OK else None)
 
-    def rebound_path(self, V, Omega, n, a, method=AUTO):
-        V, Omega, n = (np.ascontiguousarray(x, dtype=np.float64) for x in (V, Omega, n))
-        return self.lib.c.rbs_rebound_path(self.handle, _ptr(V), _ptr(Omega), _ptr(n), ctypes.c_double(a), method)
+    # -- one hit
+    def hit(self, mix, V, Omega, n, a, u=None, state=None, key: int = NO_KEY, method=METHOD_AUTO,
+            interpolation=INTERPOLATION_SCALED):
+        """rbs_rebound of one hit, uniforms ``u`` or drawn from the rng ``state``: (its rbs_result, the advanced
+        state or None). The returned status is checked to be the result's."""
+        rng = None if state is None else _rng(state)
+        h, kept = hit(V, Omega, n, a, u, rng, key)
+        result, opts = Result(), options(method, interpolation)
+        code = self.lib.c.rbs_rebound(self.handle, _mix_ref(mix), ref(h), ref(opts), ref(result))
+        assert code == result.status, (code, result.status)
+        del kept
+        return result, (None if rng is None else _state(rng))
 
-    def draw_local(self, mix, alpha1, speed, u, interpolation=SCALED):
-        u = np.ascontiguousarray(u, dtype=np.float64)
-        out = np.empty(6)
+    def rebound(self, mix, V, Omega, n, a, u=None, state=None, key: int = NO_KEY, method=METHOD_AUTO,
+                interpolation=INTERPOLATION_SCALED):
+        """(status, V⁺ m/s, Ω⁺ rad/s) of rbs_rebound; with ``state`` instead of ``u``, also the advanced state."""
+        result, after = self.hit(mix, V, Omega, n, a, u, state, key, method, interpolation)
+        out = (result.status, np.array(result.V[:]), np.array(result.Omega[:]))
+        return out if after is None else (*out, after)
+
+    def direct(self, shape: int, V, Omega, n, a, u7):
+        """The direct path of the table's shape ``shape`` (its one-shape mix, RBS_METHOD_DIRECT) with the direct
+        model's 7 uniforms ``u7`` as u[1..7] of the hit: (status, V⁺, Ω⁺), the old rbs_direct_rebound's answer."""
+        return self.rebound(self.single(shape), V, Omega, n, a, direct_uniforms(u7), method=METHOD_DIRECT)
+
+    def rebound_path(self, V, Omega, n, a, method=METHOD_AUTO):
+        h, _ = hit(V, Omega, n, a)
+        return self.lib.c.rbs_rebound_path(self.handle, ref(h), ref(options(method)))
+
+    # -- many hits
+    def draw_many(self, mix, V, n, a, u=None, state=None, interpolation=INTERPOLATION_SCALED, method=METHOD_AUTO):
+        """(status, V⁺, Ω⁺) of rbs_draw_many for the rows, uniforms ``u`` (count, 13), or drawn from the rng
+        ``state`` (then also the advanced state); its return code is checked to be RBS_OK."""
+        V, n, a = (_f64(x) for x in (V, n, a))
+        count = V.shape[0]
+        assert n.shape == (count, 3) and a.shape == (count,)
+        rng = None if state is None else _rng(state)
+        hits = Hits(count=count, V=_ptr(V), n=_ptr(n), a=_ptr(a), rng=address(rng))
+        if u is not None:
+            u = _f64(u)
+            assert u.shape == (count, U_PER_DRAW)
+            hits.u = _ptr(u)
+        V_out, W_out, status = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
+        results = Results(V=_ptr(V_out), Omega=_ptr(W_out), status=_ptr(status))
+        code = self.lib.c.rbs_draw_many(self.handle, _mix_ref(mix), ref(hits), ref(options(method, interpolation)),
+                                        ref(results))
+        assert code == OK, code
+        return (status, V_out, W_out) if rng is None else (status, V_out, W_out, _state(rng))
+
+    def draw_local(self, mix, alpha1, speed, u, interpolation=INTERPOLATION_SCALED):
+        u = _f64(u)
+        out = np.empty(LOCAL_SIZE)
         status = self.lib.c.rbs_draw_local(self.handle, _mix_ref(mix), ctypes.c_double(alpha1),
-                                           ctypes.c_double(speed), _ptr(u), interpolation, _ptr(out))
+                                           ctypes.c_double(speed), _ptr(u), ref(options(METHOD_AUTO, interpolation)),
+                                           _ptr(out))
         return status, out
+
+    def shapes_drawn(self, mix, u0) -> np.ndarray:
+        """The shape (rbs_result.shape) each uniform u[0] of ``u0`` draws from ``mix``, on the table path of one
+        valid hit."""
+        u = np.full(U_PER_DRAW, 0.5)
+        shapes = []
+        for x in u0:
+            u[0] = x
+            result, _ = self.hit(mix, (100.0, -100.0, 0.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 1e-4, u,
+                                 method=METHOD_TABLE)
+            shapes.append(result.shape)
+        return np.array(shapes)
+
+
+def direct_uniforms(u7) -> np.ndarray:
+    """The 13 uniforms of a hit whose direct path takes ``u7`` (its u[1..7]; u[0] and u[8..12] ½)."""
+    u = np.full(U_PER_DRAW, 0.5)
+    u[1:8] = _f64(u7)
+    return u
+
+
+def mix_probes(cdf) -> np.ndarray:
+    """Uniforms u[0] at and just below each inner boundary of a mix's cdf, and at both ends of [0, 1): the shapes
+    they draw tell the cdf's values bit for bit."""
+    cdf = np.asarray(cdf, dtype=np.float64)
+    inner = cdf[:-1]
+    probes = np.concatenate([[0.0, np.nextafter(1.0, 0.0)], inner, np.nextafter(inner, 0.0)])
+    return probes[(probes >= 0.0) & (probes < 1.0)]
+
+
+def mix_shapes(cdf, u0) -> np.ndarray:
+    """surrogate.kernels.locate.mix_shape, in NumPy: the first k with u0 < cdf[k]."""
+    cdf = np.asarray(cdf, dtype=np.float64)
+    return np.sum(np.asarray(u0)[:, None] >= cdf[None, :-1], axis=1)
+
+
+# ---------------------------------------------------------------- the libraries
+
+_i, _d, _sz, _u64, _i64, _ll = ctypes.c_int, ctypes.c_double, ctypes.c_size_t, ctypes.c_uint64, ctypes.c_int64, \
+    ctypes.c_longlong
+_s = ctypes.c_char_p
+# every RBS_API function of the header: restype, argtypes (records and arrays as addresses)
+PUBLIC = {
+    "rbs_rebound": (_i, [_vp, _vp, _vp, _vp, _vp]),
+    "rbs_rebound_path": (_i, [_vp, _vp, _vp]),
+    "rbs_draw_many": (_i, [_vp, _vp, _vp, _vp, _vp]),
+    "rbs_draw_many_uniforms": (None, [_vp, _sz, _vp]),
+    "rbs_draw_local": (_i, [_vp, _vp, _d, _d, _vp, _vp, _vp]),
+    "rbs_table_open": (_i, [_s, ctypes.POINTER(_vp), _s, _sz]),
+    "rbs_table_close": (None, [_vp]),
+    "rbs_table_path": (_s, [_vp]),
+    "rbs_table_info_get": (_i, [_vp, _vp]),
+    "rbs_table_alpha1_grid": (ctypes.POINTER(_d), [_vp, ctypes.POINTER(_i)]),
+    "rbs_table_speed_grid": (ctypes.POINTER(_d), [_vp, ctypes.POINTER(_i)]),
+    "rbs_table_n_shapes": (_i, [_vp]),
+    "rbs_table_shape_name": (_s, [_vp, _i]),
+    "rbs_table_shape_info": (_i, [_vp, _i, _vp]),
+    "rbs_table_wall": (_i, [_vp, _vp]),
+    "rbs_table_kernel_array": (_i, [_vp, _s, ctypes.POINTER(_vp), ctypes.POINTER(_sz), ctypes.POINTER(_i)]),
+    "rbs_mix_new_from_weights": (_vp, [_vp, _i, ctypes.POINTER(_s), _vp, _s, _sz]),
+    "rbs_mix_new_from_shape": (_vp, [_vp, _s, _s, _sz]),
+    "rbs_mix_new_equal": (_vp, [_vp]),
+    "rbs_mix_free": (None, [_vp]),
+    "rbs_grain_info": (_i, [_vp, _vp, _i64, _vp]),
+    "rbs_grain_key": (_i64, [_u64, _u64, _u64]),
+    "rbs_rng_seed": (None, [_vp, _u64]),
+    "rbs_rng_seed_stream": (None, [_vp, _u64, _u64]),
+    "rbs_rng_uniform": (_d, [_vp]),
+    "rbs_rng_fill": (None, [_vp, _vp, _sz]),
+    "rbs_status_string": (_s, [_i]),
+    "rbs_version": (_s, []),
+    "rbs_version_number": (_i, []),
+}
+# the internal functions the tests bind in the test-only library (native/src's headers)
+INTERNAL = {
+    "rbs_table_rebound": (_i, [_vp, _vp, _vp, _vp, _d, _vp, _i, _vp, _vp]),
+    "rbs_direct_rebound": (_i, [_vp, _i, _vp, _vp, _vp, _d, _vp, _vp, _vp]),
+    "rbs_collide": (_i, [_vp] * 7),
+    "rbs_body_vertices": (_i, [_i, _d, _d, _d, _d, _d, _vp]),
+    "rbs_bounding_radius": (_d, [_i, _vp, _vp, _i]),
+    "rbs_particle_body": (_i, [_vp, _i, _d, _d, _d, _vp, _vp, _vp]),
+    "rbs_rebound_model_frame": (_i, [_vp, _vp, _i, _d, _d, _d, _d, _d, _vp, _vp, _vp]),
+    "rbs_body_rebound": (_i, [_i, _vp, _i, _vp, _vp, _d, _vp, _vp, _vp, _vp, _ll, _d, _d, _ll, _vp, _vp,
+                              ctypes.POINTER(_ll), ctypes.POINTER(_ll)]),
+    "rbs_normal_quantile": (_d, [_d]),
+    "rbs_aspect_ratio": (_d, [_vp, _vp, _d]),
+    "rbs_uniform_quaternion": (None, [_d, _d, _d, _vp]),
+    "rbs_quaternion_to_matrix": (None, [_vp, _vp]),
+    "rbs_rotation_init": (None, [_vp, _vp, _vp, _vp]),
+    "rbs_rotation_at": (None, [_vp, _d, _vp, _vp]),
+    "rbs_carlson_rf": (_d, [_d, _d, _d]),
+    "rbs_carlson_rj": (_d, [_d, _d, _d, _d]),
+}
+
+
+def _declare(library, signatures: dict) -> None:
+    for name, (restype, argtypes) in signatures.items():
+        function = getattr(library, name)
+        function.restype, function.argtypes = restype, argtypes
+
+
+def _library(folder: Path, stem: str) -> Path:
+    candidates = sorted(folder.glob(f"{stem}.so*"))
+    if not candidates:
+        raise BuildError(f"no {stem}.so in {folder}")
+    return candidates[0]
 
 
 class Native:
-    """The shared library of a build folder, its functions typed for ctypes."""
+    """The public shared library of a build folder, its functions typed for ctypes; :attr:`internal` the
+    test-only library beside it."""
 
     def __init__(self, build_dir: Path):
         self.build_dir = Path(build_dir)
-        candidates = sorted(self.build_dir.glob("librebound_scatter.so*"))
-        if not candidates:
-            raise BuildError(f"no librebound_scatter.so in {self.build_dir}")
-        self.c = c = ctypes.CDLL(str(candidates[0]))
-        vp, sz, i, d = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, ctypes.c_double
-        c.rbs_table_open.argtypes = [ctypes.c_char_p, ctypes.POINTER(vp), ctypes.c_char_p, sz]
-        c.rbs_table_open.restype = i
-        c.rbs_table_close.argtypes = [vp]
-        c.rbs_table_close.restype = None
-        c.rbs_table_n_shapes.argtypes = [vp]
-        c.rbs_table_n_shapes.restype = i
-        c.rbs_table_shape_name.argtypes = [vp, i]
-        c.rbs_table_shape_name.restype = ctypes.c_char_p
-        c.rbs_table_path.argtypes = [vp]
-        c.rbs_table_path.restype = ctypes.c_char_p
-        c.rbs_table_alpha1_range.argtypes = [vp, _d, _d]
-        c.rbs_table_speed_range.argtypes = [vp, _d, _d]
-        c.rbs_table_info_get.argtypes = [vp, ctypes.POINTER(Info)]
-        c.rbs_table_kernel_array.argtypes = [vp, ctypes.c_char_p, ctypes.POINTER(vp), ctypes.POINTER(sz),
-                                             ctypes.POINTER(i)]
-        c.rbs_table_kernel_array.restype = i
-        c.rbs_mix_equal.argtypes = [vp, ctypes.POINTER(Mix)]
-        c.rbs_mix_equal.restype = i
-        c.rbs_mix_from_weights.argtypes = [vp, i, ctypes.POINTER(ctypes.c_char_p), vp, ctypes.POINTER(Mix),
-                                           ctypes.c_char_p, sz]
-        c.rbs_mix_from_weights.restype = i
-        c.rbs_mix_from_shape.argtypes = [vp, ctypes.c_char_p, ctypes.POINTER(Mix), ctypes.c_char_p, sz]
-        c.rbs_mix_from_shape.restype = i
-        c.rbs_mix_new_equal.argtypes = [vp]
-        c.rbs_mix_new_equal.restype = ctypes.POINTER(Mix)
-        c.rbs_mix_new_from_shape.argtypes = [vp, ctypes.c_char_p, ctypes.c_char_p, sz]
-        c.rbs_mix_new_from_shape.restype = ctypes.POINTER(Mix)
-        c.rbs_mix_new_from_weights.argtypes = [vp, i, ctypes.POINTER(ctypes.c_char_p), vp, ctypes.c_char_p, sz]
-        c.rbs_mix_new_from_weights.restype = ctypes.POINTER(Mix)
-        c.rbs_mix_free.argtypes = [ctypes.POINTER(Mix)]
-        c.rbs_mix_free.restype = None
-        c.rbs_table_shape_info.argtypes = [vp, i, ctypes.POINTER(ShapeInfo)]
-        c.rbs_table_shape_info.restype = i
-        c.rbs_table_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, d, vp, i, vp, vp]
-        c.rbs_table_rebound.restype = i
-        c.rbs_table_rebound_many.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, vp, i, vp, vp, vp]
-        c.rbs_table_rebound_many.restype = None
-        c.rbs_table_rebound_many_rng.argtypes = [vp, ctypes.POINTER(Mix), sz, vp, vp, vp, ctypes.POINTER(Rng), i,
-                                                 vp, vp, vp]
-        c.rbs_table_rebound_many_rng.restype = None
-        c.rbs_direct_rebound.argtypes = [vp, i, vp, vp, vp, d, vp, vp, vp]
-        c.rbs_direct_rebound.restype = i
-        c.rbs_draw_local.argtypes = [vp, ctypes.POINTER(Mix), d, d, vp, i, vp]
-        c.rbs_draw_local.restype = i
-        c.rbs_rebound.argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, vp, i, i, vp, vp]
-        c.rbs_rebound.restype = i
-        for kept in ("rbs_rebound_rng", "rbs_rebound_spin"):     # rbs_rebound_spin: its 0.x name
-            getattr(c, kept).argtypes = [vp, ctypes.POINTER(Mix), vp, vp, vp, d, ctypes.POINTER(Rng), i, i, vp, vp]
-            getattr(c, kept).restype = i
-        c.rbs_rebound_grain.argtypes = [vp, ctypes.POINTER(Mix), ctypes.c_int64, vp, vp, vp, d, vp, i, i, vp, vp]
-        c.rbs_rebound_grain.restype = i
-        c.rbs_rebound_grain_rng.argtypes = [vp, ctypes.POINTER(Mix), ctypes.c_int64, vp, vp, vp, d, ctypes.POINTER(Rng),
-                                            i, i, vp, vp]
-        c.rbs_rebound_grain_rng.restype = i
-        c.rbs_grain_info.argtypes = [vp, ctypes.POINTER(Mix), ctypes.c_int64, ctypes.POINTER(Grain)]
-        c.rbs_grain_info.restype = i
-        c.rbs_grain_key.argtypes = [ctypes.c_uint64, ctypes.c_uint64, ctypes.c_uint64]
-        c.rbs_grain_key.restype = ctypes.c_int64
-        c.rbs_rebound_path.argtypes = [vp, vp, vp, vp, d, i]
-        c.rbs_rebound_path.restype = i
-        c.rbs_rng_seed.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64]
-        c.rbs_rng_seed_stream.argtypes = [ctypes.POINTER(Rng), ctypes.c_uint64, ctypes.c_uint64]
-        c.rbs_rng_uniform.argtypes = [ctypes.POINTER(Rng)]
-        c.rbs_rng_uniform.restype = d
-        c.rbs_rng_fill.argtypes = [ctypes.POINTER(Rng), vp, sz]
-        c.rbs_table_rebound_uniforms.argtypes = [ctypes.POINTER(Rng), sz, vp]
-        c.rbs_error_string.argtypes = [i]
-        c.rbs_error_string.restype = ctypes.c_char_p
-        c.rbs_version.restype = ctypes.c_char_p
-        c.rbs_rotation_init.argtypes = [vp, vp, vp, vp]
-        c.rbs_rotation_init.restype = None
-        c.rbs_rotation_at.argtypes = [vp, d, vp, vp]
-        c.rbs_rotation_at.restype = None
-        c.rbs_carlson_rf.argtypes = [d, d, d]
-        c.rbs_carlson_rf.restype = d
-        c.rbs_carlson_rj.argtypes = [d, d, d, d]
-        c.rbs_carlson_rj.restype = d
+        self.path = _library(self.build_dir, "librebound_scatter")
+        self.c = ctypes.CDLL(str(self.path))
+        _declare(self.c, PUBLIC)
+        self._internal = None
+
+    @property
+    def internal(self):
+        """librebound_scatter_testing.so of the same build (RBS_BUILD_TESTS=ON): the same sources without hidden
+        visibility, so the internal functions (INTERNAL) are exported; never the library a program links."""
+        if self._internal is None:
+            self._internal = ctypes.CDLL(str(_library(self.build_dir, "librebound_scatter_testing")))
+            _declare(self._internal, INTERNAL)
+            _declare(self._internal, PUBLIC)
+        return self._internal
 
     def open(self, path):
         """(code, NativeTable or None, message)."""
         handle, message = ctypes.c_void_p(), ctypes.create_string_buffer(2048)
         code = self.c.rbs_table_open(str(path).encode(), ctypes.byref(handle), message, len(message))
-        return code, (NativeTable(self, handle) if code == OK else None), message.value.decode()
+        if code != OK:
+            assert not handle.value, "rbs_table_open failed but set *table"
+        return code, (NativeTable(self, handle.value, path) if code == OK else None), message.value.decode()
 
     def table(self, path) -> NativeTable:
         code, table, message = self.open(path)
@@ -421,45 +607,54 @@ class Native:
             raise RuntimeError(f"rbs_table_open failed ({code}): {message}")
         return table
 
+    def status_string(self, code: int) -> str:
+        return self.c.rbs_status_string(code).decode()
+
+    def version(self) -> str:
+        return self.c.rbs_version().decode()
+
+    def version_number(self) -> int:
+        return self.c.rbs_version_number()
+
     # -- random numbers
     def seed(self, seed: int, stream: int | None = None) -> np.ndarray:
         rng = Rng()
         if stream is None:
-            self.c.rbs_rng_seed(ctypes.byref(rng), ctypes.c_uint64(seed))
+            self.c.rbs_rng_seed(ref(rng), ctypes.c_uint64(seed))
         else:
-            self.c.rbs_rng_seed_stream(ctypes.byref(rng), ctypes.c_uint64(seed), ctypes.c_uint64(stream))
-        return np.array(list(rng.s), dtype=np.uint64)
+            self.c.rbs_rng_seed_stream(ref(rng), ctypes.c_uint64(seed), ctypes.c_uint64(stream))
+        return _state(rng)
 
     def fill(self, state: np.ndarray, count: int):
         rng, u = _rng(state), np.empty(count)
-        self.c.rbs_rng_fill(ctypes.byref(rng), _ptr(u), ctypes.c_size_t(count))
-        return u, np.array(list(rng.s), dtype=np.uint64)
+        self.c.rbs_rng_fill(ref(rng), _ptr(u), ctypes.c_size_t(count))
+        return u, _state(rng)
 
     def uniform(self, state: np.ndarray):
         rng = _rng(state)
-        x = self.c.rbs_rng_uniform(ctypes.byref(rng))
-        return x, np.array(list(rng.s), dtype=np.uint64)
+        x = self.c.rbs_rng_uniform(ref(rng))
+        return x, _state(rng)
 
     def grain_key(self, seed: int, id1: int, id2: int) -> int:
         return self.c.rbs_grain_key(ctypes.c_uint64(seed), ctypes.c_uint64(id1), ctypes.c_uint64(id2))
 
-    def table_rebound_uniforms(self, state: np.ndarray, count: int):
+    def draw_many_uniforms(self, state: np.ndarray, count: int):
         rng, u = _rng(state), np.empty((count, U_PER_DRAW))
-        self.c.rbs_table_rebound_uniforms(ctypes.byref(rng), ctypes.c_size_t(count), _ptr(u))
-        return u, np.array(list(rng.s), dtype=np.uint64)
+        self.c.rbs_draw_many_uniforms(ref(rng), ctypes.c_size_t(count), _ptr(u))
+        return u, _state(rng)
 
-    # -- torque-free flight (rotation.c, internal functions exported by the shared library)
+    # -- torque-free flight (rotation.c: internal functions of the test-only library)
     def rotation_init(self, K, R0, ell, params: np.ndarray) -> None:
         """rbs_rotation_init into ``params`` (float64, C-contiguous, written in place)."""
-        K, R0, ell = (np.ascontiguousarray(x, dtype=np.float64) for x in (K, R0, ell))
+        K, R0, ell = (_f64(x) for x in (K, R0, ell))
         assert params.dtype == np.float64 and params.flags.c_contiguous
-        self.c.rbs_rotation_init(_ptr(K), _ptr(R0), _ptr(ell), _ptr(params))
+        self.internal.rbs_rotation_init(_ptr(K), _ptr(R0), _ptr(ell), _ptr(params))
 
     def rotation_at(self, params: np.ndarray, t: float):
         """(R (3x3, body -> lab), omega (lab)) of rbs_rotation_at."""
-        params = np.ascontiguousarray(params, dtype=np.float64)
+        params = _f64(params)
         R, omega = np.empty((3, 3)), np.empty(3)
-        self.c.rbs_rotation_at(_ptr(params), ctypes.c_double(t), _ptr(R), _ptr(omega))
+        self.internal.rbs_rotation_at(_ptr(params), ctypes.c_double(t), _ptr(R), _ptr(omega))
         return R, omega
 
 

@@ -23,6 +23,8 @@ from surrogate import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, U_PER_DR
     grain_of, load, mix_cdf, seed_state
 from surrogate.kernels import draw_local, table_rebound, table_rebound_many, table_rebound_many_rng, table_rebound_uniforms
 from surrogate.kernels.direct_path import direct_rebound
+from surrogate.kernels.locate import mix_shape
+from data_schema.table import TABLE_VERSION
 from direct_model.collision import collide
 from direct_model.body_rebound import quaternion_to_matrix
 from direct_model.runtime import (SCRATCH_SIZE, U_PER_REBOUND, aspect_ratio, normal_quantile, rebound_model_frame,
@@ -64,7 +66,7 @@ def user_grains(count: int, seed: int = 34) -> list:
 
 
 def many_shape_table(source, path, n_shapes: int = 64) -> tuple:
-    """A table of ``n_shapes`` shapes written to ``path`` from the table at ``source`` (format 3.4): its own shapes
+    """A table of ``n_shapes`` shapes written to ``path`` from the table at ``source``: its own shapes
     first, then user grains (:func:`user_grains`) whose cells are copies of the source's, shape k drawing the
     cells of source shape k mod n_source (a synthetic table: the table path draws any cells). Returns the names."""
     import dataclasses
@@ -100,4 +102,4 @@ __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", 
            "collide", "normal_quantile", "quaternion_to_matrix", "direct_rebound", "uniform_quaternion",
            "A", "N", "SHAPES", "STATES", "assert_one_law", "frame_of", "incident", "one_law", "simulated", "state_id",
            "to_model_frame", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE",
-           "SPIN_TOLERANCE", "rebound_path", "rebound"]
+           "SPIN_TOLERANCE", "rebound_path", "rebound", "mix_shape", "TABLE_VERSION"]

@@ -5,6 +5,7 @@ import json
 import shutil
 
 import h5py
+import numpy as np
 
 from tests.helpers import REPO
 
@@ -69,3 +70,30 @@ def write_grain_config(folder, text=GRAIN_TABLE_CONFIG, mesh=GRAIN_MESH):
     path = folder / "grains.toml"
     path.write_text(text)
     return path
+
+
+# the grid attributes a table of format 3.4 held (its wall law and the direct model's parameters), in the order its
+# checksummed copy grid/law held them (second_moment_factors: 4 numbers)
+FORMAT_3_LAW_ATTRIBUTES = ("restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean",
+                           "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol",
+                           "max_steps", "second_moment_factors")
+
+
+def format_3_copy(source, folder, name, minor=4):
+    """A copy of the table ``source`` (format 4) in the layout of format 3.``minor`` (3.4 by default): the wall law
+    and the direct model's parameters as attributes of group grid with their checksummed copy grid/law, no groups
+    model and wall; what rebound-scatter before 1.0 wrote (its cells, shapes and configuration unchanged)."""
+    def to_format_3(f):
+        model, wall = f["model/parameters"][0], f["wall/parameters"][0]
+        grid = f["grid"]
+        values = {"restitution_k": wall["k"], "restitution_p": wall["p"], "friction_q": wall["q"]}
+        values.update({field: model[field] for field in model.dtype.names})
+        for attribute in FORMAT_3_LAW_ATTRIBUTES:
+            grid.attrs[attribute] = values[attribute]
+        grid.attrs["wall_law"] = f["wall"].attrs["name"]
+        law = [float(x) for attribute in FORMAT_3_LAW_ATTRIBUTES for x in np.ravel(values[attribute])]
+        grid.create_dataset("law", data=np.array(law), fletcher32=True)
+        del f["model"], f["wall"]
+        f.attrs["format_version"] = np.array([3, minor], dtype=np.int64)
+
+    return edited_copy(source, folder, name, to_format_3)

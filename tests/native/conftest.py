@@ -30,8 +30,8 @@ def _built(job) -> Path:
 
 @pytest.fixture(scope="session")
 def native_build(native_build_job):
-    """native/ configured and built (Release, -Werror): shared and static libraries, the C and Fortran
-    examples, the bench program."""
+    """native/ configured and built (Release, -Werror): shared and static libraries, the test-only library of the
+    internal functions, the C and Fortran examples, the C test programs, the bench program."""
     _require_tools()
     return _built(native_build_job)
 
@@ -52,7 +52,7 @@ def native_baseline(native_baseline_job):
 
 @pytest.fixture(scope="session")
 def native(native_build):
-    """The shared library, through ctypes."""
+    """The public shared library through ctypes (its ``internal``: the test-only library of the same build)."""
     return Native(native_build)
 
 

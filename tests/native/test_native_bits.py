@@ -2,10 +2,11 @@
 
 Over random incident states (random unit normals; α1 and |V⁻| over and beyond the table's grid; exact
 normal impact, grazing, trapped cells, invalid input), every shape alone, the equal mix and a weighted
-mix, both interpolations: V⁺, Ω⁺ and the status of rbs_table_rebound_many equal those of
-surrogate.kernels.table_rebound_many; rbs_table_rebound row by row equals rbs_table_rebound_many and table_rebound;
-the local draw, the derived kernel arrays and the random numbers equal surrogate's. The largest ulp
-difference is printed (run with -s to see it) and must be 0.
+mix, both interpolations: V⁺, Ω⁺ and the status of rbs_draw_many equal those of
+surrogate.kernels.table_rebound_many; rbs_rebound under RBS_METHOD_TABLE row by row equals rbs_draw_many and
+table_rebound; the mixes draw the shapes of surrogate.mix_cdf (bit for bit at the cdf's boundaries); the local
+draw, the derived kernel arrays, the table's sizes, grids and wall, and the random numbers equal surrogate's. The
+largest ulp difference is printed (run with -s to see it) and must be 0.
 """
 
 from __future__ import annotations
@@ -14,12 +15,14 @@ import numpy as np
 import pytest
 
 from tests.helpers import python_side as py
-from tests.helpers.native_library import SCALED, STOCHASTIC
+from tests.helpers.native_library import (INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC, INVALID, METHOD_TABLE,
+                                          PATH_NONE, PATH_TABLE, mix_probes)
 from tests.helpers.states import incident_states, max_ulp, uniforms
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
                  "restitution_pieces")
 STATES_PER_CASE = 100_000
+SCALED, STOCHASTIC = INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC
 INTERPOLATIONS = {"scaled": SCALED, "stochastic": STOCHASTIC}
 
 
@@ -30,12 +33,7 @@ def _mixes(table):
 
 
 def _native_mix(native_table, spec):
-    if isinstance(spec, dict):
-        code, mix, message = native_table.mix_from_weights(spec)
-    else:
-        code, mix, message = native_table.mix_from_shape(spec)
-    assert code == 0, message
-    return mix
+    return native_table.mix(spec)
 
 
 def test_derived_kernel_arrays_equal_surrogate(table_pair):
@@ -50,22 +48,51 @@ def test_derived_kernel_arrays_equal_surrogate(table_pair):
     assert (info.n_clusters, info.n_levels, info.n_dictionary, info.n_pieces) == \
         (data.n_clusters, data.n_levels, data.n_dictionary, data.n_pieces)
     assert info.kernel_bytes == data.nbytes
+    assert (info.particles_per_cell, info.n_max) == (table.particles_per_cell, table.n_max)
     assert native_table.shapes == tuple(table.shapes)
     assert native_table.ranges() == (table.alpha1_range, table.speed_range)
+    alpha1, speed = native_table.grids()
+    assert alpha1.tobytes() == np.asarray(table.alpha1_deg).tobytes()
+    assert speed.tobytes() == np.asarray(table.speed_m_s).tobytes()
+    assert native_table.lib.c.rbs_table_path(native_table.handle).decode() == str(native_table.path) == table.path
+
+
+def test_the_wall_is_the_table_s(table_pair):
+    """rbs_table_wall: the wall's law family, its name and its parameters by name in the family's order, as
+    data_schema reads them from the table (group /wall), bit for bit."""
+    from data_schema.table import read_table
+    from direct_model.wall import wall_family
+    table, native_table = table_pair
+    stored = read_table(table.path).wall
+    family = wall_family(stored.family)
+    wall = native_table.wall()
+    assert (wall["family"], wall["name"]) == (family.name, stored.name), wall
+    assert list(wall["parameters"]) == list(family.parameter_names), wall
+    assert np.array(list(wall["parameters"].values())).tobytes() == np.asarray(stored.as_array(), float).tobytes()
 
 
 def test_mixes_equal_mix_cdf(table_pair):
+    """Each mix draws, for every u[0], the shape surrogate's mix_shape draws from surrogate.mix_cdf: at and just
+    below every boundary of the cdf (so its values are the same bits) and at random; rbs_result.shape says which."""
     table, native_table = table_pair
+    rng = np.random.default_rng(12)
     for _, spec in _mixes(table):
         mix = _native_mix(native_table, spec)
         expected = py.mix_cdf(table, spec)
-        assert mix.n_shapes == len(expected)
-        assert list(mix.cdf)[:len(expected)] == list(expected), spec
+        u0 = np.concatenate([mix_probes(expected), rng.random(200)])
+        got = native_table.shapes_drawn(mix, u0)
+        assert got.tolist() == [py.mix_shape(expected, x) for x in u0], spec
+    cdf = py.mix_cdf(table, "mix")
+    for spec in (None, "mix"):      # rbs_mix_new_equal, and rbs_mix_new_from_shape's "mix"
+        mix, message = native_table.mix_new(spec)
+        assert mix is not None, message
+        u0 = mix_probes(cdf)
+        assert native_table.shapes_drawn(mix, u0).tolist() == [py.mix_shape(cdf, x) for x in u0], spec
 
 
 @pytest.mark.parametrize("interpolation", sorted(INTERPOLATIONS))
 def test_rebound_many_bit_identical(table_pair, interpolation):
-    """1e5 random incident states per mix (six mixes), against surrogate.kernels.table_rebound_many."""
+    """1e5 random incident states per mix (six mixes), rbs_draw_many against surrogate.kernels.table_rebound_many."""
     table, native_table = table_pair
     (a_lo, a_hi), (v_lo, v_hi) = table.alpha1_range, table.speed_range
     worst = {}
@@ -77,8 +104,8 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
         V_py, W_py = np.empty((STATES_PER_CASE, 3)), np.empty((STATES_PER_CASE, 3))
         status_py = np.empty(STATES_PER_CASE, dtype=np.int8)
         py.table_rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == "scaled")
-        status, V_c, W_c = native_table.table_rebound_many(_native_mix(native_table, spec), V, n, a, u,
-                                                     INTERPOLATIONS[interpolation])
+        status, V_c, W_c = native_table.draw_many(_native_mix(native_table, spec), V, n, a, u,
+                                                  interpolation=INTERPOLATIONS[interpolation])
         assert np.array_equal(status, status_py), label
         counts = {s: int(np.sum(status == s)) for s in (py.STATUS_REBOUNDED, py.STATUS_TRAPPED, py.STATUS_INVALID)}
         assert counts[py.STATUS_REBOUNDED] > 0.7 * STATES_PER_CASE and counts[py.STATUS_INVALID] > 0
@@ -94,24 +121,34 @@ def test_rebound_many_bit_identical(table_pair, interpolation):
 
 
 def test_single_calls_equal_many_and_rebound_tuple(table_pair):
-    """rbs_table_rebound row by row = rbs_table_rebound_many = surrogate's table_rebound, both interpolations."""
+    """rbs_rebound under RBS_METHOD_TABLE row by row = rbs_draw_many = surrogate's table_rebound, both
+    interpolations; each result says the table path answered (n_collisions −1) and which shape the mix gave, and
+    an invalid hit says no path and no shape."""
     table, native_table = table_pair
     rng = np.random.default_rng(7)
     count = 3000
     (v_lo, v_hi) = table.speed_range
     V, n, a = incident_states(rng, count, (0.0, 90.0), (0.2 * v_lo, 1.5 * v_hi))
     u = uniforms(rng, count, hostile=0.01)
-    mix = native_table.mix_equal()
+    mix = native_table.mix()
     cdf = py.mix_cdf(table, "mix")
+    omega = np.zeros(3)
     for interpolation in (SCALED, STOCHASTIC):
-        status, V_many, W_many = native_table.table_rebound_many(mix, V, n, a, u, interpolation)
+        status, V_many, W_many = native_table.draw_many(mix, V, n, a, u, interpolation=interpolation)
         for i in range(count):
-            st, v, w = native_table.table_rebound(mix, V[i], n[i], a[i], u[i], interpolation)
+            result, _ = native_table.hit(mix, V[i], omega, n[i], a[i], u[i], method=METHOD_TABLE,
+                                         interpolation=interpolation)
+            st, v, w = result.status, np.array(result.V[:]), np.array(result.Omega[:])
             st_py, v_py, w_py = py.table_rebound(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
                                                  interpolation == SCALED)
             assert st == status[i] == st_py, i
             assert max_ulp(v, V_many[i]) == 0 and max_ulp(w, W_many[i]) == 0, i
             assert max_ulp(v, np.array(v_py)) == 0 and max_ulp(w, np.array(w_py)) == 0, i
+            if st == INVALID:
+                assert (result.path, result.shape, result.n_collisions) == (PATH_NONE, -1, -1), i
+            else:
+                assert (result.path, result.n_collisions) == (PATH_TABLE, -1), i
+                assert result.shape == py.mix_shape(cdf, u[i][0]), i
 
 
 def test_draw_local_bit_identical(table_pair):
@@ -169,15 +206,15 @@ def test_uniforms_equal_fill_uniforms(native):
 
 
 def test_block_uniforms_and_rebound_many_rng(table_pair, native):
-    """rbs_table_rebound_uniforms = table_rebound_uniforms and rbs_table_rebound_many_rng = table_rebound_many_rng, bit for
-    bit, for row counts on and off the 32-row blocks."""
+    """rbs_draw_many_uniforms = table_rebound_uniforms and rbs_draw_many with an rng = table_rebound_many_rng, bit
+    for bit (the rng advanced alike), for row counts on and off the 32-row blocks."""
     table, native_table = table_pair
-    mix, cdf = native_table.mix_equal(), py.mix_cdf(table, "mix")
+    mix, cdf = native_table.mix(), py.mix_cdf(table, "mix")
     rng = np.random.default_rng(5)
     for count in (0, 1, 31, 32, 33, 1000, 20001):
         state = py.seed_state(count + 9)
         u_py = py.table_rebound_uniforms(state.copy(), count)
-        u_c, _ = native.table_rebound_uniforms(state, count)
+        u_c, _ = native.draw_many_uniforms(state, count)
         assert np.array_equal(u_c, u_py), count
         V, n, a = incident_states(rng, count)
         for interpolation in (SCALED, STOCHASTIC):
@@ -185,7 +222,7 @@ def test_block_uniforms_and_rebound_many_rng(table_pair, native):
             py_state = state.copy()
             py.table_rebound_many_rng(table.kernel_data, cdf, V, n, a, py_state, V_py, W_py, status_py,
                                 interpolation == SCALED)
-            status, V_c, W_c, c_state = native_table.table_rebound_many_rng(mix, V, n, a, state, interpolation)
+            status, V_c, W_c, c_state = native_table.draw_many(mix, V, n, a, state=state, interpolation=interpolation)
             assert np.array_equal(status, status_py) and np.array_equal(c_state, py_state), count
             assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0, count
 
@@ -203,9 +240,11 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     for interpolation in (SCALED, STOCHASTIC):
         V_py, W_py, status_py = np.empty((count, 3)), np.empty((count, 3)), np.empty(count, dtype=np.int8)
         py.table_rebound_many(table.kernel_data, cdf, V, n, a, u, V_py, W_py, status_py, interpolation == SCALED)
-        status, V_c, W_c = baseline.table_rebound_many(baseline.mix_equal(), V, n, a, u, interpolation)
+        mix = baseline.mix()
+        status, V_c, W_c = baseline.draw_many(mix, V, n, a, u, interpolation=interpolation)
         assert np.array_equal(status, status_py)
         assert max_ulp(V_c, V_py) == 0 and max_ulp(W_c, W_py) == 0
         for i in range(0, count, 500):
-            st, v, w = baseline.table_rebound(baseline.mix_equal(), V[i], n[i], a[i], u[i], interpolation)
+            st, v, w = baseline.rebound(mix, V[i], np.zeros(3), n[i], a[i], u[i], method=METHOD_TABLE,
+                                        interpolation=interpolation)
             assert st == status_py[i] and max_ulp(v, V_py[i]) == 0 and max_ulp(w, W_py[i]) == 0

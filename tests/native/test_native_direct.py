@@ -1,8 +1,9 @@
 """The direct model in C (native/src/direct_path.c and the kernels it calls: shapes.c, collision.c, flight.c,
 body_rebound.c, runtime.c) against numba, bit for bit for the same inputs and uniforms: the parameter array the
 loader builds, the pieces (shapes, a particle's body, the normal quantile, the uniform quaternion, one
-collision), whole rebounds in random caller frames, user grains of 8 to 256 hull vertices, and hostile inputs
-(RBS_INVALID with NaN, never a crash)."""
+collision: internal functions, bound in the test-only library), whole rebounds in random caller frames (rbs_rebound
+under RBS_METHOD_DIRECT with a one-shape mix, the public way to the direct path), user grains of 8 to 256 hull
+vertices, and hostile inputs (RBS_INVALID with NaN, never a crash)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ import numpy as np
 import pytest
 
 from tests.helpers import python_side as py
-from tests.helpers.native_library import ERR_FORMAT, NATIVE, ShapeArrays
+from tests.helpers.native_library import (ERR_FORMAT, INVALID, METHOD_DIRECT, NATIVE, PATH_DIRECT, PATH_NONE,
+                                          ShapeArrays, direct_uniforms)
 
 SPINS = (0.0, 0.02, 0.3, 1.0)     # |Ω⁻| a / |V⁻| of the whole-rebound comparisons
 PER_SHAPE = 2000                  # particles per shape and spin
@@ -24,33 +26,9 @@ LAW = py.AspectRatioLaw()
 GRAINS = [py.hull_grain(f"grain_{n}", n, seed=n, aspect=LAW if n in (24, 256) else None, both_hands=True)
           for n in (8, 24, 64, 256)] + [py.cloud_grain("cloud", 300, seed=3, aspect=LAW)]
 
-_d, _i, _p = ctypes.c_double, ctypes.c_int, ctypes.c_void_p
-
-
 def _c(native):
-    """The library with the model's functions typed (the internal kernels are exported for these tests)."""
-    c = native.c
-    c.rbs_direct_rebound.argtypes = [_p, _i, _p, _p, _p, _d, _p, _p, _p]
-    c.rbs_direct_rebound.restype = _i
-    c.rbs_collide.argtypes = [_p] * 7
-    c.rbs_collide.restype = _i
-    c.rbs_body_vertices.argtypes = [_i, _d, _d, _d, _d, _d, _p]
-    c.rbs_body_vertices.restype = _i
-    c.rbs_bounding_radius.argtypes = [_i, _p, _p, _i]
-    c.rbs_bounding_radius.restype = _d
-    c.rbs_particle_body.argtypes = [_p, _i, _d, _d, _d, _p, _p, _p]
-    c.rbs_particle_body.restype = _i
-    c.rbs_rebound_model_frame.argtypes = [_p, _p, _i, _d, _d, _d, _d, _d, _p, _p, _p]
-    c.rbs_rebound_model_frame.restype = _i
-    c.rbs_normal_quantile.argtypes = [_d]
-    c.rbs_normal_quantile.restype = _d
-    c.rbs_aspect_ratio.argtypes = [_p, _p, _d]
-    c.rbs_aspect_ratio.restype = _d
-    c.rbs_uniform_quaternion.argtypes = [_d, _d, _d, _p]
-    c.rbs_uniform_quaternion.restype = None
-    c.rbs_quaternion_to_matrix.argtypes = [_p, _p]
-    c.rbs_quaternion_to_matrix.restype = None
-    return c
+    """The test-only library, its internal functions typed (tests.helpers.native_library.INTERNAL)."""
+    return native.internal
 
 
 def _ptr(x):
@@ -58,7 +36,7 @@ def _ptr(x):
 
 
 def _direct_c(c, table, shape, V, omega, n, a, u):
-    """(status, V⁺, Ω⁺) of rbs_direct_rebound."""
+    """(status, V⁺, Ω⁺) of the test-only library's rbs_direct_rebound (the direct path alone, a shape code)."""
     V_out, W_out = np.zeros(3), np.zeros(3)
     arrays = [None if x is None else np.ascontiguousarray(x, dtype=np.float64) for x in (V, omega, n, u)]
     status = c.rbs_direct_rebound(table, shape, *(_ptr(x) for x in arrays[:3]), a, _ptr(arrays[3]), _ptr(V_out),
@@ -72,27 +50,27 @@ def _same(a, b):
     return np.array_equal(*bits)
 
 
-def _old_table(small_table_path, tmp_path, name, **changes):
-    """A copy of the small table without the direct model's attributes (a table of 3.0–3.2), with ``changes``
-    to its grid attributes (None deletes)."""
+# the direct model's parameters of another table: its rows model/parameters and wall/parameters edited (their fields
+# in reverse order, one more field: both loaders read them by name)
+OTHER_MODEL = dict(contact_tol=2e-10, set_tol=3e-9, max_steps=7000, n_max=500)
+OTHER_WALL = dict(q=0.4)
+
+
+def _other_table(small_table_path, tmp_path, name, model=None, wall=None):
+    """A copy of the small table whose parameter rows hold ``model`` and ``wall`` (field: value), written in the
+    reverse field order with one more field, chunked (1,) under Fletcher-32."""
     path = tmp_path / name
     path.write_bytes(small_table_path.read_bytes())
     with h5py.File(path, "r+") as f:
-        f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)      # its grid/law: restitution_k, _p
-        del f["shapes"]                                                    # and no group shapes (3.4)
-        law = f["grid/law"][:2]
-        del f["grid/law"]
-        f["grid"].create_dataset("law", data=law, fletcher32=True)
-        for key, value in changes.items():
-            if value is None:
-                del f["grid"].attrs[key]
-            else:
-                f["grid"].attrs[key] = value
+        for group, changes in (("model", model or {}), ("wall", wall or {})):
+            row = f[group]["parameters"][()]
+            names = list(reversed(row.dtype.names))
+            turned = np.zeros(1, dtype=[("later", "<f8")] + [(n, row.dtype[n]) for n in names])
+            for n in names:
+                turned[n] = changes.get(n, row[n])
+            del f[group]["parameters"]
+            f[group].create_dataset("parameters", data=turned, chunks=(1,), fletcher32=True)
     return path
-
-
-OLD = dict.fromkeys(("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol",
-                     "set_tol", "max_steps", "second_moment_factors", "friction_q"))
 
 
 # -- the parameters -------------------------------------------------------------------------------------
@@ -101,13 +79,17 @@ _DEFINE = re.compile(r"^#define (\w+) \(?(\w+(?: \+ \w+)*)\)?(?=\s|$)", flags=re
 
 
 def _integer_defines(*headers) -> dict:
-    """The #defines of the headers whose value is an integer or a sum of integers and earlier such names."""
-    values = {}
-    for header in headers:
-        for name, expression in _DEFINE.findall(header.read_text()):
-            terms = expression.split(" + ")
-            if all(t.isdigit() or t in values for t in terms):
+    """The #defines of the headers whose value is an integer or a sum of integers and such names (of any of the
+    headers; the first definition of a name kept)."""
+    found = [(name, expression.split(" + ")) for header in headers
+             for name, expression in _DEFINE.findall(header.read_text())]
+    values, changed = {}, True
+    while changed:
+        changed = False
+        for name, terms in found:
+            if name not in values and all(t.isdigit() or t in values for t in terms):
                 values[name] = sum(int(t) if t.isdigit() else values[t] for t in terms)
+                changed = True
     return values
 
 
@@ -115,9 +97,8 @@ def test_the_parameter_layout_is_direct_model_s(table_pair):
     """runtime.h's layout is direct_model.runtime's: every P_* offset, U_* index and N_PARAMS, which both sides
     derive from the shape count (P_KFAC, then one second-moment factor per shape code); the loader's array
     has N_PARAMS elements."""
-    c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", NATIVE / "src" / "shapes.h",
-                         NATIVE / "src" / "runtime.h")
-    c["U_PER_REBOUND"] = c["RBS_U_PER_REBOUND"]
+    c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", *sorted((NATIVE / "src").glob("*.h")))
+    c.setdefault("U_PER_REBOUND", c.get("RBS_U_PER_REBOUND"))
     layout = re.compile(r"P_[A-Z_]+|U_[A-Z_]+|N_PARAMS")
     python = {name: value for name, value in vars(py.direct_runtime).items() if layout.fullmatch(name)}
     assert {"P_KFAC", "N_PARAMS", "U_AXIS"} <= set(python)
@@ -128,68 +109,40 @@ def test_the_parameter_layout_is_direct_model_s(table_pair):
 
 
 def test_the_parameter_array_is_surrogate_s(native, table_pair, small_table_path, tmp_path):
-    """The loader's "direct_parameters" equal surrogate's table.direct_parameters bit for bit: on a table that
-    records them, and on an older one (the configuration's aspect-ratio law, the tolerances and factors every
-    build used, q = 1); Φ(low) and Φ(high) from libm's erfc on both sides."""
+    """The loader's "direct_parameters" equal surrogate's table.direct_parameters bit for bit: on the table, and on
+    one whose rows model/parameters and wall/parameters hold other values in another field order (read by name);
+    Φ(low) and Φ(high) from libm's erfc on both sides."""
     python, c_table = table_pair
     assert _same(c_table.kernel_array("direct_parameters"), python.direct_parameters)
-    old = _old_table(small_table_path, tmp_path, "old.h5", **OLD)
-    expected = py.load(old).direct_parameters
-    assert _same(native.table(old).kernel_array("direct_parameters"), expected)
-    assert _same(expected, python.direct_parameters)
-
-
-@pytest.mark.parametrize("law", [
-    "aspect_ratio = {mean = 0.75, sd = 0.25, low = 0.4, high = 0.95}",
-    "[simulation.aspect_ratio]\nmean = 0.75\nsd = 0.25 # a comment\nlow = 0.4\nhigh = 0.95",
-])
-def test_an_old_table_takes_the_configuration_s_aspect_law(native, small_table_path, tmp_path, law):
-    """Without the aspect_ratio_* attributes the law comes from the build's configuration (TOML): the inline
-    table tablegen writes, or a [simulation.aspect_ratio] table; the same bits as surrogate."""
-    path = _old_table(small_table_path, tmp_path, "config.h5", **OLD)
-    with h5py.File(path, "r+") as f:
-        lines = str(f.attrs["config"]).split("\n")
-        inline = [k for k, line in enumerate(lines) if line.startswith("aspect_ratio")]
-        assert len(inline) == 1
-        if law.startswith("["):
-            del lines[inline[0]]
-            lines += ["", law]
-        else:
-            lines[inline[0]] = law
-        f.attrs["config"] = "\n".join(lines)
-    expected = py.load(path).direct_parameters
-    assert expected[:4].tolist() == [0.75, 0.25, 0.4, 0.95]
-    assert _same(native.table(path).kernel_array("direct_parameters"), expected)
-
-
-def test_a_table_without_the_factors_has_no_direct_model(native, small_table_path, tmp_path):
-    """An old table built at κ ≠ 0.3 does not record its second-moment factors: it loads, has no
-    "direct_parameters" (RBS_ERR_ARGUMENT), and rbs_direct_rebound gives RBS_INVALID with NaN."""
-    path = _old_table(small_table_path, tmp_path, "kappa.h5", **OLD, kappa=0.25)
-    assert py.load(path).direct_parameters is None
-    table = native.table(path)
-    with pytest.raises(KeyError):
-        table.kernel_array("direct_parameters")
-    status, V, W = _direct_c(_c(native), table.handle, 1, (100.0, -100.0, 0.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 1e-3,
-                             np.full(7, 0.5))
-    assert status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
+    other = _other_table(small_table_path, tmp_path, "other.h5", OTHER_MODEL, OTHER_WALL)
+    expected = py.load(other).direct_parameters
+    table = native.table(other)
+    try:
+        assert _same(table.kernel_array("direct_parameters"), expected)
+        assert table.wall()["parameters"] == {"k": 0.1, "p": 0.61, "q": 0.4}
+    finally:
+        table.close()
+    assert expected[py.direct_runtime.P_WALL + 2] == 0.4 and expected[py.direct_runtime.P_N_MAX] == 500
+    assert not _same(expected, python.direct_parameters)
 
 
 @pytest.mark.parametrize("changes, message", [
-    (dict(contact_tol=-1.0), "The 'contact_tol' parameter must be finite and > 0 (units of a); got -1"),
-    (dict(aspect_ratio_low=0.0), "The aspect-ratio bounds must satisfy 0 < low < high <= 1; got low=0"),
-    (dict(second_moment_factors=np.array([0.2, 0.3, 1.5, 0.2])), "The 'second_moment_factors' parameter must be 4 "
-                                                                  "numbers in (0, 1)"),
-    (dict(max_steps=0), "The 'max_steps' parameter must be an integer in [1, 2**53); got 0"),
+    (dict(contact_tol=-1.0), "field 'contact_tol' of dataset 'model/parameters' must be finite and > 0; got -1"),
+    (dict(aspect_ratio_low=0.0), "field 'aspect_ratio_low' of dataset 'model/parameters' must be in (0, 1); got 0"),
+    (dict(second_moment_factors=np.array([0.2, 0.3, 1.5, 0.2])), "field 'second_moment_factors' of dataset "
+                                                                  "'model/parameters' must be 4 numbers in (0, 1), one "
+                                                                  "per shape code; got 1.5 at index 2"),
+    (dict(max_steps=0), "field 'max_steps' of dataset 'model/parameters' must be an integer in [1, 2**53); got 0"),
 ])
 def test_parameters_out_of_range_refuse_the_table(native, small_table_path, tmp_path, changes, message):
-    """A parameter out of range: both readers refuse the table, naming the file and the value."""
-    path = _old_table(small_table_path, tmp_path, "bad.h5", **changes)
-    with pytest.raises(Exception, match="the direct model's parameters are out of range"):
+    """A parameter out of range: both readers refuse the table with one message naming the file, the field and
+    its range."""
+    path = _other_table(small_table_path, tmp_path, "bad.h5", changes)
+    with pytest.raises(ValueError) as info:
         py.load(path)
     code, table, text = native.open(path)
     assert code == ERR_FORMAT and table is None
-    assert text.startswith(f"{path}: the direct model's parameters are out of range: {message}")
+    assert text == str(info.value) == f"{path}: {message}"
 
 
 # -- the pieces ---------------------------------------------------------------------------------------------
@@ -302,23 +255,33 @@ def _particles(rng, count, spin):
 
 @pytest.mark.parametrize("spin", SPINS)
 def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
-    """rbs_direct_rebound against direct_rebound, PER_SHAPE particles of each shape in random caller frames,
-    the same uniforms: the same status, and for a rebound the same bits of V⁺ and Ω⁺ — multi-collision sequences
-    included, so every operation of the port is numba's (a last-bit difference would grow through them)."""
+    """The direct path of rbs_rebound (RBS_METHOD_DIRECT, the mix of one shape, the model's uniforms as u[1..7])
+    against direct_rebound, PER_SHAPE particles of each shape in random caller frames, the same uniforms: the same
+    status, and for a rebound the same bits of V⁺ and Ω⁺ — multi-collision sequences included, so every operation
+    of the port is numba's (a last-bit difference would grow through them); the result names the direct path
+    and the shape. Every tenth particle also through the direct path alone (the test-only library's
+    rbs_direct_rebound): the same bits."""
     python, c_table = table_pair
     c = _c(native)
     params = python.direct_parameters
+    assert python.shapes == tuple(py.SHAPES)       # the small table's shape i is the family of code i
     rng = np.random.default_rng(int(100 * spin) + 1)
     statuses = {}
     for shape in range(4):
-        for V, n, a, omega, u in _particles(rng, PER_SHAPE, spin):
+        for k, (V, n, a, omega, u) in enumerate(_particles(rng, PER_SHAPE, spin)):
             status, V_py, W_py = py.direct_rebound(params, python.shape_arrays, shape, V, omega, n, a, u)
-            mine = _direct_c(c, c_table.handle, shape, V, omega, n, a, u)
+            result, _ = c_table.hit(c_table.single(shape), V, omega, n, a, direct_uniforms(u), method=METHOD_DIRECT)
+            mine = result.status, np.array(result.V[:]), np.array(result.Omega[:])
             assert mine[0] == status
+            assert (result.path, result.shape) == ((PATH_DIRECT, shape) if status != INVALID else (PATH_NONE, -1))
             if status == py.STATUS_REBOUNDED:
                 assert _same(mine[1], V_py) and _same(mine[2], W_py), (shape, V, n, a, omega, u)
+                assert result.n_collisions >= 1
             else:
                 assert np.isnan(mine[1]).all() and np.isnan(mine[2]).all()
+            if k % 10 == 0:
+                alone = _direct_c(c, c_table.handle, shape, V, omega, n, a, u)
+                assert alone[0] == status and _same(alone[1], mine[1]) and _same(alone[2], mine[2])
             statuses[status] = statuses.get(status, 0) + 1
     assert statuses.get(py.STATUS_REBOUNDED, 0) > 0.9 * 4 * PER_SHAPE
     print(f"\n|Ω⁻|a/|V⁻| = {spin}: {4 * PER_SHAPE} particles, statuses {statuses}, 0 differing")
@@ -355,48 +318,90 @@ def test_grain_rebounds_bit_for_bit(native, table_pair, spin):
     print(f"\n|Ω⁻|a/|V⁻| = {spin}: {400 * len(GRAINS)} grains, statuses {statuses}, 0 differing")
 
 
+def test_collision_counts_are_numba_s(native, table_pair):
+    """rbs_result.n_collisions of the direct path is rebound_model_frame's count: hits in the model frame itself
+    (n = +Y, V⁻ in the XY plane with V⁻_x > 0 a power of 2, so the impact frame is the caller's exactly), spinning
+    and not."""
+    python, c_table = table_pair
+    params = python.direct_parameters
+    rng = np.random.default_rng(12)
+    scratch = np.empty(py.SCRATCH_SIZE)
+    counts = set()
+    for k in range(400):
+        shape, a = k % 4, 1e-3
+        V = np.array([2.0 ** rng.integers(3, 9), -rng.uniform(5.0, 300.0), 0.0])
+        speed = np.linalg.norm(V)
+        omega = rng.normal(size=3) * (speed / a) * (0.0 if k % 3 == 0 else 0.3)
+        u = rng.random(py.U_PER_REBOUND)
+        result, _ = c_table.hit(c_table.single(shape), V, omega, (0.0, 1.0, 0.0), a, direct_uniforms(u),
+                                method=METHOD_DIRECT)
+        theirs = py.rebound_model_frame(params, python.shape_arrays, shape, V[0], V[1], *(a * omega), u, scratch)
+        assert result.status == theirs[0], k
+        if result.status == py.STATUS_REBOUNDED:
+            assert result.n_collisions == theirs[1], (k, result.n_collisions, theirs[1])
+            counts.add(result.n_collisions)
+    assert len(counts) > 2, counts
+
+
 def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_table_path):
     """The library built for the x86-64 baseline (the frame's fma() from the C library, not the FMA
-    instruction): the same bits as numba on 2000 spinning particles of every shape."""
+    instruction): the same bits as numba on 2000 spinning particles of every shape (rbs_rebound, direct path)."""
     python, _ = table_pair
-    c, table = _c(native_baseline), native_baseline.table(small_table_path)
+    table = native_baseline.table(small_table_path)
     rng = np.random.default_rng(11)
     for k, (V, n, a, omega, u) in enumerate(_particles(rng, 2000, 0.3)):
         status, V_py, W_py = py.direct_rebound(python.direct_parameters, python.shape_arrays, k % 4, V, omega, n, a, u)
-        mine = _direct_c(c, table.handle, k % 4, V, omega, n, a, u)
+        mine = table.direct(k % 4, V, omega, n, a, u)
         assert mine[0] == status and (status != py.STATUS_REBOUNDED or (_same(mine[1], V_py) and _same(mine[2], W_py)))
 
 
 # -- hostile inputs -----------------------------------------------------------------------------------------
 
 GOOD = dict(shape=1, V=(100.0, -100.0, 0.0), omega=(0.0, 0.0, 0.0), n=(0.0, 1.0, 0.0), a=1e-3, u=np.full(7, 0.5))
-
-
-@pytest.mark.parametrize("change", [
+CHANGES = [
     dict(V=(100.0, 50.0, 0.0)), dict(V=(0.0, 0.0, 0.0)), dict(V=(np.nan, -100.0, 0.0)), dict(V=(np.inf, -100.0, 0.0)),
     dict(n=(0.0, 1.1, 0.0)), dict(n=(0.0, np.nan, 0.0)), dict(a=0.0), dict(a=-1.0), dict(a=np.inf), dict(a=np.nan),
     dict(omega=(0.0, np.nan, 0.0)), dict(omega=(np.inf, 0.0, 0.0)), dict(omega=(1e308, 1e308, 0.0)),
-    dict(shape=4), dict(shape=-1), dict(u=np.full(7, 1.0)), dict(u=np.full(7, np.nan)), dict(u=np.full(7, -1e-300)),
-    dict(V=None), dict(omega=None), dict(n=None), dict(u=None),
-])
+    dict(u=np.full(7, 1.0)), dict(u=np.full(7, np.nan)), dict(u=np.full(7, -1e-300)),
+]
+
+
+@pytest.mark.parametrize("change", CHANGES)
 def test_bad_input_is_invalid_with_nan(native, table_pair, change):
-    """Every input outside its range, or a NULL pointer: RBS_INVALID and NaN outputs (numba agrees where it takes
-    the input at all)."""
+    """Every input outside its range: RBS_INVALID and NaN outputs, from rbs_rebound's direct path (the mix of one
+    shape) and from the direct path alone; numba agrees."""
     c = _c(native)
     args = dict(GOOD, **change)
-    status, V, W = _direct_c(c, table_pair[1].handle, args["shape"], args["V"], args["omega"], args["n"], args["a"],
-                             args["u"])
+    mine = table_pair[1].direct(args["shape"], args["V"], args["omega"], args["n"], args["a"], args["u"])
+    alone = _direct_c(c, table_pair[1].handle, args["shape"], args["V"], args["omega"], args["n"], args["a"],
+                      args["u"])
+    for status, V, W in (mine, alone):
+        assert status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
+    theirs = py.direct_rebound(table_pair[0].direct_parameters, table_pair[0].shape_arrays, args["shape"],
+                               np.asarray(args["V"], float), np.asarray(args["omega"], float),
+                               np.asarray(args["n"], float), args["a"], args["u"])
+    assert theirs[0] == py.STATUS_INVALID
+
+
+@pytest.mark.parametrize("change", [dict(shape=4), dict(shape=-1), dict(V=None), dict(omega=None), dict(n=None),
+                                    dict(u=None)])
+def test_bad_arguments_of_the_direct_path_alone(native, table_pair, change):
+    """The direct path alone (rbs_direct_rebound, internal) given a shape code outside the table's or a NULL
+    pointer: RBS_INVALID and NaN outputs (numba agrees on the shape codes)."""
+    args = dict(GOOD, **change)
+    status, V, W = _direct_c(_c(native), table_pair[1].handle, args["shape"], args["V"], args["omega"], args["n"],
+                             args["a"], args["u"])
     assert status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
     if all(args[k] is not None for k in ("V", "omega", "n", "u")):
         theirs = py.direct_rebound(table_pair[0].direct_parameters, table_pair[0].shape_arrays, args["shape"],
-                                   np.asarray(args["V"], float),
-                                   np.asarray(args["omega"], float), np.asarray(args["n"], float), args["a"],
-                                   args["u"])
+                                   np.asarray(args["V"], float), np.asarray(args["omega"], float),
+                                   np.asarray(args["n"], float), args["a"], args["u"])
         assert theirs[0] == py.STATUS_INVALID
 
 
 def test_null_table_and_outputs(native, table_pair):
-    """A NULL table: RBS_INVALID with NaN; a NULL output: RBS_INVALID, NaN in the other."""
+    """The direct path alone: a NULL table: RBS_INVALID with NaN; a NULL output: RBS_INVALID, NaN in the other
+    (rbs_rebound's NULL arguments: test_native_spin)."""
     c = _c(native)
     status, V, W = _direct_c(c, None, GOOD["shape"], GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], GOOD["u"])
     assert status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
@@ -411,12 +416,17 @@ def test_null_table_and_outputs(native, table_pair):
 
 
 def test_minus_zero_uniform_is_taken_as_numba_takes_it(native, table_pair):
-    """u = −0 is in [0, 1) for the direct model (numba's 0.0 <= u): a rebound, the same bits."""
-    c = _c(native)
+    """u = −0 is in [0, 1) for the direct model alone (numba's direct_rebound: 0.0 <= u): a rebound, the same bits;
+    a hit's 13 uniforms must be in [+0, 1) on every path (numba's rebound, rbs_rebound): −0 there is refused."""
+    python, c_table = table_pair
     u = np.full(7, 0.5)
     u[3] = -0.0
-    status, V, W = _direct_c(c, table_pair[1].handle, 2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
-    theirs = py.direct_rebound(table_pair[0].direct_parameters, table_pair[0].shape_arrays, 2, np.asarray(GOOD["V"]),
-                               np.asarray(GOOD["omega"]),
-                               np.asarray(GOOD["n"]), GOOD["a"], u)
+    theirs = py.direct_rebound(python.direct_parameters, python.shape_arrays, 2, np.asarray(GOOD["V"]),
+                               np.asarray(GOOD["omega"]), np.asarray(GOOD["n"]), GOOD["a"], u)
+    status, V, W = _direct_c(_c(native), c_table.handle, 2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
     assert status == theirs[0] == py.STATUS_REBOUNDED and _same(V, theirs[1]) and _same(W, theirs[2])
+    hit = py.rebound(python.kernel_data, python.direct_parameters, python.shape_arrays, python.model_shapes,
+                     py.mix_cdf(python, "cut_prism"), GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"],
+                     direct_uniforms(u), py.METHOD_DIRECT)
+    status, V, W = c_table.direct(2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
+    assert status == hit[0] == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()

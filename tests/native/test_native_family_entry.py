@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from tests.helpers import python_side as py
-from tests.helpers.native_library import DIRECT, SCALED
+from tests.helpers.native_library import FAMILY_NONE, INTERPOLATION_SCALED, METHOD_DIRECT
 
 
 def test_c_draws_the_entry_from_its_record_with_the_bits_of_numba(native, octahedron_table_path):
@@ -15,7 +15,7 @@ def test_c_draws_the_entry_from_its_record_with_the_bits_of_numba(native, octahe
     rng = np.random.default_rng(45)
     try:
         info = c_table.shape_info(1)
-        assert info["family"] == -1 and info["direct_shape"] == table.model_shapes[1] == 4
+        assert info["family"] == FAMILY_NONE and table.model_shapes[1] == 4
         assert info["vertices"].tobytes() == table.shape_datasets["vertices"][8:14].tobytes()
         mix, message = c_table.mix_new(shape="octahedron")
         assert mix is not None, message
@@ -24,7 +24,7 @@ def test_c_draws_the_entry_from_its_record_with_the_bits_of_numba(native, octahe
         alpha1, speed = np.radians(rng.uniform(30.0, 70.0, n)), rng.uniform(100.0, 200.0, n)
         V = np.stack([speed * np.cos(alpha1), -speed * np.sin(alpha1), np.zeros(n)], axis=1)
         normal, a, u = np.tile([0.0, 1.0, 0.0], (n, 1)), np.full(n, 1e-4), rng.random((n, py.U_PER_DRAW))
-        status, c_V, c_W = c_table.table_rebound_many(mix, V, normal, a, u, SCALED)
+        status, c_V, c_W = c_table.draw_many(mix, V, normal, a, u, interpolation=INTERPOLATION_SCALED)
         V_out, W_out, py_status = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int8)
         py.table_rebound_many(table.kernel_data, cdf, V, normal, a, u, V_out, W_out, py_status, True)
         assert np.array_equal(status, py_status) and np.mean(status == py.STATUS_REBOUNDED) > 0.9
@@ -32,7 +32,8 @@ def test_c_draws_the_entry_from_its_record_with_the_bits_of_numba(native, octahe
         for omega in ((0.0, 0.0, 0.0), (0.0, 0.0, 3e5), (2e5, -1e5, 0.0)):
             for k in range(5):
                 u1 = rng.random(py.U_PER_DRAW)
-                c = c_table.rebound(mix, V[k], np.array(omega), np.array([0.0, 1.0, 0.0]), 1e-4, u1, method=DIRECT)
+                c = c_table.rebound(mix, V[k], np.array(omega), np.array([0.0, 1.0, 0.0]), 1e-4, u1,
+                                    method=METHOD_DIRECT)
                 p = py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes,
                                cdf, tuple(V[k]), omega, (0.0, 1.0, 0.0), 1e-4, u1, py.METHOD_DIRECT)
                 assert c[0] == p[0] != py.STATUS_INVALID, (omega, c[0], p[0])

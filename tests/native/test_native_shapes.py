@@ -1,9 +1,8 @@
-"""Tables store their shapes (format 3.4, group /shapes; docs/format.md, "Shapes"), and both runtimes read them
+"""Tables store their shapes (group /shapes; docs/format.md, "Shapes"), and both runtimes read them
 from there: registry records round trip through the file bit for bit; a table of 64 shapes (the families and
 60 user grains) loads in Python and C with the same records, its mix draws each shape with its weight, and the
 C and numba kernels draw the same bits from it; a flipped bit or an out-of-range value in any /shapes dataset
-fails to load in both loaders with a message naming the dataset; a table without the group (before 3.4) gets
-the families' records from its κ and aspect-ratio law, in both runtimes, and draws its bits unchanged."""
+fails to load in both loaders with a message naming the dataset, and so does a table without the group."""
 
 from __future__ import annotations
 
@@ -14,7 +13,7 @@ import pytest
 from tests.helpers import python_side as py
 from tests.helpers.tables import edited_copy
 from tests.helpers.bad_files import _corrupt_chunk, _flip_bit, _set
-from tests.helpers.native_library import DIRECT, ERR_FORMAT
+from tests.helpers.native_library import ERR_FORMAT, FAMILY_NONE, METHOD_DIRECT
 
 SHAPE_DATASETS = ("name", "kind", "vertex_start", "vertices", "triangle_start", "triangles", "inertia", "aspect",
                   "both_hands")
@@ -70,8 +69,7 @@ def test_a_table_of_64_shapes_loads_alike_in_python_and_c(native, many_shapes):
             info = c_table.shape_info(i)
             start, stop = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
             assert info["name"] == name and info["kind"] == arrays["kind"][i]
-            assert info["family"] == (i if i < 4 else -1) and info["both_hands"] == arrays["both_hands"][i]
-            assert info["direct_shape"] == table.model_shapes[i]
+            assert info["family"] == (i if i < 4 else FAMILY_NONE) and info["both_hands"] == arrays["both_hands"][i]
             assert _same_arrays(info["vertices"], arrays["vertices"][start:stop])
             assert _same_arrays(info["inertia"], arrays["inertia"][i]) and _same_arrays(info["aspect"], arrays["aspect"][i])
         assert c_table.shape_info(64) is None
@@ -90,7 +88,7 @@ def _distinct_cells(source, folder):
 
 
 def test_the_mix_draws_each_of_64_shapes_with_its_weight_in_c_and_python_alike(native, many_shapes, tmp_path):
-    """Weights w_k ∝ k + 1 over the 64 shapes; n = 64 000 draws in C (rbs_table_rebound_many, a mix of
+    """Weights w_k ∝ k + 1 over the 64 shapes; n = 64 000 draws in C (rbs_draw_many, a mix of
     rbs_mix_new_from_weights) and numba (the same uniforms, surrogate.mix_cdf): the same bits. Each draw's shape
     is found as the one whose single-shape mix gives the same bits; the counts' chi-square over 63 degrees of
     freedom stays below its 1 - 1e-6 quantile, 131.4 (fixed seed: the test is deterministic; a correct mix fails
@@ -110,7 +108,7 @@ def test_the_mix_draws_each_of_64_shapes_with_its_weight_in_c_and_python_alike(n
     try:
         mix, message = c_table.mix_new(weights=dict(zip(names, weights)))
         assert mix is not None, message
-        status, c_V, _ = c_table.table_rebound_many(mix, V, normal, a, u)
+        status, c_V, _ = c_table.draw_many(mix, V, normal, a, u)
         V_out, W_out, py_status = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int8)
         py.table_rebound_many(table.kernel_data, py.mix_cdf(table, dict(zip(names, weights))), V, normal, a, u, V_out,
                               W_out, py_status)
@@ -119,7 +117,7 @@ def test_the_mix_draws_each_of_64_shapes_with_its_weight_in_c_and_python_alike(n
         shape = np.full(n, -1)
         for j, name in enumerate(names):
             single, _ = c_table.mix_new(name)
-            _, V_j, _ = c_table.table_rebound_many(single, V, normal, a, u)
+            _, V_j, _ = c_table.draw_many(single, V, normal, a, u)
             same = np.all(V_j == c_V, axis=1)
             assert np.all(shape[same] == -1)         # one shape only gives a draw's bits
             shape[same] = j
@@ -164,7 +162,7 @@ def test_a_bad_value_in_any_shapes_dataset_is_refused_by_both(native, small_tabl
 
 def test_a_bad_value_in_a_user_grain_is_refused_by_both(native, many_shapes, tmp_path):
     """A user grain's row (shape 4): a name outside NAME_PATTERN, a vertex count over 256 or under 4, a vertex
-    outside the unit box's bound, a law with low >= high, and the group missing from a 3.4 table."""
+    outside the unit box's bound, a law with low >= high, and the group missing."""
     path = many_shapes[0]
     with h5py.File(path, "r") as f:
         start = f["shapes/vertex_start"][()]
@@ -175,62 +173,28 @@ def test_a_bad_value_in_a_user_grain_is_refused_by_both(native, many_shapes, tmp
     _refused_alike(native, edited_copy(path, tmp_path, "no_group.h5", lambda f: f.__delitem__("shapes")), "'shapes'")
 
 
-def test_a_table_before_3_4_gets_the_families_records_and_draws_the_same_bits(native, small_table_path, tmp_path):
-    """Group /shapes deleted and the version set to 3.3: both runtimes synthesise the families' records at the
-    table's κ and law (C: inertia 2 s from the second-moment factors, within 4 ulp of the registry's mass
-    properties), and both draw the bits of the 3.4 file."""
-    def format_3_3(f):
-        f.attrs["format_version"] = np.array([3, 3], dtype=np.int64)
-        del f["shapes"]
-
-    old = edited_copy(small_table_path, tmp_path, "v3_3.h5", format_3_3)
-    new_table, old_table = py.load(small_table_path), py.load(old)
-    assert old_table.records and all(a.name == b.name for a, b in zip(old_table.records, new_table.records))
-    for key, values in new_table.shape_datasets.items():
-        assert _same_arrays(old_table.shape_datasets[key], values), key
-    c_old = native.table(old)
-    try:
-        for i, name in enumerate(old_table.shapes):
-            info, arrays = c_old.shape_info(i), new_table.shape_datasets
-            start, stop = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
-            assert info["name"] == name and _same_arrays(info["vertices"], arrays["vertices"][start:stop])
-            assert _same_arrays(info["aspect"], arrays["aspect"][i]) and info["both_hands"] == arrays["both_hands"][i]
-            assert np.allclose(info["inertia"], arrays["inertia"][i], rtol=4 * np.finfo(float).eps, atol=0.0)
-    finally:
-        c_old.close()
-    rng = np.random.default_rng(33)
-    n = 5_000
-    u = rng.random((n, py.U_PER_DRAW))
-    V = np.tile([100.0, -120.0, 5.0], (n, 1))
-    normal, a = np.tile([0.0, 1.0, 0.0], (n, 1)), np.full(n, 1e-4)
-    draws = []
-    for path in (small_table_path, old):
-        t = native.table(path)
-        try:
-            status, V_out, _ = t.table_rebound_many(t.mix_equal(), V, normal, a, u)
-        finally:
-            t.close()
-        draws.append((status.tobytes(), V_out.tobytes()))
-    assert draws[0] == draws[1]
-
-
 def test_a_flipped_kappa_bit_changes_the_families_and_is_refused(native, small_table_path, tmp_path):
-    """κ decides the cut prism's record: a flipped bit of the attribute fails to load (grid/law), and a table
-    whose cut prism's vertices were made at another κ (its checksums rewritten) is refused by both."""
+    """κ decides the cut prism's record: a flipped bit of the field kappa of model/parameters (its checksum
+    rewritten) no longer gives the stored record and is refused, and so is a table whose cut prism's vertices
+    were made at another κ (their checksums rewritten)."""
     def other_kappa(f):
         from direct_model.registry import built_in_shape
         from direct_model.shapes import AspectRatioLaw
-        law = AspectRatioLaw(*(float(f["grid"].attrs[k]) for k in ("aspect_ratio_mean", "aspect_ratio_sd",
-                                                                    "aspect_ratio_low", "aspect_ratio_high")))
+        row = f["model/parameters"][0]
+        law = AspectRatioLaw(*(float(row[k]) for k in ("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low",
+                                                        "aspect_ratio_high")))
         start = f["shapes/vertex_start"][()]
         vertices = f["shapes/vertices"][()]
         vertices[start[2]:start[3]] = built_in_shape("cut_prism", 0.25, law).vertices
         f["shapes/vertices"][...] = vertices
 
     _refused_alike(native, edited_copy(small_table_path, tmp_path, "kappa_vertices.h5", other_kappa), "shapes/vertices")
-    flipped = edited_copy(small_table_path, tmp_path, "kappa_bit.h5",
-                    lambda f: f["grid"].attrs.__setitem__("kappa", _flip_bit(float(f["grid"].attrs["kappa"]), 40)))
-    _refused_alike(native, flipped, "kappa")
+    def flip_kappa(f):
+        row = f["model/parameters"][()]
+        row["kappa"] = _flip_bit(float(row["kappa"][0]), 40)
+        f["model/parameters"][...] = row
+
+    _refused_alike(native, edited_copy(small_table_path, tmp_path, "kappa_bit.h5", flip_kappa), "kappa")
 
 
 def test_user_grains_of_a_table_rebound_alike_in_c_and_numba(native, many_shapes):
@@ -250,7 +214,8 @@ def test_user_grains_of_a_table_rebound_alike_in_c_and_numba(native, many_shapes
             for alpha1, omega in ((20.0, (0.0, 0.0, 0.0)), (55.0, (0.0, 0.0, 3e5)), (85.0, (2e5, -1e5, 0.0))):
                 V = np.array([120.0 * np.cos(np.radians(alpha1)), -120.0 * np.sin(np.radians(alpha1)), 0.0])
                 u = rng.random(py.U_PER_DRAW)
-                c = c_table.rebound(mix, V, np.array(omega), np.array([0.0, 1.0, 0.0]), 1e-4, u, method=DIRECT)
+                c = c_table.rebound(mix, V, np.array(omega), np.array([0.0, 1.0, 0.0]), 1e-4, u,
+                                    method=METHOD_DIRECT)
                 p = py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes,
                                cdf, tuple(V), omega, (0.0, 1.0, 0.0), 1e-4, u, py.METHOD_DIRECT)
                 assert c[0] == p[0], (names[k], alpha1, c[0], p[0])

@@ -1,12 +1,12 @@
-"""Every wall hit answered in C: rbs_rebound_path, rbs_rebound and rbs_rebound_rng give the paths and
-the bits of surrogate.kernels.wall_hit (rebound_path, rebound) for the same uniforms.
+"""Every wall hit answered in C: rbs_rebound_path and rbs_rebound (uniforms given, or drawn from an rbs_rng) give
+the paths and the bits of surrogate.kernels.wall_hit (rebound_path, rebound) for the same uniforms.
 
 Over random incident states (over and beyond the table's grid, the hostile ones of tests.helpers.states.incident_states)
 with Ω⁻ zero, below the spin tolerance, at it, above it, large, and NaN or infinite, under the three methods:
-the path, the status and V⁺, Ω⁺ of C equal numba's (0 ulp); the paths follow the rule (checked here on the
-states' own numbers, away from the edges); where the table answers under auto, the table path's bits. Hostile
-arguments (NULL pointers, unknown methods, bad Ω⁻, a NULL or all-zero rng) give RBS_INVALID and NaN, never a
-crash.
+the path, the status and V⁺, Ω⁺ of C equal numba's (0 ulp), and rbs_result says the path that answered; the paths
+follow the rule (checked here on the states' own numbers, away from the edges); where the table answers under auto,
+the table path's bits. Hostile arguments (NULL pointers, a mix of another table, unknown methods and
+interpolations, bad Ω⁻, no uniforms, a NULL or all-zero rng) give RBS_INVALID and NaN, never a crash.
 """
 
 from __future__ import annotations
@@ -17,9 +17,13 @@ import numpy as np
 import pytest
 
 from tests.helpers import python_side as py
-from tests.helpers.native_library import (AUTO, DIRECT, INVALID, PATH_DIRECT, PATH_TABLE, SCALED, STOCHASTIC, TABLE, Mix,
-                                          Rng, _ptr)
+from tests.helpers.native_library import (INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC, INVALID, METHOD_AUTO,
+                                          METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_NONE, PATH_TABLE, Options,
+                                          Result, Rng, hit, options, ref)
 from tests.helpers.states import incident_states, max_ulp, uniforms
+
+AUTO, TABLE, DIRECT = METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT
+SCALED, STOCHASTIC = INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC
 
 COUNT = 2500        # states per method: the direct path runs the model (microseconds each, twice)
 METHODS = {"auto": AUTO, "table": TABLE, "direct": DIRECT}
@@ -59,8 +63,7 @@ def spin_case(table_pair):
     assert table.direct_parameters is not None, "the small table must record the direct model's parameters"
     shapes = list(table.shapes)
     weights = dict(zip(shapes, np.arange(1.0, len(shapes) + 1) / np.arange(1.0, len(shapes) + 1).sum()))
-    code, mix, message = native_table.mix_from_weights(weights)
-    assert code == 0, message
+    mix = native_table.mix(weights)
     V, omega, kind, n, a, u = spin_states(table)
     return table, native_table, mix, py.mix_cdf(table, weights), V, omega, kind, n, a, u
 
@@ -90,6 +93,9 @@ def _numba(table, cdf, V, omega, n, a, u, method, scaled=True):
 
 @pytest.mark.parametrize("method", sorted(METHODS))
 def test_paths_and_bits_equal_numba(spin_case, method):
+    """rbs_rebound_path and rbs_rebound = numba's rebound_path and rebound; rbs_result names the path that answered
+    (rbs_rebound_path's), the shape the mix gave (u[0]) and, on the table path, no collision count; an invalid hit
+    names no path and no shape."""
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     code = METHODS[method]
     paths, status = np.empty(COUNT, dtype=int), np.empty(COUNT, dtype=int)
@@ -98,11 +104,17 @@ def test_paths_and_bits_equal_numba(spin_case, method):
         paths[i] = native_table.rebound_path(V[i], omega[i], n[i], a[i], code)
         assert paths[i] == py.rebound_path(table.kernel_data, tuple(V[i]), tuple(omega[i]), tuple(n[i]), a[i],
                                            code), i
-        st, v, w = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u[i], code)
+        result, _ = native_table.hit(mix, V[i], omega[i], n[i], a[i], u[i], method=code)
+        st, v, w = result.status, np.array(result.V[:]), np.array(result.Omega[:])
         st_py, v_py, w_py = _numba(table, cdf, V[i], omega[i], n[i], a[i], u[i], code)
         assert st == st_py, (i, st, st_py)
         worst = max(worst, max_ulp(v, np.array(v_py)), max_ulp(w, np.array(w_py)))
         status[i] = st
+        if st == INVALID:
+            assert (result.path, result.shape, result.n_collisions) == (PATH_NONE, -1, -1), i
+        else:
+            assert result.path == paths[i] and result.shape == py.mix_shape(cdf, u[i][0]), i
+            assert (result.n_collisions == -1) == (result.path == PATH_TABLE), (i, result.n_collisions)
     print(f"\n{method}: paths table {np.sum(paths == PATH_TABLE)}, direct {np.sum(paths == PATH_DIRECT)}, invalid "
           f"{np.sum(paths == INVALID)}; statuses {np.unique(status, return_counts=True)}; largest ulp difference "
           f"{worst}")
@@ -141,9 +153,9 @@ def test_auto_picks_the_path_by_spin_and_grid(spin_case):
     assert at.sum() >= 20
 
 
-def test_table_path_is_rbs_table_rebound_bit_for_bit(spin_case):
-    """Where auto takes the table, and always under table, the answer is rbs_table_rebound's with the same
-    uniforms (both interpolations)."""
+def test_table_path_is_the_table_s_draw_bit_for_bit(spin_case):
+    """Where auto takes the table, and always under table, the answer is that of the table path alone (the
+    test-only library's rbs_table_rebound, Ω⁻ not given) with the same uniforms, both interpolations."""
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     checked = 0
     for interpolation in (SCALED, STOCHASTIC):
@@ -151,84 +163,111 @@ def test_table_path_is_rbs_table_rebound_bit_for_bit(spin_case):
             for method in (AUTO, TABLE):
                 if native_table.rebound_path(V[i], omega[i], n[i], a[i], method) != PATH_TABLE:
                     continue
-                st, v, w = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u[i], method, interpolation)
-                st_t, v_t, w_t = native_table.table_rebound(mix, V[i], n[i], a[i], u[i], interpolation)
+                st, v, w = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u[i], method=method,
+                                                interpolation=interpolation)
+                st_t, v_t, w_t = _table_path_alone(native_table, mix, V[i], n[i], a[i], u[i], interpolation)
                 assert st == st_t and max_ulp(v, v_t) == 0 and max_ulp(w, w_t) == 0, (i, method)
                 checked += 1
     assert checked > COUNT
 
 
+def _table_path_alone(native_table, mix, V, n, a, u, interpolation):
+    """(status, V⁺, Ω⁺) of the test-only library's rbs_table_rebound: the table path without the path decision."""
+    arrays = [np.ascontiguousarray(x, dtype=np.float64) for x in (V, n, u)]
+    V_out, W_out = np.full(3, 7.0), np.full(3, 7.0)
+    status = native_table.lib.internal.rbs_table_rebound(native_table.handle, mix.pointer, arrays[0].ctypes.data,
+                                                         arrays[1].ctypes.data, float(a), arrays[2].ctypes.data,
+                                                         interpolation, V_out.ctypes.data, W_out.ctypes.data)
+    return status, V_out, W_out
+
+
 def test_rng_form_draws_thirteen_uniforms_whatever_the_path(spin_case, native):
-    """rbs_rebound_rng = rbs_rng_fill of 13 uniforms, then rbs_rebound; the stream advances by 13 per
-    hit whatever the path and the status (invalid hits too)."""
+    """rbs_rebound with hit.rng (hit.u NULL) = rbs_rng_fill of 13 uniforms, then rbs_rebound with them, keyed or
+    not; the stream advances by 13 per hit whatever the path and the status (invalid hits too)."""
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     state = py.seed_state(2811)
     for i in range(0, COUNT, 5):
         for method in METHODS.values():
             u_i, after = native.fill(state, 13)
-            st, v, w, advanced = native_table.rebound_rng(mix, V[i], omega[i], n[i], a[i], state, method)
-            st_u, v_u, w_u = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u_i, method)
+            st, v, w, advanced = native_table.rebound(mix, V[i], omega[i], n[i], a[i], state=state, method=method)
+            st_u, v_u, w_u = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u_i, method=method)
             assert np.array_equal(advanced, after), i
             assert st == st_u and max_ulp(v, v_u) == 0 and max_ulp(w, w_u) == 0, i
             state = advanced
 
 
-def test_the_0x_name_rbs_rebound_spin_is_rbs_rebound_rng(spin_case):
-    """rbs_rebound_spin, kept for programs written against 0.x: rbs_rebound_rng's statuses and bits, its stream
-    advanced alike, under every method."""
+def test_hit_u_is_taken_before_hit_rng(spin_case, native):
+    """A hit given both uniforms and an rng takes the uniforms and leaves the rng alone."""
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     state = py.seed_state(2812)
-    for i in range(0, COUNT, 25):
+    for i in range(0, COUNT, 50):
         for method in METHODS.values():
-            new = native_table.rebound_rng(mix, V[i], omega[i], n[i], a[i], state, method)
-            old = native_table.rebound_rng(mix, V[i], omega[i], n[i], a[i], state, method, symbol="rbs_rebound_spin")
-            assert new[0] == old[0], (i, method)
-            assert all(np.array_equal(x.view(np.uint64), y.view(np.uint64)) for x, y in zip(new[1:], old[1:])), i
-            state = new[3]
+            rng = Rng((ctypes.c_uint64 * 4)(*map(int, state)))
+            h, kept = hit(V[i], omega[i], n[i], a[i], u[i], rng)
+            result = Result()
+            assert native.c.rbs_rebound(native_table.handle, mix.pointer, ref(h), ref(options(method)),
+                                        ref(result)) == result.status
+            st, v, w = native_table.rebound(mix, V[i], omega[i], n[i], a[i], u[i], method=method)
+            assert result.status == st and max_ulp(np.array(result.V[:]), v) == 0, i
+            assert max_ulp(np.array(result.Omega[:]), w) == 0, i
+            assert list(rng.s) == [int(x) for x in state], i
 
 
-def test_hostile_arguments_give_invalid_and_nan(spin_case, native):
+def _raw_rebound(c, table_handle, mix_pointer, h, opts, result=True):
+    """rbs_rebound on raw records: (returned status, the result record, prefilled with 7.0, or None)."""
+    out = Result(status=77, path=77, shape=77, n_collisions=77) if result else None
+    if out is not None:
+        out.V[:], out.Omega[:] = [7.0] * 3, [7.0] * 3
+    st = c.rbs_rebound(table_handle, mix_pointer, ref(h), ref(opts), ref(out))
+    return st, out
+
+
+def test_hostile_arguments_give_invalid_and_nan(spin_case, native, small_table_path, grain_table_path):
     table, native_table, mix, cdf, V, omega, kind, n, a, u = spin_case
     c, h = native.c, native_table.handle
     with np.errstate(over="ignore"):
         i = int(np.flatnonzero((kind == LARGE) & (np.linalg.norm(V, axis=1) > 0))[0])
     Vi, Wi, ni, ui = (np.ascontiguousarray(x, dtype=np.float64) for x in (V[i], omega[i], n[i], u[i]))
     assert native_table.rebound_path(Vi, Wi, ni, a[i], AUTO) in (PATH_TABLE, PATH_DIRECT)
-
-    def rebound(table_handle, mix_arg, V_, W_, n_, a_, u_, method, interpolation=SCALED, outputs=True):
-        out = (np.full(3, 7.0), np.full(3, 7.0))
-        st = c.rbs_rebound(table_handle, mix_arg, V_, W_, n_, ctypes.c_double(a_), u_, method, interpolation,
-                           _ptr(out[0]) if outputs else None, _ptr(out[1]) if outputs else None)
-        return st, out
-
-    mix_ref = ctypes.byref(mix)
-    good = (_ptr(Vi), _ptr(Wi), _ptr(ni), a[i], _ptr(ui))
-    wrong_mix = Mix(mix.n_shapes + 1, mix.cdf)
-    cases = {"NULL table": (None, mix_ref, *good, AUTO), "NULL mix": (h, None, *good, AUTO),
-             "NULL V": (h, mix_ref, None, *good[1:], AUTO), "NULL Omega": (h, mix_ref, good[0], None, *good[2:], AUTO),
-             "NULL n": (h, mix_ref, *good[:2], None, *good[3:], AUTO), "NULL u": (h, mix_ref, *good[:4], None, AUTO),
-             "method 3": (h, mix_ref, *good, 3), "method -1": (h, mix_ref, *good, -1),
-             "mix of another shape count": (h, ctypes.byref(wrong_mix), *good, AUTO)}
+    good, kept = hit(Vi, Wi, ni, a[i], ui)
+    assert _raw_rebound(c, h, mix.pointer, good, None)[0] != INVALID     # the good arguments are good
+    no_uniforms, _ = hit(Vi, Wi, ni, a[i])
+    # mixes of another table: of the grain table (2 shapes), and of another rbs_table of the same file
+    other_tables = [native.table(grain_table_path), native.table(small_table_path)]
+    other_mixes = [t.mix() for t in other_tables]
+    cases = {"NULL table": (None, mix.pointer, good, None), "NULL mix": (h, None, good, None),
+             "NULL hit": (h, mix.pointer, None, None), "no u and no rng": (h, mix.pointer, no_uniforms, None),
+             "method 3": (h, mix.pointer, good, Options(method=3)),
+             "method -1": (h, mix.pointer, good, Options(method=-1)),
+             "interpolation 5": (h, mix.pointer, good, Options(interpolation=5)),
+             "interpolation -1": (h, mix.pointer, good, Options(interpolation=-1)),
+             "mix of another table": (h, other_mixes[0].pointer, good, None),
+             "mix of another rbs_table of the same file": (h, other_mixes[1].pointer, good, None)}
     for label, args in cases.items():
-        st, (v, w) = rebound(*args)
-        assert st == INVALID and np.isnan(v).all() and np.isnan(w).all(), label
-    st, (v, w) = rebound(h, mix_ref, *good, AUTO, interpolation=5)
-    assert st == INVALID and np.isnan(v).all(), "unknown interpolation"
-    st, _ = rebound(h, mix_ref, *good, AUTO, outputs=False)
-    assert st == INVALID, "NULL outputs"
+        st, result = _raw_rebound(c, *args)
+        assert st == result.status == INVALID, (label, st, result.status)
+        assert np.isnan(result.V[:]).all() and np.isnan(result.Omega[:]).all(), label
+        assert (result.path, result.shape) == (PATH_NONE, -1), label
+    st, _ = _raw_rebound(c, h, mix.pointer, good, None, result=False)
+    assert st == INVALID, "NULL result"
     for bad in (np.nan, np.inf, -np.inf):
         for k in range(3):
             W_bad = Wi.copy()
             W_bad[k] = bad
             for method in METHODS.values():
-                assert native_table.rebound_path(Vi, W_bad, ni, a[i], method) == INVALID
-                st, v, w = native_table.rebound(mix, Vi, W_bad, ni, a[i], ui, method)
+                assert native_table.rebound_path(Vi, W_bad, ni, a[i], method) == PATH_NONE
+                st, v, w = native_table.rebound(mix, Vi, W_bad, ni, a[i], ui, method=method)
                 assert st == INVALID and np.isnan(v).all() and np.isnan(w).all(), (bad, k, method)
-    assert c.rbs_rebound_path(None, _ptr(Vi), _ptr(Wi), _ptr(ni), ctypes.c_double(a[i]), AUTO) == INVALID
-    assert c.rbs_rebound_path(h, _ptr(Vi), None, _ptr(ni), ctypes.c_double(a[i]), AUTO) == INVALID
-    # a NULL or all-zero rng: invalid, the state untouched
-    for rng in (None, ctypes.byref(Rng())):
-        out = (np.empty(3), np.empty(3))
-        st = c.rbs_rebound_rng(h, mix_ref, _ptr(Vi), _ptr(Wi), _ptr(ni), ctypes.c_double(a[i]), rng, AUTO, SCALED,
-                               _ptr(out[0]), _ptr(out[1]))
-        assert st == INVALID and np.isnan(out[0]).all() and np.isnan(out[1]).all()
+    assert c.rbs_rebound_path(None, ref(good), None) == PATH_NONE
+    assert c.rbs_rebound_path(h, None, None) == PATH_NONE
+    for method in (3, -1):
+        assert c.rbs_rebound_path(h, ref(good), ref(Options(method=method))) == PATH_NONE
+    # a NULL or all-zero rng (u NULL): invalid, the state untouched
+    for rng in (None, Rng()):
+        h_rng, _ = hit(Vi, Wi, ni, a[i], rng=rng)
+        st, result = _raw_rebound(c, h, mix.pointer, h_rng, None)
+        assert st == INVALID and np.isnan(result.V[:]).all() and np.isnan(result.Omega[:]).all()
+        assert rng is None or list(rng.s) == [0, 0, 0, 0]
+    del kept
+    for t in other_tables:
+        t.close()

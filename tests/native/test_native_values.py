@@ -3,11 +3,10 @@
 For every dataset a draw reads, one element set out of the range docs/format.md ("What makes a table valid")
 allows, the chunk's Fletcher-32 rewritten by HDF5: surrogate.load and rbs_table_open both refuse the file
 with a message naming the dataset (the known case: a cells/shape_dictionary entry of 1e6 loaded in both and
-gave rebounds faster than they came). An attribute that decides a law stored with the wrong type, or with
-one bit flipped, is refused by both alike. A table whose values are in range but absurd loads, and then
-both runtimes report status 0 only for rebounds that leave the wall no faster than they came. A table of
-format 3.2 (grid/law holding restitution_k, restitution_p only, no group shapes) loads and draws the bits of
-the same cells in format 3.4.
+gave rebounds faster than they came). An attribute stored with the wrong type is refused by both alike (the
+parameter rows of groups model and wall: tests/native/test_native_format.py). A table whose values are in range
+but absurd loads, and then both runtimes report status 0 only for rebounds that leave the wall no faster than
+they came.
 """
 
 from __future__ import annotations
@@ -37,10 +36,6 @@ OUT_OF_RANGE = {      # dataset: (element, values outside its allowed range)
     "cells/mean": ((0, 0, 0, 2), (np.nan, np.inf, 2e6)),
     "cells/std": ((0, 0, 0, 2), (np.nan, -1.0, 2e6)),
 }
-# grid attributes that decide a law (data_schema.table.LAW_ATTRIBUTES)
-LAW_ATTRIBUTES = ("restitution_k", "restitution_p", "friction_q", "kappa", "n_max", "aspect_ratio_mean",
-                  "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol", "set_tol", "max_steps",
-                  "second_moment_factors")
 
 
 def _set(name, index, value):
@@ -85,32 +80,16 @@ def test_a_decreasing_quantile_function_is_refused(native, small_table_path, tmp
                   "cells/shape_dictionary")
 
 
-@pytest.mark.parametrize("name", LAW_ATTRIBUTES)
-def test_a_flipped_bit_of_any_law_attribute_fails_to_load(native, small_table_path, tmp_path, name):
-    def flip(f):
-        value = np.array(f["grid"].attrs[name])
-        bits = value.view(np.uint64 if value.dtype.itemsize == 8 else np.uint32)
-        bits.reshape(-1)[0] ^= 1 << 3
-        f["grid"].attrs[name] = value
-
-    _same_verdict(native, edited_copy(small_table_path, tmp_path, f"flip_{name}.h5", flip), ERR_FORMAT, "grid/law")
-
-
-@pytest.mark.parametrize("name, value, wanted", [
-    ("restitution_p", "0.61", "as one number"), ("kappa", "0.3", "as one number"), ("n_max", 1000.0, "as one integer"),
-    ("max_steps", "100000", "as one integer"), ("second_moment_factors", "0.2", "as 1 to 8 numbers"),
-    ("aspect_ratio_sd", np.array([0.2, 0.2]), "as one number")])
-def test_an_attribute_of_the_wrong_type_is_refused_alike(native, small_table_path, tmp_path, name, value, wanted):
+@pytest.mark.parametrize("group, name, value, wanted", [
+    ("grid", "particles_per_cell", 20000.0, "as one integer"), ("grid", "particles_per_cell", "20000", "as one integer"),
+    ("resolution", "clusters", np.array([80, 80]), "as one integer"), ("resolution", "levels", 24.0, "as one integer")])
+def test_an_attribute_of_the_wrong_type_is_refused_alike(native, small_table_path, tmp_path, group, name, value,
+                                                          wanted):
     def retype(f):
-        f["grid"].attrs[name] = value
+        f[group].attrs[name] = value
 
-    _same_verdict(native, edited_copy(small_table_path, tmp_path, f"type_{name}.h5", retype), ERR_FORMAT,
-                  f"the attribute '{name}' of group 'grid' {wanted}")
-
-
-def test_a_missing_direct_model_attribute_is_refused_since_3_3(native, small_table_path, tmp_path):
-    _same_verdict(native, edited_copy(small_table_path, tmp_path, "no_set_tol.h5",
-                                lambda f: f["grid"].attrs.__delitem__("set_tol")), ERR_FORMAT, "set_tol")
+    _same_verdict(native, edited_copy(small_table_path, tmp_path, f"type_{group}_{name}.h5", retype), ERR_FORMAT,
+                  f"the attribute '{name}' of group '{group}' {wanted}")
 
 
 def _draws(native, path, n=20_000):
@@ -122,7 +101,7 @@ def _draws(native, path, n=20_000):
     a = np.full(n, 1e-4)
     table = native.table(path)
     try:
-        c_status, c_V, _ = table.table_rebound_many(table.mix_equal(), V, normal, a, u)
+        c_status, c_V, _ = table.draw_many(table.mix(), V, normal, a, u)
     finally:
         table.close()
     surrogate_table = py.load(path)
@@ -152,18 +131,3 @@ def test_status_0_leaves_the_wall_no_faster_whatever_the_table(native, small_tab
         ok = s == py.STATUS_REBOUNDED
         assert np.all(v[ok, 1] > 0.0)
         assert np.all(np.einsum("ij,ij->i", v[ok], v[ok]) <= speed ** 2 * (1.0 + 1e-9))
-
-
-def test_a_table_of_format_3_2_draws_the_same_bits(native, small_table_path, tmp_path):
-    def format_3_2(f):
-        f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)
-        del f["shapes"]
-        law = f["grid/law"][:2]
-        del f["grid/law"]
-        f["grid"].create_dataset("law", data=law, fletcher32=True)
-
-    old = edited_copy(small_table_path, tmp_path, "v3_2.h5", format_3_2)
-    (c_new, c_V_new), (py_new, V_new), _ = _draws(native, small_table_path, n=2_000)
-    (c_old, c_V_old), (py_old, V_old), _ = _draws(native, old, n=2_000)
-    assert np.array_equal(c_new, c_old) and np.array_equal(py_new, py_old)
-    assert c_V_new.tobytes() == c_V_old.tobytes() and V_new.tobytes() == V_old.tobytes()

@@ -17,13 +17,11 @@ from scipy import stats
 
 import surrogate
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
-from data_schema.table import BUILT_WITH_SECOND_MOMENT_FACTORS, BUILT_WITH_TOLERANCES
 from direct_model.runtime import U_PER_REBOUND, aspect_ratio, model_parameters
 from direct_model.shape_arrays import family_shape_arrays
 from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL
-from direct_model.wall import CORUNDUM_ON_STEEL
-from surrogate.compilation import TABLE_KERNELS, compile_kernels
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 from surrogate.kernels import direct_rebound
 
 from tests.helpers.direct_law import A, kernel_in_frame, ks_bound, random_frame
@@ -124,36 +122,26 @@ def test_same_seed_same_bits_whatever_the_threads(small_table):
 
 
 def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path):
-    """A table records the model's parameters; one without them (3.0–3.2, built before) gets those its build
-    used: the configuration's aspect-ratio law, the simulate defaults, s at κ = 0.3; at another κ the runtime
-    refuses it."""
+    """A table records the model's parameters (its rows /model/parameters and /wall/parameters, read by name): the
+    runtime runs the model with them, bit for bit those of the build (the configuration, the simulate defaults,
+    s at its κ); a row of other values gives other parameters."""
     mine = small_table.direct_parameters
     expected = model_parameters(AspectRatioLaw(), 0.3, 1000, CORUNDUM_ON_STEEL, DEFAULT_CONTACT_TOL, DEFAULT_SET_TOL,
                                 DEFAULT_MAX_STEPS, second_moment_factors(0.3))
     np.testing.assert_array_equal(mine, expected)
-    assert BUILT_WITH_TOLERANCES == {"contact_tol": DEFAULT_CONTACT_TOL, "set_tol": DEFAULT_SET_TOL,
-                                     "max_steps": DEFAULT_MAX_STEPS}
-    np.testing.assert_array_equal(BUILT_WITH_SECOND_MOMENT_FACTORS, second_moment_factors(0.3))
-    old = tmp_path / "old.h5"
-    old.write_bytes(small_table_path.read_bytes())
-    with h5py.File(old, "r+") as f:
-        f.attrs["format_version"] = np.array([3, 2], dtype=np.int64)      # its grid/law: restitution_k, _p
-        del f["shapes"]                                                    # and no group shapes (3.4)
-        law = f["grid/law"][:2]
-        del f["grid/law"]
-        f["grid"].create_dataset("law", data=law, fletcher32=True)
-        for name in ("aspect_ratio_mean", "aspect_ratio_sd", "aspect_ratio_low", "aspect_ratio_high", "contact_tol",
-                     "set_tol", "max_steps", "second_moment_factors", "friction_q"):
-            del f["grid"].attrs[name]
-    np.testing.assert_array_equal(surrogate.load(old).direct_parameters, expected)
-    with h5py.File(old, "r+") as f:
-        f["grid"].attrs["kappa"] = 0.25
-    old_table = surrogate.load(old)
-    assert old_table.direct_parameters is None
-    with pytest.raises(ValueError, match=r"^The table .* does not record the direct model's second-moment factors"):
-        surrogate.sample_direct(old_table, [[100.0, -100.0, 0.0]], [0.0, 1.0, 0.0], A)
-    # surrogate compile on it: the table's kernels, not the model's, which it cannot run
-    assert [name for name, *_ in compile_kernels(old_table)] == list(TABLE_KERNELS)
+    other = tmp_path / "other.h5"
+    other.write_bytes(small_table_path.read_bytes())
+    with h5py.File(other, "r+") as f:
+        for group, changes in (("model", {"contact_tol": 2e-10, "max_steps": 5000}),
+                               ("wall", {"q": 0.5})):
+            row = f[group]["parameters"][()]
+            for name, value in changes.items():
+                row[name] = value
+            f[group]["parameters"][...] = row
+    table = surrogate.load(other)
+    assert table.wall == WallMaterial(0.1, 0.61, 0.5, CORUNDUM_ON_STEEL.name)
+    np.testing.assert_array_equal(table.direct_parameters, model_parameters(
+        AspectRatioLaw(), 0.3, 1000, table.wall, 2e-10, DEFAULT_SET_TOL, 5000, second_moment_factors(0.3)))
 
 
 @pytest.mark.parametrize("change", [

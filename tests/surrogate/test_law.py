@@ -197,7 +197,7 @@ def test_speed_shift_follows_the_restitution_law_of_each_regime(small_table):
     from surrogate.kernels.gather import restitution_factors
     data = small_table.kernel_data
     k, p = 0.1, 0.61       # the wall law the table was built with (tablegen's default)
-    assert (small_table.restitution_k, small_table.restitution_p) == (k, p)
+    assert (small_table.wall.family, small_table.wall.k, small_table.wall.p) == ("exponential", k, p)
     a1 = np.radians(60.0)
     c, s = np.cos(a1), np.sin(a1)
     v, w = np.array([0.2, 0.3, -0.05]), np.array([0.4, -0.1, 0.7])

@@ -131,11 +131,18 @@ def test_checkpoint_of_another_wall_law_is_refused(tmp_path):
 
 
 def test_table_records_the_wall_law(tiny_table):
+    """The wall is the group /wall: its family and name as attributes, its parameters as one row read by name."""
     table = read_table(tiny_table)
     law = CORUNDUM_ON_STEEL
-    assert (table.restitution_k, table.restitution_p, table.friction_q, table.wall_law) == (law.k, law.p, law.q,
-                                                                                             law.name)
+    assert table.wall == law and table.wall.family == "exponential"
     assert parse_config(table.config_text).wall == law
+    with h5py.File(tiny_table, "r") as f:
+        assert dict(f["wall"].attrs) == {"family": "exponential", "name": law.name}
+        row = f["wall/parameters"]
+        assert row.shape == (1,) and row.chunks == (1,) and row.fletcher32
+        assert {name: float(row[0][name]) for name in row.dtype.names} == law.parameters()
+        assert f["model/parameters"].fletcher32 and f["model/parameters"][0]["kappa"] == table.kappa
+        assert not {"restitution_k", "kappa", "wall_law"} & set(f["grid"].attrs) and "law" not in f["grid"]
 
 
 def test_checkpoint_of_another_table_format_is_refused(tmp_path):
@@ -186,8 +193,8 @@ def test_reader_rejects_version_missing_dataset_and_truncation(tiny_table, tmp_p
     bad = tmp_path / "v.h5"
     shutil.copy(tiny_table, bad)
     with h5py.File(bad, "a") as f:
-        f.attrs["format_version"] = np.array([2, 1])          # a table of the previous format
-    with pytest.raises(DataFormatError, match=r"v\.h5.*version 2\.1 .*reads major version 3; make the file again"):
+        f.attrs["format_version"] = np.array([2, 1])          # a table of an old format
+    with pytest.raises(DataFormatError, match=r"v\.h5.*version 2\.1 .*reads major version 4; make the file again"):
         read_table(bad)
     shutil.copy(tiny_table, bad)
     with h5py.File(bad, "a") as f:

@@ -75,8 +75,9 @@ typedef struct {
   char        hits_dir[RBS_CS_LINE];        /* "" if no hit records */
   double      half_size_factor;             /* a = factor * d / 2 */
   uint64_t    seed;
-  int         method;                       /* RBS_AUTO, RBS_TABLE, RBS_DIRECT */
-  int         interpolation;                /* RBS_SCALED, RBS_STOCHASTIC */
+  int         method;                       /* RBS_METHOD_AUTO, _TABLE, _DIRECT */
+  int         interpolation;                /* RBS_INTERPOLATION_SCALED,
+                                               RBS_INTERPOLATION_STOCHASTIC */
   int         remove_trapped;               /* 0: deposited, 1: removed */
   int         keep_grain;                   /* 1: kept, 0: a new grain per hit */
   uint64_t    grain_seed;                   /* the keys' seed */
@@ -297,9 +298,18 @@ _read_settings(void)
     bft_error(__FILE__, __LINE__, 0,
               "rebound-scatter settings %s: cannot open the table %s: "
               "%s: %s", _set.setup_path, _set.table_path,
-              rbs_error_string(err), msg);
-  rbs_table_alpha1_range(_table, &_alpha1_lo, &_alpha1_hi);
-  rbs_table_speed_range(_table, &_speed_lo, &_speed_hi);
+              rbs_status_string(err), msg);
+  rbs_table_info info = RBS_TABLE_INFO_INIT;
+  err = rbs_table_info_get(_table, &info);
+  if (err != RBS_OK)
+    bft_error(__FILE__, __LINE__, 0,
+              "rebound-scatter settings %s: cannot read the grids of the "
+              "table %s: %s", _set.setup_path, _set.table_path,
+              rbs_status_string(err));
+  _alpha1_lo = info.alpha1_min_deg;
+  _alpha1_hi = info.alpha1_max_deg;
+  _speed_lo = info.speed_min_m_s;
+  _speed_hi = info.speed_max_m_s;
 
   const char *shape = _value(values, given, "shape");
   const char *weights = _value(values, given, "weights");
@@ -326,13 +336,15 @@ _read_settings(void)
     : (uint64_t)_parse_integer("seed", seed, 0, 9223372036854775807LL);
 
   static const char *const method_names[] = {"auto", "table", "direct"};
-  static const int method_codes[] = {RBS_AUTO, RBS_TABLE, RBS_DIRECT};
+  static const int method_codes[] = {RBS_METHOD_AUTO, RBS_METHOD_TABLE,
+                                     RBS_METHOD_DIRECT};
   const char *method = _value(values, given, "method");
   _set.method = _parse_choice("method", method ? method : "auto", method_names,
                               method_codes, 3, "auto, table or direct");
 
   static const char *const interp_names[] = {"scaled", "stochastic"};
-  static const int interp_codes[] = {RBS_SCALED, RBS_STOCHASTIC};
+  static const int interp_codes[] = {RBS_INTERPOLATION_SCALED,
+                                     RBS_INTERPOLATION_STOCHASTIC};
   const char *interp = _value(values, given, "interpolation");
   _set.interpolation = _parse_choice("interpolation",
                                      interp ? interp : "scaled", interp_names,
@@ -432,9 +444,11 @@ _open_hits(int rank)
   else
     _copy(table, _set.table_path);
   static const char *const m[] = {"auto", "table", "direct"};
-  static const int mc[] = {RBS_AUTO, RBS_TABLE, RBS_DIRECT};
+  static const int mc[] = {RBS_METHOD_AUTO, RBS_METHOD_TABLE,
+                           RBS_METHOD_DIRECT};
   static const char *const im[] = {"scaled", "stochastic"};
-  static const int ic[] = {RBS_SCALED, RBS_STOCHASTIC};
+  static const int ic[] = {RBS_INTERPOLATION_SCALED,
+                           RBS_INTERPOLATION_STOCHASTIC};
   fprintf(_hits,
           "%s seed %llu, stream %d, "
           "table %s, mix %s, halfSizeFactor %.17g, interpolation %s, "
@@ -466,36 +480,46 @@ _open_hits(int rank)
 }
 
 static void
-_record_hit(int b_zone_id, double d, double a, const double V[3],
-            const double n[3], int status, int path, int64_t key,
-            const double Vout[3], const double Wout[3], double u0)
+_record_hit(int b_zone_id, double d, const rbs_hit *hit,
+            const rbs_result *result, int path, double u0)
 {
   if (_hits == NULL || _n_recorded >= _set.max_hit_records)
     return;
   _n_recorded++;
   const cs_zone_t *z = cs_boundary_zone_by_id(b_zone_id);
 
-  /* The grain: its shape under grain kept (empty for a new grain per hit),
-     and b/a, c/b and the hand where the direct path fixed them (NaN on the
-     table path, which draws them from the shape's law) */
+  /* The grain: its shape under grain kept (empty for a new grain per hit;
+     the result's, else, for a hit refused, the key's), and b/a, c/b and the
+     hand where the direct path fixed them (NaN on the table path, which
+     draws them from the shape's law) */
+  const int64_t key = hit->grain_key;
   const char *shape = "";
   double ratio_ba = NAN, ratio_cb = NAN, hand = NAN;
-  rbs_grain grain;
-  if (key >= 0 && rbs_grain_info(_table, _mix, key, &grain) == RBS_OK) {
-    shape = rbs_table_shape_name(_table, grain.shape);
-    if (path == RBS_PATH_DIRECT) {
-      ratio_ba = grain.ratio_ba;
-      ratio_cb = grain.ratio_cb;
-      hand = grain.hand;
+  if (key >= 0) {
+    int grain_shape = result->shape;
+    rbs_grain grain = RBS_GRAIN_INIT;
+    if ((grain_shape < 0 || path == RBS_PATH_DIRECT)
+        && rbs_grain_info(_table, _mix, key, &grain) == RBS_OK) {
+      grain_shape = grain.shape;
+      if (path == RBS_PATH_DIRECT) {
+        ratio_ba = grain.ratio_ba;
+        ratio_cb = grain.ratio_cb;
+        hand = grain.hand;
+      }
     }
+    if (grain_shape >= 0)
+      shape = rbs_table_shape_name(_table, grain_shape);
   }
+  const double *V = hit->V, *n = hit->n;
+  const double *Vout = result->V, *Wout = result->Omega;
   fprintf(_hits,
           "%.9g,%d,%s,-1,-1,%.9g,%.9g,%.17g,%.17g,%.17g,0,0,0,"
           "%.17g,%.17g,%.17g,0,0,0,%d,%d,"
           "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,0,%.17g,"
           "%lld,%s,%.17g,%.17g,%g\n",
           cs_glob_time_step->t_cur, cs_glob_rank_id < 0 ? 0 : cs_glob_rank_id,
-          z->name, d, a, V[0], V[1], V[2], n[0], n[1], n[2], status, path,
+          z->name, d, hit->a, V[0], V[1], V[2], n[0], n[1], n[2],
+          result->status, path,
           Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2], u0,
           (long long)key, shape, ratio_ba, ratio_cb, hand);
 }
@@ -532,7 +556,8 @@ rbs_cs_initialize(void)
   _initialized = 1;
 
   static const char *const m[] = {"auto", "table", "direct"};
-  static const int mc[] = {RBS_AUTO, RBS_TABLE, RBS_DIRECT};
+  static const int mc[] = {RBS_METHOD_AUTO, RBS_METHOD_TABLE,
+                           RBS_METHOD_DIRECT};
   bft_printf("\n  rebound-scatter: table %s (%d shapes, alpha1 %g-%g deg, "
              "|V| %g-%g m/s)\n"
              "    mix %s, a = %g*d/2, trapped particles %s, method %s "
@@ -656,13 +681,31 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
                      + (coords[2] - start[2])*face_norm[2];
   const double nn = sqrt(face_norm[0]*face_norm[0] + face_norm[1]*face_norm[1]
                          + face_norm[2]*face_norm[2]);
-  double n[3] = {0, 0, 0};
+  /* The hit: V⁻, Ω⁻ (6.0's particles carry no spin), n into the gas, a,
+     the particle's grain key and this rank's stream */
+  rbs_hit hit = RBS_HIT_INIT;
   if (nn > 0)
     for (int k = 0; k < 3; k++)
-      n[k] = (seg_n > 0 ? -face_norm[k] : face_norm[k])/nn;
-  const double V[3] = {vel[0], vel[1], vel[2]};
-  const double Omega[3] = {0, 0, 0};   /* 6.0's particles carry no spin */
-  const double a = _set.half_size_factor*0.5*d;
+      hit.n[k] = (seg_n > 0 ? -face_norm[k] : face_norm[k])/nn;
+  for (int k = 0; k < 3; k++)
+    hit.V[k] = vel[k];
+  hit.a = _set.half_size_factor*0.5*d;
+  /* grain kept: the key of the particle's random value (drawn at its
+     injection, carried from rank to rank and through a restart file: 6.0's
+     one persistent mark of a particle); perHit: RBS_NO_KEY, a new grain per
+     hit */
+  if (_set.keep_grain) {
+    const double random = cs_lagr_particle_get_real(particle, p_am,
+                                                    CS_LAGR_RANDOM_VALUE);
+    uint64_t bits;
+    memcpy(&bits, &random, sizeof(bits));
+    hit.grain_key = rbs_grain_key(_set.grain_seed, bits, 0);
+  }
+  hit.rng = &_rng;   /* 13 uniforms whatever the path and the result */
+
+  rbs_options options = RBS_OPTIONS_INIT;
+  options.method = _set.method;
+  options.interpolation = _set.interpolation;
 
   /* the first of the hit's 13 uniforms, for the record */
   rbs_rng peek = _rng;
@@ -670,28 +713,13 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
 
   /* the path is a pure function of the state: learnt before the draw, so
      the clock runs around the direct model's calls only */
-  const int path = rbs_rebound_path(_table, V, Omega, n, a, _set.method);
-  double t0 = 0, Vout[3], Wout[3];
+  const int path = rbs_rebound_path(_table, &hit, &options);
+  double t0 = 0;
   if (path == RBS_PATH_DIRECT)
     t0 = cs_timer_wtime();
-  /* grain kept: the key of the particle's random value (drawn at its
-     injection, carried from rank to rank and through a restart file: 6.0's
-     one persistent mark of a particle); perHit: a new grain per hit */
-  int64_t key = -1;
-  int status;
-  if (_set.keep_grain) {
-    const double random = cs_lagr_particle_get_real(particle, p_am,
-                                                    CS_LAGR_RANDOM_VALUE);
-    uint64_t bits;
-    memcpy(&bits, &random, sizeof(bits));
-    key = rbs_grain_key(_set.grain_seed, bits, 0);
-    status = rbs_rebound_grain_rng(_table, _mix, key, V, Omega, n, a, &_rng,
-                                   _set.method, _set.interpolation, Vout,
-                                   Wout);
-  }
-  else
-    status = rbs_rebound_rng(_table, _mix, V, Omega, n, a, &_rng,
-                             _set.method, _set.interpolation, Vout, Wout);
+  rbs_result result = RBS_RESULT_INIT;
+  const int status = rbs_rebound(_table, _mix, &hit, &options, &result);
+  const double *V = hit.V, *n = hit.n, *Vout = result.V;
   if (path == RBS_PATH_DIRECT) {
     _count.direct_seconds += cs_timer_wtime() - t0;
     _count.direct_path++;
@@ -711,7 +739,7 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
       _count.outside_grid++;
   }
 
-  if (status == RBS_REBOUNDED) {
+  if (status == RBS_OK) {
     /* The rest of the step: the solver's rebound mirrors it; ours goes
        along V⁺ for the time the particle had left at |V⁻|, so the end
        point lies on the gas side of the wall whatever V⁺ is */
@@ -785,6 +813,6 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
     *tracking_state = CS_LAGR_PART_TO_SYNC;
   }
 
-  _record_hit(b_zone_id, d, a, V, n, status, path, key, Vout, Wout, u0);
+  _record_hit(b_zone_id, d, &hit, &result, path, u0);
   _count.cpu_seconds += _thread_cpu_seconds() - cpu0;
 }

@@ -106,18 +106,23 @@ void Foam::StochasticRebound<CloudType>::openTable(const dictionary& dict)
     {
         FatalIOErrorInFunction(dict)
             << "Cannot open the rebound table " << tableFile_ << ": "
-            << rbs_error_string(err) << ": " << message
+            << rbs_status_string(err) << ": " << message
             << exit(FatalIOError);
     }
     table_.reset(table, rbs_table_close);
 
-    double lo, hi;
-    rbs_table_alpha1_range(table, &lo, &hi);
-    alpha1Lo_ = lo;
-    alpha1Hi_ = hi;
-    rbs_table_speed_range(table, &lo, &hi);
-    speedLo_ = lo;
-    speedHi_ = hi;
+    rbs_table_info info = RBS_TABLE_INFO_INIT;
+    const int infoErr = rbs_table_info_get(table, &info);
+    if (infoErr != RBS_OK)
+    {
+        FatalIOErrorInFunction(dict)
+            << "Cannot read the grids of the rebound table " << tableFile_
+            << ": " << rbs_status_string(infoErr) << exit(FatalIOError);
+    }
+    alpha1Lo_ = info.alpha1_min_deg;
+    alpha1Hi_ = info.alpha1_max_deg;
+    speedLo_ = info.speed_min_m_s;
+    speedHi_ = info.speed_max_m_s;
 
     // The shape mix: `weights { prism 0.7; tetrahedron 0.3; }` or `shape`
     if (dict.found("weights"))
@@ -182,11 +187,9 @@ void Foam::StochasticRebound<CloudType>::recordHit
     const double n[3],
     const vector& Uwall,
     double a,
-    int status,
+    const rbs_result& result,
     int path,
     int64_t key,
-    const double Vout[3],
-    const double Wout[3],
     scalar spinRatio,
     double u0
 )
@@ -199,19 +202,35 @@ void Foam::StochasticRebound<CloudType>::recordHit
     ++s.nRecorded;
 
     // The grain: its shape under grain kept (empty for a new grain per
-    // hit), and b/a, c/b and the hand where the direct path fixed them
-    // (NaN on the table path, which draws them from the shape's law)
+    // hit; the result's, else, for a hit refused, the key's), and b/a, c/b
+    // and the hand where the direct path fixed them (NaN on the table path,
+    // which draws them from the shape's law)
     const char* shape = "";
     double ratioBa = NAN, ratioCb = NAN, hand = NAN;
-    rbs_grain grain;
-    if (key >= 0 && rbs_grain_info(table_.get(), mix_.get(), key, &grain) == RBS_OK)
+    if (key >= 0)
     {
-        shape = rbs_table_shape_name(table_.get(), grain.shape);
-        if (path == RBS_PATH_DIRECT)
+        int grainShape = result.shape;
+        if (grainShape < 0 || path == RBS_PATH_DIRECT)
         {
-            ratioBa = grain.ratio_ba;
-            ratioCb = grain.ratio_cb;
-            hand = grain.hand;
+            rbs_grain grain = RBS_GRAIN_INIT;
+            if
+            (
+                rbs_grain_info(table_.get(), mix_.get(), key, &grain)
+             == RBS_OK
+            )
+            {
+                grainShape = grain.shape;
+                if (path == RBS_PATH_DIRECT)
+                {
+                    ratioBa = grain.ratio_ba;
+                    ratioCb = grain.ratio_cb;
+                    hand = grain.hand;
+                }
+            }
+        }
+        if (grainShape >= 0)
+        {
+            shape = rbs_table_shape_name(table_.get(), grainShape);
         }
     }
 
@@ -229,9 +248,9 @@ void Foam::StochasticRebound<CloudType>::recordHit
         int(p.origProc()), int(p.origId()), p.d(), a,
         V[0], V[1], V[2], Omega[0], Omega[1], Omega[2], n[0], n[1], n[2],
         Uwall.x(), Uwall.y(), Uwall.z(),
-        status, path, Vout[0], Vout[1], Vout[2], Wout[0], Wout[1], Wout[2],
-        spinRatio, u0, static_cast<long long>(key), shape, ratioBa, ratioCb,
-        hand
+        result.status, path, result.V[0], result.V[1], result.V[2],
+        result.Omega[0], result.Omega[1], result.Omega[2], spinRatio, u0,
+        static_cast<long long>(key), shape, ratioBa, ratioCb, hand
     );
     s.hits << line;
 }
@@ -257,8 +276,8 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     ),
     removeTrapped_(false),
     seed_(0),
-    interpolation_(RBS_SCALED),
-    method_(RBS_AUTO),
+    interpolation_(RBS_INTERPOLATION_SCALED),
+    method_(RBS_METHOD_AUTO),
     keepGrain_(true),
     grainSeed_(0),
     alpha1Lo_(0),
@@ -334,7 +353,7 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     const word interp(coeffs.getOrDefault<word>("interpolation", "scaled"));
     if (interp == "stochastic")
     {
-        interpolation_ = RBS_STOCHASTIC;
+        interpolation_ = RBS_INTERPOLATION_STOCHASTIC;
     }
     else if (interp != "scaled")
     {
@@ -346,11 +365,11 @@ Foam::StochasticRebound<CloudType>::StochasticRebound
     const word method(coeffs.getOrDefault<word>("method", "auto"));
     if (method == "table")
     {
-        method_ = RBS_TABLE;
+        method_ = RBS_METHOD_TABLE;
     }
     else if (method == "direct")
     {
-        method_ = RBS_DIRECT;
+        method_ = RBS_METHOD_DIRECT;
     }
     else if (method != "auto")
     {
@@ -520,50 +539,49 @@ bool Foam::StochasticRebound<CloudType>::correct
     const scalar nMag = mag(nw);
     const scalar a = halfSizeFactor_*0.5*p.d();
 
-    double V[3] = {Vin.x(), Vin.y(), Vin.z()};
-    double Omega[3] = {Win.x(), Win.y(), Win.z()};
-    double n[3] = {0, 0, 0};
+    // The hit: V⁻, Ω⁻, n into the gas, a, the parcel's grain key, and the 13
+    // uniforms it takes whatever the path (drawn here, the first one is
+    // recorded)
+    rbs_hit hit = RBS_HIT_INIT;
+    hit.V[0] = Vin.x();
+    hit.V[1] = Vin.y();
+    hit.V[2] = Vin.z();
+    hit.Omega[0] = Win.x();
+    hit.Omega[1] = Win.y();
+    hit.Omega[2] = Win.z();
     if (nMag > 0)
     {
         // Ours points into the gas, unit length in double precision
-        n[0] = -nw.x()/nMag;
-        n[1] = -nw.y()/nMag;
-        n[2] = -nw.z()/nMag;
+        hit.n[0] = -nw.x()/nMag;
+        hit.n[1] = -nw.y()/nMag;
+        hit.n[2] = -nw.z()/nMag;
     }
-
-    // 13 uniforms per hit whatever the path (the first one is recorded)
+    hit.a = a;
+    // grain kept: the parcel's ids, born with it, carried across ranks and
+    // restarts, give its key; perHit: RBS_NO_KEY, a new grain per hit
+    hit.grain_key =
+        keepGrain_
+      ? rbs_grain_key(grainSeed_, uint64_t(p.origProc()), uint64_t(p.origId()))
+      : RBS_NO_KEY;
     double u[RBS_U_PER_DRAW];
     rbs_rng_fill(&s.rng, u, RBS_U_PER_DRAW);
+    hit.u = u;
+
+    rbs_options options = RBS_OPTIONS_INIT;
+    options.method = method_;
+    options.interpolation = interpolation_;
 
     // The path is a pure function of the state: learnt before the draw,
     // so the clock runs around the direct model's calls only
-    double Vout[3], Wout[3];
     const rbs_table* table = table_.get();
-    const int path = rbs_rebound_path(table, V, Omega, n, a, method_);
+    const int path = rbs_rebound_path(table, &hit, &options);
     std::chrono::steady_clock::time_point t0;
     if (path == RBS_PATH_DIRECT)
     {
         t0 = std::chrono::steady_clock::now();
     }
-    // grain kept: the parcel's ids, born with it, carried across ranks and
-    // restarts, give its key (rbs_rebound_grain_rng's draw, with u kept for
-    // the record); perHit: rbs_rebound, a new grain per hit
-    const int64_t key =
-        keepGrain_
-      ? rbs_grain_key(grainSeed_, uint64_t(p.origProc()), uint64_t(p.origId()))
-      : -1;
-    const int status =
-        keepGrain_
-      ? rbs_rebound_grain
-        (
-            table, mix_.get(), key, V, Omega, n, a, u, method_,
-            interpolation_, Vout, Wout
-        )
-      : rbs_rebound
-        (
-            table, mix_.get(), V, Omega, n, a, u, method_, interpolation_,
-            Vout, Wout
-        );
+    rbs_result result = RBS_RESULT_INIT;
+    const int status = rbs_rebound(table, mix_.get(), &hit, &options, &result);
     if (path == RBS_PATH_DIRECT)
     {
         c.directSeconds += std::chrono::duration<double>
@@ -592,9 +610,11 @@ bool Foam::StochasticRebound<CloudType>::correct
     {
         // Outside the table's grid: the direct model answers under auto and
         // direct, the law at the nearest grid edge under table
+        const scalar Vn =
+            hit.V[0]*hit.n[0] + hit.V[1]*hit.n[1] + hit.V[2]*hit.n[2];
         const scalar alpha1 = radToDeg
         (
-            std::asin(min(max(-(V[0]*n[0] + V[1]*n[1] + V[2]*n[2])/speed, -1), 1))
+            std::asin(min(max(-Vn/speed, -1), 1))
         );
         if
         (
@@ -608,15 +628,17 @@ bool Foam::StochasticRebound<CloudType>::correct
 
     switch (status)
     {
-        case RBS_REBOUNDED:
+        case RBS_OK:
         {
             ++c.rebounded;
             keepParticle = true;
             p.active(true);
-            U = vector(Vout[0], Vout[1], Vout[2]) + Uwall;
+            U = vector(result.V[0], result.V[1], result.V[2]) + Uwall;
             stochasticReboundDetail::setAngularVelocity
             (
-                p, vector(Wout[0], Wout[1], Wout[2]), 0
+                p,
+                vector(result.Omega[0], result.Omega[1], result.Omega[2]),
+                0
             );
             break;
         }
@@ -656,8 +678,8 @@ bool Foam::StochasticRebound<CloudType>::correct
     {
         recordHit
         (
-            p, pp, V, Omega, n, Uwall, a, status, path, key, Vout, Wout,
-            spinRatio, u[0]
+            p, pp, hit.V, hit.Omega, hit.n, Uwall, a, result, path,
+            hit.grain_key, spinRatio, u[0]
         );
     }
 

@@ -1,11 +1,13 @@
 /*
- * loader.h: what the table loader's parts share (loader.c opens the file and reads the grids, the law and the
- * cells; shape_records.c the shapes): the error state of one rbs_table_open and the HDF5 reading helpers.
+ * hdf5_read.h: what the table loader's parts share: the error state of one rbs_table_open and the HDF5 reading
+ * helpers (hdf5_read.c). loader.c opens the file and reads the grids, the law and the cells, and calls
+ * shape_records.c for the shapes; both read through these helpers, which call neither, so the dependencies go
+ * one way: loader.c -> shape_records.c -> hdf5_read.c.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
-#ifndef RBS_LOADER_H
-#define RBS_LOADER_H
+#ifndef RBS_HDF5_READ_H
+#define RBS_HDF5_READ_H
 
 #include <hdf5.h>
 
@@ -37,11 +39,4 @@ int rbs_dataset_shape(loader *ld, hid_t group, const char *group_name, const cha
 void *rbs_read_dataset(loader *ld, hid_t group, const char *group_name, const char *name, hid_t memtype, size_t size,
                        int rank, const hsize_t *dims);
 
-/* shape_records.c: group /shapes of a table of format 3.4 into t->shapes, checked as
- * data_schema.shape_records.check_shape_datasets and records_from_arrays check them (a built-in family's row against
- * the family's record at κ and the aspect-ratio law `aspect`); before 3.4, the families' records synthesised
- * from κ, `aspect` and the second-moment factors `kfac` (NaN if not recorded). RBS_OK or the error's code. */
-int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, const double aspect[4],
-                           const double kfac[RBS_N_FAMILIES]);
-
-#endif /* RBS_LOADER_H */
+#endif /* RBS_HDF5_READ_H */
