@@ -126,7 +126,7 @@ def shape_error(name, shape, needed, first="V"):
 @numba.njit(**JIT)
 def check_state(state):
     """ValueError unless ``state`` is one xoshiro256+ state (the one-thread kernels that draw their uniforms): (4,)
-    uint64, not all zero (the generator's fixed point; rbs_table_rebound_many_rng gives every row RBS_INVALID for it)."""
+    uint64, not all zero (the generator's fixed point; rbs_draw_many gives every row RBS_INVALID for it)."""
     if state.shape[0] != 4 or (state[0] | state[1] | state[2] | state[3]) == 0:
         raise ValueError("'state' must be one xoshiro256+ state, (4,) uint64 not all zero, as surrogate.seed_state "
                          "gives")

@@ -50,7 +50,7 @@ from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from direct_model.registry import FAMILIES, ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
-from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial, wall_family
 from tablegen.tabulation.config_error import ConfigError
 from tablegen.tabulation.shape_config import parse_shape_sections
 
@@ -178,7 +178,7 @@ CONFIG_KEYS = {
     "grid": {"alpha1_deg", "speed_m_s", "shapes"},
     "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
     "table": {"resolution"},
-    "wall": {"k", "p", "q", "name"},
+    "wall": {*wall_family(CORUNDUM_ON_STEEL.family).parameter_names, "name"},
 }
 GRAINS_SECTION = "shapes"      # [shapes.NAME]: the user's grains; their keys are shape_config's
 
@@ -295,20 +295,19 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
 
 
 def _wall(raw: dict, source: str) -> WallMaterial:
-    """The wall law of the ``[wall]`` section; missing keys take the corundum-on-steel law's values."""
-    def number(key, positive):
-        value = raw.get(key, getattr(CORUNDUM_ON_STEEL, key))
-        ok = (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
-              and (value > 0 or not positive))
-        if not ok:
-            allowed = "a finite number > 0" if positive else "a finite number"
-            raise ConfigError(f"{source}: 'wall.{key}' must be {allowed}; got {value!r}")
-        return float(value)
-
+    """The wall law of the ``[wall]`` section: its family's parameters by name (:data:`direct_model.wall.WALL_FAMILIES`),
+    each checked against the family's range; missing keys take the corundum-on-steel law's values."""
+    family = wall_family(CORUNDUM_ON_STEEL.family)
+    values = {}
+    for parameter in family.parameters:
+        value = raw.get(parameter.name, CORUNDUM_ON_STEEL.parameters()[parameter.name])
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not parameter.ok(float(value)):
+            raise ConfigError(f"{source}: 'wall.{parameter.name}' must be a number, {parameter.allowed}; got {value!r}")
+        values[parameter.name] = float(value)
     name = raw.get("name", CORUNDUM_ON_STEEL.name)
     if not isinstance(name, str) or not name.strip():
         raise ConfigError(f"{source}: 'wall.name' must be a non-empty string; got {name!r}")
-    return WallMaterial(k=number("k", True), p=number("p", True), q=number("q", False), name=name)
+    return WallMaterial.from_parameters(family.name, values, name)
 
 
 def _check_keys(data: dict, source: str) -> None:

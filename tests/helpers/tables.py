@@ -41,6 +41,31 @@ OCTAHEDRON_TABLE_CONFIG = _table_config([30.0, 70.0], [100.0, 200.0], seed=45, s
                                         particles_per_cell=3000)
 
 
+
+def written_out_config(alpha1_deg, speed_m_s, shapes, seed) -> str:
+    """A configuration with every key written out, so that no preset default enters a known value: the given
+    grid and seed, the fewest particles a cell allows and a small resolution (a cell builds in well under a
+    second), the paper's shape law and wall."""
+    return f"""
+[grid]
+alpha1_deg = {list(alpha1_deg)}
+speed_m_s = {list(speed_m_s)}
+shapes = {json.dumps(list(shapes))}
+[simulation]
+particles_per_cell = 256
+seed = {seed}
+kappa = 0.3
+n_max = 1000
+aspect_ratio = {{mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}}
+[table]
+resolution = {{clusters = 16, dictionary_size = 16, levels = 24}}
+[wall]
+k = 0.1
+p = 0.61
+q = 1.0
+name = "corundum_on_St3_Lashkov1991"
+"""
+
 # a table of two user grains (docs/model.md §9) on a 2 × 2 grid: sand_a the mesh examples/grains/grain_2.obj (17
 # hull vertices, fixed proportions), sand_b the hull of seven points with its own b/a, c/b law, in both hands;
 # written next to its mesh by write_grain_config (the mesh path is relative to the configuration)

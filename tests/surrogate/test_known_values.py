@@ -25,28 +25,10 @@ from surrogate.kernels.grain import SLOT_HAND, SLOT_RATIO_BA, SLOT_RATIO_CB, SLO
 from surrogate.kernels.locate import mix_shapes
 from surrogate.kernels.rng import grain_uniform
 from tablegen import build_table, parse_config
+from tests.helpers.tables import written_out_config
 
-# every key written out (no preset default enters); 2 × 2 grid, two shapes, the fewest particles a cell allows;
-# ~1.5 s to build
-TABLE_CONFIG = """
-[grid]
-alpha1_deg = [40.0, 70.0]
-speed_m_s = [60.0, 120.0]
-shapes = ["prism", "tetrahedron"]
-[simulation]
-particles_per_cell = 256
-seed = 20250102
-kappa = 0.3
-n_max = 1000
-aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}
-[table]
-resolution = {clusters = 16, dictionary_size = 16, levels = 24}
-[wall]
-k = 0.1
-p = 0.61
-q = 1.0
-name = "corundum_on_St3_Lashkov1991"
-"""
+# 2 × 2 grid, two shapes; ~1.5 s to build
+TABLE_CONFIG = written_out_config([40.0, 70.0], [60.0, 120.0], ["prism", "tetrahedron"], seed=20250102)
 # table format 4.0 (the format alone: in the 3.4 layout the same table hashed as before, 1df2f289…bb54a)
 TABLE_FINGERPRINT = "8143ad6f24c44316a6b846f2fb08921880a7cbb644d4f2b40e314ab58a9978d0"
 MIX = {"prism": 0.5, "tetrahedron": 0.5}

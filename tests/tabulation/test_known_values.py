@@ -15,30 +15,12 @@ import pytest
 
 from data_schema.table import CELL_DATASETS, table_fingerprint
 from tablegen import build_table, parse_config
+from tests.helpers.tables import written_out_config
 from tablegen.tabulation.cells import cell_seed, derive_seed
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL
 
-# every key written out (no preset default enters): one shape, one α1, one speed, the fewest particles a cell
-# allows; ~1 s to build
-ONE_CELL_CONFIG = """
-[grid]
-alpha1_deg = [45.0]
-speed_m_s = [100.0]
-shapes = ["prism"]
-[simulation]
-particles_per_cell = 256
-seed = 20250101
-kappa = 0.3
-n_max = 1000
-aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}
-[table]
-resolution = {clusters = 16, dictionary_size = 16, levels = 24}
-[wall]
-k = 0.1
-p = 0.61
-q = 1.0
-name = "corundum_on_St3_Lashkov1991"
-"""
+# one shape, one α1, one speed; ~1 s to build
+ONE_CELL_CONFIG = written_out_config([45.0], [100.0], ["prism"], seed=20250101)
 # the same cell with a second shape before it in the table's order
 TWO_SHAPE_CONFIG = ONE_CELL_CONFIG.replace('shapes = ["prism"]', 'shapes = ["tetrahedron", "prism"]')
 
