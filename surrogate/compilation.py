@@ -25,7 +25,7 @@ ROWS = 4        # particles per call: the calls only need to run
 TABLE_KERNELS = ("sample_global", "sample_local", "table_rebound", "draw_local", "table_rebound_many",
                  "table_rebound_many_rng", "table_rebound_parallel", "table_rebound_parallel_rng",
                  "draw_local_parallel")
-# ... and, with a table that holds the direct model's parameters (format 3.3 on), the direct model's
+# ... and, with a table of a shape the direct model answers, the direct model's
 DIRECT_KERNELS = ("sample_direct", "rebound", "direct_rebound")
 
 
@@ -38,9 +38,9 @@ def _calls(table: SurrogateTable) -> list:
     outputs = np.empty((ROWS, 3)), np.empty((ROWS, 3)), np.empty(ROWS, dtype=np.int8)
     local, status = np.empty((ROWS, 6)), np.empty(ROWS, dtype=np.int8)
     alpha1, speed = np.full(ROWS, 45.0), np.full(ROWS, 100.0)
-    # the direct model's kernels need its parameters (tables of format 3.3 on) and a shape it answers
+    # the direct model's kernels need a shape it answers
     answerable = [k for k in range(len(table.shapes)) if table.model_shapes[k] >= 0]
-    direct = table.direct_parameters is not None and bool(answerable)
+    direct = bool(answerable)
     shape = table.shapes[answerable[0]] if direct and len(answerable) < len(table.shapes) else "mix"
     # half the particles spinning: method auto takes both paths
     omega = np.where(np.arange(ROWS)[:, None] < ROWS // 2, 0.0, 1e4) * np.array([0.0, 0.0, 1.0]) if direct else None
@@ -86,7 +86,7 @@ class _Counter(event.Listener):
 def compile_kernels(table: SurrogateTable, report=None) -> list:
     """Call every kernel of the runtime once, on a few particles of ``table`` (:func:`surrogate.load`), so that
     numba compiles each into its cache, or finds it there: :data:`TABLE_KERNELS`, then :data:`DIRECT_KERNELS` if
-    the table holds the direct model's parameters and a shape it answers. ``report(name, seconds, compiled)`` is
+    the table holds a shape the direct model answers. ``report(name, seconds, compiled)`` is
     called after each. Returns [(name, seconds, compiled)] in the order run, ``compiled`` the number of functions
     numba compiled for that call: 0 where all came from the cache (or had been compiled in this process)."""
     done = []

@@ -49,7 +49,7 @@ from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
 from surrogate.kernels.wall_hit import METHOD_DIRECT, METHOD_TABLE, rebound_parallel_rng
 from surrogate.table import SurrogateTable
-from surrogate.validation import (as_rows, check_direct_parameters, check_direct_paths, check_grain_key,
+from surrogate.validation import (as_rows, check_grain_key,
                                   check_half_size, check_incident, check_interpolation, check_local_states,
                                   check_method, check_omega, check_out, check_random_state, check_shape,
                                   check_vectors)
@@ -153,8 +153,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     Status 0 rebounded, 1 trapped, 2 failed (the direct model only: a collision solve or a contact search
     failed; rare, never dropped: count them with ``status == surrogate.STATUS_FAILED``); NaN rows unless
     rebounded. Every check runs before anything is written: on a ValueError the ``out`` arrays are unchanged.
-    The direct model needs ``table.direct_parameters``: with a table that lacks them, a hit the model must
-    answer is a ValueError. It takes the families and the table's user grains (convex polyhedra, format 3.4).
+    The direct model takes the families and the table's user grains (convex polyhedra), with the parameters the
+    table was built with (``table.direct_parameters``).
     """
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
     n_particles = V.shape[0]
@@ -163,24 +163,17 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     check_incident(table, V, nrm, a, grid=not clamp and code == METHOD_TABLE)
     cdf, shapes = check_shape(table, shape, n_particles)
     keys = check_grain_key(grain_key, n_particles)
-    if code == METHOD_DIRECT and table.direct_parameters is not None:
+    if code == METHOD_DIRECT:
         _check_direct_shapes(table, cdf, shapes)
     scaled = check_interpolation(interpolation)
     outputs = check_out(out, n_particles, (V, nrm, a, W), 4 if return_path else 3)
-    old_table = table.direct_parameters is None and code != METHOD_TABLE
-    # a table without the model's parameters: draw into fresh arrays, so that ``out`` stays unchanged if a hit
-    # needs the model
-    V_out, Omega_out, status, path = (check_out(None, n_particles, (), 4) if old_table
-                                      else (*outputs[:3], outputs[3] if return_path else np.empty(n_particles, np.int8)))
-    params = frozen(np.zeros(0) if table.direct_parameters is None else table.direct_parameters)
+    V_out, Omega_out, status = outputs[:3]
+    path = outputs[3] if return_path else np.empty(n_particles, np.int8)
+    params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     states = chunk_states(check_random_state(random_state), n_particles)
     rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
                          as_rows(nrm, n_particles),
                          as_rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
-    if old_table:
-        check_direct_paths(table, path, V, W, a)
-        for target, result in zip(outputs, (V_out, Omega_out, status, path)):
-            target[...] = result
     return tuple(outputs)
 
 
@@ -214,10 +207,9 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     Returns
     -------
     (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8): STATUS_REBOUNDED (0), STATUS_TRAPPED (1)
-    or STATUS_FAILED (2, a collision solve or contact search failed); NaN rows unless rebounded. A table
-    without ``direct_parameters`` is a ValueError.
+    or STATUS_FAILED (2, a collision solve or contact search failed); NaN rows unless rebounded.
     """
-    params = check_direct_parameters(table)
+    params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
     n_particles = V.shape[0]
     # every state moving into its wall is in the model's range: the table's grid is no error here

@@ -19,7 +19,7 @@ from data_schema.shape_records import shape_datasets
 from data_schema.table import ReboundTable, read_table
 from direct_model.registry import ConvexPolyhedron
 from direct_model.runtime import family_shapes, model_parameters
-from direct_model.shape_arrays import ShapeArrays, from_stored
+from direct_model.shape_arrays import ShapeArrays
 from direct_model.shapes import SHAPES, AspectRatioLaw
 from direct_model.wall import WallMaterial
 from surrogate.kernels.layout import KernelData, check_kernel_data, frozen, kernel_data
@@ -39,8 +39,8 @@ class SurrogateTable:
     wall: WallMaterial         # the wall the table was built with (its group /wall): its law family, parameters, name
     kernel_data: KernelData
     # the parameters of the direct model the table was built with (its group /model and the wall), as the
-    # kernels take them (:func:`direct_model.runtime.model_parameters`); None: a table without a direct path
-    direct_parameters: np.ndarray | None = None
+    # kernels take them (:func:`direct_model.runtime.model_parameters`)
+    direct_parameters: np.ndarray
     # the registry record (direct_model.registry) of each shape, table order, as the table holds it (group /shapes)
     records: tuple = ()
 
@@ -48,21 +48,15 @@ class SurrogateTable:
     def shape_arrays(self) -> ShapeArrays:
         """The direct model's shapes as the kernels take them (:class:`direct_model.shape_arrays.ShapeArrays`):
         the four families in code order at the κ, aspect-ratio law and factors s of :attr:`direct_parameters`,
-        then the table's other polyhedra (its user grains, and families after the paper's four) in table order;
-        no shape for a table without those parameters."""
-        if self.direct_parameters is None:
-            return from_stored(np.zeros(0), [0], np.zeros((0, 3)), [0], np.zeros((0, 3)), np.zeros((0, 3)),
-                               np.zeros((0, 4)), np.zeros(0))
+        then the table's other polyhedra (its user grains, and families after the paper's four) in table order."""
         return family_shapes(self.direct_parameters, self._stored_polyhedra)
 
     @functools.cached_property
     def model_shapes(self) -> np.ndarray:
         """Each of the table's shapes, in the table's order, as its index in :attr:`shape_arrays`: a family's code
-        (:data:`direct_model.shapes.SHAPES`), 4 + k for the table's k-th other polyhedron, −1 for a table without the
-        direct model's parameters (the direct path then answers STATUS_INVALID): read-only int64 (n_shapes,),
-        as :func:`surrogate.kernels.rebound` takes it."""
-        if self.direct_parameters is None:
-            return frozen(np.full(len(self.shapes), -1, dtype=np.int64))
+        (:data:`direct_model.shapes.SHAPES`), 4 + k for the table's k-th other polyhedron, −1 for a smooth body other
+        than the ellipsoid (the direct path then answers STATUS_INVALID): read-only int64 (n_shapes,), as
+        :func:`surrogate.kernels.rebound` takes it."""
         others = iter(range(len(SHAPES), len(SHAPES) + len(self._stored_polyhedra)))
         return frozen(np.array([SHAPES.index(r.name) if r.name in SHAPES
                                 else next(others) if isinstance(r, ConvexPolyhedron) else -1 for r in self.records],

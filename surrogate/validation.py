@@ -28,7 +28,7 @@ from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTS
                                       FAULT_VELOCITY_ZERO, SPEED_MAX, SPEED_MIN, SPIN_SCALE_MAX, first_faults)
 from surrogate.kernels.frame import NORMAL_TOLERANCE
 from surrogate.kernels.layout import frozen
-from surrogate.kernels.wall_hit import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT
+from surrogate.kernels.wall_hit import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE
 
 WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
 # physical range of a local incident state: (low, high, high included); clamp=True never reaches beyond it. For
@@ -360,26 +360,3 @@ def fault_error(fault: int, i: int, table, V, nrm, a) -> ValueError:
                           f"m/s, the range the sampler's arithmetic carries.")
     return _outside("speed", i, speed, table.speed_range, "m/s")
 
-
-# -- the direct model's parameters -------------------------------------------------------------------
-
-def check_direct_parameters(table) -> np.ndarray:
-    """``table.direct_parameters``; ValueError if the table does not record them."""
-    if table.direct_parameters is None:
-        raise ValueError(f"The table {table.path} does not record the direct model's second-moment factors (built "
-                         f"at kappa != 0.3 before tables recorded them); rebuild it with this version.")
-    return frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
-
-
-def check_direct_paths(table, path: np.ndarray, V, W, a) -> None:
-    """ValueError if a hit needs the direct model (path PATH_DIRECT) and ``table`` does not record its
-    parameters (``table.direct_parameters``)."""
-    if table.direct_parameters is not None:
-        return
-    needs = np.flatnonzero(path == PATH_DIRECT)
-    if needs.size:
-        i = int(needs[0])
-        spin = float(np.linalg.norm(W[min(i, len(W) - 1)]) * a[min(i, len(a) - 1)] / np.linalg.norm(V[i]))
-        raise ValueError(f"The hit at index {i} (|Omega-|a/|V-| = {spin!r}) needs the direct model, whose parameters "
-                         f"the table {table.path} does not record (built before tables recorded them); rebuild "
-                         f"it with this version, or pass method='table'.")

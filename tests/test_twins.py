@@ -1,6 +1,7 @@
 """The map between the C library and its Python twins stays true: every Python module, file and name that
 native/'s sources and docs/native.md cite exists, and each twin pair of docs/native.md's table is named alike."""
 
+import dataclasses
 import importlib
 import re
 from pathlib import Path
@@ -27,17 +28,20 @@ def _text(path: Path) -> str:
 
 
 def _resolves(dotted: str) -> bool:
-    """Whether ``dotted`` is a module, or a module followed by attributes."""
+    """Whether ``dotted`` is a module, or a module followed by attributes (a dataclass's field counts, with or
+    without a default)."""
     parts = dotted.split(".")
     for cut in range(len(parts), 0, -1):
         try:
             obj = importlib.import_module(".".join(parts[:cut]))
         except ImportError:
             continue
-        for name in parts[cut:]:
-            if not hasattr(obj, name):
-                return False
-            obj = getattr(obj, name)
+        for i, name in enumerate(parts[cut:]):
+            if hasattr(obj, name):
+                obj = getattr(obj, name)
+            else:
+                fields = {f.name for f in dataclasses.fields(obj)} if dataclasses.is_dataclass(obj) else set()
+                return name in fields and cut + i + 1 == len(parts)
         return True
     return False
 

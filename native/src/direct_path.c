@@ -35,7 +35,7 @@ RBS_HOT int rbs_direct_hit(const rbs_table *t, int shape, const double V[3], con
                            int *n_collisions)
 {
     *n_collisions = -1;
-    if (!t || !t->has_direct || !V || !Omega || !n || !u || !V_out || !Omega_out
+    if (!t || !V || !Omega || !n || !u || !V_out || !Omega_out
         || !valid(&t->direct_shapes, shape, V, Omega, n, a, u)) {
         nan_out(V_out);
         nan_out(Omega_out);

@@ -35,7 +35,7 @@ int rbs_grain_info(const rbs_table *t, const rbs_mix *mix, int64_t key, rbs_grai
     if (!t || !mix || mix->table != t || !RBS_RECORD_OK(grain, rbs_grain) || key < 0)
         return RBS_INVALID;
     int shape = (int)rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, rbs_grain_uniform((uint64_t)key, SLOT_SHAPE));
-    int direct_shape = t->model_shape ? t->model_shape[shape] : -1;
+    int direct_shape = t->model_shape[shape];
     grain->shape = shape;
     grain->ratio_ba = grain->ratio_cb = grain->hand = NAN;
     if (direct_shape < 0)

@@ -116,11 +116,10 @@ struct rbs_table {
     double *speed_restitution;
     double *restitution_pieces;
     size_t restitution_pieces_len;
-    int has_direct;                                 /* the table records the direct model's parameters */
     double direct_parameters[N_PARAMS];             /* surrogate.table.SurrogateTable.direct_parameters (P_*) */
     /* the direct model's shapes (surrogate.table.SurrogateTable.shape_arrays): the four families in code order,
      * from the parameters, then the table's other polyhedra in table order; model_shape[i] is the index there of the
-     * table's shape i (shape_records.c: rbs_direct_shapes_build; NULL without direct parameters) */
+     * table's shape i (shape_records.c: rbs_direct_shapes_build) */
     rbs_shape_arrays direct_shapes;
     int *model_shape;
 };

@@ -650,7 +650,6 @@ static void direct_parameters(rbs_table *t, const model_row *m)
     p[P_MAX_STEPS] = (double)m->max_steps;
     for (int k = 0; k < RBS_N_FAMILIES; k++) p[P_KFAC + k] = m->kfac[k];
     t->n_max = m->n_max;
-    t->has_direct = 1;
 }
 
 static void free_raw(rbs_raw_cells *raw)

@@ -26,7 +26,7 @@ int rbs_table_hit(const rbs_table *table, const rbs_mix *mix, const double V[3],
  * table's other polyhedra in table order: t->direct_shapes), Ω⁻ in rad/s (exactly zero: the body starts touching
  * the wall), u RBS_U_PER_REBOUND uniforms in [0, 1) (direct_model.runtime: U_ORIENTATION, U_RATIOS, U_HAND,
  * U_AXIS). RBS_OK; RBS_TRAPPED or RBS_FAILED with NaN outputs; RBS_INVALID with NaN outputs for an input out of
- * range, a NULL pointer, a shape outside those, a table without direct parameters. rbs_direct_hit also gives the
+ * range, a NULL pointer, a shape outside those. rbs_direct_hit also gives the
  * collisions of the rebound into *n_collisions (−1 for RBS_INVALID). */
 int rbs_direct_rebound(const rbs_table *table, int shape, const double V[3], const double Omega[3], const double n[3],
                        double a, const double u[RBS_U_PER_REBOUND], double V_out[3], double Omega_out[3]);

@@ -89,7 +89,7 @@ int rbs_table_kernel_array(const rbs_table *t, const char *name, const void **da
     else if (strcmp(name, "dictionary") == 0) { p = t->dictionary; n = t->dictionary_len; type = RBS_DTYPE_FLOAT32; }
     else if (strcmp(name, "speed_restitution") == 0) { p = t->speed_restitution; n = (size_t)t->n_speed; }
     else if (strcmp(name, "restitution_pieces") == 0) { p = t->restitution_pieces; n = t->restitution_pieces_len; }
-    else if (strcmp(name, "direct_parameters") == 0 && t->has_direct) { p = t->direct_parameters; n = N_PARAMS; }
+    else if (strcmp(name, "direct_parameters") == 0) { p = t->direct_parameters; n = N_PARAMS; }
     else return RBS_INVALID;
     if (data) *data = p;
     if (count) *count = n;

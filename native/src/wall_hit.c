@@ -122,6 +122,6 @@ int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const do
     /* the table's shape drawn as the table path draws it, then its index in the direct model's shapes */
     int64_t drawn = rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, u[0]);
     *shape = (int)drawn;
-    return rbs_direct_hit(t, t->model_shape ? t->model_shape[drawn] : -1, V, Omega, n, a, u + 1, V_out, Omega_out,
+    return rbs_direct_hit(t, t->model_shape[drawn], V, Omega, n, a, u + 1, V_out, Omega_out,
                           n_collisions);
 }

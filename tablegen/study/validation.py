@@ -50,11 +50,7 @@ def direct_states(shape, alpha1: float, speed: float, n: int, seed: int, **model
 def table_model(table) -> dict:
     """The direct model ``table`` (:func:`surrogate.load`) was built with, as keywords of
     :func:`direct_model.simulate.simulate`: κ, the b/a and c/b law, n_max, the wall law and the search's
-    tolerances, from its direct parameters (:func:`direct_model.runtime.model_settings`); ValueError for a table
-    that does not record them."""
-    if table.direct_parameters is None:
-        raise ValueError(f"the table {table.path} does not record its direct model's parameters (built at a kappa "
-                         f"other than 0.3 before format 3.2): rebuild it to validate it")
+    tolerances, from its direct parameters (:func:`direct_model.runtime.model_settings`)."""
     return model_settings(table.direct_parameters)
 
 

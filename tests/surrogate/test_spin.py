@@ -290,22 +290,6 @@ def test_a_writable_copy_of_the_parameters_reaches_the_kernel_read_only(small_ta
     assert all(not signature[0].mutable for signature in direct_rebound_parallel_rng.signatures)
 
 
-def test_a_table_without_the_model_s_parameters_fails_only_where_the_model_is_needed(small_table):
-    old = dataclasses.replace(small_table, direct_parameters=None)
-    V = _in_grid(50, 9)
-    want = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=5)
-    for x, y in zip(want, surrogate.sample_global(old, V, NORMAL, A, "mix", random_state=5)):
-        np.testing.assert_array_equal(x, y)
-    W = np.zeros((50, 3))
-    W[17] = [0.0, 0.0, 1e5]
-    out = np.full((50, 3), 7.0), np.full((50, 3), 7.0), np.full(50, 7, dtype=np.int8)
-    with pytest.raises(ValueError, match=r"hit at index 17 .* needs the direct model, whose parameters the table") as e:
-        surrogate.sample_global(old, V, NORMAL, A, "mix", random_state=5, omega=W, out=out)
-    assert "\n" not in str(e.value) and np.all(out[0] == 7.0) and np.all(out[2] == 7)
-    with pytest.raises(ValueError, match="needs the direct model"):
-        surrogate.sample_global(old, V, NORMAL, A, "mix", random_state=5, method="direct")
-
-
 def test_the_same_seed_gives_the_same_bits_on_one_or_two_threads(small_table):
     """A spinning, half in-grid mix over three chunks: the same bits with 1 and 2 numba threads."""
     m = 2 * CHUNK_ROWS + 300
