@@ -21,8 +21,9 @@ def _grid(values) -> str:
     return f"{len(v)} values, {v[0]:g} to {v[-1]:g}{step}"
 
 
-def _shape(record) -> str:
-    """One shape of a table: name, kind, vertex count, its aspect-ratio law and hands."""
+def _shape(record, width: int) -> str:
+    """One shape of a table: name (in a column ``width`` wide), kind, vertex count, its aspect-ratio law and
+    hands."""
     if isinstance(record, ConvexPolyhedron):
         kind = f"convex polyhedron, {len(record.vertices)} vertices"
     else:
@@ -31,7 +32,7 @@ def _shape(record) -> str:
     scaled = (f"b/a, c/b ~ N({law.mean:g}, {law.sd:g}) in [{law.low:g}, {law.high:g}]" if law is not None
               else "fixed proportions")
     built_in = "built-in" if record.name in FAMILIES else "user grain"
-    return f"{record.name:<16} {built_in}, {kind}; {scaled}{'; both hands' if record.both_hands else ''}"
+    return f"{record.name:<{width}} {built_in}, {kind}; {scaled}{'; both hands' if record.both_hands else ''}"
 
 
 def describe_table(table: ReboundTable, path: Path | None = None) -> str:
@@ -50,19 +51,22 @@ def describe_table(table: ReboundTable, path: Path | None = None) -> str:
         f"alpha1 (deg): {_grid(table.alpha1_deg)}",
         f"speed (m/s):  {_grid(table.speed_m_s)}",
         f"shapes: {len(table.shapes)} (cut_prism kappa = {table.kappa:g}); n_max = {table.n_max}",
-        *(f"  {_shape(record)}" for record in table.shape_records()),
+        *(f"  {_shape(record, max(16, *(len(r.name) for r in table.shape_records())))}"
+          for record in table.shape_records()),
         f"wall: {table.wall.name} ({table.wall.family} law: "
         + ", ".join(f"{name} = {value:g}" for name, value in table.wall.parameters().items()) + ")",
         f"cells: {total.size}, {table.particles_per_cell} particles each",
         "resolution: " + ", ".join(f"{f.name} {getattr(table.resolution, f.name)}"
                                    for f in dataclasses.fields(table.resolution)),
-        f"{'shape':<12}" + "".join(f"{name + ' %':>22}" for name in STATUS_NAMES.values()),
     ]
+    rows = []
     for s, shape in enumerate(table.shapes):
         frac = 100.0 * counts[s] / total[s][..., None]
-        cols = []
-        for k in range(len(STATUS_NAMES)):
-            f = frac[..., k]
-            cols.append(f"{f.min():6.2f}..{f.max():6.2f} (mean {f.mean():5.2f})")
-        lines.append(f"{shape:<12}" + "".join(f"{c:>22}" for c in cols))
+        rows.append([shape] + [f"{f.min():6.2f}..{f.max():6.2f} (mean {f.mean():6.2f})"
+                               for f in (frac[..., k] for k in range(len(STATUS_NAMES)))])
+    header = ["shape"] + [f"{name} %" for name in STATUS_NAMES.values()]
+    # each column as wide as its longest entry, two spaces apart: a long shape name never runs into a number
+    widths = [max(len(row[c]) for row in rows + [header]) for c in range(len(header))]
+    for row in [header] + rows:
+        lines.append(f"{row[0]:<{widths[0]}}" + "".join(f"  {x:>{w}}" for x, w in zip(row[1:], widths[1:])))
     return "\n".join(lines)
