@@ -43,7 +43,7 @@ if [ -z "$native_given" ]; then
         -DCMAKE_BUILD_TYPE=Release \
         -DCMAKE_INSTALL_PREFIX="$RBS_NATIVE_PREFIX" \
         -DCMAKE_INSTALL_LIBDIR=lib \
-        -DRBS_BUILD_STATIC=OFF -DBUILD_TESTING=OFF >/dev/null
+        -DRBS_BUILD_STATIC=OFF >/dev/null
     cmake --build "$RBS_OPENFOAM_CACHE/native-build" -j "$jobs" >/dev/null
     cmake --install "$RBS_OPENFOAM_CACHE/native-build" >/dev/null
     step_done
