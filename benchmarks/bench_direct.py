@@ -213,8 +213,9 @@ def _kernel_loop(params, shapes, shape, V, omega, n, a, state, status, V_out, W_
     u = np.empty(U_PER_REBOUND)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        st, Vo, Wo = direct_rebound(params, shapes, shape, (V[i, 0], V[i, 1], V[i, 2]),
-                                    (omega[i, 0], omega[i, 1], omega[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        hit = direct_rebound(params, shapes, shape, (V[i, 0], V[i, 1], V[i, 2]),
+                             (omega[i, 0], omega[i, 1], omega[i, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        st, Vo, Wo = hit.status, hit.V, hit.Omega
         status[i] = st
         for k in range(3):
             V_out[i, k], W_out[i, k] = Vo[k], Wo[k]
@@ -237,10 +238,10 @@ def _model_frame_loop(params, shapes, model, shape, u_all, counts, W_after):
     W_after[i] = Ω⁺ ((m/s)/a, model frame)."""
     scratch = np.empty(SCRATCH_SIZE)
     for i in range(model.shape[0]):
-        st, n_coll, n_steps, _, _, _, wx, wy, wz = rebound_model_frame(
+        done = rebound_model_frame(
             params, shapes, shape, model[i, 0], model[i, 1], model[i, 2], model[i, 3], model[i, 4], u_all[i], scratch)
-        counts[i, 0], counts[i, 1], counts[i, 2] = st, n_coll, n_steps
-        W_after[i, 0], W_after[i, 1], W_after[i, 2] = wx, wy, wz
+        counts[i, 0], counts[i, 1], counts[i, 2] = done.status, done.n_collisions, done.n_search_steps
+        W_after[i, 0], W_after[i, 1], W_after[i, 2] = done.Omega
 
 
 # ----------------------------------------------------------------------------- the pieces of a rebound

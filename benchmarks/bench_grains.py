@@ -66,9 +66,9 @@ def _rebounds(params, arrays, shape, model, u, counts):
     """rebound_model_frame on every row; counts[i] = (status, collisions, search steps)."""
     scratch = np.empty(SCRATCH_SIZE)
     for i in range(model.shape[0]):
-        status, n_coll, n_steps, _, _, _, _, _, _ = rebound_model_frame(
+        done = rebound_model_frame(
             params, arrays, shape, model[i, 0], model[i, 1], model[i, 2], model[i, 3], model[i, 4], u[i], scratch)
-        counts[i, 0], counts[i, 1], counts[i, 2] = status, n_coll, n_steps
+        counts[i, 0], counts[i, 1], counts[i, 2] = done.status, done.n_collisions, done.n_search_steps
 
 
 def best_us(params, arrays, model, u, counts, repeats) -> np.ndarray:

@@ -199,8 +199,9 @@ def loop_kernel_rng(data, cdf, V, n, a, state, V_out, Omega_out, status):
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
-                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        hit = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                            (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
 
@@ -212,8 +213,9 @@ def loop_rebound_rng(data, params, shape_arrays, model_shapes, cdf, V, n, a, sta
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        status[i], V_new, W_new = rebound(data, params, shape_arrays, model_shapes, cdf, (V[i, 0], V[i, 1], V[i, 2]),
-                                          (0.0, 0.0, 0.0), (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        hit = rebound(data, params, shape_arrays, model_shapes, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                      (0.0, 0.0, 0.0), (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
 
@@ -225,7 +227,8 @@ def loop_kernel_views(data, cdf, V, n, a, state, V_out, Omega_out, status):
     u = np.empty(U_PER_DRAW)
     for i in range(V.shape[0]):
         fill_uniforms(state, u)
-        status[i], V_new, W_new = table_rebound(data, cdf, V[i], n[i], a[i], u)
+        hit = table_rebound(data, cdf, V[i], n[i], a[i], u)
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         V_row, W_row = V_out[i], Omega_out[i]
         for k in range(3):
             V_row[k], W_row[k] = V_new[k], W_new[k]
@@ -252,8 +255,9 @@ def loop_kernel_nprandom(data, cdf, V, n, a, V_out, Omega_out, status):
     for i in range(V.shape[0]):
         for k in range(U_PER_DRAW):
             u[k] = np.random.random()
-        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
-                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        hit = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                            (n[i, 0], n[i, 1], n[i, 2]), a[i], u)
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
 
@@ -263,8 +267,9 @@ def loop_kernel_predrawn(data, cdf, V, n, a, U, V_out, Omega_out, status, scaled
     """(b') The same loop on pre-drawn uniforms U (N, U_PER_DRAW); with scaled=False, plain stochastic
     interpolation (no moment scaling, breakdown row)."""
     for i in range(V.shape[0]):
-        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
-                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i], scaled)
+        hit = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                            (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i], scaled)
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         V_out[i, 0], V_out[i, 1], V_out[i, 2] = V_new
         Omega_out[i, 0], Omega_out[i, 1], Omega_out[i, 2] = W_new
 
@@ -518,8 +523,10 @@ def main(argv=None) -> int:
     def api():
         return surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED)
 
+    kept = surrogate.empty_rebounds(count)
+
     def api_out():
-        return surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED, out=(V_out, Omega_out, status))
+        return surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED, out=kept)
 
     record("a_all", "(a) sample_global, all cores", threads, api)
     record("a_1", "(a) sample_global, 1 numba thread", 1, api)
@@ -565,7 +572,7 @@ def main(argv=None) -> int:
     for key, label, omega in (("e_spin", "(e) auto, spinning states, 1 thread", spin),
                               ("e_mix", "(e) auto, half of the states spinning, 1 thread", half)):
         paths = surrogate.sample_global(table, V[:m_spin], nrm[:m_spin], a[:m_spin], shape=mix, random_state=SEED,
-                                        omega=omega, return_path=True)[3]
+                                        omega=omega).path
         record(key, label, 1, lambda: surrogate.sample_global(table, V[:m_spin], nrm[:m_spin], a[:m_spin], shape=mix,
                                                               random_state=SEED, omega=omega),
                note=f"{np.mean(paths == PATH_DIRECT):.3f} of the hits answered by the direct model", states=m_spin)

@@ -21,6 +21,8 @@ caller and passed in, so each particle's result depends on its own inputs only:
 the batch is bit-identical whatever the number of threads.
 """
 
+from typing import NamedTuple
+
 import numba
 import numpy as np
 
@@ -37,6 +39,19 @@ from direct_model.rotation import ROT_PARAMS_SIZE
 from direct_model.shape_arrays import bounding_radius, particle_body
 
 HISTORY_COLUMNS = 17
+
+
+class BodyRebound(NamedTuple):
+    """What one particle's rebound did (:func:`body_rebound`), model frame (module doc's units)."""
+
+    status: int                 # STATUS_REBOUNDED, STATUS_TRAPPED or STATUS_FAILED (data_schema.samples)
+    failure: int                # why it failed: a FAILURE_* code of data_schema.samples; FAILURE_NONE otherwise
+    n_collisions: int           # collisions applied (up to the trap or the failure)
+    n_search_steps: int         # contact-search steps over every flight
+    n_multiple_roots: int       # collisions whose impulse equation had several roots
+    rotational_energy: float    # ½ Ω·KΩ per unit mass after the last collision, (m/s)²
+    V: tuple                    # V after the last collision, m/s (3 floats): V⁺ if rebounded
+    Omega: tuple                # Ω after the last collision, (m/s)/a (3 floats): Ω⁺ if rebounded
 
 # layout of the scratch array of :func:`body_rebound`: the candidate points' heights and rates, then g̈ (curvatures)
 _HEIGHTS = 0
@@ -86,7 +101,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
     n_max : collisions allowed before the particle is trapped.
     contact_tol, set_tol : contact and contact-set tolerances, units of a.
     max_steps : search-step budget per flight.
-    V, W : (3,) outputs, velocity and angular velocity just after the last collision.
+    V, W : (3,) work arrays: the velocity and angular velocity as the rebound goes, V⁺ and Ω⁺ at the end.
     history : (H, HISTORY_COLUMNS) output; row k receives the state at the start
         of flight k (k < H): time (a/(m/s)), centre height y (a), V (3), Ω (3),
         R (9, row-major). Pass an array with H = 0 to record nothing.
@@ -94,9 +109,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
 
     Returns
     -------
-    (status, failure_reason, n_collisions, n_search_steps, n_multiple_root_events, e_rot)
-    with e_rot = ½ Ω·KΩ, the rotational energy per unit mass after the rebound, and
-    failure_reason one of the FAILURE_* codes of :mod:`data_schema.samples`.
+    :class:`BodyRebound`.
     """
     h = work[_HEIGHTS:_HEIGHTS + MAX_HULL_VERTICES]
     h1 = work[_RATES:_RATES + MAX_HULL_VERTICES]
@@ -176,7 +189,8 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         V += dV
         W += dW
         n_coll += 1
-    return status, failure, n_coll, n_steps, n_multi, e_rot
+    return BodyRebound(np.int64(status), np.int64(failure), np.int64(n_coll), np.int64(n_steps), np.int64(n_multi),
+                       e_rot, (V[0], V[1], V[2]), (W[0], W[1], W[2]))
 
 
 @numba.njit(parallel=True, **JIT)
@@ -206,12 +220,11 @@ def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall,
             nv = particle_body(shape_arrays, shape, ratios[i, 0], ratios[i, 1], float(hands[i]), verts, K, semi)
             kind = np.int64(shape_arrays.kind[shape])
             quaternion_to_matrix(quats[i], R0)
-            status, failure, ncoll, steps, multi, erot = body_rebound(
-                kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, wall, n_max,
-                contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
-            out_status[i] = status
-            out_failure[i] = failure
-            out_ncoll[i] = ncoll
-            out_steps[i] = steps
-            out_multi[i] = multi
-            out_erot[i] = erot
+            rebound = body_rebound(kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, wall,
+                                   n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
+            out_status[i] = rebound.status
+            out_failure[i] = rebound.failure
+            out_ncoll[i] = rebound.n_collisions
+            out_steps[i] = rebound.n_search_steps
+            out_multi[i] = rebound.n_multiple_roots
+            out_erot[i] = rebound.rotational_energy

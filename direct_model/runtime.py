@@ -163,8 +163,7 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
 
     Returns
     -------
-    (status, n_collisions, n_search_steps, V⁺ as 3 floats in m/s, Ω⁺ as 3 floats in (m/s)/a), model frame;
-    status as in :func:`direct_model.body_rebound.body_rebound`.
+    :class:`direct_model.body_rebound.BodyRebound`, model frame: V⁺ in m/s, Ω⁺ in (m/s)/a.
     """
     verts = scratch[_VERTS:_VERTS + 3 * MAX_HULL_VERTICES].reshape((MAX_HULL_VERTICES, 3))
     semi, K = scratch[_SEMI:_SEMI + 3], scratch[_K:_K + 3]
@@ -184,8 +183,7 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
     kind = np.int64(shape_arrays.kind[shape])
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
-    status, _, n_coll, n_steps, _, _ = body_rebound(
+    return body_rebound(
         kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, params[P_WALL:P_WALL + 3],
         int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
         scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])
-    return status, n_coll, n_steps, V[0], V[1], V[2], W[0], W[1], W[2]

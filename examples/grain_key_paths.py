@@ -59,8 +59,9 @@ def keyed_hits(table, keys: np.ndarray, hits: int, method: str, seed: int):
     a1 = np.radians(ALPHA1_DEG)
     V = np.tile([SPEED * np.cos(a1), -SPEED * np.sin(a1), 0.0], (n, 1))
     # clamp: |V⁻| rounds to just above a grid speed of 100 m/s; the table path reads that edge's law
-    V_out, _, status = surrogate.sample_global(table, V, (0.0, 1.0, 0.0), HALF_SIZE, MIX, random_state=seed,
-                                               method=method, clamp=True, grain_key=np.repeat(keys, hits))
+    hits = surrogate.sample_global(table, V, (0.0, 1.0, 0.0), HALF_SIZE, MIX, random_state=seed,
+                                   method=method, clamp=True, grain_key=np.repeat(keys, hits))
+    V_out, status = hits.V, hits.status
     with np.errstate(invalid="ignore"):
         alpha2 = np.degrees(np.arctan2(V_out[:, 1], np.hypot(V_out[:, 0], V_out[:, 2])))
     ratio = np.linalg.norm(V_out, axis=1) / SPEED

@@ -125,9 +125,10 @@ def track(pos, vel, omega, t_end, dt, geometry, radius, model, data, params, sha
                 normal[0], normal[1], normal[2] = p[0] / r, p[1] / r, 0.0
             if model == TABLE:
                 fill_uniforms(rng_state, u)
-                status, V_new, _ = rebound(data, params, shape_arrays, model_shapes, mix_cdf, (v[0], v[1], v[2]),
-                                           (omega[i, 0], omega[i, 1], omega[i, 2]),
-                                           (normal[0], normal[1], normal[2]), half_size, u, METHOD_AUTO)
+                hit = rebound(data, params, shape_arrays, model_shapes, mix_cdf, (v[0], v[1], v[2]),
+                              (omega[i, 0], omega[i, 1], omega[i, 2]),
+                              (normal[0], normal[1], normal[2]), half_size, u, METHOD_AUTO)
+                status, V_new = hit.status, hit.V
                 vo[0], vo[1], vo[2] = V_new
             else:
                 vn = v[0] * normal[0] + v[1] * normal[1] + v[2] * normal[2]

@@ -5,8 +5,8 @@ imports :mod:`tablegen`, so a flow solver installs the runtime alone::
 
     import surrogate
     table = surrogate.load("table.h5")
-    V_out, Omega_out, status = surrogate.sample_global(table, V, normals, half_size, shape="prism",
-                                                       random_state=1)
+    hits = surrogate.sample_global(table, V, normals, half_size, shape="prism", random_state=1)
+    hits.V, hits.Omega, hits.status          # V⁺ m/s, Ω⁺ rad/s, 0 rebounded (surrogate.Rebounds: by name)
 
 From numba code, the call that answers any wall hit is :func:`surrogate.kernels.rebound` (module doc's last
 paragraph); the table path alone is :func:`surrogate.kernels.table_rebound`, called with ``table.kernel_data``
@@ -40,10 +40,12 @@ from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED,
 from direct_model.runtime import U_PER_REBOUND
 from surrogate.grains import Grains, grain_key, grain_of
 from surrogate.kernels import SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
+from surrogate.kernels.hit import Hit, Rebounds, empty_rebounds
 from surrogate.sampling import LocalDraws, sample_direct, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 from surrogate.validation import METHODS, check_random_state, mix_cdf
 
-__all__ = ["Grains", "LocalDraws", "METHODS", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID", "STATUS_REBOUNDED",
-           "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state", "fill_uniforms",
-           "grain_key", "grain_of", "load", "mix_cdf", "sample_direct", "sample_global", "sample_local", "seed_state"]
+__all__ = ["Grains", "Hit", "LocalDraws", "METHODS", "Rebounds", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID",
+           "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "check_random_state",
+           "empty_rebounds", "fill_uniforms", "grain_key", "grain_of", "load", "mix_cdf", "sample_direct",
+           "sample_global", "sample_local", "seed_state"]

@@ -106,9 +106,10 @@ def _draw(table, args, shape, omega, keys=None):
         return draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio), PATH_TABLE
     if keys is None and keyed:
         keys = np.full(args.n, args.grain_key)
-    V_out, Omega_out, status = surrogate.sample_global(
+    hits = surrogate.sample_global(
         table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape, random_state=args.seed, omega=spin,
         method="direct" if path == PATH_DIRECT else "table", clamp=args.clamp, grain_key=keys)
+    V_out, Omega_out, status = hits.V, hits.Omega, hits.status
     alpha2, beta2, v = rebound_angles(V_out)
     draws = surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
                                  omega=Omega_out * (half_size / speed), status=status)

@@ -3,8 +3,9 @@
 Three entry points:
 
 * :func:`sample_global` — the solver's API: incident velocities, spins and wall
-  normals in any global frame in, V⁺ (m/s) and Ω⁺ (rad/s) out; every hit answered,
-  by the table where it is valid and by the direct model elsewhere (``method``);
+  normals in any global frame in, a record of every hit out (:class:`Rebounds`: V⁺ in m/s, Ω⁺ in rad/s, status,
+  path, shape, collisions); every hit answered, by the table where it is valid and by the direct model elsewhere
+  (``method``);
 * :func:`sample_direct` — the same hits answered by the direct model alone, with the parameters the table
   was built with (:mod:`surrogate.kernels.direct_path`; microseconds per hit, not nanoseconds);
 * :func:`sample_local` — for arrays of incidence angle α1 (deg) and speed |V⁻|
@@ -43,6 +44,7 @@ import numpy as np
 from data_schema.table import STATE_NAMES
 from surrogate.kernels.direct_path import direct_rebound_parallel_rng
 from surrogate.kernels.grain import keyed_shapes
+from surrogate.kernels.hit import Rebounds
 from surrogate.kernels.layout import frozen
 from surrogate.kernels.locate import mix_shapes
 from surrogate.kernels.parallel import draw_local_parallel_rng
@@ -97,7 +99,7 @@ def _incident(table: SurrogateTable, velocity, normal, half_size, omega) -> tupl
 
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
                   clamp: bool = False, interpolation: str = "scaled", out=None, *, omega=None, method: str = "auto",
-                  return_path: bool = False, grain_key=None):
+                  grain_key=None) -> Rebounds:
     """Reflected velocities and spins of particles hitting walls, in the global frame: every hit answered, by
     the table where it is valid and by the direct model elsewhere.
 
@@ -125,11 +127,10 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         state that moves into its wall is physical (α1 in (0, 90]), with |V⁻| in
         [1e-150, 1e150] m/s (what the arithmetic carries). The other methods send such states
         to the direct model.
-    out : None (default: new arrays) or a tuple (V_out, Omega_out, status) of
-        arrays to write the results into and return (with ``return_path``, a fourth: path): C-contiguous,
-        writeable, float64 (N, 3), float64 (N, 3), int8 (N,) (and int8 (N,)), sharing no memory with
-        the inputs. A solver calling this every time step can keep them, which
-        spares it the allocation and the first touch of fresh pages.
+    out : None (default: a new record) or a :class:`Rebounds` of N rows to write the results into and return
+        (:func:`surrogate.empty_rebounds`; C-contiguous, writeable, sharing no memory with the inputs). A solver
+        calling this every time step can keep it, which spares it the allocation and the first touch of fresh
+        pages.
     omega : None (default: no spin) or (N, 3) or (3,) incident angular velocities Ω⁻, rad/s, in the frame of
         ``velocity`` (finite).
     method : ``"auto"`` (default): the table iff |Ω⁻|a/|V⁻| ≤ :data:`surrogate.SPIN_TOLERANCE` and α1, |V⁻|
@@ -137,8 +138,6 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         microseconds per hit) for every other hit; ``"table"``: the table for every hit, Ω⁻ ignored (the
         behaviour before spin was taken into account; ``clamp`` applies); ``"direct"``: the direct model
         for every hit. With Ω⁻ zero and every state in the grid, ``"auto"`` gives ``"table"``'s bits.
-    return_path : also return which path answered each hit (0 the table, 1 the direct model;
-        :data:`surrogate.kernels.PATH_TABLE`, :data:`surrogate.kernels.PATH_DIRECT`).
     grain_key : None (default: every hit a new grain drawn from the stream) or (N,) integers in [0, 2**63), one
         per particle, kept for its life (:func:`surrogate.grain_key` derives them): the particle hits as the same
         grain every time. Its shape is the key's on either path (a shape given per particle wins); on the direct
@@ -149,10 +148,14 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
 
     Returns
     -------
-    (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8), and path (N,) int8 with ``return_path``.
-    Status 0 rebounded, 1 trapped, 2 failed (the direct model only: a collision solve or a contact search
-    failed; rare, never dropped: count them with ``status == surrogate.STATUS_FAILED``); NaN rows unless
-    rebounded. Every check runs before anything is written: on a ValueError the ``out`` arrays are unchanged.
+    :class:`Rebounds`, one row per hit, read by name: ``V`` (N, 3) V⁺ in m/s, ``Omega`` (N, 3) Ω⁺ in rad/s (NaN
+    rows unless rebounded), ``status`` (N,) int8: 0 rebounded, 1 trapped, 2 failed (the direct model only: a
+    collision solve or a contact search failed; rare, never dropped: count them with
+    ``status == surrogate.STATUS_FAILED``); ``path`` (N,) int8: which path answered the hit (0 the table, 1 the
+    direct model; :data:`surrogate.kernels.PATH_TABLE`, :data:`surrogate.kernels.PATH_DIRECT`); ``shape`` (N,)
+    int32: the particle's shape, its index in ``table.shapes``; ``n_collisions`` (N,) int32: the direct path's
+    collisions, −1 on the table path. Every check runs before anything is written: on a ValueError ``out`` is
+    unchanged.
     The direct model takes the families and the table's user grains (convex polyhedra), with the parameters the
     table was built with (``table.direct_parameters``).
     """
@@ -166,19 +169,17 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     if code == METHOD_DIRECT:
         _check_direct_shapes(table, cdf, shapes)
     scaled = check_interpolation(interpolation)
-    outputs = check_out(out, n_particles, (V, nrm, a, W), 4 if return_path else 3)
-    V_out, Omega_out, status = outputs[:3]
-    path = outputs[3] if return_path else np.empty(n_particles, np.int8)
+    out = check_out(out, n_particles, (V, nrm, a, W))
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     states = chunk_states(check_random_state(random_state), n_particles)
     rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
                          as_rows(nrm, n_particles),
-                         as_rows(a, n_particles), states, code, V_out, Omega_out, status, path, scaled)
-    return tuple(outputs)
+                         as_rows(a, n_particles), states, code, out, scaled)
+    return out
 
 
 def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None, *,
-                  omega=None, out=None, grain_key=None):
+                  omega=None, out=None, grain_key=None) -> Rebounds:
     """Reflected velocities and spins of particles hitting walls, from the direct model alone, in the caller's
     frame (docs/model.md §10): for any hit to be computed by the model itself, a spinning one or one off the
     table's grid (:func:`sample_global`'s ``method="auto"`` does this where the table does not apply).
@@ -199,15 +200,16 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     omega : None (default: no spin) or (N, 3) or (3,) incident angular velocities Ω⁻, rad/s; exactly zero: the
         body starts touching the wall (as in the tables), otherwise the flight in from a clear start is
         simulated.
-    out : None or (V_out, Omega_out, status) arrays to fill (as :func:`sample_global`'s).
+    out : None or a :class:`Rebounds` to fill (as :func:`sample_global`'s).
     grain_key : None or (N,) integers in [0, 2**63), one per particle (as :func:`sample_global`'s): a keyed
         particle's shape (unless given per particle), proportions and hand are its key's
         (:func:`surrogate.grain_of`), its orientation random per hit. The stream advances as without keys.
 
     Returns
     -------
-    (V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,) int8): STATUS_REBOUNDED (0), STATUS_TRAPPED (1)
-    or STATUS_FAILED (2, a collision solve or contact search failed); NaN rows unless rebounded.
+    :class:`Rebounds` (as :func:`sample_global`'s): status STATUS_REBOUNDED (0), STATUS_TRAPPED (1) or
+    STATUS_FAILED (2, a collision solve or contact search failed), NaN rows unless rebounded; path PATH_DIRECT;
+    n_collisions the rebound's collisions (up to the trap).
     """
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
@@ -217,17 +219,17 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     cdf, shapes = check_shape(table, shape, n_particles)
     _check_direct_shapes(table, cdf, shapes)
     keys = check_grain_key(grain_key, n_particles)
-    V_out, Omega_out, status = check_out(out, n_particles, (V, nrm, a, W))
+    out = check_out(out, n_particles, (V, nrm, a, W))
     generator = check_random_state(random_state)
     if shapes.size == 0:
         shapes = _mix_rows(cdf, n_particles, generator)      # drawn with keys too: the stream advances alike
         if keys.size:
             shapes = keyed_shapes(cdf, np.zeros(0, dtype=np.int64), keys)
-    codes = np.ascontiguousarray(table.model_shapes[shapes])
     states = chunk_states(generator, n_particles)
-    direct_rebound_parallel_rng(params, table.shape_arrays, codes, keys, V, as_rows(W, n_particles),
-                                as_rows(nrm, n_particles), as_rows(a, n_particles), states, V_out, Omega_out, status)
-    return V_out, Omega_out, status
+    direct_rebound_parallel_rng(params, table.shape_arrays, table.model_shapes, shapes, keys, V,
+                                as_rows(W, n_particles), as_rows(nrm, n_particles), as_rows(a, n_particles), states,
+                                out)
+    return out
 
 
 def _check_direct_shapes(table: SurrogateTable, cdf: np.ndarray, shapes: np.ndarray) -> None:

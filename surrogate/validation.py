@@ -27,6 +27,7 @@ from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTS
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
                                       FAULT_VELOCITY_ZERO, SPEED_MAX, SPEED_MIN, SPIN_SCALE_MAX, first_faults)
 from surrogate.kernels.frame import NORMAL_TOLERANCE
+from surrogate.kernels.hit import REBOUNDS_ARRAYS, Rebounds, empty_rebounds
 from surrogate.kernels.layout import frozen
 from surrogate.kernels.wall_hit import METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE
 
@@ -36,7 +37,6 @@ WEIGHT_SUM_TOLERANCE = 1e-9     # |Σ weights − 1| allowed for a mix
 PHYSICAL_RANGE = {"alpha1": (*ALPHA1_RANGE_DEG, True), "speed": (SPEED_MIN, SPEED_MAX, True)}
 METHODS = {"auto": METHOD_AUTO, "table": METHOD_TABLE, "direct": METHOD_DIRECT}
 INTERPOLATIONS = ("stochastic", "scaled")
-OUT_NAMES = ("V_out", "Omega_out", "status", "path")
 
 
 # -- numbers and arrays ------------------------------------------------------------------------------
@@ -251,26 +251,26 @@ def check_interpolation(interpolation) -> bool:
     return interpolation == "scaled"
 
 
-def check_out(out, n: int, inputs, count: int = 3) -> tuple:
-    """The first ``count`` of the (V_out, Omega_out, status, path) arrays of a call over n particles: new
-    ones, or the ``out`` arrays once checked (ValueError naming the first that is not float64 (n, 3),
-    float64 (n, 3), int8 (n,), int8 (n,), C-contiguous, writeable and sharing no memory with ``inputs``)."""
-    wanted = ((n, 3), np.float64), ((n, 3), np.float64), ((n,), np.int8), ((n,), np.int8)
+def check_out(out, n: int, inputs) -> Rebounds:
+    """The :class:`surrogate.kernels.hit.Rebounds` a call over n hits fills: a new one, or ``out`` once checked
+    (ValueError naming the first field that is not an array of the dtype and shape of
+    :func:`surrogate.kernels.hit.empty_rebounds`, C-contiguous, writeable and sharing no memory with ``inputs``
+    or another field)."""
     if out is None:
-        return tuple(np.empty(shape, dtype=dtype) for shape, dtype in wanted[:count])
-    if not isinstance(out, tuple) or len(out) != count:
-        raise ValueError(f"The 'out' parameter must be None or a tuple of {count} arrays "
-                         f"({', '.join(OUT_NAMES[:count])}); got {type(out).__name__}"
-                         f"{f' of {len(out)}' if isinstance(out, tuple) else ''}.")
-    for i, (name, arr, (shape, dtype)) in enumerate(zip(OUT_NAMES, out, wanted)):
+        return empty_rebounds(n)
+    if not isinstance(out, Rebounds):
+        raise ValueError(f"The 'out' parameter must be None or a surrogate.Rebounds "
+                         f"(surrogate.empty_rebounds({n})); got {type(out).__name__}.")
+    for i, (name, (dtype, tail)) in enumerate(REBOUNDS_ARRAYS.items()):
+        arr, shape = out[i], (n, *tail)
         if not isinstance(arr, np.ndarray) or arr.shape != shape or arr.dtype != dtype:
             got = f"dtype {arr.dtype}, shape {arr.shape}" if isinstance(arr, np.ndarray) else type(arr).__name__
-            raise ValueError(f"out[{i}] ({name}) must be an array of dtype {np.dtype(dtype)} and shape {shape}; "
+            raise ValueError(f"out.{name} must be an array of dtype {np.dtype(dtype)} and shape {shape}; "
                              f"got {got}.")
         if not (arr.flags.c_contiguous and arr.flags.writeable):
-            raise ValueError(f"out[{i}] ({name}) must be C-contiguous and writeable.")
+            raise ValueError(f"out.{name} must be C-contiguous and writeable.")
         if any(np.may_share_memory(arr, x) for x in (*inputs, *out[:i])):
-            raise ValueError(f"out[{i}] ({name}) shares memory with an input or another output array.")
+            raise ValueError(f"out.{name} shares memory with an input or another field of out.")
     return out
 
 

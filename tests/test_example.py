@@ -63,8 +63,9 @@ def test_wall_table_rebounds_leave_the_wall_and_follow_the_sampler(beam, small_t
     # and of the speed ratio agree within 4 standard errors of their difference (two-sided p ≈ 6e-5
     # under equal laws; a wrong frame, e.g. a flipped normal or tangent, moves them by tens of SE).
     normals = np.tile([0.0, 1.0, 0.0], (N, 1))
-    V_api, _, status = surrogate.sample_global(small_table, vel, normals, np.full(N, beam.HALF_SIZE), shape="mix",
-                                                random_state=9)   # method "auto", as the tracker's kernel
+    hits = surrogate.sample_global(small_table, vel, normals, np.full(N, beam.HALF_SIZE), shape="mix",
+                                    random_state=9)
+    V_api, status = hits.V, hits.status   # method "auto", as the tracker's kernel
     api = status == 0
     for f in (lambda v, v0: beam.angles(v)[0], lambda v, v0: np.linalg.norm(v, axis=1) / np.linalg.norm(v0, axis=1)):
         x, y = f(v_out[ok], vel[ok]), f(V_api[api], vel[api])

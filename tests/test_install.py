@@ -31,9 +31,10 @@ def test_plain_install_draws_from_a_table(small_table_path, plain_install):
     assert 'pip install "rebound-scatter[build]"' in fresh["refused"]
     table = surrogate.load(small_table_path)
     local = surrogate.sample_local(table, np.full(200, 33.7), np.full(200, 144.6), "mix", random_state=7)
-    V_out, Omega_out, status = surrogate.sample_direct(table, np.tile([120.0, -80.0, 10.0], (50, 1)),
-                                                       [0.0, 1.0, 0.0], 5e-5, "prism", random_state=7,
-                                                       omega=[0.0, 0.0, 2e5])
+    hits = surrogate.sample_direct(table, np.tile([120.0, -80.0, 10.0], (50, 1)),
+                                   [0.0, 1.0, 0.0], 5e-5, "prism", random_state=7,
+                                   omega=[0.0, 0.0, 2e5])
+    V_out, Omega_out, status = hits.V, hits.Omega, hits.status
     assert (local.status == 0).sum() > 150 and (status == 0).sum() > 40
     np.testing.assert_array_equal(np.array(fresh["local"], dtype=float),
                                   np.column_stack([local.alpha2, local.beta2, local.speed_ratio, local.omega,

@@ -16,8 +16,10 @@ xoshiro256+ state. Where each part lives:
                  :func:`direct_rebound_parallel_rng` (many, all threads)
 ``wall_hit``     every hit answered, spinning or not (the call a solver reaches first): :func:`rebound` (one
                  particle), :func:`rebound_parallel_rng` (many, all threads), :func:`rebound_path` (which path
-                 answers a hit: the table where it is valid, the direct model elsewhere); METHOD_*, PATH_*,
+                 answers a hit: the table where it is valid, the direct model elsewhere); METHOD_*,
                  SPIN_TOLERANCE
+``hit``          what a hit did, as a record (the twin of C's rbs_result): ``Hit`` (one), ``Rebounds``
+                 (many; both exported by :mod:`surrogate`); PATH_*
 ``grain``        grain keys: a particle's shape, proportions and hand from its key (:func:`keyed_uniforms`,
                  :func:`grain_properties`, :func:`grain_key`); NO_KEY
 ``block``        the block form of the stages' records, field-major over BLOCK particles
@@ -54,13 +56,14 @@ from surrogate.kernels.parallel import (draw_local_parallel, draw_local_parallel
 from surrogate.kernels.pipeline import table_rebound_many, table_rebound_many_rng, table_rebound_uniforms
 from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
 from surrogate.kernels.table_path import draw_local, table_rebound
-from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
-                                        SPIN_TOLERANCE, rebound, rebound_parallel_rng, rebound_path)
+from surrogate.kernels.hit import PATH_DIRECT, PATH_NONE, PATH_TABLE
+from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, SPIN_TOLERANCE, rebound,
+                                        rebound_parallel_rng, rebound_path)
 
 __all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT",
-           "PATH_TABLE", "SPIN_TOLERANCE", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND", "arithmetic",
-           "chunk_states", "direct_rebound", "direct_rebound_parallel_rng", "draw_local", "draw_local_parallel",
-           "draw_local_parallel_rng", "draw_velocity", "fill_uniforms", "gather", "grid_interval", "impact_frame",
-           "locate", "next_uniform", "rebound", "rebound_parallel_rng", "rebound_path", "seed_state",
-           "table_rebound", "table_rebound_many", "table_rebound_many_rng", "table_rebound_parallel",
-           "table_rebound_parallel_rng", "table_rebound_uniforms"]
+           "PATH_NONE", "PATH_TABLE", "SPIN_TOLERANCE", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND",
+           "arithmetic", "chunk_states", "direct_rebound", "direct_rebound_parallel_rng", "draw_local",
+           "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity", "fill_uniforms", "gather",
+           "grid_interval", "impact_frame", "locate", "next_uniform", "rebound", "rebound_parallel_rng",
+           "rebound_path", "seed_state", "table_rebound", "table_rebound_many", "table_rebound_many_rng",
+           "table_rebound_parallel", "table_rebound_parallel_rng", "table_rebound_uniforms"]

@@ -19,10 +19,11 @@ import math
 import numba
 import numpy as np
 
-from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from data_schema.samples import STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import SCRATCH_SIZE, U_AXIS, U_PER_REBOUND, rebound_model_frame
 from surrogate.kernels.checks import check_keys
 from surrogate.kernels.frame import NAN3, dot, float3, impact_frame, moves_into_wall, particle_ok, to_global
+from surrogate.kernels.hit import PATH_DIRECT, hit, invalid_hit, put_hit
 from surrogate.kernels.grain import key_model_uniforms
 from surrogate.kernels.memory import stack_scratch
 from surrogate.kernels.options import JIT, KERNEL
@@ -31,8 +32,8 @@ from surrogate.kernels.rng import CHUNK_ROWS, fill_uniforms
 
 @numba.njit(**KERNEL)
 def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
-    """One particle's rebound by the direct model, in the caller's frame: (status, V⁺, Ω⁺) with V⁺ in m/s
-    and Ω⁺ in rad/s as 3-tuples.
+    """One particle's rebound by the direct model, in the caller's frame: a :class:`surrogate.kernels.hit.Hit`
+    (V⁺ in m/s and Ω⁺ in rad/s; its ``shape`` the index given here, its ``path`` PATH_DIRECT).
 
     Parameters
     ----------
@@ -48,9 +49,9 @@ def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
     u : (≥ U_PER_REBOUND,) uniforms in [0, 1) (:mod:`direct_model.runtime`), e.g. from
         :func:`surrogate.kernels.rng.fill_uniforms`.
 
-    Returns STATUS_REBOUNDED; STATUS_TRAPPED (still colliding after n_max collisions) or STATUS_FAILED
-    (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID with NaN vectors for
-    an input outside the ranges above.
+    Status STATUS_REBOUNDED; STATUS_TRAPPED (still colliding after n_max collisions) or STATUS_FAILED
+    (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID (the record of
+    :func:`surrogate.kernels.hit.invalid_hit`) for an input outside the ranges above.
     """
     return direct_rebound_typed(params, shape_arrays, np.int64(shape), float3(V), float3(omega), float3(n), float(a), u,
                                 stack_scratch(SCRATCH_SIZE))
@@ -72,15 +73,17 @@ def direct_rebound_typed(params, shape_arrays, shape, V, omega, n, a, u, scratch
     """:func:`direct_rebound` with its scratch space given: ``shape`` an int64, V, omega and n 3-tuples of float64,
     a a float64, ``scratch`` (SCRATCH_SIZE,) float64 (module doc)."""
     if not _valid(shape_arrays, shape, V, omega, n, a, u):
-        return STATUS_INVALID, NAN3, NAN3
+        return invalid_hit()
     ex, ez = _frame_axes(V, n, u[U_AXIS])
     # Ω⁻ in (m/s)/a, the model's unit (direct_model.body_rebound): rad/s times a
-    status, _, _, vx, vy, vz, wx, wy, wz = rebound_model_frame(
-        params, shape_arrays, shape, dot(V, ex), dot(V, n), a * dot(omega, ex), a * dot(omega, n), a * dot(omega, ez),
-        u, scratch)
-    if status != STATUS_REBOUNDED:
-        return (STATUS_TRAPPED if status == STATUS_TRAPPED else STATUS_FAILED), NAN3, NAN3
-    return to_global(status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
+    rebound = rebound_model_frame(params, shape_arrays, shape, dot(V, ex), dot(V, n), a * dot(omega, ex),
+                                  a * dot(omega, n), a * dot(omega, ez), u, scratch)
+    if rebound.status != STATUS_REBOUNDED:
+        status = STATUS_TRAPPED if rebound.status == STATUS_TRAPPED else STATUS_FAILED
+        return hit(status, PATH_DIRECT, shape, rebound.n_collisions, NAN3, NAN3)
+    (vx, vy, vz), (wx, wy, wz) = rebound.V, rebound.Omega
+    status, V_new, Omega_new = to_global(rebound.status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
+    return hit(status, PATH_DIRECT, shape, rebound.n_collisions, V_new, Omega_new)
 
 
 @numba.njit(**KERNEL)
@@ -91,30 +94,32 @@ def _frame_axes(V, n, u_axis):
 
 
 @numba.njit(parallel=True, **JIT)
-def direct_rebound_parallel_rng(params, shape_arrays, shape, keys, V, omega, n, a, states, V_out, Omega_out,
-                                status):
-    """:func:`direct_rebound` for every row i of shape (N,) indices into ``shape_arrays``, V, omega, n (N, 3) and
-    a (N,), on all
-    threads: chunk j of CHUNK_ROWS rows draws its uniforms, U_PER_REBOUND per row in row order, from a copy of
-    the xoshiro256+ state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the results do not
-    depend on the number of threads. ``keys``: (N,) int64 grain keys (≥ 0; NO_KEY −1: none) or empty (none):
-    a keyed row's proportions and hand are its key's (:func:`surrogate.kernels.grain.key_model_uniforms`; its
-    shape is the caller's ``shape[i]``, :func:`surrogate.kernels.grain.grain_shape` for a grain of the mix).
-    Outputs V_out (N, 3) m/s, Omega_out (N, 3) rad/s, status (N,)."""
+def direct_rebound_parallel_rng(params, shape_arrays, model_shapes, shapes, keys, V, omega, n, a, states, out):
+    """:func:`direct_rebound` for every row i of V, omega, n (N, 3) and a (N,), on all threads, into ``out``
+    (:class:`surrogate.kernels.hit.Rebounds` of N rows). Row i is of the table's shape ``shapes[i]`` (its index in
+    the table, written to ``out.shape``), whose index in ``shape_arrays`` is ``model_shapes[shapes[i]]``. Chunk j
+    of CHUNK_ROWS rows draws its uniforms, U_PER_REBOUND per row in row order, from a copy of the xoshiro256+
+    state ``states[j]`` (:func:`surrogate.kernels.rng.chunk_states`), so the results do not depend on the number
+    of threads. ``keys``: (N,) int64 grain keys (≥ 0; NO_KEY −1: none) or empty (none): a keyed row's
+    proportions and hand are its key's (:func:`surrogate.kernels.grain.key_model_uniforms`; its shape is the
+    caller's ``shapes[i]``, :func:`surrogate.kernels.grain.grain_shape` for a grain of the mix)."""
     check_keys(keys, V.shape[0])
     for j in numba.prange(states.shape[0]):
-        state = states[j].copy()
-        u = np.empty(U_PER_REBOUND)
-        scratch = np.empty(SCRATCH_SIZE)
-        for i in range(j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0])):
-            fill_uniforms(state, u)
-            if keys.shape[0] > 0 and keys[i] >= 0:
-                key_model_uniforms(keys[i], u)
-            st, V_new, Omega_new = direct_rebound_typed(params, shape_arrays, np.int64(shape[i]),
-                                                        (V[i, 0], V[i, 1], V[i, 2]),
-                                                        (omega[i, 0], omega[i, 1], omega[i, 2]),
-                                                        (n[i, 0], n[i, 1], n[i, 2]), float(a[i]), u, scratch)
-            status[i] = st
-            for k in range(3):
-                V_out[i, k] = V_new[k]
-                Omega_out[i, k] = Omega_new[k]
+        _direct_chunk(params, shape_arrays, model_shapes, shapes, keys, V, omega, n, a, states[j].copy(), out,
+                      j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, V.shape[0]))
+
+
+@numba.njit(**JIT)
+def _direct_chunk(params, shape_arrays, model_shapes, shapes, keys, V, omega, n, a, state, out, lo, hi):
+    """Rows [lo, hi) of :func:`direct_rebound_parallel_rng`, their uniforms from ``state``. Called, not inlined:
+    numba 0.68's parallel loops drop the writes their body makes to the arrays of a tuple such as ``out``."""
+    u = np.empty(U_PER_REBOUND)
+    scratch = np.empty(SCRATCH_SIZE)
+    for i in range(lo, hi):
+        fill_uniforms(state, u)
+        if keys.shape[0] > 0 and keys[i] >= 0:
+            key_model_uniforms(keys[i], u)
+        result = direct_rebound_typed(params, shape_arrays, np.int64(model_shapes[shapes[i]]),
+                                      (V[i, 0], V[i, 1], V[i, 2]), (omega[i, 0], omega[i, 1], omega[i, 2]),
+                                      (n[i, 0], n[i, 1], n[i, 2]), float(a[i]), u, scratch)
+        put_hit(out, i, hit(result.status, result.path, shapes[i], result.n_collisions, result.V, result.Omega))

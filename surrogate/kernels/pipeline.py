@@ -18,12 +18,12 @@ import numba
 import numpy as np
 
 from surrogate.kernels.arithmetic import OUT_FIELDS, arithmetic_block
-from surrogate.kernels.block import BLOCK
+from surrogate.kernels.block import BLOCK, field
 from surrogate.kernels.checks import check_rows, check_state, check_uniforms
 from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.frame import FRAME_FIELDS
 from surrogate.kernels.gather import GATHERED_FIELDS, gather_block
-from surrogate.kernels.locate import INDEX_FIELDS, WEIGHT_FIELDS, locate_block, resolve_block
+from surrogate.kernels.locate import I_DRAWN, INDEX_FIELDS, WEIGHT_FIELDS, locate_block, resolve_block
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import fill_lanes, seed_lanes
 
@@ -49,7 +49,7 @@ def table_rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scal
     """
     check_rows(V, n, a, V_out, Omega_out, status)
     check_uniforms(u, V.shape[0], "V")
-    run_blocks(data, mix_cdf, no_shapes(), V, n, a, u, no_state(), V_out, Omega_out, status, scaled)
+    run_blocks(data, mix_cdf, no_shapes(), V, n, a, u, no_state(), V_out, Omega_out, status, no_shape_out(), scaled)
 
 
 @numba.njit(**JIT)
@@ -67,7 +67,8 @@ def table_rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, stat
     """
     check_state(state)
     check_rows(V, n, a, V_out, Omega_out, status)
-    run_blocks(data, mix_cdf, no_shapes(), V, n, a, no_uniforms(), state, V_out, Omega_out, status, scaled)
+    run_blocks(data, mix_cdf, no_shapes(), V, n, a, no_uniforms(), state, V_out, Omega_out, status, no_shape_out(),
+               scaled)
 
 
 @numba.njit(**JIT)
@@ -92,19 +93,27 @@ def _lanes():
 
 
 @numba.njit(inline="always", **JIT)
-def run_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, scaled):
+def run_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, shape_out, scaled):
     """The pipeline (:func:`table_rebound_many` with ``u``, :func:`table_rebound_many_rng` with ``state``; the other
     argument empty: :func:`no_state`, :func:`no_uniforms`) with its scratch, V, n, a made C-contiguous
     (copied if they are not). ``shapes``: each row's shape index in the table, or SHAPE_FROM_MIX
-    (:func:`surrogate.kernels.locate.row_shape`); empty (:func:`no_shapes`): every row's from the mix."""
+    (:func:`surrogate.kernels.locate.row_shape`); empty (:func:`no_shapes`): every row's from the mix.
+    ``shape_out``: (rows,) int32, each row's shape index (that of a row that does not move into its wall is
+    meaningless), or empty (:func:`no_shape_out`): not written."""
     _rebound_blocks(data, mix_cdf, shapes, np.ascontiguousarray(V), np.ascontiguousarray(n),
-                    np.ascontiguousarray(a), u, state, V_out, Omega_out, status, scaled, *_block_scratch())
+                    np.ascontiguousarray(a), u, state, V_out, Omega_out, status, shape_out, scaled, *_block_scratch())
 
 
 @numba.njit(inline="always", **JIT)
 def no_shapes():
     """The ``shapes`` argument of :func:`run_blocks` when every row's shape is drawn from the mix."""
     return np.zeros(0, dtype=np.int64)
+
+
+@numba.njit(inline="always", **JIT)
+def no_shape_out():
+    """The ``shape_out`` argument of :func:`run_blocks` when the rows' shapes are not wanted."""
+    return np.zeros(0, dtype=np.int32)
 
 
 @numba.njit(inline="always", **JIT)
@@ -130,8 +139,8 @@ def _block_scratch():
 
 
 @numba.njit(**KERNEL)
-def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, scaled, us, fr, index, weights, g,
-                    out, lanes):
+def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, shape_out, scaled, us, fr, index,
+                    weights, g, out, lanes):
     """:func:`table_rebound_many` (uniforms ``u``) or :func:`table_rebound_many_rng` (uniforms drawn from ``state``)
     with its scratch arrays (:func:`_block_scratch`): a pipeline of STAGES blocks, so that a block's table
     reads have a whole step to arrive before they are used."""
@@ -146,6 +155,8 @@ def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, 
             _block_uniforms(u, state, lanes, start, min(BLOCK, rows - start), us[j])
             locate_block(data, mix_cdf, shapes, V_flat, n_flat, a, us[j], state.shape[0] != 4, start,
                          min(BLOCK, rows - start), fr[j], index[j], weights[j])
+            for b in range(min(BLOCK, rows - start) if shape_out.shape[0] > 0 else 0):
+                shape_out[start + b] = field(index[j], I_DRAWN, b) // (data.n_alpha1 * data.n_speed)
         if 1 <= k <= n_blocks:
             j, start = (k - 1) % STAGES, (k - 1) * BLOCK
             resolve_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j])

@@ -17,16 +17,18 @@ import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
 from surrogate.kernels.draw import draw_in_cell, draw_velocity
-from surrogate.kernels.frame import (NAN3, float3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
+from surrogate.kernels.frame import (float3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
                                      uniforms_ok)
+from surrogate.kernels.hit import PATH_TABLE, hit, invalid_hit
 from surrogate.kernels.locate import hint, locate
 from surrogate.kernels.options import JIT, KERNEL
 
 
 @numba.njit(**KERNEL)
 def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
-    """Reflected state of one particle in the global frame, drawn from the table: (status, V⁺, Ω⁺), V⁺ in
-    m/s and Ω⁺ in rad/s as 3-tuples.
+    """Reflected state of one particle in the global frame, drawn from the table: a
+    :class:`surrogate.kernels.hit.Hit` (V⁺ in m/s, Ω⁺ in rad/s; ``path`` PATH_TABLE, ``shape`` the shape drawn
+    from the mix, ``n_collisions`` −1).
 
     Parameters
     ----------
@@ -39,7 +41,7 @@ def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
     scaled : between grid points, move the draw to the incident state
         (default; :func:`draw_velocity`); False: plain stochastic interpolation.
 
-    Returns STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
+    Status STATUS_REBOUNDED, STATUS_TRAPPED, or STATUS_INVALID when V does not
     move into the wall (V·n ≥ 0, zero or non-finite), n is not a unit vector,
     a is not finite and > 0, a uniform is outside [0, 1), or the result would
     not be finite or would not leave the wall (as rbs_table_rebound); NaN vectors unless rebounded. The
@@ -60,13 +62,14 @@ def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
 def table_rebound_typed(data, mix_cdf, V, n, a, u, scaled):
     """:func:`table_rebound` with V and n 3-tuples of float64, a a float64 and ``scaled`` a bool (module doc)."""
     if not moves_into_wall(V, n):
-        return STATUS_INVALID, NAN3, NAN3
+        return invalid_hit()
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
     cell = locate(data, mix_cdf, alpha1, speed, u)
     hint(data, cell, u)
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
     ok = particle_ok(n, a) & uniforms_ok(u)
-    return to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
+    status, V_new, Omega_new = to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
+    return hit(status, PATH_TABLE, cell[0] // (data.n_alpha1 * data.n_speed), -1, V_new, Omega_new)
 
 
 @numba.njit(inline="always", **JIT)

@@ -10,7 +10,8 @@ Methods (integer codes, as in C): METHOD_AUTO, the table iff |Ω⁻| a/|V⁻| �
 table's [first, last] α1 grid range and |V⁻| in its speed range (inclusive; α1 and |V⁻| computed as the
 table path computes them, :func:`surrogate.kernels.frame.incidence`), otherwise the direct model;
 METHOD_TABLE, always the table (the law of the nearest grid edge outside the grid, Ω⁻ ignored);
-METHOD_DIRECT, always the direct model. Paths: PATH_TABLE, PATH_DIRECT.
+METHOD_DIRECT, always the direct model. Paths (:mod:`surrogate.kernels.hit`): PATH_TABLE, PATH_DIRECT; PATH_NONE
+for a hit refused.
 
 One hit consumes U_PER_DRAW = 13 uniforms whatever path answers it, so streams stay aligned. The table path
 is :func:`surrogate.kernels.table_path.table_rebound` with those 13. The direct path draws the shape from the mix
@@ -43,7 +44,8 @@ from data_schema.samples import STATUS_INVALID
 from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
 from surrogate.kernels.direct_path import direct_rebound_typed
 from surrogate.kernels.draw import U_PER_DRAW
-from surrogate.kernels.frame import NAN3, dot, float3, incidence, incidence_angle, particle_ok, uniforms_ok
+from surrogate.kernels.frame import dot, float3, incidence, incidence_angle, particle_ok, uniforms_ok
+from surrogate.kernels.hit import PATH_DIRECT, PATH_NONE, PATH_TABLE, hit, invalid_hit, put_hit
 from surrogate.kernels.grain import keyed_shapes, keyed_uniforms
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
@@ -55,7 +57,6 @@ from surrogate.kernels.rng import CHUNK_ROWS
 from surrogate.kernels.table_path import table_rebound_typed
 
 METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
-PATH_TABLE, PATH_DIRECT = 0, 1
 # largest |Ω⁻| a/|V⁻| the table answers under METHOD_AUTO: where the table's law and the direct model's with
 # that spin stay within classifier accuracy 0.52, measured (docs/design/spin_tolerance.md; 0.0015 fails)
 SPIN_TOLERANCE = 0.001
@@ -79,12 +80,12 @@ def _auto_path(bounds, V, omega, n, a):
              & (speed <= speed_hi))
     valid = ((vn < 0.0) & math.isfinite(V[0] + V[1] + V[2]) & particle_ok(n, a)
              & math.isfinite(omega[0] + omega[1] + omega[2]))
-    return np.int8(PATH_TABLE if table else PATH_DIRECT) if valid else np.int8(STATUS_INVALID)
+    return np.int8(PATH_TABLE if table else PATH_DIRECT) if valid else np.int8(PATH_NONE)
 
 
 @numba.njit(**KERNEL)
 def rebound_path(data, V, omega, n, a, method):
-    """Which path answers a hit: PATH_TABLE or PATH_DIRECT; STATUS_INVALID for a bad input.
+    """Which path answers a hit: PATH_TABLE or PATH_DIRECT; PATH_NONE for a bad input.
 
     Parameters
     ----------
@@ -98,18 +99,19 @@ def rebound_path(data, V, omega, n, a, method):
     A pure function of the state: a caller learns the path of a hit without drawing anything.
     """
     path = _auto_path(_grid_bounds(data), V, omega, n, a)
-    if path == STATUS_INVALID or method == METHOD_AUTO:
+    if path == PATH_NONE or method == METHOD_AUTO:
         return path
     if method == METHOD_TABLE:
         return PATH_TABLE
-    return PATH_DIRECT if method == METHOD_DIRECT else STATUS_INVALID
+    return PATH_DIRECT if method == METHOD_DIRECT else PATH_NONE
 
 
 @numba.njit(**KERNEL)
 def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True,
             key=None):
-    """One hit answered by its path (:func:`rebound_path`): (status, V⁺, Ω⁺), V⁺ in m/s and Ω⁺ in rad/s as
-    3-tuples in the caller's frame.
+    """One hit answered by its path (:func:`rebound_path`): a :class:`surrogate.kernels.hit.Hit` (status, path,
+    the particle's shape in the table, the direct path's collisions, V⁺ in m/s and Ω⁺ in rad/s in the caller's
+    frame; read it by name, ``hit.V``).
 
     Parameters
     ----------
@@ -127,9 +129,9 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
         direct path its proportions and hand, are the key's, whatever u[0], u[4], u[5], u[6] are; the 13
         uniforms are still all checked).
 
-    Returns STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
-    a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0); NaN vectors unless
-    rebounded.
+    Status STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
+    a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0; then path PATH_NONE);
+    NaN vectors unless rebounded.
     """
     V, omega, n, a, scaled = float3(V), float3(omega), float3(n), float(a), scaled != 0
     path = rebound_path(data, V, omega, n, a, np.int64(method))
@@ -142,8 +144,8 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
 @numba.njit(inline="always", **JIT)
 def _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path, key):
     """:func:`rebound` of a particle of grain key ``key`` along its path ``path``: u with the key's slots."""
-    if key < 0 or path == STATUS_INVALID or not uniforms_ok(u):
-        return STATUS_INVALID, NAN3, NAN3
+    if key < 0 or path == PATH_NONE or not uniforms_ok(u):
+        return invalid_hit()
     keyed = stack_scratch(U_PER_DRAW)
     keyed_uniforms(key, u, path == PATH_DIRECT, keyed)
     return rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, keyed, scaled, path)
@@ -157,7 +159,7 @@ def rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n
         return table_rebound_typed(data, mix_cdf, V, n, a, u, scaled)
     if path == PATH_DIRECT:
         return _direct_path_on_stack(params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u)
-    return STATUS_INVALID, NAN3, NAN3
+    return invalid_hit()
 
 
 @numba.njit(**KERNEL)
@@ -172,11 +174,12 @@ def _direct_path(params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n
     """The direct path of :func:`rebound` with its scratch space given; ``shape`` the table's shape index, or
     SHAPE_FROM_MIX to draw it from the mix with u[0]."""
     if not (uniforms_ok(u) and params.shape[0] == N_PARAMS and model_shapes.shape[0] == mix_cdf.shape[0]):
-        return STATUS_INVALID, NAN3, NAN3
+        return invalid_hit()
     if shape == SHAPE_FROM_MIX:
         shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
-    return direct_rebound_typed(params, shape_arrays, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND],
-                                scratch)
+    result = direct_rebound_typed(params, shape_arrays, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND],
+                                  scratch)
+    return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega)
 
 
 @numba.njit(**JIT)
@@ -194,9 +197,10 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 @numba.njit(parallel=True, **JIT)
 def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
-                         method, V_out, Omega_out, status, path, scaled=True):
+                         method, out, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
-    a (N,), on all threads; the path of each row into ``path`` (N,).
+    a (N,), on all threads, into ``out`` (:class:`surrogate.kernels.hit.Rebounds` of N rows: row i is the
+    :class:`surrogate.kernels.hit.Hit` of hit i).
 
     ``shapes``: (N,) int64, each row's shape (its index in the table, or SHAPE_FROM_MIX to draw it from
     ``mix_cdf``), or empty, every row's from the mix (:func:`surrogate.kernels.locate.row_shape`); ValueError
@@ -211,9 +215,8 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     pipeline answers every row of a chunk that has a table row (at the table's cost; the rows of the other
     path are answered again), then the direct model answers the direct rows with the same row's uniforms
     (:func:`surrogate.kernels.pipeline.table_rebound_uniforms`). Rows are not checked here
-    (:func:`surrogate.sample_global` checks them first): a row with a bad input gets status STATUS_INVALID,
-    and path STATUS_INVALID under METHOD_AUTO, the method's path under the others. A method code outside
-    the three is a ValueError.
+    (:func:`surrogate.sample_global` checks them first): a row with a bad input gets :func:`rebound`'s record of
+    a refused hit (STATUS_INVALID, PATH_NONE). A method code outside the three is a ValueError.
     """
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
@@ -223,15 +226,16 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     rows = V.shape[0]
     for j in numba.prange(states.shape[0]):
         _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, states[j],
-                    method, V_out, Omega_out, status, path, scaled, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
+                    method, out, scaled, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
 
 
 @numba.njit(**JIT)
 def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state, method,
-                V_out, Omega_out, status, path, scaled, lo, hi):
+                out, scaled, lo, hi):
     """Rows [lo, hi) of :func:`rebound_parallel_rng` along their paths (one chunk, its uniforms from a copy of
     ``state``). Called, not inlined: numba's parallel passes then see one call in the loop, not the chunk's work
     (docs/design/test_time.md)."""
+    path = out.path
     if method == METHOD_AUTO:
         _auto_paths(data, V, omega, n, a, lo, hi, path)
     else:
@@ -241,7 +245,12 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
         n_table += path[i] == PATH_TABLE
     if n_table > 0:
         run_blocks(data, mix_cdf, row_shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), state.copy(),
-                   V_out[lo:hi], Omega_out[lo:hi], status[lo:hi], scaled)
+                   out.V[lo:hi], out.Omega[lo:hi], out.status[lo:hi], out.shape[lo:hi], scaled)
+    for i in range(lo, hi):
+        if path[i] == PATH_TABLE:       # the pipeline's rows completed as rebound's records (hit.hit)
+            out.n_collisions[i] = -1
+            if out.status[i] == STATUS_INVALID:
+                path[i], out.shape[i] = PATH_NONE, -1
     if n_table == hi - lo:
         return
     keyed = keys.shape[0] > 0
@@ -252,15 +261,12 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
         if path[i] == PATH_TABLE:
             continue
         w = min(i, last_omega)
-        st, V_new, Omega_new = STATUS_INVALID, NAN3, NAN3
+        result = invalid_hit()
         if path[i] == PATH_DIRECT:
             shape = row_shapes[i] if row_shapes.shape[0] > 0 else SHAPE_FROM_MIX
             if keyed and keys[i] >= 0:
                 keyed_uniforms(keys[i], u[i - lo], True, u[i - lo])
-            st, V_new, Omega_new = _direct_path(
+            result = _direct_path(
                 params, shape_arrays, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
                 (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo], scratch)
-        status[i] = st
-        for k in range(3):
-            V_out[i, k] = V_new[k]
-            Omega_out[i, k] = Omega_new[k]
+        put_hit(out, i, result)

@@ -16,8 +16,10 @@ write one CSV file per rank, ``hits_<rank>.csv``:
   draw's first uniform, and the grain (:data:`GRAIN_COLUMNS`): the particle's grain key (−1: a new grain per
   hit), its shape's name (empty: drawn per hit), and b/a, c/b and the hand (±1) where the direct path fixed
   them (NaN on the table path, which draws them from the shape's law, and for a shape without them); all in
-  the solver's frame. Files written before grain keys lack the grain columns: they read with key −1, shape
-  empty and NaN.
+  the solver's frame; then what the patch does (:data:`PATCH_COLUMNS`): ``interaction`` (the title's model,
+  or a stock one such as ``rebound``) and ``wall``, the name of its table's wall (empty for a stock one).
+  Files written before grain keys lack the grain columns: they read with key −1, shape empty and NaN; files
+  without the patch columns (code_saturne's) read as the title's model with the wall empty.
 
 The solver's log ends with a summary of counts (``- wall hits = N`` and so on, :func:`summary_counts`).
 What is a solver's own (where the files are, its other records) stays in its integration; the comparison's
@@ -35,15 +37,17 @@ import surrogate
 from surrogate.kernels import PATH_DIRECT
 from tablegen.study.solver_comparison import SolverHits
 
-__all__ = ["GRAIN_COLUMNS", "HIT_COLUMNS", "grain_mismatches", "parse_header", "rank_files", "read_hit_files",
+__all__ = ["GRAIN_COLUMNS", "HIT_COLUMNS", "PATCH_COLUMNS", "grain_mismatches", "parse_header", "rank_files", "read_hit_files",
            "solver_hits", "summary_counts"]
 
 _HIT_COLUMNS_BEFORE_GRAINS = ("time,rank,patch,origProc,origId,d,a,Vx,Vy,Vz,Winx,Winy,Winz,nx,ny,nz,Uwx,Uwy,Uwz,"
                               "status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,spin_ratio,u0").split(",")
 GRAIN_COLUMNS = ["key", "shape", "ratio_ba", "ratio_cb", "hand"]
-HIT_COLUMNS = _HIT_COLUMNS_BEFORE_GRAINS + GRAIN_COLUMNS
+_HIT_COLUMNS_BEFORE_PATCHES = _HIT_COLUMNS_BEFORE_GRAINS + GRAIN_COLUMNS
+PATCH_COLUMNS = ["interaction", "wall"]
+HIT_COLUMNS = _HIT_COLUMNS_BEFORE_PATCHES + PATCH_COLUMNS
 _INTEGER_COLUMNS = ("rank", "origProc", "origId", "status", "path", "key")
-_TEXT_COLUMNS = ("patch", "shape")
+_TEXT_COLUMNS = ("patch", "shape", "interaction", "wall")
 _GRAIN_DEFAULTS = {"key": "-1", "shape": "", "ratio_ba": "nan", "ratio_cb": "nan", "hand": "nan"}
 _VECTORS = {"V": "Vx Vy Vz", "Win": "Winx Winy Winz", "n": "nx ny nz", "Uw": "Uwx Uwy Uwz",
             "Vout": "Voutx Vouty Voutz", "Wout": "Wx Wy Wz"}
@@ -80,9 +84,10 @@ def parse_header(line: str, title: str) -> dict:
 def read_hit_files(files, title: str) -> tuple[dict, list]:
     """The hit records of ``files`` (in the order given) as columns, and each file's settings.
 
-    Columns by :data:`HIT_COLUMNS` name (``patch`` and ``shape`` strings, the integer columns int64, the rest
-    float64), plus the (N, 3) arrays V, Win, n, Uw, Vout and Wout. A file written before grain keys (no
-    :data:`GRAIN_COLUMNS`) reads with key −1, shape ``""`` and NaN proportions and hand. ValueError naming the
+    Columns by :data:`HIT_COLUMNS` name (``patch``, ``shape``, ``interaction`` and ``wall`` strings, the integer
+    columns int64, the rest float64), plus the (N, 3) arrays V, Win, n, Uw, Vout and Wout. A file written before
+    grain keys (no :data:`GRAIN_COLUMNS`) reads with key −1, shape ``""`` and NaN proportions and hand; one
+    without :data:`PATCH_COLUMNS`, with interaction ``title`` and wall ``""``. ValueError naming the
     file and line for a file of another layout.
     """
     headers, rows = [], []
@@ -91,9 +96,10 @@ def read_hit_files(files, title: str) -> tuple[dict, list]:
             headers.append(parse_header(fh.readline(), title))
             fh.readline()
             columns = fh.readline().strip().split(",")
-            if columns not in (HIT_COLUMNS, _HIT_COLUMNS_BEFORE_GRAINS):
+            if columns not in (HIT_COLUMNS, _HIT_COLUMNS_BEFORE_PATCHES, _HIT_COLUMNS_BEFORE_GRAINS):
                 raise ValueError(f"{f}: line 3 is not the hits columns {','.join(HIT_COLUMNS)}")
-            missing = [_GRAIN_DEFAULTS[c] for c in HIT_COLUMNS[len(columns):]]
+            defaults = {**_GRAIN_DEFAULTS, "interaction": title, "wall": ""}
+            missing = [defaults[c] for c in HIT_COLUMNS[len(columns):]]
             for line_no, line in enumerate(fh, start=4):
                 if not line.strip():
                     continue

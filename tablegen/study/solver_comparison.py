@@ -346,10 +346,11 @@ def surrogate_answers(table, hits: SolverHits, seed: int = 1, interpolation: str
         for shape, rows in _shape_groups(hits.shape, len(hits)):
             rows = rows[taken[rows] == code]
             if len(rows):
-                V_out[rows], Omega_out[rows], status[rows] = surrogate.sample_global(
+                answered = surrogate.sample_global(
                     table, hits.V[rows], hits.n[rows], hits.a[rows], shape=shape, random_state=rng, clamp=True,
                     interpolation=interpolation, omega=hits.Omega[rows] if name == "direct" else None, method=name,
                     grain_key=None if hits.grain_key is None else hits.grain_key[rows])
+                V_out[rows], Omega_out[rows], status[rows] = answered.V, answered.Omega, answered.status
     return replace(hits, V_out=V_out, Omega_out=Omega_out, status=status, path=taken)
 
 

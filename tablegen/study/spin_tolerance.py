@@ -84,9 +84,10 @@ def global_states(table, shape, alpha1, speed, omega, n, seed, method) -> np.nda
     a1 = np.radians(alpha1)
     V = np.tile([speed * np.cos(a1), -speed * np.sin(a1), 0.0], (n, 1))
     # clamp: α1 recomputed from V may fall a rounding error below the grid's first point
-    V_out, W_out, status = surrogate.sample_global(table, V, (0.0, 1.0, 0.0), HALF_SIZE, shape, random_state=seed,
-                                                   omega=np.asarray(omega) * speed / HALF_SIZE, method=method,
-                                                   clamp=True)
+    hits = surrogate.sample_global(table, V, (0.0, 1.0, 0.0), HALF_SIZE, shape, random_state=seed,
+                                   omega=np.asarray(omega) * speed / HALF_SIZE, method=method,
+                                   clamp=True)
+    V_out, W_out, status = hits.V, hits.Omega, hits.status
     ok = status == STATUS_REBOUNDED
     alpha2, beta2, v = rebound_angles(V_out[ok])
     return np.column_stack([alpha2, beta2, v / speed, W_out[ok] * HALF_SIZE / speed])

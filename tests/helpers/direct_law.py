@@ -96,7 +96,8 @@ def kernel_in_frame(table, shape, alpha1, speed, omega_in, Q, seed, n=N):
     """``surrogate.sample_direct`` at one incident state given in the model frame, run in the caller's frame Q;
     outputs rotated back to the model frame: (V⁺/|V⁻|, Ω⁺a/|V⁻|, status)."""
     V, normal, W = incident(alpha1, speed, omega_in, Q)
-    Vo, Wo, status = surrogate.sample_direct(table, np.tile(V, (n, 1)), normal, A, shape, random_state=seed, omega=W)
+    hits = surrogate.sample_direct(table, np.tile(V, (n, 1)), normal, A, shape, random_state=seed, omega=W)
+    Vo, Wo, status = hits.V, hits.Omega, hits.status
     return (*to_model_frame(Vo, Wo, Q, speed), status)
 
 

@@ -36,8 +36,9 @@ def main(table_path: str, input_path: str, output_path: str) -> None:
     # every speed drawn, so that no process's rounding moves a row across it)
     speed = np.linalg.norm(V, axis=1)
     valid = (status != py.STATUS_INVALID) & (speed > 1e-6) & (speed < 1e6)
-    V_g, W_g, status_g = py.surrogate.sample_global(table, V[valid], n[valid], a[valid], shape=WEIGHTS,
-                                                    random_state=5, clamp=True, method="table")
+    hits = py.surrogate.sample_global(table, V[valid], n[valid], a[valid], shape=WEIGHTS,
+                                      random_state=5, clamp=True, method="table")
+    V_g, W_g, status_g = hits.V, hits.Omega, hits.status
     out["global"] = np.column_stack([V_g, W_g, status_g])
     local = py.surrogate.sample_local(table, np.full(5000, 45.0), np.linspace(60.0, 240.0, 5000), "mix",
                                       random_state=6)

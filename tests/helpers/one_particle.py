@@ -47,11 +47,11 @@ def run_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0
     verts[:len(b.vertices)] = b.vertices
     V, W = np.empty(3), np.empty(3)
     history = np.full((history_rows, HISTORY_COLUMNS), np.nan)
-    status, _, ncoll, _, _, erot = body_rebound(
+    done = body_rebound(
         b.kind, verts, len(b.vertices), b.semi, b.K, b.radius, np.ascontiguousarray(R0),
         incident_velocity(alpha1, speed), np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(),
         n_max, contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE))
-    return V, W, status, ncoll, erot, history
+    return V, W, done.status, done.n_collisions, done.rotational_energy, history
 
 
 def random_bodies(n, seed, shapes=("ellipsoid", "prism", "cut_prism", "tetrahedron")):

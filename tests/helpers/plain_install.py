@@ -21,8 +21,9 @@ import numpy as np
 import surrogate
 table = surrogate.load(sys.argv[1])
 local = surrogate.sample_local(table, np.full(200, 33.7), np.full(200, 144.6), "mix", random_state=7)
-V_out, Omega_out, status = surrogate.sample_direct(table, np.tile([120.0, -80.0, 10.0], (50, 1)), [0.0, 1.0, 0.0],
-                                                   5e-5, "prism", random_state=7, omega=[0.0, 0.0, 2e5])
+hits = surrogate.sample_direct(table, np.tile([120.0, -80.0, 10.0], (50, 1)), [0.0, 1.0, 0.0],
+                               5e-5, "prism", random_state=7, omega=[0.0, 0.0, 2e5])
+V_out, Omega_out, status = hits.V, hits.Omega, hits.status
 missing = [m for m in sys.argv[2:] if importlib.util.find_spec(m) is None]
 try:
     import tablegen

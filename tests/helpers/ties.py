@@ -225,11 +225,11 @@ def kernel_body(s: TieState):
 def rebound(s: TieState):
     """The state's rebound by the numba kernel: (V⁺ m/s, Ω⁺ (m/s)/a, status, n_collisions)."""
     V, W = np.empty(3), np.empty(3)
-    status, _, n_coll, _, _, _ = body_rebound(
+    done = body_rebound(
         s.body.kind, kernel_body(s), len(s.body.vertices), s.body.semi, s.body.K, s.body.radius, s.R, s.V,
         np.zeros(3), WALL.as_array(), N_MAX, CONTACT_TOL, SET_TOL, MAX_STEPS, V, W, np.empty((0, HISTORY_COLUMNS)),
         np.empty(WORK_SIZE))
-    return V, W, status, n_coll
+    return V, W, done.status, done.n_collisions
 
 
 # -- one collision, solved independently ------------------------------------------------------------------------

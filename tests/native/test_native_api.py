@@ -141,6 +141,22 @@ def test_the_ctypes_records_have_the_header_s_layout(header_facts):
         assert header_facts[("init", name)] == bytes(record()).hex(), name
 
 
+def test_a_hit_s_record_has_rbs_result_s_fields_in_every_language(header_facts):
+    """surrogate.Hit (one hit, numba) and Rebounds (many, NumPy) have the fields of rbs_result, in its
+    order (``size`` aside), the paths the header's values, the vectors its length: a new output of a hit is a
+    field of all three."""
+    from surrogate.kernels import hit
+    names = fields(Result)
+    assert names[0] == "size" and hit.Hit._fields == hit.Rebounds._fields == tuple(names[1:])
+    assert tuple(hit.REBOUNDS_ARRAYS) == tuple(names[1:])
+    for name, (dtype, tail) in hit.REBOUNDS_ARRAYS.items():
+        c_type = getattr(Result, name)
+        assert tail == (() if c_type.size == ctypes.sizeof(ctypes.c_int) else (c_type.size // 8,)), name
+        assert np.dtype(dtype).kind == ("f" if tail else "i"), name
+    assert (hit.PATH_NONE, hit.PATH_TABLE, hit.PATH_DIRECT) == tuple(
+        int(header_facts[("enum", f"RBS_PATH_{p}")]) for p in ("NONE", "TABLE", "DIRECT"))
+
+
 def test_the_enumerations_and_constants_are_the_helper_s_and_the_packages(header_facts):
     from data_schema.shape_records import MAX_TABLE_SHAPES
     from surrogate.kernels.frame import NORMAL_TOLERANCE

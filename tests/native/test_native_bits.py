@@ -139,8 +139,9 @@ def test_single_calls_equal_many_and_rebound_tuple(table_pair):
             result, _ = native_table.hit(mix, V[i], omega, n[i], a[i], u[i], method=METHOD_TABLE,
                                          interpolation=interpolation)
             st, v, w = result.status, np.array(result.V[:]), np.array(result.Omega[:])
-            st_py, v_py, w_py = py.table_rebound(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
-                                                 interpolation == SCALED)
+            hit = py.table_rebound(table.kernel_data, cdf, tuple(V[i]), tuple(n[i]), a[i], u[i],
+                                   interpolation == SCALED)
+            st_py, v_py, w_py = hit.status, hit.V, hit.Omega
             assert st == status[i] == st_py, i
             assert max_ulp(v, V_many[i]) == 0 and max_ulp(w, W_many[i]) == 0, i
             assert max_ulp(v, np.array(v_py)) == 0 and max_ulp(w, np.array(w_py)) == 0, i

@@ -269,7 +269,8 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
     statuses = {}
     for shape in range(4):
         for k, (V, n, a, omega, u) in enumerate(_particles(rng, PER_SHAPE, spin)):
-            status, V_py, W_py = py.direct_rebound(params, python.shape_arrays, shape, V, omega, n, a, u)
+            hit = py.direct_rebound(params, python.shape_arrays, shape, V, omega, n, a, u)
+            status, V_py, W_py = hit.status, hit.V, hit.Omega
             result, _ = c_table.hit(c_table.single(shape), V, omega, n, a, direct_uniforms(u), method=METHOD_DIRECT)
             mine = result.status, np.array(result.V[:]), np.array(result.Omega[:])
             assert mine[0] == status
@@ -310,9 +311,9 @@ def test_grain_rebounds_bit_for_bit(native, table_pair, spin):
         V, W = np.zeros(3), np.zeros(3)
         status = c.rbs_rebound_model_frame(params.ctypes.data, ctypes.byref(struct), shape, *state, u.ctypes.data,
                                            V.ctypes.data, W.ctypes.data)
-        assert status == theirs[0]
+        assert status == theirs.status
         if status == py.STATUS_REBOUNDED:
-            assert _same(V, theirs[3:6]) and _same(W, theirs[6:9]), (GRAINS[shape].name, state, u)
+            assert _same(V, theirs.V) and _same(W, theirs.Omega), (GRAINS[shape].name, state, u)
         statuses[status] = statuses.get(status, 0) + 1
     assert statuses.get(py.STATUS_REBOUNDED, 0) > 0.9 * 400 * len(GRAINS)
     print(f"\n|Ω⁻|a/|V⁻| = {spin}: {400 * len(GRAINS)} grains, statuses {statuses}, 0 differing")
@@ -336,9 +337,9 @@ def test_collision_counts_are_numba_s(native, table_pair):
         result, _ = c_table.hit(c_table.single(shape), V, omega, (0.0, 1.0, 0.0), a, direct_uniforms(u),
                                 method=METHOD_DIRECT)
         theirs = py.rebound_model_frame(params, python.shape_arrays, shape, V[0], V[1], *(a * omega), u, scratch)
-        assert result.status == theirs[0], k
+        assert result.status == theirs.status, k
         if result.status == py.STATUS_REBOUNDED:
-            assert result.n_collisions == theirs[1], (k, result.n_collisions, theirs[1])
+            assert result.n_collisions == theirs.n_collisions, (k, result.n_collisions, theirs.n_collisions)
             counts.add(result.n_collisions)
     assert len(counts) > 2, counts
 
@@ -350,7 +351,8 @@ def test_baseline_build_gives_the_same_bits(native_baseline, table_pair, small_t
     table = native_baseline.table(small_table_path)
     rng = np.random.default_rng(11)
     for k, (V, n, a, omega, u) in enumerate(_particles(rng, 2000, 0.3)):
-        status, V_py, W_py = py.direct_rebound(python.direct_parameters, python.shape_arrays, k % 4, V, omega, n, a, u)
+        hit = py.direct_rebound(python.direct_parameters, python.shape_arrays, k % 4, V, omega, n, a, u)
+        status, V_py, W_py = hit.status, hit.V, hit.Omega
         mine = table.direct(k % 4, V, omega, n, a, u)
         assert mine[0] == status and (status != py.STATUS_REBOUNDED or (_same(mine[1], V_py) and _same(mine[2], W_py)))
 
@@ -424,9 +426,9 @@ def test_minus_zero_uniform_is_taken_as_numba_takes_it(native, table_pair):
     theirs = py.direct_rebound(python.direct_parameters, python.shape_arrays, 2, np.asarray(GOOD["V"]),
                                np.asarray(GOOD["omega"]), np.asarray(GOOD["n"]), GOOD["a"], u)
     status, V, W = _direct_c(_c(native), c_table.handle, 2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
-    assert status == theirs[0] == py.STATUS_REBOUNDED and _same(V, theirs[1]) and _same(W, theirs[2])
+    assert status == theirs.status == py.STATUS_REBOUNDED and _same(V, theirs.V) and _same(W, theirs.Omega)
     hit = py.rebound(python.kernel_data, python.direct_parameters, python.shape_arrays, python.model_shapes,
                      py.mix_cdf(python, "cut_prism"), GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"],
                      direct_uniforms(u), py.METHOD_DIRECT)
     status, V, W = c_table.direct(2, GOOD["V"], GOOD["omega"], GOOD["n"], GOOD["a"], u)
-    assert status == hit[0] == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()
+    assert status == hit.status == py.STATUS_INVALID and np.isnan(V).all() and np.isnan(W).all()

@@ -36,8 +36,8 @@ def test_c_draws_the_entry_from_its_record_with_the_bits_of_numba(native, octahe
                                     method=METHOD_DIRECT)
                 p = py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes,
                                cdf, tuple(V[k]), omega, (0.0, 1.0, 0.0), 1e-4, u1, py.METHOD_DIRECT)
-                assert c[0] == p[0] != py.STATUS_INVALID, (omega, c[0], p[0])
-                assert np.array_equal(c[1], np.array(p[1]), equal_nan=True), omega
-                assert np.array_equal(c[2], np.array(p[2]), equal_nan=True), omega
+                assert c[0] == p.status != py.STATUS_INVALID, (omega, c[0], p.status)
+                assert np.array_equal(c[1], np.array(p.V), equal_nan=True), omega
+                assert np.array_equal(c[2], np.array(p.Omega), equal_nan=True), omega
     finally:
         c_table.close()

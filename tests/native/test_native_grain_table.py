@@ -70,8 +70,8 @@ def test_each_grain_rebounds_the_same_bits_in_c_and_numba_on_the_direct_path(nat
                                         method=METHOD_DIRECT)
                     p = py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes,
                                    cdf, tuple(V), omega, (0.0, 1.0, 0.0), 1e-4, u, py.METHOD_DIRECT)
-                    assert c[0] == p[0] != py.STATUS_INVALID, (name, alpha1, c[0], p[0])
-                    assert np.array_equal(c[1], np.array(p[1]), equal_nan=True), (name, alpha1)
-                    assert np.array_equal(c[2], np.array(p[2]), equal_nan=True), (name, alpha1)
+                    assert c[0] == p.status != py.STATUS_INVALID, (name, alpha1, c[0], p.status)
+                    assert np.array_equal(c[1], np.array(p.V), equal_nan=True), (name, alpha1)
+                    assert np.array_equal(c[2], np.array(p.Omega), equal_nan=True), (name, alpha1)
     finally:
         c_table.close()

@@ -218,9 +218,9 @@ def test_user_grains_of_a_table_rebound_alike_in_c_and_numba(native, many_shapes
                                     method=METHOD_DIRECT)
                 p = py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes,
                                cdf, tuple(V), omega, (0.0, 1.0, 0.0), 1e-4, u, py.METHOD_DIRECT)
-                assert c[0] == p[0], (names[k], alpha1, c[0], p[0])
-                assert np.array_equal(c[1], np.array(p[1]), equal_nan=True) and \
-                    np.array_equal(c[2], np.array(p[2]), equal_nan=True), (names[k], alpha1)
+                assert c[0] == p.status, (names[k], alpha1, c[0], p.status)
+                assert np.array_equal(c[1], np.array(p.V), equal_nan=True) and \
+                    np.array_equal(c[2], np.array(p.Omega), equal_nan=True), (names[k], alpha1)
                 rebounded += c[0] == py.STATUS_REBOUNDED
                 total += 1
     finally:

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, grain_mismatches, parse_header, rank_files,
+from tablegen.study.hit_records import (GRAIN_COLUMNS, HIT_COLUMNS, PATCH_COLUMNS, grain_mismatches, parse_header, rank_files,
                                         read_hit_files, solver_hits, summary_counts)
 
 OPENFOAM = ("# stochasticRebound hits: seed 7, stream 1, table /t/a.h5, mix weights (prism 0.25, tetrahedron 0.75), "
@@ -18,7 +18,8 @@ def _write(path, header, rows, columns=HIT_COLUMNS):
         values = dict.fromkeys(HIT_COLUMNS, "0.5")
         values.update(rank="1", patch=f"wall{k}", origProc="-1", origId=str(k), status="0", path=str(k % 2),
                       Vx=str(k), Vy="-3", Vz="0.25", key=str(1000 + k), shape="prism" if k % 2 else "tetrahedron",
-                      hand="-1" if k % 2 else "nan")
+                      hand="-1" if k % 2 else "nan", interaction="rebound" if k == 1 else "stochasticRebound",
+                      wall="corundum_on_St3" if k != 1 else "")
         lines.append(",".join(values[c] for c in columns))
     path.write_text("\n".join(lines) + "\n")
 
@@ -47,7 +48,7 @@ def test_the_header_names_the_grain_mode_and_the_keys_seed(grain, seed):
 
 def test_the_grain_columns_and_a_file_written_before_them(tmp_path):
     _write(tmp_path / "hits_0.csv", OPENFOAM + ", grain kept (key seed 7)", 2)
-    _write(tmp_path / "hits_1.csv", OPENFOAM, 2, columns=HIT_COLUMNS[:-len(GRAIN_COLUMNS)])
+    _write(tmp_path / "hits_1.csv", OPENFOAM, 2, columns=HIT_COLUMNS[:-len(GRAIN_COLUMNS) - len(PATCH_COLUMNS)])
     cols, headers = read_hit_files(rank_files(tmp_path), "stochasticRebound")
     assert [h["grain"] for h in headers] == ["kept", "perHit"]
     assert cols["key"].dtype == np.int64 and cols["key"].tolist() == [1000, 1001, -1, -1]
@@ -55,6 +56,9 @@ def test_the_grain_columns_and_a_file_written_before_them(tmp_path):
     assert cols["ratio_ba"][:2].tolist() == [0.5, 0.5] and np.isnan(cols["ratio_ba"][2:]).all()
     assert np.isnan(cols["hand"][[0, 2, 3]]).all() and cols["hand"][1] == -1
     assert cols["V"][:, 0].tolist() == [0, 1, 0, 1]
+    # what the patch did, and a file without those columns: the title's model, no wall
+    assert cols["interaction"].tolist() == ["stochasticRebound", "rebound", "stochasticRebound", "stochasticRebound"]
+    assert cols["wall"].tolist() == ["corundum_on_St3", "", "", ""]
     # the comparison draws a kept grain's hits as its grain, and every hit afresh otherwise
     kept, kept_headers = read_hit_files(rank_files(tmp_path)[:1], "stochasticRebound")
     assert solver_hits(kept, kept_headers[0]).grain_key.tolist() == [1000, 1001]
@@ -78,7 +82,7 @@ def test_a_file_of_another_layout_is_named(tmp_path):
     _write(tmp_path / "hits_0.csv", OPENFOAM, 1)
     text = (tmp_path / "hits_0.csv").read_text()
     (tmp_path / "hits_0.csv").write_text(text + "1,2,3\n")
-    with pytest.raises(ValueError, match=r"hits_0.csv, line 5: 3 fields, not 34"):
+    with pytest.raises(ValueError, match=rf"hits_0.csv, line 5: 3 fields, not {len(HIT_COLUMNS)}"):
         read_hit_files(rank_files(tmp_path), "stochasticRebound")
     (tmp_path / "hits_0.csv").write_text(text.replace("Winx", "Wx0"))
     with pytest.raises(ValueError, match="line 3 is not the hits columns"):

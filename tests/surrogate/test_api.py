@@ -7,8 +7,11 @@ import numpy as np
 import pytest
 
 import surrogate
-from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
-from surrogate.kernels.rng import CHUNK_ROWS
+from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED, read_samples
+from surrogate.kernels import PATH_DIRECT, PATH_NONE, PATH_TABLE, rebound, table_rebound_uniforms
+from surrogate.kernels.rng import CHUNK_ROWS, chunk_states
+
+A, NORMAL = 1e-4, np.array([0.0, 1.0, 0.0])
 
 
 def test_reproducible_and_generator_accepted(small_table):
@@ -43,35 +46,43 @@ def test_bad_input_is_rejected_with_the_value(small_table, kwargs, message):
         surrogate.sample_global(small_table, **args)
 
 
+def _sevens(m):
+    """A Rebounds of m rows, every byte of it set (float 7.0, int 7)."""
+    out = surrogate.empty_rebounds(m)
+    for arr in out:
+        arr[...] = 7
+    return out
+
+
 def test_global_writes_into_given_outputs_or_leaves_them_untouched(small_table):
-    """out=(V_out, Omega_out, status): the same bits as new arrays, written into those objects; an out array
-    of the wrong dtype, shape or layout, read-only, or overlapping an input is a ValueError naming it, and
-    no out array is written when any check (theirs or the inputs') fails."""
+    """out=surrogate.empty_rebounds(m): the same bits as a new record, written into those arrays; a field of the
+    wrong dtype, shape or layout, read-only, or overlapping an input or another field is a ValueError naming it,
+    and nothing is written when any check (theirs or the inputs') fails."""
     m = 2 * CHUNK_ROWS + 5
     rng = np.random.default_rng(12)
     speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
     V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m)])
     n, a = np.tile([0.0, 1.0, 0.0], (m, 1)), np.full(m, 1e-4)
     fresh = surrogate.sample_global(small_table, V, n, a, "mix", random_state=8)
-    out = np.full((m, 3), 7.0), np.full((m, 3), 7.0), np.full(m, 7, dtype=np.int8)
+    out = _sevens(m)
     got = surrogate.sample_global(small_table, V, n, a, "mix", random_state=8, out=out)
-    assert all(x is y for x, y in zip(got, out))
+    assert got is out and all(x is y for x, y in zip(got, out))
     for x, y in zip(fresh, got):
         np.testing.assert_array_equal(x, y)
 
-    untouched = np.full((m, 3), 7.0), np.full((m, 3), 7.0), np.full(m, 7, dtype=np.int8)
+    untouched = _sevens(m)
     read_only = np.full((m, 3), 7.0)
     read_only.flags.writeable = False
-    bad = [((untouched[0], untouched[1], untouched[2].astype(np.int64)),
-            rf"out\[2\] \(status\) must be an array of dtype int8 and shape \({m},\); got dtype int64"),
-           ((untouched[0][:-1], untouched[1], untouched[2]),
-            rf"out\[0\] \(V_out\) must be an array of dtype float64 and shape \({m}, 3\); got dtype float64, "
+    bad = [(untouched._replace(status=untouched.status.astype(np.int64)),
+            rf"out\.status must be an array of dtype int8 and shape \({m},\); got dtype int64"),
+           (untouched._replace(V=untouched.V[:-1]),
+            rf"out\.V must be an array of dtype float64 and shape \({m}, 3\); got dtype float64, "
             rf"shape \({m - 1}, 3\)"),
-           ((untouched[0], np.full((3, m), 7.0).T, untouched[2]), r"out\[1\] \(Omega_out\) must be C-contiguous"),
-           ((untouched[0], read_only, untouched[2]), r"out\[1\] \(Omega_out\) must be C-contiguous and writeable"),
-           ((V, untouched[1], untouched[2]), r"out\[0\] \(V_out\) shares memory with an input"),
-           ((untouched[0], untouched[0], untouched[2]), r"out\[1\] \(Omega_out\) shares memory"),
-           (untouched[:2], "tuple of 3 arrays")]
+           (untouched._replace(Omega=np.full((3, m), 7.0).T), r"out\.Omega must be C-contiguous"),
+           (untouched._replace(Omega=read_only), r"out\.Omega must be C-contiguous and writeable"),
+           (untouched._replace(V=V), r"out\.V shares memory with an input"),
+           (untouched._replace(Omega=untouched.V), r"out\.Omega shares memory"),
+           (tuple(untouched), "must be None or a surrogate.Rebounds")]
     for arrays, message in bad:
         with pytest.raises(ValueError, match=message):
             surrogate.sample_global(small_table, V, n, a, "mix", random_state=8, out=arrays)
@@ -79,7 +90,33 @@ def test_global_writes_into_given_outputs_or_leaves_them_untouched(small_table):
     V_bad[m - 1] = [0.0, 0.0, 0.0]
     with pytest.raises(ValueError, match="is zero"):
         surrogate.sample_global(small_table, V_bad, n, a, "mix", random_state=8, out=untouched)
-    assert np.all(untouched[0] == 7.0) and np.all(untouched[1] == 7.0) and np.all(untouched[2] == 7)
+    assert all(np.all(arr == 7) for arr in untouched)
+
+
+def test_a_hit_record_is_the_rows_of_the_many_hits_record(small_table):
+    """Every field of sample_global's record, row by row, is that of rebound (surrogate.Hit) with the
+    row's uniforms; on the table path ``shape`` is the shape the mix drew (u[0]) and n_collisions −1, on the
+    direct path n_collisions ≥ 1; a refused hit is STATUS_INVALID, PATH_NONE, −1, −1."""
+    m = 400
+    rng = np.random.default_rng(5)
+    speed, a1 = rng.uniform(50, 250, m), np.radians(rng.uniform(30, 90, m))
+    V = np.column_stack([speed * np.cos(a1), -speed * np.sin(a1), np.zeros(m)])
+    W = np.zeros((m, 3))
+    W[::3, 2] = 0.4 * speed[::3] / A           # every third hit spins: the direct path
+    cdf = surrogate.mix_cdf(small_table, "mix")
+    got = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=9, omega=W)
+    u = table_rebound_uniforms(chunk_states(surrogate.check_random_state(9), m)[0].copy(), m)
+    assert set(got.path) == {PATH_TABLE, PATH_DIRECT}
+    for i in range(m):
+        hit = rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
+                      small_table.model_shapes, cdf, tuple(V[i]), tuple(W[i]), tuple(NORMAL), A, u[i])
+        assert hit.shape == got.shape[i] == min(int(u[i, 0] * 4), 3), i
+        assert (hit.status, hit.path, hit.n_collisions) == (got.status[i], got.path[i], got.n_collisions[i]), i
+        assert np.array(hit.V + hit.Omega).tobytes() == np.concatenate([got.V[i], got.Omega[i]]).tobytes(), i
+        assert (hit.n_collisions == -1) if hit.path == PATH_TABLE else (hit.n_collisions >= 1), i
+    refused = rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
+                      small_table.model_shapes, cdf, (10.0, 5.0, 0.0), (0.0, 0.0, 0.0), tuple(NORMAL), A, u[0])
+    assert refused[:4] == (STATUS_INVALID, PATH_NONE, -1, -1) and np.isnan(refused.V + refused.Omega).all()
 
 
 def test_the_error_names_the_first_failing_check_and_its_first_row(small_table):
@@ -108,8 +145,9 @@ def test_the_error_names_the_first_failing_check_and_its_first_row(small_table):
         fix()
     with pytest.raises(ValueError, match=r"'alpha1' value [\d.]+ deg \(index 1500\)"):
         surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, method="table")
-    V_out, _, status = surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, clamp=True,
-                                               method="table")
+    hits = surrogate.sample_global(small_table, V, n, a, "prism", random_state=0, clamp=True,
+                                   method="table")
+    V_out, status = hits.V, hits.status
     assert np.all(np.isfinite(V_out[status == STATUS_REBOUNDED])) and status[700] in (STATUS_REBOUNDED, STATUS_TRAPPED)
     V[1500] = V[0]
     with pytest.raises(ValueError, match=r"'speed' value 400\.0 m/s \(index 700\)"):

@@ -73,7 +73,8 @@ def test_a_rebound_never_adds_energy(params, shapes, shape):
         V = Q @ (rng.normal(size=3) * [100.0, 0.0, 100.0] - [0.0, rng.uniform(30.0, 250.0), 0.0])
         W = rng.normal(size=3) * 150.0 / A * (i % 3) / 2             # |Ω⁻|a/|V⁻| around 0, 1, 2
         u[:] = rng.random(U_PER_REBOUND)
-        status, V_out, W_out = direct_rebound(params, shapes, code, V, W, Q[:, 1], A, u)
+        hit = direct_rebound(params, shapes, code, V, W, Q[:, 1], A, u)
+        status, V_out, W_out = hit.status, hit.V, hit.Omega
         if status != STATUS_REBOUNDED:
             continue
         b = aspect_ratio(law, cdf, u[3])
@@ -97,7 +98,8 @@ def test_near_sphere_keeps_angular_momentum_about_the_contact_point():
         Q = random_frame(300 + i)
         n = Q[:, 1]
         V = Q @ (rng.normal(size=3) * [80.0, 0.0, 80.0] - [0.0, rng.uniform(40.0, 250.0), 0.0])
-        status, V_out, W_out = direct_rebound(near, near_shapes, 0, V, np.zeros(3), n, A, rng.random(U_PER_REBOUND))
+        hit = direct_rebound(near, near_shapes, 0, V, np.zeros(3), n, A, rng.random(U_PER_REBOUND))
+        status, V_out, W_out = hit.status, hit.V, hit.Omega
         assert status == STATUS_REBOUNDED
         before = A * np.cross(n, V)
         after = 0.4 * A * A * np.asarray(W_out) + A * np.cross(n, V_out)
@@ -118,7 +120,7 @@ def test_same_seed_same_bits_whatever_the_threads(small_table):
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     for one, many in zip(*runs):
         np.testing.assert_array_equal(one, many)
-    assert set(np.unique(runs[0][2])) <= {STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED}
+    assert set(np.unique(runs[0].status)) <= {STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED}
 
 
 def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path):
@@ -154,7 +156,8 @@ def test_bad_kernel_input_is_invalid_with_nan(params, shapes, change):
                 u=np.full(U_PER_REBOUND, 0.5))
     assert direct_rebound(params, shapes, **args)[0] == STATUS_REBOUNDED
     args.update(change)
-    status, V_out, W_out = direct_rebound(params, shapes, **args)
+    hit = direct_rebound(params, shapes, **args)
+    status, V_out, W_out = hit.status, hit.V, hit.Omega
     assert status == STATUS_INVALID and np.isnan(V_out).all() and np.isnan(W_out).all()
 
 
@@ -171,7 +174,7 @@ def test_a_state_whose_flight_underflows_ends(params, shapes):
     worker.start()
     worker.join(timeout=120.0)
     assert result, "direct_rebound did not return within 120 s"
-    status, V_out, W_out = result[0]
+    status, V_out, W_out = result[0].status, result[0].V, result[0].Omega
     assert status in (STATUS_REBOUNDED, STATUS_FAILED)
     assert np.isfinite(V_out).all() if status == STATUS_REBOUNDED else np.isnan(V_out).all()
 

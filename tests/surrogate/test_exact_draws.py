@@ -95,8 +95,8 @@ def test_a_keyed_hit_is_the_hit_with_the_key_s_uniforms(small_table, method):
             keyed[1 + U_RATIOS], keyed[2 + U_RATIOS], keyed[1 + U_HAND] = (keyed_uniform(key, s) for s in (1, 2, 3))
         got = rebound(*args, V, (0.0, 0.0, 0.0), NORMAL, A, u, method, True, key)
         want = rebound(*args, V, (0.0, 0.0, 0.0), NORMAL, A, keyed, method, True)
-        assert got[0] == want[0] and np.array(got[1:]).tobytes() == np.array(want[1:]).tobytes(), key
-        rebounded += got[0] == STATUS_REBOUNDED
+        assert got == want and np.array(got.V + got.Omega).tobytes() == np.array(want.V + want.Omega).tobytes(), key
+        rebounded += got.status == STATUS_REBOUNDED
     assert rebounded > 100
 
 
@@ -137,7 +137,8 @@ def test_the_mirror_sign_is_u11_below_one_half(small_table):
         draws = []
         for u11 in (0.25, np.nextafter(0.5, 0.0), 0.5, 0.75):
             u[11] = u11
-            status, v, w = table_rebound(data, cdf, V, NORMAL, A, u, True)
+            hit = table_rebound(data, cdf, V, NORMAL, A, u, True)
+            status, v, w = hit.status, hit.V, hit.Omega
             draws.append((status, np.array(v + w)))
         assert draws[0][1].tobytes() == draws[1][1].tobytes() and draws[2][1].tobytes() == draws[3][1].tobytes()
         if draws[0][0] == STATUS_REBOUNDED:
@@ -158,11 +159,12 @@ def test_at_normal_impact_the_azimuth_is_u12(small_table):
         theta = 2 * math.pi * u[12]
         turned = table_rebound(data, cdf, V, n, A, u, True)
         u[12] = 0.0
-        status, v, w = table_rebound(data, cdf, V, n, A, u, True)
-        assert turned[0] == status
+        hit = table_rebound(data, cdf, V, n, A, u, True)
+        status, v, w = hit.status, hit.V, hit.Omega
+        assert turned.status == status
         if status != STATUS_REBOUNDED:
             continue
         c, s = math.cos(theta), math.sin(theta)
         R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        np.testing.assert_allclose(turned[1], R @ v, rtol=0, atol=1e-12 * 200)
-        np.testing.assert_allclose(turned[2], R @ w, rtol=0, atol=1e-12 * np.linalg.norm(w))
+        np.testing.assert_allclose(turned.V, R @ v, rtol=0, atol=1e-12 * 200)
+        np.testing.assert_allclose(turned.Omega, R @ w, rtol=0, atol=1e-12 * np.linalg.norm(w))

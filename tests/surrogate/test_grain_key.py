@@ -35,19 +35,18 @@ def test_no_key_gives_the_bits_of_a_call_without_keys(small_table, method):
     draws (spinning hits and not, so both paths answer under auto)."""
     V = _in_grid(M, 1)
     W = np.where(np.arange(M)[:, None] % 2 == 0, 0.0, _spinning(V, 0.3, 2))
-    plain = surrogate.sample_global(small_table, V, NORMAL, A, MIX, random_state=3, omega=W, method=method,
-                                    return_path=True)
+    plain = surrogate.sample_global(small_table, V, NORMAL, A, MIX, random_state=3, omega=W, method=method)
     assert _bits(plain) == _bits(surrogate.sample_global(small_table, V, NORMAL, A, MIX, random_state=3, omega=W,
-                                                         method=method, return_path=True, grain_key=None))
+                                                         method=method, grain_key=None))
     from surrogate.kernels import rebound_parallel_rng
-    outputs = np.empty((M, 3)), np.empty((M, 3)), np.empty(M, np.int8), np.empty(M, np.int8)
+    outputs = surrogate.empty_rebounds(M)
     rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                          small_table.model_shapes, surrogate.mix_cdf(small_table, MIX), np.zeros(0, np.int64),
                          np.full(M, NO_KEY), V, W, np.tile(NORMAL, (M, 1)), np.full(M, A),
-                         chunk_states(np.random.default_rng(3), M), surrogate.METHODS[method], *outputs, True)
+                         chunk_states(np.random.default_rng(3), M), surrogate.METHODS[method], outputs, True)
     assert _bits(plain) == _bits(outputs)
     if method == "auto":
-        assert {PATH_TABLE, PATH_DIRECT} <= set(plain[3])
+        assert {PATH_TABLE, PATH_DIRECT} <= set(plain.path)
     direct = surrogate.sample_direct(small_table, V, NORMAL, A, MIX, random_state=4, omega=W)
     assert _bits(direct) == _bits(surrogate.sample_direct(small_table, V, NORMAL, A, MIX, random_state=4, omega=W,
                                                           grain_key=None))
@@ -63,19 +62,20 @@ def test_keyed_rows_are_the_single_hit_with_the_key(small_table, method):
     keys = np.where(np.arange(M) % 4 == 1, NO_KEY, _keys(M))
     cdf = surrogate.mix_cdf(small_table, MIX)
     states = chunk_states(np.random.default_rng(7), M)
-    outputs = np.empty((M, 3)), np.empty((M, 3)), np.empty(M, np.int8), np.empty(M, np.int8)
+    outputs = surrogate.empty_rebounds(M)
     rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                          small_table.model_shapes, cdf, np.zeros(0, np.int64), keys, V, W, np.tile(NORMAL, (M, 1)),
-                         np.full(M, A), states, surrogate.METHODS[method], *outputs, True)
+                         np.full(M, A), states, surrogate.METHODS[method], outputs, True)
     u = np.concatenate([table_rebound_uniforms(states[j].copy(), min(CHUNK_ROWS, M - j * CHUNK_ROWS))
                         for j in range(len(states))])
     for i in range(M):
-        st, v, w = rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
-                           small_table.model_shapes, cdf, tuple(V[i]), tuple(W[i]), NORMAL, A, u[i],
-                           surrogate.METHODS[method], True, None if keys[i] == NO_KEY else keys[i])
-        assert st == outputs[2][i] and np.array(v).tobytes() == outputs[0][i].tobytes(), i
-        assert np.array(w).tobytes() == outputs[1][i].tobytes(), i
-    assert np.mean(outputs[2] == STATUS_REBOUNDED) > 0.5
+        hit = rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
+                      small_table.model_shapes, cdf, tuple(V[i]), tuple(W[i]), NORMAL, A, u[i],
+                      surrogate.METHODS[method], True, None if keys[i] == NO_KEY else keys[i])
+        st, v, w = hit.status, hit.V, hit.Omega
+        assert st == outputs.status[i] and np.array(v).tobytes() == outputs.V[i].tobytes(), i
+        assert np.array(w).tobytes() == outputs.Omega[i].tobytes(), i
+    assert np.mean(outputs.status == STATUS_REBOUNDED) > 0.5
 
 
 @pytest.mark.parametrize("method", ["auto", "direct"])
@@ -122,8 +122,8 @@ def test_a_keyed_particle_keeps_its_grain_hit_after_hit(small_table):
         hits = [rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                         small_table.model_shapes, cdf, tuple(V[i]), tuple(W[i]), NORMAL, A, x, 0, True, key)
                 for x in (u, other)]
-        assert hits[0][0] == hits[1][0] and np.array(hits[0][1]).tobytes() == np.array(hits[1][1]).tobytes()
-    for V_out, status in ((table[0], table[2]), (direct[0], direct[2])):
+        assert hits[0].status == hits[1].status and np.array(hits[0].V).tobytes() == np.array(hits[1].V).tobytes()
+    for V_out, status in ((table.V, table.status), (direct.V, direct.status)):
         rebounded = V_out[status == STATUS_REBOUNDED]
         alpha2 = np.degrees(np.arctan2(rebounded[:, 1], np.hypot(rebounded[:, 0], rebounded[:, 2])))
         assert len(rebounded) > M // 2 and np.std(alpha2) > 5.0      # one grain over random orientations
@@ -175,7 +175,7 @@ def test_a_population_of_keys_draws_the_law_of_new_grains(small_table, method):
     new = surrogate.sample_global(small_table, V, NORMAL, A, MIX, random_state=26, omega=W, method=method)
     speed = np.linalg.norm(V[0])
     for ratio in (lambda x: np.linalg.norm(x, axis=1) / speed, lambda x: x[:, 1] / speed):
-        a, b = (np.sort(ratio(out[0][out[2] == STATUS_REBOUNDED])) for out in (keyed, new))
+        a, b = (np.sort(ratio(out.V[out.status == STATUS_REBOUNDED])) for out in (keyed, new))
         grid = np.concatenate([a, b])
         distance = np.max(np.abs(np.searchsorted(a, grid, "right") / len(a) - np.searchsorted(b, grid, "right") / len(b)))
         assert distance < ks_bound(len(a), len(b)), distance
@@ -259,7 +259,7 @@ def test_cli_draws_one_grain_over_orientations(small_table_path, small_table, tm
             V = np.tile([100.0 * math.cos(a1), -100.0 * math.sin(a1), 0.0], (500, 1))
             keyed = surrogate.sample_global(small_table, V, NORMAL, 1.0, MIX, random_state=5, method="direct",
                                             grain_key=np.full(500, key))
-            assert samples.velocity.tobytes() == keyed[0].tobytes()
+            assert samples.velocity.tobytes() == keyed.V.tobytes()
             assert samples.provenance["grain_ratio_ba"] == surrogate.grain_of(small_table, [key], MIX).ratio_ba[0]
 
 
@@ -306,7 +306,7 @@ def test_cli_draws_one_grain_per_draw_from_a_file_of_keys(small_table_path, smal
         assert samples.provenance["grain_shapes"] == shapes
         expected = surrogate.sample_global(small_table, V, NORMAL, 1.0, MIX, random_state=5, method=method,
                                            grain_key=keys)
-        assert samples.velocity.tobytes() == expected[0].tobytes()
+        assert samples.velocity.tobytes() == expected.V.tobytes()
 
 
 @pytest.mark.parametrize("content, words", [

@@ -136,7 +136,8 @@ def _draw(table, V=(40.0, -0.3, 0.0), n=(0.0, 1.0, 0.0), a=1e-4, u=None):
         u = np.empty(surrogate.U_PER_DRAW)
         surrogate.fill_uniforms(surrogate.seed_state(1), u)
     cdf = surrogate.mix_cdf(table, "mix")
-    return table_rebound(table.kernel_data, cdf, V, n, a, np.asarray(u, dtype=np.float64), True)
+    hit = table_rebound(table.kernel_data, cdf, V, n, a, np.asarray(u, dtype=np.float64), True)
+    return hit.status, hit.V, hit.Omega
 
 
 @pytest.mark.parametrize("k", range(13))

@@ -32,9 +32,9 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
                          surrogate.sample_local(small_table, np.degrees(a1), speed, "mix", random_state=6)))
     finally:
         numba.set_num_threads(before)
-    (V1, W1, s1), local = runs[0]
-    for (V2, W2, s2), local2 in runs[1:]:
-        for x, y in zip((V1, W1, s1) + tuple(local), (V2, W2, s2) + tuple(local2)):
+    hits, local = runs[0]
+    for hits2, local2 in runs[1:]:
+        for x, y in zip(tuple(hits) + tuple(local), tuple(hits2) + tuple(local2)):
             np.testing.assert_array_equal(x, y)
 
     def uniforms(seed):
@@ -46,9 +46,9 @@ def test_api_draws_do_not_depend_on_the_thread_count(small_table):
     cdf = surrogate.mix_cdf(small_table, "mix")
     V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     table_rebound_many(small_table.kernel_data, cdf, V, n, a, uniforms(5), V3, W3, s3)
-    np.testing.assert_array_equal(V1, V3)
-    np.testing.assert_array_equal(W1, W3)
-    np.testing.assert_array_equal(s1, s3)
+    np.testing.assert_array_equal(hits.V, V3)
+    np.testing.assert_array_equal(hits.Omega, W3)
+    np.testing.assert_array_equal(hits.status, s3)
     for wrong in (chunk_states(np.random.default_rng(5), m - CHUNK_ROWS), np.ones((3, 3), np.uint64)):
         with pytest.raises(ValueError, match="one xoshiro256\\+ state"):
             table_rebound_parallel_rng(small_table.kernel_data, cdf, V, n, a, wrong, V3, W3, s3)
@@ -87,7 +87,8 @@ def _solver_loop(data, cdf, V, n, a, seed):
         for k in range(U_PER_DRAW):
             u[k] = np.random.random()
         U[i] = u
-        status[i], V_new, W_new = table_rebound(data, cdf, V[i], n[i], a[i], u)
+        hit = table_rebound(data, cdf, V[i], n[i], a[i], u)
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         for k in range(3):
             V_out[i, k], Omega_out[i, k] = V_new[k], W_new[k]
     return V_out, Omega_out, status, U
@@ -113,8 +114,9 @@ def test_callable_from_a_numba_loop(small_table):
 def _tuple_loop(data, cdf, V, n, a, U, V_out, Omega_out, status):
     """A solver loop on scalars: table_rebound on 3-tuples built from the rows (no array views)."""
     for i in range(V.shape[0]):
-        status[i], V_new, W_new = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
-                                                (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i])
+        hit = table_rebound(data, cdf, (V[i, 0], V[i, 1], V[i, 2]),
+                            (n[i, 0], n[i, 1], n[i, 2]), a[i], U[i])
+        status[i], V_new, W_new = hit.status, hit.V, hit.Omega
         for k in range(3):
             V_out[i, k], Omega_out[i, k] = V_new[k], W_new[k]
 
@@ -140,7 +142,8 @@ def test_block_and_tuple_kernels_give_the_row_by_row_results(small_table):
     data = small_table.kernel_data
     V1, W1, s1 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     for i in range(m):
-        s1[i], V1[i], W1[i] = table_rebound(data, cdf, V[i], n[i], a[i], U[i])
+        hit = table_rebound(data, cdf, V[i], n[i], a[i], U[i])
+        s1[i], V1[i], W1[i] = hit.status, hit.V, hit.Omega
     V2, W2, s2 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
     table_rebound_many(data, cdf, V, n, a, U, V2, W2, s2)
     V3, W3, s3 = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, dtype=np.int8)
@@ -209,8 +212,9 @@ def test_block_kernel_takes_strided_rows_and_rejects_short_arrays(small_table):
 
 def test_numba_kernel_flags_a_particle_leaving_the_wall(small_table):
     cdf = surrogate.mix_cdf(small_table, "mix")
-    status, V_out, Omega_out = table_rebound(small_table.kernel_data, cdf, np.array([10.0, 5.0, 0.0]),
-                                             np.array([0.0, 1.0, 0.0]), 1e-4, np.full(U_PER_DRAW, 0.5))
+    hit = table_rebound(small_table.kernel_data, cdf, np.array([10.0, 5.0, 0.0]),
+                        np.array([0.0, 1.0, 0.0]), 1e-4, np.full(U_PER_DRAW, 0.5))
+    status, V_out, Omega_out = hit.status, hit.V, hit.Omega
     assert status == STATUS_INVALID and np.all(np.isnan(V_out)) and np.all(np.isnan(Omega_out))
     np.testing.assert_allclose(cdf, [0.25, 0.5, 0.75, 1.0])
 

@@ -160,13 +160,16 @@ def _draw(table, path, u):
         status, *values = draw_velocity(table.kernel_data, cdf, 40.0, 60.0, u, True)
         return status, tuple(values)
     if path == "table":
-        status, v, w = table_rebound(table.kernel_data, cdf, V_IN, NORMAL, A, u, True)
+        hit = table_rebound(table.kernel_data, cdf, V_IN, NORMAL, A, u, True)
+        status, v, w = hit.status, hit.V, hit.Omega
     elif path == "direct":          # the prism (the direct model's shape 1), u[1..7] as in rebound
-        status, v, w = direct_rebound(table.direct_parameters, table.shape_arrays, 1, V_IN, zero, NORMAL, A, u[1:8])
+        hit = direct_rebound(table.direct_parameters, table.shape_arrays, 1, V_IN, zero, NORMAL, A, u[1:8])
+        status, v, w = hit.status, hit.V, hit.Omega
     else:
         method = METHOD_DIRECT if path == "keyed_direct" else METHOD_TABLE
-        status, v, w = rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes, cdf,
-                               V_IN, zero, NORMAL, A, u, method, True, KEY)
+        hit = rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes, cdf,
+                      V_IN, zero, NORMAL, A, u, method, True, KEY)
+        status, v, w = hit.status, hit.V, hit.Omega
     return status, tuple(v) + tuple(w)
 
 

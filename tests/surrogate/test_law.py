@@ -20,7 +20,8 @@ def test_global_equals_local_in_the_model_frame(small_table):
     n, speed, alpha1 = 500, 150.0, 60.0
     a1 = np.radians(alpha1)
     V = np.tile([speed * np.cos(a1), -speed * np.sin(a1), 0.0], (n, 1))
-    V_out, Omega_out, status = surrogate.sample_global(small_table, V, [0.0, 1.0, 0.0], 2e-4, "prism", random_state=4)
+    hits = surrogate.sample_global(small_table, V, [0.0, 1.0, 0.0], 2e-4, "prism", random_state=4)
+    V_out, Omega_out, status = hits.V, hits.Omega, hits.status
     d = surrogate.sample_local(small_table, np.full(n, alpha1), speed, "prism", random_state=4)
     np.testing.assert_array_equal(status, d.status)
     np.testing.assert_allclose(V_out, _local_velocity(d, speed), rtol=1e-12, atol=1e-9)
@@ -39,9 +40,9 @@ def test_global_frame_is_rotation_equivariant(small_table):
     Q = Rotation.random(random_state=1).as_matrix()
     out1 = surrogate.sample_global(small_table, V, normal, 1e-3, [0.25] * 4, random_state=7)
     out2 = surrogate.sample_global(small_table, V @ Q.T, normal @ Q.T, 1e-3, [0.25] * 4, random_state=7)
-    np.testing.assert_array_equal(out1[2], out2[2])
-    np.testing.assert_allclose(out2[0], out1[0] @ Q.T, atol=1e-9 * 250)
-    np.testing.assert_allclose(out2[1], out1[1] @ Q.T, atol=1e-9 * 250 / 1e-3)
+    np.testing.assert_array_equal(out1.status, out2.status)
+    np.testing.assert_allclose(out2.V, out1.V @ Q.T, atol=1e-9 * 250)
+    np.testing.assert_allclose(out2.Omega, out1.Omega @ Q.T, atol=1e-9 * 250 / 1e-3)
 
 
 def test_normal_impact_picks_a_uniform_in_wall_axis(small_table):
@@ -52,8 +53,9 @@ def test_normal_impact_picks_a_uniform_in_wall_axis(small_table):
     """
     n = 4000
     normal = np.array([0.0, 0.0, 1.0])
-    V_out, _, status = surrogate.sample_global(small_table, np.tile([0.0, 0.0, -200.0], (n, 1)), normal, 1e-3,
-                                               "cut_prism", random_state=3)
+    hits = surrogate.sample_global(small_table, np.tile([0.0, 0.0, -200.0], (n, 1)), normal, 1e-3,
+                                   "cut_prism", random_state=3)
+    V_out, status = hits.V, hits.status
     ok = status == STATUS_REBOUNDED
     assert np.all(V_out[ok, 2] > 0)
     azimuth = np.arctan2(V_out[ok, 1], V_out[ok, 0])
@@ -104,8 +106,9 @@ def test_every_rebound_leaves_the_wall_without_gaining_energy(request, fixture, 
         speed = np.resize(speeds, a.size)
         V = speed[:, None] * np.column_stack([np.cos(a), -np.sin(a), np.zeros(a.size)])
         normals = np.tile([0.0, 1.0, 0.0], (a.size, 1))
-        V_out, _, status = surrogate.sample_global(table, V, normals, np.full(a.size, 1e-4), shape=shape,
-                                                   random_state=1, clamp=True, method="table")
+        hits = surrogate.sample_global(table, V, normals, np.full(a.size, 1e-4), shape=shape,
+                                       random_state=1, clamp=True, method="table")
+        V_out, status = hits.V, hits.status
         ok = status == STATUS_REBOUNDED
         assert np.all(V_out[ok, 1] > 0.0)
         assert np.all(np.linalg.norm(V_out[ok], axis=1) <= speed[ok] * (1 + 1e-12))

@@ -59,9 +59,8 @@ def test_auto_without_spin_inside_the_grid_is_the_table_bit_for_bit(small_table)
     V = _in_grid(m, 1)
     table = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=3, method="table")
     for omega in (None, np.zeros(3), np.zeros((m, 3))):
-        *auto, path = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=3, omega=omega,
-                                              return_path=True)
-        assert np.all(path == PATH_TABLE)
+        auto = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=3, omega=omega)
+        assert np.all(auto.path == PATH_TABLE)
         for x, y in zip(table, auto):
             np.testing.assert_array_equal(x, y)
 
@@ -69,9 +68,9 @@ def test_auto_without_spin_inside_the_grid_is_the_table_bit_for_bit(small_table)
 def test_table_method_ignores_spin(small_table):
     V = _in_grid(500, 2)
     plain = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=4, method="table")
-    *spun, path = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=4, method="table",
-                                          omega=_spinning(V, 0.5, 3), return_path=True)
-    assert np.all(path == PATH_TABLE)
+    spun = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=4, method="table",
+                                   omega=_spinning(V, 0.5, 3))
+    assert np.all(spun.path == PATH_TABLE)
     for x, y in zip(plain, spun):
         np.testing.assert_array_equal(x, y)
 
@@ -91,15 +90,17 @@ def test_direct_method_is_the_direct_model_with_the_hit_s_uniforms(small_table):
     W = _spinning(V, 0.3, 6)
     W[::3] = 0.0
     weights = [0.1, 0.2, 0.3, 0.4]
-    V_out, W_out, status, path = surrogate.sample_global(small_table, V, NORMAL, A, weights, random_state=7,
-                                                         omega=W, method="direct", return_path=True)
+    hits = surrogate.sample_global(small_table, V, NORMAL, A, weights, random_state=7,
+                                   omega=W, method="direct")
+    V_out, W_out, status, path = hits.V, hits.Omega, hits.status, hits.path
     assert np.all(path == PATH_DIRECT)
     u = _chunk_uniforms(7, m)
     cdf = surrogate.mix_cdf(small_table, weights)
     for i in range(0, m, 7):
         shape = small_table.model_shapes[np.searchsorted(cdf, u[i, 0], side="right")]
-        st, v, w = direct_rebound(small_table.direct_parameters, small_table.shape_arrays, shape, tuple(V[i]),
-                                  tuple(W[i]), NORMAL, A, u[i, 1:1 + U_PER_REBOUND])
+        hit = direct_rebound(small_table.direct_parameters, small_table.shape_arrays, shape, tuple(V[i]),
+                             tuple(W[i]), NORMAL, A, u[i, 1:1 + U_PER_REBOUND])
+        st, v, w = hit.status, hit.V, hit.Omega
         assert st == status[i]
         np.testing.assert_array_equal(np.array(v), V_out[i])
         np.testing.assert_array_equal(np.array(w), W_out[i])
@@ -122,14 +123,16 @@ def test_rebound_is_the_table_or_the_direct_kernel_by_path(small_table):
         else:
             shape = shapes[np.searchsorted(cdf, u[0], side="right")]
             want = direct_rebound(params, arrays, shape, V, W, NORMAL, A, u[1:8])
-        assert got[0] == want[0]
-        np.testing.assert_array_equal(np.array(got[1:]), np.array(want[1:]))
+        assert got.status == want.status
+        np.testing.assert_array_equal(np.array(got.V + got.Omega), np.array(want.V + want.Omega))
         for method in (METHOD_TABLE, METHOD_DIRECT):
             bad = u.copy()
             bad[12] = 1.0
-            st, v, _ = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, bad, method, True)
+            hit = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, bad, method, True)
+            st, v = hit.status, hit.V
             assert st == STATUS_INVALID and np.all(np.isnan(v))
-    st, v, _ = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, rng.random(13), 3, True)
+    hit = rebound(data, params, arrays, shapes, cdf, V, W, NORMAL, A, rng.random(13), 3, True)
+    st, v = hit.status, hit.V
     assert st == STATUS_INVALID and np.all(np.isnan(v))
 
 
@@ -140,11 +143,13 @@ def test_spinning_hits_follow_the_direct_model_s_law(small_table):
     n = 4000
     V = np.tile(_velocity(45.0, 150.0), (n, 1))
     W = np.array([0.0, 0.0, -0.6 * 150.0 / A])
-    V_a, W_a, st_a, path = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=11, omega=W,
-                                                   return_path=True)
+    hits = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=11, omega=W)
+    V_a, W_a, st_a, path = hits.V, hits.Omega, hits.status, hits.path
     assert np.all(path == PATH_DIRECT)
-    V_d, W_d, st_d = surrogate.sample_direct(small_table, V, NORMAL, A, omega=W, shape="prism", random_state=12)
-    V_t, W_t, st_t = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=13, method="table")
+    hits = surrogate.sample_direct(small_table, V, NORMAL, A, omega=W, shape="prism", random_state=12)
+    V_d, W_d, st_d = hits.V, hits.Omega, hits.status
+    hits = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=13, method="table")
+    V_t, W_t, st_t = hits.V, hits.Omega, hits.status
     x, y, z = (np.column_stack([v, w])[s == STATUS_REBOUNDED] for v, w, s in ((V_a, W_a, st_a), (V_d, W_d, st_d),
                                                                             (V_t, W_t, st_t)))
     bound = ks_bound(len(x), len(y))
@@ -178,8 +183,9 @@ def test_the_path_at_the_tolerance_and_the_grid_s_edges(small_table):
         assert rebound_path(data, V_in, W, NORMAL, A, METHOD_TABLE) == PATH_TABLE
         assert rebound_path(data, V_in, W, NORMAL, A, METHOD_DIRECT) == PATH_DIRECT
     # sample_global reports the same paths
-    *_, path = surrogate.sample_global(small_table, [c[0] for c in cases], NORMAL, A, random_state=1,
-                                       omega=[c[1] for c in cases], return_path=True)
+    hits = surrogate.sample_global(small_table, [c[0] for c in cases], NORMAL, A, random_state=1,
+                                   omega=[c[1] for c in cases])
+    path = hits.path
     np.testing.assert_array_equal(path, [c[2] for c in cases])
     for bad in [dict(V_in=(1.0, 1.0, 0.0)), dict(W=(np.nan, 0.0, 0.0)), dict(W=(0.0, np.inf, 0.0)),
                 dict(a=0.0), dict(n=(0.0, 2.0, 0.0)), dict(method=3), dict(method=-1)]:
@@ -216,14 +222,14 @@ def test_bad_method_names_the_allowed_ones(small_table):
 
 def test_the_many_hit_kernel_refuses_a_method_code_outside_the_three(small_table):
     V = np.array(_in_grid(3, 1))
-    outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
+    outputs = surrogate.empty_rebounds(3)
     with pytest.raises(ValueError, match=r"'method' code must be METHOD_AUTO \(0\)"):
         rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                              small_table.model_shapes,
                              surrogate.mix_cdf(small_table, "mix"), np.zeros(0, np.int64), np.zeros(0, np.int64), V,
                              np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 3,
-                             *outputs, True)
+                             outputs, True)
 
 
 @pytest.mark.parametrize("shapes, message", [
@@ -236,24 +242,24 @@ def test_the_many_hit_kernel_refuses_shape_indices_outside_the_table(small_table
     """A per-particle shape index outside the table's shapes would read outside the table: a ValueError before
     the parallel loop."""
     V = np.array(_in_grid(3, 1))
-    outputs = np.empty((3, 3)), np.empty((3, 3)), np.empty(3, np.int8), np.empty(3, np.int8)
+    outputs = surrogate.empty_rebounds(3)
     with pytest.raises(ValueError, match=message):
         rebound_parallel_rng(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
                              small_table.model_shapes,
                              surrogate.mix_cdf(small_table, "mix"), shapes, np.zeros(0, np.int64), V, np.zeros((1, 3)),
                              np.tile(NORMAL, (3, 1)), np.full(3, A), chunk_states(np.random.default_rng(1), 3), 0,
-                             *outputs, True)
+                             outputs, True)
 
 
 def test_auto_sends_states_outside_the_grid_to_the_model_and_table_keeps_its_errors(small_table):
     V = np.array([_velocity(10.0, 150.0), _velocity(60.0, 400.0), _velocity(60.0, 20.0)])
-    V_out, _, status, path = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=2,
-                                                     return_path=True)
+    hits = surrogate.sample_global(small_table, V, NORMAL, A, "prism", random_state=2)
+    V_out, status, path = hits.V, hits.status, hits.path
     assert np.all(path == PATH_DIRECT) and np.all(np.isfinite(V_out[status == STATUS_REBOUNDED]))
     with pytest.raises(ValueError, match=r"'alpha1' value [\d.]+ deg \(index 0\) is outside the table's range"):
         surrogate.sample_global(small_table, V, NORMAL, A, "prism", method="table")
-    _, _, _, path = surrogate.sample_global(small_table, V, NORMAL, A, "prism", method="table", clamp=True,
-                                            return_path=True)
+    hits = surrogate.sample_global(small_table, V, NORMAL, A, "prism", method="table", clamp=True)
+    path = hits.path
     assert np.all(path == PATH_TABLE)
 
 
@@ -266,8 +272,8 @@ def test_failed_rebounds_are_status_2_and_never_dropped(small_table):
     V = _in_grid(300, 3)
     W = _spinning(V, 0.5, 4)
     W[::2] = 0.0
-    V_out, W_out, status, path = surrogate.sample_global(starved, V, NORMAL, A, "mix", random_state=4, omega=W,
-                                                         return_path=True)
+    hits = surrogate.sample_global(starved, V, NORMAL, A, "mix", random_state=4, omega=W)
+    V_out, W_out, status, path = hits.V, hits.Omega, hits.status, hits.path
     failed = status == STATUS_FAILED
     assert len(status) == 300 and np.sum(path == PATH_DIRECT) == 150 and failed.sum() > 0
     assert np.all(path[failed] == PATH_DIRECT) and np.all(np.isin(status[path == PATH_TABLE], (0, 1)))
@@ -301,8 +307,7 @@ def test_the_same_seed_gives_the_same_bits_on_one_or_two_threads(small_table):
     try:
         for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
             numba.set_num_threads(threads)
-            runs.append(surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=12, omega=W,
-                                                return_path=True))
+            runs.append(surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=12, omega=W))
     finally:
         numba.set_num_threads(before)
     assert 0 < np.sum(runs[0][3] == PATH_DIRECT) < m
@@ -349,10 +354,10 @@ def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, me
     data, params, model_shapes = small_table.kernel_data, small_table.direct_parameters, small_table.model_shapes
 
     def run(cdf, rows):
-        outputs = np.empty((m, 3)), np.empty((m, 3)), np.empty(m, np.int8), np.empty(m, np.int8)
+        outputs = surrogate.empty_rebounds(m)
         rebound_parallel_rng(data, params, small_table.shape_arrays, model_shapes, cdf, rows, np.zeros(0, np.int64), V,
                              W, np.tile(NORMAL, (m, 1)), np.full(m, A),
-                             chunk_states(np.random.default_rng(11), m), method, *outputs, True)
+                             chunk_states(np.random.default_rng(11), m), method, outputs, True)
         return outputs
 
     mix = surrogate.mix_cdf(small_table, {"prism": 0.5, "tetrahedron": 0.5})
@@ -364,4 +369,4 @@ def test_a_row_given_its_shape_draws_what_that_shape_s_mix_draws(small_table, me
         assert rows.any()
         for got, wanted in zip(given, want):
             np.testing.assert_array_equal(got[rows], wanted[rows])
-    assert np.mean(given[2] == STATUS_REBOUNDED) > 0.5
+    assert np.mean(given.status == STATUS_REBOUNDED) > 0.5

@@ -26,7 +26,8 @@ def test_the_table_path_draws_a_user_grain_by_name(grains_path):
     table = surrogate.load(grains_path)
     assert table.shapes[4:] == ("grain_00", "grain_01") and table.model_shapes.tolist() == [0, 1, 2, 3, 4, 5]
     for shape in ("grain_01", {"grain_00": 0.5, "prism": 0.5}):
-        V_out, _, status = surrogate.sample_global(table, V, NORMAL, A, shape=shape, random_state=1, method="table")
+        hits = surrogate.sample_global(table, V, NORMAL, A, shape=shape, random_state=1, method="table")
+        V_out, status = hits.V, hits.status
         rebounded = status == surrogate.STATUS_REBOUNDED
         assert np.all(rebounded | (status == surrogate.STATUS_TRAPPED)) and rebounded.sum() > 150
         assert np.all(V_out[rebounded, 1] > 0.0)
@@ -37,13 +38,14 @@ def test_the_direct_model_answers_a_user_grain(grains_path):
     (the wall law dissipates; docs/model.md §4.4); spinning, under "auto", every hit goes to the direct model and
     none is invalid."""
     table = surrogate.load(grains_path)
-    V_out, _, status = surrogate.sample_direct(table, V, NORMAL, A, shape="grain_00", random_state=1)
+    hits = surrogate.sample_direct(table, V, NORMAL, A, shape="grain_00", random_state=1)
+    V_out, status = hits.V, hits.status
     rebounded = status == surrogate.STATUS_REBOUNDED
     assert rebounded.sum() > 150 and np.all(V_out[rebounded, 1] > 0.0)
     assert np.all(np.linalg.norm(V_out[rebounded], axis=1) <= np.linalg.norm(V[0]) * (1 + 1e-12))
     spin = [0.0, 0.0, 0.3 * np.linalg.norm(V[0]) / A]
-    _, _, status, path = surrogate.sample_global(table, V, NORMAL, A, shape="grain_00", random_state=1, omega=spin,
-                                                 return_path=True)
+    hits = surrogate.sample_global(table, V, NORMAL, A, shape="grain_00", random_state=1, omega=spin)
+    status, path = hits.status, hits.path
     assert np.all(status != surrogate.STATUS_INVALID) and np.all(path == 1)
 
 

@@ -126,17 +126,15 @@ def test_sample_global_with_one_shape_per_particle(small_table, method):
     m = CHUNK_ROWS + 40
     V, W = _hits(m, 3)
     names = np.array(small_table.shapes)[np.random.default_rng(4).integers(0, len(small_table.shapes), m)]
-    got = surrogate.sample_global(small_table, V, NORMAL, A, list(names), random_state=5, omega=W, method=method,
-                                  return_path=True)
+    got = surrogate.sample_global(small_table, V, NORMAL, A, list(names), random_state=5, omega=W, method=method)
     for name in small_table.shapes:
         rows = names == name
-        want = surrogate.sample_global(small_table, V, NORMAL, A, name, random_state=5, omega=W, method=method,
-                                       return_path=True)
+        want = surrogate.sample_global(small_table, V, NORMAL, A, name, random_state=5, omega=W, method=method)
         for g, w in zip(got, want):
             np.testing.assert_array_equal(g[rows], w[rows])
     if method == "auto":
-        assert 0 < np.count_nonzero(got[3]) < m         # both paths
-    assert np.mean(got[2] == STATUS_REBOUNDED) > 0.5
+        assert 0 < np.count_nonzero(got.path) < m         # both paths
+    assert np.mean(got.status == STATUS_REBOUNDED) > 0.5
 
 
 def test_sample_direct_with_one_shape_per_particle_and_with_a_mix(small_table):
