@@ -1,4 +1,4 @@
-"""Command line of tablegen: ``tablegen simulate|build|info|report ...``.
+"""Command line of tablegen: ``tablegen simulate|build|info|report|calibrate|grid ...``.
 
 A user error ends the command with one line on stderr naming the value and
 its allowed range, and exit status 2; SIGINT and SIGTERM with one line and
@@ -16,11 +16,12 @@ from pathlib import Path
 from data_schema.command_line import CommandParser, count_argument, run, seed_argument
 from data_schema.output import check_memory, check_output
 from data_schema.samples import ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, write_samples
+from tablegen.tabulation.calibration import DEFAULT_PARTICLES, DEFAULT_SEED
 from tablegen.tabulation.config import PRESETS
 from direct_model.registry import FAMILIES
-from direct_model.shapes import DEFAULT_KAPPA, MIX, AspectRatioLaw
+from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw
 from direct_model.simulate import DEFAULT_N_MAX
-from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from direct_model.wall import CORUNDUM_ON_STEEL, EXPONENTIAL, WALL_FAMILIES, WallMaterial
 from tablegen.study.report import DEFAULT_N as REPORT_DEFAULT_N
 
 # memory per simulated particle: its arrays, their merge and the file made in memory
@@ -124,7 +125,136 @@ def _build_parser() -> argparse.ArgumentParser:
     report.add_argument("--overwrite", action="store_true",
                         help="replace an existing output folder if it is a report this command wrote")
     report.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
+
+    calibrate = sub.add_parser(
+        "calibrate", help="fit the wall law's parameters to measured mean rebounds",
+        description="Fit the parameters of a wall law (docs/model.md section 4.6) to measured mean rebounds by "
+                    "weighted least squares against the direct model (Omega- = 0, the same particles at every "
+                    "evaluation), print the fit and write it as the [wall] section that tablegen build --config "
+                    "reads: paste it into a configuration, or build with the file itself.")
+    calibrate.add_argument("--data", required=True, metavar="FILE.csv",
+                           help="measurements, CSV with a header: alpha1_deg (in (0, 90]), speed_m_s (> 0), then the "
+                                "means over the rebounded particles of e_n = -v+/v- and e_t = u+/u- (alpha1 < 90) or "
+                                "of u_ratio = u+/|V-| and v_ratio = v+/|V-|; optional: their standard deviations over "
+                                "the particles (e_n_sd, e_t_sd or u_ratio_sd, v_ratio_sd) and the particle count n. "
+                                "Weights 1/(sd^2/n + the model's variance of its mean); a missing sd is taken as the "
+                                "same in every row and estimated from the fit's residuals (standard errors then "
+                                "scaled by chi2/dof); a missing n is 1. Other columns are ignored with a warning")
+    calibrate.add_argument("-o", "--out", required=True, metavar="WALL.toml",
+                           help="output: the fitted law as a [wall] section (TOML) with comments on the fit")
+    grains = calibrate.add_mutually_exclusive_group()
+    grains.add_argument("--shapes", type=_name_list, metavar="NAME,...",
+                        help=f"the grains, in equal parts: among {', '.join(FAMILIES)} and --config's grid shapes "
+                             f"(default: {', '.join(SHAPES)} in equal parts)")
+    grains.add_argument("--mix", type=_weight_list, metavar="NAME=W,...",
+                        help="the grains with weights (normalised), e.g. prism=0.7,tetrahedron=0.3")
+    calibrate.add_argument("--config", metavar="FILE",
+                           help="TOML build configuration: its grid's user grains may be named in --shapes/--mix, and "
+                                "its kappa, b/a and c/b law and n_max are run (its [wall] is not: it is fitted)")
+    calibrate.add_argument("--law", default=EXPONENTIAL, choices=tuple(WALL_FAMILIES),
+                           help="the wall law family (default: %(default)s, parameters k, p, q)")
+    calibrate.add_argument("--fix", type=_fixed_list, action="append", default=[], metavar="NAME=VALUE,...",
+                           help="hold parameters at values instead of fitting them, e.g. --fix p=0.61 (repeatable)")
+    calibrate.add_argument("--particles", type=count_argument, default=DEFAULT_PARTICLES, metavar="N",
+                           help="direct-model particles per data row, shared by the grains by weight, >= 1 (default "
+                                "%(default)s: a mean's model standard error about 0.002)")
+    calibrate.add_argument("--seed", type=seed_argument, default=DEFAULT_SEED,
+                           help="seed of the model's particles, in [0, 2**63) (default %(default)s); the same "
+                                "particles serve every evaluation of the fit")
+    calibrate.add_argument("--figure", metavar="FILE.png",
+                           help="also draw the data, the fit and the default law against alpha1 (PNG; matplotlib)")
+    calibrate.add_argument("--overwrite", action="store_true",
+                           help="replace an existing -o or --figure file if this command wrote it (nothing else)")
+    calibrate.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
+
+    grid = sub.add_parser(
+        "grid", help="propose a table grid that covers a run's wall hits",
+        description="Read a run's wall hits, print the quantiles of their incidence alpha1 (deg from the wall) and "
+                    "speed |V-| (m/s, relative to the wall), and propose the [grid] section (alpha1_deg, speed_m_s) "
+                    "that tablegen build --config reads, whose ranges cover the share --cover of the hits: the "
+                    "hits a table of that grid answers instead of the direct model (docs/tables.md).")
+    grid.add_argument("--from-hits", required=True, nargs="+", metavar="HITS",
+                      help="hits files or folders (a folder: every hits file under it): an adapter's hits_<rank>.csv "
+                           "(OpenFOAM's stochasticRebound or code_saturne's), or OpenFOAM's patchPostProcessing "
+                           "records postProcessing/lagrangian/<cloud>/<name>/<time>/<patch>.post, whose normals come "
+                           "from the case's mesh (the walls taken at rest)")
+    grid.add_argument("--cover", type=_share, default=0.99, metavar="SHARE",
+                      help="the share of the hits the grid's ranges cover, in (0, 1] (default %(default)s): as many "
+                           "hits trimmed from the low end of alpha1 as from each end of |V-|")
+    grid.add_argument("--alpha1-points", type=int, metavar="N",
+                      help="alpha1 grid points, linear up to 90 deg, an integer in [2, 1000] (default: the default "
+                           "preset's density, about one per 2.4 deg)")
+    grid.add_argument("--speed-points", type=int, metavar="M",
+                      help="speed grid points, geometric when the range spans more than a factor 3, else linear, an "
+                           "integer in [2, 1000], neighbours at most a factor 16 apart (default: the default "
+                           "preset's density, about a factor 1.35 per point)")
+    grid.add_argument("--normal", type=_normal, action="append", default=[], metavar="PATCH=NX,NY,NZ",
+                      help="a flat patch's normal into the gas for its patchPostProcessing records, instead of the "
+                           "mesh's (repeatable; normalised)")
+    grid.add_argument("--patch", action="append", metavar="NAME",
+                      help="only the hits on this patch (repeatable; default: every patch of the files)")
+    grid.add_argument("--table", metavar="TABLE.h5", help="also print the share of the hits this table's grid covers")
+    grid.add_argument("-o", "--out", metavar="GRID.toml",
+                      help="write the [grid] section there (default: print it, after the report as TOML comments)")
+    grid.add_argument("--overwrite", action="store_true",
+                      help="replace an existing -o file if tablegen grid wrote it (nothing else)")
     return parser
+
+
+def _share(text: str) -> float:
+    """A share in (0, 1] (argparse type)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 < value <= 1.0:
+        raise argparse.ArgumentTypeError(f"must be a share in (0, 1]; got {text!r}")
+    return value
+
+
+def _normal(text: str) -> tuple:
+    """``PATCH=NX,NY,NZ`` as (patch, (nx, ny, nz)) (argparse type)."""
+    name, equals, vector = (part.strip() for part in text.partition("="))
+    try:
+        values = tuple(float(v) for v in vector.split(","))
+    except ValueError:
+        values = ()
+    if not (name and equals) or len(values) != 3:
+        raise argparse.ArgumentTypeError(f"PATCH=NX,NY,NZ, the patch's normal into the gas; got {text!r}")
+    return name, values
+
+
+def _name_list(text: str) -> tuple:
+    """Comma-separated names (argparse type)."""
+    names = tuple(name.strip() for name in text.split(","))
+    if not all(names):
+        raise argparse.ArgumentTypeError(f"comma-separated grain names; got {text!r}")
+    return names
+
+
+def _pairs(text: str, what: str) -> dict:
+    """``NAME=NUMBER,...`` as a dict; ArgumentTypeError saying ``what`` is expected."""
+    pairs = {}
+    for item in text.split(","):
+        name, equals, value = (part.strip() for part in item.partition("="))
+        try:
+            number = float(value)
+        except ValueError:
+            number = None
+        if not (name and equals) or number is None or name in pairs:
+            raise argparse.ArgumentTypeError(f"comma-separated {what}; got {text!r}")
+        pairs[name] = number
+    return pairs
+
+
+def _weight_list(text: str) -> dict:
+    """``NAME=WEIGHT,...`` (argparse type)."""
+    return _pairs(text, "NAME=WEIGHT pairs, each name once, e.g. prism=0.7,tetrahedron=0.3")
+
+
+def _fixed_list(text: str) -> dict:
+    """``NAME=VALUE,...`` (argparse type)."""
+    return _pairs(text, "NAME=VALUE pairs, each name once, e.g. p=0.61")
 
 
 def _alpha1_list(text: str) -> tuple:
@@ -277,9 +407,87 @@ def _report(args) -> int:
     return 0
 
 
+def _calibrate(args) -> int:
+    from data_schema.output import replace_file
+    from tablegen.progress import progress_bar
+    from tablegen.tabulation import calibration
+
+    if args.figure is not None and Path(args.figure).resolve() == Path(args.out).resolve():
+        raise ValueError(f"--figure {args.figure} is the -o file; give two files")
+    calibration.check_output_file(args.out, calibration.WALL_FILE_KIND, args.overwrite, inputs=(args.data,))
+    if args.figure is not None:
+        calibration.check_output_file(args.figure, calibration.FIGURE_KIND, args.overwrite, inputs=(args.data,))
+        calibration.require_matplotlib()
+    fixed = {}
+    for pairs in args.fix:
+        repeated = set(pairs) & set(fixed)
+        if repeated:
+            raise ValueError(f"--fix names '{sorted(repeated)[0]}' twice; give each parameter once")
+        fixed.update(pairs)
+    data = calibration.read_measurements(args.data)
+    config = _config(args)
+    bars = []
+
+    def advance(count):
+        if not bars:        # the bar starts with the work: a refusal before it stays one line
+            bars.append(progress_bar(True, None, "evaluation", "calibrate"))
+        bars[0].update(count)
+
+    try:
+        result = calibration.calibrate(data, args.law, fixed, args.mix or args.shapes, args.particles, args.seed,
+                                       config, progress=advance if _progress(args) else None,
+                                       log=lambda line: print(line, file=sys.stderr))
+    finally:
+        for bar in bars:
+            bar.close()
+    print(calibration.format_calibration(result))
+    figure = calibration.figure_png(result) if args.figure is not None else None
+    replace_file(args.out, calibration.wall_toml(result, f"calibrated_{Path(args.data).stem}").encode("utf-8"),
+                 args.overwrite)
+    print(f"\nwall law written to {args.out}")
+    if figure is not None:
+        replace_file(args.figure, figure, args.overwrite)
+        print(f"figure written to {args.figure}")
+    return 0
+
+
+def _grid(args) -> int:
+    from data_schema.output import replace_file
+    from data_schema.table import read_table
+    from tablegen.tabulation import grid_fit
+
+    normals = {}
+    for patch, vector in args.normal:
+        if patch in normals:
+            raise ValueError(f"--normal names patch {patch!r} twice; give each patch once")
+        normals[patch] = vector
+    grid_fit.check_options(args.cover, args.alpha1_points, args.speed_points)
+    inputs = [*args.from_hits, *([args.table] if args.table else [])]
+    if args.out is not None:
+        grid_fit.check_grid_output(args.out, args.overwrite, inputs)
+    table = None
+    if args.table is not None:
+        stored = read_table(args.table)
+        table = (args.table, stored.alpha1_deg, stored.speed_m_s)
+    hits = grid_fit.read_hits(args.from_hits, normals, args.patch)
+    proposal = grid_fit.propose_grid(hits.alpha1, hits.speed, args.cover, args.alpha1_points, args.speed_points)
+    report = grid_fit.format_report(hits, proposal, table)
+    section = grid_fit.grid_toml(proposal, hits, args.from_hits)
+    if args.out is None:
+        # the report after the section, as TOML comments: the output redirected to a file is a grid file
+        print(section)
+        print("\n".join(f"# {line}".rstrip() for line in report.splitlines()))
+        return 0
+    print(report)
+    replace_file(args.out, section.encode("utf-8"), args.overwrite)
+    print(f"\ngrid written to {args.out}")
+    return 0
+
+
 def main(argv=None) -> int:
     args = _build_parser().parse_args(argv)
-    commands = {"simulate": _simulate, "build": _build, "info": _info, "report": _report}
+    commands = {"simulate": _simulate, "build": _build, "info": _info, "report": _report, "calibrate": _calibrate,
+                "grid": _grid}
     on_interrupt = _build_interrupted if args.command == "build" else None
     return run(f"tablegen {args.command}", commands[args.command], args,
                on_interrupt=lambda signal_number: on_interrupt(args) if on_interrupt else None)
