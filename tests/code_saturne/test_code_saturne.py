@@ -7,8 +7,9 @@ well-formed and agree with the solver's log; every rebound leaves the wall; the 
 method auto; the solver's rebounds follow surrogate's law at the same incident states, path by path (the
 solver-neutral comparison tablegen.study.solver_comparison, called through compare_saturne_rebounds.py); each
 rank draws its own stream; each particle hits as one grain (grain kept) and the grains follow the mix's
-weights; trapped particles are deposited or removed; a bad setup stops the solver with one clear message; and
-the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
+weights; trapped particles are deposited or removed; each boundary zone does what its [zone] section says
+(its own wall's table, or a stock behaviour) and is counted apart; a bad setup stops the solver with one
+clear message; and the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
 
 These tests need code_saturne: they fail (they are not skipped) when it is missing, with a message naming
 integrations/code_saturne/install-deps.sh.
@@ -38,7 +39,7 @@ sys.path.insert(0, str(CS_DIR))
 
 import compare_saturne_rebounds  # noqa: E402
 import make_channel_table  # noqa: E402
-from read_hits import read_cpu_seconds, read_hits, read_summary  # noqa: E402
+from read_hits import HITS_TITLE, read_cpu_seconds, read_hits, read_summary, zone_summary  # noqa: E402
 from saturne_api import (PATH_DIRECT, PATH_TABLE, STATUS_REBOUNDED, build_table_from_text,  # noqa: E402
                          grain_mismatches, load)
 
@@ -433,3 +434,202 @@ def test_settings_without_a_table_are_one_clear_error(cs_build, case_table, tmp_
     proc = _allrun(case, case_table, check=False)
     assert proc.returncode != 0
     assert "no table (table = path of a table written by tablegen build)" in (case / "RESU" / "error").read_text()
+
+
+# ----------------------------------------------------------------------------- a wall per zone
+
+# Two walls for one grain, on a coarse grid (α1 from 10°, |V⁻| 50-150 m/s) that the case's hits fall below,
+# inside and above, and below in α1: an elastic wall (small k: little of the normal speed lost) and a lossy one
+# (large k) that traps (n_max = 2); the lossy wall's name holds a comma, which the hits files write as ';'
+WALL_TABLE_CONFIG = """\
+[grid]
+alpha1_deg = [10.0, 45.0, 90.0]
+speed_m_s = [50.0, 150.0]
+shapes = ["prism"]
+[simulation]
+particles_per_cell = 1000
+seed = 20261127
+n_max = {n_max}
+[wall]
+k = {k}
+p = 0.61
+q = {q}
+name = "{name}"
+{speed_range}
+"""
+# the elastic wall's law holds over 60-200 m/s (some hits fall outside it); the lossy one states no range
+WALLS = {"elastic": {"k": 0.02, "q": 0.5, "n_max": 1000, "name": "elastic (hard steel)",
+                     "speed_range": "speed_range_m_s = [60.0, 200.0]"},
+         "lossy": {"k": 0.5, "q": 1.5, "n_max": 2, "name": "lossy, soft", "speed_range": ""}}
+GRID = {"alpha1_lo": 10.0, "speed_lo": 50.0, "speed_hi": 150.0}
+
+# the side walls as two zones: walls (y = 0 and 0.02 m) and sides (z = 0 and 0.02 m)
+SPLIT_ZONES = ('  cs_boundary_zone_define("walls", "3", 0);\n',
+               '  cs_boundary_zone_define("walls", "y < 0.001 or y > 0.019", 0);\n'
+               '  cs_boundary_zone_define("sides", "z < 0.001 or z > 0.019", 0);\n')
+
+
+@pytest.fixture(scope="session")
+def wall_tables(tmp_path_factory):
+    """The two walls' tables (6 cells each), by name."""
+    folder = tmp_path_factory.mktemp("cs_wall_tables")
+    paths = {wall: folder / f"wall_{wall}.h5" for wall in WALLS}
+    for wall, law in WALLS.items():
+        # one worker: starting a pool takes longer than these 6 cells
+        build_table_from_text(WALL_TABLE_CONFIG.format(**law), paths[wall], workers=1)
+    return paths
+
+
+def _zones_case(tmp_path_factory, name, wall_tables, sections: str, split: bool = True) -> Path:
+    """The case on the elastic wall's table (the global settings, shape prism), with ``sections`` appended
+    to its settings and, if ``split``, the side walls as the zones walls and sides. Not run."""
+    case = _copy_case(tmp_path_factory, name)
+    if split:
+        zones = case / "SRC" / "cs_user_zones.c"
+        zones.write_text(zones.read_text().replace(*SPLIT_ZONES))
+    _set(case, "table", str(wall_tables["elastic"]))
+    _set(case, "weights", None)
+    _set(case, "shape", "prism")
+    with (case / "rebound_scatter.conf").open("a") as conf:
+        conf.write(sections)
+    return case
+
+
+@pytest.fixture(scope="session")
+def zones_case(cs_build, wall_tables, tmp_path_factory):
+    """walls on the global settings (the elastic wall, method auto, trapped deposit), target on the lossy
+    wall's table with method table and trapped remove, sides with the solver's rebound."""
+    case = _zones_case(tmp_path_factory, "cs_zones", wall_tables,
+                       f"\n[zone target]\ntable = {wall_tables['lossy']}\nmethod = table\ntrapped = remove\n"
+                       "\n[zone sides]\ntype = rebound\n")
+    _allrun(case, wall_tables["elastic"])
+    return case
+
+
+def _outside_by_cause(hits: dict, on) -> dict:
+    """The hits ``on`` outside the walls' grid, by cause, from their records."""
+    V, n = hits["V"][on], hits["n"][on]
+    speed = np.linalg.norm(V, axis=1)
+    alpha1 = np.degrees(np.arcsin(np.clip(-np.einsum("ij,ij->i", V, n) / speed, -1, 1)))
+    return {"speed_below": np.sum(speed < GRID["speed_lo"]), "speed_above": np.sum(speed > GRID["speed_hi"]),
+            "alpha1_outside": np.sum(alpha1 < GRID["alpha1_lo"])}
+
+
+def test_each_zone_does_what_its_section_says(zones_case):
+    """The per-zone summary: each hit has one fate; walls draws from the elastic wall's table by both paths and
+    deposits what it traps, target from the lossy wall's by the table alone and removes what it traps, sides
+    rebounds as the solver's CS_LAGR_REBOUND (V⁺ = V⁻ − 2 (V⁻·n) n, no draw); the hits outside each table's
+    grid by cause equal those of the records; each record names its zone's interaction and wall; the tables
+    are opened once each; the solver counts the removed particles as deposited and loses none."""
+    log = (zones_case / "RESU" / "run_solver.log").read_text()
+    rows, info = zone_summary(log), read_summary(log)
+    print("\n" + log[log.rindex("  rebound-scatter ("):log.rindex("Destroying")].rstrip())
+    assert log.count("rebound-scatter: opened the table") == 2
+    assert {z: r["interaction"] for z, r in rows.items()} == {
+        "target": "rebound-scatter, wall lossy, soft", "walls": "rebound-scatter, wall elastic (hard steel)",
+        "sides": "rebound"}
+    walls, target, sides = rows["walls"], rows["target"], rows["sides"]
+    for zone, r in rows.items():
+        assert r["hits"] == r["rebounded"] + r["stuck"] + r["removed"] + r["escaped"] + r["invalid"] > 1000, zone
+        assert r["escaped"] == r["invalid"] == 0, zone
+    assert walls["table"] > 0 and walls["direct"] > 0 and walls["table"] + walls["direct"] == walls["hits"]
+    assert walls["stuck"] == walls["trapped"] + walls["failed"] and walls["removed"] == 0
+    assert target["table"] == target["hits"] and target["direct"] == target["failed"] == 0
+    assert target["removed"] == target["trapped"] > 200 and target["stuck"] == 0
+    assert sides["rebounded"] == sides["hits"] and sum(sides[k] for k in (
+        "table", "direct", "trapped", "speed_below", "speed_above", "alpha1_outside")) == 0
+    # the first block: the hits a table or the direct model answered, both drawing zones'
+    assert info["hits"] == walls["hits"] + target["hits"] and info["direct"] == walls["direct"]
+    assert info["trapped"] == walls["trapped"] + target["trapped"]
+
+    hits, headers = read_hits(zones_case / "RESU")
+    assert headers[0]["table"].endswith("wall_elastic.h5") and headers[0]["shape"] == "prism"
+    for zone, interaction, wall in (("walls", HITS_TITLE, "elastic (hard steel)"),
+                                    ("target", HITS_TITLE, "lossy; soft"), ("sides", "rebound", "")):
+        on = hits["patch"] == zone
+        assert np.sum(on) == rows[zone]["hits"], zone
+        assert set(hits["interaction"][on]) == {interaction} and set(hits["wall"][on]) == {wall}, zone
+    for zone in ("walls", "target"):
+        counted = _outside_by_cause(hits, hits["patch"] == zone)
+        for cause, count in counted.items():
+            # a hit at the grid's edge itself may fall either side by a rounding of the record
+            assert rows[zone][cause] == pytest.approx(count, abs=2) and count > 0, (zone, cause)
+    # the hits outside the speeds the zone's wall law holds over: the elastic wall's 60-200 m/s; the lossy wall
+    # states none
+    on = hits["patch"] == "walls"
+    speed = np.linalg.norm(hits["V"][on], axis=1)
+    outside = int(np.sum((speed < 60.0) | (speed > 200.0)))
+    assert rows["walls"]["outside_law"] == pytest.approx(outside, abs=2) and outside > 0
+    assert rows["target"]["outside_law"] == rows["sides"]["outside_law"] == 0
+    on = hits["patch"] == "sides"
+    V, n = hits["V"][on], hits["n"][on]
+    np.testing.assert_allclose(hits["Vout"][on], V - 2 * np.einsum("ij,ij->i", V, n)[:, None] * n,
+                               rtol=0, atol=1e-12 * 300)
+    assert (hits["status"][on] == STATUS_REBOUNDED).all() and (hits["path"][on] == -1).all()
+    assert np.isnan(hits["u0"][on]).all() and (hits["key"][on] == -1).all() and (hits["Wout"][on] == 0).all()
+
+    lagr = _lagrangian_log(zones_case)
+    assert lagr[:, 4].sum() == INJECTED and lagr[:, 10].sum() == 0
+    assert lagr[:, 8].sum() == target["removed"] + walls["stuck"]
+    assert lagr[-1, 2] == INJECTED - lagr[:, 6].sum()
+
+
+def test_each_zone_draws_from_its_own_table(zones_case, wall_tables):
+    """walls' hits follow the elastic wall's law, target's the lossy wall's (surrogate at the same incident
+    states with the zone's table, mix, method and interpolation); the elastic law at target's hits is not
+    theirs (faster, and never trapped); the hits of two tables are not compared together."""
+    for zone, wall in (("walls", "elastic"), ("target", "lossy")):
+        res = compare_saturne_rebounds.compare(zones_case / "RESU", classifier=False, zones=[zone])
+        assert res["table"] == str(wall_tables[wall]) and res["zones"] == [zone]
+        assert res["checks_passed"], (zone, compare_saturne_rebounds.report(res))
+    res = compare_saturne_rebounds.compare(zones_case / "RESU", wall_tables["elastic"], classifier=False,
+                                           zones=["target"])
+    other = res["comparison"].agreement["table"]
+    assert not other.ks_ok and not other.not_rebounded_ok, other
+    assert other.mean_speed_ratio[0] < other.mean_speed_ratio[1] - 0.1, other
+    with pytest.raises(ValueError, match="the zones target, walls draw with 2 tables or settings"):
+        compare_saturne_rebounds.compare(zones_case / "RESU", classifier=False)
+
+
+def test_deposit_and_outlet_zones(cs_build, wall_tables, tmp_path_factory):
+    """A deposit zone keeps every particle that hits it, at rest (the solver counts them as deposited), an
+    outlet zone lets every one leave; neither is recorded, both are counted."""
+    case = _zones_case(tmp_path_factory, "cs_stock_zones", wall_tables,
+                       "\n[zone sides]\ntype = deposit\n[zone target]\ntype = outlet\n")
+    _allrun(case, wall_tables["elastic"])
+    rows = zone_summary((case / "RESU" / "run_solver.log").read_text())
+    assert {z: r["interaction"] for z, r in rows.items()} == {
+        "target": "outlet", "walls": "rebound-scatter, wall elastic (hard steel)", "sides": "deposit"}
+    assert rows["sides"]["stuck"] == rows["sides"]["hits"] > 100
+    assert rows["target"]["escaped"] == rows["target"]["hits"] > 100
+    hits, _ = read_hits(case / "RESU")
+    assert set(hits["patch"].tolist()) == {"walls"}
+    lagr = _lagrangian_log(case)
+    assert lagr[:, 8].sum() == rows["sides"]["stuck"] + rows["walls"]["stuck"]
+    assert lagr[:, 6].sum() >= rows["target"]["escaped"] and lagr[:, 10].sum() == 0
+    assert lagr[-1, 2] == INJECTED - lagr[:, 6].sum() >= rows["sides"]["stuck"]
+
+
+@pytest.mark.parametrize("sections, words", [
+    ("[zone target]\ntype = bounce\n",
+     ['[zone target]: type must be rebound-scatter, rebound, deposit or outlet, not "bounce"']),
+    ("[zone wals]\ntype = rebound\n",
+     ["[zone wals]: no boundary zone is named wals; the zones are inlet, target, walls"]),
+    ("[zone inlet]\ntype = outlet\n",
+     ["[zone inlet]: the zone's Lagrangian type is CS_LAGR_INLET, not CS_LAGR_BC_USER: give it CS_LAGR_BC_USER "
+      "in cs_user_lagr_boundary_conditions before calling rbs_cs_initialize()"]),
+    ("[zone target]\ntype = rebound\ntable = hard.h5\n",
+     ['[zone target]: a zone of type rebound takes no key but type, not "table"']),
+    ("[zone target]\nseed = 3\n",
+     ['global key "seed" in [zone target]; the keys of a section are type, table, shape, weights, method, '
+      "interpolation, trapped"]),
+], ids=["unknown type", "unknown zone", "zone not CS_LAGR_BC_USER", "key of another type", "global key"])
+def test_bad_zone_section_is_one_clear_error(cs_build, wall_tables, tmp_path_factory, sections, words):
+    case = _zones_case(tmp_path_factory, "cs_bad_zone", wall_tables, "\n" + sections, split=False)
+    proc = _allrun(case, wall_tables["elastic"], check=False)
+    assert proc.returncode != 0
+    error = (case / "RESU" / "error").read_text()
+    assert "rebound-scatter settings rebound_scatter.conf" in error, error
+    for word in words:
+        assert word in error, error
+    assert not list((case / "RESU").glob("hits/hits_*.csv"))

@@ -27,11 +27,12 @@
 /*
  * Use: put rbs_cs_rebound.c and this header in the case's SRC folder, give
  * the walls the zone type CS_LAGR_BC_USER in cs_user_lagr_boundary_conditions
- * and call rbs_cs_initialize() there, call rbs_cs_finalize() from
- * cs_user_extra_operations_finalize, and link the C runtime
- * (code_saturne compile --cflags=-I<prefix>/include
+ * and call rbs_cs_initialize() there after the zone types, call
+ * rbs_cs_finalize() from cs_user_extra_operations_finalize, and link the C
+ * runtime (code_saturne compile --cflags=-I<prefix>/include
  *  --libs="-L<prefix>/lib -lrebound_scatter -Wl,-rpath,<prefix>/lib").
- * The settings are read from a key = value file (docs/code_saturne.md).
+ * The settings, global and per boundary zone, are read from a key = value
+ * file with [zone NAME] sections (docs/code_saturne.md).
  */
 
 #ifdef __cplusplus
@@ -39,14 +40,17 @@ extern "C" {
 #endif
 
 /* Read the settings (the file named by $RBS_CS_SETUP, else
- * rebound_scatter.conf in the run folder), open the table, seed this rank's
- * stream and open its hits file. Called on every rank; only the first call
- * does anything. A bad setting stops the run with one message (bft_error)
- * naming the file, the key, the value and what is allowed. */
+ * rebound_scatter.conf in the run folder), open the tables, check the zones
+ * the settings name against the Lagrangian zone types given so far (so call
+ * it after them), seed this rank's stream and open its hits file. Called on
+ * every rank; only the first call does anything. A bad setting stops the run
+ * with one message (bft_error) naming the file, the section, the key, the
+ * value and what is allowed. */
 void rbs_cs_initialize(void);
 
-/* The counts summed over the ranks, written to the solver's log; the hits
- * files closed and the table released. Collective: call it on every rank. */
+/* The counts summed over the ranks, in total and per zone, written to the
+ * solver's log; the hits files closed and the tables released. Collective:
+ * call it on every rank. */
 void rbs_cs_finalize(void);
 
 #ifdef __cplusplus

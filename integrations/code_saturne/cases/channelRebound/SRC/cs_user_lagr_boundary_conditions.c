@@ -57,13 +57,18 @@ cs_user_lagr_boundary_conditions(const int  bc_type[])
     bft_error(__FILE__, __LINE__, 0,
               "RBS_CS_WALLS must be rebound-scatter or specular, not \"%s\"",
               walls);
-  if (wall_type == CS_LAGR_BC_USER)
-    rbs_cs_initialize();
 
+  /* Every zone but the inlet is a wall (zone 0 is the zone of the faces no
+     zone selects: none here) */
   const cs_zone_t *inlet = cs_boundary_zone_by_name("inlet");
   lagr_bcs->zone_type[inlet->id] = CS_LAGR_INLET;
-  lagr_bcs->zone_type[cs_boundary_zone_by_name("target")->id] = wall_type;
-  lagr_bcs->zone_type[cs_boundary_zone_by_name("walls")->id] = wall_type;
+  for (int z_id = 1; z_id < cs_boundary_zone_n_zones(); z_id++)
+    if (z_id != inlet->id)
+      lagr_bcs->zone_type[z_id] = wall_type;
+
+  /* after the zone types: it checks those its settings name */
+  if (wall_type == CS_LAGR_BC_USER)
+    rbs_cs_initialize();
 
   /* Sand (2650 kg/m3); speed, direction and diameter set per particle in
      cs_user_lagr_in */
