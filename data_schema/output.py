@@ -36,6 +36,9 @@ import h5py
 
 FOLDER_MARKER = ".rebound-scatter"          # file inside a folder we wrote, holding its kind
 TEXT_MARKER = "<!-- rebound-scatter {kind}: generated, do not edit -->"
+TOML_MARKER = "# rebound-scatter {kind}: "      # the start of a generated TOML file's first line (a comment)
+PNG_KEY = "rebound-scatter"                     # the keyword of a generated PNG's text chunk, its kind the value
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _TEMP = re.compile(r"^\.(?P<name>.+)\.rebound-scatter-(?P<pid>\d+)-[0-9a-f]+\.tmp$")
 BYTES_PER_GIB = 2 ** 30
 
@@ -53,7 +56,8 @@ def kind_of(path) -> str | None:
     """The kind of an existing output of ours at ``path``, or None if it is not one.
 
     An HDF5 file's ``file_type``; a folder's :data:`FOLDER_MARKER` content; a
-    text file's kind from its first line (:func:`text_marker`).
+    text file's kind from its first line (:func:`text_marker`, or :data:`TOML_MARKER` for TOML); a PNG's from its
+    text chunk :data:`PNG_KEY`.
     """
     path = Path(path)
     if path.is_dir():
@@ -67,12 +71,28 @@ def kind_of(path) -> str | None:
             with h5py.File(path, "r") as f:
                 found = f.attrs.get("file_type")
             return found.decode() if isinstance(found, bytes) else (found if isinstance(found, str) else None)
-        with open(path, encoding="utf-8") as f:
-            first = f.readline(200).strip()
-    except (OSError, UnicodeDecodeError):
+        with open(path, "rb") as f:
+            start = f.read(65536)         # the markers are at the start: a large file is not read whole
+    except OSError:
         return None
-    match = re.fullmatch(re.escape(TEXT_MARKER).replace(r"\{kind\}", r"(\S+)"), first)
+    if start.startswith(_PNG_SIGNATURE):
+        return _png_kind(start)
+    first = start.split(b"\n", 1)[0].decode("utf-8", errors="replace").strip()
+    match = (re.fullmatch(re.escape(TEXT_MARKER).replace(r"\{kind\}", r"(\S+)"), first)
+             or re.match(re.escape(TOML_MARKER.rstrip()).replace(r"\{kind\}", r"(\S+)"), first))
     return match.group(1) if match else None
+
+
+def _png_kind(blob: bytes) -> str | None:
+    """The value of the PNG text chunk :data:`PNG_KEY` among the chunks in ``blob``, or None."""
+    at = len(_PNG_SIGNATURE)
+    while at + 8 <= len(blob):
+        length, chunk = int.from_bytes(blob[at:at + 4], "big"), blob[at + 4:at + 8]
+        key, _, value = blob[at + 8:at + 8 + length].partition(b"\0")
+        if chunk == b"tEXt" and key == PNG_KEY.encode():
+            return value.decode("latin-1")
+        at += 12 + length
+    return None
 
 
 def check_output(path, kind: str, overwrite: bool = False, inputs=(), folder: bool = False) -> Path:

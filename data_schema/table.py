@@ -11,6 +11,7 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
     /model/parameters      one row of a compound type: the direct model's parameters by name (MODEL_FIELDS)
     /wall                  attrs: family (the wall law family, direct_model.wall.WALL_FAMILIES), name (the
                            wall's label); parameters: one row of a compound type, the family's parameters by name
+                           and speed_range_m_s (2 numbers: the |V⁻| the law holds over, [0, inf]: not stated)
     /shapes                the definition of every shape the table holds, one row per shape
                            (data_schema.shape_records: name, kind, vertices, triangles, inertia, aspect law, hands)
     /resolution            attrs: clusters, dictionary_size, levels
@@ -64,7 +65,7 @@ from data_schema.samples import SHAPE_NAMES
 from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_datasets,
                                        family_records, records_from_arrays, write_shape_records)
 from data_schema.output import hdf5_bytes, write_output
-from direct_model.wall import WALL_FAMILIES, WallMaterial, wall_family
+from direct_model.wall import WALL_FAMILIES, WallMaterial, check_speed_range, wall_family
 
 TABLE_FILE_TYPE = "rebound_table"
 TABLE_VERSION = (4, 0)
@@ -154,6 +155,7 @@ INTEGER_ATTRIBUTES = ("particles_per_cell", "clusters", "dictionary_size", "leve
 # under Fletcher-32, read by field name (a field of another name is ignored; its order does not matter)
 MODEL_GROUP, WALL_GROUP, PARAMETERS = "model", "wall", "parameters"
 WALL_ATTRIBUTES = ("family", "name")        # of group wall: the law family and the wall's label, strings
+WALL_SPEED_RANGE = "speed_range_m_s"        # the field of wall/parameters after the family's parameters
 N_SECOND_MOMENT_FACTORS = 4                 # s per shape code of the paper's four families
 _INTEGER_RANGE = "an integer in [1, 2**53)"
 
@@ -319,8 +321,10 @@ class ReboundTable:
         wall = f.create_group(WALL_GROUP)
         wall.attrs["family"] = family.name
         wall.attrs["name"] = self.wall.name
-        _write_row(wall, np.array([tuple(self.wall.as_array())], dtype=[(p.name, "<f8") for p in family.parameters]),
-                   [p.units for p in family.parameters], f"the {family.name} wall law's parameters, by name")
+        row = np.array([(*self.wall.as_array(), self.wall.speed_range_m_s)],
+                       dtype=[(p.name, "<f8") for p in family.parameters] + [(WALL_SPEED_RANGE, "<f8", (2,))])
+        _write_row(wall, row, [p.units for p in family.parameters] + ["m/s"],
+                   f"the {family.name} wall law's parameters, by name, and the incident speeds it holds over")
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -480,12 +484,20 @@ def _wall(group: h5py.Group, row: np.ndarray) -> WallMaterial:
                               f"'{family_name}' (this version knows: {', '.join(WALL_FAMILIES)})") from None
     dataset = f"{WALL_GROUP}/{PARAMETERS}"
     fields = f"{', '.join(family.parameter_names)} (the {family.name} wall law)"
+    fields += f" and {WALL_SPEED_RANGE}"
     values = {p.name: _field(row, dataset, p.name, "number", None, fields) for p in family.parameters}
     for parameter in family.parameters:
         if not parameter.ok(values[parameter.name]):
             raise DataFormatError(f"field '{parameter.name}' of dataset '{dataset}' must be {parameter.allowed}; "
                                   f"got {_g(values[parameter.name])}")
-    return WallMaterial.from_parameters(family.name, values, name)
+    speed_range = _field(row, dataset, WALL_SPEED_RANGE, "number", 2, fields)
+    try:
+        speed_range = check_speed_range(speed_range)
+    except ValueError:
+        raise DataFormatError(f"field '{WALL_SPEED_RANGE}' of dataset '{dataset}' must be [low, high] m/s with "
+                              f"0 <= low < high finite, or [0, inf] (not stated); got [{_g(speed_range[0])}, "
+                              f"{_g(speed_range[1])}]") from None
+    return WallMaterial.from_parameters(family.name, values, name, speed_range)
 
 
 def _number(group: h5py.Group, name: str, count: int | None = 1):

@@ -26,7 +26,6 @@ from direct_model.shapes import (
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 CHUNK_SIZE = 16384                  # particles drawn at a time: fixed, so a seed gives the same bits for any n
-VALID_SPEED_RANGE = (50.0, 300.0)   # m/s, where the default wall law was measured
 DEFAULT_N_MAX = 1000                # collisions before a particle counts as trapped
 DEFAULT_CONTACT_TOL = 1e-10         # contact distance, units of a
 DEFAULT_SET_TOL = 1e-9              # points this close to the lowest share a contact, units of a
@@ -116,8 +115,8 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
         four with weight ¼); or a shape's record (:mod:`direct_model.registry`, a user's grain say), stretched
         per particle by its own law (``aspect`` and ``kappa`` are the families'), in both hands if it says so.
     alpha1 : incidence angle from the wall, degrees, in (0, 90].
-    speed : incident speed |V⁻|, m/s, > 0 (the default wall law is validated
-        for 50–300 m/s; outside it a warning is issued).
+    speed : incident speed |V⁻|, m/s, > 0 (outside the speeds the wall law holds over, its
+        ``speed_range_m_s``, a warning is issued: the default law's are 50–300 m/s).
     n : number of particles, ≥ 1.
     seed : integer seed; None draws one, recorded in the result.
     omega_in : incident angular velocity Ω⁻ a/|V⁻|, lab frame (3 numbers).
@@ -152,9 +151,9 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
     omega_arr = np.asarray(omega_in, dtype=float)
     if omega_arr.shape != (3,) or not np.all(np.isfinite(omega_arr)):
         raise ValueError(f"The 'omega_in' parameter must be 3 finite numbers; got {omega_in!r}.")
-    if not VALID_SPEED_RANGE[0] <= speed <= VALID_SPEED_RANGE[1]:
-        warnings.warn(f"speed {speed} m/s is outside {VALID_SPEED_RANGE} m/s, the range of the "
-                      f"default wall law; the law in use is {wall.name!r}", stacklevel=2)
+    if wall.outside_speed_range(speed):
+        warnings.warn(f"speed {speed} m/s is outside {wall.speed_range_text()}, where the wall law {wall.name!r} "
+                      f"holds (its speed_range_m_s)", stacklevel=2)
 
     V0 = incident_velocity(alpha1, speed)
     W0 = omega_arr * speed                      # (m/s)/a

@@ -22,7 +22,10 @@ Another particle/wall pair of the same functional family is another
 A wall is a named record of a law *family* (:data:`WALL_FAMILIES`): the
 family names the law's form and its parameters, in the order the kernels read
 them, with their units and ranges; a record holds the family's name, its
-parameters' values and the wall's label. The law above is the family
+parameters' values, the wall's label and where the law holds: the range of
+incident speeds |V⁻| it was measured or fitted over (:data:`SPEED_RANGE_NOT_STATED`
+for a law given without one). The model applies the law at any speed; the
+runtimes count the hits answered outside that range. The law above is the family
 ``exponential`` (k, p, q), the only one so far. A table stores the record as
 its group ``/wall`` (docs/format.md), read back by field name.
 """
@@ -104,6 +107,9 @@ def wall_family(name: str) -> WallFamily:
     return family
 
 
+SPEED_RANGE_NOT_STATED = (0.0, math.inf)      # a law given without the speeds it was measured over
+
+
 @dataclasses.dataclass(frozen=True)
 class WallMaterial:
     """A wall: the record of one wall law (see module doc), here of the ``exponential`` family.
@@ -120,6 +126,10 @@ class WallMaterial:
         Label stored with results.
     family : str
         The law family (:data:`WALL_FAMILIES`) whose parameters k, p, q are.
+    speed_range_m_s : (float, float)
+        The incident speeds |V⁻|, m/s, the law was measured or fitted over, low < high (Lashkov's: 50–300 m/s,
+        :data:`CORUNDUM_ON_STEEL`); :data:`SPEED_RANGE_NOT_STATED` (0, inf, the default) for a law given without
+        one.
     """
 
     k: float = 0.1
@@ -127,6 +137,7 @@ class WallMaterial:
     q: float = 1.0
     name: str = "corundum_on_St3_Lashkov1991"
     family: str = EXPONENTIAL
+    speed_range_m_s: tuple = SPEED_RANGE_NOT_STATED
 
     def __post_init__(self):
         if self.family != EXPONENTIAL:      # the record's fields are the exponential family's
@@ -134,17 +145,36 @@ class WallMaterial:
                              f"{wall_family(self.family).name!r} has the parameters "
                              f"{', '.join(wall_family(self.family).parameter_names)}")
         wall_family(self.family).check(self.parameters())
+        object.__setattr__(self, "speed_range_m_s", check_speed_range(self.speed_range_m_s))
+
+    @property
+    def speed_range_stated(self) -> bool:
+        """Whether the law states where it holds (a speed range other than :data:`SPEED_RANGE_NOT_STATED`)."""
+        return self.speed_range_m_s != SPEED_RANGE_NOT_STATED
+
+    def outside_speed_range(self, speed):
+        """Whether each |V⁻| of ``speed`` (m/s; a number or an array) lies outside :attr:`speed_range_m_s`."""
+        low, high = self.speed_range_m_s
+        return (np.asarray(speed) < low) | (np.asarray(speed) > high)
+
+    def speed_range_text(self) -> str:
+        """The range in words: "50-300 m/s", or "not stated"."""
+        low, high = self.speed_range_m_s
+        return f"{low:g}-{high:g} m/s" if self.speed_range_stated else "not stated"
 
     def parameters(self) -> dict:
         """The family's parameters by name, in the family's order: {"k": .., "p": .., "q": ..}."""
         return {name: getattr(self, name) for name in wall_family(self.family).parameter_names}
 
     @classmethod
-    def from_parameters(cls, family: str, parameters: Mapping, name: str) -> "WallMaterial":
-        """The wall of ``family`` with ``parameters`` by name (others ignored) and label ``name``; ValueError
-        naming an unknown family, a missing parameter or one out of its range."""
+    def from_parameters(cls, family: str, parameters: Mapping, name: str,
+                        speed_range_m_s=None) -> "WallMaterial":
+        """The wall of ``family`` with ``parameters`` by name (others ignored), label ``name`` and the speed range
+        it holds over (None: :data:`SPEED_RANGE_NOT_STATED`); ValueError naming an unknown family, a missing
+        parameter or one out of its range, or a bad range."""
         values = wall_family(family).check(parameters)
-        return cls(*values, name=name, family=family)
+        return cls(*values, name=name, family=family,
+                   speed_range_m_s=SPEED_RANGE_NOT_STATED if speed_range_m_s is None else speed_range_m_s)
 
     def as_array(self) -> np.ndarray:
         """The coefficients (k, p, q) as the float64 array the kernels take, read-only as the slice of the model's
@@ -154,7 +184,23 @@ class WallMaterial:
         return coefficients
 
 
-CORUNDUM_ON_STEEL = WallMaterial()
+def check_speed_range(value) -> tuple:
+    """``value`` as (low, high) floats, m/s: 0 <= low < high, high finite unless ``value`` is
+    SPEED_RANGE_NOT_STATED; ValueError naming it otherwise."""
+    try:
+        low, high = (float(x) for x in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"The wall law's 'speed_range_m_s' must be two numbers [low, high] in m/s; got {value!r}.") \
+            from None
+    if (low, high) == SPEED_RANGE_NOT_STATED:
+        return SPEED_RANGE_NOT_STATED
+    if not (math.isfinite(low) and math.isfinite(high) and 0.0 <= low < high):
+        raise ValueError(f"The wall law's 'speed_range_m_s' must be finite with 0 <= low < high (m/s); got "
+                         f"{[low, high]!r}.")
+    return low, high
+
+
+CORUNDUM_ON_STEEL = WallMaterial(speed_range_m_s=(50.0, 300.0))     # Lashkov measured 50–300 m/s
 
 
 @numba.njit(**KERNEL)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -106,9 +107,11 @@ def _draw(table, args, shape, omega, keys=None):
         return draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio), PATH_TABLE
     if keys is None and keyed:
         keys = np.full(args.n, args.grain_key)
-    hits = surrogate.sample_global(
-        table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape, random_state=args.seed, omega=spin,
-        method="direct" if path == PATH_DIRECT else "table", clamp=args.clamp, grain_key=keys)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", surrogate.WallLawRangeWarning)      # the summary says it (_sample)
+        hits = surrogate.sample_global(
+            table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape, random_state=args.seed, omega=spin,
+            method="direct" if path == PATH_DIRECT else "table", clamp=args.clamp, grain_key=keys)
     V_out, Omega_out, status = hits.V, hits.Omega, hits.status
     alpha2, beta2, v = rebound_angles(V_out)
     draws = surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
@@ -153,6 +156,9 @@ def _sample(args) -> int:
     print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s{spin}, {label}: {counts}")
     print(f"  answered by the table {0 if path else args.n}, by the direct model {args.n if path else 0} "
           f"(method {args.method}); failed {int(np.sum(draws.status == STATUS_FAILED))}")
+    if table.wall.outside_speed_range(speed):
+        print(f"  outside the speeds the wall law {table.wall.name!r} holds over ({table.wall.speed_range_text()}): "
+              f"all {args.n}; the law is applied all the same")
     if keys is not None:
         print(f"  {args.n} grains, one per draw, from {args.grain_keys}: {grain['grain_shapes']}")
     elif grain:

@@ -37,6 +37,7 @@ are NaN, not a made-up rebound), 2 failed (the direct model only: NaN, never dro
 
 from __future__ import annotations
 
+import warnings
 from typing import NamedTuple
 
 import numpy as np
@@ -55,6 +56,27 @@ from surrogate.validation import (as_rows, check_grain_key,
                                   check_half_size, check_incident, check_interpolation, check_local_states,
                                   check_method, check_omega, check_out, check_random_state, check_shape,
                                   check_vectors)
+
+
+class WallLawRangeWarning(UserWarning):
+    """Hits answered with |V⁻| outside the speeds the table's wall law holds over (``table.wall.speed_range_m_s``):
+    the law is applied there all the same."""
+
+
+def warn_outside_law(table: SurrogateTable, V: np.ndarray, stacklevel: int = 3) -> int:
+    """The number of rows of V (N, 3), m/s, whose |V⁻| lies outside the table's wall law's speed range, and a
+    :class:`WallLawRangeWarning` saying so if there are any (none for a law that states no range)."""
+    wall = table.wall
+    if not wall.speed_range_stated or V.shape[0] == 0:
+        return 0
+    low, high = wall.speed_range_m_s
+    squared = V[:, 0] * V[:, 0] + V[:, 1] * V[:, 1] + V[:, 2] * V[:, 2]   # element by element: no SIMD sum
+    outside = int(np.count_nonzero((squared < low * low) | (squared > high * high)))
+    if outside:
+        warnings.warn(f"{outside} of {V.shape[0]} hits have |V-| outside {wall.speed_range_text()}, where the wall "
+                      f"law {wall.name!r} holds; it is applied there all the same", WallLawRangeWarning,
+                      stacklevel=stacklevel)
+    return outside
 
 
 class LocalDraws(NamedTuple):
@@ -155,7 +177,9 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     direct model; :data:`surrogate.kernels.PATH_TABLE`, :data:`surrogate.kernels.PATH_DIRECT`); ``shape`` (N,)
     int32: the particle's shape, its index in ``table.shapes``; ``n_collisions`` (N,) int32: the direct path's
     collisions, −1 on the table path. Every check runs before anything is written: on a ValueError ``out`` is
-    unchanged.
+    unchanged. Hits whose |V⁻| lies outside the speeds the table's wall law holds over
+    (``table.wall.speed_range_m_s``) are answered all the same, with one :class:`WallLawRangeWarning` giving
+    their number.
     The direct model takes the families and the table's user grains (convex polyhedra), with the parameters the
     table was built with (``table.direct_parameters``).
     """
@@ -164,6 +188,7 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     code = check_method(method)
     # the grid's range is an error only where the table must answer every hit
     check_incident(table, V, nrm, a, grid=not clamp and code == METHOD_TABLE)
+    warn_outside_law(table, V)
     cdf, shapes = check_shape(table, shape, n_particles)
     keys = check_grain_key(grain_key, n_particles)
     if code == METHOD_DIRECT:
@@ -209,13 +234,15 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     -------
     :class:`Rebounds` (as :func:`sample_global`'s): status STATUS_REBOUNDED (0), STATUS_TRAPPED (1) or
     STATUS_FAILED (2, a collision solve or contact search failed), NaN rows unless rebounded; path PATH_DIRECT;
-    n_collisions the rebound's collisions (up to the trap).
+    n_collisions the rebound's collisions (up to the trap). Hits outside the wall law's speed range: as
+    :func:`sample_global`.
     """
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     V, nrm, a, W = _incident(table, velocity, normal, half_size, omega)
     n_particles = V.shape[0]
     # every state moving into its wall is in the model's range: the table's grid is no error here
     check_incident(table, V, nrm, a, grid=False)
+    warn_outside_law(table, V)
     cdf, shapes = check_shape(table, shape, n_particles)
     _check_direct_shapes(table, cdf, shapes)
     keys = check_grain_key(grain_key, n_particles)

@@ -414,9 +414,9 @@ def _calibrate(args) -> int:
 
     if args.figure is not None and Path(args.figure).resolve() == Path(args.out).resolve():
         raise ValueError(f"--figure {args.figure} is the -o file; give two files")
-    calibration.check_output_file(args.out, calibration.WALL_FILE_KIND, args.overwrite, inputs=(args.data,))
+    check_output(args.out, calibration.WALL_FILE_KIND, args.overwrite, inputs=(args.data,))
     if args.figure is not None:
-        calibration.check_output_file(args.figure, calibration.FIGURE_KIND, args.overwrite, inputs=(args.data,))
+        check_output(args.figure, calibration.FIGURE_KIND, args.overwrite, inputs=(args.data,))
         calibration.require_matplotlib()
     fixed = {}
     for pairs in args.fix:
@@ -464,7 +464,7 @@ def _grid(args) -> int:
     grid_fit.check_options(args.cover, args.alpha1_points, args.speed_points)
     inputs = [*args.from_hits, *([args.table] if args.table else [])]
     if args.out is not None:
-        grid_fit.check_grid_output(args.out, args.overwrite, inputs)
+        check_output(args.out, grid_fit.GRID_FILE_KIND, args.overwrite, inputs)
     table = None
     if args.table is not None:
         stored = read_table(args.table)

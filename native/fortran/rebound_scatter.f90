@@ -120,6 +120,7 @@ module rebound_scatter
     type(c_ptr) :: family = c_null_ptr, name = c_null_ptr
     integer(c_int) :: n_parameters = 0
     type(c_ptr) :: parameter_names = c_null_ptr, parameter_values = c_null_ptr
+    real(c_double) :: speed_range_m_s(2) = 0.0_c_double   ! the |V-| (m/s) the law holds over; (0, +inf): not stated
   end type rbs_wall_info
 
   ! one grain of a table's mix (rbs_grain): its table shape index (0-based), the b/a, c/b and hand the direct path

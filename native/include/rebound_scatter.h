@@ -351,8 +351,11 @@ typedef struct rbs_wall_info {
     int n_parameters;
     const char *const *parameter_names;     /* n_parameters names, e.g. "k", "p", "q" */
     const double *parameter_values;         /* their values, in the family's units (docs/model.md §10) */
+    double speed_range_m_s[2];  /* the incident speeds |V⁻| (m/s) the law was measured or fitted over, low < high;
+                                   {0, INFINITY}: not stated. Hits outside it are answered with the law all the
+                                   same: count them (the adapters' summaries do) */
 } rbs_wall_info;
-#define RBS_WALL_INFO_INIT {sizeof(rbs_wall_info), NULL, NULL, 0, NULL, NULL}
+#define RBS_WALL_INFO_INIT {sizeof(rbs_wall_info), NULL, NULL, 0, NULL, NULL, {0.0, 0.0}}
 
 /* *info up to info->size. RBS_OK, or RBS_INVALID for a NULL pointer or a record too small. */
 RBS_API int rbs_table_wall(const rbs_table *table, rbs_wall_info *info);

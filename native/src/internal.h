@@ -102,6 +102,7 @@ struct rbs_table {
     int n_wall_parameters;
     char wall_name[RBS_WALL_NAME_SIZE];
     double wall_parameters[RBS_WALL_MAX_PARAMETERS];
+    double wall_speed_range[2];                     /* m/s; {0, inf}: not stated (direct_model.wall) */
     char (*shape_names)[RBS_SHAPE_NAME_SIZE];       /* (n_shapes) names, grid/shapes */
     rbs_shape_records shapes;
     double *alpha1_deg, *speed_m_s;                 /* the grids */

@@ -603,22 +603,36 @@ static int read_wall(loader *ld, hid_t file, rbs_table *t)
         rbs_fail(ld, RBS_ERR_FORMAT, "the attribute 'family' of group 'wall' names an unknown wall law family '%s' (this "
                  "version knows: %s)", family_name, known);
     }
+    double row[RBS_WALL_MAX_PARAMETERS + 2];        /* the family's parameters, then the speed range */
+    int n = ld->code == RBS_OK ? family->n_parameters : 0;
     if (ld->code == RBS_OK) {
-        row_field fields[RBS_WALL_MAX_PARAMETERS];
+        row_field fields[RBS_WALL_MAX_PARAMETERS + 1];
         char names[512] = "";
-        for (int i = 0; i < family->n_parameters; i++) {
+        for (int i = 0; i < n; i++) {
             fields[i] = (row_field){family->parameters[i], FIELD_REAL, 1, (size_t)i * sizeof(double)};
             snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "", family->parameters[i]);
         }
-        snprintf(names + strlen(names), sizeof names - strlen(names), " (the %s wall law)", family->name);
-        read_row(ld, group, "wall", fields, family->n_parameters, names, t->wall_parameters,
-                 (size_t)family->n_parameters * sizeof(double));
+        fields[n] = (row_field){"speed_range_m_s", FIELD_ARRAY, 2, (size_t)n * sizeof(double)};
+        snprintf(names + strlen(names), sizeof names - strlen(names), " (the %s wall law) and speed_range_m_s",
+                 family->name);
+        read_row(ld, group, "wall", fields, n + 1, names, row, (size_t)(n + 2) * sizeof(double));
     }
     H5Gclose(group);
-    for (int i = 0; ld->code == RBS_OK && i < family->n_parameters; i++)
-        if (!family->ok[i](t->wall_parameters[i]))
+    for (int i = 0; ld->code == RBS_OK && i < n; i++) {
+        t->wall_parameters[i] = row[i];
+        if (!family->ok[i](row[i]))
             rbs_fail(ld, RBS_ERR_FORMAT, "field '%s' of dataset 'wall/parameters' must be %s; got %.17g",
-                     family->parameters[i], family->allowed[i], t->wall_parameters[i]);
+                     family->parameters[i], family->allowed[i], row[i]);
+    }
+    if (ld->code == RBS_OK) {
+        /* direct_model.wall.check_speed_range: [0, inf] (not stated), or finite with 0 <= low < high */
+        double low = row[n], high = row[n + 1];
+        if (!((low == 0.0 && isinf(high) && high > 0.0) || (isfinite(low) && isfinite(high) && 0.0 <= low && low < high)))
+            rbs_fail(ld, RBS_ERR_FORMAT, "field 'speed_range_m_s' of dataset 'wall/parameters' must be [low, high] m/s "
+                     "with 0 <= low < high finite, or [0, inf] (not stated); got [%.17g, %.17g]", low, high);
+        t->wall_speed_range[0] = low;
+        t->wall_speed_range[1] = high;
+    }
     if (ld->code != RBS_OK) return ld->code;
     t->wall_family = family->name;
     t->wall_parameter_names = family->parameters;

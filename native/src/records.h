@@ -25,7 +25,7 @@
 #define RBS_SIZE_1_0_rbs_results RBS_END_OF(rbs_results, status)
 #define RBS_SIZE_1_0_rbs_table_info RBS_END_OF(rbs_table_info, kernel_bytes)
 #define RBS_SIZE_1_0_rbs_shape_info RBS_END_OF(rbs_shape_info, both_hands)
-#define RBS_SIZE_1_0_rbs_wall_info RBS_END_OF(rbs_wall_info, parameter_values)
+#define RBS_SIZE_1_0_rbs_wall_info RBS_END_OF(rbs_wall_info, speed_range_m_s)
 #define RBS_SIZE_1_0_rbs_grain RBS_END_OF(rbs_grain, hand)
 
 /* a record the caller gave: not NULL, and at least its 1.0 size */

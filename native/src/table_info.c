@@ -63,7 +63,8 @@ int rbs_table_shape_info(const rbs_table *t, int i, rbs_shape_info *info)
     return RBS_OK;
 }
 
-/* the wall as the loader read it from group wall (loader.c, read_wall): its family, name and parameters by name */
+/* the wall as the loader read it from group wall (loader.c, read_wall): its family, name, parameters by name and the
+ * speeds it holds over */
 int rbs_table_wall(const rbs_table *t, rbs_wall_info *info)
 {
     if (!t || !RBS_RECORD_OK(info, rbs_wall_info))
@@ -73,6 +74,7 @@ int rbs_table_wall(const rbs_table *t, rbs_wall_info *info)
     info->n_parameters = t->n_wall_parameters;
     info->parameter_names = t->wall_parameter_names;
     info->parameter_values = t->wall_parameters;
+    memcpy(info->speed_range_m_s, t->wall_speed_range, sizeof info->speed_range_m_s);
     return RBS_OK;
 }
 

@@ -29,6 +29,7 @@ Needs scipy and scikit-learn (the ``build`` extra).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, fields, replace
 from statistics import NormalDist
 
@@ -346,10 +347,12 @@ def surrogate_answers(table, hits: SolverHits, seed: int = 1, interpolation: str
         for shape, rows in _shape_groups(hits.shape, len(hits)):
             rows = rows[taken[rows] == code]
             if len(rows):
-                answered = surrogate.sample_global(
-                    table, hits.V[rows], hits.n[rows], hits.a[rows], shape=shape, random_state=rng, clamp=True,
-                    interpolation=interpolation, omega=hits.Omega[rows] if name == "direct" else None, method=name,
-                    grain_key=None if hits.grain_key is None else hits.grain_key[rows])
+                with warnings.catch_warnings():      # the solver's summary counted them: the same hits again
+                    warnings.simplefilter("ignore", surrogate.WallLawRangeWarning)
+                    answered = surrogate.sample_global(
+                        table, hits.V[rows], hits.n[rows], hits.a[rows], shape=shape, random_state=rng, clamp=True,
+                        interpolation=interpolation, omega=hits.Omega[rows] if name == "direct" else None,
+                        method=name, grain_key=None if hits.grain_key is None else hits.grain_key[rows])
                 V_out[rows], Omega_out[rows], status[rows] = answered.V, answered.Omega, answered.status
     return replace(hits, V_out=V_out, Omega_out=Omega_out, status=status, path=taken)
 

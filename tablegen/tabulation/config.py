@@ -23,6 +23,8 @@ the ``default`` preset, and the published corundum-on-steel wall law)::
     p = 0.61                          # restitution speed exponent, > 0
     q = 1.0                           # friction factor exp(q cos gamma), finite
     name = "corundum_on_St3_Lashkov1991"
+    speed_range_m_s = [50.0, 300.0]   # the |V⁻| the law was measured over (not stated for your own k, p, q
+                                      # unless given): the runtimes count the hits answered outside it
 
     [shapes.sand_a]                   # a user's grain, named in grid.shapes (tablegen.tabulation.shape_config)
     mesh = "grains/sand_a.stl"        # relative to the configuration file; or vertices = [[x, y, z], ...]
@@ -50,7 +52,7 @@ from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from direct_model.registry import FAMILIES, ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
-from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial, wall_family
+from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial, check_speed_range, wall_family
 from tablegen.tabulation.config_error import ConfigError
 from tablegen.tabulation.shape_config import parse_shape_sections
 
@@ -142,6 +144,8 @@ class BuildConfig:
             f"p = {w.p!r}",
             f"q = {w.q!r}",
             f"name = {json.dumps(w.name)}",
+            *([f"speed_range_m_s = [{w.speed_range_m_s[0]!r}, {w.speed_range_m_s[1]!r}]"]
+              if w.speed_range_stated else []),
             "",
             *(_grain_toml(g) for g in self.grains),
         ])
@@ -178,7 +182,7 @@ CONFIG_KEYS = {
     "grid": {"alpha1_deg", "speed_m_s", "shapes"},
     "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
     "table": {"resolution"},
-    "wall": {*wall_family(CORUNDUM_ON_STEEL.family).parameter_names, "name"},
+    "wall": {*wall_family(CORUNDUM_ON_STEEL.family).parameter_names, "name", "speed_range_m_s"},
 }
 GRAINS_SECTION = "shapes"      # [shapes.NAME]: the user's grains; their keys are shape_config's
 
@@ -210,7 +214,8 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
     """Parse and validate TOML text; defaults come from the ``default`` preset.
 
     ``base_dir``: the folder relative mesh paths of ``[shapes.NAME]`` start from (default: the current
-    directory); ``log``: called with a warning line (a grain's mesh that is not convex).
+    directory); ``log``: called with a warning line (a grain's mesh that is not convex, grid speeds outside the
+    wall law's speed range).
     """
     try:
         data = tomllib.loads(text)
@@ -286,9 +291,15 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
     else:
         raise ConfigError(f"{source}: 'table.resolution' must be \"auto\" or a table of sizes; got {res_raw!r}")
 
+    wall = _wall(wall, source)
+    outside = [v for v in speeds if wall.outside_speed_range(v)]
+    if outside and log is not None:
+        log(f"warning: {source}: the grid's speeds {', '.join(f'{v:g}' for v in outside)} m/s lie outside "
+            f"{wall.speed_range_text()}, where the wall law {wall.name!r} holds (wall.speed_range_m_s); its cells "
+            f"apply the law there all the same")
     return BuildConfig(alpha1_deg=tuple(alpha1), speed_m_s=tuple(speeds), shapes=tuple(shapes),
                        particles_per_cell=n, seed=seed, kappa=kappa, n_max=n_max, aspect=aspect,
-                       resolution=resolution, wall=_wall(wall, source),
+                       resolution=resolution, wall=wall,
                        grains=tuple(grains[s] for s in shapes if s in grains),
                        families=tuple(built_in_shape(s, kappa, aspect) for s in shapes
                                       if s in FAMILIES and s not in SHAPES))
@@ -296,7 +307,9 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
 
 def _wall(raw: dict, source: str) -> WallMaterial:
     """The wall law of the ``[wall]`` section: its family's parameters by name (:data:`direct_model.wall.WALL_FAMILIES`),
-    each checked against the family's range; missing keys take the corundum-on-steel law's values."""
+    each checked against the family's range; missing keys take the corundum-on-steel law's values. Its speed
+    range ``speed_range_m_s`` = [low, high] m/s: the default law's when no law parameter is given, else not stated
+    unless given."""
     family = wall_family(CORUNDUM_ON_STEEL.family)
     values = {}
     for parameter in family.parameters:
@@ -307,7 +320,19 @@ def _wall(raw: dict, source: str) -> WallMaterial:
     name = raw.get("name", CORUNDUM_ON_STEEL.name)
     if not isinstance(name, str) or not name.strip():
         raise ConfigError(f"{source}: 'wall.name' must be a non-empty string; got {name!r}")
-    return WallMaterial.from_parameters(family.name, values, name)
+    own_law = any(p in raw for p in family.parameter_names)
+    speed_range = raw.get("speed_range_m_s", None if own_law else CORUNDUM_ON_STEEL.speed_range_m_s)
+    if speed_range is not None:
+        if (not isinstance(speed_range, (list, tuple)) or len(speed_range) != 2
+                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in speed_range)):
+            raise ConfigError(f"{source}: 'wall.speed_range_m_s' must be two numbers [low, high] in m/s, "
+                              f"0 <= low < high; got {speed_range!r}")
+        try:
+            speed_range = check_speed_range(speed_range)
+        except ValueError:
+            raise ConfigError(f"{source}: 'wall.speed_range_m_s' must be finite with 0 <= low < high (m/s); "
+                              f"got {speed_range!r}") from None
+    return WallMaterial.from_parameters(family.name, values, name, speed_range)
 
 
 def _check_keys(data: dict, source: str) -> None:

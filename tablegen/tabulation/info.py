@@ -54,7 +54,8 @@ def describe_table(table: ReboundTable, path: Path | None = None) -> str:
         *(f"  {_shape(record, max(16, *(len(r.name) for r in table.shape_records())))}"
           for record in table.shape_records()),
         f"wall: {table.wall.name} ({table.wall.family} law: "
-        + ", ".join(f"{name} = {value:g}" for name, value in table.wall.parameters().items()) + ")",
+        + ", ".join(f"{name} = {value:g}" for name, value in table.wall.parameters().items())
+        + f"; holds for |V-| {table.wall.speed_range_text()})",
         f"cells: {total.size}, {table.particles_per_cell} particles each",
         "resolution: " + ", ".join(f"{f.name} {getattr(table.resolution, f.name)}"
                                    for f in dataclasses.fields(table.resolution)),

@@ -64,10 +64,13 @@ def test_the_layout_of_format_4(small_table_path):
         assert set(f) == {"grid", "model", "wall", "shapes", "resolution", "cells"}
         assert set(f["grid"]) == {"alpha1_deg", "speed_m_s", "shapes", "shape_codes"}
         assert set(f["grid"].attrs) == {"particles_per_cell"}
-        for group, names in (("model", tuple(MODEL_FIELDS)), ("wall", WALL_FAMILIES["exponential"].parameter_names)):
+        for group, names in (("model", tuple(MODEL_FIELDS)),
+                             ("wall", (*WALL_FAMILIES["exponential"].parameter_names, "speed_range_m_s"))):
             row = f[group]["parameters"]
             assert row.shape == (1,) and row.chunks == (1,) and row.fletcher32 and row.dtype.names == names
         assert f["model/parameters"].dtype["second_moment_factors"].subdtype[1] == (4,)
+        assert f["wall/parameters"].dtype["speed_range_m_s"].subdtype[1] == (2,)
+        assert tuple(f["wall/parameters"][0]["speed_range_m_s"]) == (50.0, 300.0)
         assert f["model/parameters"].dtype["n_max"].kind == f["model/parameters"].dtype["max_steps"].kind == "i"
         assert dict(f["wall"].attrs) == {"family": "exponential", "name": "corundum_on_St3_Lashkov1991"}
 

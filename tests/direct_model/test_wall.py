@@ -11,8 +11,8 @@ import pytest
 
 from direct_model.runtime import P_WALL, model_parameters
 from direct_model.shapes import AspectRatioLaw, second_moment_factors
-from direct_model.wall import (CORUNDUM_ON_STEEL, EXPONENTIAL, WALL_FAMILIES, WallMaterial, friction_factor,
-                               restitution, wall_family)
+from direct_model.wall import (CORUNDUM_ON_STEEL, EXPONENTIAL, SPEED_RANGE_NOT_STATED, WALL_FAMILIES, WallMaterial,
+                               friction_factor, restitution, wall_family)
 
 
 @pytest.mark.parametrize("name", list(WALL_FAMILIES))
@@ -58,10 +58,24 @@ def test_a_record_from_its_parameters_by_name():
     wall = WallMaterial.from_parameters("exponential", {"q": 0.5, "p": 0.7, "k": 0.3, "later": 1.0}, "glass")
     assert wall == WallMaterial(0.3, 0.7, 0.5, "glass")
     assert WallMaterial.from_parameters(CORUNDUM_ON_STEEL.family, CORUNDUM_ON_STEEL.parameters(),
-                                        CORUNDUM_ON_STEEL.name) == CORUNDUM_ON_STEEL
+                                        CORUNDUM_ON_STEEL.name, (50, 300)) == CORUNDUM_ON_STEEL
     with pytest.raises(ValueError, match="needs the parameters k, p, q; 'p' is missing"):
         WallMaterial.from_parameters("exponential", {"k": 0.3, "q": 0.5}, "glass")
     with pytest.raises(ValueError, match="unknown wall law family 'linear'; the families: exponential"):
         WallMaterial.from_parameters("linear", {"k": 0.3}, "glass")
     with pytest.raises(ValueError, match="unknown wall law family 'linear'"):
         WallMaterial(family="linear")
+
+
+def test_the_speed_range_is_where_the_law_holds():
+    """Lashkov's law holds over 50-300 m/s, a law given without a range states none (0, inf: nothing is outside
+    it); a range must be 0 <= low < high, finite."""
+    assert CORUNDUM_ON_STEEL.speed_range_m_s == (50.0, 300.0) and CORUNDUM_ON_STEEL.speed_range_stated
+    assert CORUNDUM_ON_STEEL.outside_speed_range([49.9, 50.0, 300.0, 300.1]).tolist() == [True, False, False, True]
+    own = WallMaterial(0.3, 0.7, 0.5, "glass")
+    assert own.speed_range_m_s == SPEED_RANGE_NOT_STATED and not own.speed_range_stated
+    assert not own.outside_speed_range([1e-9, 1e9]).any() and own.speed_range_text() == "not stated"
+    assert WallMaterial(speed_range_m_s=[1, 30]).speed_range_text() == "1-30 m/s"
+    for bad in ([30.0, 1.0], [1.0, 1.0], [-1.0, 30.0], [1.0, float("inf")], [float("nan"), 30.0], [1.0], "fast"):
+        with pytest.raises(ValueError, match="speed_range_m_s"):
+            WallMaterial(speed_range_m_s=bad)

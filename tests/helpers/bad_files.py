@@ -211,7 +211,18 @@ def parameter_row_cases(good, folder) -> list:
          "the attribute 'family' of group 'wall' names an unknown wall law family 'linear' (this version knows: "
          "exponential)"),
         ("no_q", _row_edit("wall", drop="q"), f"{wall} has no field 'q'; the fields read: k, p, q (the exponential "
-                                              f"wall law)"),
+                                              f"wall law) and speed_range_m_s"),
+        ("no_speed_range", _row_edit("wall", drop="speed_range_m_s"),
+         f"{wall} has no field 'speed_range_m_s'; the fields read: k, p, q (the exponential wall law) and "
+         f"speed_range_m_s"),
+        ("speed_range_reversed", _row_edit("wall", speed_range_m_s=[300.0, 50.0]),
+         f"field 'speed_range_m_s' of {wall} must be [low, high] m/s with 0 <= low < high finite, or [0, inf] (not "
+         f"stated); got [300, 50]"),
+        ("speed_range_half_open", _row_edit("wall", speed_range_m_s=[50.0, np.inf]),
+         f"field 'speed_range_m_s' of {wall} must be [low, high] m/s with 0 <= low < high finite, or [0, inf] (not "
+         f"stated); got [50, inf]"),
+        ("speed_range_one", _row_edit("wall", dtype={"speed_range_m_s": "<f8"}, speed_range_m_s=50.0),
+         f"field 'speed_range_m_s' of {wall} must be stored as 2 numbers"),
         ("p_zero", _row_edit("wall", p=0.0), f"field 'p' of {wall} must be finite and > 0; got 0"),
         ("p_negative", _row_edit("wall", p=-0.61),
          f"field 'p' of {wall} must be finite and > 0; got -0.60999999999999999"),

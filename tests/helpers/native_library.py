@@ -192,7 +192,7 @@ class WallInfo(Record):
 
     _fields_ = [("family", ctypes.c_char_p), ("name", ctypes.c_char_p), ("n_parameters", ctypes.c_int),
                 ("parameter_names", ctypes.POINTER(ctypes.c_char_p)),
-                ("parameter_values", ctypes.POINTER(ctypes.c_double))]
+                ("parameter_values", ctypes.POINTER(ctypes.c_double)), ("speed_range_m_s", ctypes.c_double * 2)]
 
 
 class Grain(Record):
@@ -363,13 +363,13 @@ class NativeTable:
                 "both_hands": info.both_hands}
 
     def wall(self) -> dict:
-        """rbs_table_wall as a dict: family, name, parameters {name: value}."""
+        """rbs_table_wall as a dict: family, name, parameters {name: value}, speed_range_m_s (low, high)."""
         info = WallInfo()
         assert self.lib.c.rbs_table_wall(self.handle, ref(info)) == OK
         names = [info.parameter_names[i].decode() for i in range(info.n_parameters)]
         values = [info.parameter_values[i] for i in range(info.n_parameters)]
         return {"family": info.family.decode(), "name": info.name.decode(), "parameters": dict(zip(names, values)),
-                "n_parameters": info.n_parameters}
+                "n_parameters": info.n_parameters, "speed_range_m_s": tuple(info.speed_range_m_s)}
 
     # -- mixes
     def mix_new(self, shape="mix", weights: dict | None = None):

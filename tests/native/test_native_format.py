@@ -66,8 +66,9 @@ def test_rbs_table_wall_reports_the_wall_as_read(native, small_table_path, tmp_p
     Python read; the derived restitution arrays and direct parameters are Python's, bit for bit."""
     def other_wall(f):
         row = f["wall/parameters"][()]
-        turned = np.zeros(1, dtype=[("q", "<f8"), ("later", "<i4"), ("p", "<f4"), ("k", "<f8")])
-        turned["q"], turned["p"], turned["k"] = 0.45, 0.5, row["k"]
+        turned = np.zeros(1, dtype=[("q", "<f8"), ("later", "<i4"), ("speed_range_m_s", "<i4", (2,)), ("p", "<f4"),
+                                    ("k", "<f8")])
+        turned["q"], turned["p"], turned["k"], turned["speed_range_m_s"] = 0.45, 0.5, row["k"], (2, 30)
         del f["wall/parameters"]
         f["wall"].create_dataset("parameters", data=turned, chunks=(1,), fletcher32=True)
         f["wall"].attrs["name"] = "glass_on_steel"
@@ -75,12 +76,13 @@ def test_rbs_table_wall_reports_the_wall_as_read(native, small_table_path, tmp_p
     path = edited_copy(small_table_path, tmp_path, "other_wall.h5", other_wall)
     python = py.load(path)
     assert python.wall.name == "glass_on_steel" and python.wall.parameters() == {"k": 0.1, "p": 0.5, "q": 0.45}
+    assert python.wall.speed_range_m_s == (2.0, 30.0)
     code, table, message = native.open(path)
     assert code == OK, message
     try:
         wall = table.wall()
         assert (wall["family"], wall["name"], wall["n_parameters"]) == ("exponential", "glass_on_steel", 3)
-        assert list(wall["parameters"]) == ["k", "p", "q"]
+        assert list(wall["parameters"]) == ["k", "p", "q"] and wall["speed_range_m_s"] == (2.0, 30.0)
         assert np.array(list(wall["parameters"].values())).tobytes() == python.wall.as_array().tobytes()
         for name in ("speed_restitution", "restitution_pieces"):
             assert table.kernel_array(name).tobytes() == getattr(python.kernel_data, name).tobytes(), name

@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -178,3 +179,19 @@ def test_cli_sample_writes_the_raw_layout(small_table_path, tmp_path):
                           "--alpha1", "10", "--speed", "100", "--shape", "prism", "-n", "5", "--method", "table"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "alpha1" in bad.stderr
+
+
+def test_hits_outside_the_wall_law_s_speeds_are_counted_in_a_warning(small_table):
+    """The table's wall holds over 50-300 m/s: sample_global and sample_direct answer hits at 20 and 400 m/s all
+    the same, with one WallLawRangeWarning giving their number; none for hits inside the range."""
+    assert small_table.wall.speed_range_m_s == (50.0, 300.0)
+    a1 = np.radians(60.0)
+    speeds = np.array([20.0, 100.0, 400.0, 299.0, 300.0])
+    V = np.column_stack([speeds * np.cos(a1), -speeds * np.sin(a1), np.zeros(5)])
+    for sample in (surrogate.sample_global, surrogate.sample_direct):
+        with pytest.warns(surrogate.WallLawRangeWarning, match=r"^2 of 5 hits have \|V-\| outside 50-300 m/s"):
+            hits = sample(small_table, V, NORMAL, A, "prism", random_state=1)
+        assert np.all(hits.status[[0, 2]] != STATUS_INVALID)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", surrogate.WallLawRangeWarning)
+        surrogate.sample_global(small_table, V[1:2], NORMAL, A, "prism", random_state=1)

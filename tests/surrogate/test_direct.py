@@ -141,7 +141,7 @@ def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path)
                 row[name] = value
             f[group]["parameters"][...] = row
     table = surrogate.load(other)
-    assert table.wall == WallMaterial(0.1, 0.61, 0.5, CORUNDUM_ON_STEEL.name)
+    assert table.wall == WallMaterial(0.1, 0.61, 0.5, CORUNDUM_ON_STEEL.name, speed_range_m_s=(50.0, 300.0))
     np.testing.assert_array_equal(table.direct_parameters, model_parameters(
         AspectRatioLaw(), 0.3, 1000, table.wall, 2e-10, DEFAULT_SET_TOL, 5000, second_moment_factors(0.3)))
 

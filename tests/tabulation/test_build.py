@@ -140,7 +140,8 @@ def test_table_records_the_wall_law(tiny_table):
         assert dict(f["wall"].attrs) == {"family": "exponential", "name": law.name}
         row = f["wall/parameters"]
         assert row.shape == (1,) and row.chunks == (1,) and row.fletcher32
-        assert {name: float(row[0][name]) for name in row.dtype.names} == law.parameters()
+        assert {name: float(row[0][name]) for name in law.parameters()} == law.parameters()
+        assert tuple(row[0]["speed_range_m_s"]) == law.speed_range_m_s == (50.0, 300.0)
         assert f["model/parameters"].fletcher32 and f["model/parameters"][0]["kappa"] == table.kappa
         assert not {"restitution_k", "kappa", "wall_law"} & set(f["grid"].attrs) and "law" not in f["grid"]
 

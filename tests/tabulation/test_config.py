@@ -36,6 +36,24 @@ def test_wall_law_defaults_to_corundum_on_steel_and_round_trips():
                                                                    q=CORUNDUM_ON_STEEL.q, name=CORUNDUM_ON_STEEL.name)
 
 
+def test_the_wall_law_s_speed_range_and_the_grid_beyond_it():
+    """The default law holds over 50-300 m/s; a law of one's own states none unless given; a given range round-trips;
+    grid speeds outside it are one warning line (the build goes on)."""
+    assert parse_config('[wall]\nname = "renamed"\n').wall.speed_range_m_s == (50.0, 300.0)
+    assert not parse_config("[wall]\nq = 0.5\n").wall.speed_range_stated
+    config = parse_config("[wall]\nk = 0.2\nspeed_range_m_s = [1, 30]\n")
+    assert config.wall.speed_range_m_s == (1.0, 30.0) and parse_config(config.to_toml()) == config
+    lines = []
+    parse_config("[grid]\nspeed_m_s = [0.5, 5.0, 40.0]\n[wall]\nk = 0.2\nspeed_range_m_s = [1, 30]\n", "case.toml",
+                 log=lines.append)
+    assert lines == ["warning: case.toml: the grid's speeds 0.5, 40 m/s lie outside 1-30 m/s, where the wall law "
+                     "'corundum_on_St3_Lashkov1991' holds (wall.speed_range_m_s); its cells apply the law there all "
+                     "the same"]
+    lines.clear()
+    load_config(log=lines.append)
+    assert lines == []
+
+
 def test_range_grid_includes_stop_and_defaults_fill_in():
     config = parse_config("[grid]\nspeed_m_s = {start = 100, stop = 200, step = 50}\n")
     assert config.speed_m_s == (100.0, 150.0, 200.0)
@@ -72,6 +90,11 @@ BAD = [
     ("[wall]\nk = true", "wall.k"),
     ("[wall]\nname = \"\"", "wall.name"),
     ("[wall]\nfriction = 1.0", "wall.friction"),
+    ("[wall]\nspeed_range_m_s = [300.0, 50.0]", "wall.speed_range_m_s"),
+    ("[wall]\nspeed_range_m_s = [50.0]", "wall.speed_range_m_s"),
+    ("[wall]\nspeed_range_m_s = [-1.0, 50.0]", "wall.speed_range_m_s"),
+    ("[wall]\nspeed_range_m_s = [1.0, inf]", "wall.speed_range_m_s"),
+    ("[wall]\nspeed_range_m_s = \"fast\"", "wall.speed_range_m_s"),
 ]
 
 
