@@ -6,6 +6,11 @@
 #
 #   integrations/openfoam/build.sh            # both
 #   RBS_NATIVE_PREFIX=/opt/rbs build.sh       # use an installed C runtime
+#   RBS_OPENFOAM_CLOUDS="colliding MPPIC" build.sh   # these cloud families only
+#
+# The cloud families (one translation unit each, compiled in parallel):
+# kinematic colliding MPPIC thermo reacting reactingMultiphase (with coal)
+# heterogeneous spray; all by default.
 #
 # Run install-deps.sh first. Each step prints its wall time.
 #
@@ -18,6 +23,9 @@ repo=$(cd "$here/../.." && pwd)
 native_given=${RBS_NATIVE_PREFIX:-}
 # shellcheck source=openfoam-env.sh
 . "$here/openfoam-env.sh"
+# where a new shell's openfoam-env.sh finds the library
+mkdir -p "$RBS_OPENFOAM_CACHE"
+(cd "$RBS_OPENFOAM_CACHE" && pwd) > "$here/.cache-location"
 
 if [ ! -x "$WM_PROJECT_DIR/platforms/tools/$WM_ARCH$WM_COMPILER/wmkdepend" ]; then
     echo "No OpenFOAM v1912 headers and wmake tools in $WM_PROJECT_DIR:" \
@@ -60,11 +68,31 @@ mkdir -p "$src/Make" "$FOAM_USER_LIBBIN"
 for f in "$src"/*.[CH]; do  # sources since removed
     if [ -e "$f" ] && [ ! -e "$here/stochasticRebound/${f##*/}" ]; then rm -f "$f"; fi
 done
-for f in "$here"/stochasticRebound/*.[CH] "$here"/stochasticRebound/Make/files "$here"/stochasticRebound/Make/options; do
+make_files=("$here"/stochasticRebound/Make/files)
+[ -z "${RBS_OPENFOAM_CLOUDS:-}" ] || make_files=()
+for f in "$here"/stochasticRebound/*.[CH] "${make_files[@]}" "$here"/stochasticRebound/Make/options; do
     rel=${f#"$here"/stochasticRebound/}
     cmp -s "$f" "$src/$rel" 2>/dev/null || cp "$f" "$src/$rel"
 done
-(cd "$src" && wmake -s libso >"$RBS_OPENFOAM_CACHE/adapter/log.wmake" 2>&1) || {
+# the cloud families asked for: Make/files of the copy names only theirs
+families=(kinematic colliding MPPIC thermo reacting reactingMultiphase heterogeneous spray)
+if [ -n "${RBS_OPENFOAM_CLOUDS:-}" ]; then
+    {
+        echo "stochasticReboundCore.C"
+        for family in $RBS_OPENFOAM_CLOUDS; do
+            case " ${families[*]} " in
+                *" $family "*) echo "makeStochasticRebound${family^}.C" ;;
+                *) echo "RBS_OPENFOAM_CLOUDS: unknown cloud family $family; the families are ${families[*]}" >&2
+                   exit 1 ;;
+            esac
+        done
+        echo
+        echo 'LIB = $(FOAM_USER_LIBBIN)/libstochasticRebound'
+    } > "$src/Make/files.selected"
+    cmp -s "$src/Make/files.selected" "$src/Make/files" || mv "$src/Make/files.selected" "$src/Make/files"
+    rm -f "$src/Make/files.selected"
+fi
+(cd "$src" && wmake -s -j "$jobs" libso >"$RBS_OPENFOAM_CACHE/adapter/log.wmake" 2>&1) || {
     cat "$RBS_OPENFOAM_CACHE/adapter/log.wmake" >&2; exit 1; }
 step_done
 echo "built $FOAM_USER_LIBBIN/libstochasticRebound.so"

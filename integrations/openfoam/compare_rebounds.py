@@ -16,7 +16,8 @@ their bounds). The script:
 1. checks that both OpenFOAM records hold the same hits: the same number per patch, and per parcel the
    same sequence of incident velocities;
 2. checks the path of every hit against the rule of method auto (``solver_comparison.path_rule``) and
-   compares each path's answers with surrogate's at the same incident states
+   compares each path's answers with surrogate's at the same incident states, for the hits a table
+   answered on the patches of one wall (``--patch``; a run with a ``patches`` list has a table per wall)
    (``solver_comparison.compare_hits``: the table's hits with ``surrogate.sample_global``, method
    "table", the direct model's with method "direct", Ω⁻ included; KS per variable, a classifier
    two-sample test, the fractions not rebounded, each against the bound of one law);
@@ -52,6 +53,11 @@ from rbs_api import (PATH_DIRECT, PATH_TABLE, STATUS_FAILED, STATUS_INVALID, STA
                      rank_files, read_hit_files, solver_hits, specular_answers, surrogate_answers)
 
 HITS_TITLE = "stochasticRebound"   # the hits files' header: "# stochasticRebound hits: seed ..."
+# the per-patch summary's count columns in the solver's log: key -> column name
+PATCH_SUMMARY = {"hits": "hits", "rebounded": "rebounded", "stuck": "stuck", "removed": "removed",
+                 "escaped": "escaped", "invalid": "invalid", "trapped": "trapped", "failed": "failed",
+                 "table": "table", "direct": "direct", "speed_below": "|V|<grid", "speed_above": "|V|>grid",
+                 "alpha1_outside": "alpha1-out", "outside_law": "out-of-law"}
 
 
 # ----------------------------------------------------------------------------- reading
@@ -65,8 +71,57 @@ def hits_dir(case: Path) -> Path:
 
 
 def read_hits(case: Path) -> tuple[dict, list]:
-    """All ranks' hit records as columns, and each file's header settings (tablegen.study.hit_records)."""
+    """All ranks' hit records as columns, and each file's header settings (tablegen.study.hit_records): with
+    ``interaction``, what the hit's patch does (``stochasticRebound``, or ``rebound``: OpenFOAM's stock
+    rebound), and ``wall``, the wall of its table (empty for a stock rebound)."""
     return read_hit_files(rank_files(hits_dir(case)), HITS_TITLE)
+
+
+def select_hits(hits: dict, rows) -> dict:
+    """The columns of :func:`read_hits` at ``rows`` (a boolean mask or indices)."""
+    return {name: column[rows] for name, column in hits.items()}
+
+
+def drawn_hits(hits: dict, patches=None) -> dict:
+    """The hits a table or the direct model answered (interaction ``stochasticRebound``), of ``patches``
+    (names; all if None). ValueError if none is left, or if they are of more than one wall: each wall has
+    its table, and a comparison takes one."""
+    keep = hits["interaction"] == HITS_TITLE
+    if patches is not None:
+        keep &= np.isin(hits["patch"], list(patches))
+    if not keep.any():
+        where = f"the patches {', '.join(patches)}" if patches else "any patch"
+        raise ValueError(f"no hit a table answered on {where}")
+    walls = sorted(set(hits["wall"][keep].tolist()))
+    if len(walls) > 1:
+        raise ValueError(f"the hits are of {len(walls)} walls ({', '.join(walls)}): compare the patches of one "
+                         "wall at a time (patches, --patch) with its table (--table)")
+    return select_hits(hits, keep)
+
+
+def _table_of(settings: dict, table_path: Path | None) -> Path:
+    """The table to compare with: the one given, else the run's global table."""
+    if table_path is None and settings["table"] == "none":
+        raise ValueError("the run names no global table (every patch entry gives its own): give the table of "
+                         "the patches compared (--table)")
+    return Path(table_path or settings["table"])
+
+
+def patch_summary(log: str) -> dict:
+    """The adapter's per-patch counts at the last time step of a solver log: patch name -> the counts of
+    :data:`PATCH_SUMMARY`'s columns by key, and ``interaction``, what the patch does."""
+    block = log[log.rindex("    Per patch ("):].splitlines()
+    header = block[1].split()
+    if header != ["patch", *PATCH_SUMMARY.values(), "interaction"]:
+        raise ValueError(f"not the per-patch summary's columns: {block[1]!r}")
+    out = {}
+    for line in block[2:]:
+        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(PATCH_SUMMARY)}}})  (.*)$", line)
+        if m is None:
+            break
+        counts = dict(zip(PATCH_SUMMARY, map(int, m.group(2).split())))
+        out[m.group(1)] = dict(counts, interaction=m.group(3))
+    return out
 
 
 def read_patch_post(case: Path) -> dict:
@@ -123,22 +178,26 @@ def check_records(hits: dict, post: dict) -> dict:
             "max_relative_difference_of_incident_velocity": worst}
 
 
-def compare_paths(case: Path, table_path: Path | None = None) -> dict:
-    """``solver_comparison.path_rule`` of a run's hit records (the table from the path the run recorded)."""
+def compare_paths(case: Path, table_path: Path | None = None, patches=None) -> dict:
+    """``solver_comparison.path_rule`` of a run's hit records (:func:`drawn_hits` of ``patches``; the table
+    from the path the run recorded)."""
     hits, headers = read_hits(case)
     settings = headers[0]
-    return path_rule(solver_hits(hits, settings), load(Path(table_path or settings["table"])),
+    return path_rule(solver_hits(drawn_hits(hits, patches), settings), load(_table_of(settings, table_path)),
                      settings["spin_tolerance"])
 
 
-def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifier: bool = True) -> dict:
+def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifier: bool = True,
+            patches=None) -> dict:
     """The comparisons 2 and 3 of the module docstring (``classifier=False``: KS and fractions not rebounded
-    only): ``res["comparison"]`` the solver against surrogate per path (a ``ComparisonReport``),
+    only) on the hits a table answered (:func:`drawn_hits` of ``patches``, all by default: one wall's):
+    ``res["comparison"]`` the solver against surrogate per path (a ``ComparisonReport``),
     ``res["spinning_vs_table_only"]`` the spinning hits against the table alone, ``res["table_vs_specular"]``
     the table's hits against the stock bounce (``Agreement`` records; their classifier is not run)."""
     hits, headers = read_hits(case)
+    hits = drawn_hits(hits, patches)
     settings = headers[0]
-    table_path = Path(table_path or settings["table"])
+    table_path = _table_of(settings, table_path)
     table = load(table_path)
     record = solver_hits(hits, settings)
     status = record.status
@@ -383,7 +442,9 @@ def plot_erosion(cases: dict, png: Path, patch: str = "walls") -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("case", type=Path)
-    parser.add_argument("--table", type=Path, help="the table (default: the path the run recorded)")
+    parser.add_argument("--table", type=Path, help="the table (default: the global one the run recorded)")
+    parser.add_argument("--patch", action="append", metavar="NAME",
+                        help="compare the hits of this patch only (repeat for several patches of one wall)")
     parser.add_argument("--seed", type=int, default=1, help="seed of the sampler's draws")
     parser.add_argument("--png", type=Path, help="write the figure here")
     parser.add_argument("--json", type=Path, help="write the figures here")
@@ -393,7 +454,11 @@ def main(argv=None) -> int:
                         help="a run of the same case with standardWallInteraction: compare the erosion of both")
     parser.add_argument("--erosion-png", type=Path, help="write the two erosion maps side by side here")
     args = parser.parse_args(argv)
-    res = compare(args.case, args.table, args.seed, classifier=not args.no_classifier)
+    try:
+        res = compare(args.case, args.table, args.seed, classifier=not args.no_classifier, patches=args.patch)
+    except ValueError as exc:
+        print(f"compare_rebounds.py: {exc}", file=sys.stderr)
+        return 2
     post = read_patch_post(args.case)
     if post:
         hits, _ = read_hits(args.case)

@@ -4,14 +4,17 @@
 #   1. Debian's OpenFOAM v1912 (openfoam, libopenfoam), Open MPI, a compiler,
 #      CMake and HDF5 (for native/) and lbzip2;
 #   2. the OpenFOAM v1912 source, from `apt-get source openfoam` (Debian ships
-#      no OpenFOAM headers): its src/, wmake/, etc/ and the lagrangian
-#      tutorials are unpacked into $RBS_OPENFOAM_CACHE/OpenFOAM-v1912;
+#      no OpenFOAM headers and no tutorials): its src/, wmake/, etc/, bin/
+#      and the whole tutorials/ tree (with tutorials/resources, the geometry
+#      some tutorials take) are unpacked into $RBS_OPENFOAM_CACHE/OpenFOAM-v1912;
 #   3. the wmake tools (wmkdepend, lemon) and the lnInclude folders of the
 #      libraries the adapter includes.
 #
 # Idempotent: a finished step is skipped (remove $RBS_OPENFOAM_CACHE to start
-# over). RBS_OPENFOAM_CACHE defaults to integrations/openfoam/.build. Each
-# step prints its wall time. Then build.sh builds native/ and the adapter.
+# over). RBS_OPENFOAM_CACHE defaults to integrations/openfoam/.build; the one
+# used is recorded in integrations/openfoam/.cache-location, where
+# openfoam-env.sh finds it in a new shell. Each step prints its wall time.
+# Then build.sh builds native/ and the adapter.
 #
 # Copyright (C) 2026 the rebound-scatter authors. License: GPL-3.0-or-later
 # (see LICENSE in this folder).
@@ -20,6 +23,8 @@ set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 export RBS_OPENFOAM_CACHE="${RBS_OPENFOAM_CACHE:-$here/.build}"
 mkdir -p "$RBS_OPENFOAM_CACHE"
+RBS_OPENFOAM_CACHE=$(cd "$RBS_OPENFOAM_CACHE" && pwd)
+echo "$RBS_OPENFOAM_CACHE" > "$here/.cache-location"
 tree="$RBS_OPENFOAM_CACHE/OpenFOAM-v1912"
 download="$RBS_OPENFOAM_CACHE/download"
 
@@ -82,9 +87,21 @@ EOF
     top=$(set +o pipefail; tar -I lbzip2 -tf "$orig" 2>/dev/null | head -n 1 | cut -d/ -f1)
     tar -I lbzip2 -xf "$orig" -C "$tree.tmp" --strip-components=1 --wildcards \
         "$top/src/*" "$top/wmake/*" "$top/etc/*" "$top/bin/*" "$top/META-INFO/*" "$top/COPYING" \
-        "$top/tutorials/lagrangian/*"
+        "$top/tutorials/*"
     mv "$tree.tmp" "$tree"
-    touch "$tree/.unpacked"
+    touch "$tree/.unpacked" "$tree/.tutorials-unpacked"
+fi
+step_done
+
+# a tree unpacked before the whole tutorials tree was: the rest of it
+step "OpenFOAM v1912 tutorials"
+if [ -f "$tree/.tutorials-unpacked" ]; then
+    echo "already unpacked in $tree/tutorials"
+else
+    orig=$(ls "$download"/openfoam_*.orig.tar.* | head -n 1)
+    top=$(set +o pipefail; tar -I lbzip2 -tf "$orig" 2>/dev/null | head -n 1 | cut -d/ -f1)
+    tar -I lbzip2 -xf "$orig" -C "$tree" --strip-components=1 --wildcards "$top/tutorials/*"
+    touch "$tree/.tutorials-unpacked"
 fi
 step_done
 
@@ -103,7 +120,8 @@ step_done
 step "lnInclude folders"
 lninclude_dirs=(
     OpenFOAM OSspecific/POSIX finiteVolume meshTools fileFormats surfMesh
-    dynamicMesh dynamicFvMesh lagrangian/basic lagrangian/intermediate lagrangian/distributionModels
+    dynamicMesh dynamicFvMesh lagrangian/basic lagrangian/intermediate lagrangian/spray
+    lagrangian/distributionModels
     transportModels/compressible thermophysicalModels/specie thermophysicalModels/basic
     thermophysicalModels/thermophysicalProperties thermophysicalModels/reactionThermo
     thermophysicalModels/SLGThermo thermophysicalModels/radiation

@@ -8,8 +8,9 @@ from the session's start), and checks the hit counts per path, the
 rebounds the table answered and those the direct model answered against
 surrogate on the same incident states (the BSD statistics of
 tablegen.study.solver_comparison, called through compare_rebounds), the random streams per rank, the grain
-each parcel keeps from hit to hit (grain kept), a moving wall, OpenFOAM's erosion model beside ours, and times
-the runs against standardWallInteraction.
+each parcel keeps from hit to hit (grain kept), a moving wall, OpenFOAM's erosion model beside ours, a wall per
+patch (two tables, OpenFOAM's rebound, an open patch; the per-patch summary) and the refused patch entries, and
+times the runs against standardWallInteraction.
 
 These tests need OpenFOAM: they fail (they are not skipped) when it is
 missing, with a message naming integrations/openfoam/install-deps.sh.
@@ -41,7 +42,8 @@ HITS = Path("postProcessing/lagrangian/kinematicCloud/stochasticRebound")
 sys.path.insert(0, str(OPENFOAM_DIR))
 
 import compare_rebounds  # noqa: E402
-from rbs_api import grain_key, grain_mismatches, load, summary_counts  # noqa: E402
+from rbs_api import (PATH_TABLE, agreement, grain_key, grain_mismatches, incident_states, load,  # noqa: E402
+                     solver_hits, summary_counts, surrogate_answers)
 
 from tests.openfoam import cases  # noqa: E402
 
@@ -51,7 +53,8 @@ INSTALL_HINT = ("run `bash integrations/openfoam/install-deps.sh` (as root on De
 
 
 def _cache() -> Path:
-    return Path(os.environ.get("RBS_OPENFOAM_CACHE", OPENFOAM_DIR / ".build"))
+    """The folder of install-deps.sh's and build.sh's outputs, as openfoam-env.sh finds it."""
+    return Path(cases.openfoam_env("RBS_OPENFOAM_CACHE"))
 
 
 def _run(cmd, cwd, env=None, timeout=600) -> subprocess.CompletedProcess:
@@ -63,12 +66,19 @@ def _timings(case: Path) -> dict:
     return {k: float(v) for k, v in (line.split() for line in (case / "log.timings").read_text().splitlines())}
 
 
-def _cloud_info(log: str) -> dict:
-    """The stochasticRebound counts of the last time step in a solver log, and the incoming spin's mean and max."""
-    block = log[log.rindex("Stochastic rebound"):]
+def _cloud_info(log: str, cloud: str | None = None) -> dict:
+    """The stochasticRebound counts of the last time step in a solver log (of ``cloud``'s block, where a solver has
+    several clouds), the incoming spin's mean and max, and the spin memory's: the hits with a remembered spin, the
+    parcels holding one and the hits that missed it (None where the summary has no such line)."""
+    start = log.rindex(f"Cloud: {cloud}\n") if cloud else log.rindex("Stochastic rebound")
+    block = log[log.index("Stochastic rebound", start):]
+    block = block[:block.index("Per patch (")]
     spin = re.search(r"incoming spin \|Omega\|a/\|V\|\s*= mean\s*([-0-9.eE+]+), max\s*([-0-9.eE+]+)", block)
+    memory = re.search(r"hits with a remembered spin = (\d+) \(held for (\d+) parcels; (\d+) missed it", block)
     return dict(summary_counts(block), spin_mean=float(spin.group(1)) if spin else None,
-                spin_max=float(spin.group(2)) if spin else None)
+                spin_max=float(spin.group(2)) if spin else None,
+                remembered=int(memory.group(1)) if memory else None, held=int(memory.group(2)) if memory else None,
+                missed=int(memory.group(3)) if memory else None)
 
 
 def _cloud_parcels(log: str) -> dict:
@@ -135,13 +145,24 @@ def parallel_case(runs_folder):
 
 # ----------------------------------------------------------------------------- build
 
-def test_adapter_registers_the_model_for_three_clouds(openfoam_build):
+# the outermost parcel type of each cloud family's kinematic cloud type (coal clouds are reacting-multiphase ones)
+FAMILY_PARCELS = {"kinematic": "KinematicParcel", "colliding": "CollidingParcel", "MPPIC": "MPPICParcel",
+                  "thermo": "ThermoParcel", "reacting": "ReactingParcel",
+                  "reactingMultiphase": "ReactingMultiphaseParcel", "heterogeneous": "ReactingHeterogeneousParcel",
+                  "spray": "SprayParcel"}
+
+
+def test_adapter_registers_the_model_for_every_cloud_family(openfoam_build):
     symbols = subprocess.run(["nm", "-DC", str(openfoam_build["lib"])], capture_output=True, text=True,
                              check=True).stdout
     names = [line for line in symbols.splitlines() if "StochasticRebound<" in line and "::typeName" in line]
-    parcels = {p for p in ("KinematicParcel<Foam::particle> > > >::typeName", "CollidingParcel", "MPPICParcel")
-               if any(p in line for line in names)}
-    assert len(parcels) == 3, names
+    registered = {family for family, parcel in FAMILY_PARCELS.items()
+                  if any(f"StochasticRebound<Foam::KinematicCloud<Foam::Cloud<Foam::{parcel}<" in line
+                         for line in names)}
+    assert registered == set(FAMILY_PARCELS), names
+    # one translation unit per family, each built
+    objects = {p.name for p in (_cache() / "adapter" / "stochasticRebound" / "Make").glob("*/*.o")}
+    assert objects >= {f"makeStochasticRebound{f[0].upper() + f[1:]}.o" for f in FAMILY_PARCELS}, objects
     linked = subprocess.run(["ldd", str(openfoam_build["lib"])], capture_output=True, text=True).stdout
     assert "librebound_scatter" in linked and "not found" not in linked, linked
 
@@ -316,8 +337,7 @@ def test_a_parcel_keeps_its_grain_over_a_restart(runs_folder, case_table):
     seed = before_headers[0]["seed"]
     cases.set_coeff(case, "seed", str(seed + 1))
     cases.insert_coeff(case, f"grainSeed {seed};")
-    script = (f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {{ [ -f \"$WM_PROJECT_DIR/etc/controlDict\" ] || "
-              f"export WM_PROJECT_DIR=/usr/share/openfoam; }} && {SOLVER} > log.restart 2>&1")
+    script = f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {SOLVER} > log.restart 2>&1"
     _run(["bash", "-c", script], cwd=case)
     assert "Starting time loop" in (case / "log.restart").read_text()
     after, after_headers = compare_rebounds.read_hits(case)
@@ -347,6 +367,10 @@ def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(runs_folder)
     assert r["parcels_mismatched"] == 0 and r["max_relative_difference_of_incident_velocity"] < 1e-5, r
     res = compare_rebounds.compare(case, classifier=False)
     assert res["comparison"].ok, res
+    # the prisms' own halfSizeFactor (weights { prism { weight 1; halfSizeFactor 1.4; } }): a = 1.4 d/2
+    _, headers = compare_rebounds.read_hits(case)
+    assert headers[0]["shape"] == {"prism": 1.0} and headers[0]["half_size_factor"] == 1.0
+    np.testing.assert_allclose(hits["a"], cases.PRISM_HALF_SIZE_FACTOR * hits["d"] / 2, rtol=1e-8)
 
 
 @pytest.fixture(scope="session")
@@ -481,7 +505,7 @@ def test_trapped_parcels_stick_or_are_removed(policy, runs_folder, trapping_tabl
 def test_mppic_cloud_selects_and_runs_the_model(openfoam_build, case_table, tmp_path):
     """MPPICFoam's cloud (basicKinematicMPPICCloud): the stock v1912 tutorial MPPICFoam/column with the
     parcels thrown down at 60 m/s onto its bottom wall for 1 ms."""
-    tutorial = _cache() / "OpenFOAM-v1912" / "tutorials" / "lagrangian" / "MPPICFoam" / "column"
+    tutorial = cases.tutorials() / "lagrangian" / "MPPICFoam" / "column"
     case = tmp_path / "column"
     shutil.copytree(tutorial, case)
     props = case / "constant" / "kinematicCloudProperties"
@@ -504,10 +528,153 @@ def test_mppic_cloud_selects_and_runs_the_model(openfoam_build, case_table, tmp_
     info = _cloud_info(log)
     assert info["hits"] > 200 and info["rebounded"] + info["invalid"] <= info["hits"] and info["invalid"] == 0, \
         info_block[:600]
-    # MPPIC parcels carry no spin: no incoming-spin line, and Ω⁻ = 0, so under auto the direct model answers
-    # exactly the hits outside the table's grid
-    assert "incoming spin" not in info_block.split("Min cell volume fraction")[0]
-    assert info["spin_mean"] is None and info["direct"] == info["outside"], info
+    # MPPIC parcels carry no spin: the spin memory (spinRelaxation auto, the default) gives a parcel's later hits
+    # the spin of its last rebound, so under auto the direct model answers the hits outside the table's grid and
+    # hits that arrive with a remembered spin
+    assert "spin memory (spinRelaxation) = auto" in info_block
+    assert info["outside"] <= info["direct"] <= info["outside"] + info["remembered"], info
+
+
+@pytest.fixture(scope="session")
+def patches_case(runs_folder):
+    """The case with a wall per patch (cases.CASES["patches"]): frontAndBack split into front and back; walls on
+    the elastic wall's table, front on the lossy wall's (method table, trapped remove), back OpenFOAM's stock
+    rebound, inlet the elastic table again, outlet named by no entry."""
+    return _case(runs_folder, "patches")
+
+
+def test_each_patch_does_what_its_entry_says(patches_case, capsys):
+    """The per-patch summary: every patch with its interaction, every hit with one fate, the tables' hits by path
+    and outside the grid by cause (as the hits file's incident states give them); the stock rebound exact; each
+    table opened once."""
+    log = (patches_case / f"log.{SOLVER}").read_text()
+    with capsys.disabled():
+        print("\n" + log[log.rindex("    Stochastic rebound ("):log.rindex("    Rotational kinetic energy")])
+    rows = compare_rebounds.patch_summary(log)
+    elastic, lossy = cases.WALLS["elastic"]["name"], cases.WALLS["lossy"]["name"]
+    assert {name: r["interaction"] for name, r in rows.items()} == {
+        "walls": f"stochasticRebound, wall {elastic}", "front": f"stochasticRebound, wall {lossy}",
+        "back": "rebound, e 0.5, mu 0.2", "inlet": f"stochasticRebound, wall {elastic}",
+        "outlet": "escape (open patch no entry names: OpenFOAM's default)"}
+    for name, r in rows.items():
+        assert r["hits"] == r["rebounded"] + r["stuck"] + r["removed"] + r["escaped"] + r["invalid"], (name, r)
+    drawn = {name: rows[name] for name in ("walls", "front", "inlet")}
+    for name, r in drawn.items():
+        assert r["hits"] == r["table"] + r["direct"] + r["invalid"] and r["escaped"] == 0, (name, r)
+        assert r["trapped"] + r["failed"] == r["stuck"] + r["removed"], (name, r)
+    walls, front, back, outlet = rows["walls"], rows["front"], rows["back"], rows["outlet"]
+    # walls: method auto, the spinning hits to the direct model; front: method table, the trapped removed
+    assert walls["direct"] > 500 and walls["table"] > 1000 and walls["stuck"] == walls["trapped"] == 0, walls
+    assert front["direct"] == 0 and front["stuck"] == 0 and front["removed"] == front["trapped"] > 100, front
+    assert back["hits"] == back["rebounded"] > 1000 and outlet["hits"] == outlet["escaped"] > 100, (back, outlet)
+    # the totals of the tables' hits are the drawing patches' sums
+    info = _cloud_info(log)
+    for key in ("hits", "table", "direct", "rebounded", "trapped", "failed", "invalid"):
+        assert info[key] == sum(r[key] for r in drawn.values()), key
+    # OpenFOAM's own count of parcels leaving: a hit on a patch not a wall (its comment: whatever the interaction
+    # does); the parcels left: those added, less the outlet's escapes and the front's removals
+    parcels = _cloud_parcels(log)
+    assert parcels["escaped"] == outlet["hits"] + rows["inlet"]["hits"]
+    assert parcels["current"] == parcels["added"] - outlet["escaped"] - front["removed"], (parcels, rows)
+    # the elastic table, the global one, and named by another path for inlet, is opened once
+    assert log.count("stochasticRebound: opened the table") == 2
+
+    hits, headers = compare_rebounds.read_hits(patches_case)
+    assert headers[0]["table"].endswith("constant/rebound_table.h5")
+    # every hit the adapter answered is recorded, with its patch's interaction and wall, and patchPostProcessing
+    # saw the same hits (the outlet's escapes are OpenFOAM's, not recorded)
+    recorded = {str(p): int(np.sum(hits["patch"] == p)) for p in np.unique(hits["patch"])}
+    assert recorded == {name: rows[name]["hits"] for name in ("walls", "front", "back")}
+    for name, interaction, wall in (("walls", "stochasticRebound", elastic), ("front", "stochasticRebound",
+                                    lossy.replace(",", ";")), ("back", "rebound", "")):
+        on = hits["patch"] == name
+        assert set(hits["interaction"][on]) == {interaction} and set(hits["wall"][on]) == {wall}, name
+    r = compare_rebounds.check_records(hits, compare_rebounds.read_patch_post(patches_case))
+    assert r["hits_per_patch_adapter"] == r["hits_per_patch_patchPostProcessing"], r
+    assert r["parcels_mismatched"] == 0 and r["max_relative_difference_of_incident_velocity"] < 1e-5, r
+    # back: localInteraction's rebound, V⁺ = V⁻ − (1 + e) Vn n − mu V_t (n out of the domain), no draw
+    on = hits["patch"] == "back"
+    V, n = hits["V"][on], -hits["n"][on]
+    Vn = np.einsum("ij,ij->i", V, n)[:, None]
+    np.testing.assert_allclose(hits["Vout"][on], V - 1.5 * Vn * n - 0.2 * (V - Vn * n), rtol=0, atol=1e-9 * 150)
+    assert (hits["path"][on] == -1).all() and (hits["status"][on] == 0).all() and np.isnan(hits["u0"][on]).all()
+    # the hits outside each table's grid by cause (both tables: α1 5-90°, |V⁻| 80-140 m/s); the adapter's count
+    # of hits at the grid's edge itself may differ by a rounding
+    for name in ("walls", "front"):
+        on = hits["patch"] == name
+        alpha1, speed, _ = incident_states(hits["V"][on], hits["n"][on], hits["a"][on], hits["Win"][on])
+        for key, count in (("speed_below", np.sum(speed < 80)), ("speed_above", np.sum(speed > 140)),
+                           ("alpha1_outside", np.sum(alpha1 < 5))):
+            assert rows[name][key] == pytest.approx(count, abs=2), (name, key)
+        assert min(rows[name]["speed_below"], rows[name]["alpha1_outside"]) > 0, name
+    assert front["speed_above"] > 0
+    # the hits outside the speeds the wall law holds over: the elastic wall's (walls) 60-200 m/s, the lossy
+    # wall (front) states none
+    on = hits["patch"] == "walls"
+    _, speed, _ = incident_states(hits["V"][on], hits["n"][on], hits["a"][on], hits["Win"][on])
+    outside = int(np.sum((speed < 60.0) | (speed > 200.0)))
+    assert rows["walls"]["outside_law"] == pytest.approx(outside, abs=2) and outside > 0
+    assert front["outside_law"] == 0
+
+
+def test_each_wall_draws_from_its_own_table(patches_case, runs_folder):
+    """The hits of walls follow the elastic wall's law and those of front the lossy wall's (surrogate on the same
+    incident states, per patch); the lossy wall's law at the walls' hits is not theirs and slower, as its
+    larger k predicts; the hits of two walls are not compared with one table."""
+    elastic, lossy = (runs_folder / cases.TABLES[name] for name in ("elastic", "lossy"))
+    for patch, table in (("walls", elastic), ("front", lossy)):
+        res = compare_rebounds.compare(patches_case, table, classifier=False, patches=[patch])
+        assert res["comparison"].ok, (patch, res["comparison"].lines())
+    hits, headers = compare_rebounds.read_hits(patches_case)
+    record = solver_hits(compare_rebounds.drawn_hits(hits, ["walls"]), headers[0])
+    on_table = record.take(record.path == PATH_TABLE)
+    other = agreement(on_table, surrogate_answers(load(lossy), on_table, method="table"), classifier=False)
+    assert not other.ks_ok and other.mean_speed_ratio[0] > other.mean_speed_ratio[1] + 0.05, other
+    with pytest.raises(ValueError, match="of 2 walls"):
+        compare_rebounds.compare(patches_case, elastic, classifier=False)
+
+
+def _refused(case_table, folder, edit, solver=SOLVER) -> str:
+    """The solver's log of the case edited by ``edit``, which must stop with a FatalIOError before a time step."""
+    case = cases.copy_case(folder)
+    edit(case)
+    proc = cases.run_allrun(case, case_table)
+    log = (case / f"log.{solver}").read_text()
+    assert proc.returncode != 0 and "FOAM FATAL IO ERROR" in log, log[-3000:]
+    assert "stochasticReboundCoeffs" in log and "Time = " not in log.split("FOAM FATAL IO ERROR")[0]
+    return log
+
+
+def _patches(entries: str):
+    return lambda case: cases.insert_coeff(case, f"patches ( {entries} );")
+
+
+@pytest.mark.parametrize("edit, words", [
+    (_patches("walls { type stick; }"),
+     ["wall patch frontAndBack is named by no entry of patches in stochasticReboundCoeffs: say what each wall does"]),
+    (_patches("walls { type bounce; } frontAndBack { type stick; }"),
+     ["patches entry walls in stochasticReboundCoeffs: type bounce is unknown; the types are stochasticRebound, "
+      "rebound, stick, escape"]),
+    (_patches("walls { type stick; } frontAndBack { type rebound; e 1.5; mu 0.1; }"),
+     ["patches entry frontAndBack in stochasticReboundCoeffs: e must be in [0, 1], not 1.5"]),
+    (_patches('walls { type stochasticRebound; table "constant/steel.h5"; } frontAndBack { type stick; }'),
+     ["patches entry walls in stochasticReboundCoeffs: cannot open the rebound table", "constant/steel.h5"]),
+    (_patches("wals { type stick; } walls { type stick; } frontAndBack { type stick; }"),
+     ["patches entry wals in stochasticReboundCoeffs: no patch or patch group is named wals; the patches are "
+      "walls, frontAndBack, inlet, outlet"]),
+    (_patches("walls { type stochasticRebound; shape cube; } frontAndBack { type stick; }"),
+     ["patches entry walls in stochasticReboundCoeffs: bad shape cube for the table"]),
+    (_patches("walls { type stochasticRebound; } frontAndBack { type escape; e 0.5; }"),
+     ["unknown entry e in patches entry frontAndBack in stochasticReboundCoeffs; the entries are type"]),
+])
+def test_bad_patches_entries_stop_before_the_first_step(openfoam_build, case_table, tmp_path_factory, edit,
+                                                        words):
+    """A wall no entry names, an unknown type, e outside [0, 1], a table file missing, a name no patch has, a
+    shape the table lacks and an entry the type does not read: each a one-line FatalIOError naming the entry and
+    what is allowed, before any time step."""
+    log = _refused(case_table, tmp_path_factory.mktemp("bad_patches"), edit)
+    for word in words:
+        assert word in log, log[-3000:]
 
 
 @pytest.mark.parametrize("edit, words", [
@@ -516,16 +683,205 @@ def test_mppic_cloud_selects_and_runs_the_model(openfoam_build, case_table, tmp_
     (lambda c: cases.set_coeff(c, "maxHitRecords", "-1"), ["maxHitRecords must be >= 0, not -1"]),
     (lambda c: cases.insert_coeff(c, "method tabel;"), ["method must be auto, table or direct, not tabel"]),
     (lambda c: cases.insert_coeff(c, "grain once;"), ["grain must be kept or perHit, not once"]),
+    (lambda c: cases.insert_coeff(c, "spinRelaxation fast;"),
+     ["spinRelaxation must be auto, off or a time in s > 0, not fast"]),
+    (lambda c: cases.insert_coeff(c, "spinRelaxation -1;"),
+     ["spinRelaxation must be auto, off or a time in s > 0, not -1"]),
+    (lambda c: cases.set_weights(c, "prism { weight 1; halfSizeFactor 0; }"),
+     ["weights entry prism in stochasticReboundCoeffs: halfSizeFactor must be > 0, not 0"]),
+    (lambda c: cases.set_weights(c, "prism { weight 1; size 2; }"),
+     ["unknown entry size in weights entry prism in stochasticReboundCoeffs; the entries are weight, halfSizeFactor"]),
+    (lambda c: (cases.set_weights(c, "prism { weight 1; halfSizeFactor 1.4; }"),
+                cases.insert_coeff(c, "grain perHit;")),
+     ["halfSizeFactor per shape in weights needs grain kept, not perHit"]),
 ])
 def test_dictionary_contradictions_and_unknown_entries_are_fatal(openfoam_build, case_table, tmp_path_factory,
                                                                  edit, words):
     """A misspelled entry silently fell back to its default, shape was ignored under weights, and
     maxHitRecords -1 wrote nothing: each is now a FatalIOError naming the entry, before any time step."""
-    case = cases.copy_case(tmp_path_factory.mktemp("bad_dictionary"))
-    edit(case)
-    proc = cases.run_allrun(case, case_table)
-    log = (case / f"log.{SOLVER}").read_text()
-    assert proc.returncode != 0 and "FOAM FATAL IO ERROR" in log, log[-3000:]
-    assert "stochasticReboundCoeffs" in log and "Time = " not in log.split("FOAM FATAL IO ERROR")[0]
+    log = _refused(case_table, tmp_path_factory.mktemp("bad_dictionary"), edit)
     for word in words:
         assert word in log, log[-3000:]
+
+
+def test_spin_relaxation_auto_needs_a_gas_viscosity(openfoam_build, case_table, tmp_path_factory):
+    """spinRelaxation auto (the default) in a kinematic cloud whose gas has no viscosity: stopped before the first
+    step, naming the entry and what to give instead."""
+    def no_viscosity(case):
+        cases._kinematic(case)
+        thermo = case / "constant" / "thermophysicalProperties"
+        thermo.write_text(thermo.read_text().replace(f"mu {cases.AIR_MU};", "mu 0;"))
+    log = _refused(case_table, tmp_path_factory.mktemp("no_viscosity"), no_viscosity, cases.KINEMATIC_SOLVER)
+    assert ("spinRelaxation auto needs the gas viscosity, but the cloud's mu field is not > 0 everywhere (min 0): "
+            "give spinRelaxation as a time in s, or off") in log, log[-3000:]
+
+
+# ----------------------------------------------------------------------------- every cloud family
+
+@pytest.mark.parametrize("name", list(cases.FAMILY_RUNS))
+def test_every_cloud_family_selects_the_model_and_draws(runs_folder, name):
+    """The stock tutorials of the thermo (coalChemistryFoam's limestone), reacting-multiphase (reactingParcelFoam)
+    and coal, heterogeneous reacting and spray clouds (cases.FAMILY_RUNS), aimed at a wall for a few steps: each
+    cloud selects stochasticRebound, its parcels hit walls and rebound, and as they carry no spin the spin memory
+    (auto: the gas thermo's viscosity) stands in for it."""
+    case, done = cases.read_runs(runs_folder)[name]
+    background.succeeded(done)
+    _, solver, clouds, _, _ = cases.FAMILY_RUNS[name]
+    log = (case / f"log.{solver}").read_text()
+    assert log.count("Selecting patch interaction model stochasticRebound") == len(clouds) and "\nEnd\n" in log
+    for cloud in clouds:
+        info = _cloud_info(log, cloud)
+        assert info["hits"] > 0, (cloud, info)
+        assert info["hits"] == info["rebounded"] + info["trapped"] + info["failed"] + info["invalid"], (cloud, info)
+        assert info["hits"] == info["table"] + info["direct"] + info["invalid"], (cloud, info)
+        assert info["remembered"] is not None and info["held"] > 0, (cloud, info)
+
+
+# ----------------------------------------------------------------------------- spin memory
+
+KINEMATIC_LOG = f"log.{cases.KINEMATIC_SOLVER}"
+SAND_DENSITY = 2650.0   # the case's rho0
+
+
+def _parcel_keys(hits: dict) -> np.ndarray:
+    return (hits["origProc"].astype(np.int64) << 32) | hits["origId"]
+
+
+def _next_hits(hits: dict):
+    """Each parcel's consecutive hits on one rank's records (a serial run): the rows (i, j), j the next hit after
+    i (the records of a rank are in the order of the hits)."""
+    keys = _parcel_keys(hits)
+    order = np.lexsort((np.arange(len(keys)), keys))
+    same = keys[order][1:] == keys[order][:-1]
+    return order[:-1][same], order[1:][same]
+
+
+def _check_relaxation(hits: dict, i, j, tau, delta_t: float, rtol: float = 1e-12, time_slack: float = 1e-12) -> None:
+    """Ω⁻ of hit j is Ω⁺ of hit i relaxed over the flight: the same direction (to rtol), |Ω⁻| = |Ω⁺| exp(−Δt/τ)
+    with Δt between the hits' time steps' ends ±1 step (a hit's time is its step's end in the records; time_slack
+    for times read back from a file)."""
+    w_out, w_in = hits["Wout"][i], hits["Win"][j]
+    np.testing.assert_allclose(w_in / np.linalg.norm(w_in, axis=1)[:, None],
+                               w_out / np.linalg.norm(w_out, axis=1)[:, None], rtol=0, atol=10 * rtol + 1e-14)
+    flight = -tau * np.log(np.linalg.norm(w_in, axis=1) / np.linalg.norm(w_out, axis=1))
+    steps = hits["time"][j] - hits["time"][i]
+    slack = rtol * tau + time_slack
+    assert np.all(flight >= steps - delta_t - slack) and np.all(flight <= steps + delta_t + slack), \
+        (np.min(flight - steps + delta_t), np.max(flight - steps - delta_t))
+
+
+@pytest.fixture(scope="session")
+def kinematic_runs(runs_folder):
+    """The case with the plain kinematic cloud (parcels without spin): spinRelaxation auto (the default), off, and
+    auto on 2 ranks (cases.CASES)."""
+    return {name: _case(runs_folder, name) for name in ("kinematic", "kinematic_off", "kinematic_parallel")}
+
+
+def test_spin_memory_gives_spinless_parcels_their_last_spin(kinematic_runs, serial_case, capsys):
+    """Parcels that carry no spin: with spinRelaxation auto every hit after a parcel's first drawn rebound arrives
+    with that rebound's Ω⁺, relaxed with τ_r = ρ_p (2a)²/(60 μ), and under auto goes to the direct model; with off
+    none does, and the direct model answers the hits outside the grid only. The remembered spin is the colliding
+    cloud's (serial_case): no fluid torque acts on colliding parcels in v1912 and τ_r (25-100 ms) is long against
+    the flights."""
+    on, off = (kinematic_runs[name] for name in ("kinematic", "kinematic_off"))
+    info = {name: _cloud_info((case / KINEMATIC_LOG).read_text()) for name, case in (("on", on), ("off", off))}
+    colliding = _cloud_info((serial_case / f"log.{SOLVER}").read_text())
+    hits, _ = compare_rebounds.read_hits(on)
+    off_hits, _ = compare_rebounds.read_hits(off)
+    with capsys.disabled():
+        for name, i in info.items():
+            print(f"\nkinematic cloud, spin memory {name}: {i['hits']} hits, {i['direct']} by the direct model "
+                  f"({i['direct'] / i['hits']:.3f}), {i['outside']} outside the grid, remembered spin "
+                  f"{i['remembered']}, incoming |Omega|a/|V| mean {i['spin_mean']}")
+        print(f"colliding cloud: {colliding['hits']} hits, {colliding['direct']} by the direct model "
+              f"({colliding['direct'] / colliding['hits']:.3f}), |Omega|a/|V| mean {colliding['spin_mean']:.3f}")
+    # off: no memory, no spin, the direct model for the hits outside the grid only
+    assert info["off"]["remembered"] is None and info["off"]["spin_mean"] is None
+    assert "spin memory (spinRelaxation) = off" in (off / KINEMATIC_LOG).read_text()
+    assert info["off"]["direct"] == info["off"]["outside"] and not off_hits["Win"].any()
+    # auto: every hit but each parcel's first arrives with a remembered spin, and all of those are answered by
+    # the direct model (|Ω⁻|a/|V⁻| far above the tolerance)
+    first = np.unique(_parcel_keys(hits), return_index=True)[1]
+    later = np.ones(len(hits["time"]), bool)
+    later[first] = False
+    spinning = np.linalg.norm(hits["Win"], axis=1) > 0
+    assert np.array_equal(spinning, later) and info["on"]["remembered"] == later.sum() > 5000, info["on"]
+    assert np.all(hits["path"][later] == compare_rebounds.PATH_DIRECT)
+    assert info["on"]["direct"] > 0.4 * info["on"]["hits"] > info["off"]["direct"], info
+    parcels = _cloud_parcels((on / KINEMATIC_LOG).read_text())
+    assert info["on"]["missed"] == 0 and info["on"]["held"] <= parcels["current"], (info["on"], parcels)
+    # the spin the colliding cloud carries itself
+    assert info["on"]["spin_mean"] == pytest.approx(colliding["spin_mean"], rel=0.1), (info["on"], colliding)
+    # τ_r = ρ_p (2a)²/(60 μ) at the later hit, μ the air's
+    i, j = _next_hits(hits)
+    tau = SAND_DENSITY * (2 * hits["a"][j]) ** 2 / (60 * cases.AIR_MU)
+    _check_relaxation(hits, i, j, tau, delta_t=2e-5)
+    # the parcels' rebounds follow the direct model's law at their remembered spins
+    assert compare_rebounds.compare(on, classifier=False)["comparison"].ok
+
+
+def test_spin_relaxation_over_the_flight_and_over_a_restart(runs_folder):
+    """spinRelaxation 2e-4 s (cases.CASES["kinematic_tau"], run to 2.5 ms): each later hit's Ω⁻ is the last Ω⁺
+    relaxed over the flight, exp(−Δt/τ_r); the remembered spins are written with the parcels at the write time
+    and read back by a restart, which goes on relaxing them from the rebounds before it."""
+    case = _case(runs_folder, "kinematic_tau")
+    tau = cases.SPIN_RELAXATION_S
+    before, _ = compare_rebounds.read_hits(case)
+    i, j = _next_hits(before)
+    assert len(i) > 300
+    _check_relaxation(before, i, j, tau, delta_t=2e-5)
+    # written with the cloud at 2.5 ms: one value per parcel, zero for those that never rebounded
+    cloud = case / "0.0025" / "lagrangian" / "kinematicCloud"
+    omega = (cloud / "stochasticReboundOmega").read_text()
+    n_parcels = int(re.search(r"\n(\d+)\n\(", (cloud / "origId").read_text()).group(1))
+    values = re.findall(r"^\(([-0-9.e+ ]+)\)$", omega.split("\n(", 1)[1], re.M)
+    assert len(values) == n_parcels and (cloud / "stochasticReboundTime").is_file()
+    remembered = sum(any(float(v) for v in value.split()) for value in values)
+    assert remembered > 1000
+    # the restart: to 5 ms from 2.5 ms
+    control = case / "system" / "controlDict"
+    text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.005;", control.read_text())
+    control.write_text(re.sub(r"\nstartFrom\s+[^;]+;", "\nstartFrom       latestTime;", text))
+    _run(["bash", "-c", f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {cases.KINEMATIC_SOLVER} > log.restart 2>&1"],
+         cwd=case)
+    log = (case / "log.restart").read_text()
+    assert f"stochasticRebound: read the remembered spins of {remembered} parcels" in log
+    after, _ = compare_rebounds.read_hits(case)
+    # each parcel's first hit after the restart against its last rebound before it (written to 8 digits)
+    last = {key: row for row, key in enumerate(_parcel_keys(before).tolist())}
+    keys_after = _parcel_keys(after).tolist()
+    first_after = {}
+    for row, key in enumerate(keys_after):
+        first_after.setdefault(key, row)
+    pairs = [(last[key], row) for key, row in first_after.items() if key in last]
+    assert len(pairs) > 1000
+    joined = {name: np.concatenate([before[name], after[name]]) for name in ("Win", "Wout", "time")}
+    i = np.array([p[0] for p in pairs])
+    j = np.array([p[1] for p in pairs]) + len(before["time"])
+    _check_relaxation(joined, i, j, tau, delta_t=2e-5, rtol=1e-7, time_slack=1e-9)
+    # the counts go on from the ones stored at the write
+    assert _cloud_info(log)["remembered"] == int(np.sum(np.linalg.norm(joined["Win"], axis=1) > 0))
+
+
+def test_spin_follows_a_parcel_to_another_rank(kinematic_runs):
+    """On 2 ranks the remembered spins of the parcels that crossed to the other rank in a time step are handed
+    over at its end: every hit after a parcel's first used its remembered spin, but for the hits of parcels that
+    crossed and hit in the same time step, which the summary counts as missed."""
+    case = kinematic_runs["kinematic_parallel"]
+    info = _cloud_info((case / KINEMATIC_LOG).read_text())
+    hits, _ = compare_rebounds.read_hits(case)
+    keys = _parcel_keys(hits)
+    spinning = np.linalg.norm(hits["Win"], axis=1) > 0
+    first = np.unique(keys, return_index=True)[1]
+    assert info["remembered"] == spinning.sum() and info["remembered"] + info["missed"] == len(keys) - len(first)
+    assert info["missed"] < 0.01 * info["remembered"], info
+    # hits on a rank a parcel came to after hitting on the other: its spin came with it
+    crossed = 0
+    for key in np.unique(keys):
+        rows = np.flatnonzero(keys == key)
+        rows = rows[np.argsort(hits["time"][rows], kind="stable")]
+        ranks = hits["rank"][rows]
+        if len(set(ranks.tolist())) == 2:
+            arrival = rows[np.argmax(ranks != ranks[0])]
+            crossed += bool(spinning[arrival])
+    assert crossed > 100, crossed
