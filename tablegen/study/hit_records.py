@@ -81,6 +81,15 @@ def parse_header(line: str, title: str) -> dict:
             "grain_seed": int(m.group(10)) if m.group(10) else None}
 
 
+def _is_number(text: str, integer: bool) -> bool:
+    """Whether ``text`` reads as an int (``integer``) or a float."""
+    try:
+        int(text) if integer else float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def read_hit_files(files, title: str) -> tuple[dict, list]:
     """The hit records of ``files`` (in the order given) as columns, and each file's settings.
 
@@ -106,6 +115,10 @@ def read_hit_files(files, title: str) -> tuple[dict, list]:
                 row = line.rstrip("\n").split(",")
                 if len(row) != len(columns):
                     raise ValueError(f"{f}, line {line_no}: {len(row)} fields, not {len(columns)}")
+                for name, value in zip(columns, row):
+                    if name not in _TEXT_COLUMNS and not _is_number(value, name in _INTEGER_COLUMNS):
+                        raise ValueError(f"{f}, line {line_no}: column {name} is not "
+                                         f"{'an integer' if name in _INTEGER_COLUMNS else 'a number'}: {value!r}")
                 rows.append(row + missing)
     cols = {}
     for j, name in enumerate(HIT_COLUMNS):

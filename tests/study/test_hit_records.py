@@ -84,6 +84,12 @@ def test_a_file_of_another_layout_is_named(tmp_path):
     (tmp_path / "hits_0.csv").write_text(text + "1,2,3\n")
     with pytest.raises(ValueError, match=rf"hits_0.csv, line 5: 3 fields, not {len(HIT_COLUMNS)}"):
         read_hit_files(rank_files(tmp_path), "stochasticRebound")
+    for column, value, kind in (("Vx", "abc", "a number"), ("origId", "1.5", "an integer")):
+        row = text.splitlines()[3].split(",")
+        row[HIT_COLUMNS.index(column)] = value
+        (tmp_path / "hits_0.csv").write_text("\n".join(text.splitlines()[:3] + [",".join(row)]) + "\n")
+        with pytest.raises(ValueError, match=rf"hits_0.csv, line 4: column {column} is not {kind}: '{value}'"):
+            read_hit_files(rank_files(tmp_path), "stochasticRebound")
     (tmp_path / "hits_0.csv").write_text(text.replace("Winx", "Wx0"))
     with pytest.raises(ValueError, match="line 3 is not the hits columns"):
         read_hit_files(rank_files(tmp_path), "stochasticRebound")
