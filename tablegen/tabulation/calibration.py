@@ -48,7 +48,7 @@ DEFAULT_SEED = 1
 STEP = 0.05
 XTOL = 2e-3                     # a step this small relative to the fit coordinates ends the fit: below the model noise
 FTOL = 1e-4                     # a step that lowers the cost by less than this fraction of it ends the fit too
-MAX_STEPS = 40                  # trial points per stage (scipy's max_nfev); each accepted one adds a Jacobian
+MAX_STEPS = 40                  # trial points per stage (least_squares_fit); each accepted one adds a Jacobian
 WALL_FILE_KIND = "wall_law"
 FIGURE_KIND = "wall_law_figure"
 INSTALL_HINT = 'pip install "rebound-scatter[plots]"'
@@ -281,11 +281,16 @@ def model_means(wall: WallMaterial, alpha1, speed, bodies, weights, counts, seed
                 rebounded = result.velocity[result.status == 0, :2] / v
                 if len(rebounded):
                     share[j] = weights[j] * len(rebounded) / counts[j]
-                    part_mean[j] = rebounded.mean(axis=0)
-                    part_var[j] = rebounded.var(axis=0) / len(rebounded)
-            if share.sum() > 0:
-                c = share / share.sum()
-                means[i], variances[i] = c @ part_mean, c ** 2 @ part_var
+                    for k in range(2):
+                        mean = math.fsum(rebounded[:, k]) / len(rebounded)
+                        part_mean[j, k] = mean
+                        part_var[j, k] = math.fsum((rebounded[:, k] - mean) ** 2) / len(rebounded) ** 2
+            total = math.fsum(share)
+            if total > 0:
+                c = share / total
+                for k in range(2):
+                    means[i, k] = _dot(c, part_mean[:, k])
+                    variances[i, k] = _dot(c ** 2, part_var[:, k])
     return means, variances
 
 
@@ -312,7 +317,8 @@ def residual_variance(sd, count, model_variance, sd_estimate) -> np.ndarray:
 def estimated_sd(residual, count, n_free: int) -> np.ndarray:
     """(2,) each quantity's sd over the particles, the same in every row, from the residuals (m, 2) of the fit:
     sqrt(Σ n r² / (m − n_free / 2)), each quantity carrying half the free parameters."""
-    return np.sqrt(np.sum(count[:, None] * residual ** 2, axis=0) / (len(residual) - n_free / 2.0))
+    return np.array([math.sqrt(math.fsum(count * residual[:, k] ** 2) / (len(residual) - n_free / 2.0))
+                     for k in range(residual.shape[1])])
 
 
 def jacobian(residuals: Callable, t, step: float = STEP, central: bool = False, at=None) -> np.ndarray:
@@ -334,7 +340,108 @@ def jacobian(residuals: Callable, t, step: float = STEP, central: bool = False, 
 def covariance(jac, scale: float = 1.0) -> np.ndarray:
     """(P, P) covariance of the fit coordinates from the Jacobian of the weighted residuals, (JᵀJ)⁻¹ × ``scale``
     (a pseudo-inverse: parameters the data cannot tell apart get a large, not a failing, variance)."""
-    return np.linalg.pinv(jac.T @ jac) * scale
+    return _pseudo_inverse(_normal_matrix(jac)) * scale
+
+
+# Deterministic linear algebra for the few fit coordinates: exactly rounded sums (math.fsum) and plain loops, no
+# BLAS or SIMD reduction, so that a fit gives the same bits on any x86-64 CPU (numpy's and OpenBLAS's kernels
+# differ by CPU and moved the fitted k by 1e-6 relative).
+
+def _dot(a, b) -> float:
+    """a · b, exactly rounded."""
+    return math.fsum(np.asarray(a, dtype=float) * np.asarray(b, dtype=float))
+
+
+def _normal_matrix(jac) -> np.ndarray:
+    """JᵀJ of the (N, P) Jacobian, each entry exactly rounded."""
+    p = jac.shape[1]
+    return np.array([[_dot(jac[:, i], jac[:, j]) for j in range(p)] for i in range(p)])
+
+
+def _solve(a, b) -> np.ndarray:
+    """x with a x = b for a small (P, P) matrix: Gaussian elimination with partial pivoting, in Python floats."""
+    m = [list(map(float, row)) + [float(v)] for row, v in zip(a, b)]
+    p = len(m)
+    for col in range(p):
+        pivot = max(range(col, p), key=lambda r: abs(m[r][col]))
+        m[col], m[pivot] = m[pivot], m[col]
+        if m[col][col] == 0.0:
+            raise ZeroDivisionError("singular")
+        for r in range(col + 1, p):
+            f = m[r][col] / m[col][col]
+            m[r] = [x - f * y for x, y in zip(m[r], m[col])]
+    x = [0.0] * p
+    for r in range(p - 1, -1, -1):
+        x[r] = (m[r][p] - math.fsum(m[r][c] * x[c] for c in range(r + 1, p))) / m[r][r]
+    return np.array(x)
+
+
+def _pseudo_inverse(a) -> np.ndarray:
+    """The pseudo-inverse of a small symmetric positive semi-definite matrix: cyclic Jacobi eigenvalues, the
+    eigenvalues below 1e-12 of the largest taken as zero."""
+    p = len(a)
+    a = [list(map(float, row)) for row in a]
+    v = [[float(i == j) for j in range(p)] for i in range(p)]
+    for _ in range(100):
+        off = math.fsum(a[i][j] ** 2 for i in range(p) for j in range(p) if i != j)
+        if off <= 1e-30 * math.fsum(a[i][i] ** 2 for i in range(p)):
+            break
+        for i in range(p - 1):
+            for j in range(i + 1, p):
+                if a[i][j] == 0.0:
+                    continue
+                theta = (a[j][j] - a[i][i]) / (2.0 * a[i][j])
+                t = math.copysign(1.0, theta) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                s = t * c
+                for k in range(p):          # a := a R, then a := Rᵀ a, R the rotation in the (i, j) plane
+                    aki, akj = a[k][i], a[k][j]
+                    a[k][i], a[k][j] = c * aki - s * akj, s * aki + c * akj
+                for k in range(p):
+                    aik, ajk = a[i][k], a[j][k]
+                    a[i][k], a[j][k] = c * aik - s * ajk, s * aik + c * ajk
+                for k in range(p):
+                    vki, vkj = v[k][i], v[k][j]
+                    v[k][i], v[k][j] = c * vki - s * vkj, s * vki + c * vkj
+    eig = [a[i][i] for i in range(p)]
+    top = max(eig, default=0.0)
+    inv = [1.0 / e if e > 1e-12 * top else 0.0 for e in eig]
+    return np.array([[math.fsum(v[i][k] * inv[k] * v[j][k] for k in range(p)) for j in range(p)] for i in range(p)])
+
+
+def least_squares_fit(residuals: Callable, t0, xtol: float = XTOL, ftol: float = FTOL,
+                      max_steps: int = MAX_STEPS) -> np.ndarray:
+    """The coordinates minimising ½|residuals(t)|² from ``t0``: Levenberg–Marquardt with forward-difference
+    Jacobians (:func:`jacobian`) and the deterministic arithmetic above. Ends when a step is below ``xtol``
+    relative to t, when it lowers the cost by less than ``ftol`` of it, or after ``max_steps`` trial points."""
+    t = np.asarray(t0, dtype=float)
+    r = residuals(t)
+    cost = 0.5 * _dot(r, r)
+    damping, trials = 1e-3, 0
+    while trials < max_steps:
+        jac = jacobian(residuals, t, at=r)
+        a, g = _normal_matrix(jac), np.array([_dot(jac[:, i], r) for i in range(jac.shape[1])])
+        while trials < max_steps:
+            damped = a + np.diag([damping * (d if d > 0.0 else 1.0) for d in np.diag(a)])
+            try:
+                step = _solve(damped, -g)
+            except ZeroDivisionError:
+                return t
+            trial = t + step
+            r_trial = residuals(trial)
+            trials += 1
+            cost_trial = 0.5 * _dot(r_trial, r_trial)
+            if cost_trial < cost:
+                done = (math.sqrt(_dot(step, step)) <= xtol * (xtol + math.sqrt(_dot(t, t)))
+                        or cost - cost_trial <= ftol * cost)
+                t, r, cost, damping = trial, r_trial, cost_trial, max(damping / 10.0, 1e-12)
+                if done:
+                    return t
+                break
+            damping *= 10.0
+            if damping > 1e12:
+                return t
+    return t
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -406,7 +513,7 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
     ``log``: None, or called with one warning line naming the data's columns that the fit ignores, once the
     arguments are checked (so that a refusal is the only line).
 
-    The fit is weighted least squares (scipy's trust-region ``least_squares``) in the coordinates of
+    The fit is weighted least squares (:func:`least_squares_fit`, the same bits on any CPU) in the coordinates of
     :data:`TRANSFORMS`, from the published law; a residual's variance is :func:`residual_variance`, the model's
     variance taken at the stage's start. Where an sd is missing, a first stage takes it as the model's own scatter
     among particles at the published law and a second refits from the first's optimum with it estimated from the
@@ -414,8 +521,6 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
     determine the free parameters (fewer rows than them; one speed with both of :data:`ONE_SPEED_TRADE_OFFS`
     free), a parameter to fix is unknown or out of its range, or the model leaves a row without rebounds.
     """
-    from scipy.optimize import least_squares
-
     law = wall_family(family)
     fixed = dict(fixed or {})
     unknown = [name for name in fixed if name not in law.parameter_names]
@@ -484,16 +589,14 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
         return residual_variance(data.sd, data.count, evaluate(values_at(t))[1], sd_estimate)
 
     def fit(t0, variance):
-        def residuals(t):
-            return weighted(t, variance)
-        return least_squares(residuals, t0, jac=lambda t: jacobian(residuals, t, at=residuals(t)), method="trf",
-                             x_scale=1.0, xtol=XTOL, ftol=FTOL, max_nfev=MAX_STEPS).x
+        return least_squares_fit(lambda t: weighted(t, variance), t0)
 
     start = {**default_values, **fixed}
     t = np.array([tr.forward(start[name]) for name, tr in zip(free, transforms)])
     # stage 1: a missing sd starts as the model's own scatter among particles at the published law
     model_variance = evaluate(start)[1]
-    sd_estimate = np.where(data.sd_given, np.nan, np.sqrt(np.mean(model_variance * particles, axis=0)))
+    sd_estimate = np.where(data.sd_given, np.nan, [math.sqrt(math.fsum(model_variance[:, k] * particles) / m)
+                                                   for k in range(2)])
     variance = stage_variance(t, sd_estimate)
     t = fit(t, variance)
     if not np.all(data.sd_given):
@@ -503,7 +606,7 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
         variance = stage_variance(t, sd_estimate)
         t = fit(t, variance)
     fitted, fitted_variance = evaluate(values_at(t))
-    chi2 = float(np.sum((fitted - data.mean) ** 2 / variance))
+    chi2 = math.fsum(((fitted - data.mean) ** 2 / variance).ravel())
     dof = 2 * m - len(free)
     scaled = not bool(np.all(data.sd_given))
     cov = covariance(jacobian(lambda x: weighted(x, variance), t, central=True), chi2 / dof if scaled else 1.0)

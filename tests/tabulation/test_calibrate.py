@@ -4,6 +4,8 @@ refused in one line with exit 2 and nothing written; the [wall] section written 
 configuration reader."""
 
 import functools
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ from direct_model.wall import WallMaterial
 from tablegen.cli import main
 from tablegen.tabulation import calibration as cal
 from tablegen.tabulation.config import load_config, parse_config
+from tests.helpers import REPO, cpu_dispatch
 from tests.helpers.cli import run_cli, user_error
 
 _run = functools.partial(run_cli, main)
@@ -131,6 +134,25 @@ def test_command_line_fit_writes_a_wall_section_the_build_reads(tmp_path, capsys
     _user_error(argv[:4] + [str(foreign)] + argv[5:] + ["--overwrite"], capsys, str(foreign), "not an output")
     assert foreign.read_text() == "[wall]\nk = 1.0\n"
     assert _run(argv + ["--overwrite"], capsys)[0] == 0 and load_config(out).wall.q == wall.q
+
+
+def test_a_fit_gives_the_same_bits_on_other_simd_code_paths(tmp_path):
+    """tablegen calibrate with numpy and OpenBLAS forced onto their baseline kernels (tests.helpers.cpu_dispatch)
+    writes the very file of the default ones: the fit's sums and solves do not go through them (scipy's
+    least_squares moved k by 1e-6 relative there)."""
+    data = _csv(tmp_path, HEADER + "".join(GOOD_ROWS) + "40,60,0.45,0.55,0.15,0.2,50\n")
+    written = {}
+    for case in ("default", "baseline"):
+        env = cpu_dispatch.environment(case, generic_numba=False)
+        out = tmp_path / f"{case}.toml"
+        done = subprocess.run([sys.executable, "-m", "tablegen.cli", "calibrate", "--data", str(data), "-o", str(out),
+                               "--fix", "q=1", "--shapes", "prism", "--particles", "200", "--no-progress"],
+                              env=env, capture_output=True, text=True, timeout=600, cwd=REPO)
+        assert done.returncode == 0, done.stderr[-2000:]
+        written[case] = out.read_bytes()
+        if case == "baseline":
+            assert cpu_dispatch.code_paths(env) != cpu_dispatch.code_paths(cpu_dispatch.environment("default"))
+    assert written["baseline"] == written["default"]
 
 
 @pytest.mark.parametrize("rows, words", [
