@@ -344,8 +344,7 @@ def covariance(jac, scale: float = 1.0) -> np.ndarray:
 
 
 # Deterministic linear algebra for the few fit coordinates: exactly rounded sums (math.fsum) and plain loops, no
-# BLAS or SIMD reduction, so that a fit gives the same bits on any x86-64 CPU (numpy's and OpenBLAS's kernels
-# differ by CPU and moved the fitted k by 1e-6 relative).
+# BLAS or SIMD reduction: numpy's and OpenBLAS's kernels differ by CPU, and a fit must give the same bits on any.
 
 def _dot(a, b) -> float:
     """a · b, exactly rounded."""

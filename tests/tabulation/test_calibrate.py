@@ -138,8 +138,7 @@ def test_command_line_fit_writes_a_wall_section_the_build_reads(tmp_path, capsys
 
 def test_a_fit_gives_the_same_bits_on_other_simd_code_paths(tmp_path):
     """tablegen calibrate with numpy and OpenBLAS forced onto their baseline kernels (tests.helpers.cpu_dispatch)
-    writes the very file of the default ones: the fit's sums and solves do not go through them (scipy's
-    least_squares moved k by 1e-6 relative there)."""
+    writes the very file of the default ones: the fit's sums and solves do not go through them."""
     data = _csv(tmp_path, HEADER + "".join(GOOD_ROWS) + "40,60,0.45,0.55,0.15,0.2,50\n")
     written = {}
     for case in ("default", "baseline"):
