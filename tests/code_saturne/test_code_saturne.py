@@ -20,6 +20,7 @@ Copyright (C) 2026 the rebound-scatter authors. License: GPL-2.0-or-later
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import subprocess
@@ -400,8 +401,9 @@ def test_each_particle_hits_as_one_grain_of_the_mix(serial_case, parallel_case, 
     ({"method": "tabel"}, ["method must be auto, table or direct, not \"tabel\""]),
     ({"interpolaton": "scaled"}, ["unknown key \"interpolaton\""]),
     ({"grain": "once"}, ["grain must be kept or perHit, not \"once\""]),
+    ({"hits_every": "0"}, ["hits_every must be an integer in [1, 9223372036854775807], not \"0\""]),
 ], ids=["missing table", "unknown shape", "negative seed", "seed not a number", "unknown method",
-        "misspelled key", "unknown grain mode"])
+        "misspelled key", "unknown grain mode", "zero hits_every"])
 def test_bad_setup_is_one_clear_error_from_the_solver(cs_build, case_table, tmp_path_factory, edits, words):
     case = _copy_case(tmp_path_factory, "cs_bad_setup")
     for key, value in edits.items():
@@ -593,9 +595,11 @@ def test_each_zone_draws_from_its_own_table(zones_case, wall_tables):
 
 def test_deposit_and_outlet_zones(cs_build, wall_tables, tmp_path_factory):
     """A deposit zone keeps every particle that hits it, at rest (the solver counts them as deposited), an
-    outlet zone lets every one leave; neither is recorded, both are counted."""
+    outlet zone lets every one leave; neither is recorded, both are counted. The records are thinned
+    (hits_every = 3): the 1st, 4th, 7th, ... of the walls' hits, as the file's second line says."""
+    # hits_every before the sections: a global key
     case = _zones_case(tmp_path_factory, "cs_stock_zones", wall_tables,
-                       "\n[zone sides]\ntype = deposit\n[zone target]\ntype = outlet\n")
+                       "hits_every = 3\n\n[zone sides]\ntype = deposit\n[zone target]\ntype = outlet\n")
     _allrun(case, wall_tables["elastic"])
     rows = zone_summary((case / "RESU" / "run_solver.log").read_text())
     assert {z: r["interaction"] for z, r in rows.items()} == {
@@ -604,6 +608,12 @@ def test_deposit_and_outlet_zones(cs_build, wall_tables, tmp_path_factory):
     assert rows["target"]["escaped"] == rows["target"]["hits"] > 100
     hits, _ = read_hits(case / "RESU")
     assert set(hits["patch"].tolist()) == {"walls"}
+    # one rank: its walls hits are all the hits it would record, of which every 3rd is written
+    assert len(hits["status"]) == math.ceil(rows["walls"]["hits"] / 3), rows["walls"]
+    with (case / "RESU" / "hits" / "hits_0.csv").open() as f:
+        f.readline()
+        assert f.readline().startswith("# Every 3rd hit (hits_every 3): the 1st, 4th, 7th, ... of the hits this "
+                                       "rank would record. V: incident velocity")
     lagr = _lagrangian_log(case)
     assert lagr[:, 8].sum() == rows["sides"]["stuck"] + rows["walls"]["stuck"]
     assert lagr[:, 6].sum() >= rows["target"]["escaped"] and lagr[:, 10].sum() == 0

@@ -277,6 +277,10 @@ def _then(*edits):
     return edit
 
 
+# the run "restart" writes every 3rd hit of its first half, whose draws are the run "serial"'s first 2.5 ms: its
+# rows are every 3rd of serial's there
+RESTART_HITS_EVERY = 3
+
 # the relaxation time of the run "kinematic_tau": of the order of the flights between hits (0.1-1 ms), so that the
 # remembered spin decays measurably
 SPIN_RELAXATION_S = 2e-4
@@ -288,7 +292,8 @@ CASES = {
     "standard1": ("case", 1, "standardWallInteraction", None),
     "standard2": ("case", 2, "standardWallInteraction", None),
     "many_shapes": ("many_shapes", 1, "stochasticRebound", lambda case: set_coeff(case, "shape", "mix")),
-    "restart": ("case", 1, "stochasticRebound", _first_half),
+    "restart": ("case", 1, "stochasticRebound",
+                _then(_first_half, lambda case: insert_coeff(case, f"hitsEvery {RESTART_HITS_EVERY};"))),
     "moving": ("case", 1, "stochasticRebound",
                _then(_moving_walls, lambda case: set_weights(
                    case, f"prism {{ weight 1; halfSizeFactor {PRISM_HALF_SIZE_FACTOR}; }}"))),

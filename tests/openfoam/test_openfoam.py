@@ -325,18 +325,38 @@ def test_each_parcel_hits_as_one_grain_on_one_and_two_ranks(serial_case, paralle
     assert {p[0] for p in serial_rows} == {0} and {p[0] for p in rows} == {1}
 
 
-def test_a_parcel_keeps_its_grain_over_a_restart(runs_folder, case_table):
+def _check_every_kth_hit(thinned: Path, full: Path, k: int, said: str, end: float) -> None:
+    """The hits file of ``thinned`` (serial, hitsEvery k, run to ``end``) holds every k-th row of ``full``'s up to
+    ``end``, from its first: the same draws, bit for bit; its first header line is full's (the case's folder
+    aside), its second says ``said`` ahead of full's text."""
+    rows = {case: (case / HITS / "hits_0.csv").read_text().splitlines() for case in (thinned, full)}
+    lines = [line.replace(str(full), str(thinned)) for line in rows[full][:3]]
+    assert rows[thinned][0] == lines[0] and rows[thinned][2] == lines[2]
+    assert rows[thinned][1] == f"# {said} " + lines[1][2:]
+    until_end = [row for row in rows[full][3:] if float(row.split(",", 1)[0]) <= end]
+    assert len(until_end) > 1000 and rows[thinned][3:] == until_end[::k]
+
+
+def test_a_parcel_keeps_its_grain_over_a_restart(runs_folder, serial_case, case_table):
     """The case run to 2.5 ms (cases.CASES["restart"]), then restarted from its written time to 5 ms with another
     seed (new streams) and grainSeed the first run's: the parcels (their ids are written with the cloud and read
-    back) hit after the restart as the grains they were before it."""
+    back) hit after the restart as the grains they were before it. The first run draws as the serial run does
+    and wrote every 3rd hit (hitsEvery 3): its rows are every 3rd of the serial run's to 2.5 ms, whose hits stand
+    for its own."""
     case = _case(runs_folder, "restart")
-    before, before_headers = compare_rebounds.read_hits(case)
+    _check_every_kth_hit(case, serial_case, cases.RESTART_HITS_EVERY, "Every 3rd hit (hitsEvery 3): the 1st, 4th, "
+                         "7th, ... of the hits this rank would record.", 0.0025)
+    _, before_headers = compare_rebounds.read_hits(case)
+    serial, _ = compare_rebounds.read_hits(serial_case)
+    before = {name: column[serial["time"] <= 0.0025] for name, column in serial.items()}
     control = case / "system" / "controlDict"
     text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.005;", control.read_text())
     control.write_text(re.sub(r"\nstartFrom\s+[^;]+;", "\nstartFrom       latestTime;", text))
     seed = before_headers[0]["seed"]
     cases.set_coeff(case, "seed", str(seed + 1))
     cases.insert_coeff(case, f"grainSeed {seed};")
+    # every hit again: the grain checks below need them all
+    cases.set_coeff(case, "hitsEvery", "1")
     script = f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {SOLVER} > log.restart 2>&1"
     _run(["bash", "-c", script], cwd=case)
     assert "Starting time loop" in (case / "log.restart").read_text()
@@ -681,6 +701,7 @@ def test_bad_patches_entries_stop_before_the_first_step(openfoam_build, case_tab
     (lambda c: cases.insert_coeff(c, "interpolaton stochastic;"), ["unknown entry interpolaton", "interpolation"]),
     (lambda c: cases.insert_coeff(c, "weights { prism 1; }"), ["shape and weights are both given"]),
     (lambda c: cases.set_coeff(c, "maxHitRecords", "-1"), ["maxHitRecords must be >= 0, not -1"]),
+    (lambda c: cases.insert_coeff(c, "hitsEvery 2.5;"), ["hitsEvery must be an integer >= 1, not 2.5"]),
     (lambda c: cases.insert_coeff(c, "method tabel;"), ["method must be auto, table or direct, not tabel"]),
     (lambda c: cases.insert_coeff(c, "grain once;"), ["grain must be kept or perHit, not once"]),
     (lambda c: cases.insert_coeff(c, "spinRelaxation fast;"),
@@ -698,7 +719,8 @@ def test_bad_patches_entries_stop_before_the_first_step(openfoam_build, case_tab
 def test_dictionary_contradictions_and_unknown_entries_are_fatal(openfoam_build, case_table, tmp_path_factory,
                                                                  edit, words):
     """A misspelled entry silently fell back to its default, shape was ignored under weights, and
-    maxHitRecords -1 wrote nothing: each is now a FatalIOError naming the entry, before any time step."""
+    maxHitRecords -1 wrote nothing: each is now a FatalIOError naming the entry, before any time step (so is a
+    hitsEvery that is no integer >= 1)."""
     log = _refused(case_table, tmp_path_factory.mktemp("bad_dictionary"), edit)
     for word in words:
         assert word in log, log[-3000:]

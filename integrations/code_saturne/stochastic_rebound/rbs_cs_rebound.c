@@ -130,6 +130,7 @@ typedef struct {
   int         keep_grain;                   /* 1: kept, 0: a new grain per hit */
   uint64_t    grain_seed;                   /* the keys' seed */
   long long   max_hit_records;
+  long long   hits_every;                   /* k: the 1st, (k+1)-th, ... hit */
 } rbs_cs_settings_t;
 
 /* The drawn hits (a table or the direct model answered) of all zones; the
@@ -166,6 +167,7 @@ static cs_gnum_t          *_zone_count = NULL;    /* ZC_N per zone */
 static rbs_rng             _rng;
 static FILE               *_hits = NULL;
 static long long           _n_recorded = 0;
+static unsigned long long  _n_recordable = 0;   /* hits_every counts these */
 static rbs_cs_counters_t   _count;
 
 /* CPU seconds of the calling thread: what the hits cost whatever else runs on
@@ -186,7 +188,7 @@ _thread_cpu_seconds(void)
 static const char *_keys[] = {"type", "table", "shape", "weights", "method",
                               "interpolation", "trapped", "seed",
                               "half_size_factor", "hits", "max_hit_records",
-                              "grain", "grain_seed"};
+                              "hits_every", "grain", "grain_seed"};
 #define RBS_CS_N_KEYS (sizeof(_keys)/sizeof(_keys[0]))
 #define RBS_CS_N_SECTION_KEYS 7
 
@@ -346,8 +348,8 @@ _read_settings_file(const char *path, int *n_blocks)
                 "rebound-scatter settings %s, line %d: unknown key \"%s\"; "
                 "the keys are table, shape, weights, seed, method, "
                 "interpolation, trapped, half_size_factor, hits, "
-                "max_hit_records, grain, grain_seed, then [zone NAME] "
-                "sections", path, line_no, key);
+                "max_hit_records, hits_every, grain, grain_seed, then "
+                "[zone NAME] sections", path, line_no, key);
     if (b->zone[0] == '\0' && i == 0)
       bft_error(__FILE__, __LINE__, 0,
                 "rebound-scatter settings %s, line %d: type is a key of a "
@@ -658,6 +660,10 @@ _read_settings(void)
     : _parse_integer(where, "max_hit_records", max_rec, 0,
                      9223372036854775807LL);
 
+  const char *every = _value(g, "hits_every");
+  _set.hits_every = (every == NULL) ? 1
+    : _parse_integer(where, "hits_every", every, 1, 9223372036854775807LL);
+
   /* Rule 0, the global settings: the defaults of every section */
   BFT_MALLOC(_rules, 1, rbs_cs_rule_t);
   _n_rules = 1;
@@ -749,6 +755,20 @@ _describe(const rbs_cs_rule_t *rule, int full, char *out, size_t size)
  * The hits file of this rank: the layout of the OpenFOAM adapter's
  *----------------------------------------------------------------------------*/
 
+/* n as an English ordinal (1st, 2nd, 3rd, 4th, 11th, 21st) in `out` (32
+   characters), for the hits file's words on hits_every */
+static const char *
+_ordinal(unsigned long long n, char out[32])
+{
+  const unsigned long long tens = n % 100;
+  const char *suffix = (tens >= 11 && tens <= 13) ? "th"
+                       : n % 10 == 1 ? "st"
+                       : n % 10 == 2 ? "nd"
+                       : n % 10 == 3 ? "rd" : "th";
+  snprintf(out, 32, "%llu%s", n, suffix);
+  return out;
+}
+
 static void
 _open_hits(int rank)
 {
@@ -799,8 +819,18 @@ _open_hits(int rank)
             (unsigned long long)_set.grain_seed);
   else
     fprintf(_hits, "perHit\n");
+  fprintf(_hits, "# ");
+  if (_set.hits_every > 1) {
+    /* a reader of the file must know it holds a sample */
+    const unsigned long long k = (unsigned long long)_set.hits_every;
+    char kth[32], second[32], third[32];
+    fprintf(_hits,
+            "Every %s hit (hits_every %llu): the 1st, %s, %s, ... of the hits "
+            "this rank would record. ", _ordinal(k, kth), k,
+            _ordinal(k + 1, second), _ordinal(2*k + 1, third));
+  }
   fprintf(_hits,
-          "# V: incident velocity relative to the wall (at rest), Win: "
+          "V: incident velocity relative to the wall (at rest), Win: "
           "incident angular velocity (0: code_saturne 6.0's particles carry "
           "none), n: unit normal into the gas, Uw: wall velocity, patch: "
           "boundary zone, origProc/origId: -1 (6.0's particles carry no "
@@ -834,6 +864,9 @@ _record_hit(int b_zone_id, const rbs_cs_rule_t *rule, double d,
             const rbs_hit *hit, const rbs_result *result, int path, double u0)
 {
   if (_hits == NULL || _n_recorded >= _set.max_hit_records)
+    return;
+  /* hits_every k keeps the 1st, (k+1)-th, ... hit of those this rank records */
+  if (_n_recordable++ % (unsigned long long)_set.hits_every != 0)
     return;
   _n_recorded++;
   const cs_zone_t *z = cs_boundary_zone_by_id(b_zone_id);

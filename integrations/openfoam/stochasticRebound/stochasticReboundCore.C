@@ -102,6 +102,20 @@ const char* interpolationName(int interpolation)
         ? "stochastic" : "scaled";
 }
 
+// n as an English ordinal (1st, 2nd, 3rd, 4th, 11th, 21st), for the hits
+// file's words on hitsEvery
+std::string ordinal(uint64_t n)
+{
+    const uint64_t tens = n % 100;
+    const char* suffix =
+        tens >= 11 && tens <= 13 ? "th"
+      : n % 10 == 1 ? "st"
+      : n % 10 == 2 ? "nd"
+      : n % 10 == 3 ? "rd"
+      : "th";
+    return std::to_string(n) + suffix;
+}
+
 // A halfSizeFactor: finite and > 0
 scalar positiveFactor
 (
@@ -810,6 +824,11 @@ void Foam::stochasticReboundCore::recordHit
     {
         return;
     }
+    // hitsEvery k keeps the 1st, (k+1)-th, ... hit of those this rank records
+    if (s.nRecordable++ % uint64_t(hitsEvery_) != 0)
+    {
+        return;
+    }
     ++s.nRecorded;
 
     // The grain: its shape under grain kept (empty for a new grain per
@@ -1237,6 +1256,7 @@ Foam::stochasticReboundCore::stochasticReboundCore
     grainSeed_(0),
     writeHits_(coeffs.getOrDefault<bool>("writeHits", false)),
     maxHitRecords_(coeffs.getOrDefault<label>("maxHitRecords", 1000000)),
+    hitsEvery_(1),
     ownSpin_(ownSpin),
     steady_(steady),
     memory_(memoryAuto),
@@ -1248,7 +1268,7 @@ Foam::stochasticReboundCore::stochasticReboundCore
     ({
         "table", "shape", "weights", "halfSizeFactor", "trapped", "seed",
         "interpolation", "method", "grain", "grainSeed", "writeHits",
-        "maxHitRecords", "patches", "spinRelaxation",
+        "maxHitRecords", "hitsEvery", "patches", "spinRelaxation",
         "U", "writePrecision", "writeToFile", "useUserTime", "defaultCoeffs"
     });
     checkEntries(coeffs, known, std::string(coeffs.dictName()));
@@ -1257,6 +1277,21 @@ Foam::stochasticReboundCore::stochasticReboundCore
         FatalIOErrorInFunction(coeffs)
             << "maxHitRecords must be >= 0, not " << maxHitRecords_
             << exit(FatalIOError);
+    }
+    if (coeffs.found("hitsEvery"))
+    {
+        // One token, a whole number (3.0 is 3): get<label> refuses 2.5
+        // without naming the range
+        ITstream& is = coeffs.lookup("hitsEvery");
+        const scalar every =
+            is.size() == 1 && is[0].isNumber() ? is[0].number() : 0;
+        if (!(every >= 1 && every <= labelMax && every == std::floor(every)))
+        {
+            FatalIOErrorInFunction(coeffs)
+                << "hitsEvery must be an integer >= 1, not "
+                << is.toString().c_str() << exit(FatalIOError);
+        }
+        hitsEvery_ = label(every);
     }
 
     halfSizeFactor_ = positiveFactor
@@ -1349,8 +1384,19 @@ Foam::stochasticReboundCore::stochasticReboundCore
         {
             state_->hits << " (key seed " << grainSeed_ << ")";
         }
-        state_->hits << "\n"
-            << "# V: incident velocity relative to the wall, Win: incident"
+        state_->hits << "\n# ";
+        if (hitsEvery_ > 1)
+        {
+            // A reader of the file must know it holds a sample
+            const uint64_t k = hitsEvery_;
+            state_->hits
+                << "Every " << ordinal(k) << " hit (hitsEvery " << k
+                << "): the 1st, " << ordinal(k + 1) << ", "
+                << ordinal(2*k + 1) << ", ... of the hits this rank"
+                   " would record. ";
+        }
+        state_->hits
+            << "V: incident velocity relative to the wall, Win: incident"
                " angular velocity (colliding parcels' own; else the spin"
                " remembered from the parcel's last rebound, or 0), n: unit"
                " normal into the gas, Uw: wall velocity, path: 0 table, 1"
