@@ -11,7 +11,8 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
     /model/parameters      one row of a compound type: the direct model's parameters by name (MODEL_FIELDS)
     /wall                  attrs: family (the wall law family, direct_model.wall.WALL_FAMILIES), name (the
                            wall's label); parameters: one row of a compound type, the family's parameters by name
-                           and speed_range_m_s (2 numbers: the |V⁻| the law holds over, [0, inf]: not stated)
+                           and speed_range_m_s (2 numbers: the |V⁻| the law holds over, [0, inf]: not stated);
+                           the family's arrays by name (tabulated: contact_speed_m_s, contact_sine, restitution)
     /shapes                the definition of every shape the table holds, one row per shape
                            (data_schema.shape_records: name, kind, vertices, triangles, inertia, aspect law, hands)
     /resolution            attrs: clusters, dictionary_size, levels
@@ -65,7 +66,7 @@ from data_schema.samples import SHAPE_NAMES
 from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_datasets,
                                        family_records, records_from_arrays, write_shape_records)
 from data_schema.output import hdf5_bytes, write_output
-from direct_model.wall import WALL_FAMILIES, WallMaterial, check_speed_range, wall_family
+from direct_model.wall import WALL_FAMILIES, Wall, check_speed_range, wall_family, wall_record
 
 TABLE_FILE_TYPE = "rebound_table"
 TABLE_VERSION = (4, 0)
@@ -253,7 +254,7 @@ class ReboundTable:
     created: str
     package_version: str
     model_sha256: str                    # hash of the direct model's source that computed the cells
-    wall: WallMaterial                   # the wall the cells were built with (group /wall)
+    wall: Wall                           # the wall the cells were built with (group /wall)
     # the rest of the direct model's parameters (group /model, MODEL_FIELDS, with kappa and n_max): the
     # aspect-ratio law (mean, sd, low, high) of b/a and c/b, the contact and contact-set tolerances (units of
     # a), the search-step budget per flight, and s per shape code
@@ -321,10 +322,14 @@ class ReboundTable:
         wall = f.create_group(WALL_GROUP)
         wall.attrs["family"] = family.name
         wall.attrs["name"] = self.wall.name
-        row = np.array([(*self.wall.as_array(), self.wall.speed_range_m_s)],
+        row = np.array([(*self.wall.parameters().values(), self.wall.speed_range_m_s)],
                        dtype=[(p.name, "<f8") for p in family.parameters] + [(WALL_SPEED_RANGE, "<f8", (2,))])
         _write_row(wall, row, [p.units for p in family.parameters] + ["m/s"],
                    f"the {family.name} wall law's parameters, by name, and the incident speeds it holds over")
+        for spec, values in zip(family.arrays, self.wall.arrays().values()):
+            ds = wall.create_dataset(spec.name, data=values, fletcher32=True)
+            ds.attrs["units"] = spec.units
+            ds.attrs["meaning"] = spec.meaning
         res = f.create_group("resolution")
         for field in dataclasses.fields(self.resolution):
             res.attrs[field.name] = getattr(self.resolution, field.name)
@@ -472,7 +477,7 @@ def _string_attribute(group: h5py.Group, name: str) -> str:
     return value
 
 
-def _wall(group: h5py.Group, row: np.ndarray) -> WallMaterial:
+def _wall(group: h5py.Group, row: np.ndarray) -> Wall:
     """The wall record of group /wall and its parameters' row: its family by name (one of
     direct_model.wall.WALL_FAMILIES), each of the family's parameters by field name within its range;
     DataFormatError (no file name) naming the attribute or field otherwise."""
@@ -497,7 +502,20 @@ def _wall(group: h5py.Group, row: np.ndarray) -> WallMaterial:
         raise DataFormatError(f"field '{WALL_SPEED_RANGE}' of dataset '{dataset}' must be [low, high] m/s with "
                               f"0 <= low < high finite, or [0, inf] (not stated); got [{_g(speed_range[0])}, "
                               f"{_g(speed_range[1])}]") from None
-    return WallMaterial.from_parameters(family.name, values, name, speed_range)
+    for spec in family.arrays:
+        if spec.name not in group or not isinstance(group[spec.name], h5py.Dataset):
+            raise DataFormatError(f"missing dataset '{WALL_GROUP}/{spec.name}' (an array of the {family.name} wall "
+                                  f"law: {spec.meaning.split(':')[0]})")
+        values[spec.name] = np.asarray(_read(group, spec.name))
+        if values[spec.name].dtype.kind not in "iuf" or values[spec.name].ndim != len(spec.dims):
+            raise DataFormatError(f"dataset '{WALL_GROUP}/{spec.name}' must hold {len(spec.dims)}-dimensional "
+                                  f"numbers; got {values[spec.name].dtype} of shape {values[spec.name].shape}")
+    # as lists: an error quotes them as the C loader does
+    values.update({spec.name: values[spec.name].tolist() for spec in family.arrays})
+    try:
+        return wall_record(family.name, values, name, speed_range)
+    except ValueError as exc:       # a tabulated law's nodes or values
+        raise DataFormatError(f"group '{WALL_GROUP}': {exc}") from None
 
 
 def _number(group: h5py.Group, name: str, count: int | None = 1):

@@ -97,7 +97,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         and its bounding radius (:func:`direct_model.shape_arrays.bounding_radius`).
     R0 : (3, 3) body→lab orientation at the start.
     V0 : (3,) incident velocity, m/s; W0 : (3,) incident angular velocity, (m/s)/a.
-    wall : (3,) wall-law coefficients.
+    wall : the wall law's kernel array (:meth:`direct_model.wall.Wall.as_array`, layout W_*).
     n_max : collisions allowed before the particle is trapped.
     contact_tol, set_tol : contact and contact-set tolerances, units of a.
     max_steps : search-step budget per flight.

@@ -157,7 +157,7 @@ def collide(V, W, r, Kinv, wall, dV, dW):
     W : (3,) angular velocity before, (m/s)/a, lab frame.
     r : (3,) contact point relative to the centre of mass, units of a, lab frame.
     Kinv : (3, 3) inverse of K = J/m in the lab frame, 1/a².
-    wall : (3,) wall law coefficients, :meth:`direct_model.wall.WallMaterial.as_array`.
+    wall : the wall law's kernel array, :meth:`direct_model.wall.Wall.as_array` (layout W_*).
     dV, dW : (3,) outputs, the changes of V and W.
 
     Returns

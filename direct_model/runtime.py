@@ -27,7 +27,7 @@ from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_
 from direct_model.registry import MAX_HULL_VERTICES
 from direct_model.shape_arrays import ShapeArrays, bounding_radius, family_shape_arrays, particle_body
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa, normal_cdf
-from direct_model.wall import WallMaterial
+from direct_model.wall import WALL_ARRAY_SIZE, Wall, wall_from_array
 
 U_PER_REBOUND = 7
 U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS = 0, 3, 5, 6
@@ -35,10 +35,11 @@ U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS = 0, 3, 5, 6
 # layout of the parameter array (float64)
 P_ASPECT_MEAN, P_ASPECT_SD, P_ASPECT_LOW, P_ASPECT_HIGH = 0, 1, 2, 3   # the aspect-ratio law (b/a and c/b)
 P_CDF_LOW, P_CDF_HIGH = 4, 5     # Φ((low − mean)/sd), Φ((high − mean)/sd): the law's CDF bounds
-P_KAPPA, P_N_MAX, P_WALL = 6, 7, 8                  # κ, n_max, the wall law (k, p, q) at 8, 9, 10
-P_CONTACT_TOL, P_SET_TOL, P_MAX_STEPS = 11, 12, 13  # units of a, units of a, search steps per flight
-P_KFAC = 14                                          # second-moment factor s per shape code, 14..17
-N_PARAMS = P_KFAC + len(SHAPES)
+P_KAPPA, P_N_MAX = 6, 7                              # κ, n_max
+P_CONTACT_TOL, P_SET_TOL, P_MAX_STEPS = 8, 9, 10    # units of a, units of a, search steps per flight
+P_KFAC = 11                                          # second-moment factor s per shape code, 11..14
+P_WALL = P_KFAC + len(SHAPES)                        # the wall's array (direct_model.wall, layout W_*), zero-padded
+N_PARAMS = P_WALL + WALL_ARRAY_SIZE
 
 # the scratch of one call: rebound's work, then the body's vertices, its half-extents and J/m, R0, V0, W0, V, W
 _VERTS = WORK_SIZE
@@ -49,10 +50,10 @@ _V0 = _R0 + 9
 SCRATCH_SIZE = _V0 + 12
 
 
-def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: WallMaterial, contact_tol: float,
+def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: Wall, contact_tol: float,
                      set_tol: float, max_steps: int, second_moment_factors) -> np.ndarray:
     """The parameter array of :func:`rebound_model_frame` (P_* layout), read-only; ValueError naming a value
-    outside its range. Units: tolerances in units of a, the wall law as :class:`WallMaterial`."""
+    outside its range. Units: tolerances in units of a, the wall law as a :class:`direct_model.wall.Wall`."""
     kappa = check_kappa(kappa)
     for name, value in (("n_max", n_max), ("max_steps", max_steps)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value < 2 ** 53:
@@ -64,14 +65,15 @@ def model_parameters(aspect: AspectRatioLaw, kappa: float, n_max: int, wall: Wal
     if kfac.shape != (len(SHAPES),) or not np.all((kfac > 0.0) & (kfac < 1.0)):
         raise ValueError(f"The 'second_moment_factors' parameter must be {len(SHAPES)} numbers in (0, 1), one per "
                          f"shape code; got {second_moment_factors!r}.")
-    p = np.empty(N_PARAMS)
+    p = np.zeros(N_PARAMS)
     p[P_ASPECT_MEAN:P_ASPECT_HIGH + 1] = aspect.mean, aspect.sd, aspect.low, aspect.high
     p[P_CDF_LOW] = normal_cdf((aspect.low - aspect.mean) / aspect.sd)
     p[P_CDF_HIGH] = normal_cdf((aspect.high - aspect.mean) / aspect.sd)
     p[P_KAPPA], p[P_N_MAX] = kappa, n_max
-    p[P_WALL:P_WALL + 3] = wall.as_array()
+    wall_array = wall.as_array()
+    p[P_WALL:P_WALL + len(wall_array)] = wall_array
     p[P_CONTACT_TOL], p[P_SET_TOL], p[P_MAX_STEPS] = contact_tol, set_tol, max_steps
-    p[P_KFAC:] = kfac
+    p[P_KFAC:P_KFAC + len(SHAPES)] = kfac
     p.flags.writeable = False
     return p
 
@@ -83,7 +85,7 @@ def model_settings(params) -> dict:
     return {"kappa": float(params[P_KAPPA]),
             "aspect": AspectRatioLaw(*map(float, params[P_ASPECT_MEAN:P_ASPECT_HIGH + 1])),
             "n_max": int(params[P_N_MAX]),
-            "wall": WallMaterial(*map(float, params[P_WALL:P_WALL + 3]), name="from the model's parameters"),
+            "wall": wall_from_array(params[P_WALL:], name="from the model's parameters"),
             "contact_tol": float(params[P_CONTACT_TOL]), "set_tol": float(params[P_SET_TOL]),
             "max_steps": int(params[P_MAX_STEPS])}
 
@@ -184,6 +186,6 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
     return body_rebound(
-        kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, params[P_WALL:P_WALL + 3],
+        kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, params[P_WALL:],
         int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
         scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])

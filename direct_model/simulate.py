@@ -23,7 +23,7 @@ from direct_model.shape_arrays import family_shape_arrays, shape_arrays
 from direct_model.shapes import (
     DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, second_moment_factors,
 )
-from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
+from direct_model.wall import CORUNDUM_ON_STEEL, Wall
 
 CHUNK_SIZE = 16384                  # particles drawn at a time: fixed, so a seed gives the same bits for any n
 DEFAULT_N_MAX = 1000                # collisions before a particle counts as trapped
@@ -103,7 +103,7 @@ def draw_inputs(rng: np.random.Generator, m: int, code: int, both_hands: np.ndar
 
 def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None,
              omega_in=(0.0, 0.0, 0.0), *, kappa: float = DEFAULT_KAPPA,
-             aspect: AspectRatioLaw = AspectRatioLaw(), wall: WallMaterial = CORUNDUM_ON_STEEL,
+             aspect: AspectRatioLaw = AspectRatioLaw(), wall: Wall = CORUNDUM_ON_STEEL,
              n_max: int = DEFAULT_N_MAX, contact_tol: float = DEFAULT_CONTACT_TOL, set_tol: float = DEFAULT_SET_TOL,
              max_steps: int = DEFAULT_MAX_STEPS, progress=None) -> SampleSet:
     """Simulate the rebound of ``n`` particles at one incident state.
@@ -122,7 +122,7 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
     omega_in : incident angular velocity Ω⁻ a/|V⁻|, lab frame (3 numbers).
     kappa : cut-prism truncation fraction in [0, 1).
     aspect : distribution of b/a and c/b.
-    wall : wall law (restitution and friction coefficients).
+    wall : the wall law, a :class:`direct_model.wall.Wall` (WallMaterial, TabulatedWall).
     n_max : collisions allowed before a particle counts as trapped, ≥ 1.
     contact_tol : contact distance, units of a (> 0).
     set_tol : points within this of the lowest share a contact, units of a (> 0).
@@ -202,5 +202,6 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
                     "contact_tol": contact_tol, "set_tol": set_tol, "max_steps": max_steps,
                     **dict(zip(("aspect_mean", "aspect_sd", "aspect_low", "aspect_high"),
                                (law.mean, law.sd, law.low, law.high) if law else (np.nan,) * 4)),
-                    "wall_law": wall.name, "wall_k": wall.k, "wall_p": wall.p, "wall_q": wall.q,
+                    "wall_law": wall.name, "wall_family": wall.family,
+                    **{f"wall_{name}": value for name, value in (*wall.parameters().items(), *wall.arrays().items())},
                     "chunk_size": CHUNK_SIZE, "package_version": package_version()})

@@ -2,32 +2,33 @@
 
 Two empirical coefficients close the impulse model:
 
-* normal restitution of the contact point (Lashkov's corundum/St3 correlation,
-  valid for 50–300 m/s)::
+* normal restitution a_nc ∈ (0, 1] of the contact point, a function of its speed |V_c⁻| (m/s) and of the sine
+  |v_c⁻|/|V_c⁻| of its impact angle. The law *family* gives its form:
 
-      a_nc = 1 − [1 − exp(−k |V_c⁻|^p)] · |v_c⁻| / |V_c⁻|       (|V_c⁻| in m/s)
+  - ``exponential`` (Lashkov's corundum/St3 correlation, valid for 50–300 m/s)::
 
-  where |v_c⁻|/|V_c⁻| is the sine of the contact point's impact angle, so
-  a_nc ∈ (0, 1];
-* the friction factor (Panfilov & Tsirkunov's heuristic)::
+        a_nc = 1 − [1 − exp(−k |V_c⁻|^p)] · |v_c⁻| / |V_c⁻|
+
+  - ``tabulated``: a_nc given at nodes of contact speed and contact sine, bilinear between them and constant
+    beyond the first and last speed node (the sine nodes run from 0 to 1, so a_nc is defined everywhere; node
+    values in (0, 1] keep it there, as a bilinear blend of them);
+
+* the friction factor (Panfilov & Tsirkunov's heuristic), the same in every family::
 
       C_f = exp(q · cos γ),   cos γ = (r_c · V_p⁻) / (|r_c| |V_p⁻|)
 
   with V_p⁻ the centre-of-mass velocity just before the current collision.
 
-The published law is k = 0.1, p = 0.61, q = 1 (:data:`CORUNDUM_ON_STEEL`).
-Another particle/wall pair of the same functional family is another
-:class:`WallMaterial`; the kernels receive it as the array :meth:`as_array`.
+The published law is the exponential one with k = 0.1, p = 0.61, q = 1 (:data:`CORUNDUM_ON_STEEL`).
 
-A wall is a named record of a law *family* (:data:`WALL_FAMILIES`): the
-family names the law's form and its parameters, in the order the kernels read
-them, with their units and ranges; a record holds the family's name, its
-parameters' values, the wall's label and where the law holds: the range of
-incident speeds |V⁻| it was measured or fitted over (:data:`SPEED_RANGE_NOT_STATED`
-for a law given without one). The model applies the law at any speed; the
-runtimes count the hits answered outside that range. The law above is the family
-``exponential`` (k, p, q), the only one so far. A table stores the record as
-its group ``/wall`` (docs/format.md), read back by field name.
+A wall is a named record (:class:`Wall`) of a law family (:data:`WALL_FAMILIES`): the family names the law's
+form, its scalar parameters with their units and ranges, and its arrays; a record holds the family's name, its
+values, the wall's label and where the law holds: the range of incident speeds |V⁻| it was measured or fitted
+over (:data:`SPEED_RANGE_NOT_STATED` for a law given without one). The model applies the law at any speed; the
+runtimes count the hits answered outside that range. :class:`WallMaterial` is a wall of the exponential family,
+:class:`TabulatedWall` one of the tabulated family; :func:`wall_record` makes either by family name. A table
+stores the record as its group ``/wall`` (docs/format.md), read back by name. The kernels receive a wall as one
+float64 array (:meth:`Wall.as_array`, layout W_*): the family's code, q, then the family's own values.
 """
 
 from __future__ import annotations
@@ -44,8 +45,8 @@ from direct_model.options import KERNEL
 
 @dataclasses.dataclass(frozen=True)
 class WallParameter:
-    """One parameter of a wall law family: its name (a field of the table's ``wall/parameters``), units, meaning,
-    and its range as words (what an error says) and as a check."""
+    """One scalar parameter of a wall law family: its name (a field of the table's ``wall/parameters``), units,
+    meaning, and its range as words (what an error says) and as a check."""
 
     name: str
     units: str
@@ -62,25 +63,42 @@ class WallParameter:
 
 
 @dataclasses.dataclass(frozen=True)
-class WallFamily:
-    """A wall law family: its name, its law in words and its parameters in the order the kernels read them
-    (:meth:`WallMaterial.as_array`)."""
+class WallArray:
+    """One array of a wall law family (a dataset of the table's group ``wall``): its name, units, dimensions (by
+    the names of the arrays that give their lengths) and meaning."""
 
     name: str
+    units: str
+    dims: tuple
+    meaning: str
+
+
+@dataclasses.dataclass(frozen=True)
+class WallFamily:
+    """A wall law family: its name, its code in the kernels' wall array (W_FAMILY), its law in words, its scalar
+    parameters and its arrays."""
+
+    name: str
+    code: int
     law: str
     parameters: tuple
+    arrays: tuple = ()
 
     @property
     def parameter_names(self) -> tuple:
         return tuple(p.name for p in self.parameters)
 
+    @property
+    def array_names(self) -> tuple:
+        return tuple(a.name for a in self.arrays)
+
     def check(self, values: Mapping) -> tuple:
-        """The values of ``values`` (a mapping by parameter name) in the family's order, as floats; ValueError
+        """The scalar parameters of ``values`` (a mapping by name) in the family's order, as floats; ValueError
         naming a parameter that is missing or out of its range (in the family's order)."""
-        missing = [name for name in self.parameter_names if name not in values]
+        missing = [name for name in (*self.parameter_names, *self.array_names) if name not in values]
         if missing:
-            raise ValueError(f"The {self.name} wall law needs the parameters {', '.join(self.parameter_names)}; "
-                             f"'{missing[0]}' is missing.")
+            raise ValueError(f"The {self.name} wall law needs the parameters "
+                             f"{', '.join((*self.parameter_names, *self.array_names))}; '{missing[0]}' is missing.")
         return tuple(p.check(values[p.name]) for p in self.parameters)
 
 
@@ -88,15 +106,36 @@ def _finite_positive(x: float) -> bool:
     return math.isfinite(x) and x > 0.0
 
 
-EXPONENTIAL = "exponential"
+_Q = WallParameter("q", "1", "friction exponent scale in C_f = exp(q cos γ)", "finite", math.isfinite)
+EXPONENTIAL, TABULATED = "exponential", "tabulated"
+MAX_CONTACT_SPEEDS, MAX_CONTACT_SINES = 16, 16      # nodes of a tabulated law: what the C runtime's record holds
 # every wall law family, by name; an entry here (and its twin in native/src/loader.c, WALL_FAMILIES) is a family
 WALL_FAMILIES = {
     EXPONENTIAL: WallFamily(
-        EXPONENTIAL, "a_nc = 1 − [1 − exp(−k |V_c⁻|^p)] |v_c⁻|/|V_c⁻|, C_f = exp(q cos γ) (docs/model.md §4)",
+        EXPONENTIAL, 0,
+        "a_nc = 1 − [1 − exp(−k |V_c⁻|^p)] |v_c⁻|/|V_c⁻|, C_f = exp(q cos γ) (docs/model.md §4)",
         (WallParameter("k", "(m/s)^-p", "restitution rate constant", "finite and > 0", _finite_positive),
-         WallParameter("p", "1", "restitution speed exponent", "finite and > 0", _finite_positive),
-         WallParameter("q", "1", "friction exponent scale in C_f = exp(q cos γ)", "finite", math.isfinite))),
+         WallParameter("p", "1", "restitution speed exponent", "finite and > 0", _finite_positive), _Q)),
+    TABULATED: WallFamily(
+        TABULATED, 1,
+        "a_nc bilinear in |V_c⁻| and |v_c⁻|/|V_c⁻| between nodes (constant beyond the speed nodes), "
+        "C_f = exp(q cos γ) (docs/model.md §4)",
+        (_Q,),
+        (WallArray("contact_speed_m_s", "m/s", ("contact_speed_m_s",),
+                   f"the speed nodes |V_c⁻|: 1 to {MAX_CONTACT_SPEEDS}, finite, > 0 and increasing"),
+         WallArray("contact_sine", "1", ("contact_sine",),
+                   f"the sine nodes |v_c⁻|/|V_c⁻|: 2 to {MAX_CONTACT_SINES}, increasing from 0 to 1"),
+         WallArray("restitution", "1", ("contact_speed_m_s", "contact_sine"),
+                   "a_nc at the nodes, one row per speed node, each value in (0, 1]"))),
 }
+
+# the kernels' wall array: the family's code and q, then the exponential family's k, p, or the tabulated family's
+# node counts, speed nodes, sine nodes and a_nc (row-major: speed, then sine)
+W_FAMILY, W_Q = 0, 1
+W_K, W_P = 2, 3
+W_N_SPEEDS, W_N_SINES, W_NODES = 2, 3, 4
+WALL_ARRAY_SIZE = W_NODES + MAX_CONTACT_SPEEDS + MAX_CONTACT_SINES + MAX_CONTACT_SPEEDS * MAX_CONTACT_SINES
+EXPONENTIAL_CODE = WALL_FAMILIES[EXPONENTIAL].code
 
 
 def wall_family(name: str) -> WallFamily:
@@ -110,42 +149,13 @@ def wall_family(name: str) -> WallFamily:
 SPEED_RANGE_NOT_STATED = (0.0, math.inf)      # a law given without the speeds it was measured over
 
 
-@dataclasses.dataclass(frozen=True)
-class WallMaterial:
-    """A wall: the record of one wall law (see module doc), here of the ``exponential`` family.
+class Wall:
+    """What every wall record has beside its family's values (``family``, ``name``, ``speed_range_m_s``): where
+    the law holds, its values by name and the kernels' array."""
 
-    Attributes
-    ----------
-    k : float
-        Restitution rate constant, (m/s)^(−p); > 0.
-    p : float
-        Restitution speed exponent; > 0.
-    q : float
-        Friction exponent scale in C_f = exp(q cos γ); finite.
-    name : str
-        Label stored with results.
-    family : str
-        The law family (:data:`WALL_FAMILIES`) whose parameters k, p, q are.
-    speed_range_m_s : (float, float)
-        The incident speeds |V⁻|, m/s, the law was measured or fitted over, low < high (Lashkov's: 50–300 m/s,
-        :data:`CORUNDUM_ON_STEEL`); :data:`SPEED_RANGE_NOT_STATED` (0, inf, the default) for a law given without
-        one.
-    """
-
-    k: float = 0.1
-    p: float = 0.61
-    q: float = 1.0
-    name: str = "corundum_on_St3_Lashkov1991"
-    family: str = EXPONENTIAL
-    speed_range_m_s: tuple = SPEED_RANGE_NOT_STATED
-
-    def __post_init__(self):
-        if self.family != EXPONENTIAL:      # the record's fields are the exponential family's
-            raise ValueError(f"a WallMaterial holds a wall of the {EXPONENTIAL} family (k, p, q); "
-                             f"{wall_family(self.family).name!r} has the parameters "
-                             f"{', '.join(wall_family(self.family).parameter_names)}")
-        wall_family(self.family).check(self.parameters())
-        object.__setattr__(self, "speed_range_m_s", check_speed_range(self.speed_range_m_s))
+    family: str
+    name: str
+    speed_range_m_s: tuple
 
     @property
     def speed_range_stated(self) -> bool:
@@ -163,25 +173,167 @@ class WallMaterial:
         return f"{low:g}-{high:g} m/s" if self.speed_range_stated else "not stated"
 
     def parameters(self) -> dict:
-        """The family's parameters by name, in the family's order: {"k": .., "p": .., "q": ..}."""
+        """The family's scalar parameters by name, in the family's order (exponential: k, p, q)."""
         return {name: getattr(self, name) for name in wall_family(self.family).parameter_names}
 
-    @classmethod
-    def from_parameters(cls, family: str, parameters: Mapping, name: str,
-                        speed_range_m_s=None) -> "WallMaterial":
-        """The wall of ``family`` with ``parameters`` by name (others ignored), label ``name`` and the speed range
-        it holds over (None: :data:`SPEED_RANGE_NOT_STATED`); ValueError naming an unknown family, a missing
-        parameter or one out of its range, or a bad range."""
-        values = wall_family(family).check(parameters)
-        return cls(*values, name=name, family=family,
-                   speed_range_m_s=SPEED_RANGE_NOT_STATED if speed_range_m_s is None else speed_range_m_s)
+    def arrays(self) -> dict:
+        """The family's arrays by name, as float64 numpy arrays ({} for the exponential family)."""
+        return {name: np.array(getattr(self, name), dtype=np.float64) for name in wall_family(self.family).array_names}
+
+    def law_text(self) -> str:
+        """The law's values in words: "k=0.1, p=0.61, q=1", with a tabulated law's node counts."""
+        text = ", ".join(f"{name}={value:.4g}" for name, value in self.parameters().items())
+        shapes = [f"{name} {'x'.join(map(str, array.shape))}" for name, array in self.arrays().items()]
+        return ", ".join([text, *shapes]) if shapes else text
 
     def as_array(self) -> np.ndarray:
-        """The coefficients (k, p, q) as the float64 array the kernels take, read-only as the slice of the model's
-        parameters that the runtime passes (a writable one would compile the kernels a second time)."""
-        coefficients = np.array(list(self.parameters().values()), dtype=np.float64)
-        coefficients.setflags(write=False)
-        return coefficients
+        """The kernels' wall array (layout W_*), read-only as the slice of the model's parameters that the runtime
+        passes (a writable one would compile the kernels a second time)."""
+        family = wall_family(self.family)
+        values = [float(family.code), float(self.q)]
+        if family.name == EXPONENTIAL:
+            values += [self.k, self.p]
+        else:
+            arrays = self.arrays()
+            speeds, sines = arrays["contact_speed_m_s"], arrays["contact_sine"]
+            values += [len(speeds), len(sines), *speeds, *sines, *arrays["restitution"].ravel()]
+        array = np.array(values, dtype=np.float64)
+        array.setflags(write=False)
+        return array
+
+
+def _record_fields(record) -> None:
+    """Check ``record``'s family, its scalar parameters and speed range (ValueError naming them)."""
+    wall_family(record.family).check({**record.parameters(), **{a: 0 for a in wall_family(record.family).array_names}})
+    object.__setattr__(record, "speed_range_m_s", check_speed_range(record.speed_range_m_s))
+
+
+@dataclasses.dataclass(frozen=True)
+class WallMaterial(Wall):
+    """A wall of the ``exponential`` family (see module doc).
+
+    Attributes
+    ----------
+    k : float
+        Restitution rate constant, (m/s)^(−p); > 0.
+    p : float
+        Restitution speed exponent; > 0.
+    q : float
+        Friction exponent scale in C_f = exp(q cos γ); finite.
+    name : str
+        Label stored with results.
+    family : str
+        The law family (:data:`WALL_FAMILIES`): ``exponential``.
+    speed_range_m_s : (float, float)
+        The incident speeds |V⁻|, m/s, the law was measured or fitted over, low < high (Lashkov's: 50–300 m/s,
+        :data:`CORUNDUM_ON_STEEL`); :data:`SPEED_RANGE_NOT_STATED` (0, inf, the default) for a law given without
+        one.
+    """
+
+    k: float = 0.1
+    p: float = 0.61
+    q: float = 1.0
+    name: str = "corundum_on_St3_Lashkov1991"
+    family: str = EXPONENTIAL
+    speed_range_m_s: tuple = SPEED_RANGE_NOT_STATED
+
+    def __post_init__(self):
+        if self.family != EXPONENTIAL:      # the record's fields are the exponential family's
+            raise ValueError(f"a WallMaterial holds a wall of the {EXPONENTIAL} family (k, p, q); "
+                             f"{wall_family(self.family).name!r} has the parameters "
+                             f"{', '.join((*wall_family(self.family).parameter_names, *wall_family(self.family).array_names))}")
+        _record_fields(self)
+
+
+def _nodes(name: str, values, count: tuple, first_last=None) -> tuple:
+    """``values`` as a tuple of floats: ``count`` = (least, most) of them, finite, strictly increasing, all > 0
+    or (``first_last``) from first_last[0] to first_last[1]; ValueError naming ``name`` otherwise."""
+    array = np.asarray(values, dtype=np.float64) if np.ndim(values) == 1 else None
+    allowed = (f"{count[0]} to {count[1]} finite, strictly increasing numbers "
+               + (f"from {first_last[0]:g} to {first_last[1]:g}" if first_last else "> 0"))
+    if (array is None or not count[0] <= array.size <= count[1] or not np.all(np.isfinite(array))
+            or not np.all(np.diff(array) > 0.0)
+            or (first_last is None and not np.all(array > 0.0))
+            or (first_last is not None and (array[0], array[-1]) != first_last)):
+        raise ValueError(f"The wall law parameter '{name}' must be {allowed}; got {values!r}.")
+    return tuple(float(x) for x in array)
+
+
+@dataclasses.dataclass(frozen=True)
+class TabulatedWall(Wall):
+    """A wall of the ``tabulated`` family (see module doc): a_nc at nodes of contact speed and contact sine.
+
+    Attributes
+    ----------
+    contact_speed_m_s : tuple of float
+        The speed nodes |V_c⁻|, m/s: 1 to MAX_CONTACT_SPEEDS, > 0 and increasing; a_nc is constant beyond the
+        first and the last.
+    contact_sine : tuple of float
+        The sine nodes |v_c⁻|/|V_c⁻|: 2 to MAX_CONTACT_SINES, increasing from 0 to 1.
+    restitution : tuple of tuples of float
+        a_nc at the nodes, one row per speed node, one value per sine node, each in (0, 1].
+    q : float
+        Friction exponent scale in C_f = exp(q cos γ); finite.
+    name, family, speed_range_m_s
+        As :class:`WallMaterial`'s; ``family`` is ``tabulated``.
+    """
+
+    contact_speed_m_s: tuple
+    contact_sine: tuple
+    restitution: tuple
+    q: float = 1.0
+    name: str = "tabulated"
+    family: str = TABULATED
+    speed_range_m_s: tuple = SPEED_RANGE_NOT_STATED
+
+    def __post_init__(self):
+        if self.family != TABULATED:
+            raise ValueError(f"a TabulatedWall holds a wall of the {TABULATED} family; got {self.family!r}")
+        _record_fields(self)
+        speeds = _nodes("contact_speed_m_s", self.contact_speed_m_s, (1, MAX_CONTACT_SPEEDS))
+        sines = _nodes("contact_sine", self.contact_sine, (2, MAX_CONTACT_SINES), (0.0, 1.0))
+        values = np.asarray(self.restitution, dtype=np.float64) if np.ndim(self.restitution) == 2 else None
+        if values is None or values.shape != (len(speeds), len(sines)):
+            raise ValueError(f"The wall law parameter 'restitution' must be {len(speeds)} rows (one per speed node) "
+                             f"of {len(sines)} numbers (one per sine node); got {self.restitution!r}.")
+        bad = np.argwhere(~((values > 0.0) & (values <= 1.0)))
+        if bad.size:
+            i, j = bad[0]
+            raise ValueError(f"The wall law parameter 'restitution' must be in (0, 1] at every node; got "
+                             f"{float(values[i, j])!r} at [{i}][{j}] (|V_c| = {speeds[i]:g} m/s, sine {sines[j]:g}).")
+        object.__setattr__(self, "contact_speed_m_s", speeds)
+        object.__setattr__(self, "contact_sine", sines)
+        object.__setattr__(self, "restitution", tuple(tuple(float(x) for x in row) for row in values))
+        object.__setattr__(self, "q", float(self.q))
+
+
+_RECORDS = {EXPONENTIAL: WallMaterial, TABULATED: TabulatedWall}
+
+
+def wall_record(family: str, values: Mapping, name: str, speed_range_m_s=None) -> Wall:
+    """The wall of ``family`` with ``values`` by name (scalar parameters and arrays; others ignored), label
+    ``name`` and the speed range it holds over (None: :data:`SPEED_RANGE_NOT_STATED`); ValueError naming an
+    unknown family, a missing value or one out of its range, or a bad range."""
+    law = wall_family(family)
+    law.check(values)
+    fields = {n: values[n] for n in (*law.parameter_names, *law.array_names)}
+    return _RECORDS[law.name](**fields, name=name, family=law.name,
+                              speed_range_m_s=SPEED_RANGE_NOT_STATED if speed_range_m_s is None else speed_range_m_s)
+
+
+def wall_from_array(array, name: str) -> Wall:
+    """The wall whose kernels' array (:meth:`Wall.as_array`, or the model's parameters from P_WALL on) is
+    ``array``, labelled ``name``, its speed range not stated."""
+    array = np.asarray(array, dtype=np.float64)
+    code = int(array[W_FAMILY])
+    family = next(f for f in WALL_FAMILIES.values() if f.code == code)
+    if family.name == EXPONENTIAL:
+        return WallMaterial(float(array[W_K]), float(array[W_P]), float(array[W_Q]), name=name)
+    ns, nz = int(array[W_N_SPEEDS]), int(array[W_N_SINES])
+    speeds = array[W_NODES:W_NODES + ns]
+    sines = array[W_NODES + ns:W_NODES + ns + nz]
+    values = array[W_NODES + ns + nz:W_NODES + ns + nz + ns * nz].reshape(ns, nz)
+    return TabulatedWall(tuple(speeds), tuple(sines), tuple(map(tuple, values)), float(array[W_Q]), name=name)
 
 
 def check_speed_range(value) -> tuple:
@@ -204,12 +356,43 @@ CORUNDUM_ON_STEEL = WallMaterial(speed_range_m_s=(50.0, 300.0))     # Lashkov me
 
 
 @numba.njit(**KERNEL)
+def node_weight(wall, first, count, x):
+    """Of the ``count`` increasing nodes wall[first:first + count]: the index (from ``first``) of the node at or
+    below ``x`` and of the next, and the weight of the next, 0 below the first node and 1 above the last."""
+    if count == 1:
+        return 0, 0, 0.0
+    i = 0
+    while i < count - 2 and wall[first + i + 1] <= x:
+        i += 1
+    w = (x - wall[first + i]) / (wall[first + i + 1] - wall[first + i])
+    if w < 0.0:
+        w = 0.0
+    elif w > 1.0:
+        w = 1.0
+    return i, i + 1, w
+
+
+@numba.njit(**KERNEL)
+def tabulated_restitution(wall, contact_speed, sin_impact):
+    """a_nc of the tabulated family: bilinear between the nodes (module doc); ``contact_speed`` in m/s."""
+    ns, nz = int(wall[W_N_SPEEDS]), int(wall[W_N_SINES])
+    sines, values = W_NODES + ns, W_NODES + ns + nz
+    i0, i1, ws = node_weight(wall, W_NODES, ns, contact_speed)
+    j0, j1, wz = node_weight(wall, sines, nz, sin_impact)
+    low = (1.0 - wz) * wall[values + i0 * nz + j0] + wz * wall[values + i0 * nz + j1]
+    high = (1.0 - wz) * wall[values + i1 * nz + j0] + wz * wall[values + i1 * nz + j1]
+    return (1.0 - ws) * low + ws * high
+
+
+@numba.njit(**KERNEL)
 def restitution(wall, contact_speed, sin_impact):
     """Normal restitution a_nc of the contact point; ``contact_speed`` in m/s."""
-    return 1.0 - (1.0 - np.exp(-wall[0] * contact_speed ** wall[1])) * sin_impact
+    if wall[W_FAMILY] == EXPONENTIAL_CODE:
+        return 1.0 - (1.0 - np.exp(-wall[W_K] * contact_speed ** wall[W_P])) * sin_impact
+    return tabulated_restitution(wall, contact_speed, sin_impact)
 
 
 @numba.njit(**KERNEL)
 def friction_factor(wall, cos_gamma):
     """Friction factor C_f = exp(q cos γ)."""
-    return np.exp(wall[2] * cos_gamma)
+    return np.exp(wall[W_Q] * cos_gamma)

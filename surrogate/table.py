@@ -21,7 +21,7 @@ from direct_model.registry import ConvexPolyhedron
 from direct_model.runtime import family_shapes, model_parameters
 from direct_model.shape_arrays import ShapeArrays
 from direct_model.shapes import SHAPES, AspectRatioLaw
-from direct_model.wall import WallMaterial
+from direct_model.wall import Wall
 from surrogate.kernels.layout import KernelData, check_kernel_data, frozen, kernel_data
 
 
@@ -36,7 +36,7 @@ class SurrogateTable:
     particles_per_cell: int
     n_max: int
     config_sha256: str
-    wall: WallMaterial         # the wall the table was built with (its group /wall): its law family, parameters, name
+    wall: Wall                 # the wall the table was built with (its group /wall): its law family, parameters, name
     kernel_data: KernelData
     # the parameters of the direct model the table was built with (its group /model and the wall), as the
     # kernels take them (:func:`direct_model.runtime.model_parameters`)

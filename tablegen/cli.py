@@ -21,7 +21,7 @@ from tablegen.tabulation.config import PRESETS
 from direct_model.registry import FAMILIES
 from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw
 from direct_model.simulate import DEFAULT_N_MAX
-from direct_model.wall import CORUNDUM_ON_STEEL, EXPONENTIAL, WALL_FAMILIES, WallMaterial
+from direct_model.wall import CORUNDUM_ON_STEEL, EXPONENTIAL, WALL_FAMILIES, Wall, wall_record
 from tablegen.study.report import DEFAULT_N as REPORT_DEFAULT_N
 
 # memory per simulated particle: its arrays, their merge and the file made in memory
@@ -152,9 +152,11 @@ def _build_parser() -> argparse.ArgumentParser:
                            help="TOML build configuration: its grid's user grains may be named in --shapes/--mix, and "
                                 "its kappa, b/a and c/b law and n_max are run (its [wall] is not: it is fitted)")
     calibrate.add_argument("--law", default=EXPONENTIAL, choices=tuple(WALL_FAMILIES),
-                           help="the wall law family (default: %(default)s, parameters k, p, q)")
+                           help="the wall law family (default: %(default)s, parameters k, p, q; tabulated: a_nc at "
+                                "normal contact at each speed of the data, a_nc_<speed>, and q)")
     calibrate.add_argument("--fix", type=_fixed_list, action="append", default=[], metavar="NAME=VALUE,...",
-                           help="hold parameters at values instead of fitting them, e.g. --fix p=0.61 (repeatable)")
+                           help="hold parameters at values instead of fitting them, e.g. --fix p=0.61 or --fix q=1 "
+                                "(repeatable)")
     calibrate.add_argument("--particles", type=count_argument, default=DEFAULT_PARTICLES, metavar="N",
                            help="direct-model particles per data row, shared by the grains by weight, >= 1 (default "
                                 "%(default)s: a mean's model standard error about 0.002)")
@@ -322,18 +324,24 @@ def _shape(args, config):
     return record
 
 
-def _wall(args, law: WallMaterial) -> WallMaterial:
+def _wall(args, law: Wall) -> Wall:
     """The wall law: ``law`` (the default or --config's) with what --wall-k/-p/-q change, a custom law if they
-    change it; ValueError naming the flag."""
-    given = {"k": args.wall_k, "p": args.wall_p, "q": args.wall_q}
-    values = {key: getattr(law, key) if value is None else value for key, value in given.items()}
-    if values == {"k": law.k, "p": law.p, "q": law.q}:
+    change it; ValueError naming the flag (--wall-k and --wall-p set the exponential family's k and p only)."""
+    given = {key: value for key, value in {"k": args.wall_k, "p": args.wall_p, "q": args.wall_q}.items()
+             if value is not None}
+    own = law.parameters()
+    foreign = [key for key in given if key not in own]
+    if foreign:
+        raise ValueError(f"--wall-{foreign[0]} sets the exponential law's {foreign[0]}; the wall law of "
+                         f"{args.config} is {law.family} (its parameters: {', '.join(own)})")
+    values = {**own, **given}
+    if values == own:
         return law
     for key, value in values.items():
         positive = key != "q"
         if not (math.isfinite(value) and (value > 0 or not positive)):
             raise ValueError(f"--wall-{key} must be finite{' and > 0' if positive else ''}; got {value!r}")
-    return WallMaterial(**values, name=CUSTOM_WALL)
+    return wall_record(law.family, {**values, **law.arrays()}, CUSTOM_WALL)
 
 
 def _build(args) -> int:

@@ -13,7 +13,8 @@ from tests.helpers.families import octahedron_entered
 from tests.helpers.native_library import build as native_build_in
 from tests.helpers.plain_install import install_and_draw
 from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OCTAHEDRON_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG,
-                                  SMALL_TABLE_CONFIG, WIDE_GRAZING_TABLE_CONFIG, write_grain_config)
+                                  SMALL_TABLE_CONFIG, TABULATED_TABLE_CONFIG, WIDE_GRAZING_TABLE_CONFIG,
+                                  write_grain_config)
 
 
 def _build(tmp_path_factory, name, config_text):
@@ -46,6 +47,12 @@ def octahedron_table_path(tmp_path_factory):
     with octahedron_entered():
         build_table(parse_config(OCTAHEDRON_TABLE_CONFIG), path, workers=1)
     return path
+
+
+@pytest.fixture(scope="session")
+def tabulated_table_path(tmp_path_factory):
+    """A table of the prism on a 2 × 2 grid with a tabulated wall law (TABULATED_TABLE_CONFIG)."""
+    return _build(tmp_path_factory, "tabulated", TABULATED_TABLE_CONFIG)
 
 
 @pytest.fixture(scope="session")

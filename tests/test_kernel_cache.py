@@ -69,8 +69,8 @@ def test_an_edited_callee_is_compiled_again(tmp_path, where):
 
     wall = copy / "direct_model" / "wall.py"
     source = wall.read_text()
-    assert source.count("contact_speed ** wall[1]") == 1
-    wall.write_text(source.replace("contact_speed ** wall[1]", "contact_speed ** (1.01 * wall[1])"))
+    assert source.count("contact_speed ** wall[W_P]") == 1
+    wall.write_text(source.replace("contact_speed ** wall[W_P]", "contact_speed ** (1.01 * wall[W_P])"))
     edited = _run(copy, env)
     assert [hits for _, hits in edited] == [0, 0], "both callers compiled again with the edited callee"
     assert edited[0][0] == edited[1][0] != first[0][0]

@@ -104,7 +104,10 @@ def test_twins_are_named_alike(files, twin):
 # value, so that a slot moved on one side only fails here rather than as wrong bits somewhere else.
 MIRRORED = [
     ("direct_model.rotation", ["rotation.c"], re.compile(r"_(I_\w+|MODE_\w+|NLEV_MAX|TH_TERMS)"), lambda n: n[1:]),
-    ("direct_model.runtime", ["runtime.h", "shapes.h"], re.compile(r"P_\w+|U_(?!PER)\w+|N_PARAMS"), lambda n: n),
+    ("direct_model.runtime", ["runtime.h", "shapes.h", "wall.h"], re.compile(r"P_\w+|U_(?!PER)\w+|N_PARAMS"),
+     lambda n: n),
+    ("direct_model.wall", ["wall.h"], re.compile(r"W_\w+|MAX_CONTACT_\w+|WALL_ARRAY_SIZE|EXPONENTIAL_CODE"),
+     lambda n: n),
     ("surrogate.kernels.layout", ["internal.h"], re.compile(r"(ROW|CELL|AXIS)_\w+"), lambda n: n),
     ("direct_model.collision", ["collision.h"], re.compile(r"COLLISION_\w+"), lambda n: n),
     ("direct_model.flight", ["flight.h"], re.compile(r"SEARCH_\w+"), lambda n: n),
@@ -134,3 +137,14 @@ def test_mirrored_offsets_are_equal(module, files, names, spelled):
     c = _defines(files)
     assert len(python) >= 3
     assert {n: c.get(n) for n in python} == python
+
+
+def test_every_wall_law_family_has_its_code_in_c():
+    """Each family of direct_model.wall.WALL_FAMILIES has its code in wall.h (<NAME>_CODE, what the kernels' wall
+    array holds at W_FAMILY), and the C loader's table of families names it."""
+    from direct_model.wall import WALL_FAMILIES
+    codes = _defines(["wall.h"])
+    loader = (ROOT / "native" / "src" / "loader.c").read_text()
+    for name, family in WALL_FAMILIES.items():
+        assert codes.get(f"{name.upper()}_CODE") == family.code, name
+        assert f'{{"{name}", {name.upper()}_CODE,' in loader, name

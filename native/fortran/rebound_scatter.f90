@@ -114,13 +114,19 @@ module rebound_scatter
     integer(c_int) :: both_hands = 0
   end type rbs_shape_info
 
-  ! the wall of a table (rbs_wall_info): family and name C strings, n_parameters names (C strings) and values
+  ! the wall of a table (rbs_wall_info): family and name C strings, n_parameters names (C strings) and values; a
+  ! tabulated law's nodes and a_nc (c_f_pointer: restitution as (n_contact_sines, n_contact_speeds), C's row-major)
   type, bind(c) :: rbs_wall_info
     integer(c_size_t) :: size = 0
     type(c_ptr) :: family = c_null_ptr, name = c_null_ptr
     integer(c_int) :: n_parameters = 0
     type(c_ptr) :: parameter_names = c_null_ptr, parameter_values = c_null_ptr
     real(c_double) :: speed_range_m_s(2) = 0.0_c_double   ! the |V-| (m/s) the law holds over; (0, +inf): not stated
+    integer(c_int) :: n_contact_speeds = 0                 ! 0 (and null pointers) for the exponential family
+    type(c_ptr) :: contact_speed_m_s = c_null_ptr         ! |V_c-| nodes, m/s
+    integer(c_int) :: n_contact_sines = 0
+    type(c_ptr) :: contact_sine = c_null_ptr              ! |v_c-|/|V_c-| nodes, from 0 to 1
+    type(c_ptr) :: restitution = c_null_ptr               ! a_nc at the nodes
   end type rbs_wall_info
 
   ! one grain of a table's mix (rbs_grain): its table shape index (0-based), the b/a, c/b and hand the direct path

@@ -98,7 +98,7 @@ extern "C" {
 #endif
 
 #define RBS_VERSION_MAJOR 1
-#define RBS_VERSION_MINOR 0
+#define RBS_VERSION_MINOR 1
 #define RBS_VERSION_PATCH 0
 /* MAJOR · 1 000 000 + MINOR · 1 000 + PATCH, as rbs_version_number() returns it for the library linked */
 #define RBS_VERSION_NUMBER (RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 + RBS_VERSION_PATCH)
@@ -342,20 +342,28 @@ typedef struct rbs_shape_info {
  * of range. */
 RBS_API int rbs_table_shape_info(const rbs_table *table, int i, rbs_shape_info *info);
 
-/* The wall of a table (group /wall; docs/model.md §10): its law family and named parameters, as the build's
- * [wall] section gave them. */
+/* The wall of a table (group /wall; docs/model.md §10): its law family, named parameters and arrays, as the build's
+ * [wall] section gave them. The fields after speed_range_m_s came after 1.0: written only where the caller's
+ * record reaches them (its size). Every pointer is valid until rbs_table_close. */
 typedef struct rbs_wall_info {
     size_t size;                /* sizeof(rbs_wall_info) */
-    const char *family;         /* the law family, e.g. "exponential"; valid until rbs_table_close */
+    const char *family;         /* the law family, "exponential" or "tabulated" */
     const char *name;           /* the wall's name (the pair of materials), "" if none */
     int n_parameters;
-    const char *const *parameter_names;     /* n_parameters names, e.g. "k", "p", "q" */
+    const char *const *parameter_names;     /* n_parameters names: "k", "p", "q" (exponential), "q" (tabulated) */
     const double *parameter_values;         /* their values, in the family's units (docs/model.md §10) */
     double speed_range_m_s[2];  /* the incident speeds |V⁻| (m/s) the law was measured or fitted over, low < high;
                                    {0, INFINITY}: not stated. Hits outside it are answered with the law all the
                                    same: count them (the adapters' summaries do) */
+    /* the tabulated family's nodes and a_nc (0 and NULL for the exponential family): a_nc bilinear between them */
+    int n_contact_speeds;                   /* 1 to 16 */
+    const double *contact_speed_m_s;        /* the contact-point speeds |V_c⁻| (m/s), increasing, > 0 */
+    int n_contact_sines;                    /* 2 to 16 */
+    const double *contact_sine;             /* the sines |v_c⁻|/|V_c⁻| of the impact angle, increasing from 0 to 1 */
+    const double *restitution;              /* a_nc at the nodes, in (0, 1], row-major: n_contact_speeds rows of
+                                               n_contact_sines values */
 } rbs_wall_info;
-#define RBS_WALL_INFO_INIT {sizeof(rbs_wall_info), NULL, NULL, 0, NULL, NULL, {0.0, 0.0}}
+#define RBS_WALL_INFO_INIT {sizeof(rbs_wall_info), NULL, NULL, 0, NULL, NULL, {0.0, 0.0}, 0, NULL, 0, NULL, NULL}
 
 /* *info up to info->size. RBS_OK, or RBS_INVALID for a NULL pointer or a record too small. */
 RBS_API int rbs_table_wall(const rbs_table *table, rbs_wall_info *info);

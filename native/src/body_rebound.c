@@ -42,7 +42,7 @@ static void lab_tensor(const double *R, const double *diag, double *out)
 }
 
 int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
-                     const double R0[9], const double V0[3], const double W0[3], const double wall[3], long long n_max,
+                     const double R0[9], const double V0[3], const double W0[3], const double *wall, long long n_max,
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
                      long long *n_collisions, long long *n_steps)
 {

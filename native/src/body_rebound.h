@@ -15,12 +15,12 @@ void rbs_quaternion_to_matrix(const double q[4], double R[9]);
 /* One particle's rebound (direct_model.body_rebound.body_rebound without history). The body as rbs_particle_body
  * gives it (shapes.h): kind, its nv vertices verts (at most MAX_HULL_VERTICES; the ellipsoid's support point is
  * written into verts[0..2], so at least one row), its half-extents semi, principal J/m K (a²) and bounding
- * radius Rb; R0 body → lab at the start, V0 (m/s) and W0 ((m/s)/a) incident, wall = (k, p, q), n_max collisions
- * allowed, contact_tol and set_tol (units of a), max_steps per flight; V, W receive the state after the last
- * collision. Returns RBS_OK (rebounded), RBS_TRAPPED or RBS_FAILED; the collisions and search steps into
+ * radius Rb; R0 body → lab at the start, V0 (m/s) and W0 ((m/s)/a) incident, wall the wall array (wall.h, layout
+ * W_*), n_max collisions allowed, contact_tol and set_tol (units of a), max_steps per flight; V, W receive the state
+ * after the last collision. Returns RBS_OK (rebounded), RBS_TRAPPED or RBS_FAILED; the collisions and search steps into
  * *n_collisions, *n_steps. */
 int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
-                     const double R0[9], const double V0[3], const double W0[3], const double wall[3], long long n_max,
+                     const double R0[9], const double V0[3], const double W0[3], const double *wall, long long n_max,
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
                      long long *n_collisions, long long *n_steps);
 

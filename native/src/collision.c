@@ -109,7 +109,7 @@ static inline double form(const double *A, const double *p, const double *q)
     return acc;
 }
 
-int rbs_collide(const double V[3], const double W[3], const double r[3], const double Kinv[9], const double wall[3],
+int rbs_collide(const double V[3], const double W[3], const double r[3], const double Kinv[9], const double *wall,
                 double dV[3], double dW[3])
 {
     for (int k = 0; k < 3; k++) {

@@ -21,9 +21,9 @@ int rbs_smallest_positive_root(double c0, double c1, double c2, double c3, doubl
 
 /* One collision at the contact point r (from the centre of mass, units of a) of a body with velocity V (m/s)
  * and angular velocity W ((m/s)/a), Kinv the inverse of K = J/m in the lab frame (1/a², row-major 3 × 3),
- * wall = (k, p, q): dV, dW the changes of V and W (zero unless OK or MULTIPLE_ROOTS); returns a COLLISION_*
+ * wall the wall array (wall.h, layout W_*): dV, dW the changes of V and W (zero unless OK or MULTIPLE_ROOTS); returns a COLLISION_*
  * code (direct_model.collision.collide). */
-int rbs_collide(const double V[3], const double W[3], const double r[3], const double Kinv[9], const double wall[3],
+int rbs_collide(const double V[3], const double W[3], const double r[3], const double Kinv[9], const double *wall,
                 double dV[3], double dW[3]);
 
 #endif /* RBS_COLLISION_H */

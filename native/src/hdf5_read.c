@@ -17,7 +17,7 @@ int rbs_fail(loader *ld, int code, const char *format, ...)
     if (ld->code != RBS_OK) return ld->code;
     ld->code = code;
     if (ld->message && ld->message_size > 0) {
-        char detail[512];
+        char detail[2048];         /* room for a message quoting a wall law's nodes (loader.c) */
         va_list args;
         va_start(args, format);
         vsnprintf(detail, sizeof detail, format, args);

@@ -6,8 +6,9 @@
  *   cells        float64 (n_cells · CELL_SIZE): P(trapped), 6 means, 6 sds, 6 inverse sds per cell
  *   clusters     float32 (n_cells · C · ROW_SIZE): one row per mixture component (ROW_* layout)
  *   dictionary   float32 (n_cells · 6 · n_levels · n_dictionary): residual shapes, level-major
- *   speed_restitution   float64 (n_speed): exp(−k V^p) at the grid speeds
- *   restitution_pieces  float64: polynomial pieces of exp(−k V^p) between them (layout.c)
+ *   speed_restitution   float64 (n_speed): the wall's restitution factor f(V) (exp(−k V^p) for the exponential
+ *                       law) at the grid speeds
+ *   restitution_pieces  float64: polynomial pieces of f(V) between them (layout.c)
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -94,15 +95,16 @@ struct rbs_table {
     int n_shapes, n_alpha1, n_speed, n_clusters, n_levels, n_dictionary, n_pieces;
     int format_major, format_minor;
     long long particles_per_cell, n_max;
-    double restitution_k, restitution_p;            /* the exponential wall law's k, p: the restitution pieces */
     /* the wall (group wall, read by loader.c; rbs_table_wall): its family's name and parameter names (static, of
-     * WALL_FAMILIES), its name, its parameters' values in the family's order */
+     * WALL_FAMILIES), its name, its parameters' values in the family's order, and the kernels' wall array
+     * (direct_model.wall.Wall.as_array, layout W_*; zero after its own values), which holds a tabulated law's nodes */
     const char *wall_family;
     const char *const *wall_parameter_names;
     int n_wall_parameters;
     char wall_name[RBS_WALL_NAME_SIZE];
     double wall_parameters[RBS_WALL_MAX_PARAMETERS];
     double wall_speed_range[2];                     /* m/s; {0, inf}: not stated (direct_model.wall) */
+    double wall[WALL_ARRAY_SIZE];
     char (*shape_names)[RBS_SHAPE_NAME_SIZE];       /* (n_shapes) names, grid/shapes */
     rbs_shape_records shapes;
     double *alpha1_deg, *speed_m_s;                 /* the grids */
@@ -171,13 +173,13 @@ static inline double rbs_normal_cdf(double x)
     return 0.5 * erfc(-x / sqrt(2.0));
 }
 
-/* layout.c: the kernel arrays of `table` (grids, sizes and restitution law set) from the raw cells.
+/* layout.c: the kernel arrays of `table` (grids, sizes and direct parameters set) from the raw cells.
  * RBS_OK, RBS_ERR_MEMORY, or RBS_ERR_FORMAT with `what` set to the array that is not finite. */
 int rbs_derive(rbs_table *table, const rbs_raw_cells *raw, const char **what);
 
-/* layout.c, exposed for tests of the pieces alone */
-double *rbs_restitution_pieces(const double *grid, int n, double k, double p, int *n_pieces, size_t *len);
-double rbs_restitution_factor(double V, double k, double p);
+/* layout.c, exposed for tests of the pieces alone; `wall` the kernels' wall array (wall.h, layout W_*) */
+double *rbs_restitution_pieces(const double *grid, int n, const double *wall, int *n_pieces, size_t *len);
+double rbs_restitution_factor(double V, const double *wall);
 
 /* error.c: printf into a caller's message buffer (NULL or size 0: nothing). */
 void rbs_message(char *message, size_t message_size, const char *format, ...)

@@ -6,7 +6,8 @@
  *   component rows     surrogate.kernels.layout.kernel_rows, with Walker's alias tables (alias_table)
  *   cell records       surrogate.kernels.layout.cell_records
  *   restitution        surrogate.kernels.fastmath.restitution_factor at the grid speeds, and
- *                      surrogate.kernels.fastmath.restitution_pieces between them
+ *                      surrogate.kernels.fastmath.restitution_pieces between them, of the table's wall array
+ *                      (wall.h: the exponential family's exp(−k V^p), or the tabulated family's a_nc(V, 1))
  *
  * Every sum is a plain loop in index order and the only libm calls are exp and pow on one value at
  * a time, as the Python side makes them: no step depends on which SIMD kernels numpy or its BLAS pick
@@ -110,14 +111,16 @@ static void alias_table(const double *weights, int n, double *keep, int *alias, 
 
 #define N_NODES (RESTITUTION_DEGREE + 1)   /* surrogate.kernels.fastmath.N_NODES */
 
-/* surrogate.kernels.fastmath.restitution_factor: exp(−k V^p), V in m/s */
-double rbs_restitution_factor(double V, double k, double p)
+/* surrogate.kernels.fastmath.restitution_factor: the wall's restitution factor f(V) = a_nc(V, 1), exp(−k V^p) for
+ * the exponential family, V in m/s */
+double rbs_restitution_factor(double V, const double *wall)
 {
-    return exp(-k * pow(V, p));
+    if (wall[W_FAMILY] == EXPONENTIAL_CODE) return exp(-wall[W_K] * pow(V, wall[W_P]));
+    return rbs_tabulated_restitution(wall, V, 1.0);
 }
 
 /* surrogate.kernels.fastmath.restitution_pieces, loop for loop */
-double *rbs_restitution_pieces(const double *grid, int n, double k, double p, int *n_pieces, size_t *len)
+double *rbs_restitution_pieces(const double *grid, int n, const double *wall, int *n_pieces, size_t *len)
 {
     if (n == 1) {
         double *zeros = calloc(N_NODES, sizeof *zeros);
@@ -162,7 +165,7 @@ double *rbs_restitution_pieces(const double *grid, int n, double k, double p, in
         for (int i = 0; i < pieces; i++) {
             double start = grid[j] + width * (double)i / (double)pieces;
             double f[N_NODES], series[N_NODES];
-            for (int q = 0; q < N_NODES; q++) f[q] = rbs_restitution_factor(start + (x[q] + 1.0) * half, k, p);
+            for (int q = 0; q < N_NODES; q++) f[q] = rbs_restitution_factor(start + (x[q] + 1.0) * half, wall);
             for (int d = 0; d < N_NODES; d++) {
                 double sum = 0.0;
                 for (int q = 0; q < N_NODES; q++) sum += f[q] * basis[d][q];
@@ -263,13 +266,13 @@ int rbs_derive(rbs_table *t, const rbs_raw_cells *raw, const char **what)
             for (size_t m = 0; m < M; m++)
                 t->dictionary[(ck * L1 + i) * M + m] = raw->shape_dictionary[(ck * M + m) * L1 + i];
 
-    /* the wall law at the grid speeds and between them */
+    /* the wall law at the grid speeds and between them (surrogate.kernels.layout.kernel_data: table.wall.as_array) */
+    const double *wall = t->direct_parameters + P_WALL;
     t->speed_restitution = malloc((size_t)t->n_speed * sizeof *t->speed_restitution);
     if (!t->speed_restitution) return RBS_ERR_MEMORY;
-    for (int j = 0; j < t->n_speed; j++)
-        t->speed_restitution[j] = rbs_restitution_factor(t->speed_m_s[j], t->restitution_k, t->restitution_p);
-    t->restitution_pieces = rbs_restitution_pieces(t->speed_m_s, t->n_speed, t->restitution_k, t->restitution_p,
-                                                   &t->n_pieces, &t->restitution_pieces_len);
+    for (int j = 0; j < t->n_speed; j++) t->speed_restitution[j] = rbs_restitution_factor(t->speed_m_s[j], wall);
+    t->restitution_pieces = rbs_restitution_pieces(t->speed_m_s, t->n_speed, wall, &t->n_pieces,
+                                                   &t->restitution_pieces_len);
     if (!t->restitution_pieces) return RBS_ERR_MEMORY;
 
     if (!all_finite(t->alpha1_axis, t->alpha1_axis_len)) *what = "alpha1_axis";

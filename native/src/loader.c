@@ -556,14 +556,23 @@ static int read_model(loader *ld, hid_t file, model_row *m)
     return RBS_OK;
 }
 
-/* The wall law families (direct_model.wall.WALL_FAMILIES, its twin: the same names, parameters in the order the
- * kernels read them, and ranges in the same words). */
+/* The wall law families (direct_model.wall.WALL_FAMILIES, its twin: the same names and codes, scalar parameters in
+ * the family's order with their ranges in the same words, and the arrays of each, datasets of group wall). */
+typedef struct wall_array {
+    const char *name;
+    int rank;
+    const char *meaning;        /* direct_model.wall.WallArray's meaning up to its colon: a missing dataset's words */
+} wall_array;
+
 typedef struct wall_family {
     const char *name;
+    int code;                   /* wall.h: EXPONENTIAL_CODE, TABULATED_CODE */
     int n_parameters;
     const char *const *parameters;
     const char *const *allowed;
     int (*const *ok)(double);
+    int n_arrays;
+    const wall_array *arrays;
 } wall_family;
 
 static int finite_and_positive(double x) { return isfinite(x) && x > 0.0; }
@@ -572,14 +581,184 @@ static int finite(double x) { return isfinite(x); }
 static const char *const EXPONENTIAL_PARAMETERS[] = {"k", "p", "q"};
 static const char *const EXPONENTIAL_ALLOWED[] = {"finite and > 0", "finite and > 0", "finite"};
 static int (*const EXPONENTIAL_OK[])(double) = {finite_and_positive, finite_and_positive, finite};
+static const char *const TABULATED_PARAMETERS[] = {"q"};
+static const char *const TABULATED_ALLOWED[] = {"finite"};
+static int (*const TABULATED_OK[])(double) = {finite};
+static const wall_array TABULATED_ARRAYS[] = {
+    {"contact_speed_m_s", 1, "the speed nodes |V_c⁻|"},
+    {"contact_sine", 1, "the sine nodes |v_c⁻|/|V_c⁻|"},
+    {"restitution", 2, "a_nc at the nodes, one row per speed node, each value in (0, 1]"},
+};
 static const wall_family WALL_FAMILIES[] = {
-    {"exponential", 3, EXPONENTIAL_PARAMETERS, EXPONENTIAL_ALLOWED, EXPONENTIAL_OK},
+    {"exponential", EXPONENTIAL_CODE, 3, EXPONENTIAL_PARAMETERS, EXPONENTIAL_ALLOWED, EXPONENTIAL_OK, 0, NULL},
+    {"tabulated", TABULATED_CODE, 1, TABULATED_PARAMETERS, TABULATED_ALLOWED, TABULATED_OK, 3, TABULATED_ARRAYS},
 };
 #define N_WALL_FAMILIES ((int)(sizeof WALL_FAMILIES / sizeof WALL_FAMILIES[0]))
 
+/* `text` appended to the string `out` of `size` bytes (truncated) */
+static void append(char *out, size_t size, const char *text)
+{
+    size_t used = strlen(out);
+    if (used + 1 < size) snprintf(out + used, size - used, "%s", text);
+}
+
+/* x as Python's repr(float) writes it (the shortest digits that read back as x, fixed notation for decimal exponents
+ * -4 to 15 with at least one decimal), so that a message quoting a value is the Python reader's */
+static void python_repr(double x, char *out, size_t size)
+{
+    if (!isfinite(x)) {
+        snprintf(out, size, "%s", isnan(x) ? "nan" : x > 0.0 ? "inf" : "-inf");
+        return;
+    }
+    char scientific[40];
+    int digits = 1;
+    for (;; digits++) {
+        snprintf(scientific, sizeof scientific, "%.*e", digits - 1, x);
+        if (digits == 17 || strtod(scientific, NULL) == x) break;
+    }
+    int exponent = atoi(strchr(scientific, 'e') + 1);
+    if (exponent < -4 || exponent >= 16) {
+        snprintf(out, size, "%s", scientific);
+        return;
+    }
+    snprintf(out, size, "%.*f", digits - 1 - exponent > 0 ? digits - 1 - exponent : 0, x);
+    if (!strchr(out, '.')) append(out, size, ".0");
+}
+
+/* The values of a dataset of rank 1 or 2 as Python writes a list of floats (nested for rank 2): [0.0, 0.5, 1.0] */
+static void list_text(const double *values, int rank, const hsize_t *dims, char *out, size_t size)
+{
+    size_t rows = rank == 2 ? (size_t)dims[0] : 1, columns = (size_t)dims[rank - 1];
+    out[0] = '\0';
+    if (rank == 2) append(out, size, "[");
+    for (size_t i = 0; i < rows; i++) {
+        append(out, size, i ? ", [" : "[");
+        for (size_t j = 0; j < columns; j++) {
+            char number[40];
+            python_repr(values[i * columns + j], number, sizeof number);
+            if (j) append(out, size, ", ");
+            append(out, size, number);
+        }
+        append(out, size, "]");
+    }
+    if (rank == 2) append(out, size, "]");
+}
+
+/* Whether `name` in `where` is a dataset (not a group): h5py's isinstance(group[name], h5py.Dataset) */
+static int is_dataset(hid_t where, const char *name)
+{
+    if (!rbs_link_exists(where, name)) return 0;
+    hid_t object = -1;
+    H5E_BEGIN_TRY { object = H5Oopen(where, name, H5P_DEFAULT); } H5E_END_TRY;
+    if (object < 0) return 0;
+    int dataset = H5Iget_type(object) == H5I_DATASET;
+    H5Oclose(object);
+    return dataset;
+}
+
+/* The numpy name of dataset `name`'s element type into `out` (float64, int32, uint8, ...): 1 if it holds numbers
+ * (numpy's kinds i, u, f), else 0 with `out` saying what it holds */
+static int numeric_type(hid_t where, const char *name, char *out, size_t size)
+{
+    hid_t ds = -1, type = -1;
+    int numeric = 0;
+    snprintf(out, size, "no numbers");
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(where, name, H5P_DEFAULT);
+        if (ds >= 0) type = H5Dget_type(ds);
+        if (type >= 0) {
+            H5T_class_t cls = H5Tget_class(type);
+            size_t bits = 8 * H5Tget_size(type);
+            numeric = cls == H5T_FLOAT || cls == H5T_INTEGER;
+            if (cls == H5T_FLOAT) snprintf(out, size, "float%zu", bits);
+            else if (cls == H5T_INTEGER) snprintf(out, size, "%sint%zu", H5Tget_sign(type) == H5T_SGN_NONE ? "u" : "", bits);
+            else if (cls == H5T_STRING) snprintf(out, size, "strings");
+        }
+    } H5E_END_TRY;
+    if (type >= 0) H5Tclose(type);
+    if (ds >= 0) H5Dclose(ds);
+    return numeric;
+}
+
+/* direct_model.wall._nodes: `least` to `most` values, finite, strictly increasing, and > 0 (`unit` 0) or from
+ * exactly 0 to exactly 1 */
+static int nodes_ok(const double *x, size_t n, size_t least, size_t most, int unit)
+{
+    if (n < least || n > most) return 0;
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(x[i]) || (i > 0 && !(x[i] > x[i - 1])) || (!unit && !(x[i] > 0.0))) return 0;
+    return !unit || (x[0] == 0.0 && x[n - 1] == 1.0);
+}
+
+/* The family's arrays, datasets of group wall (data_schema.table._wall, then direct_model.wall.TabulatedWall: the
+ * same checks in the same order and words): each present and numbers of its rank; the speed nodes 1 to
+ * MAX_CONTACT_SPEEDS, finite, strictly increasing and > 0; the sine nodes 2 to MAX_CONTACT_SINES, strictly
+ * increasing from 0 to 1; a_nc one row per speed node, one value per sine node, each in (0, 1]. Into t->wall as
+ * direct_model.wall.Wall.as_array lays them out (the counts at W_N_SPEEDS, W_N_SINES, the values from W_NODES). */
+static int read_wall_arrays(loader *ld, hid_t group, const wall_family *family, rbs_table *t)
+{
+    double *values[3] = {NULL, NULL, NULL};
+    hsize_t dims[3][8] = {{0}};
+    int ranks[3] = {0, 0, 0};
+    for (int a = 0; a < family->n_arrays && ld->code == RBS_OK; a++) {
+        const wall_array *spec = &family->arrays[a];
+        char type[32], shape[160] = "(";
+        if (!is_dataset(group, spec->name)) {
+            rbs_fail(ld, RBS_ERR_FORMAT, "missing dataset 'wall/%s' (an array of the %s wall law: %s)", spec->name,
+                     family->name, spec->meaning);
+            break;
+        }
+        if (rbs_dataset_shape(ld, group, "wall", spec->name, &ranks[a], dims[a]) != RBS_OK) break;
+        if (!numeric_type(group, spec->name, type, sizeof type) || ranks[a] != spec->rank) {
+            for (int k = 0; k < ranks[a]; k++)      /* numpy's shape: (3,), (3, 2) */
+                snprintf(shape + strlen(shape), sizeof shape - strlen(shape), "%s%llu%s", k ? " " : "",
+                         (unsigned long long)dims[a][k], k + 1 < ranks[a] || ranks[a] == 1 ? "," : "");
+            append(shape, sizeof shape, ")");
+            rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'wall/%s' must hold %d-dimensional numbers; got %s of shape %s",
+                     spec->name, spec->rank, type, shape);
+            break;
+        }
+        values[a] = rbs_read_dataset(ld, group, "wall", spec->name, H5T_NATIVE_DOUBLE, sizeof(double), ranks[a],
+                                     dims[a]);
+    }
+    char got[1024];
+    const size_t ns = ld->code == RBS_OK ? (size_t)dims[0][0] : 0, nz = ld->code == RBS_OK ? (size_t)dims[1][0] : 0;
+    if (ld->code == RBS_OK && !nodes_ok(values[0], ns, 1, MAX_CONTACT_SPEEDS, 0)) {
+        list_text(values[0], 1, dims[0], got, sizeof got);
+        rbs_fail(ld, RBS_ERR_FORMAT, "group 'wall': The wall law parameter 'contact_speed_m_s' must be 1 to %d finite, "
+                 "strictly increasing numbers > 0; got %s.", MAX_CONTACT_SPEEDS, got);
+    } else if (ld->code == RBS_OK && !nodes_ok(values[1], nz, 2, MAX_CONTACT_SINES, 1)) {
+        list_text(values[1], 1, dims[1], got, sizeof got);
+        rbs_fail(ld, RBS_ERR_FORMAT, "group 'wall': The wall law parameter 'contact_sine' must be 2 to %d finite, "
+                 "strictly increasing numbers from 0 to 1; got %s.", MAX_CONTACT_SINES, got);
+    } else if (ld->code == RBS_OK && (dims[2][0] != ns || dims[2][1] != nz)) {
+        list_text(values[2], 2, dims[2], got, sizeof got);
+        rbs_fail(ld, RBS_ERR_FORMAT, "group 'wall': The wall law parameter 'restitution' must be %zu rows (one per speed "
+                 "node) of %zu numbers (one per sine node); got %s.", ns, nz, got);
+    }
+    for (size_t k = 0; ld->code == RBS_OK && k < ns * nz; k++) {
+        double v = values[2][k];
+        if (!(v > 0.0 && v <= 1.0)) {       /* the first node out of range, row-major as numpy.argwhere finds it */
+            python_repr(v, got, sizeof got);
+            rbs_fail(ld, RBS_ERR_FORMAT, "group 'wall': The wall law parameter 'restitution' must be in (0, 1] at every "
+                     "node; got %s at [%zu][%zu] (|V_c| = %g m/s, sine %g).", got, k / nz, k % nz, values[0][k / nz],
+                     values[1][k % nz]);
+        }
+    }
+    if (ld->code == RBS_OK) {
+        t->wall[W_N_SPEEDS] = (double)ns;
+        t->wall[W_N_SINES] = (double)nz;
+        memcpy(t->wall + W_NODES, values[0], ns * sizeof(double));
+        memcpy(t->wall + W_NODES + ns, values[1], nz * sizeof(double));
+        memcpy(t->wall + W_NODES + ns + nz, values[2], ns * nz * sizeof(double));
+    }
+    for (int a = 0; a < 3; a++) free(values[a]);
+    return ld->code;
+}
+
 /* The wall (group wall, data_schema.table._wall): its attributes family and name (strings), the family one of
- * WALL_FAMILIES, its parameters by field name within their ranges; into t (wall_*, and the exponential family's
- * k, p as restitution_k, _p for the restitution pieces). */
+ * WALL_FAMILIES, its parameters by field name within their ranges, then the family's arrays; into t (wall_*, and the
+ * kernels' wall array t->wall, direct_model.wall.Wall.as_array: the family's code, q, then k, p or the arrays). */
 static int read_wall(loader *ld, hid_t file, rbs_table *t)
 {
     hid_t group = open_group(ld, file, "wall");
@@ -617,7 +796,6 @@ static int read_wall(loader *ld, hid_t file, rbs_table *t)
                  family->name);
         read_row(ld, group, "wall", fields, n + 1, names, row, (size_t)(n + 2) * sizeof(double));
     }
-    H5Gclose(group);
     for (int i = 0; ld->code == RBS_OK && i < n; i++) {
         t->wall_parameters[i] = row[i];
         if (!family->ok[i](row[i]))
@@ -633,17 +811,25 @@ static int read_wall(loader *ld, hid_t file, rbs_table *t)
         t->wall_speed_range[0] = low;
         t->wall_speed_range[1] = high;
     }
+    if (ld->code == RBS_OK && family->n_arrays > 0) read_wall_arrays(ld, group, family, t);
+    H5Gclose(group);
     if (ld->code != RBS_OK) return ld->code;
     t->wall_family = family->name;
     t->wall_parameter_names = family->parameters;
     t->n_wall_parameters = family->n_parameters;
-    t->restitution_k = t->wall_parameters[0];      /* the exponential family's k, p: exp(−k V^p) */
-    t->restitution_p = t->wall_parameters[1];
+    /* direct_model.wall.Wall.as_array: [code, q, ...], the exponential family's k, p after q */
+    t->wall[W_FAMILY] = (double)family->code;
+    for (int i = 0; i < n; i++)
+        if (strcmp(family->parameters[i], "q") == 0) t->wall[W_Q] = row[i];
+    if (family->code == EXPONENTIAL_CODE) {
+        t->wall[W_K] = row[0];
+        t->wall[W_P] = row[1];
+    }
     return RBS_OK;
 }
 
 /* The direct model's parameters (surrogate.table.SurrogateTable.direct_parameters): the P_* array of
- * direct_model.runtime.model_parameters from the model's row and the wall's parameters, in range (read_model,
+ * direct_model.runtime.model_parameters from the model's row and the wall's array, in range (read_model,
  * read_wall). */
 static void direct_parameters(rbs_table *t, const model_row *m)
 {
@@ -657,12 +843,11 @@ static void direct_parameters(rbs_table *t, const model_row *m)
     p[P_CDF_HIGH] = rbs_normal_cdf((high - mean) / sd);
     p[P_KAPPA] = m->kappa;
     p[P_N_MAX] = (double)m->n_max;
-    /* the wall's parameters in the order the kernels read them (the exponential family's k, p, q) */
-    for (int k = 0; k < P_CONTACT_TOL - P_WALL && k < t->n_wall_parameters; k++) p[P_WALL + k] = t->wall_parameters[k];
     p[P_CONTACT_TOL] = m->contact_tol;
     p[P_SET_TOL] = m->set_tol;
     p[P_MAX_STEPS] = (double)m->max_steps;
     for (int k = 0; k < RBS_N_FAMILIES; k++) p[P_KFAC + k] = m->kfac[k];
+    memcpy(p + P_WALL, t->wall, sizeof t->wall);      /* zero after the wall's own values, as np.zeros leaves them */
     t->n_max = m->n_max;
 }
 

@@ -9,8 +9,9 @@
 
 #include "rebound_scatter.h"
 #include "shapes.h"
+#include "wall.h"
 
-/* layout of the parameter array (float64; direct_model.runtime: P_ASPECT_MEAN ... P_KFAC, N_PARAMS) */
+/* layout of the parameter array (float64; direct_model.runtime: P_ASPECT_MEAN ... P_WALL, N_PARAMS) */
 #define P_ASPECT_MEAN 0     /* the aspect-ratio law (b/a and c/b): mean, sd, low, high */
 #define P_ASPECT_SD 1
 #define P_ASPECT_LOW 2
@@ -19,12 +20,12 @@
 #define P_CDF_HIGH 5
 #define P_KAPPA 6
 #define P_N_MAX 7
-#define P_WALL 8            /* the wall law (k, p, q) at 8, 9, 10 */
-#define P_CONTACT_TOL 11    /* units of a */
-#define P_SET_TOL 12        /* units of a */
-#define P_MAX_STEPS 13      /* search steps per flight */
-#define P_KFAC 14           /* second-moment factor s per shape code, 14..17 */
-#define N_PARAMS (P_KFAC + RBS_N_FAMILIES)     /* one factor per family code, as direct_model.runtime derives it */
+#define P_CONTACT_TOL 8     /* units of a */
+#define P_SET_TOL 9         /* units of a */
+#define P_MAX_STEPS 10      /* search steps per flight */
+#define P_KFAC 11           /* second-moment factor s per shape code, 11..14 */
+#define P_WALL (P_KFAC + RBS_N_FAMILIES)       /* one factor per family code, as direct_model.runtime derives it */
+#define N_PARAMS (P_WALL + WALL_ARRAY_SIZE)    /* the wall's array (wall.h, layout W_*), zero after its own values */
 
 /* the uniforms of one rebound (direct_model.runtime: U_PER_REBOUND; U_ORIENTATION, U_RATIOS, U_HAND, U_AXIS) */
 #define RBS_U_PER_REBOUND 7

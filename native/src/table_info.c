@@ -63,8 +63,8 @@ int rbs_table_shape_info(const rbs_table *t, int i, rbs_shape_info *info)
     return RBS_OK;
 }
 
-/* the wall as the loader read it from group wall (loader.c, read_wall): its family, name, parameters by name and the
- * speeds it holds over */
+/* the wall as the loader read it from group wall (loader.c, read_wall): its family, name, parameters by name, the
+ * speeds it holds over and a tabulated law's arrays (pointers into its wall array, layout W_*) */
 int rbs_table_wall(const rbs_table *t, rbs_wall_info *info)
 {
     if (!t || !RBS_RECORD_OK(info, rbs_wall_info))
@@ -75,6 +75,16 @@ int rbs_table_wall(const rbs_table *t, rbs_wall_info *info)
     info->parameter_names = t->wall_parameter_names;
     info->parameter_values = t->wall_parameters;
     memcpy(info->speed_range_m_s, t->wall_speed_range, sizeof info->speed_range_m_s);
+    int tabulated = t->wall[W_FAMILY] == TABULATED_CODE;
+    int ns = tabulated ? (int)t->wall[W_N_SPEEDS] : 0, nz = tabulated ? (int)t->wall[W_N_SINES] : 0;
+    /* the fields after 1.0, each where the caller's record reaches it (records.h) */
+    if (RBS_HAS_FIELD(info, rbs_wall_info, n_contact_speeds)) info->n_contact_speeds = ns;
+    if (RBS_HAS_FIELD(info, rbs_wall_info, contact_speed_m_s))
+        info->contact_speed_m_s = tabulated ? t->wall + W_NODES : NULL;
+    if (RBS_HAS_FIELD(info, rbs_wall_info, n_contact_sines)) info->n_contact_sines = nz;
+    if (RBS_HAS_FIELD(info, rbs_wall_info, contact_sine)) info->contact_sine = tabulated ? t->wall + W_NODES + ns : NULL;
+    if (RBS_HAS_FIELD(info, rbs_wall_info, restitution))
+        info->restitution = tabulated ? t->wall + W_NODES + ns + nz : NULL;
     return RBS_OK;
 }
 

@@ -5,6 +5,7 @@
  *   - a collision keeps the angular momentum about the contact point, KΩ − r_c × V;
  *   - a free flight keeps the energy ½ΩᵀKΩ and the angular momentum L = KΩ (lab) to 1e-9;
  *   - a whole rebound never adds energy, for the four families and a grain of MAX_HULL_VERTICES vertices;
+ * each under the published exponential wall law and a tabulated one, every other trial;
  * then hostile calls of rbs_direct_rebound on a table (RBS_INVALID and NaN, never a crash), and four threads
  * calling it on one table give the bits of one thread.
  *
@@ -30,6 +31,13 @@
 #include "shapes.h"
 
 #define TRIALS 20000
+
+/* the walls of the trials, as the kernels' wall arrays (wall.h, layout W_*): the published exponential law (q 1, k 0.1,
+ * p 0.61) and a tabulated one of 2 speed nodes (40, 300 m/s) × 3 sine nodes (q 0.8) */
+static const double WALLS[2][WALL_ARRAY_SIZE] = {
+    {EXPONENTIAL_CODE, 1.0, 0.1, 0.61},
+    {TABULATED_CODE, 0.8, 2, 3, 40.0, 300.0, 0.0, 0.5, 1.0, 1.0, 0.8, 0.55, 1.0, 0.7, 0.42},
+};
 
 /* a random body: principal K (units a²) of half-extents (1, b/a, c/a) and factor s, orientation R */
 static void random_body(rbs_rng *rng, double K[3], double R[9])
@@ -70,7 +78,6 @@ static void cross(const double a[3], const double b[3], double out[3])
 
 static void collisions(rbs_rng *rng)
 {
-    const double wall[3] = {0.1, 0.61, 1.0};
     int collided = 0;
     double worst_gain = -INFINITY, worst_momentum = 0.0;
     for (int trial = 0; trial < TRIALS; trial++) {
@@ -86,7 +93,7 @@ static void collisions(rbs_rng *rng)
             r[k] = 2.0 * rbs_rng_uniform(rng) - 1.0;
         }
         r[1] = -fabs(r[1]);     /* the contact point below the centre */
-        int outcome = rbs_collide(V, W, r, Kinv_lab, wall, dV, dW);
+        int outcome = rbs_collide(V, W, r, Kinv_lab, WALLS[trial % 2], dV, dW);
         if (outcome != COLLISION_OK && outcome != COLLISION_MULTIPLE_ROOTS) continue;
         collided++;
         double V1[3], W1[3], KW0[3], KW1[3], rV0[3], rV1[3];
@@ -180,7 +187,6 @@ static void make_shapes(test_shapes *s, rbs_rng *rng)
 
 static void rebounds(rbs_rng *rng)
 {
-    const double wall[3] = {0.1, 0.61, 1.0};
     test_shapes shapes;
     make_shapes(&shapes, rng);
     double worst = -INFINITY, verts[3 * MAX_HULL_VERTICES];
@@ -201,8 +207,8 @@ static void rebounds(rbs_rng *rng)
         int kind = shapes.kind[shape];
         double Rb = rbs_bounding_radius(kind, semi, verts, nv);
         long long n_coll, n_steps;
-        int status = rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, 1000, 1e-10, 1e-9, 100000, V, W,
-                                      &n_coll, &n_steps);
+        int status = rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, WALLS[trial % 2], 1000, 1e-10, 1e-9,
+                                      100000, V, W, &n_coll, &n_steps);
         CHECK(status == RBS_OK || status == RBS_TRAPPED || status == RBS_FAILED, "status %d", status);
         if (status >= 0 && status < 3) counts[status]++;
         if (status != RBS_OK) continue;

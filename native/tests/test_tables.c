@@ -460,14 +460,36 @@ static void table_records(const rbs_table *table)
     CHECK(rbs_table_info_get(NULL, &info) == RBS_INVALID && rbs_table_info_get(table, NULL) == RBS_INVALID, "info NULL");
 
     rbs_wall_info wall = RBS_WALL_INFO_INIT;
-    CHECK(rbs_table_wall(table, &wall) == RBS_OK && strcmp(wall.family, "exponential") == 0 && wall.name != NULL
-          && (wall.n_parameters == 3 || wall.n_parameters == 0), "wall");
-    if (wall.n_parameters == 3) {
+    CHECK(rbs_table_wall(table, &wall) == RBS_OK && wall.name != NULL, "wall");
+    int tabulated = strcmp(wall.family, "tabulated") == 0;
+    CHECK(tabulated || strcmp(wall.family, "exponential") == 0, "wall family %s", wall.family);
+    if (!tabulated) {
         static const char *const names[3] = {"k", "p", "q"};
-        for (int k = 0; k < 3; k++)
+        CHECK(wall.n_parameters == 3 && wall.n_contact_speeds == 0 && wall.n_contact_sines == 0
+              && !wall.contact_speed_m_s && !wall.contact_sine && !wall.restitution, "exponential wall: no arrays");
+        for (int k = 0; k < 3 && wall.n_parameters == 3; k++)
             CHECK(strcmp(wall.parameter_names[k], names[k]) == 0 && isfinite(wall.parameter_values[k])
                   && (k == 2 || wall.parameter_values[k] > 0.0), "wall parameter %d: %g", k, wall.parameter_values[k]);
+    } else {
+        /* the tabulated law's rules (direct_model.wall.TabulatedWall), as the loader checked them */
+        int ns = wall.n_contact_speeds, nz = wall.n_contact_sines;
+        CHECK(wall.n_parameters == 1 && strcmp(wall.parameter_names[0], "q") == 0 && isfinite(wall.parameter_values[0])
+              && ns >= 1 && ns <= 16 && nz >= 2 && nz <= 16 && wall.contact_speed_m_s && wall.contact_sine
+              && wall.restitution, "tabulated wall: %d speeds, %d sines", ns, nz);
+        for (int i = 0; wall.contact_speed_m_s && i < ns; i++)
+            CHECK(wall.contact_speed_m_s[i] > (i ? wall.contact_speed_m_s[i - 1] : 0.0), "speed node %d", i);
+        for (int j = 0; wall.contact_sine && j < nz; j++)
+            CHECK(j ? wall.contact_sine[j] > wall.contact_sine[j - 1] : wall.contact_sine[j] == 0.0, "sine node %d", j);
+        CHECK(!wall.contact_sine || wall.contact_sine[nz - 1] == 1.0, "the last sine node is 1");
+        for (int k = 0; wall.restitution && k < ns * nz; k++)
+            CHECK(wall.restitution[k] > 0.0 && wall.restitution[k] <= 1.0, "a_nc %d: %g", k, wall.restitution[k]);
     }
+    /* a record of the 1.0 size (up to speed_range_m_s): its later fields left alone */
+    rbs_wall_info old = RBS_WALL_INFO_INIT;
+    old.size = offsetof(rbs_wall_info, speed_range_m_s) + sizeof old.speed_range_m_s;
+    old.n_contact_speeds = -7;
+    CHECK(rbs_table_wall(table, &old) == RBS_OK && old.family == wall.family && old.n_contact_speeds == -7
+          && !old.restitution, "a 1.0 wall record");
     wall.size = 4;
     CHECK(rbs_table_wall(table, &wall) == RBS_INVALID && rbs_table_wall(NULL, &wall) == RBS_INVALID, "wall refused");
 
@@ -652,8 +674,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s GOOD.h5 [PATH EXPECTED_STATUS]...\n", argv[0]);
         return 2;
     }
-    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.0.0") == 0
-          && RBS_VERSION_NUMBER == 1000000, "version %s, %d", rbs_version(), rbs_version_number());
+    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.1.0") == 0
+          && RBS_VERSION_NUMBER == 1001000, "version %s, %d", rbs_version(), rbs_version_number());
     rbs_table_close(NULL);
     CHECK(rbs_table_open(argv[1], NULL, NULL, 0) == RBS_INVALID, "NULL table pointer");
     for (int repeat = 0; repeat < 2; repeat++) draw_from(argv[1]);

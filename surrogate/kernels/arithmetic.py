@@ -91,11 +91,11 @@ def _velocity(alpha2, beta2, s):
 def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, wy, wz):
     """A rebound drawn at grid speed V_iv, moved to the incident speed V; returns (vx, vy, vz, wx, wy, wz).
 
-    ``f_target``, ``f_grid``: exp(−k V^p) at V and at V_iv
-    (:func:`surrogate.kernels.gather.restitution_factors`). Local frame, V⁺ in units of |V⁻|, Ω⁺ in
-    units of |V⁻|/a. With a(V) = 1 − (1 − exp(−k V^p)) sin α1, the normal
-    restitution of the wall law for a contact point moving like the centre
-    of mass:
+    ``f_target``, ``f_grid``: the wall's restitution factor f, its a_nc at normal impact (exp(−k V^p) for
+    the exponential law), at V and at V_iv (:func:`surrogate.kernels.gather.restitution_factors`). Local
+    frame, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. With a(V) = 1 − (1 − f(V)) sin α1, the normal
+    restitution of the wall law for a contact point moving like the centre of mass (a tabulated law's
+    own a_nc where it is linear in the sine from 1 at sine 0, as calibrate writes it):
 
     * regime 0 (at most two collisions): the velocity change V⁺ − V⁻ and the
       spin Ω⁺ are multiplied by (1 + a(V))/(1 + a(V_iv)). For one

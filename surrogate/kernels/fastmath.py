@@ -9,12 +9,14 @@ share with the direct model (:mod:`direct_model.elementary`):
 * :func:`atan2_first_quadrant`, x, y ≥ 0: t = min/max, atan t = atan c +
   atan z with c the nearest of 0, 1/4, 1/2, 3/4, 1 and z = (t − c)/(1 + c t),
   |z| ≤ 1/8, atan z by its Taylor series to z¹⁷ (truncation below 1e-18);
-* :func:`restitution_at` — exp(−k V^p) (V in m/s) at a particle's incident
-  speed from polynomial pieces (:func:`restitution_pieces`, made when a table
-  is loaded): every interval of the speed grid cut into S equal pieces, each
-  spanning at most a factor :data:`PIECE_RATIO` in V (away from V = 0, where
-  V^p is singular), interpolated at Chebyshev points by a polynomial of degree
-  :data:`DEGREE`, exact to about 1e-14 absolute.
+* :func:`restitution_at` — the wall's restitution factor (exp(−k V^p) for the
+  exponential law; V in m/s) at a particle's incident speed from polynomial
+  pieces (:func:`restitution_pieces`, made when a table is loaded): every
+  interval of the speed grid cut into S equal pieces, each spanning at most a
+  factor :data:`PIECE_RATIO` in V (away from V = 0, where V^p is singular),
+  interpolated at Chebyshev points by a polynomial of degree :data:`DEGREE`,
+  exact to about 1e-14 absolute for the exponential law (a tabulated law's
+  kinks at its speed nodes are rounded off within the piece that holds them).
 
 tests/surrogate/test_kernel_math.py compares each with libm or NumPy on dense grids.
 """
@@ -30,6 +32,7 @@ from numba import types
 from numba.extending import intrinsic
 
 from direct_model.elementary import fma
+from direct_model.wall import EXPONENTIAL_CODE, W_FAMILY, W_K, W_P, tabulated_restitution
 from surrogate.kernels.memory import load
 from surrogate.kernels.options import JIT
 
@@ -81,11 +84,14 @@ DEGREE = 9          # polynomial degree of a piece
 PIECE_RATIO = 1.25  # a piece [V_lo, V_hi] has V_hi ≤ PIECE_RATIO · V_lo
 
 
-def restitution_factor(speed: float, k: float, p: float) -> float:
-    """The wall's restitution factor exp(−k V^p) at V = ``speed`` (m/s), from the C library's exp and pow,
-    called one value at a time as native/src/layout.c calls them (no array function whose SIMD kernel
-    depends on the CPU)."""
-    return math.exp(-k * math.pow(speed, p))
+def restitution_factor(speed: float, wall) -> float:
+    """The wall's restitution factor f(V) at V = ``speed`` (m/s): the normal-impact restitution a_nc(V, 1) of
+    the wall law (``wall``: the kernels' array, direct_model.wall layout W_*), exp(−k V^p) for the exponential
+    family, from the C library's exp and pow, called one value at a time as native/src/layout.c calls them (no
+    array function whose SIMD kernel depends on the CPU)."""
+    if wall[W_FAMILY] == EXPONENTIAL_CODE:
+        return math.exp(-wall[W_K] * math.pow(speed, wall[W_P]))
+    return float(tabulated_restitution(wall, speed, 1.0))
 
 
 N_NODES = DEGREE + 1
@@ -109,8 +115,9 @@ def _chebyshev_power_coefficients() -> tuple:
 CHEBYSHEV_POWERS = _chebyshev_power_coefficients()
 
 
-def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
-    """Polynomial pieces of exp(−k V^p) over each interval of ``speed_grid`` (m/s, increasing, > 0).
+def restitution_pieces(speed_grid, wall) -> np.ndarray:
+    """Polynomial pieces of the wall's restitution factor f(V) (:func:`restitution_factor`; exp(−k V^p) for the
+    exponential family) over each interval of ``speed_grid`` (m/s, increasing, > 0).
 
     Returns coefficients (max(n − 1, 1), S, DEGREE + 1): piece i of interval j
     covers V_j + [i, i + 1]·(V_{j+1} − V_j)/S, in powers of x ∈ [−1, 1]
@@ -141,7 +148,7 @@ def restitution_pieces(speed_grid, k: float, p: float) -> np.ndarray:
         half = 0.5 * width / pieces
         for i in range(pieces):
             start = grid[j] + width * i / pieces
-            f = [restitution_factor(start + (x + 1.0) * half, k, p) for x in CHEBYSHEV_NODES]
+            f = [restitution_factor(start + (x + 1.0) * half, wall) for x in CHEBYSHEV_NODES]
             series = []
             for d in range(N_NODES):
                 total = 0.0

@@ -79,7 +79,8 @@ def _term(cells, lo, hi, here, wa, k):
 
 @numba.njit(inline="always", **JIT)
 def restitution_factors(data, jv, wv, iv):
-    """exp(−k V^p) at the incident speed V = V_jv + wv (V_jv+1 − V_jv) and at the drawn grid speed V_iv."""
+    """The wall's restitution factor f (exp(−k V^p) for the exponential law) at the incident speed
+    V = V_jv + wv (V_jv+1 − V_jv) and at the drawn grid speed V_iv."""
     return restitution_at(data.restitution_pieces, data.n_pieces, jv, wv), np.float64(load(data.speed_restitution, iv))
 
 

@@ -204,8 +204,8 @@ def kernel_data(table: ReboundTable) -> KernelData:
     counts = table.cells["status_counts"].astype(np.float64)
     landed = counts[..., STATUS_REBOUNDED] + counts[..., STATUS_TRAPPED]
     rows, dictionary = kernel_rows(table.cells)
-    k, p = table.wall.k, table.wall.p       # the exponential wall law's restitution exp(−k V^p)
-    pieces = restitution_pieces(table.speed_m_s, k, p)
+    wall = table.wall.as_array()
+    pieces = restitution_pieces(table.speed_m_s, wall)
     speed = np.asarray(table.speed_m_s, dtype=np.float64)
     lead = counts.shape[:3]
     dic_shape = table.cells["shape_dictionary"].shape     # (..., 6, M, L + 1)
@@ -213,7 +213,7 @@ def kernel_data(table: ReboundTable) -> KernelData:
         alpha1_axis=frozen(axis_record(table.alpha1_deg)), speed_axis=frozen(axis_record(speed)),
         cells=frozen(cell_records(counts[..., STATUS_TRAPPED] / landed, table.cells["mean"], table.cells["std"])),
         clusters=frozen(rows), dictionary=frozen(dictionary),
-        speed_restitution=frozen(np.array([restitution_factor(v, k, p) for v in speed.tolist()])),
+        speed_restitution=frozen(np.array([restitution_factor(v, wall) for v in speed.tolist()])),
         restitution_pieces=frozen(pieces.ravel()),
         n_shapes=lead[0], n_alpha1=lead[1], n_speed=lead[2], n_clusters=table.cells["cluster_weight"].shape[3],
         n_levels=dic_shape[-1], n_dictionary=dic_shape[-2], n_pieces=pieces.shape[1])

@@ -8,8 +8,8 @@ the wall normal), and optionally their standard deviations over the particles an
 The model: the same means from the direct model for a mix of grains; every row's particles (orientations,
 proportions, hands) come from seeds fixed for the whole fit (common random numbers), so the objective is a
 deterministic function of the law's parameters. The fit: weighted least squares over the free parameters of a
-family of :data:`direct_model.wall.WALL_FAMILIES`, each in the coordinate of :data:`TRANSFORMS` that keeps it in
-its range.
+family of :data:`direct_model.wall.WALL_FAMILIES` (its fit values, :func:`fit_form`), each in the coordinate that
+keeps it in its range.
 
 The kernels (:func:`model_means`, :func:`in_form`, :func:`residual_variance`, :func:`estimated_sd`,
 :func:`jacobian`, :func:`covariance`) are plain functions over arrays; :func:`measurements`,
@@ -33,7 +33,9 @@ from data_schema.output import PNG_KEY, TOML_MARKER
 from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
 from direct_model.registry import FAMILIES
 from direct_model.shapes import SHAPES
-from direct_model.wall import CORUNDUM_ON_STEEL, EXPONENTIAL, WallMaterial, wall_family
+from direct_model.wall import (CORUNDUM_ON_STEEL, EXPONENTIAL, MAX_CONTACT_SPEEDS, TABULATED, TabulatedWall, Wall,
+                               wall_family, wall_record)
+from tablegen.tabulation.config import wall_values_toml
 
 COEFFICIENTS = ("e_n", "e_t")           # e_n = −v⁺/v⁻, e_t = u⁺/u⁻
 RATIOS = ("u_ratio", "v_ratio")         # u⁺/|V⁻|, v⁺/|V⁻|
@@ -65,12 +67,60 @@ class Transform:
 
 LOG = Transform(math.log, math.exp, math.exp)
 LINEAR = Transform(float, float, lambda t: 1.0)
-# per family, each parameter's fit coordinate: the log of one that must stay > 0
-TRANSFORMS = {EXPONENTIAL: {"k": LOG, "p": LOG, "q": LINEAR}}
-# per family, the pair of parameters that data at one speed cannot tell apart (k |V|^p: only the product is seen)
-ONE_SPEED_TRADE_OFFS = {EXPONENTIAL: ("k", "p")}
-# per family, the published law: the fit's start and the comparison printed
-DEFAULT_LAWS = {EXPONENTIAL: CORUNDUM_ON_STEEL}
+# a value in (0, 1): its logit; smooth, and every t gives a value inside
+LOGIT = Transform(lambda x: math.log(x / (1.0 - x)), lambda t: 1.0 / (1.0 + math.exp(-t)),
+                  lambda t: math.exp(-t) / (1.0 + math.exp(-t)) ** 2)
+DEFAULT_LAW = CORUNDUM_ON_STEEL      # the published law: the fit's start and the comparison printed
+
+
+@dataclasses.dataclass(frozen=True)
+class FitForm:
+    """How a family's law is fitted: the names of its fit values (what --fix names), each one's fit coordinate
+    (:class:`Transform`), their values at the published law (the start), the wall they make
+    (``make(values, name)``) and the pair that data at one speed cannot tell apart (if any)."""
+
+    family: str
+    names: tuple
+    transforms: dict
+    start: dict
+    make: Callable
+    trade_off: tuple = ()
+    allowed: dict = dataclasses.field(default_factory=dict)     # name → (check, range in words)
+
+
+def node_name(speed: float) -> str:
+    """The fit value of a tabulated law's a_nc at normal contact at the speed node ``speed`` (m/s): a_nc_100."""
+    return f"a_nc_{speed:g}"
+
+
+def fit_form(family: str, speeds) -> FitForm:
+    """The :class:`FitForm` of ``family`` for data at the incident speeds ``speeds`` (m/s).
+
+    exponential: k, p (log coordinates: > 0) and q, from the published law; k and p trade off at one speed.
+    tabulated: q and, at each distinct speed of the data as a contact-speed node, a_nc at normal contact
+    (``a_nc_<speed>``, logit coordinate: in (0, 1)); the law is linear in the contact sine from a_nc = 1 at
+    sine 0, like the exponential law, so that its values stay in (0, 1] and it is smooth in them; it starts from
+    the published law's a_nc at those speeds.
+    """
+    q = wall_family(EXPONENTIAL).parameters[-1]
+    if family == EXPONENTIAL:
+        law = wall_family(EXPONENTIAL)
+        return FitForm(family, law.parameter_names, {"k": LOG, "p": LOG, "q": LINEAR}, DEFAULT_LAW.parameters(),
+                       lambda values, name: wall_record(EXPONENTIAL, values, name), ("k", "p"),
+                       {p.name: (p.ok, p.allowed) for p in law.parameters})
+    nodes = tuple(float(v) for v in np.unique(np.asarray(speeds, dtype=np.float64)))
+    if len(nodes) > MAX_CONTACT_SPEEDS:
+        raise ValueError(f"the tabulated wall law holds at most {MAX_CONTACT_SPEEDS} speed nodes and the data have "
+                         f"{len(nodes)} speeds; allowed: at most {MAX_CONTACT_SPEEDS} (fit the exponential law)")
+    names = (*(node_name(v) for v in nodes), "q")
+    start = {**{node_name(v): math.exp(-DEFAULT_LAW.k * v ** DEFAULT_LAW.p) for v in nodes}, "q": DEFAULT_LAW.q}
+
+    def make(values, name):
+        return TabulatedWall(nodes, (0.0, 1.0), tuple((1.0, values[node_name(v)]) for v in nodes), values["q"],
+                             name=name)
+    in_unit = (lambda x: 0.0 < x < 1.0, "in (0, 1)")
+    return FitForm(TABULATED, names, {**{node_name(v): LOGIT for v in nodes}, "q": LINEAR}, start, make, (),
+                   {**{node_name(v): in_unit for v in nodes}, "q": (q.ok, q.allowed)})
 
 
 # ------------------------------------------------------------------------------------------------ the data
@@ -258,7 +308,7 @@ def particle_seeds(seed: int, rows: int, constituents: int) -> np.ndarray:
                       for j in range(constituents)] for i in range(rows)], dtype=np.int64)
 
 
-def model_means(wall: WallMaterial, alpha1, speed, bodies, weights, counts, seeds, model: Mapping):
+def model_means(wall: Wall, alpha1, speed, bodies, weights, counts, seeds, model: Mapping):
     """The direct model's mean u⁺/|V⁻| and v⁺/|V⁻| (columns 0, 1) over the rebounded particles of a mix, per row
     (α1 in degrees, |V⁻| in m/s, Ω⁻ = 0; lab frame of docs/model.md §2), and the variances of those means:
     two (m, 2) arrays.
@@ -447,17 +497,18 @@ def least_squares_fit(residuals: Callable, t0, xtol: float = XTOL, ftol: float =
 class Calibration:
     """A fitted wall law and what it was fitted to.
 
-    ``values``: every parameter of the family by name (the fitted and the fixed, units of
-    :data:`direct_model.wall.WALL_FAMILIES`); ``free``: those fitted; ``standard_error``: theirs (delta method from
+    ``values``: every fit value of the family by name (:func:`fit_form`: the fitted and the fixed, units of
+    :data:`direct_model.wall.WALL_FAMILIES`); ``wall``: the law they make; ``free``: those fitted; ``standard_error``: theirs (delta method from
     the fit coordinates); ``correlation``: (P, P) of the free ones. ``chi2`` over ``dof`` = 2m − P degrees of
     freedom; ``scaled``: the covariance is scaled by χ²/dof (an sd was estimated). ``sd_estimate``: (2,) the sd per
     particle estimated for a quantity given without one (NaN where given). ``fitted``, ``default``: (m, 2) the
-    model's means in the data's quantities at the fit and at the published law (``default_values``);
+    model's means in the data's quantities at the fit and at the published law (``default_law``);
     ``fitted_se``: the model's Monte Carlo standard errors of ``fitted``. ``mix``: weight by constituent.
     """
 
     family: str
     values: dict
+    wall: Wall
     free: tuple
     standard_error: dict
     correlation: np.ndarray
@@ -469,7 +520,7 @@ class Calibration:
     fitted: np.ndarray
     fitted_se: np.ndarray
     default: np.ndarray
-    default_values: dict
+    default_law: Wall
     mix: dict
     particles: int
     seed: int
@@ -513,39 +564,38 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
     arguments are checked (so that a refusal is the only line).
 
     The fit is weighted least squares (:func:`least_squares_fit`, the same bits on any CPU) in the coordinates of
-    :data:`TRANSFORMS`, from the published law; a residual's variance is :func:`residual_variance`, the model's
+    :func:`fit_form`, from the published law; a residual's variance is :func:`residual_variance`, the model's
     variance taken at the stage's start. Where an sd is missing, a first stage takes it as the model's own scatter
     among particles at the published law and a second refits from the first's optimum with it estimated from the
     residuals there (:func:`estimated_sd`). ValueError if the data cannot
-    determine the free parameters (fewer rows than them; one speed with both of :data:`ONE_SPEED_TRADE_OFFS`
+    determine the free parameters (fewer rows than them; one speed with both of the form's trade-off pair
     free), a parameter to fix is unknown or out of its range, or the model leaves a row without rebounds.
     """
-    law = wall_family(family)
+    form = fit_form(wall_family(family).name, data.speed)
     fixed = dict(fixed or {})
-    unknown = [name for name in fixed if name not in law.parameter_names]
+    unknown = [name for name in fixed if name not in form.names]
     if unknown:
-        raise ValueError(f"cannot fix '{unknown[0]}': the {family} wall law's parameters are "
-                         f"{', '.join(law.parameter_names)}")
-    default_values = DEFAULT_LAWS[family].parameters()
-    for parameter in law.parameters:
-        if parameter.name in fixed and not parameter.ok(float(fixed[parameter.name])):
-            raise ValueError(f"cannot fix '{parameter.name}' at {fixed[parameter.name]!r}: the {family} wall law's "
-                             f"'{parameter.name}' must be {parameter.allowed}")
-    fixed = {name: float(fixed[name]) for name in law.parameter_names if name in fixed}
-    free = tuple(name for name in law.parameter_names if name not in fixed)
+        raise ValueError(f"cannot fix '{unknown[0]}': the {family} wall law's fit values are "
+                         f"{', '.join(form.names)}")
+    for name, value in fixed.items():
+        ok, allowed = form.allowed[name]
+        if not ok(float(value)):
+            raise ValueError(f"cannot fix '{name}' at {value!r}: the {family} wall law's '{name}' must be {allowed}")
+    fixed = {name: float(fixed[name]) for name in form.names if name in fixed}
+    free = tuple(name for name in form.names if name not in fixed)
     m = len(data.alpha1)
     if not free:
-        raise ValueError(f"every parameter of the {family} wall law is fixed ({', '.join(law.parameter_names)}); "
+        raise ValueError(f"every parameter of the {family} wall law is fixed ({', '.join(form.names)}); "
                          f"leave at least one free")
     if m < len(free):
         raise ValueError(f"{data.source}: {m} data row{'s' * (m != 1)} and {len(free)} free parameters "
                          f"({', '.join(free)}); allowed: at least as many rows as free parameters (add rows or fix "
-                         f"parameters, e.g. --fix {free[-1]}={default_values[free[-1]]:g})")
-    pair = ONE_SPEED_TRADE_OFFS.get(family, ())
+                         f"parameters, e.g. --fix {free[-1]}={form.start[free[-1]]:g})")
+    pair = form.trade_off
     if pair and all(name in free for name in pair) and len(np.unique(data.speed)) == 1:
         raise ValueError(f"{data.source}, column 'speed_m_s': every row has the speed {data.speed[0]:g} m/s; "
                          f"{pair[0]} and {pair[1]} trade off at one speed; fix one, e.g. --fix "
-                         f"{pair[1]}={default_values[pair[1]]:g} (or give two speeds or more)")
+                         f"{pair[1]}={form.start[pair[1]]:g} (or give two speeds or more)")
     weights = _mix(mix, config)
     if not (isinstance(particles, (int, np.integer)) and not isinstance(particles, bool) and particles >= 1):
         raise ValueError(f"the particles per row must be an integer >= 1; got {particles!r}")
@@ -554,25 +604,26 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
     counts = [max(1, round(particles * weights[name])) for name in names]
     seeds = particle_seeds(seed, m, len(names))
     model = {} if config is None else {key: value for key, value in config.model().items() if key != "wall"}
-    transforms = [TRANSFORMS[family][name] for name in free]
+    transforms = [form.transforms[name] for name in free]
     if data.ignored and log is not None:
         log(f"{data.source}: warning: columns ignored: {', '.join(data.ignored)} (the columns read: "
             f"{', '.join(known_columns(data.names))})")
 
     cache = {}
 
-    def evaluate(values: dict):
-        """The model's means and their variances in the data's quantities at the law ``values``."""
+    def evaluate(values: dict, wall: Wall | None = None):
+        """The model's means and their variances in the data's quantities at the fit values ``values`` (or at
+        ``wall``, the published law)."""
         # 12 digits: exp(log x) may miss x by an ulp, and is the same law
-        key = tuple(float(f"{values[name]:.12g}") for name in law.parameter_names)
+        key = (wall,) if wall is not None else tuple(float(f"{values[name]:.12g}") for name in form.names)
         if key not in cache:
-            wall = WallMaterial.from_parameters(family, values, "calibration")
+            wall = wall if wall is not None else form.make(values, "calibration")
             means, variances = model_means(wall, data.alpha1, data.speed, bodies, [weights[n] for n in names],
                                            counts, seeds, model)
             empty = np.flatnonzero(np.isnan(means[:, 0]))
             if empty.size:
                 raise ValueError(f"{data.source} {data.rows[empty[0]]}: no particle of the mix rebounded with "
-                                 f"{_law_text(values)}; the data are far from this law (check the columns)")
+                                 f"{wall.law_text()}; the data are far from this law (check the columns)")
             cache[key] = (in_form(data.names, data.alpha1, means), in_form(data.names, data.alpha1, variances, True))
             if progress is not None:
                 progress(1)
@@ -590,7 +641,7 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
     def fit(t0, variance):
         return least_squares_fit(lambda t: weighted(t, variance), t0)
 
-    start = {**default_values, **fixed}
+    start = {**form.start, **fixed}
     t = np.array([tr.forward(start[name]) for name, tr in zip(free, transforms)])
     # stage 1: a missing sd starts as the model's own scatter among particles at the published law
     model_variance = evaluate(start)[1]
@@ -612,11 +663,12 @@ def calibrate(data: Measurements, family: str = EXPONENTIAL, fixed: Mapping | No
     se_t = np.sqrt(np.diag(cov))
     values = values_at(t)
     return Calibration(
-        family=family, values={name: values[name] for name in law.parameter_names}, free=free,
+        family=form.family, values={name: values[name] for name in form.names}, wall=form.make(values, "calibrated"),
+        free=free,
         standard_error={name: float(tr.slope(x) * s) for name, tr, x, s in zip(free, transforms, t, se_t)},
         correlation=cov / np.outer(se_t, se_t), chi2=chi2, dof=dof, scaled=scaled, sd_estimate=sd_estimate,
-        data=data, fitted=fitted, fitted_se=np.sqrt(fitted_variance), default=evaluate(default_values)[0],
-        default_values=default_values, mix=weights, particles=particles, seed=seed, evaluations=len(cache))
+        data=data, fitted=fitted, fitted_se=np.sqrt(fitted_variance), default=evaluate({}, DEFAULT_LAW)[0],
+        default_law=DEFAULT_LAW, mix=weights, particles=particles, seed=seed, evaluations=len(cache))
 
 
 # ------------------------------------------------------------------------------------------------ the outputs
@@ -648,7 +700,7 @@ def format_calibration(cal: Calibration) -> str:
         lines.append(f"{name:>11}  " + "  ".join(f"{c:6.3f}" for c in row))
     lines += ["", f"chi2/dof = {cal.chi2_dof:.3g} (chi2 {cal.chi2:.4g}, dof {cal.dof}); standard errors from the "
                   f"Jacobian at the optimum" + (", scaled by chi2/dof (an sd was estimated)" if cal.scaled else ""),
-              "", f"means: measured, fitted (model s.e.), default law ({_law_text(cal.default_values)})",
+              "", f"means: measured, fitted (model s.e.), default law ({cal.default_law.law_text()})",
               f"{'row':<26} {'alpha1':>7} {'speed':>7}"
               + "".join(f" {name + ' data':>11} {'fit':>16} {'default':>8}" for name in names)]
     for i, row in enumerate(data.rows):
@@ -673,7 +725,7 @@ def wall_toml(cal: Calibration, name: str) -> str:
         + f"; {cal.particles} particles per row, seed {cal.seed}",
         "# paste the [wall] section into a build configuration (or build with this file as --config)",
         "[wall]",
-        *(f"{p} = {float(v)!r}" for p, v in cal.values.items()),
+        *wall_values_toml(cal.wall),
         f"name = {json.dumps(name)}",
         f"speed_range_m_s = [{float(data.speed.min())!r}, {float(data.speed.max())!r}]   # the data's: where the "
         "law holds",

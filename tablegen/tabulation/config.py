@@ -18,13 +18,15 @@ the ``default`` preset, and the published corundum-on-steel wall law)::
     [table]
     resolution = "auto"               # or {clusters = .., dictionary_size = .., levels = ..}
 
-    [wall]                            # the wall law of docs/model.md §4
+    [wall]                            # the wall law of docs/model.md §4 (law = "exponential", the default)
     k = 0.1                           # restitution rate constant, (m/s)^-p, > 0
     p = 0.61                          # restitution speed exponent, > 0
     q = 1.0                           # friction factor exp(q cos gamma), finite
     name = "corundum_on_St3_Lashkov1991"
     speed_range_m_s = [50.0, 300.0]   # the |V⁻| the law was measured over (not stated for your own k, p, q
                                       # unless given): the runtimes count the hits answered outside it
+    # or law = "tabulated": q, contact_speed_m_s = [...], contact_sine = [0.0, ..., 1.0], and
+    # restitution = [[a_nc per sine node], one row per speed node] (docs/model.md §4)
 
     [shapes.sand_a]                   # a user's grain, named in grid.shapes (tablegen.tabulation.shape_config)
     mesh = "grains/sand_a.stl"        # relative to the configuration file; or vertices = [[x, y, z], ...]
@@ -47,12 +49,15 @@ import tomllib
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
+
 from data_schema.samples import ALPHA1_RANGE_TEXT, alpha1_is_physical
 from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from direct_model.registry import FAMILIES, ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
-from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial, check_speed_range, wall_family
+from direct_model.wall import (CORUNDUM_ON_STEEL, EXPONENTIAL, WALL_FAMILIES, Wall, check_speed_range, wall_family,
+                               wall_record)
 from tablegen.tabulation.config_error import ConfigError
 from tablegen.tabulation.shape_config import parse_shape_sections
 
@@ -81,7 +86,7 @@ class BuildConfig:
     n_max: int
     aspect: AspectRatioLaw
     resolution: TableResolution
-    wall: WallMaterial = CORUNDUM_ON_STEEL
+    wall: Wall = CORUNDUM_ON_STEEL
     grains: tuple = ()
     families: tuple = ()
 
@@ -140,9 +145,7 @@ class BuildConfig:
             f"resolution = {{{res}}}",
             "",
             "[wall]",
-            f"k = {w.k!r}",
-            f"p = {w.p!r}",
-            f"q = {w.q!r}",
+            *wall_values_toml(w),
             f"name = {json.dumps(w.name)}",
             *([f"speed_range_m_s = [{w.speed_range_m_s[0]!r}, {w.speed_range_m_s[1]!r}]"]
               if w.speed_range_stated else []),
@@ -153,6 +156,20 @@ class BuildConfig:
     def sha256(self) -> str:
         """Hash of :meth:`to_toml`: identifies the configuration in files and checkpoints."""
         return hashlib.sha256(self.to_toml().encode()).hexdigest()
+
+
+def wall_values_toml(wall: Wall) -> list:
+    """The ``[wall]`` lines of a law's family and values (exact float reprs): an exponential law's k, p, q as
+    they always were (so a default table's configuration text, hash and fingerprint stay the same), another
+    family's ``law`` line first."""
+    def number(x):
+        return repr(float(x))
+    lines = [] if wall.family == EXPONENTIAL else [f"law = {json.dumps(wall.family)}"]
+    lines += [f"{name} = {number(value)}" for name, value in wall.parameters().items()]
+    for name, array in wall.arrays().items():
+        rows = ["[" + ", ".join(map(number, row)) + "]" for row in np.atleast_2d(array)]
+        lines.append(f"{name} = " + ("[" + ", ".join(rows) + "]" if array.ndim == 2 else rows[0]))
+    return lines
 
 
 def _grain_toml(record: ConvexPolyhedron) -> str:
@@ -178,11 +195,13 @@ def _grain_toml(record: ConvexPolyhedron) -> str:
     return "\n".join(lines) + "\n"
 
 
+# every family's parameters and arrays: a [wall] key of another family than its law is named as such
+WALL_VALUE_KEYS = {key for family in WALL_FAMILIES.values() for key in (*family.parameter_names, *family.array_names)}
 CONFIG_KEYS = {
     "grid": {"alpha1_deg", "speed_m_s", "shapes"},
     "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
     "table": {"resolution"},
-    "wall": {*wall_family(CORUNDUM_ON_STEEL.family).parameter_names, "name", "speed_range_m_s"},
+    "wall": {"law", *WALL_VALUE_KEYS, "name", "speed_range_m_s"},
 }
 GRAINS_SECTION = "shapes"      # [shapes.NAME]: the user's grains; their keys are shape_config's
 
@@ -305,22 +324,42 @@ def parse_config(text: str, source: str = "<config>", base_dir=None, log=None) -
                                       if s in FAMILIES and s not in SHAPES))
 
 
-def _wall(raw: dict, source: str) -> WallMaterial:
-    """The wall law of the ``[wall]`` section: its family's parameters by name (:data:`direct_model.wall.WALL_FAMILIES`),
-    each checked against the family's range; missing keys take the corundum-on-steel law's values. Its speed
-    range ``speed_range_m_s`` = [low, high] m/s: the default law's when no law parameter is given, else not stated
-    unless given."""
-    family = wall_family(CORUNDUM_ON_STEEL.family)
+def _wall(raw: dict, source: str) -> Wall:
+    """The wall law of the ``[wall]`` section: its family ``law`` (:data:`direct_model.wall.WALL_FAMILIES`;
+    default exponential) and that family's parameters and arrays by name, each checked against its range;
+    missing scalar parameters take the corundum-on-steel law's values (its q for the tabulated family), a
+    tabulated law's arrays must be given. Its speed range ``speed_range_m_s`` = [low, high] m/s: the default
+    law's when no law value is given, else not stated unless given."""
+    law = raw.get("law", EXPONENTIAL)
+    if law not in WALL_FAMILIES:
+        raise ConfigError(f"{source}: 'wall.law' must be one of {', '.join(WALL_FAMILIES)}; got {law!r}")
+    family = wall_family(law)
+    own_keys = {*family.parameter_names, *family.array_names}
+    foreign = sorted(k for k in raw if k in WALL_VALUE_KEYS and k not in own_keys)
+    if foreign:
+        raise ConfigError(f"{source}: 'wall.{foreign[0]}' is not a parameter of the {law} wall law (its "
+                          f"parameters: {', '.join((*family.parameter_names, *family.array_names))})")
     values = {}
     for parameter in family.parameters:
         value = raw.get(parameter.name, CORUNDUM_ON_STEEL.parameters()[parameter.name])
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not parameter.ok(float(value)):
             raise ConfigError(f"{source}: 'wall.{parameter.name}' must be a number, {parameter.allowed}; got {value!r}")
         values[parameter.name] = float(value)
+    for array in family.arrays:
+        if array.name not in raw:
+            raise ConfigError(f"{source}: the {law} wall law needs 'wall.{array.name}': {array.meaning}")
+        value = raw[array.name]
+        rows = value if len(array.dims) == 2 and isinstance(value, list) else [value]
+        if not isinstance(value, list) or any(not isinstance(row, list) or any(
+                isinstance(x, bool) or not isinstance(x, (int, float)) for x in row) for row in rows):
+            raise ConfigError(f"{source}: 'wall.{array.name}' must be "
+                              f"{'a list of lists' if len(array.dims) == 2 else 'a list'} of numbers "
+                              f"({array.meaning}); got {value!r}")
+        values[array.name] = value
     name = raw.get("name", CORUNDUM_ON_STEEL.name)
     if not isinstance(name, str) or not name.strip():
         raise ConfigError(f"{source}: 'wall.name' must be a non-empty string; got {name!r}")
-    own_law = any(p in raw for p in family.parameter_names)
+    own_law = any(k in raw for k in (*own_keys, "law"))
     speed_range = raw.get("speed_range_m_s", None if own_law else CORUNDUM_ON_STEEL.speed_range_m_s)
     if speed_range is not None:
         if (not isinstance(speed_range, (list, tuple)) or len(speed_range) != 2
@@ -332,7 +371,10 @@ def _wall(raw: dict, source: str) -> WallMaterial:
         except ValueError:
             raise ConfigError(f"{source}: 'wall.speed_range_m_s' must be finite with 0 <= low < high (m/s); "
                               f"got {speed_range!r}") from None
-    return WallMaterial.from_parameters(family.name, values, name, speed_range)
+    try:
+        return wall_record(family.name, values, name, speed_range)
+    except ValueError as exc:       # a tabulated law's nodes or values: the message names the parameter
+        raise ConfigError(f"{source}: [wall]: {exc}") from None
 
 
 def _check_keys(data: dict, source: str) -> None:

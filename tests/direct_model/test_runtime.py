@@ -62,7 +62,7 @@ def test_parameters_hold_the_law_and_the_second_moments():
     params = _params()
     assert params.shape == (N_PARAMS,) and not params.flags.writeable
     np.testing.assert_allclose(params[[P_CDF_LOW, P_CDF_HIGH]], stats.norm.cdf([-1.5, 1.0]), rtol=1e-15)
-    np.testing.assert_array_equal(params[P_KFAC:], second_moment_factors(0.3))
+    np.testing.assert_array_equal(params[P_KFAC:P_KFAC + 4], second_moment_factors(0.3))
 
 
 @pytest.mark.parametrize("change, message", [

@@ -209,7 +209,7 @@ def parameter_row_cases(good, folder) -> list:
          "cannot read the attribute 'family' of group 'wall' as a string"),
         ("unknown_family", _attribute("wall", "family", "linear"),
          "the attribute 'family' of group 'wall' names an unknown wall law family 'linear' (this version knows: "
-         "exponential)"),
+         "exponential, tabulated)"),
         ("no_q", _row_edit("wall", drop="q"), f"{wall} has no field 'q'; the fields read: k, p, q (the exponential "
                                               f"wall law) and speed_range_m_s"),
         ("no_speed_range", _row_edit("wall", drop="speed_range_m_s"),
@@ -254,3 +254,41 @@ def parameter_row_cases(good, folder) -> list:
          f"index 2"),
     ]
     return [(edited_copy(good, folder, f"row_{name}.h5", edit), ERR_FORMAT, message) for name, edit, message in specs]
+
+
+def _wall_dataset(name, values=None):
+    """An edit of the wall's dataset ``name``: rewritten with ``values`` (float64, under Fletcher-32), or removed."""
+    def edit(f):
+        del f["wall"][name]
+        if values is not None:
+            f["wall"].create_dataset(name, data=np.asarray(values, dtype=np.float64), fletcher32=True)
+    return edit
+
+
+def tabulated_wall_cases(good, folder) -> list:
+    """(path, expected C code, the message after "PATH: ", Python's and C's) for faults of a tabulated wall law's
+    arrays in the table ``good`` (of TABULATED_TABLE_CONFIG's wall: speed nodes 40, 120, 300 m/s, sine nodes 0,
+    0.5, 1). Both loaders quote values as a Python list of floats."""
+    folder.mkdir(parents=True, exist_ok=True)
+    rule = "group 'wall': The wall law parameter"
+    specs = [
+        ("restitution_above_1", _set("wall/restitution", (1, 1), 1.5),
+         f"{rule} 'restitution' must be in (0, 1] at every node; got 1.5 at [1][1] (|V_c| = 120 m/s, sine 0.5)."),
+        ("restitution_zero", _set("wall/restitution", (2, 0), 0.0),
+         f"{rule} 'restitution' must be in (0, 1] at every node; got 0.0 at [2][0] (|V_c| = 300 m/s, sine 0)."),
+        ("sine_not_to_1", _wall_dataset("contact_sine", [0.0, 0.5, 0.9]),
+         f"{rule} 'contact_sine' must be 2 to 16 finite, strictly increasing numbers from 0 to 1; got [0.0, 0.5, 0.9]."),
+        ("speeds_not_increasing", _wall_dataset("contact_speed_m_s", [40.0, 300.0, 120.0]),
+         f"{rule} 'contact_speed_m_s' must be 1 to 16 finite, strictly increasing numbers > 0; got [40.0, 300.0, "
+         f"120.0]."),
+        ("restitution_columns", _wall_dataset("restitution", [[1.0, 0.8], [1.0, 0.75], [1.0, 0.7]]),
+         f"{rule} 'restitution' must be 3 rows (one per speed node) of 3 numbers (one per sine node); got [[1.0, 0.8], "
+         f"[1.0, 0.75], [1.0, 0.7]]."),
+        ("restitution_flat", _wall_dataset("restitution", [1.0, 0.8, 0.55, 1.0, 0.75, 0.5, 1.0, 0.7, 0.42]),
+         "dataset 'wall/restitution' must hold 2-dimensional numbers; got float64 of shape (9,)"),
+        ("no_sines", _wall_dataset("contact_sine"),
+         "missing dataset 'wall/contact_sine' (an array of the tabulated wall law: the sine nodes |v_c⁻|/|V_c⁻|)"),
+        ("q_nan", _row_edit("wall", q=np.nan), "field 'q' of dataset 'wall/parameters' must be finite; got nan"),
+    ]
+    return [(edited_copy(good, folder, f"tabulated_{name}.h5", edit), ERR_FORMAT, message)
+            for name, edit, message in specs]

@@ -31,7 +31,7 @@ U_PER_DRAW = 13                         # RBS_U_PER_DRAW
 BLOCK = 32                              # RBS_BLOCK
 LOCAL_SIZE = 6                          # RBS_LOCAL_SIZE
 NO_KEY = -1                             # RBS_NO_KEY
-VERSION_NUMBER = 1_000_000              # RBS_VERSION_NUMBER of 1.0.0
+VERSION_NUMBER = 1_001_000              # RBS_VERSION_NUMBER of 1.1.0
 
 # rbs_status: one status space (the hits' codes are surrogate's STATUS_*)
 OK, TRAPPED, FAILED = 0, 1, 2
@@ -113,9 +113,11 @@ class Rng(ctypes.Structure):
 
 class Record(ctypes.Structure):
     """A record of the header that begins with ``size_t size``: created with its size set to its own ctypes.sizeof
-    (what the header's RBS_*_INIT does), unless ``size`` is given."""
+    (what the header's RBS_*_INIT does), unless ``size`` is given. ``LAST_1_0``: the last field of its version 1.0
+    (None: its last field), whose end is the smallest size the library takes."""
 
     _fields_ = [("size", ctypes.c_size_t)]
+    LAST_1_0 = None
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -188,11 +190,15 @@ class ShapeInfo(Record):
 
 
 class WallInfo(Record):
-    """rbs_wall_info."""
+    """rbs_wall_info (its fields of 1.0 up to speed_range_m_s, then a tabulated law's arrays)."""
 
     _fields_ = [("family", ctypes.c_char_p), ("name", ctypes.c_char_p), ("n_parameters", ctypes.c_int),
                 ("parameter_names", ctypes.POINTER(ctypes.c_char_p)),
-                ("parameter_values", ctypes.POINTER(ctypes.c_double)), ("speed_range_m_s", ctypes.c_double * 2)]
+                ("parameter_values", ctypes.POINTER(ctypes.c_double)), ("speed_range_m_s", ctypes.c_double * 2),
+                ("n_contact_speeds", ctypes.c_int), ("contact_speed_m_s", ctypes.POINTER(ctypes.c_double)),
+                ("n_contact_sines", ctypes.c_int), ("contact_sine", ctypes.POINTER(ctypes.c_double)),
+                ("restitution", ctypes.POINTER(ctypes.c_double))]
+    LAST_1_0 = "speed_range_m_s"
 
 
 class Grain(Record):
@@ -363,13 +369,22 @@ class NativeTable:
                 "both_hands": info.both_hands}
 
     def wall(self) -> dict:
-        """rbs_table_wall as a dict: family, name, parameters {name: value}, speed_range_m_s (low, high)."""
+        """rbs_table_wall as a dict: family, name, parameters {name: value}, speed_range_m_s (low, high) and the
+        arrays {name: copied values} of a tabulated law (contact_speed_m_s, contact_sine, restitution (speeds,
+        sines)), {} where the record's pointers are NULL (the exponential family; their counts then 0)."""
         info = WallInfo()
         assert self.lib.c.rbs_table_wall(self.handle, ref(info)) == OK
         names = [info.parameter_names[i].decode() for i in range(info.n_parameters)]
         values = [info.parameter_values[i] for i in range(info.n_parameters)]
+        ns, nz = info.n_contact_speeds, info.n_contact_sines
+        pointers = {"contact_speed_m_s": (info.contact_speed_m_s, (ns,)), "contact_sine": (info.contact_sine, (nz,)),
+                    "restitution": (info.restitution, (ns, nz))}
+        given = [bool(pointer) for pointer, _ in pointers.values()]
+        assert all(given) or (not any(given) and ns == nz == 0), (given, ns, nz)
+        arrays = {name: np.ctypeslib.as_array(pointer, shape=shape).copy()
+                  for name, (pointer, shape) in pointers.items() if pointer}
         return {"family": info.family.decode(), "name": info.name.decode(), "parameters": dict(zip(names, values)),
-                "n_parameters": info.n_parameters, "speed_range_m_s": tuple(info.speed_range_m_s)}
+                "n_parameters": info.n_parameters, "speed_range_m_s": tuple(info.speed_range_m_s), "arrays": arrays}
 
     # -- mixes
     def mix_new(self, shape="mix", weights: dict | None = None):
@@ -556,6 +571,7 @@ INTERNAL = {
     "rbs_rotation_at": (None, [_vp, _d, _vp, _vp]),
     "rbs_carlson_rf": (_d, [_d, _d, _d]),
     "rbs_carlson_rj": (_d, [_d, _d, _d, _d]),
+    "rbs_restitution_factor": (_d, [_d, _vp]),
 }
 
 

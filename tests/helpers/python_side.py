@@ -8,7 +8,8 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``draw_local``; the direct model's free flight from ``direct_model.rotation``, its run-time kernel
 ``direct_rebound`` and the kernels it calls (``direct_model``: collide, body_vertices, the shape arrays and
 particle_body, bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix,
-rebound_model_frame), user grains (tests/helpers/grains.py); those of every
+rebound_model_frame), the wall records (``direct_model.wall``: WallMaterial, TabulatedWall and the node maxima) and
+the sampler's restitution factor (``surrogate.kernels.fastmath.restitution_factor``), user grains (tests/helpers/grains.py); those of every
 hit (``surrogate.kernels.wall_hit``: ``rebound``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
 and PATH_* codes); the law comparisons of tests/helpers/direct_law.py (its states, ``tablegen simulate`` and the
 statistics); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
@@ -26,6 +27,8 @@ from surrogate.kernels.direct_path import direct_rebound
 from surrogate.kernels.locate import mix_shape
 from data_schema.table import TABLE_VERSION
 from direct_model.collision import collide
+from direct_model.wall import MAX_CONTACT_SINES, MAX_CONTACT_SPEEDS, TabulatedWall, WallMaterial
+from surrogate.kernels.fastmath import restitution_factor
 from direct_model.body_rebound import quaternion_to_matrix
 from direct_model.runtime import (SCRATCH_SIZE, U_PER_REBOUND, aspect_ratio, normal_quantile, rebound_model_frame,
                                   uniform_quaternion)

@@ -39,7 +39,17 @@ NEAR_NORMAL_TABLE_CONFIG = _table_config([83.75, 85.0], [50.0, 75.0], seed=13)
 # the prism and a family entered by the tests alone (tests/helpers/families.py) on a 2 × 2 grid
 OCTAHEDRON_TABLE_CONFIG = _table_config([30.0, 70.0], [100.0, 200.0], seed=45, shapes=["prism", "octahedron"],
                                         particles_per_cell=3000)
-
+# a tabulated wall law (docs/model.md §4) on a 2 × 2 grid of the prism
+TABULATED_WALL = """[wall]
+law = "tabulated"
+q = 0.8
+contact_speed_m_s = [40.0, 120.0, 300.0]
+contact_sine = [0.0, 0.5, 1.0]
+restitution = [[1.0, 0.8, 0.55], [1.0, 0.75, 0.5], [1.0, 0.7, 0.42]]
+name = "test_tabulated"
+"""
+TABULATED_TABLE_CONFIG = _table_config([30.0, 70.0], [100.0, 200.0], seed=46, shapes=["prism"],
+                                       particles_per_cell=3000) + TABULATED_WALL
 
 
 def written_out_config(alpha1_deg, speed_m_s, shapes, seed) -> str:

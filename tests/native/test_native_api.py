@@ -10,7 +10,7 @@
   call; an rbs_result whose size covers only up to its status gets only that written; records larger than the
   library's (a program built against a later header) work, their later bytes neither read nor written; a NULL
   rbs_options is RBS_OPTIONS_INIT.
-- The version (1.0.0, 1000000) and the one status space: each status a distinct value and a string.
+- The version (1.1.0, 1001000) and the one status space: each status a distinct value and a string.
 - The many-hit and local draws' refusals (rbs_draw_many, rbs_draw_local).
 """
 
@@ -166,7 +166,7 @@ def test_the_enumerations_and_constants_are_the_helper_s_and_the_packages(header
     defines = {key[1]: float(value) for key, value in header_facts.items() if key[0] == "define"}
     for constant, value in DEFINES.items():
         assert defines[constant] == value, constant
-    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 0, 0)
+    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 1, 0)
     assert defines["RBS_U_PER_DRAW"] == py.U_PER_DRAW
     assert defines["RBS_SPIN_TOLERANCE"] == py.SPIN_TOLERANCE
     assert defines["RBS_NORMAL_TOLERANCE"] == NORMAL_TOLERANCE
@@ -202,7 +202,7 @@ def test_the_header_compiles_without_warnings(tmp_path, language):
 def test_version(native):
     version = native.version()
     major, minor, patch = map(int, version.split("."))
-    assert (major, minor, patch) == (1, 0, 0)
+    assert (major, minor, patch) == (1, 1, 0)
     assert native.version_number() == VERSION_NUMBER == major * 1_000_000 + minor * 1_000 + patch
 
 
@@ -246,8 +246,9 @@ def _rebound(c, table, mix, h, opts, result):
 
 
 def _size_1_0(record) -> int:
-    """The record's 1.0 size: the end of its last field (its sizeof but for trailing padding)."""
-    last = getattr(record, fields(record)[-1])
+    """The record's 1.0 size: the end of its last field of 1.0 (Record.LAST_1_0; else its last field: its sizeof but
+    for trailing padding)."""
+    last = getattr(record, record.LAST_1_0 or fields(record)[-1])
     return last.offset + last.size
 
 

@@ -95,15 +95,16 @@ def _integer_defines(*headers) -> dict:
 
 def test_the_parameter_layout_is_direct_model_s(table_pair):
     """runtime.h's layout is direct_model.runtime's: every P_* offset, U_* index and N_PARAMS, which both sides
-    derive from the shape count (P_KFAC, then one second-moment factor per shape code); the loader's array
-    has N_PARAMS elements."""
+    derive from the shape count and the wall array's size (P_KFAC, then one second-moment factor per shape code,
+    then the wall's array of WALL_ARRAY_SIZE); the loader's array has N_PARAMS elements."""
     c = _integer_defines(NATIVE / "include" / "rebound_scatter.h", *sorted((NATIVE / "src").glob("*.h")))
     c.setdefault("U_PER_REBOUND", c.get("RBS_U_PER_REBOUND"))
     layout = re.compile(r"P_[A-Z_]+|U_[A-Z_]+|N_PARAMS")
     python = {name: value for name, value in vars(py.direct_runtime).items() if layout.fullmatch(name)}
     assert {"P_KFAC", "N_PARAMS", "U_AXIS"} <= set(python)
     assert {name: value for name, value in c.items() if layout.fullmatch(name)} == python
-    assert c["N_PARAMS"] == c["P_KFAC"] + len(py.SHAPES) == c["P_KFAC"] + c["RBS_N_FAMILIES"]
+    assert c["P_WALL"] == c["P_KFAC"] + len(py.SHAPES) == c["P_KFAC"] + c["RBS_N_FAMILIES"]
+    assert c["N_PARAMS"] == c["P_WALL"] + c["WALL_ARRAY_SIZE"]
     assert table_pair[1].kernel_array("direct_parameters").size == python["N_PARAMS"]
 
 
@@ -122,7 +123,7 @@ def test_the_parameter_array_is_surrogate_s(native, table_pair, small_table_path
         assert table.wall()["parameters"] == {"k": 0.1, "p": 0.61, "q": 0.4}
     finally:
         table.close()
-    assert expected[py.direct_runtime.P_WALL + 2] == 0.4 and expected[py.direct_runtime.P_N_MAX] == 500
+    assert expected[py.direct_runtime.P_WALL + 1] == 0.4 and expected[py.direct_runtime.P_N_MAX] == 500   # W_Q
     assert not _same(expected, python.direct_parameters)
 
 
@@ -207,13 +208,28 @@ def test_random_inputs_bit_for_bit(native, table_pair):
         assert _same(R_c, R_py.ravel())
 
 
+def _random_tabulated_wall(rng, ns=None, nz=None):
+    """A wall of ``ns`` speed nodes in 1 to 400 m/s and ``nz`` sine nodes (random counts where None: 1 to 16 and 2 to
+    16), a_nc in (0, 1], q in [-1, 2]."""
+    ns = int(rng.integers(1, py.MAX_CONTACT_SPEEDS + 1)) if ns is None else ns
+    nz = int(rng.integers(2, py.MAX_CONTACT_SINES + 1)) if nz is None else nz
+    speeds = np.unique(rng.uniform(1.0, 400.0, ns))
+    sines = np.concatenate([[0.0], np.unique(rng.uniform(0.0, 1.0, nz - 2)), [1.0]])
+    values = 1.0 - rng.uniform(0.0, 1.0, (len(speeds), len(sines)))     # (0, 1]
+    return py.TabulatedWall(tuple(speeds), tuple(sines), tuple(map(tuple, values)), q=rng.uniform(-1.0, 2.0))
+
+
 def test_one_collision_bit_for_bit(native):
     """rbs_collide against numba's collide on 10⁴ random states (any body, orientation, contact point, spin and
-    wall law; a third not approaching): the same outcome and the same bits of ΔV and ΔΩ."""
+    wall law: every other state an exponential law, the others a tabulated one, its node counts from the fewest
+    to the most; a third not approaching): the same outcome and the same bits of ΔV and ΔΩ."""
     c = _c(native)
     rng = np.random.default_rng(7)
+    counts = [(1, 2), (1, 16), (16, 2), (py.MAX_CONTACT_SPEEDS, py.MAX_CONTACT_SINES)] + [(None, None)] * 60
+    # writable, as the kernels' arrays elsewhere
+    tabulated = [np.array(_random_tabulated_wall(rng, *count).as_array()) for count in counts]
     outcomes = {}
-    for _ in range(N_COLLISIONS):
+    for i in range(N_COLLISIONS):
         q = rng.normal(size=4)
         R = np.zeros((3, 3))
         py.quaternion_to_matrix(q, R)
@@ -223,7 +239,8 @@ def test_one_collision_bit_for_bit(native):
         V, W = speed * rng.uniform(-1, 1, 3), speed * rng.uniform(-1, 1, 3) * rng.choice([0.0, 0.1, 1.0, 5.0])
         r = rng.uniform(-1, 1, 3)
         r[1] = -abs(r[1]) if rng.random() < 0.7 else abs(r[1])
-        wall = np.array([rng.uniform(0.02, 0.3), rng.uniform(0.3, 1.0), rng.uniform(-1.0, 2.0)])
+        k, p, q = rng.uniform(0.02, 0.3), rng.uniform(0.3, 1.0), rng.uniform(-1.0, 2.0)
+        wall = np.array(py.WallMaterial(k, p, q).as_array()) if i % 2 else tabulated[(i // 2) % len(tabulated)]
         dV_c, dW_c, dV_py, dW_py = (np.full(3, 7.0) for _ in range(4))
         code = c.rbs_collide(*(x.ctypes.data for x in (V, W, r, Kinv, wall, dV_c, dW_c)))
         assert code == py.collide(V, W, r, Kinv, wall, dV_py, dW_py)

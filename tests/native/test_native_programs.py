@@ -8,7 +8,7 @@ import shutil
 
 import pytest
 
-from tests.helpers.bad_files import bad_tables, parameter_row_cases
+from tests.helpers.bad_files import bad_tables, parameter_row_cases, tabulated_wall_cases
 from tests.helpers.native_library import INSTALL_HINT, NATIVE, run
 
 SANITIZER_ENV = {"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0:halt_on_error=1",
@@ -26,17 +26,20 @@ def _sanitized_run(command, timeout=300):
     return done.stdout
 
 
-def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tmp_path):
+def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tabulated_table_path, tmp_path):
     """Open the good table twice (every draw function, good and bad mixes), then every bad file: the
     expected code, a message naming the file, no sanitizer report, no leak; tables of 1 and 64 shapes (a mix
-    sized by the table, the shapes' records, the direct path's answer for a user's grain) drawn from alike."""
+    sized by the table, the shapes' records, the direct path's answer for a user's grain) and a table of a
+    tabulated wall law (its arrays in rbs_table_wall, and its bad files) drawn from alike."""
     from tests.helpers.python_side import many_shape_table
     one, many = tmp_path / "one_shape.h5", tmp_path / "many_shapes.h5"
     many_shape_table(small_table_path, one, 1)
     many_shape_table(small_table_path, many, 64)
-    arguments = [one, 0, many, 0]
+    arguments = [one, 0, many, 0, tabulated_table_path, 0]
     for path, code, _ in bad_tables(small_table_path, tmp_path / "bad") + parameter_row_cases(small_table_path,
                                                                                                tmp_path / "rows"):
+        arguments += [path, code]
+    for path, code, _ in tabulated_wall_cases(tabulated_table_path, tmp_path / "tabulated"):
         arguments += [path, code]
     out = _sanitized_run([native_sanitized / "rbs_test_tables", small_table_path, *arguments])
     assert "0 failure(s)" in out
@@ -119,7 +122,7 @@ def test_installed_package_config(native_build, tmp_path):
     done = run(["cmake", "--build", str(build)])
     assert done.returncode == 0, done.stdout + done.stderr
     outputs = {run([str(build / name)]).stdout for name in ("consumer", "consumer_static")}
-    assert len(outputs) == 1 and outputs.pop().startswith("1.0.0 1000000 1000000 ")
+    assert len(outputs) == 1 and outputs.pop().startswith("1.1.0 1001000 1001000 ")
 
 
 @pytest.mark.parametrize("script", ["install-deps.sh"])

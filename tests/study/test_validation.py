@@ -71,7 +71,7 @@ def test_the_direct_side_is_the_model_the_table_was_built_with(grain_table_path)
     """table_model reads the table's own parameters, not the defaults: a table whose direct parameters are
     changed gives those back."""
     import surrogate
-    from direct_model.runtime import model_parameters
+    from direct_model.runtime import P_KFAC, model_parameters
     from direct_model.shapes import AspectRatioLaw
     from direct_model.wall import WallMaterial
 
@@ -80,7 +80,7 @@ def test_the_direct_side_is_the_model_the_table_was_built_with(grain_table_path)
                wall=WallMaterial(0.2, 0.5, 0.8, "test"), contact_tol=1e-9, set_tol=1e-8, max_steps=1000)
     other = dataclasses.replace(table, direct_parameters=model_parameters(
         own["aspect"], own["kappa"], own["n_max"], own["wall"], own["contact_tol"], own["set_tol"], own["max_steps"],
-        table.direct_parameters[-4:]))
+        table.direct_parameters[P_KFAC:P_KFAC + 4]))
     model = table_model(other)
     assert model["wall"].as_array().tobytes() == own.pop("wall").as_array().tobytes()
     assert {k: model[k] for k in own} == own

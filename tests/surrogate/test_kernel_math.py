@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from direct_model.elementary import fma, sincos
-from surrogate.kernels.fastmath import atan2_first_quadrant, restitution_at, restitution_pieces
+from direct_model.wall import WallMaterial
+from surrogate.kernels.fastmath import atan2_first_quadrant, restitution_at, restitution_factor, restitution_pieces
 from surrogate import kernels
 from surrogate.kernels.memory import load, stack_scratch
 
@@ -144,7 +145,7 @@ def test_restitution_pieces_match_the_closed_form(grid):
     and enters a(V) = 1 − (1 − f) sin α1 additively)."""
     grid = np.array(grid)
     for k, p in ((0.1, 0.61), (0.02, 0.3), (0.5, 0.9), (1.0, 1.0), (0.1, 1.5)):
-        pieces = restitution_pieces(grid, k, p)
+        pieces = restitution_pieces(grid, WallMaterial(k, p).as_array())
         if len(grid) == 1:
             assert pieces.shape[:2] == (1, 1)      # no interval: the kernel never reads it (weight 0)
             continue
@@ -154,6 +155,27 @@ def test_restitution_pieces_match_the_closed_form(grid):
             _restitution_all(pieces.ravel(), pieces.shape[1], np.full(w.size, j), w, got)
             exact = np.exp(-k * (grid[j] + w * (grid[j + 1] - grid[j])) ** p)
             assert np.max(np.abs(got - exact)) <= 1e-12, (grid, k, p, j)
+
+
+def test_restitution_pieces_of_a_tabulated_law():
+    """A tabulated law's factor f(V) = a_nc(V, 1), piecewise linear between its speed nodes: exact where a piece
+    holds no node (a polynomial interpolates a line exactly, to round-off), and within the kink's rounding where
+    one does (degree-9 Chebyshev interpolation of a slope change Δs over a piece of width h misses by about
+    Δs·h/20 at most); the grid's own factors are the law's."""
+    from direct_model.wall import TabulatedWall
+
+    wall = TabulatedWall((60.0, 130.0), (0.0, 1.0), ((1.0, 0.8), (1.0, 0.5)), name="t").as_array()
+    grid = np.array([50.0, 60.0, 100.0, 150.0, 200.0])
+    pieces = restitution_pieces(grid, wall)
+    w = np.linspace(0.0, 1.0, 2001)
+    for j in range(len(grid) - 1):
+        got = np.empty_like(w)
+        _restitution_all(pieces.ravel(), pieces.shape[1], np.full(w.size, j), w, got)
+        exact = np.array([restitution_factor(v, wall) for v in grid[j] + w * (grid[j + 1] - grid[j])])
+        kink = grid[j] < 130.0 < grid[j + 1]
+        slope_change, width = 0.3 / 70.0, (grid[j + 1] - grid[j]) / pieces.shape[1]
+        assert np.max(np.abs(got - exact)) <= (slope_change * width / 20.0 if kink else 1e-14), j
+    assert [restitution_factor(v, wall) for v in grid] == [0.8, 0.8, 0.8 - 0.3 * 40.0 / 70.0, 0.5, 0.5]
 
 
 def test_chebyshev_nodes_are_correctly_rounded():

@@ -52,6 +52,50 @@ def test_kernel_arrays_hold_the_file_s_law(small_table_path, small_table):
     assert data.dictionary.ctypes.data % 64 == 0 and data.clusters.ctypes.data % 64 == 0
 
 
+def test_a_tabulated_wall_law_is_stored_read_and_drawn_from(tabulated_table_path, tmp_path):
+    """A table built with a tabulated wall law: /wall holds its arrays and reads back as the configuration's law;
+    the direct model's parameters hold its kernel array, the speed interpolation its a_nc at normal contact at
+    the grid speeds; both paths answer hits; a stored a_nc outside (0, 1] is refused naming the dataset."""
+    import h5py
+
+    from data_schema.table import DataFormatError, read_table
+    from direct_model.runtime import P_WALL
+    from surrogate.kernels.fastmath import restitution_factor
+    from tablegen.tabulation.config import parse_config
+    from tests.helpers.tables import TABULATED_WALL, edited_copy
+
+    wall = parse_config(TABULATED_WALL).wall
+    assert read_table(tabulated_table_path).wall == wall
+    table = surrogate.load(tabulated_table_path)
+    array = wall.as_array()
+    np.testing.assert_array_equal(table.direct_parameters[P_WALL:P_WALL + array.size], array)
+    assert not table.direct_parameters[P_WALL + array.size:].any()
+    # a(V, 1) between the nodes 40 and 120, and 120 and 300 m/s
+    expected = [0.5 + 0.05 * (120.0 - 100.0) / 80.0, 0.5 - 0.08 * (200.0 - 120.0) / 180.0]
+    np.testing.assert_allclose(table.kernel_data.speed_restitution, expected, rtol=1e-15)
+    assert restitution_factor(100.0, array) == table.kernel_data.speed_restitution[0]
+    n = 400
+    rng = np.random.default_rng(8)
+    alpha = np.radians(rng.uniform(30.0, 70.0, n))
+    speed = rng.uniform(100.0, 200.0, n)
+    velocity = np.stack([np.cos(alpha) * speed, -np.sin(alpha) * speed, np.zeros(n)], axis=1)
+    for method in ("table", "direct"):
+        out = surrogate.sample_global(table, velocity, [0.0, 1.0, 0.0], 1e-4, shape="prism", random_state=3,
+                                      method=method)
+        rebounded = out.status == 0
+        assert rebounded.mean() > 0.9 and np.all(out.V[rebounded, 1] > 0.0)
+        assert np.all(np.linalg.norm(out.V[rebounded], axis=1) <= speed[rebounded] * (1 + 1e-12))
+
+    def corrupt(f):
+        del f["wall/restitution"]
+        f["wall"].create_dataset("restitution", data=np.array([[1.0, 0.8, 0.55], [1.0, 0.75, 1.5], [1.0, 0.7, 0.4]]))
+    with pytest.raises(DataFormatError, match=r"group 'wall': The wall law parameter 'restitution' must be in "
+                                              r"\(0, 1\] at every node; got 1.5 at \[1\]\[2\]"):
+        read_table(edited_copy(tabulated_table_path, tmp_path, "bad.h5", corrupt))
+    with h5py.File(tabulated_table_path) as f:
+        assert f["wall/contact_sine"].attrs["units"] == "1" and f["wall/restitution"].shape == (3, 3)
+
+
 @pytest.mark.parametrize("weights", [[0.25, 0.25, 0.25, 0.25], [0.7, 0.0, 0.2, 0.1, 0.0], [1.0, 0.0, 0.0],
                                      np.random.default_rng(3).dirichlet(np.ones(500))])
 def test_alias_table_reproduces_the_weights(weights):

@@ -131,3 +131,35 @@ def test_speed_grids_the_runtime_cannot_serve_name_the_allowed_range(tmp_path, c
     for word in words:
         assert word in err[0], err[0]
     assert not (tmp_path / "t.h5").exists()
+
+
+def test_a_tabulated_wall_law_reads_checks_and_round_trips():
+    """law = "tabulated": q and the three arrays; its text round-trips (so the table's configuration rebuilds it);
+    a key of another family, a missing array and a value outside (0, 1] are one error naming the key."""
+    from direct_model.wall import TabulatedWall
+    from tests.helpers.tables import TABULATED_WALL
+
+    config = parse_config(TABULATED_WALL)
+    assert config.wall == TabulatedWall((40.0, 120.0, 300.0), (0.0, 0.5, 1.0),
+                                        ((1.0, 0.8, 0.55), (1.0, 0.75, 0.5), (1.0, 0.7, 0.42)), 0.8,
+                                        name="test_tabulated")
+    assert not config.wall.speed_range_stated and parse_config(config.to_toml()) == config
+    assert 'law = "tabulated"' in config.to_toml() and "k = " not in config.to_toml()
+    for edit, word in [
+        (TABULATED_WALL + "k = 0.2\n", "'wall.k' is not a parameter of the tabulated wall law"),
+        (TABULATED_WALL.replace("contact_sine = [0.0, 0.5, 1.0]\n", ""), "needs 'wall.contact_sine'"),
+        (TABULATED_WALL.replace("0.42", "1.2"), r"'restitution' must be in \(0, 1\] at every node; got 1.2 at \[2\]\[2\]"),
+        (TABULATED_WALL.replace("[0.0, 0.5, 1.0]", "[0.0, 0.5, 0.9]"), "'contact_sine' must be 2 to 16"),
+        (TABULATED_WALL.replace("[40.0, 120.0, 300.0]", "[40.0, true, 300.0]"), "'wall.contact_speed_m_s' must be a list"),
+        (TABULATED_WALL.replace('"tabulated"', '"linear"'), "'wall.law' must be one of exponential, tabulated"),
+    ]:
+        with pytest.raises(ConfigError, match=word):
+            parse_config(edit, "case.toml")
+
+
+def test_the_default_configuration_text_is_unchanged_by_the_law_families():
+    """The exponential law's [wall] lines are what they were before the families (k, p, q, name, range), so the
+    default table's configuration, its hash and its fingerprint stay those of 1.0."""
+    text = load_config().to_toml()
+    assert text.split("[wall]\n")[1].strip() == (
+        "k = 0.1\np = 0.61\nq = 1.0\nname = \"corundum_on_St3_Lashkov1991\"\nspeed_range_m_s = [50.0, 300.0]")
