@@ -105,7 +105,7 @@ from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
 from direct_model.runtime import (P_WALL, SCRATCH_SIZE, U_AXIS, U_HAND, U_ORIENTATION, U_PER_REBOUND, U_RATIOS,
                                   aspect_ratio, family_shapes, model_parameters, rebound_model_frame,
                                   uniform_quaternion)
-from direct_model.shape_arrays import bounding_radius, particle_body
+from direct_model.shape_arrays import bounding_radius, particle_body, scanned_hull
 from direct_model.shapes import MAX_VERTICES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_SET_TOL, simulate
 from direct_model.wall import CORUNDUM_ON_STEEL
@@ -247,7 +247,7 @@ def _model_frame_loop(params, shapes, model, shape, u_all, counts, W_after):
 # ----------------------------------------------------------------------------- the pieces of a rebound
 
 @numba.njit
-def _bodies(shapes, shape, u_all, semi, K, R, verts, nv):
+def _bodies(shapes, shape, u_all, semi, K, R, verts, nv, scale):
     """The bodies the rows' uniforms draw (as rebound_model_frame draws them): half-extents, J/m, orientation R,
     vertices (untimed)."""
     q = np.empty(4)
@@ -257,7 +257,7 @@ def _bodies(shapes, shape, u_all, semi, K, R, verts, nv):
         quaternion_to_matrix(q, R[i])
         ratio_ba, ratio_cb = aspect_ratio(law, cdf, u_all[i, U_RATIOS]), aspect_ratio(law, cdf, u_all[i, U_RATIOS + 1])
         hand = 1.0 if shapes.both_hands[shape] == 0 or u_all[i, U_HAND] < 0.5 else -1.0
-        nv[i] = particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts[i], K[i], semi[i])
+        nv[i] = particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts[i], K[i], semi[i], scale)
 
 
 # without numba's reference counts, like the kernels they time: with them, each row's view (verts[i], R[i], ...)
@@ -266,17 +266,17 @@ PIECE_LOOP = dict(_nrt=False)
 
 
 @numba.njit(**PIECE_LOOP)
-def _flight_setups(shapes, shape, semi, K, R, verts, nv, W, rot, K_lab, ell):
+def _flight_setups(shapes, shape, semi, K, R, verts, nv, W, rot, K_lab, ell, hull):
     """What rebound does at the start of a flight: K in the lab frame, ℓ = KΩ, curvature_bound, jerk_bound and
     (at the flight's second search step, if it has one) rotation_init; rot[i] receives the rotation parameters;
-    K_lab (3, 3) and ell (3,) are work arrays."""
+    K_lab (3, 3) and ell (3,) are work arrays; ``hull`` a family's (scanned: no tree)."""
     kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
         lab_tensor(R[i], K[i], K_lab)
         for j in range(3):
             ell[j] = K_lab[j, 0] * W[i, 0] + K_lab[j, 1] * W[i, 1] + K_lab[j, 2] * W[i, 2]
         rotation_init(K[i], R[i], ell, rot[i])
-        Rb = bounding_radius(kind, semi[i], verts[i], nv[i])
+        Rb = bounding_radius(kind, semi[i], verts[i], nv[i], hull)
         curvature_bound(kind, semi[i], Rb, K[i], ell, W[i])
         jerk_bound(kind, semi[i], Rb, K[i], ell, W[i])
 
@@ -305,7 +305,7 @@ def _collisions(params, shapes, shape, semi, K, R, verts, nv, model, out, h, h1,
     (MAX_VERTICES,), vectors (7, 3) and Kinv_lab (3, 3) are work arrays."""
     curv, r, Kinv, V, W, dV, dW = vectors[0], vectors[1], vectors[2], vectors[3], vectors[4], vectors[5], vectors[6]
     W[:] = 0.0
-    wall = params[P_WALL:P_WALL + 3]
+    wall = params[P_WALL:]
     kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
         m = lowest_points(kind, verts[i], nv[i], semi[i], K[i], R[i], W, 0.0, 0.0, h, h1, curv)
@@ -344,7 +344,7 @@ def piece_inputs(shapes, shape_code, u_all, model, W_after) -> dict:
     m = len(u_all)
     semi, K, R = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3, 3))
     verts, nv = np.zeros((m, MAX_VERTICES, 3)), np.empty(m, dtype=np.int64)
-    _bodies(shapes, shape_code, u_all, semi, K, R, verts, nv)
+    _bodies(shapes, shape_code, u_all, semi, K, R, verts, nv, np.empty(3))
     return {"semi": semi, "K": K, "R": R, "verts": verts, "nv": nv, "W": np.where(np.isfinite(W_after), W_after, 0.0),
             "t": 0.5 / np.hypot(model[:, 0], model[:, 1]), "model": model, "u": u_all}
 
@@ -368,8 +368,9 @@ def piece_costs(params, shapes, shape_code, pieces: dict, repeats) -> dict:
     R1, vectors = np.empty((3, 3)), np.empty((7, 3))
     h, h1 = np.empty(MAX_VERTICES), np.empty(MAX_VERTICES)
     runs = 5 * repeats
+    family = scanned_hull(verts[0])
     return {"us_flight_setup": 1e6 * _best(lambda: _flight_setups(shapes, shape_code, semi, K, R, verts, nv, W, rot,
-                                                                    R1, vectors[0]), runs) / m,
+                                                                    R1, vectors[0], family), runs) / m,
             "us_orientation": 1e6 * _best(lambda: _orientations(rot, t, R1, vectors[0]), runs) / m,
             "us_lowest_points": 1e6 * _best(lambda: _lowest_points(shapes, shape_code, semi, K, R, verts, nv, W, h,
                                                                    h1, vectors[0]), runs) / m,

@@ -57,10 +57,11 @@ TARGET_MANY_NS = 100.0
 TARGET_MANY_OVER_BOUNCE = 3.0
 
 
-def build_native(folder: Path, target: str = "rbs_bench") -> Path:
-    """Configure and build native/ (Release) with the bench program ``target`` into ``folder``."""
+def build_native(folder: Path, target: str = "rbs_bench", shared: bool = False) -> Path:
+    """Configure and build native/ (Release) with the bench program ``target`` into ``folder`` (and the shared
+    library with ``shared``)."""
     for command in (["cmake", "-S", str(NATIVE), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release",
-                     "-DRBS_BUILD_BENCH=ON", "-DRBS_BUILD_SHARED=OFF"],
+                     "-DRBS_BUILD_BENCH=ON", f"-DRBS_BUILD_SHARED={'ON' if shared else 'OFF'}"],
                     ["cmake", "--build", str(folder), "-j", "2", "--target", target]):
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:

@@ -34,9 +34,9 @@ from direct_model.options import JIT, KERNEL
 from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
 from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, jerk_bound,
                                   lowest_points)
-from direct_model.registry import MAX_HULL_VERTICES
 from direct_model.rotation import ROT_PARAMS_SIZE
-from direct_model.shape_arrays import bounding_radius, particle_body
+from direct_model.shape_arrays import bounding_radius, particle_body, particle_hull
+from direct_model.vertex_tree import TREE_ABOVE, lowest_two
 
 HISTORY_COLUMNS = 17
 
@@ -55,8 +55,8 @@ class BodyRebound(NamedTuple):
 
 # layout of the scratch array of :func:`body_rebound`: the candidate points' heights and rates, then g̈ (curvatures)
 _HEIGHTS = 0
-_RATES = _HEIGHTS + MAX_HULL_VERTICES
-_CURVATURE = _RATES + MAX_HULL_VERTICES
+_RATES = _HEIGHTS + TREE_ABOVE     # a scanned body's candidates: at most TREE_ABOVE (more: its tree)
+_CURVATURE = _RATES + TREE_ABOVE
 _PARAMS = _CURVATURE + 3
 _R = _PARAMS + ROT_PARAMS_SIZE
 _K_LAB = _R + 9
@@ -86,7 +86,7 @@ def lab_tensor(R, diag, out):
 
 @numba.njit(**KERNEL)
 def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_tol, set_tol, max_steps, V, W,
-                 history, work):
+                 history, work, hull):
     """Simulate one particle's rebound.
 
     Parameters
@@ -106,13 +106,15 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         of flight k (k < H): time (a/(m/s)), centre height y (a), V (3), Ω (3),
         R (9, row-major). Pass an array with H = 0 to record nothing.
     work : (WORK_SIZE,) float64 scratch space (no allocation per particle).
+    hull : (unit, scale, nodes, links), the hull's tree (:func:`direct_model.flight.find_contact`): its vertices
+        are unit[i] · scale and ``verts`` is not read; nodes of no rows: ``verts[:nv]`` are scanned.
 
     Returns
     -------
     :class:`BodyRebound`.
     """
-    h = work[_HEIGHTS:_HEIGHTS + MAX_HULL_VERTICES]
-    h1 = work[_RATES:_RATES + MAX_HULL_VERTICES]
+    h = work[_HEIGHTS:_HEIGHTS + TREE_ABOVE]
+    h1 = work[_RATES:_RATES + TREE_ABOVE]
     curv = work[_CURVATURE:_CURVATURE + 3]
     params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
     R = work[_R:_R + 9].reshape((3, 3))
@@ -132,7 +134,9 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         for j in range(3):
             R[i, j] = R0[i, j]
 
-    if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
+    if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0 and hull[2].shape[0] > 0:
+        y = -lowest_two(hull[0], hull[1], hull[2], hull[3], (R[1, 0], R[1, 1], R[1, 2]), 0.0)[0]
+    elif W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
         n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv)
         y = -np.inf
         for i in range(n):
@@ -165,7 +169,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         for i in range(3):
             Wt[i] = W[i]
         code, t, steps = find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
-                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, curv, rc)
+                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, curv, rc, hull)
         n_steps += steps
         if code == SEARCH_ESCAPED:
             status = STATUS_REBOUNDED
@@ -210,18 +214,22 @@ def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall,
     for block in numba.prange(n_blocks):
         no_history = np.empty((0, HISTORY_COLUMNS))
         work = np.empty(WORK_SIZE)
-        verts = np.empty((MAX_HULL_VERTICES, 3))
+        verts = np.empty((TREE_ABOVE, 3))
         K = np.empty(3)
         semi = np.empty(3)
+        scale = np.empty(3)
         R0 = np.empty((3, 3))
         for i in range(block * n // n_blocks, (block + 1) * n // n_blocks):
             # int64 shape and kind, as the runtime passes them: one compilation of the model for both
             shape = np.int64(shapes[i])
-            nv = particle_body(shape_arrays, shape, ratios[i, 0], ratios[i, 1], float(hands[i]), verts, K, semi)
+            nv = particle_body(shape_arrays, shape, ratios[i, 0], ratios[i, 1], float(hands[i]), verts, K, semi,
+                               scale)
+            hull = particle_hull(shape_arrays, shape, scale)
             kind = np.int64(shape_arrays.kind[shape])
             quaternion_to_matrix(quats[i], R0)
-            rebound = body_rebound(kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, wall,
-                                   n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work)
+            rebound = body_rebound(kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv, hull), R0, V0, W0,
+                                   wall, n_max, contact_tol, set_tol, max_steps, out_V[i], out_W[i], no_history, work,
+                                   hull)
             out_status[i] = rebound.status
             out_failure[i] = rebound.failure
             out_ncoll[i] = rebound.n_collisions

@@ -68,6 +68,8 @@ import numpy as np
 from direct_model.options import KERNEL
 from direct_model.rotation import rotation_at, rotation_init
 from direct_model.shape_arrays import KIND_ELLIPSOID
+from direct_model.vertex_tree import (FLOOR, ROUNDING, contact_sums, height, leaf_vertices, lower_bound, lowest_two,
+                                      spread, vertex)
 
 SEARCH_CONTACT = 0      # a point touches the wall (within contact_tol) and approaches it
 SEARCH_ESCAPED = 1      # the body can never reach the wall again
@@ -167,16 +169,10 @@ def taylor_root(h, hdot, hddot):
     return -2.0 * h / (hdot + math.copysign(np.sqrt(disc), hdot))
 
 
-@numba.njit(**KERNEL)
-def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv):
-    """Heights ``h[i]`` and rates ``h1[i]`` of the candidate lowest points, and ``curv`` (3,), from which
-    :func:`curvature` gives any one's curvature h'' (only the binding point's is needed).
-
-    ``R``, ``W``: orientation and lab Ω now; ``y``, ``v``: the centre's height and vertical
-    velocity. Candidates (body frame): the vertices ``verts[:nv]``, or the ellipsoid's support
-    point, written into ``verts[0]``. ``curv`` receives g̈ (a vertex p has h'' = g̈·p), or the
-    ellipsoid's h'' in ``curv[0]``. Returns the number of candidates (module doc).
-    """
+@numba.njit(inline="always", **KERNEL)
+def turning(R, W, K):
+    """The lab's normal seen from the body and how it turns (module doc): g = Rᵀ e_y, ġ, g̈, as 9 floats, from
+    the orientation ``R``, the lab Ω ``W`` and the principal J/m ``K``."""
     g0, g1, g2 = R[1, 0], R[1, 1], R[1, 2]
     w0 = R[0, 0] * W[0] + R[1, 0] * W[1] + R[2, 0] * W[2]      # ω = Rᵀ Ω
     w1 = R[0, 1] * W[0] + R[1, 1] * W[1] + R[2, 1] * W[2]
@@ -189,6 +185,20 @@ def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv):
     a0 = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1)                  # g̈ = ġ × ω + g × ω̇
     a1 = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2)
     a2 = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0)
+    return g0, g1, g2, d0, d1, d2, a0, a1, a2
+
+
+@numba.njit(**KERNEL)
+def lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv):
+    """Heights ``h[i]`` and rates ``h1[i]`` of the candidate lowest points, and ``curv`` (3,), from which
+    :func:`curvature` gives any one's curvature h'' (only the binding point's is needed).
+
+    ``R``, ``W``: orientation and lab Ω now; ``y``, ``v``: the centre's height and vertical
+    velocity. Candidates (body frame): the vertices ``verts[:nv]``, or the ellipsoid's support
+    point, written into ``verts[0]``. ``curv`` receives g̈ (a vertex p has h'' = g̈·p), or the
+    ellipsoid's h'' in ``curv[0]``. Returns the number of candidates (module doc).
+    """
+    g0, g1, g2, d0, d1, d2, a0, a1, a2 = turning(R, W, K)
     if kind == KIND_ELLIPSOID:
         u0, u1, u2 = semi[0] * g0, semi[1] * g1, semi[2] * g2
         sigma = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
@@ -239,19 +249,79 @@ def choose_contact(n, verts, h, h1, R, set_tol, rc):
             p0, p1, p2, rate = p0 + verts[i, 0], p1 + verts[i, 1], p2 + verts[i, 2], rate + h1[i]
             if h1[i] < 0.0 and h[i] < best_h:
                 best, best_h = i, h[i]
+    k = max(best, 0)
+    return contact_point(count, p0, p1, p2, rate, best, verts[k, 0], verts[k, 1], verts[k, 2], R, rc)
+
+
+@numba.njit(inline="always", **KERNEL)
+def contact_point(count, p0, p1, p2, rate, best, q0, q1, q2, R, rc):
+    """:func:`choose_contact`'s choice from the contact set's sums (``count`` points, Σp, Σh') and its lowest
+    approaching point ``best`` at q (−1: none): the centroid if it approaches, else q; False if neither."""
     if not (count > 1 and rate < 0.0):
         if best < 0:
             return False
-        p0, p1, p2, count = verts[best, 0], verts[best, 1], verts[best, 2], 1
+        p0, p1, p2, count = q0, q1, q2, 1
     p0, p1, p2 = p0 / count, p1 / count, p2 / count
     for k in range(3):
         rc[k] = R[k, 0] * p0 + R[k, 1] * p1 + R[k, 2] * p2
     return True
 
 
+@numba.njit(inline="always", **KERNEL)
+def take_step(h, hdot, M, T, i, tau, tau_other, b):
+    """The safe-step loop's work on point i (:func:`find_contact`): (tau, tau_other, b) after it. A point whose
+    safe step surely exceeds the second smallest so far (or T, at least the final second smallest) changes
+    neither."""
+    bound = min(T, tau_other)
+    if bound < np.inf and not may_reach(h, hdot, M, bound):
+        return tau, tau_other, b
+    tau_i = safe_step(h, hdot, M)
+    if tau_i < tau:
+        return tau_i, tau, i
+    return tau, min(tau_other, tau_i), b
+
+
+@numba.njit(**KERNEL)
+def tree_safe_steps(unit, scale, nodes, links, g, d, y, v, M, T):
+    """(tau, tau_other, b) of the hull's vertices through its tree (:mod:`direct_model.vertex_tree`), what
+    :func:`find_contact`'s loop over every vertex finds (b = −1 if no step is finite) when ``T`` is at least the
+    second smallest safe step (:func:`pass_over_bound`); h = y + g·p, h' = v + d·p, M the curvature bound. A
+    node is passed over when a lower bound of max(h, 0) + h'T' − ½MT'² over its box (T' = T(1 + 10⁻¹²) +
+    10⁻³⁰⁰, as :func:`may_reach`) is positive beyond 10⁻¹² of its terms: every vertex in it then has a safe step
+    above T, which may_reach would say too."""
+    Tp = T * (1.0 + 1e-12) + 1e-300
+    tau, tau_other, b = np.inf, np.inf, -1
+    k = 0
+    while k < nodes.shape[0]:
+        if T < np.inf:
+            low_h, low_rate = lower_bound(y, g, scale, nodes, k), lower_bound(v, d, scale, nodes, k)
+            q = max(low_h, 0.0) + (low_rate - 0.5 * M * Tp) * Tp
+            size = (abs(low_h) + 2.0 * spread(g, scale, nodes, k)
+                    + (abs(low_rate) + 2.0 * spread(d, scale, nodes, k)) * Tp + 0.5 * abs(M) * Tp * Tp + FLOOR)
+            if q > ROUNDING * size:
+                k = links[k, 2]
+                continue
+        for i in leaf_vertices(links, k):
+            h, p0, p1, p2 = height(unit, scale, g, y, i)
+            tau, tau_other, b = take_step(h, v + (d[0] * p0 + d[1] * p1 + d[2] * p2), M, T, i, tau, tau_other, b)
+        k += 1                  # into the first child, or past a leaf
+    return tau, tau_other, b
+
+
+@numba.njit(inline="always", **KERNEL)
+def point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b):
+    """(h, h', h'') of candidate ``b``: from the scan's arrays, or computed for vertex b of a hull with a tree
+    (the same operations as :func:`lowest_points` and :func:`curvature`)."""
+    if tree:
+        p0, p1, p2 = vertex(unit, scale, b)
+        return (y + (g[0] * p0 + g[1] * p1 + g[2] * p2), v + (d[0] * p0 + d[1] * p1 + d[2] * p2),
+                curv[0] * p0 + curv[1] * p1 + curv[2] * p2)
+    return h[b], h1[b], curvature(kind, verts, b, curv)
+
+
 @numba.njit(**KERNEL)
 def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
-                 max_steps, R, W, h, h1, curv, rc):
+                 max_steps, R, W, h, h1, curv, rc, hull):
     """Advance a flight from its start (t = 0) to the next collision or to escape.
 
     Parameters
@@ -270,11 +340,18 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         return, at the returned time.
     h, h1, curv, rc : work arrays (nv, nv, 3, 3 entries; :func:`lowest_points`); for a
         contact, rc receives the contact point relative to the centroid (lab frame).
+    hull : (unit, scale, nodes, links): a hull's tree (:mod:`direct_model.vertex_tree`; its vertices are
+        unit[i] · scale, and ``verts``, ``h``, ``h1`` are not read), or nodes of no rows: the candidates are
+        scanned. The same steps and bits either way.
 
     Returns
     -------
     (code, t, n_steps) with code one of the ``SEARCH_*`` values.
     """
+    unit, scale, nodes, links = hull
+    tree = nodes.shape[0] > 0
+    g, d = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)       # the tree's view of the normal and its turn (module doc)
+    n, h_second, second = nv, np.inf, -1
     b = -1                # the binding point of the last step
     t = 0.0
     t_lo = 0.0            # latest time known to precede any contact
@@ -285,55 +362,71 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
                 rotation_init(K, R, ell, params)
             rotation_at(params, t, R, W)
         y = y0 + v * t
-        n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv)
-        hmin, low = np.inf, 0
-        for i in range(n):
-            if h[i] < hmin:
-                hmin, low = h[i], i
-        if -contact_tol <= hmin <= contact_tol and choose_contact(n, verts, h, h1, R, set_tol, rc):
-            return SEARCH_CONTACT, t, step + 1
+        if tree:
+            g0, g1, g2, d0, d1, d2, a0, a1, a2 = turning(R, W, K)
+            g, d = (g0, g1, g2), (d0, d1, d2)
+            curv[0], curv[1], curv[2] = a0, a1, a2
+            hmin, low, h_second, second = lowest_two(unit, scale, nodes, links, g, y)
+        else:
+            n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv)
+            hmin, low = np.inf, 0
+            for i in range(n):
+                if h[i] < hmin:
+                    hmin, low = h[i], i
+        if -contact_tol <= hmin <= contact_tol:
+            if tree:
+                count, p0, p1, p2, rate, best = contact_sums(unit, scale, nodes, links, g, d, y, v, hmin + set_tol)
+                q0, q1, q2 = vertex(unit, scale, max(best, 0))
+                touching = contact_point(count, p0, p1, p2, rate, best, q0, q1, q2, R, rc)
+            else:
+                touching = choose_contact(n, verts, h, h1, R, set_tol, rc)
+            if touching:
+                return SEARCH_CONTACT, t, step + 1
         if hmin < -contact_tol or t_hi < np.inf:
             # Bracket [t_lo, t_hi] in which only point b reaches the wall, monotonically:
             # safeguarded second-order Newton on its height.
             if b < 0:             # below the wall at the start: no bracket, the budget ends it
                 b = low
-            if h[b] < 0.0:
+            hb, h1b, h2b = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b)
+            if hb < 0.0:
                 t_hi = t
             else:
                 t_lo = t
-            t_new = t + taylor_root(h[b], h1[b], curvature(kind, verts, b, curv))
+            t_new = t + taylor_root(hb, h1b, h2b)
             t = t_new if t_lo < t_new < t_hi else 0.5 * (t_lo + t_hi)
             continue
         if v > 0.0 and y > Rb:
             return SEARCH_ESCAPED, t, step + 1
         # the smallest and second smallest safe steps are at most T: points that surely take longer are passed
-        T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
-        tau, tau_other = np.inf, np.inf
-        for i in range(n):
-            # a point whose safe step surely exceeds the second smallest so far changes neither
-            bound = min(T, tau_other)
-            if bound < np.inf and not may_reach(h[i], h1[i], M, bound):
-                continue
-            tau_i = safe_step(h[i], h1[i], M)
-            if tau_i < tau:
-                tau, tau_other, b = tau_i, tau, i
-            else:
-                tau_other = min(tau_other, tau_i)
+        if tree:
+            T = np.inf
+            if second >= 0:
+                h1_low = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, low)[1]
+                h1_second = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, second)[1]
+                T = max(safe_step(hmin, h1_low, M), safe_step(h_second, h1_second, M))
+            tau, tau_other, found = tree_safe_steps(unit, scale, nodes, links, g, d, y, v, M, T)
+        else:
+            T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
+            tau, tau_other, found = np.inf, np.inf, -1
+            for i in range(n):
+                tau, tau_other, found = take_step(h[i], h1[i], M, T, i, tau, tau_other, found)
+        if found >= 0:
+            b = found
         if 0.0 < tau < np.inf:
             # b's longer step from its exact curvature, valid up to the horizon (module doc)
-            h2b = curvature(kind, verts, b, curv)  # read again below only with a finite step
+            hb, h1b, h2b = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b)
             horizon = min(tau_other, HORIZON * tau)
-            tau = max(tau, min(horizon, safe_step(h[b], h1[b], min(M, M3 * horizon / 3.0 - h2b))))
+            tau = max(tau, min(horizon, safe_step(hb, h1b, min(M, M3 * horizon / 3.0 - h2b))))
         if v > 0.0 and tau >= (Rb - y) / v:
             return SEARCH_ESCAPED, t, step + 1
         if not (0.0 < tau < np.inf):
             return SEARCH_STALLED, t, step + 1
         # second-order Newton step of b where it is safe (module doc): no other point can
         # reach the wall first, and b approaches monotonically
-        if h1[b] < 0.0:
-            t_newton = taylor_root(h[b], h1[b], h2b)
-            if tau < t_newton < tau_other and (h1[b] + M * t_newton < 0.0
-                                                or h1[b] + (h2b + 0.5 * M3 * t_newton) * t_newton < 0.0):
+        if h1b < 0.0:
+            t_newton = taylor_root(hb, h1b, h2b)
+            if tau < t_newton < tau_other and (h1b + M * t_newton < 0.0
+                                               or h1b + (h2b + 0.5 * M3 * t_newton) * t_newton < 0.0):
                 tau = t_newton
         t_lo = t
         t += tau

@@ -29,10 +29,9 @@ import numpy as np
 from direct_model.polyhedron import canonical_frame, mass_properties, vertex_graph
 from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, shape_vertices
 
-# The C direct path keeps 56 bytes of work space per vertex on the stack (vertices, lab-frame offsets, heights):
-# 256 vertices are 14 KiB, far inside the smallest thread stack in common use (musl, 128 KiB); and a hull of 256
-# vertices resolves a grain's outline to about 1/16 of its size in each direction (docs/design/grains.md).
-MAX_HULL_VERTICES = 256
+# A hull of more than direct_model.vertex_tree.TREE_ABOVE vertices is searched through its tree, with no work space
+# per vertex; 2^16 vertices hold a micro-CT scan's hull several times over (docs/design/grains.md).
+MAX_HULL_VERTICES = 65536
 MIN_THICKNESS = 1e-3        # thinnest half-extent, in units of a: the flight bound grows as (a / thickness)²
 NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")   # also an HDF5 dataset name and a C identifier's tail
 FRAME_CHECK = 1e-9       # a given frame must be principal and centred to this (units of a and a²)
@@ -54,8 +53,8 @@ def check_name(name) -> str:
 
 def _check_hull_size(n_vertices):
     if n_vertices > MAX_HULL_VERTICES:
-        raise ShapeError(f"the hull has {n_vertices} vertices; allowed: at most {MAX_HULL_VERTICES} (what the C "
-                         f"runtime's work space holds); simplify the mesh")
+        raise ShapeError(f"the hull has {n_vertices} vertices; allowed: at most {MAX_HULL_VERTICES}; simplify the "
+                         f"mesh ([shapes.NAME] max_vertices)")
 
 
 def _stretch_factors(ratio_ba, ratio_cb):

@@ -24,9 +24,9 @@ import numpy as np
 
 from direct_model.options import KERNEL
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, body_rebound
-from direct_model.registry import MAX_HULL_VERTICES
-from direct_model.shape_arrays import ShapeArrays, bounding_radius, family_shape_arrays, particle_body
+from direct_model.shape_arrays import ShapeArrays, bounding_radius, family_shape_arrays, particle_body, particle_hull
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa, normal_cdf
+from direct_model.vertex_tree import TREE_ABOVE
 from direct_model.wall import WALL_ARRAY_SIZE, Wall, wall_from_array
 
 U_PER_REBOUND = 7
@@ -41,11 +41,13 @@ P_KFAC = 11                                          # second-moment factor s pe
 P_WALL = P_KFAC + len(SHAPES)                        # the wall's array (direct_model.wall, layout W_*), zero-padded
 N_PARAMS = P_WALL + WALL_ARRAY_SIZE
 
-# the scratch of one call: rebound's work, then the body's vertices, its half-extents and J/m, R0, V0, W0, V, W
+# the scratch of one call: rebound's work, then the body's vertices (those of a hull scanned without its tree), its
+# half-extents, J/m and scale, R0, V0, W0, V, W
 _VERTS = WORK_SIZE
-_SEMI = _VERTS + 3 * MAX_HULL_VERTICES
+_SEMI = _VERTS + 3 * TREE_ABOVE
 _K = _SEMI + 3
-_R0 = _K + 3
+_SCALE = _K + 3
+_R0 = _SCALE + 3
 _V0 = _R0 + 9
 SCRATCH_SIZE = _V0 + 12
 
@@ -167,8 +169,8 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
     -------
     :class:`direct_model.body_rebound.BodyRebound`, model frame: V⁺ in m/s, Ω⁺ in (m/s)/a.
     """
-    verts = scratch[_VERTS:_VERTS + 3 * MAX_HULL_VERTICES].reshape((MAX_HULL_VERTICES, 3))
-    semi, K = scratch[_SEMI:_SEMI + 3], scratch[_K:_K + 3]
+    verts = scratch[_VERTS:_VERTS + 3 * TREE_ABOVE].reshape((TREE_ABOVE, 3))
+    semi, K, scale = scratch[_SEMI:_SEMI + 3], scratch[_K:_K + 3], scratch[_SCALE:_SCALE + 3]
     R0 = scratch[_R0:_R0 + 9].reshape((3, 3))
     V0, W0 = scratch[_V0:_V0 + 3], scratch[_V0 + 3:_V0 + 6]
     V, W = scratch[_V0 + 6:_V0 + 9], scratch[_V0 + 9:_V0 + 12]
@@ -181,11 +183,12 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
     else:
         ratio_ba, ratio_cb = aspect_ratio(law, cdf, u[U_RATIOS]), aspect_ratio(law, cdf, u[U_RATIOS + 1])
     hand = 1.0 if shape_arrays.both_hands[shape] == 0 or u[U_HAND] < 0.5 else -1.0
-    nv = particle_body(shape_arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi)
+    nv = particle_body(shape_arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi, scale)
+    hull = particle_hull(shape_arrays, shape, scale)
     kind = np.int64(shape_arrays.kind[shape])
     V0[0], V0[1], V0[2] = vt, vn, 0.0
     W0[0], W0[1], W0[2] = wx, wy, wz
     return body_rebound(
-        kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv), R0, V0, W0, params[P_WALL:],
+        kind, verts, nv, semi, K, bounding_radius(kind, semi, verts, nv, hull), R0, V0, W0, params[P_WALL:],
         int(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL], int(params[P_MAX_STEPS]), V, W,
-        scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE])
+        scratch[:0].reshape((0, HISTORY_COLUMNS)), scratch[:WORK_SIZE], hull)

@@ -25,6 +25,12 @@ array              dtype, shape        content
 ``both_hands``     uint8 (n,)          1: half of the particles are the mirror image (ζ → −ζ)
 ``aspect_cdf``     float64 (n, 2)      derived, never stored: Φ((low − mean)/sd), Φ((high − mean)/sd) of the law
                                        (libm's erfc), NaN for fixed proportions
+``half_extents``   float64 (n, 3)      derived: (max − min)/2 of the unit body's vertices along ξ, η, ζ (an
+                                       ellipsoid's semi-axes)
+``tree_start``     int64 (n + 1,)      derived: shape i's rows of ``tree_nodes`` and ``tree_links`` (none for a hull
+                                       of at most :data:`direct_model.vertex_tree.TREE_ABOVE` vertices)
+``tree_nodes``,    float64, int64      derived: the tree of each hull of more vertices (:mod:`direct_model.vertex_tree`:
+``tree_links``     (total_k, 4)        spheres; first vertex, count, next node, leaf), vertex indices the shape's own
 =================  ==================  ===========================================================================
 
 The unit body of a family (docs/model.md §3) is its body at b/a = c/b = 1, its vertices in the order of
@@ -56,6 +62,7 @@ from direct_model.options import KERNEL
 from direct_model.registry import (FRAME_CHECK, MAX_HULL_VERTICES, ConvexPolyhedron, Ellipsoid, built_in_shape,
                                    built_in_shapes, polyhedron)
 from direct_model.shapes import DEFAULT_KAPPA, SHAPES, AspectRatioLaw, normal_cdf, second_moment_factor, shape_vertices
+from direct_model.vertex_tree import NODE_SIZE, build_tree, farthest
 
 KIND_ELLIPSOID, KIND_POLYHEDRON = 0, 1
 MIN_HULL_VERTICES = 4
@@ -74,6 +81,10 @@ class ShapeArrays(NamedTuple):
     aspect: np.ndarray           # float64 (n, 4): mean, sd, low, high; NaN row: fixed proportions
     both_hands: np.ndarray       # uint8 (n,)
     aspect_cdf: np.ndarray       # float64 (n, 2): derived from aspect
+    half_extents: np.ndarray     # float64 (n, 3): derived from vertices
+    tree_start: np.ndarray       # int64 (n + 1,): derived, the hulls' trees
+    tree_nodes: np.ndarray       # float64 (total_k, 4)
+    tree_links: np.ndarray       # int64 (total_k, 4)
 
     @property
     def n_shapes(self) -> int:
@@ -101,11 +112,23 @@ def from_stored(kind, vertex_start, vertices, triangle_start, triangles, second_
                   second_moments=_frozen(np.reshape(second_moments, (-1, 3)), np.float64),
                   aspect=_frozen(np.reshape(aspect, (-1, 4)), np.float64), both_hands=_frozen(both_hands, np.uint8))
     _check(**arrays)
-    cdf = np.full((len(arrays["kind"]), 2), np.nan)
+    n = len(arrays["kind"])
+    cdf, half, trees = np.full((n, 2), np.nan), np.zeros((n, 3)), []
     for i, (mean, sd, low, high) in enumerate(arrays["aspect"]):
         if not np.isnan(mean):
             cdf[i] = normal_cdf((low - mean) / sd), normal_cdf((high - mean) / sd)
-    return ShapeArrays(**arrays, aspect_cdf=_frozen(cdf, np.float64))
+        lo, hi = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
+        if arrays["kind"][i] == KIND_ELLIPSOID:
+            half[i] = arrays["vertices"][lo]
+            trees.append(build_tree(arrays["vertices"][lo:lo]))
+        else:
+            half[i] = _half_extents(arrays["vertices"], lo, hi - lo)
+            trees.append(build_tree(arrays["vertices"][lo:hi]))
+    counts = [len(nodes) for nodes, _ in trees]
+    return ShapeArrays(**arrays, aspect_cdf=_frozen(cdf, np.float64), half_extents=_frozen(half, np.float64),
+                       tree_start=_frozen(np.concatenate([[0], np.cumsum(counts)]), np.int64),
+                       tree_nodes=_frozen(np.concatenate([nodes for nodes, _ in trees]).reshape(-1, NODE_SIZE), np.float64),
+                       tree_links=_frozen(np.concatenate([links for _, links in trees]).reshape(-1, 4), np.int64))
 
 
 def _check(kind, vertex_start, vertices, triangle_start, triangles, second_moments, aspect, both_hands):
@@ -241,13 +264,15 @@ def shape_records(arrays: ShapeArrays, names) -> dict:
 
 
 @numba.njit(**KERNEL)
-def particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi):
+def particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi, scale):
     """One particle's body from shape ``shape`` of ``shapes`` (:class:`ShapeArrays`, module doc); returns nv.
 
     ``ratio_ba``, ``ratio_cb``: the particle's b/a and c/b (ignored for a shape of fixed proportions);
-    ``hand`` ±1 (−1: the mirror image ζ → −ζ; an ellipsoid is its own). Writes the body frame's vertices
-    into ``verts[:nv]`` (nv = 0 for an ellipsoid), the principal J/m into ``K`` (a²) and the half-extents along
-    ξ, η, ζ into ``semi`` (an ellipsoid's semi-axes), all in units of the particle's a (the largest is 1).
+    ``hand`` ±1 (−1: the mirror image ζ → −ζ; an ellipsoid is its own). Writes the factors that take the unit
+    body to the particle's into ``scale`` (its vertex i is unit[i] · scale), the body frame's vertices into
+    ``verts[:nv]`` if it has room for them (nv = 0 for an ellipsoid; a hull searched through its tree needs
+    none), the principal J/m into ``K`` (a²) and the half-extents along ξ, η, ζ into ``semi`` (an ellipsoid's
+    semi-axes), all in units of the particle's a (the largest is 1).
     """
     lo, nv = shapes.vertex_start[shape], shapes.vertex_start[shape + 1] - shapes.vertex_start[shape]
     unit = shapes.vertices
@@ -256,17 +281,17 @@ def particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi):
     d0, d1, d2 = 1.0, ratio_ba, ratio_ba * ratio_cb
     if shapes.kind[shape] == KIND_ELLIPSOID:
         nv = 0
-        e0, e1, e2 = unit[lo, 0], unit[lo, 1], unit[lo, 2]
-    else:
-        e0, e1, e2 = _half_extents(unit, lo, nv)
+    e0, e1, e2 = shapes.half_extents[shape, 0], shapes.half_extents[shape, 1], shapes.half_extents[shape, 2]
     e0, e1, e2 = d0 * e0, d1 * e1, d2 * e2
     a = max(e0, max(e1, e2))
     semi[0], semi[1], semi[2] = e0 / a, e1 / a, e2 / a
     f0, f1, f2 = d0 / a, d1 / a, d2 / a
     if hand < 0.0:
         f2 = -f2
-    for i in range(nv):
-        verts[i, 0], verts[i, 1], verts[i, 2] = unit[lo + i, 0] * f0, unit[lo + i, 1] * f1, unit[lo + i, 2] * f2
+    scale[0], scale[1], scale[2] = f0, f1, f2
+    if nv <= verts.shape[0]:
+        for i in range(nv):
+            verts[i, 0], verts[i, 1], verts[i, 2] = unit[lo + i, 0] * f0, unit[lo + i, 1] * f1, unit[lo + i, 2] * f2
     s0, s1, s2 = shapes.second_moments[shape, 0], shapes.second_moments[shape, 1], shapes.second_moments[shape, 2]
     a2, b2, c2 = f0 * f0, f1 * f1, f2 * f2
     if s0 == s1 and s1 == s2:           # a family's: J/m = s (b² + c², a² + c², a² + b²)
@@ -290,12 +315,31 @@ def _half_extents(unit, lo, nv):
 
 
 @numba.njit(**KERNEL)
-def bounding_radius(kind, semi, verts, nv):
+def bounding_radius(kind, semi, verts, nv, hull):
     """Radius of the smallest centroid-centred sphere holding the body (units of a): the largest semi-axis of
-    an ellipsoid, the farthest vertex of a polyhedron."""
+    an ellipsoid, the farthest vertex of a polyhedron (of ``verts[:nv]``, or through the tree of ``hull``,
+    :func:`particle_hull`)."""
     if kind == KIND_ELLIPSOID:
         return max(semi[0], max(semi[1], semi[2]))
+    if hull[2].shape[0] > 0:
+        return np.sqrt(farthest(hull[0], hull[1], hull[2], hull[3]))
     r2 = 0.0
     for i in range(nv):
         r2 = max(r2, verts[i, 0] ** 2 + verts[i, 1] ** 2 + verts[i, 2] ** 2)
     return np.sqrt(r2)
+
+
+def scanned_hull(verts) -> tuple:
+    """The ``hull`` argument of the kernels for a body given by its vertices alone (``verts``, scanned: no tree)."""
+    return (np.asarray(verts, dtype=np.float64), np.ones(3), np.zeros((0, NODE_SIZE)), np.zeros((0, 4), dtype=np.int64))
+
+
+@numba.njit(inline="always", **KERNEL)
+def particle_hull(shapes, shape, scale):
+    """(unit, scale, nodes, links): shape ``shape``'s unit vertices and tree (no rows for a hull scanned from
+    ``verts``) with the particle's ``scale`` (:func:`particle_body`), what the contact search takes
+    (:func:`direct_model.flight.find_contact`). From Python call ``particle_hull.py_func``: compiled without
+    numba's reference counts, the kernel hands Python each slice's whole parent array."""
+    lo, hi = shapes.vertex_start[shape], shapes.vertex_start[shape + 1]
+    first, last = shapes.tree_start[shape], shapes.tree_start[shape + 1]
+    return shapes.vertices[lo:hi], scale, shapes.tree_nodes[first:last], shapes.tree_links[first:last]

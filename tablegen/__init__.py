@@ -21,7 +21,7 @@ from importlib.util import find_spec
 
 # the distributions of the build extra (pyproject.toml), by the module each installs
 BUILD_EXTRA = {"scipy": "scipy", "sklearn": "scikit-learn", "threadpoolctl": "threadpoolctl", "tqdm": "tqdm",
-               "trimesh": "trimesh"}
+               "trimesh": "trimesh", "fast_simplification": "fast-simplification"}
 
 
 def _require_build_extra() -> None:

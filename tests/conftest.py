@@ -14,7 +14,7 @@ from tests.helpers.native_library import build as native_build_in
 from tests.helpers.plain_install import install_and_draw
 from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OCTAHEDRON_TABLE_CONFIG, OFF_GRID_TABLE_CONFIG,
                                   SMALL_TABLE_CONFIG, TABULATED_TABLE_CONFIG, WIDE_GRAZING_TABLE_CONFIG,
-                                  write_grain_config)
+                                  big_grain_config, write_grain_config)
 
 
 def _build(tmp_path_factory, name, config_text):
@@ -37,6 +37,12 @@ def grain_table_path(tmp_path_factory):
     path = folder / "grains.h5"
     build_table(load_config(write_grain_config(folder)), path)
     return path
+
+
+@pytest.fixture(scope="session")
+def big_grain_table_path(tmp_path_factory):
+    """A table of one user grain of 10 000 hull vertices on one grid point (tests.helpers.tables.big_grain_config)."""
+    return _build(tmp_path_factory, "big_grain", big_grain_config())
 
 
 @pytest.fixture(scope="session")

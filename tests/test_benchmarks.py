@@ -93,4 +93,5 @@ def test_bench_grains_reports_the_cost_against_hull_size(tmp_path, capsys):
         assert row["us_per_rebound"] > 0 and row["collisions_per_rebound"] >= 1
         assert row["over_prism"] == pytest.approx(row["us_per_rebound"] / next(
             r["us_per_rebound"] for r in rows if r["shape"] == "prism" and r["states"] == row["states"]))
-    assert "Target: a 64-vertex grain within 2x" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert all(f"Target: a {size}-vertex grain within {ratio:g}x" in printed for size, ratio in bench_grains.TARGETS.items())

@@ -3,12 +3,14 @@
  * quaternion_to_matrix, lab_tensor): with Ω⁻ = 0 the body starts touching the wall, otherwise with its centre at
  * the bounding radius; then search the flight for the next contact (flight.c, rotation.c) and collide
  * (collision.c) until the body escapes (rebounded), n_max is exceeded (trapped) or a search or collision fails
- * (failed). The same operations in the same order as the numba kernels; the work space on the stack: the heights,
- * rates and curvatures of up to MAX_HULL_VERTICES vertices (6 KiB) and a few 3-vectors and matrices.
+ * (failed). The same operations in the same order as the numba kernels; the work space: the heights and rates
+ * of the nv vertices (the caller's, or on the stack up to MAX_STACK_VERTICES, 4 KiB, and one malloc above) and a
+ * few 3-vectors and matrices on the stack.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
+#include <stdlib.h>
 
 #include "body_rebound.h"
 #include "collision.h"
@@ -46,7 +48,26 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
                      long long *n_collisions, long long *n_steps)
 {
-    double h[MAX_HULL_VERTICES], h1[MAX_HULL_VERTICES], curv[3];
+    double stack[2 * MAX_STACK_VERTICES], *h = stack;
+    /* a large hull's heights and rates on the heap: one block per call, so that threads share nothing */
+    if (nv > MAX_STACK_VERTICES && !(h = malloc(2 * (size_t)nv * sizeof *h))) {
+        *n_collisions = 0;
+        *n_steps = 0;
+        return RBS_FAILED;
+    }
+    int room = nv > MAX_STACK_VERTICES ? nv : MAX_STACK_VERTICES;
+    int status = rbs_body_rebound_in(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_tol, set_tol,
+                                     max_steps, V, W, n_collisions, n_steps, h, h + room);
+    if (h != stack) free(h);
+    return status;
+}
+
+int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
+                        const double R0[9], const double V0[3], const double W0[3], const double *wall,
+                        long long n_max, double contact_tol, double set_tol, long long max_steps, double V[3],
+                        double W[3], long long *n_collisions, long long *n_steps, double *h, double *h1)
+{
+    double curv[3];
     double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
     double Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
 

@@ -3,12 +3,14 @@
  * uniform_quaternion, rebound_model_frame): the random inputs of one rebound from RBS_U_PER_REBOUND uniforms,
  * the particle's body from the shape arrays (shapes.c), every other model parameter from the P_* array, then the
  * rebound (body_rebound.c). The same operations in the same order as the numba kernels; libm's sqrt, log, sin
- * and cos. The work space on the stack: the body's vertices, MAX_HULL_VERTICES rows (6 KiB), and
- * rbs_body_rebound's (heights and rates, about 4.5 KiB): 11 KiB in all.
+ * and cos. The work space of one call: the body's vertices and their heights and rates (40 bytes a vertex), on the
+ * stack up to MAX_STACK_VERTICES vertices (10 KiB), above in one malloc freed before the return (no buffer is shared:
+ * threads may call it on one table).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #include <math.h>
+#include <stdlib.h>
 
 #include "body_rebound.h"
 #include "fastmath.h"
@@ -78,7 +80,15 @@ int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays
                                     double vn, double wx, double wy, double wz, const double *u, double V[3],
                                     double W[3], long long *n_collisions)
 {
-    double quat[4], R0[9], verts[3 * MAX_HULL_VERTICES], K[3], semi[3];
+    double quat[4], R0[9], K[3], semi[3], stack[5 * MAX_STACK_VERTICES];
+    /* the shape's vertex rows: room for the particle's vertices (an ellipsoid's one row: its support point) */
+    int64_t rows = shapes->vertex_start[shape + 1] - shapes->vertex_start[shape];
+    int room = rows > MAX_STACK_VERTICES ? (int)rows : MAX_STACK_VERTICES;
+    double *verts = stack;
+    if (room > MAX_STACK_VERTICES && !(verts = malloc(5 * (size_t)room * sizeof *verts))) {
+        *n_collisions = 0;
+        return RBS_FAILED;
+    }
     rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat);
     rbs_quaternion_to_matrix(quat, R0);
     const double *law = shapes->aspect + 4 * shape, *cdf = shapes->aspect_cdf + 2 * shape;
@@ -92,8 +102,11 @@ int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays
     double Rb = rbs_bounding_radius(kind, semi, verts, nv);
     const double V0[3] = {vt, vn, 0.0}, W0[3] = {wx, wy, wz};
     long long n_steps;
-    /* n_max and max_steps as numba's int() of the float64 parameters */
-    return rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL, rbs_trunc(params[P_N_MAX]),
-                            params[P_CONTACT_TOL], params[P_SET_TOL], rbs_trunc(params[P_MAX_STEPS]), V, W,
-                            n_collisions, &n_steps);
+    /* n_max and max_steps as numba's int() of the float64 parameters; the heights and rates after the vertices */
+    int status = rbs_body_rebound_in(kind, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL,
+                                     rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
+                                     rbs_trunc(params[P_MAX_STEPS]), V, W, n_collisions, &n_steps, verts + 3 * room,
+                                     verts + 4 * room);
+    if (verts != stack) free(verts);
+    return status;
 }

@@ -49,7 +49,8 @@ void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4]);
  * P_* array, shape the index of the particle's shape in `shapes` (0 .. shapes->n_shapes − 1), incident velocity
  * (vt, vn, 0) m/s (vn < 0), angular velocity (wx, wy, wz) in (m/s)/a (all zero: the body starts touching the
  * wall), u RBS_U_PER_REBOUND uniforms. V⁺ (m/s) into V and Ω⁺ ((m/s)/a) into W; returns RBS_OK (rebounded),
- * RBS_TRAPPED or RBS_FAILED. */
+ * RBS_TRAPPED or RBS_FAILED (also, with no collision, when the work space of a hull of more than
+ * MAX_STACK_VERTICES vertices cannot be allocated). */
 int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes, int shape, double vt, double vn,
                             double wx, double wy, double wz, const double *u, double V[3], double W[3]);
 

@@ -30,6 +30,9 @@
 #define INERTIA_BOUND (2.0 * VERTEX_BOUND * VERTEX_BOUND)   /* data_schema.shape_records.INERTIA_BOUND */
 #define NAME_MAX_LENGTH (RBS_SHAPE_NAME_SIZE - 1)
 #define MAX_FAMILY_NORMALS 14       /* the cut prism's faces: 6 sides and 8 corners */
+#define MAX_FAMILY_TRIANGLES (2 * MAX_VERTICES - 4)         /* a family's surface: a hull of MAX_VERTICES at most */
+
+_Static_assert(MAX_VERTICES <= MAX_STACK_VERTICES, "a family's hull takes no malloc (its checks have no memory error)");
 
 void rbs_shape_records_free(rbs_shape_records *r)
 {
@@ -95,12 +98,15 @@ static double numpy_min(double m, double x) { return isnan(m) || isnan(x) ? NAN 
 
 /* What direct_model.registry.polyhedron makes of a hull given in its principal frame, units of a: its principal
  * J/m into inertia, 0; or -1 and, into `why`, the words of its ValueError (no volume) or ShapeError (not a
- * principal frame of unit size, too flat). Its checks as it writes them (a comparison with NaN is false). */
+ * principal frame of unit size, too flat); -2 out of memory (a large hull's work space). Its checks as it writes
+ * them (a comparison with NaN is false). */
 static int hull_inertia(const double *vertices, int n_vertices, const int32_t *triangles, int n_triangles,
                         double inertia[3], char *why, size_t size)
 {
     rbs_mass_properties props;
-    if (rbs_hull_mass_properties(vertices, n_vertices, triangles, n_triangles, &props) != 0) {
+    int found = rbs_hull_mass_properties(vertices, n_vertices, triangles, n_triangles, &props);
+    if (found == -2) return -2;
+    if (found != 0) {
         snprintf(why, size, "the triangles enclose no volume (volume %.17g): not a closed outward surface",
                  props.volume);
         return -1;
@@ -210,11 +216,13 @@ static int check_records(loader *ld, rbs_table *t, const char *names, const int3
     for (int i = 0; i < n; i++) {
         int64_t nv = r->vertex_start[i + 1] - r->vertex_start[i], nt = triangle_start[i + 1] - triangle_start[i];
         int polyhedral = r->kind[i] == RBS_POLYHEDRON;
-        if (polyhedral ? nv < MIN_HULL_VERTICES || nv > MAX_HULL_VERTICES : nv != 0)
-            return rbs_fail(ld, RBS_ERR_FORMAT, polyhedral ? "dataset 'shapes/vertex_start' gives shape '%s' %lld "
-                            "vertices; allowed: 4 to 256 for a convex polyhedron" : "dataset 'shapes/vertex_start' "
-                            "gives shape '%s' %lld vertices; allowed: 0 for a smooth body", t->shape_names[i],
-                            (long long)nv);
+        if (polyhedral && (nv < MIN_HULL_VERTICES || nv > MAX_HULL_VERTICES))
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/vertex_start' gives shape '%s' %lld vertices; "
+                            "allowed: %d to %d for a convex polyhedron", t->shape_names[i], (long long)nv,
+                            MIN_HULL_VERTICES, MAX_HULL_VERTICES);
+        if (!polyhedral && nv != 0)
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/vertex_start' gives shape '%s' %lld vertices; "
+                            "allowed: 0 for a smooth body", t->shape_names[i], (long long)nv);
         if (nt != (polyhedral ? 2 * nv - 4 : 0))
             return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/triangle_start' gives shape '%s' %lld triangles; a hull "
                             "of %lld vertices has %lld", t->shape_names[i], (long long)nt, (long long)nv,
@@ -281,7 +289,12 @@ static int check_records(loader *ld, rbs_table *t, const char *names, const int3
         if (family < 0) {
             double inertia[3];
             if (r->kind[i] != RBS_POLYHEDRON) continue;     /* a smooth body: its semi-axes come from its inertia */
-            if (hull_inertia(r->vertices + 3 * v0, (int)nv, triangles + 3 * t0, (int)nt, inertia, why, sizeof why) != 0)
+            int made = hull_inertia(r->vertices + 3 * v0, (int)nv, triangles + 3 * t0, (int)nt, inertia, why,
+                                    sizeof why);
+            if (made == -2)
+                return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory for the mass properties of shape '%s' (%lld "
+                                "vertices)", name, (long long)nv);
+            if (made != 0)
                 return rbs_fail(ld, RBS_ERR_FORMAT, "datasets 'shapes/vertices' and 'shapes/triangles' of shape '%s' "
                                 "are not a hull in its principal frame: %s", name, why);
             const double *stored = r->inertia + 3 * i;
@@ -298,12 +311,13 @@ static int check_records(loader *ld, rbs_table *t, const char *names, const int3
                             "aspect-ratio law (%.17g, %.17g, %.17g, %.17g)", name, kappa, aspect[0], aspect[1],
                             aspect[2], aspect[3]);
         double body[3 * MAX_VERTICES], normals[3 * MAX_FAMILY_NORMALS], inertia[3] = {2.0 / 5.0, 2.0 / 5.0, 2.0 / 5.0};
-        int32_t surface[3 * MAX_HULL_TRIANGLES];
+        int32_t surface[3 * MAX_FAMILY_TRIANGLES];
         int n_body = family_vertices(family, kappa, body), n_surface = 0;
         if (family != RBS_ELLIPSOID) {
+            /* at most MAX_VERTICES vertices: their work space on the stack, no malloc to fail */
             n_surface = rbs_faces_to_triangles(body, n_body, normals, family_normals(family, body, n_body, normals),
-                                               surface, MAX_HULL_TRIANGLES);
-            if (n_surface < 0) snprintf(why, sizeof why, "its faces give more than %d triangles", MAX_HULL_TRIANGLES);
+                                               surface, MAX_FAMILY_TRIANGLES);
+            if (n_surface < 0) snprintf(why, sizeof why, "its faces give more than %d triangles", MAX_FAMILY_TRIANGLES);
             if (n_surface < 0 || hull_inertia(body, n_body, surface, n_surface, inertia, why, sizeof why) != 0)
                 return rbs_fail(ld, RBS_ERR_FORMAT, "the built-in shape '%s' cannot be made at the table's kappa %.17g "
                                 "and aspect-ratio law (%.17g, %.17g, %.17g, %.17g): %s", name, kappa, aspect[0],

@@ -21,7 +21,11 @@
 #define RBS_SMOOTH RBS_KIND_SMOOTH
 #define RBS_POLYHEDRON RBS_KIND_POLYHEDRON
 #define MAX_VERTICES 24             /* direct_model.shapes.MAX_VERTICES: the cut prism's */
-#define MAX_HULL_VERTICES 256       /* direct_model.registry.MAX_HULL_VERTICES: the most a shape has */
+#define MAX_HULL_VERTICES 65536     /* direct_model.registry.MAX_HULL_VERTICES: the most a shape has */
+/* the most vertices whose work space a call keeps on its stack (a hit's 40 bytes each, 10 KiB; the loader's mass
+ * properties 64, 16 KiB: far inside the smallest thread stack in common use, musl's 128 KiB); a larger hull's takes
+ * one malloc per call */
+#define MAX_STACK_VERTICES 256
 #define KIND_ELLIPSOID 0            /* direct_model.shape_arrays.KIND_ELLIPSOID */
 #define KIND_POLYHEDRON 1           /* direct_model.shape_arrays.KIND_POLYHEDRON */
 #define FAMILY_VERTEX_ROWS 37       /* the families' unit bodies: the ellipsoid's semi-axes, 8, 24 and 4 vertices */
@@ -60,8 +64,10 @@ void rbs_family_shapes_fill(int8_t *kind, int64_t *vertex_start, double *vertice
                             const double law[4], const double law_cdf[2], const double kfac[RBS_N_FAMILIES]);
 
 /* One particle's body from shape `shape` of `s` (direct_model.shape_arrays.particle_body): b/a and c/b
- * (ignored for fixed proportions), hand ±1; the vertices into verts (row-major, at most MAX_HULL_VERTICES),
- * the principal J/m into K (a²), the half-extents into semi; returns their number, 0 for an ellipsoid. */
+ * (ignored for fixed proportions), hand ±1; the vertices into verts (row-major, room for the shape's
+ * vertex_start[shape + 1] − vertex_start[shape] rows: numba copies them only into a scan's room, the bits are the
+ * same), the principal J/m into K (a²), the half-extents into semi (from all the vertices, the values of numba's
+ * precomputed half_extents); returns their number, 0 for an ellipsoid. */
 int rbs_particle_body(const rbs_shape_arrays *s, int shape, double ratio_ba, double ratio_cb, double hand,
                       double *verts, double K[3], double semi[3]);
 

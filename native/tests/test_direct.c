@@ -4,7 +4,8 @@
  *   - a collision never adds energy, ½|V|² + ½ΩᵀKΩ per unit mass (m²/s², lengths in units of a);
  *   - a collision keeps the angular momentum about the contact point, KΩ − r_c × V;
  *   - a free flight keeps the energy ½ΩᵀKΩ and the angular momentum L = KΩ (lab) to 1e-9;
- *   - a whole rebound never adds energy, for the four families and a grain of MAX_HULL_VERTICES vertices;
+ *   - a whole rebound never adds energy, for the four families and a grain of GRAIN_VERTICES vertices (its work
+ *     space on the heap: rbs_body_rebound's, and rbs_rebound_model_frame's on the table's parameters);
  * each under the published exponential wall law and a tabulated one, every other trial;
  * then hostile calls of rbs_direct_rebound on a table (RBS_INVALID and NaN, never a crash), and four threads
  * calling it on one table give the bits of one thread.
@@ -24,6 +25,7 @@
 #include "body_rebound.h"
 #include "check.h"
 #include "collision.h"
+#include "fastmath.h"
 #include "paths.h"
 #include "rebound_scatter.h"
 #include "rotation.h"
@@ -151,13 +153,14 @@ static void free_flights(rbs_rng *rng)
 }
 
 /* The shapes of the rebounds: the four families (κ = 0.3, the default law) and, as shape 4, a grain of
- * MAX_HULL_VERTICES vertices on the ellipsoid of semi-axes (1, 0.7, 0.5) (each one a hull vertex; its second
+ * GRAIN_VERTICES vertices on the ellipsoid of semi-axes (1, 0.7, 0.5) (each one a hull vertex; its second
  * moments the ellipsoid's, a valid inertia for the energy check), both hands, fixed proportions. */
+#define GRAIN_VERTICES (2 * MAX_STACK_VERTICES)     /* beyond the stack's room: the heap's work space runs */
 typedef struct test_shapes {
     rbs_shape_arrays arrays;
     int8_t kind[5];
     int64_t vertex_start[6];
-    double vertices[3 * (FAMILY_VERTEX_ROWS + MAX_HULL_VERTICES)], second_moments[15], aspect[20], aspect_cdf[10];
+    double vertices[3 * (FAMILY_VERTEX_ROWS + GRAIN_VERTICES)], second_moments[15], aspect[20], aspect_cdf[10];
     uint8_t both_hands[5];
 } test_shapes;
 
@@ -168,8 +171,8 @@ static void make_shapes(test_shapes *s, rbs_rng *rng)
     rbs_family_shapes_fill(s->kind, s->vertex_start, s->vertices, s->second_moments, s->aspect, s->aspect_cdf,
                            s->both_hands, 0.3, law, cdf, kfac);
     s->kind[4] = KIND_POLYHEDRON;
-    s->vertex_start[5] = FAMILY_VERTEX_ROWS + MAX_HULL_VERTICES;
-    for (int i = 0; i < MAX_HULL_VERTICES; i++) {
+    s->vertex_start[5] = FAMILY_VERTEX_ROWS + GRAIN_VERTICES;
+    for (int i = 0; i < GRAIN_VERTICES; i++) {
         double p[3], norm = 0.0;
         for (int k = 0; k < 3; k++) {      /* a direction uniform enough for a test: a cube's point, normalised */
             p[k] = 2.0 * rbs_rng_uniform(rng) - 1.0;
@@ -189,7 +192,7 @@ static void rebounds(rbs_rng *rng)
 {
     test_shapes shapes;
     make_shapes(&shapes, rng);
-    double worst = -INFINITY, verts[3 * MAX_HULL_VERTICES];
+    double worst = -INFINITY, verts[3 * GRAIN_VERTICES];
     int counts[3] = {0, 0, 0};
     for (int trial = 0; trial < TRIALS / 10; trial++) {
         int shape = trial % 5;
@@ -222,6 +225,45 @@ static void rebounds(rbs_rng *rng)
         CHECK(gain <= 1e-12, "a rebound added energy: at least %.3g relative (trial %d)", gain, trial);
     }
     printf("rebounds: %d rebounded, %d trapped, %d failed; energy after (bounded below) / before − 1 at most %.3g\n", counts[0], counts[1], counts[2], worst);
+}
+
+/* The grain of GRAIN_VERTICES vertices on the table's model parameters: rbs_rebound_model_frame (its work space in
+ * one malloc) gives the bits of rbs_particle_body and rbs_body_rebound (theirs in another) from the same uniforms. */
+static void grain_model_frame(const rbs_table *table, rbs_rng *rng)
+{
+    const void *data = NULL;
+    size_t count = 0;
+    int dtype = -1;
+    CHECK(rbs_table_kernel_array(table, "direct_parameters", &data, &count, &dtype) == RBS_OK && count == N_PARAMS,
+          "the table's direct parameters");
+    if (!data) return;
+    const double *params = data;
+    test_shapes shapes;
+    make_shapes(&shapes, rng);
+    int same = 0, rebounded = 0;
+    for (int trial = 0; trial < 100; trial++) {
+        double u[RBS_U_PER_REBOUND], q[4], R0[9], K[3], semi[3], verts[3 * GRAIN_VERTICES], V[3], W[3], Vr[3], Wr[3];
+        rbs_rng_fill(rng, u, RBS_U_PER_REBOUND);
+        double speed = 10.0 + 290.0 * rbs_rng_uniform(rng), angle = 0.05 + 1.5 * rbs_rng_uniform(rng);
+        double W0[3] = {0.0, 0.0, 0.0}, V0[3] = {speed * cos(angle), -speed * sin(angle), 0.0};
+        for (int k = 0; k < 3; k++) W0[k] = trial % 2 ? 0.0 : 0.3 * speed * (2.0 * rbs_rng_uniform(rng) - 1.0);
+        int status = rbs_rebound_model_frame(params, &shapes.arrays, 4, V0[0], V0[1], W0[0], W0[1], W0[2], u, V, W);
+        /* runtime.c's steps for a shape of fixed proportions in both hands */
+        rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], q);
+        rbs_quaternion_to_matrix(q, R0);
+        int nv = rbs_particle_body(&shapes.arrays, 4, 1.0, 1.0, u[U_HAND] < 0.5 ? 1.0 : -1.0, verts, K, semi);
+        double Rb = rbs_bounding_radius(KIND_POLYHEDRON, semi, verts, nv);
+        long long n_coll, n_steps;
+        int again = rbs_body_rebound(KIND_POLYHEDRON, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL,
+                                     rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
+                                     rbs_trunc(params[P_MAX_STEPS]), Vr, Wr, &n_coll, &n_steps);
+        same += status == again && (status != RBS_OK || (memcmp(V, Vr, sizeof V) == 0 && memcmp(W, Wr, sizeof W) == 0));
+        rebounded += status == RBS_OK;
+    }
+    CHECK(same == 100 && rebounded >= 80, "grain of %d vertices: %d of 100 the same, %d rebounded", GRAIN_VERTICES,
+          same, rebounded);
+    printf("grain of %d vertices (work space on the heap): %d rebounded, the bits of rbs_body_rebound\n",
+           GRAIN_VERTICES, rebounded);
 }
 
 /* every output NaN */
@@ -384,6 +426,7 @@ int main(int argc, char **argv)
     if (argc == 3) CHECK(rbs_table_open(argv[2], &without, message, sizeof message) == RBS_OK, "%s", message);
     if (table) {
         hostile(table, without);
+        grain_model_frame(table, &rng);
         threads(table, &rng);
     }
     rbs_table_close(table);

@@ -31,6 +31,10 @@ COPLANAR = 1e-9             # points whose spread off their best plane is below 
 # precision. Two copies differ only if a coordinate lies within that round-off of a rounding boundary (a chance
 # of about 1e-4 per coordinate); a settled record settles to itself exactly.
 SETTLE = 2.0 ** -36
+# a larger hull's vertices go in Morton order: neighbours in space near in index, so that a leaf of its contact
+# search's tree (direct_model.vertex_tree) is a small patch; a smaller hull keeps the order its tables were built in
+SPATIAL_ORDER_ABOVE = 256
+MORTON_BITS = 21            # per axis: 63 bits in all
 
 
 class GrainError(ValueError):
@@ -100,20 +104,70 @@ def convex_hull(points, source):
     return points[used], index[triangles], float(hull.volume)
 
 
-def grain_from_points(name, points, source, aspect=None, both_hands=False, mesh_volume=None, log=None):
+def grain_from_points(name, points, source, aspect=None, both_hands=False, mesh_volume=None, log=None,
+                      max_vertices=None):
     """The record of the grain whose body is the hull of ``points`` (any frame and length unit).
 
     ``mesh_volume``: the volume the mesh encloses, if it closes one; when the hull adds more than
-    :data:`NOT_CONVEX` of it, ``log`` (if given) gets one line saying how much.
+    :data:`NOT_CONVEX` of it, ``log`` (if given) gets one line saying how much. ``max_vertices``: a hull of more
+    vertices is simplified to at most that many (:func:`simplified_hull`) and ``log`` gets what that changed
+    (:func:`simplification_report`).
     """
     vertices, triangles, volume = convex_hull(points, source)
     if mesh_volume is not None and log is not None and volume > mesh_volume * (1.0 + NOT_CONVEX):
         log(f"{source}: warning: the mesh is not convex; its convex hull, the body used, adds "
             f"{100.0 * (volume / mesh_volume - 1.0):.3g}% to its volume")
+    if max_vertices is not None and len(vertices) > max_vertices:
+        simple = simplified_hull(vertices, triangles, max_vertices, source)
+        if log is not None:
+            log(f"{source}: " + simplification_report(vertices, triangles, *simple))
+        vertices, triangles = simple
     try:
         return settled(grain(name, vertices, triangles, aspect=aspect, both_hands=both_hands))
     except ShapeError as exc:
         raise GrainError(f"{source}: {exc}") from None
+
+
+def simplified_hull(vertices, triangles, max_vertices: int, source) -> tuple:
+    """(vertices, triangles): the convex hull of the hull's surface decimated by quadric error (the
+    fast-simplification library, what trimesh and PyVista use) to at most ``max_vertices`` vertices; the target
+    triangle count is lowered until the hull of what is left has no more vertices than that."""
+    from fast_simplification import simplify     # here: the build extra
+
+    target = 2 * max_vertices - 4                 # the triangles of a closed hull of max_vertices vertices
+    while True:
+        points, _ = simplify(np.asarray(vertices, dtype=np.float64), np.asarray(triangles, dtype=np.int32),
+                             target_count=target)
+        hull, hull_triangles, _ = convex_hull(points, source)
+        if len(hull) <= max_vertices or target <= 4:
+            return hull, hull_triangles
+        target = max(4, int(target * max_vertices / len(hull)) - 2)
+
+
+def simplification_report(vertices, triangles, simple_vertices, simple_triangles) -> str:
+    """One line on what a simplification changed: the vertex count, the volume, the principal moments of inertia
+    and a (in the original's units), and the largest distance between the two hulls' surfaces relative to the
+    original's a (each hull's vertices against the other's face planes)."""
+    from scipy.spatial import ConvexHull     # here: the build extra
+    from direct_model.polyhedron import canonical_frame, mass_properties, symmetric_eigen
+
+    def described(points, tris):
+        props = mass_properties(points, tris)
+        return props.volume, np.sort(symmetric_eigen(props.inertia)[0]), canonical_frame(points, tris).a
+
+    (volume, moments, a), (volume_s, moments_s, a_s) = described(vertices, triangles), described(
+        simple_vertices, simple_triangles)
+
+    def farthest_from(points, hull_points):
+        planes = ConvexHull(hull_points).equations          # unit outward normals and offsets
+        signed = points @ planes[:, :3].T + planes[:, 3]    # > 0 outside a face's plane
+        return float(np.abs(signed.max(axis=1)).max())
+
+    distance = max(farthest_from(simple_vertices, vertices), farthest_from(vertices, simple_vertices))
+    change = ", ".join(f"{100.0 * (x / y - 1.0):+.2f}%" for x, y in zip(moments_s, moments))
+    return (f"simplified from {len(vertices)} to {len(simple_vertices)} hull vertices: volume "
+            f"{100.0 * (volume_s / volume - 1.0):+.2f}%, principal moments {change}, a {100.0 * (a_s / a - 1.0):+.2f}%, "
+            f"largest distance from the original hull {distance / a:.3g} a")
 
 
 def canonical_grain(name, vertices, triangles, source, aspect=None, both_hands=False):
@@ -136,12 +190,16 @@ def canonical_grain(name, vertices, triangles, source, aspect=None, both_hands=F
 
 def settled(record):
     """The canonical record with its vertices rounded to multiples of :data:`SETTLE` and put in ascending order of
-    (their height along SORT_DIRECTION, as canonical_frame orders them, then ξ, η, ζ), its triangles each turned
+    (their height along SORT_DIRECTION, as canonical_frame orders them, then ξ, η, ζ), a hull of more than
+    :data:`SPATIAL_ORDER_ABOVE` vertices first by their :func:`morton_codes`; its triangles each turned
     to start at its smallest index (a cyclic turn keeps it counter-clockwise) and in ascending order; mass
     properties recomputed from these (module doc)."""
     vertices = np.round(record.vertices / SETTLE) * SETTLE
     along = sum(vertices[:, i] * SORT_DIRECTION[i] for i in range(3))         # elementwise: no BLAS
-    order = np.lexsort((vertices[:, 2], vertices[:, 1], vertices[:, 0], along))
+    keys = (vertices[:, 2], vertices[:, 1], vertices[:, 0], along)
+    if len(vertices) > SPATIAL_ORDER_ABOVE:
+        keys += (morton_codes(vertices),)
+    order = np.lexsort(keys)
     rank = np.empty(len(order), dtype=np.int32)
     rank[order] = np.arange(len(order), dtype=np.int32)
     triangles = rank[record.triangles]
@@ -151,7 +209,21 @@ def settled(record):
     return polyhedron(record.name, vertices[order], triangles, record.aspect, record.both_hands)
 
 
-def grain_from_mesh(name, path, aspect=None, both_hands=False, log=None):
-    """The record of the grain in a mesh file (STL, OBJ, OFF, PLY): the hull of its vertices (module doc)."""
+def morton_codes(vertices) -> np.ndarray:
+    """Each vertex's Morton code (uint64): its coordinates scaled to integers in [0, 2^21) over the hull's box,
+    their bits interleaved (ξ lowest). Elementwise float operations and integer ones: the same on any CPU."""
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    top = float(2 ** MORTON_BITS - 1)
+    cells = np.floor((vertices - low) / np.where(high > low, high - low, 1.0) * top).astype(np.uint64)
+    codes = np.zeros(len(vertices), dtype=np.uint64)
+    for bit in range(MORTON_BITS):
+        for axis in range(3):
+            codes |= ((cells[:, axis] >> np.uint64(bit)) & np.uint64(1)) << np.uint64(3 * bit + axis)
+    return codes
+
+
+def grain_from_mesh(name, path, aspect=None, both_hands=False, log=None, max_vertices=None):
+    """The record of the grain in a mesh file (STL, OBJ, OFF, PLY): the hull of its vertices (module doc),
+    simplified to at most ``max_vertices`` (:func:`grain_from_points`)."""
     points, mesh_volume = read_mesh(path)
-    return grain_from_points(name, points, str(path), aspect, both_hands, mesh_volume, log)
+    return grain_from_points(name, points, str(path), aspect, both_hands, mesh_volume, log, max_vertices)

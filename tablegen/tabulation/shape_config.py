@@ -8,6 +8,7 @@
     vertices = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], ...]     # points whose convex hull is the grain
     aspect_ratio = {mean = 0.8, sd = 0.2, low = 0.5, high = 1.0}   # optional: b/a, c/b drawn per particle
     both_hands = true                  # optional: half of the particles are the mirror image (default false)
+    max_vertices = 256                 # optional: a hull of more vertices is simplified (tablegen build says how)
     [shapes.sand_c]
     vertices = [[...], ...]            # with triangles: the grain's canonical hull, taken as it is
     triangles = [[0, 1, 2], ...]
@@ -30,12 +31,13 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from direct_model.registry import ShapeError, check_name
+from data_schema.shape_records import MIN_HULL_VERTICES
+from direct_model.registry import MAX_HULL_VERTICES, ShapeError, check_name
 from direct_model.shapes import AspectRatioLaw
 from tablegen.tabulation.config_error import ConfigError
 from tablegen.tabulation.grain_files import GrainError, canonical_grain, grain_from_mesh, grain_from_points
 
-SHAPE_KEYS = ("mesh", "vertices", "triangles", "aspect_ratio", "both_hands")
+SHAPE_KEYS = ("mesh", "vertices", "triangles", "aspect_ratio", "both_hands", "max_vertices")
 ASPECT_KEYS = ("mean", "sd", "low", "high")
 
 
@@ -75,19 +77,28 @@ def parse_shape_sections(shapes, base_dir, source: str, log=None, used=None) -> 
         both_hands = spec.get("both_hands", False)
         if not isinstance(both_hands, bool):
             raise ConfigError(f"{source}: '{key}.both_hands' must be true or false; got {both_hands!r}")
+        max_vertices = spec.get("max_vertices")
+        if max_vertices is not None and (isinstance(max_vertices, bool) or not isinstance(max_vertices, int)
+                                         or not MIN_HULL_VERTICES <= max_vertices <= MAX_HULL_VERTICES):
+            raise ConfigError(f"{source}: '{key}.max_vertices' must be an integer in [{MIN_HULL_VERTICES}, "
+                              f"{MAX_HULL_VERTICES}]; got {max_vertices!r}")
+        if max_vertices is not None and "triangles" in spec:
+            raise ConfigError(f"{source}: '{key}.max_vertices' goes with mesh or vertices (points), not with a "
+                              f"canonical hull (triangles), which is taken as it is")
         try:
             if "mesh" in spec:
                 mesh = spec["mesh"]
                 if not isinstance(mesh, str) or not mesh.strip():
                     raise ConfigError(f"{source}: '{key}.mesh' must be a file name; got {mesh!r}")
-                records[name] = grain_from_mesh(name, Path(base_dir) / mesh, aspect, both_hands, log)
+                records[name] = grain_from_mesh(name, Path(base_dir) / mesh, aspect, both_hands, log, max_vertices)
             elif "triangles" in spec:
                 points = _points(spec["vertices"], f"{key}.vertices", source)
                 triangles = _triangles(spec["triangles"], len(points), f"{key}.triangles", source)
                 records[name] = canonical_grain(name, points, triangles, f"{source}: '[{key}]'", aspect, both_hands)
             else:
                 points = _points(spec["vertices"], f"{key}.vertices", source)
-                records[name] = grain_from_points(name, points, f"{source}: '{key}.vertices'", aspect, both_hands)
+                records[name] = grain_from_points(name, points, f"{source}: '{key}.vertices'", aspect, both_hands,
+                                                  log=log, max_vertices=max_vertices)
         except GrainError as exc:
             raise ConfigError(f"{source}: '{key}': {exc}" if "mesh" in spec else str(exc)) from None
     return records

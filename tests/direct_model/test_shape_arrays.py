@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from direct_model import shapes
-from direct_model.registry import AspectRatioLaw, built_in_shapes
+from direct_model.registry import MAX_HULL_VERTICES, AspectRatioLaw, built_in_shapes
 from direct_model.shape_arrays import (
     KIND_ELLIPSOID, KIND_POLYHEDRON, STORED, bounding_radius, family_shape_arrays, from_stored, particle_body,
-    shape_arrays, shape_records,
+    scanned_hull, shape_arrays, shape_records,
 )
 from tests.helpers.grains import cloud_grain
 
@@ -84,9 +84,9 @@ def test_arrays_out_of_their_ranges_are_refused(change, message):
 
 def test_a_hull_over_the_limit_is_refused():
     stored = shape_arrays([cloud_grain("sand", 60, 4)]).stored()
-    count = 257
+    count = MAX_HULL_VERTICES + 1
     stored.update(vertex_start=[0, count], vertices=np.zeros((count, 3)))
-    with pytest.raises(ValueError, match="has 257 vertices; allowed: 4 to 256"):
+    with pytest.raises(ValueError, match=f"has {count} vertices; allowed: 4 to {MAX_HULL_VERTICES}"):
         from_stored(**stored)
 
 
@@ -95,23 +95,25 @@ def test_a_particle_s_body_is_the_record_stretched(hand):
     """particle_body = the registry's stretched(): vertices, J/m, half-extents (largest 1) and radius."""
     sand = cloud_grain("sand", 150, 5, LAW)
     arrays = shape_arrays([sand])
-    verts, K, semi = np.empty((256, 3)), np.empty(3), np.empty(3)
+    verts, K, semi, scale = np.empty((256, 3)), np.empty(3), np.empty(3), np.empty(3)
     for ba, cb in [(1.0, 1.0), (0.7, 0.9), (0.5, 0.5)]:
-        nv = particle_body(arrays, 0, ba, cb, hand, verts, K, semi)
+        nv = particle_body(arrays, 0, ba, cb, hand, verts, K, semi, scale)
         body = sand.stretched(ba, cb, int(hand))
         np.testing.assert_allclose(verts[:nv], body.vertices, rtol=0, atol=1e-15)
         np.testing.assert_allclose(K, body.inertia, rtol=1e-14)
         half = (body.vertices.max(axis=0) - body.vertices.min(axis=0)) / 2.0
         np.testing.assert_allclose(semi, half, rtol=1e-15)
         assert semi.max() == 1.0
-        assert bounding_radius(KIND_POLYHEDRON, semi, verts, nv) == pytest.approx(
+        np.testing.assert_array_equal(arrays.vertices * scale, verts[:nv])      # the tree's view of the body
+        assert bounding_radius(KIND_POLYHEDRON, semi, verts, nv, scanned_hull(verts)) == pytest.approx(
             np.linalg.norm(body.vertices, axis=1).max(), rel=1e-15)
 
 
 def test_fixed_proportions_ignore_the_ratios():
     sand = cloud_grain("sand", 80, 6)
     arrays = shape_arrays([sand])
-    one, other = (np.empty((256, 3)), np.empty(3), np.empty(3)), (np.empty((256, 3)), np.empty(3), np.empty(3))
+    one, other = ((np.empty((256, 3)), np.empty(3), np.empty(3), np.empty(3)),
+                  (np.empty((256, 3)), np.empty(3), np.empty(3), np.empty(3)))
     n1 = particle_body(arrays, 0, 1.0, 1.0, 1.0, *one)
     n2 = particle_body(arrays, 0, 0.6, 0.7, 1.0, *other)
     assert n1 == n2 == len(sand.vertices)

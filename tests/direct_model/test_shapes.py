@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from direct_model.shape_arrays import KIND_ELLIPSOID, KIND_POLYHEDRON, bounding_radius
+from direct_model.shape_arrays import KIND_ELLIPSOID, KIND_POLYHEDRON, bounding_radius, scanned_hull
 from direct_model.shapes import (
     AspectRatioLaw, body_vertices, polyhedron_mass_properties,
     second_moment_factor, shape_code, shape_vertices, MAX_VERTICES,
@@ -81,8 +81,9 @@ def test_vertex_counts_and_bounding_radius():
         n = body_vertices(shape_code(name), a, b, c, 0.3, 1.0, out)
         assert n == count
         assert len(np.unique(out[:n], axis=0)) == count
-        assert bounding_radius(KIND_POLYHEDRON, np.array([a, b, c]), out, n) == pytest.approx(radius, rel=1e-15)
-    assert bounding_radius(KIND_ELLIPSOID, np.array([a, b, c]), out, 0) == a
+        assert bounding_radius(KIND_POLYHEDRON, np.array([a, b, c]), out, n, scanned_hull(out)) == pytest.approx(
+            radius, rel=1e-15)
+    assert bounding_radius(KIND_ELLIPSOID, np.array([a, b, c]), out, 0, scanned_hull(out)) == a
 
 
 def test_tetrahedron_hands_are_mirror_images():

@@ -364,8 +364,8 @@ class NativeTable:
         n = info.n_vertices
         vertices = (np.ctypeslib.as_array(info.vertices, shape=(n, 3)).copy() if n else np.zeros((0, 3)))
         assert n or not info.vertices
-        return {"name": info.name.decode(), "kind": info.kind, "family": info.family, "vertices": vertices,
-                "inertia": np.array(info.inertia[:]), "aspect": np.array(info.aspect[:]),
+        return {"name": info.name.decode(), "kind": info.kind, "family": info.family, "n_vertices": n,
+                "vertices": vertices, "inertia": np.array(info.inertia[:]), "aspect": np.array(info.aspect[:]),
                 "both_hands": info.both_hands}
 
     def wall(self) -> dict:

@@ -7,8 +7,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, body_rebound
-from direct_model.registry import MAX_HULL_VERTICES
-from direct_model.shape_arrays import bounding_radius, family_shape_arrays, particle_body, shape_arrays
+from direct_model.shape_arrays import bounding_radius, family_shape_arrays, particle_body, particle_hull, shape_arrays
 from direct_model.shapes import SHAPES, AspectRatioLaw, second_moment_factors
 from direct_model.simulate import incident_velocity
 from direct_model.wall import CORUNDUM_ON_STEEL
@@ -24,6 +23,7 @@ class Body(NamedTuple):
     semi: np.ndarray         # half-extents along ξ, η, ζ (an ellipsoid's semi-axes)
     K: np.ndarray            # principal J/m, a²
     radius: float            # bounding radius
+    hull: tuple              # the kernels' hull argument (direct_model.shape_arrays.particle_hull)
 
 
 def body(shape, ratios=(1.0, 1.0), hand=1, kappa=0.3) -> Body:
@@ -32,10 +32,12 @@ def body(shape, ratios=(1.0, 1.0), hand=1, kappa=0.3) -> Body:
         arrays, index = family_shape_arrays(kappa, AspectRatioLaw(), second_moment_factors(kappa)), SHAPES.index(shape)
     else:
         arrays, index = shape_arrays([shape]), 0
-    verts, K, semi = np.empty((MAX_HULL_VERTICES, 3)), np.empty(3), np.empty(3)
-    nv = particle_body(arrays, index, float(ratios[0]), float(ratios[1]), float(hand), verts, K, semi)
+    count = arrays.vertex_start[index + 1] - arrays.vertex_start[index]
+    verts, K, semi, scale = np.empty((count, 3)), np.empty(3), np.empty(3), np.empty(3)
+    nv = particle_body(arrays, index, float(ratios[0]), float(ratios[1]), float(hand), verts, K, semi, scale)
     kind = int(arrays.kind[index])
-    return Body(kind, verts[:nv].copy(), semi, K, bounding_radius(kind, semi, verts, nv))
+    hull = particle_hull.py_func(arrays, index, scale)     # compiled, it would hand Python the whole arrays
+    return Body(kind, verts[:nv].copy(), semi, K, bounding_radius(kind, semi, verts, nv, hull), hull)
 
 
 def run_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0), hand=1,
@@ -43,14 +45,14 @@ def run_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0
     """Rebound of one particle (``shape`` and ``ratios`` as :func:`body`); returns (V⁺ m/s, Ω⁺ (m/s)/a, status,
     n_coll, e_rot, history)."""
     b = body(shape, ratios, hand, kappa)
-    verts = np.zeros((MAX_HULL_VERTICES, 3))
+    verts = np.zeros((max(len(b.vertices), 1), 3))         # an ellipsoid's support point goes to row 0
     verts[:len(b.vertices)] = b.vertices
     V, W = np.empty(3), np.empty(3)
     history = np.full((history_rows, HISTORY_COLUMNS), np.nan)
     done = body_rebound(
         b.kind, verts, len(b.vertices), b.semi, b.K, b.radius, np.ascontiguousarray(R0),
         incident_velocity(alpha1, speed), np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(),
-        n_max, contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE))
+        n_max, contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE), b.hull)
     return V, W, done.status, done.n_collisions, done.rotational_energy, history
 
 

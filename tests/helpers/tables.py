@@ -1,5 +1,6 @@
 """The configurations of the small tables the session builds once (tests/conftest.py): 2e4 particles per cell,
-all four shapes, a table of two user grains and one of a family entered by the tests; and edited copies of a table."""
+all four shapes, a table of two user grains, one of a grain of 10 000 vertices and one of a family entered by the
+tests; and edited copies of a table."""
 
 import json
 import shutil
@@ -105,6 +106,23 @@ def write_grain_config(folder, text=GRAIN_TABLE_CONFIG, mesh=GRAIN_MESH):
     path = folder / "grains.toml"
     path.write_text(text)
     return path
+
+
+# a table of one user grain of BIG_GRAIN_VERTICES hull vertices on one grid point, the fewest particles a cell allows
+# (it builds in a few seconds): points on the surface of the ellipsoid of semi-axes (1, 0.7, 0.5), each one a hull
+# vertex, given as the configuration's points; numba searches its contact through the hull's tree, C scans every
+# vertex with its work space on the heap
+BIG_GRAIN_VERTICES = 10_000
+
+
+def big_grain_config() -> str:
+    """The configuration of the table of one grain of BIG_GRAIN_VERTICES vertices, named "scan"."""
+    rng = np.random.default_rng(54)
+    points = rng.normal(size=(BIG_GRAIN_VERTICES, 3))
+    points /= np.linalg.norm(points, axis=1)[:, None]
+    points *= [1.0, 0.7, 0.5]
+    return (_table_config([40.0], [150.0], seed=55, shapes=["scan"], particles_per_cell=256)
+            + f"[shapes.scan]\nvertices = {json.dumps(points.tolist())}\n")
 
 
 # the grid attributes a table of format 3.4 held (its wall law and the direct model's parameters), in the order its

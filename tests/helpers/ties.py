@@ -16,7 +16,9 @@ import mpmath
 import numpy as np
 
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, body_rebound
-from direct_model.registry import MAX_HULL_VERTICES, grain
+from direct_model.registry import grain
+from direct_model.shape_arrays import scanned_hull
+from direct_model.vertex_tree import TREE_ABOVE
 from direct_model.wall import CORUNDUM_ON_STEEL
 from tablegen.tabulation.grain_files import convex_hull
 from tests.helpers.one_particle import Body, body
@@ -216,8 +218,8 @@ def tie_states():
 # -- the rebound ---------------------------------------------------------------------------------------------------
 
 def kernel_body(s: TieState):
-    """The state's vertices as the kernels take them: MAX_HULL_VERTICES rows, the body's first."""
-    verts = np.zeros((MAX_HULL_VERTICES, 3))
+    """The state's vertices as the kernels take them: TREE_ABOVE rows (a scanned body's most), the body's first."""
+    verts = np.zeros((TREE_ABOVE, 3))
     verts[:len(s.body.vertices)] = s.body.vertices
     return verts
 
@@ -228,7 +230,7 @@ def rebound(s: TieState):
     done = body_rebound(
         s.body.kind, kernel_body(s), len(s.body.vertices), s.body.semi, s.body.K, s.body.radius, s.R, s.V,
         np.zeros(3), WALL.as_array(), N_MAX, CONTACT_TOL, SET_TOL, MAX_STEPS, V, W, np.empty((0, HISTORY_COLUMNS)),
-        np.empty(WORK_SIZE))
+        np.empty(WORK_SIZE), scanned_hull(kernel_body(s)))
     return V, W, done.status, done.n_collisions
 
 

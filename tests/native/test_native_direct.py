@@ -2,7 +2,7 @@
 body_rebound.c, runtime.c) against numba, bit for bit for the same inputs and uniforms: the parameter array the
 loader builds, the pieces (shapes, a particle's body, the normal quantile, the uniform quaternion, one
 collision: internal functions, bound in the test-only library), whole rebounds in random caller frames (rbs_rebound
-under RBS_METHOD_DIRECT with a one-shape mix, the public way to the direct path), user grains of 8 to 256 hull
+under RBS_METHOD_DIRECT with a one-shape mix, the public way to the direct path), user grains of 8 to 1000 hull
 vertices, and hostile inputs (RBS_INVALID with NaN, never a crash)."""
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import h5py
 import numpy as np
 import pytest
 
+from direct_model.shape_arrays import particle_hull     # not yet re-exported by tests/helpers/python_side.py
 from tests.helpers import python_side as py
 from tests.helpers.native_library import (ERR_FORMAT, INVALID, METHOD_DIRECT, NATIVE, PATH_DIRECT, PATH_NONE,
                                           ShapeArrays, direct_uniforms)
@@ -22,9 +23,10 @@ SPINS = (0.0, 0.02, 0.3, 1.0)     # |Ω⁻| a / |V⁻| of the whole-rebound comp
 PER_SHAPE = 2000                  # particles per shape and spin
 N_COLLISIONS = 10_000
 LAW = py.AspectRatioLaw()
-# user grains: hulls of 8 to 256 vertices in both hands, of fixed proportions or stretched by the families' law
-GRAINS = [py.hull_grain(f"grain_{n}", n, seed=n, aspect=LAW if n in (24, 256) else None, both_hands=True)
-          for n in (8, 24, 64, 256)] + [py.cloud_grain("cloud", 300, seed=3, aspect=LAW)]
+# user grains: hulls of 8 to 1000 vertices in both hands, of fixed proportions or stretched by the families' law (above
+# 64 vertices numba searches through the hull's tree, C scans; above 256 C's work space is on the heap)
+GRAINS = [py.hull_grain(f"grain_{n}", n, seed=n, aspect=LAW if n in (24, 256, 1000) else None, both_hands=True)
+          for n in (8, 24, 64, 256, 1000)] + [py.cloud_grain("cloud", 300, seed=3, aspect=LAW)]
 
 def _c(native):
     """The test-only library, its internal functions typed (tests.helpers.native_library.INTERNAL)."""
@@ -165,7 +167,10 @@ def test_shapes_bit_for_bit(native):
 
 def test_particle_bodies_bit_for_bit(native, table_pair):
     """One particle's body from the shape arrays (rbs_particle_body, rbs_bounding_radius): vertices, J/m,
-    half-extents and radius as numba's, for the table's families and the user grains, random ratios and hands."""
+    half-extents and radius as numba's, for the table's families and the user grains (hulls of more than
+    direct_model.vertex_tree.TREE_ABOVE vertices: numba's radius through the hull's tree, C's from every vertex),
+    random ratios and hands. C computes the half-extents from the vertices, numba reads them precomputed; numba's
+    vertices (room for 256 here) are unit[i] · scale."""
     c = _c(native)
     rng = np.random.default_rng(4)
     for arrays in (table_pair[0].shape_arrays, py.shape_arrays(GRAINS)):
@@ -174,13 +179,19 @@ def test_particle_bodies_bit_for_bit(native, table_pair):
             shape = trial % arrays.n_shapes
             ba, cb = rng.uniform(0.5, 1.0, 2)
             hand = (1.0, -1.0)[trial % 8 // 4]
-            out = [(np.zeros((256, 3)), np.zeros(3), np.zeros(3)) for _ in range(2)]
-            n = c.rbs_particle_body(ctypes.byref(struct), shape, ba, cb, hand, *(x.ctypes.data for x in out[0]))
-            assert n == py.particle_body(arrays, shape, ba, cb, hand, *out[1])
-            assert all(_same(mine, theirs) for mine, theirs in zip(*out))
+            # C's vertices: room for the shape's rows; numba's: room for 256 (it copies them only where they fit)
+            mine = (np.zeros((int(np.diff(arrays.vertex_start).max()), 3)), np.zeros(3), np.zeros(3))
+            theirs, scale = (np.zeros((256, 3)), np.zeros(3), np.zeros(3)), np.zeros(3)
+            n = c.rbs_particle_body(ctypes.byref(struct), shape, ba, cb, hand, *(x.ctypes.data for x in mine))
+            assert n == py.particle_body(arrays, shape, ba, cb, hand, *theirs, scale)
+            assert _same(mine[1], theirs[1]) and _same(mine[2], theirs[2])
+            unit = arrays.vertices[arrays.vertex_start[shape]:arrays.vertex_start[shape] + n]
+            assert _same(mine[0][:n], unit * scale) and (n > 256 or _same(mine[0][:n], theirs[0][:n]))
             kind = int(arrays.kind[shape])
-            assert _same(c.rbs_bounding_radius(kind, out[0][2].ctypes.data, out[0][0].ctypes.data, n),
-                         py.bounding_radius(kind, out[1][2], out[1][0], n))
+            # its Python form: a view numba returns to Python is boxed as the array it was sliced from
+            hull = particle_hull.py_func(arrays, shape, scale)
+            assert _same(c.rbs_bounding_radius(kind, mine[2].ctypes.data, mine[0].ctypes.data, n),
+                         py.bounding_radius(kind, theirs[2], theirs[0], n, hull))
 
 
 def test_random_inputs_bit_for_bit(native, table_pair):
@@ -308,7 +319,7 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
 @pytest.mark.parametrize("spin", SPINS)
 def test_grain_rebounds_bit_for_bit(native, table_pair, spin):
     """A user's grain rebounds in C as in numba: rbs_rebound_model_frame against rebound_model_frame over the
-    grains' arrays (hulls of 8 to 256 vertices), 400 particles each at random incidence, the same uniforms:
+    grains' arrays (hulls of 8 to 1000 vertices), 400 particles each at random incidence, the same uniforms:
     the same status and, for a rebound, the same bits of V⁺ and Ω⁺."""
     c = _c(native)
     params = table_pair[0].direct_parameters

@@ -49,7 +49,8 @@ def test_tables_program_under_sanitizers(native_sanitized, small_table_path, tab
 def test_direct_model_program_under_sanitizers(native_sanitized, small_table_path, tmp_path):
     """The direct model's invariants as C tests (a collision never adds energy and keeps the angular momentum
     about the contact point, a free flight keeps energy and L to 1e-9, a rebound never adds energy), its
-    hostile calls on the small table (every table of format 4 records the direct model's parameters), four
+    hostile calls on the small table (every table of format 4 records the direct model's parameters), a grain of
+    512 vertices whose work space is on the heap (rbs_rebound_model_frame's equals rbs_body_rebound's), four
     threads on one table against one: no failure, no sanitizer report."""
     out = _sanitized_run([native_sanitized / "rbs_test_direct", small_table_path])
     assert "0 failure(s)" in out

@@ -6,6 +6,8 @@ fails to load in both loaders with a message naming the dataset, and so does a t
 
 from __future__ import annotations
 
+import re
+
 import h5py
 import numpy as np
 import pytest
@@ -13,7 +15,7 @@ import pytest
 from tests.helpers import python_side as py
 from tests.helpers.tables import edited_copy
 from tests.helpers.bad_files import _corrupt_chunk, _flip_bit, _set
-from tests.helpers.native_library import ERR_FORMAT, FAMILY_NONE, METHOD_DIRECT
+from tests.helpers.native_library import ERR_FORMAT, FAMILY_NONE, METHOD_DIRECT, NATIVE
 
 SHAPE_DATASETS = ("name", "kind", "vertex_start", "vertices", "triangle_start", "triangles", "inertia", "aspect",
                   "both_hands")
@@ -161,8 +163,8 @@ def test_a_bad_value_in_any_shapes_dataset_is_refused_by_both(native, small_tabl
 
 
 def test_a_bad_value_in_a_user_grain_is_refused_by_both(native, many_shapes, tmp_path):
-    """A user grain's row (shape 4): a name outside NAME_PATTERN, a vertex count over 256 or under 4, a vertex
-    outside the unit box's bound, a law with low >= high, and the group missing."""
+    """A user grain's row (shape 4): a name outside NAME_PATTERN, a vertex count under 4, a vertex outside the
+    unit box's bound, a law with low >= high, and the group missing."""
     path = many_shapes[0]
     with h5py.File(path, "r") as f:
         start = f["shapes/vertex_start"][()]
@@ -171,6 +173,26 @@ def test_a_bad_value_in_a_user_grain_is_refused_by_both(native, many_shapes, tmp
     for name, edit in edits.items():
         _refused_alike(native, edited_copy(path, tmp_path, f"grain_{name}.h5", edit), f"shapes/{name}")
     _refused_alike(native, edited_copy(path, tmp_path, "no_group.h5", lambda f: f.__delitem__("shapes")), "'shapes'")
+
+
+def test_a_hull_over_the_vertex_limit_is_refused_alike(native, small_table_path, tmp_path):
+    """The last shape's row given MAX_HULL_VERTICES + 1 vertices (shapes.h's limit; rows of zeros appended to
+    shapes/vertices): both loaders refuse it in the same words, which state the limit, so C's is Python's."""
+    limit = int(re.search(r"#define MAX_HULL_VERTICES (\d+)", (NATIVE / "src" / "shapes.h").read_text()).group(1))
+
+    def too_many(f):
+        start, vertices = f["shapes/vertex_start"][()], f["shapes/vertices"][()]
+        extra = limit + 1 - int(start[-1] - start[-2])
+        start[-1] += extra
+        f["shapes/vertex_start"][...] = start
+        del f["shapes/vertices"]
+        f["shapes"].create_dataset("vertices", data=np.concatenate([vertices, np.zeros((extra, 3))]), fletcher32=True)
+
+    path = edited_copy(small_table_path, tmp_path, "too_many_vertices.h5", too_many)
+    with h5py.File(path, "r") as f:
+        name = f["shapes/name"][-1].decode()
+    words = f"dataset 'shapes/vertex_start' gives shape '{name}' {limit + 1} vertices; allowed: 4 to {limit} for a convex"
+    _refused_alike(native, path, words)
 
 
 def test_a_flipped_kappa_bit_changes_the_families_and_is_refused(native, small_table_path, tmp_path):

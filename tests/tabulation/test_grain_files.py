@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 
 from direct_model import shapes
 from direct_model.registry import MAX_HULL_VERTICES
-from tablegen.tabulation.config import ConfigError
+from tablegen.tabulation.config import ConfigError, parse_config
 from tablegen.tabulation.grain_files import GrainError, grain_from_mesh, grain_from_points
 from tablegen.tabulation.shape_config import parse_shape_sections
 
@@ -128,6 +128,10 @@ def _hostile_files(folder):
         ('mesh = "x.stl"\naspect_ratio = {mean = 0.8, width = 1}', ["shapes.sand.aspect_ratio", "mean, sd, low, high"]),
         ('mesh = "x.stl"\naspect_ratio = {low = 0.9, high = 0.5}', ["shapes.sand.aspect_ratio", "low < high"]),
         ('mesh = "x.stl"\naspect_ratio = {sd = nan}', ["shapes.sand.aspect_ratio", "finite"]),
+        ('mesh = "x.stl"\nmax_vertices = 3', ["shapes.sand.max_vertices", f"[4, {MAX_HULL_VERTICES}]", "got 3"]),
+        ('mesh = "x.stl"\nmax_vertices = 8.5', ["shapes.sand.max_vertices", "an integer"]),
+        ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]\ntriangles = [[0, 1, 2]]\nmax_vertices = 8",
+         ["shapes.sand.max_vertices", "not with a canonical hull"]),
     ]
 
 
@@ -155,3 +159,49 @@ def test_the_shapes_table_must_hold_sections(tmp_path):
 def test_grain_error_names_the_points_source():
     with pytest.raises(GrainError, match="^my points: point 1 is"):
         grain_from_points("sand", [[0, 0, 0], [np.inf, 0, 0], [0, 1, 0], [0, 0, 1]], "my points")
+
+
+def _bulging_octahedron(height=1e-3, per_face=30, seed=1):
+    """The octahedron of corners (±1, 0, 0), (0, ±1, 0), (0, 0, ±1) with points on its faces pushed out by
+    ``height`` along the faces' normals: a hull of many vertices whose simplification to 6 is the octahedron."""
+    corners = np.vstack([np.eye(3), -np.eye(3)])
+    rng = np.random.default_rng(seed)
+    points = [corners]
+    for signs in np.array(np.meshgrid([1, -1], [1, -1], [1, -1])).reshape(3, -1).T:
+        face = rng.dirichlet([2.0, 2.0, 2.0], per_face) @ np.diag(signs.astype(float))
+        points.append(face + height * signs / np.sqrt(3.0))
+    return np.vstack(points)
+
+
+def test_a_simplified_hull_is_reported_against_the_one_it_replaces():
+    """max_vertices = 6 on an octahedron whose faces bulge by 10⁻³: the simplified hull is the octahedron (each
+    vertex within 3·10⁻³ of a corner: quadric decimation places a kept vertex off the corner by up to twice the
+    bulge), and the report says so: 66 to 6 vertices, the volume lost between 0 and
+    the bulges' at most (area 4√3 times 10⁻³ over the volume 4/3: 0.52 %), the largest distance between the
+    hulls between half and twice the bulge (a is 1 here, to 3 %)."""
+    import re
+
+    from tablegen.tabulation.grain_files import convex_hull, simplification_report, simplified_hull
+
+    vertices, triangles, _ = convex_hull(_bulging_octahedron(), "octahedron")
+    simple, simple_triangles = simplified_hull(vertices, triangles, 6, "octahedron")
+    corners = np.vstack([np.eye(3), -np.eye(3)])
+    assert len(simple) == 6
+    assert np.abs(np.sort(simple, axis=0) - np.sort(corners, axis=0)).max() < 3e-3
+    line = simplification_report(vertices, triangles, simple, simple_triangles)
+    assert line.startswith(f"simplified from {len(vertices)} to 6 hull vertices: volume -")
+    volume = float(re.search(r"volume ([-+.\d]+)%", line).group(1))
+    distance = float(re.search(r"original hull ([\d.e-]+) a", line).group(1))
+    assert -0.52 < volume < 0.0 and 0.5e-3 < distance < 2e-3, line
+
+
+def test_a_config_s_max_vertices_simplifies_the_grain_and_says_so():
+    """The build's configuration reader: a grain of more hull vertices than max_vertices gets at most that many
+    and one line on what changed; its stored text is the simplified hull, which reads back as it is."""
+    points = _bulging_octahedron(per_face=60).tolist()
+    lines = []
+    config = parse_config(f'[grid]\nshapes = ["oct"]\n[shapes.oct]\nvertices = {points}\nmax_vertices = 10\n',
+                          "case.toml", log=lines.append)
+    assert len(config.grains[0].vertices) <= 10
+    assert len(lines) == 1 and lines[0].startswith("case.toml: 'shapes.oct.vertices': simplified from ")
+    assert parse_config(config.to_toml()).grains[0].vertices.tolist() == config.grains[0].vertices.tolist()
