@@ -4,13 +4,14 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from direct_model import shapes
+from direct_model import registry, shapes
 from direct_model.polyhedron import mass_properties
 from direct_model.registry import (
     MAX_HULL_VERTICES, MIN_THICKNESS, ConvexPolyhedron, Ellipsoid, ShapeError, built_in_shape, built_in_shapes, grain,
     polyhedron,
 )
 from tablegen.tabulation.grain_files import convex_hull
+from tests.helpers.grains import LOWERED_HULL_LIMIT
 
 RATIOS = [(1.0, 1.0), (0.8, 0.9), (0.5, 0.5), (0.93, 0.61)]       # (b/a, c/b) inside the law's [0.5, 1]
 POLYHEDRA = ["prism", "cut_prism", "tetrahedron"]
@@ -99,15 +100,20 @@ def test_names_of_built_ins_and_malformed_names_are_refused(name):
         grain(name, vertices, triangles)
 
 
-def test_a_hull_over_the_runtime_limit_is_refused():
+
+
+def test_a_hull_over_the_runtime_limit_is_refused(monkeypatch):
+    """The limit read where it is checked (the real one, 65536, in tests/native/test_native_shapes.py: both
+    loaders refuse one vertex more alike); here lowered so that the hulls stay small."""
+    monkeypatch.setattr(registry, "MAX_HULL_VERTICES", LOWERED_HULL_LIMIT)
     rng = np.random.default_rng(2)
-    points = rng.normal(size=(MAX_HULL_VERTICES + 1, 3))
+    points = rng.normal(size=(LOWERED_HULL_LIMIT + 1, 3))
     points /= np.linalg.norm(points, axis=1)[:, None]           # on a sphere: every point is a hull vertex
     vertices, triangles, _ = convex_hull(points, "test")
-    assert len(vertices) == MAX_HULL_VERTICES + 1
-    with pytest.raises(ShapeError, match=f"{MAX_HULL_VERTICES + 1} vertices; allowed: at most {MAX_HULL_VERTICES}"):
+    assert len(vertices) == LOWERED_HULL_LIMIT + 1 and MAX_HULL_VERTICES == 65536
+    with pytest.raises(ShapeError, match=f"{LOWERED_HULL_LIMIT + 1} vertices; allowed: at most {LOWERED_HULL_LIMIT}"):
         grain("sphere", vertices, triangles)
-    grain("sphere", *convex_hull(points[:MAX_HULL_VERTICES], "test")[:2])      # at the limit: taken
+    grain("sphere", *convex_hull(points[:LOWERED_HULL_LIMIT], "test")[:2])      # at the limit: taken
 
 
 def test_a_flat_hull_is_refused():

@@ -7,6 +7,9 @@ from direct_model.registry import grain
 from tablegen.tabulation.grain_files import convex_hull
 
 PROPORTIONS = (1.0, 0.7, 0.5)      # the clouds' spread along three axes: an irregular, flattened grain
+# the hull limit the tests of a refusal lower direct_model.registry.MAX_HULL_VERTICES to: small hulls, quick (the
+# real limit, 65536, is checked in tests/native/test_native_shapes.py, where both loaders refuse one vertex more)
+LOWERED_HULL_LIMIT = 300
 
 
 def cloud_grain(name, n_points, seed, aspect=None, both_hands=False):

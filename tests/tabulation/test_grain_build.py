@@ -9,12 +9,13 @@ from scipy.spatial.transform import Rotation
 
 import surrogate
 from data_schema.table import read_table, table_fingerprint
-from direct_model.registry import MAX_HULL_VERTICES
+from direct_model import registry
 from surrogate.cli import main as surrogate_main
 from tablegen.cli import main as tablegen_main
 from tablegen.tabulation.config import load_config, parse_config
 from tablegen.tabulation.driver import build_table
 from tests.helpers.cli import run_cli, user_error
+from tests.helpers.grains import LOWERED_HULL_LIMIT
 from tests.helpers.tables import GRAIN_MESH, GRAIN_TABLE_CONFIG, write_grain_config
 
 
@@ -106,26 +107,29 @@ def test_tablegen_simulate_takes_a_grain_of_a_config(tmp_path, capsys):
     assert not (tmp_path / "x.h5").exists()
 
 
+
+
 def _hostile(folder):
     """(configuration text, words of its one-line error): a missing mesh, a degenerate (flat) hull, a name of a
     built-in, too many hull vertices, a grid name without a section, a section not in the grid."""
     (folder / "flat.off").write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n")
     import trimesh
-    sphere = np.random.default_rng(0).normal(size=(MAX_HULL_VERTICES + 1, 3))
+    sphere = np.random.default_rng(0).normal(size=(LOWERED_HULL_LIMIT + 1, 3))
     trimesh.convex.convex_hull(sphere / np.linalg.norm(sphere, axis=1)[:, None]).export(folder / "big.ply")
     grid = '[grid]\nshapes = ["prism", "sand"]\n'
     return [
         (grid + '[shapes.sand]\nmesh = "missing.stl"\n', ["shapes.sand", "missing.stl", "cannot read"]),
         (grid + '[shapes.sand]\nmesh = "flat.off"\n', ["flat.off", "one plane"]),
         ('[grid]\nshapes = ["prism"]\n[shapes.prism]\nmesh = "flat.off"\n', ["shapes.prism", "built-in"]),
-        (grid + '[shapes.sand]\nmesh = "big.ply"\n', ["big.ply", f"at most {MAX_HULL_VERTICES}"]),
+        (grid + '[shapes.sand]\nmesh = "big.ply"\n', ["big.ply", f"at most {LOWERED_HULL_LIMIT}"]),
         (grid, ["grid.shapes", "'sand'", "no section"]),
         (grid + '[shapes.sand]\nmesh = "flat.off"\n[shapes.dust]\nmesh = "flat.off"\n',
          ["[shapes.dust]", "not named in 'grid.shapes'"]),
     ]
 
 
-def test_bad_grains_are_one_line_exit_2_and_nothing_written(tmp_path, capsys):
+def test_bad_grains_are_one_line_exit_2_and_nothing_written(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(registry, "MAX_HULL_VERTICES", LOWERED_HULL_LIMIT)     # small hulls (the real limit: registry's)
     for k, (text, words) in enumerate(_hostile(tmp_path)):
         config = tmp_path / f"c{k}.toml"
         config.write_text(text)

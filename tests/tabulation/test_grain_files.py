@@ -7,11 +7,12 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from direct_model import shapes
+from direct_model import registry, shapes
 from direct_model.registry import MAX_HULL_VERTICES
 from tablegen.tabulation.config import ConfigError, parse_config
 from tablegen.tabulation.grain_files import GrainError, grain_from_mesh, grain_from_points
 from tablegen.tabulation.shape_config import parse_shape_sections
+from tests.helpers.grains import LOWERED_HULL_LIMIT
 
 ROTATION = Rotation.random(random_state=3).as_matrix()
 
@@ -88,6 +89,8 @@ both_hands = true
     assert records["sand_b"].volume == pytest.approx(8 * 0.8 * 0.6, rel=1e-10)
 
 
+
+
 def _hostile_files(folder):
     """(config text, words of its one-line error), with the files it names written into ``folder``."""
     (folder / "empty.stl").write_bytes(b"")
@@ -98,7 +101,7 @@ def _hostile_files(folder):
     (folder / "flat.off").write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n")
     (folder / "grain.xyz").write_text("0 0 0\n")
     (folder / "a_folder.stl").mkdir()
-    sphere = np.random.default_rng(0).normal(size=(MAX_HULL_VERTICES + 1, 3))
+    sphere = np.random.default_rng(0).normal(size=(LOWERED_HULL_LIMIT + 1, 3))
     trimesh.convex.convex_hull(sphere / np.linalg.norm(sphere, axis=1)[:, None]).export(folder / "big.ply")
     thin = shapes.shape_vertices("prism", 1.0, 0.5, 1e-4).tolist()
     return [
@@ -110,7 +113,7 @@ def _hostile_files(folder):
         ('mesh = "grain.xyz"', ["grain.xyz", "unknown mesh format", ".stl, .obj, .off, .ply"]),
         ('mesh = "nan.off"', ["nan.off", "finite"]),
         ('mesh = "flat.off"', ["flat.off", "one plane"]),
-        ('mesh = "big.ply"', ["big.ply", f"{MAX_HULL_VERTICES + 1} vertices", f"at most {MAX_HULL_VERTICES}"]),
+        ('mesh = "big.ply"', ["big.ply", f"{LOWERED_HULL_LIMIT + 1} vertices", f"at most {LOWERED_HULL_LIMIT}"]),
         ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]", ["shapes.sand.vertices", "3 distinct points", "at least 4"]),
         ("vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 0]]", ["shapes.sand.vertices", "3 distinct points"]),
         ("vertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]]", ["shapes.sand.vertices", "one plane"]),
@@ -135,7 +138,8 @@ def _hostile_files(folder):
     ]
 
 
-def test_hostile_grains_give_one_line_naming_the_file_or_key(tmp_path):
+def test_hostile_grains_give_one_line_naming_the_file_or_key(tmp_path, monkeypatch):
+    monkeypatch.setattr(registry, "MAX_HULL_VERTICES", LOWERED_HULL_LIMIT)     # small hulls (the real limit: registry's)
     for body, words in _hostile_files(tmp_path):
         with pytest.raises(ConfigError) as error:
             _config(f"[shapes.sand]\n{body}\n", tmp_path)
