@@ -50,7 +50,7 @@ restitution = [[1.0, 0.8, 0.55], [1.0, 0.75, 0.5], [1.0, 0.7, 0.42]]
 name = "test_tabulated"
 """
 TABULATED_TABLE_CONFIG = _table_config([30.0, 70.0], [100.0, 200.0], seed=46, shapes=["prism"],
-                                       particles_per_cell=3000) + TABULATED_WALL
+                                       particles_per_cell=1000) + TABULATED_WALL
 
 
 def written_out_config(alpha1_deg, speed_m_s, shapes, seed) -> str:

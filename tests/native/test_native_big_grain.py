@@ -12,7 +12,7 @@ from tests.helpers import python_side as py
 from tests.helpers.native_library import FAMILY_NONE, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE
 from tests.helpers.tables import BIG_GRAIN_VERTICES
 
-HITS = 300      # half of them spinning; C scans the 10 000 vertices at every search step (about a millisecond a hit)
+HITS = 150      # half of them spinning; C scans the 10 000 vertices at every search step (about a millisecond a hit)
 
 
 def test_the_big_grain_loads_in_c_with_its_vertices(native, big_grain_table_path):
