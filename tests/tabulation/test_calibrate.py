@@ -99,8 +99,8 @@ def test_recovers_a_tabulated_law_at_two_speeds():
     at sine 0), recovered from data the direct model made with such a law at 2 speeds (q held at the truth: the
     exponential fits above recover q, the same friction law); its [wall] section reads back as the fitted law."""
     truth = TabulatedWall((60.0, 300.0), (0.0, 1.0), ((1.0, 0.72), (1.0, 0.45)), 0.9, name="truth")
-    data = _data(truth, **TWO_SPEEDS, mix=cal.DEFAULT_MIX, seed=7, particles=PARTICLES, n_exp=2000, noise_seed=4)
-    fit = cal.calibrate(data, "tabulated", {"q": 0.9}, particles=PARTICLES, seed=7)
+    data = _data(truth, **TWO_SPEEDS, mix=MIX_B, seed=7, particles=PARTICLES, n_exp=2000, noise_seed=4)
+    fit = cal.calibrate(data, "tabulated", {"q": 0.9}, mix=MIX_B, particles=PARTICLES, seed=7)
     assert fit.free == ("a_nc_60", "a_nc_300") and fit.wall.contact_speed_m_s == (60.0, 300.0)
     _assert_recovered(fit, {"a_nc_60": 0.72, "a_nc_300": 0.45}, {"a_nc_60": 0.3, "a_nc_300": 0.3})
     wall = parse_config(cal.wall_toml(fit, "calibrated_tabulated")).wall
