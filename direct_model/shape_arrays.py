@@ -29,8 +29,10 @@ array              dtype, shape        content
                                        ellipsoid's semi-axes)
 ``tree_start``     int64 (n + 1,)      derived: shape i's rows of ``tree_nodes`` and ``tree_links`` (none for a hull
                                        of at most :data:`direct_model.vertex_tree.TREE_ABOVE` vertices)
-``tree_nodes``,    float64, int64      derived: the tree of each hull of more vertices (:mod:`direct_model.vertex_tree`:
-``tree_links``     (total_k, 4)        spheres; first vertex, count, next node, leaf), vertex indices the shape's own
+``tree_nodes``     float64 (total_k,   derived: the boxes of the tree of each hull of more vertices
+                   NODE_SIZE)          (:mod:`direct_model.vertex_tree`: centre, axes, half-extents)
+``tree_links``     int64 (total_k, 4)  derived: first vertex, count, next node after the subtree, leaf flag;
+                                       vertex indices the shape's own
 =================  ==================  ===========================================================================
 
 The unit body of a family (docs/model.md §3) is its body at b/a = c/b = 1, its vertices in the order of
@@ -83,7 +85,7 @@ class ShapeArrays(NamedTuple):
     aspect_cdf: np.ndarray       # float64 (n, 2): derived from aspect
     half_extents: np.ndarray     # float64 (n, 3): derived from vertices
     tree_start: np.ndarray       # int64 (n + 1,): derived, the hulls' trees
-    tree_nodes: np.ndarray       # float64 (total_k, 4)
+    tree_nodes: np.ndarray       # float64 (total_k, NODE_SIZE)
     tree_links: np.ndarray       # int64 (total_k, 4)
 
     @property
@@ -125,10 +127,11 @@ def from_stored(kind, vertex_start, vertices, triangle_start, triangles, second_
             half[i] = _half_extents(arrays["vertices"], lo, hi - lo)
             trees.append(build_tree(arrays["vertices"][lo:hi]))
     counts = [len(nodes) for nodes, _ in trees]
+    nodes = np.concatenate([nodes for nodes, _ in trees]).reshape(-1, NODE_SIZE)
+    links = np.concatenate([links for _, links in trees]).reshape(-1, 4)
     return ShapeArrays(**arrays, aspect_cdf=_frozen(cdf, np.float64), half_extents=_frozen(half, np.float64),
                        tree_start=_frozen(np.concatenate([[0], np.cumsum(counts)]), np.int64),
-                       tree_nodes=_frozen(np.concatenate([nodes for nodes, _ in trees]).reshape(-1, NODE_SIZE), np.float64),
-                       tree_links=_frozen(np.concatenate([links for _, links in trees]).reshape(-1, 4), np.int64))
+                       tree_nodes=_frozen(nodes, np.float64), tree_links=_frozen(links, np.int64))
 
 
 def _check(kind, vertex_start, vertices, triangle_start, triangles, second_moments, aspect, both_hands):

@@ -4,15 +4,15 @@ with their number, with the bits of a scan of every vertex (docs/design/grains.m
 The tree. Leaves hold :data:`LEAF_SIZE` consecutive vertices (the last one fewer), an inner node :data:`BRANCH`
 consecutive nodes of the level below, so that every node covers a contiguous range of vertex indices and a
 depth-first walk that takes the children in order meets the vertices in index order. A node's box
-(:func:`node_box`): centred on its vertices' bounding box, along the principal axes of their spread (a patch of
-surface gives a thin box along its normal), each half-extent the vertices' largest distance from the centre
-along the axis, widened by a relative 10⁻¹² and an absolute 10⁻¹⁴ (units of a). The nodes are stored in depth-first preorder,
-so a walk needs no stack: from node k it goes on to k + 1 (its first child, or the next node) or skips k's
-subtree. Arrays of one tree: ``nodes`` (k, :data:`NODE_SIZE`) float64, the centre, the three axes and the three
-half-extents (unit body frame, units of a); ``links`` (k, 4) int64, the first vertex, the vertex count, the node
-after the subtree and 1 for a leaf (0 for an inner node). Node 0 is the root. A hull of :data:`TREE_ABOVE`
-vertices or fewer has no tree (k = 0) and is scanned. A grain's hull of more than 256 vertices is settled in
-Morton order (:func:`tablegen.tabulation.grain_files.settled`), so that a leaf is a small patch of the surface.
+(:func:`node_boxes`): centred on its vertices' bounding box, along the principal axes of their spread (a patch
+of surface gives a thin box along its normal), each half-extent the vertices' largest distance from the centre
+along the axis, widened by a relative 10⁻¹² and an absolute 10⁻¹⁴ (units of a). The nodes are stored in
+depth-first preorder, so a walk needs no stack: from node k it goes on to k + 1 (its first child, or the next
+node) or skips k's subtree. Arrays of one tree: ``nodes`` (k, :data:`NODE_SIZE`) float64, the centre, the three
+axes and the three half-extents (unit body frame, units of a); ``links`` (k, 4) int64, the first vertex, the
+vertex count, the node after the subtree and 1 for a leaf (0 for an inner node). Node 0 is the root. A hull
+of :data:`TREE_ABOVE` vertices or fewer has no tree (k = 0) and is scanned. A grain's hull of more than 256
+vertices is settled in Morton order (:func:`tablegen.tabulation.grain_files.settled`), so that a leaf is a small patch of the surface.
 
 The queries (:func:`lowest_two`, :func:`contact_sums`, :func:`farthest` here, and
 :func:`direct_model.flight.tree_safe_steps`). One particle's vertex i is p = unit[i] · scale (the unit body

@@ -239,9 +239,9 @@ class WallMaterial(Wall):
 
     def __post_init__(self):
         if self.family != EXPONENTIAL:      # the record's fields are the exponential family's
-            raise ValueError(f"a WallMaterial holds a wall of the {EXPONENTIAL} family (k, p, q); "
-                             f"{wall_family(self.family).name!r} has the parameters "
-                             f"{', '.join((*wall_family(self.family).parameter_names, *wall_family(self.family).array_names))}")
+            other = wall_family(self.family)
+            raise ValueError(f"a WallMaterial holds a wall of the {EXPONENTIAL} family (k, p, q); {other.name!r} has "
+                             f"the parameters {', '.join((*other.parameter_names, *other.array_names))}")
         _record_fields(self)
 
 
