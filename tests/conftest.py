@@ -155,9 +155,11 @@ def dispatch_children(small_table_path, tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def forced_rebuilds(tmp_path_factory):
-    """The future of tests/tabulation/test_build_dispatch.py's rebuilds of the small table under forced numpy and
-    OpenBLAS kernels (tests.helpers.cpu_dispatch.forced_rebuilds)."""
-    return background.submit(cpu_dispatch.forced_rebuilds, SMALL_TABLE_CONFIG, tmp_path_factory.mktemp("rebuild"))
+    """The future of tests/tabulation/test_build_dispatch.py's rebuilds of the tabulated table (four cells: the
+    representation's numpy and OpenBLAS work on every cell at little cost) under forced numpy and OpenBLAS kernels
+    (tests.helpers.cpu_dispatch.forced_rebuilds)."""
+    return background.submit(cpu_dispatch.forced_rebuilds, TABULATED_TABLE_CONFIG,
+                             tmp_path_factory.mktemp("rebuild"))
 
 
 @pytest.fixture(scope="session")

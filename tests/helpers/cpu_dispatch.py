@@ -107,7 +107,7 @@ def forced_rebuilds(config_text, folder) -> dict:
     case of REBUILD_CASES (numba keeps the host CPU); per case (its code paths, the default ones, the finished
     process or None where the case runs this CPU's default kernels, the table's path)."""
     default = code_paths(environment("default"))
-    config = folder / "small.toml"
+    config = folder / "table.toml"
     config.write_text(config_text)
     runs = {}
     for case in REBUILD_CASES:

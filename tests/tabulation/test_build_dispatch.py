@@ -1,7 +1,8 @@
 """A table built from a seed has the same bits whichever SIMD kernels numpy, OpenBLAS and numba use.
 
-The session's small table (built in this process with the kernels numpy, OpenBLAS and numba pick for this
-CPU) is built again by ``tablegen build`` in a subprocess under each forced case of tests/helpers/cpu_dispatch.py
+The session's tabulated table (four cells of the prism with a tabulated wall law, built in this process with the
+kernels numpy, OpenBLAS and numba pick for this CPU) is built again by ``tablegen build`` in a subprocess under
+each forced case of tests/helpers/cpu_dispatch.py
 (tests.helpers.cpu_dispatch.forced_rebuilds, started with the session):
 numpy without its AVX-512 targets and OpenBLAS's Haswell kernels, then numpy without any dispatch target and
 OpenBLAS's Prescott kernels. Every dataset of the files must be equal byte for byte. numba keeps the host CPU
@@ -48,18 +49,18 @@ def _bytes(values) -> bytes:
 
 
 @pytest.mark.parametrize("case", REBUILD_CASES)
-def test_table_bits_do_not_depend_on_numpy_or_openblas_kernels(case, small_table_path, forced_rebuilds):
+def test_table_bits_do_not_depend_on_numpy_or_openblas_kernels(case, tabulated_table_path, forced_rebuilds):
     paths, default, done, rebuilt = forced_rebuilds.result()[case]      # started with the session
     if case == "baseline":
         assert paths["numpy"] == [] and paths["openblas"] != default["openblas"], (paths, default)
     elif done is None:      # a CPU without AVX-512 runs this case on its default kernels: nothing to compare
         pytest.skip(f"the {case} kernels are this CPU's default ones ({paths})")
     assert done.returncode == 0, done.stderr[-3000:]
-    expected, got = _datasets(small_table_path), _datasets(rebuilt)
+    expected, got = _datasets(tabulated_table_path), _datasets(rebuilt)
     assert sorted(got) == sorted(expected)
     differ = [name for name in expected if _bytes(got[name]) != _bytes(expected[name])]
     assert differ == [], f"datasets that differ with {case} kernels ({paths}): {differ}"
-    assert table_fingerprint(rebuilt) == table_fingerprint(small_table_path)
+    assert table_fingerprint(rebuilt) == table_fingerprint(tabulated_table_path)
 
 
 def test_representation_bits_do_not_depend_on_numbas_target(tmp_path):
