@@ -11,7 +11,8 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
     /model/parameters      one row of a compound type: the direct model's parameters by name (MODEL_FIELDS)
     /wall                  attrs: family (the wall law family, direct_model.wall.WALL_FAMILIES), name (the
                            wall's label); parameters: one row of a compound type, the family's parameters by name
-                           and speed_range_m_s (2 numbers: the |V⁻| the law holds over, [0, inf]: not stated);
+                           and speed_range_m_s (2 numbers: the |V⁻| the law holds over, [0, inf]: not stated),
+                           then, for a rough wall only, roughness_deg (Δγ, degrees; absent: 0, smooth);
                            the family's arrays by name (tabulated: contact_speed_m_s, contact_sine, restitution)
     /shapes                the definition of every shape the table holds, one row per shape
                            (data_schema.shape_records: name, kind, vertices, triangles, inertia, aspect law, hands)
@@ -66,7 +67,7 @@ from data_schema.samples import SHAPE_NAMES
 from data_schema.shape_records import (SHAPE_DATASETS, SHAPES_GROUP, USER_SHAPE_CODE, check_shape_datasets,
                                        family_records, records_from_arrays, write_shape_records)
 from data_schema.output import hdf5_bytes, write_output
-from direct_model.wall import WALL_FAMILIES, Wall, check_speed_range, wall_family, wall_record
+from direct_model.wall import MAX_ROUGHNESS_DEG, WALL_FAMILIES, Wall, check_speed_range, wall_family, wall_record
 
 TABLE_FILE_TYPE = "rebound_table"
 TABLE_VERSION = (4, 0)
@@ -157,6 +158,7 @@ INTEGER_ATTRIBUTES = ("particles_per_cell", "clusters", "dictionary_size", "leve
 MODEL_GROUP, WALL_GROUP, PARAMETERS = "model", "wall", "parameters"
 WALL_ATTRIBUTES = ("family", "name")        # of group wall: the law family and the wall's label, strings
 WALL_SPEED_RANGE = "speed_range_m_s"        # the field of wall/parameters after the family's parameters
+WALL_ROUGHNESS = "roughness_deg"            # the field after it, written for a rough wall only (absent: 0)
 N_SECOND_MOMENT_FACTORS = 4                 # s per shape code of the paper's four families
 _INTEGER_RANGE = "an integer in [1, 2**53)"
 
@@ -322,10 +324,14 @@ class ReboundTable:
         wall = f.create_group(WALL_GROUP)
         wall.attrs["family"] = family.name
         wall.attrs["name"] = self.wall.name
-        row = np.array([(*self.wall.parameters().values(), self.wall.speed_range_m_s)],
-                       dtype=[(p.name, "<f8") for p in family.parameters] + [(WALL_SPEED_RANGE, "<f8", (2,))])
-        _write_row(wall, row, [p.units for p in family.parameters] + ["m/s"],
-                   f"the {family.name} wall law's parameters, by name, and the incident speeds it holds over")
+        rough = self.wall.roughness_deg != 0.0      # a smooth wall's row as before roughness: the same file
+        row = np.array([(*self.wall.parameters().values(), self.wall.speed_range_m_s,
+                         *([self.wall.roughness_deg] if rough else []))],
+                       dtype=[(p.name, "<f8") for p in family.parameters] + [(WALL_SPEED_RANGE, "<f8", (2,))]
+                       + ([(WALL_ROUGHNESS, "<f8")] if rough else []))
+        _write_row(wall, row, [p.units for p in family.parameters] + ["m/s"] + (["deg"] if rough else []),
+                   f"the {family.name} wall law's parameters, by name, the incident speeds it holds over"
+                   + (" and the wall's roughness" if rough else ""))
         for spec, values in zip(family.arrays, self.wall.arrays().values()):
             ds = wall.create_dataset(spec.name, data=values, fletcher32=True)
             ds.attrs["units"] = spec.units
@@ -502,6 +508,12 @@ def _wall(group: h5py.Group, row: np.ndarray) -> Wall:
         raise DataFormatError(f"field '{WALL_SPEED_RANGE}' of dataset '{dataset}' must be [low, high] m/s with "
                               f"0 <= low < high finite, or [0, inf] (not stated); got [{_g(speed_range[0])}, "
                               f"{_g(speed_range[1])}]") from None
+    roughness = 0.0
+    if row.dtype.names is not None and WALL_ROUGHNESS in row.dtype.names:
+        roughness = _field(row, dataset, WALL_ROUGHNESS, "number", None, fields)
+        if not 0.0 <= roughness <= MAX_ROUGHNESS_DEG:
+            raise DataFormatError(f"field '{WALL_ROUGHNESS}' of dataset '{dataset}' must be in "
+                                  f"[0, {MAX_ROUGHNESS_DEG:g}] degrees; got {_g(roughness)}")
     for spec in family.arrays:
         if spec.name not in group or not isinstance(group[spec.name], h5py.Dataset):
             raise DataFormatError(f"missing dataset '{WALL_GROUP}/{spec.name}' (an array of the {family.name} wall "
@@ -513,7 +525,7 @@ def _wall(group: h5py.Group, row: np.ndarray) -> Wall:
     # as lists: an error quotes them as the C loader does
     values.update({spec.name: values[spec.name].tolist() for spec in family.arrays})
     try:
-        return wall_record(family.name, values, name, speed_range)
+        return wall_record(family.name, values, name, speed_range, float(roughness))
     except ValueError as exc:       # a tabulated law's nodes or values
         raise DataFormatError(f"group '{WALL_GROUP}': {exc}") from None
 

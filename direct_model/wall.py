@@ -147,15 +147,22 @@ def wall_family(name: str) -> WallFamily:
 
 
 SPEED_RANGE_NOT_STATED = (0.0, math.inf)      # a law given without the speeds it was measured over
+MAX_ROUGHNESS_DEG = 45.0    # the largest roughness Δγ, degrees: the facet law's rejection keeps ≥ 0.38 of draws
 
 
 class Wall:
-    """What every wall record has beside its family's values (``family``, ``name``, ``speed_range_m_s``): where
-    the law holds, its values by name and the kernels' array."""
+    """What every wall record has beside its family's values (``family``, ``name``, ``speed_range_m_s``,
+    ``roughness_deg``): where the law holds, its values by name and the kernels' array.
+
+    ``roughness_deg`` is the wall's roughness Δγ in degrees, in [0, MAX_ROUGHNESS_DEG] (0, a smooth wall: the
+    default): the spread of the facets a rough wall puts under each hit (docs/model.md §12). The law holds on
+    each facet as on a smooth wall, so the runtimes apply it at run time (a call may override it) and the
+    table's cells do not depend on it."""
 
     family: str
     name: str
     speed_range_m_s: tuple
+    roughness_deg: float
 
     @property
     def speed_range_stated(self) -> bool:
@@ -203,9 +210,10 @@ class Wall:
 
 
 def _record_fields(record) -> None:
-    """Check ``record``'s family, its scalar parameters and speed range (ValueError naming them)."""
+    """Check ``record``'s family, its scalar parameters, speed range and roughness (ValueError naming them)."""
     wall_family(record.family).check({**record.parameters(), **{a: 0 for a in wall_family(record.family).array_names}})
     object.__setattr__(record, "speed_range_m_s", check_speed_range(record.speed_range_m_s))
+    object.__setattr__(record, "roughness_deg", check_roughness(record.roughness_deg))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -228,6 +236,8 @@ class WallMaterial(Wall):
         The incident speeds |V⁻|, m/s, the law was measured or fitted over, low < high (Lashkov's: 50–300 m/s,
         :data:`CORUNDUM_ON_STEEL`); :data:`SPEED_RANGE_NOT_STATED` (0, inf, the default) for a law given without
         one.
+    roughness_deg : float
+        The wall's roughness Δγ, degrees, in [0, MAX_ROUGHNESS_DEG]; 0 (the default): smooth (:class:`Wall`).
     """
 
     k: float = 0.1
@@ -236,6 +246,7 @@ class WallMaterial(Wall):
     name: str = "corundum_on_St3_Lashkov1991"
     family: str = EXPONENTIAL
     speed_range_m_s: tuple = SPEED_RANGE_NOT_STATED
+    roughness_deg: float = 0.0
 
     def __post_init__(self):
         if self.family != EXPONENTIAL:      # the record's fields are the exponential family's
@@ -274,7 +285,7 @@ class TabulatedWall(Wall):
         a_nc at the nodes, one row per speed node, one value per sine node, each in (0, 1].
     q : float
         Friction exponent scale in C_f = exp(q cos γ); finite.
-    name, family, speed_range_m_s
+    name, family, speed_range_m_s, roughness_deg
         As :class:`WallMaterial`'s; ``family`` is ``tabulated``.
     """
 
@@ -285,6 +296,7 @@ class TabulatedWall(Wall):
     name: str = "tabulated"
     family: str = TABULATED
     speed_range_m_s: tuple = SPEED_RANGE_NOT_STATED
+    roughness_deg: float = 0.0
 
     def __post_init__(self):
         if self.family != TABULATED:
@@ -310,15 +322,16 @@ class TabulatedWall(Wall):
 _RECORDS = {EXPONENTIAL: WallMaterial, TABULATED: TabulatedWall}
 
 
-def wall_record(family: str, values: Mapping, name: str, speed_range_m_s=None) -> Wall:
+def wall_record(family: str, values: Mapping, name: str, speed_range_m_s=None, roughness_deg=0.0) -> Wall:
     """The wall of ``family`` with ``values`` by name (scalar parameters and arrays; others ignored), label
-    ``name`` and the speed range it holds over (None: :data:`SPEED_RANGE_NOT_STATED`); ValueError naming an
-    unknown family, a missing value or one out of its range, or a bad range."""
+    ``name``, the speed range it holds over (None: :data:`SPEED_RANGE_NOT_STATED`) and its roughness (degrees);
+    ValueError naming an unknown family, a missing value or one out of its range, a bad range or roughness."""
     law = wall_family(family)
     law.check(values)
     fields = {n: values[n] for n in (*law.parameter_names, *law.array_names)}
     return _RECORDS[law.name](**fields, name=name, family=law.name,
-                              speed_range_m_s=SPEED_RANGE_NOT_STATED if speed_range_m_s is None else speed_range_m_s)
+                              speed_range_m_s=SPEED_RANGE_NOT_STATED if speed_range_m_s is None else speed_range_m_s,
+                              roughness_deg=roughness_deg)
 
 
 def wall_from_array(array, name: str) -> Wall:
@@ -350,6 +363,15 @@ def check_speed_range(value) -> tuple:
         raise ValueError(f"The wall law's 'speed_range_m_s' must be finite with 0 <= low < high (m/s); got "
                          f"{[low, high]!r}.")
     return low, high
+
+
+def check_roughness(value) -> float:
+    """``value`` as a roughness Δγ in degrees, a float in [0, MAX_ROUGHNESS_DEG]; ValueError naming it otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not 0.0 <= value <= MAX_ROUGHNESS_DEG:
+        raise ValueError(f"The wall's 'roughness_deg' must be a number in [0, {MAX_ROUGHNESS_DEG:g}] degrees; got "
+                         f"{value!r}.")
+    return float(value)
 
 
 CORUNDUM_ON_STEEL = WallMaterial(speed_range_m_s=(50.0, 300.0))     # Lashkov measured 50–300 m/s

@@ -39,13 +39,13 @@ Every argument of the NumPy API goes through :mod:`surrogate.validation` (``chec
 from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import U_PER_REBOUND
 from surrogate.grains import Grains, grain_key, grain_of
-from surrogate.kernels import SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
+from surrogate.kernels import MAX_WALL_HITS, SPIN_TOLERANCE, U_PER_DRAW, fill_uniforms, seed_state
 from surrogate.kernels.hit import Hit, Rebounds, empty_rebounds
 from surrogate.sampling import LocalDraws, WallLawRangeWarning, sample_direct, sample_global, sample_local
 from surrogate.table import SurrogateTable, load
 from surrogate.validation import METHODS, check_random_state, mix_cdf
 
-__all__ = ["Grains", "Hit", "LocalDraws", "METHODS", "Rebounds", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID",
+__all__ = ["Grains", "Hit", "LocalDraws", "MAX_WALL_HITS", "METHODS", "Rebounds", "SPIN_TOLERANCE", "STATUS_FAILED", "STATUS_INVALID",
            "STATUS_REBOUNDED", "STATUS_TRAPPED", "SurrogateTable", "U_PER_DRAW", "U_PER_REBOUND", "WallLawRangeWarning",
            "check_random_state", "empty_rebounds", "fill_uniforms", "grain_key", "grain_of", "load", "mix_cdf", "sample_direct",
            "sample_global", "sample_local", "seed_state"]

@@ -78,17 +78,19 @@ def _grain_keys(path: str, n: int) -> np.ndarray:
     return keys
 
 
-def _draw(table, args, shape, omega, keys=None):
-    """(draws in the local frame, V⁺ in m/s lab frame, the path of the draws) at the incident state of ``args``.
+def _draw(table, args, shape, omega, keys=None, roughness=0.0):
+    """(draws in the local frame, V⁺ in m/s lab frame, each draw's path, each draw's wall hits) at the incident
+    state of ``args``.
 
     The lab frame (wall y = 0, normal +Y, V⁻ in the XY plane) is the impact frame of that state, so the local
-    draws are lab-frame vectors. The path is that of :func:`surrogate.kernels.rebound_path`, the same for
-    every draw of one incident state; the table's draws are those of ``sample_local``, the direct model's
+    draws are lab-frame vectors. On a smooth wall the path is that of :func:`surrogate.kernels.rebound_path`, the
+    same for every draw of one incident state; the table's draws are those of ``sample_local``, the direct model's
     those of ``sample_global``. With --grain-key every draw is the grain of that key (one grain over random
     orientations): on the table path its shape, drawn by ``sample_local`` with the key's shape alone (the table
     holds that shape's law over its random proportions), on the direct path its shape, proportions and hand.
     With ``keys`` ((n,) int64, --grain-keys: one grain per draw), the draws of ``sample_global`` with those keys
-    on either path."""
+    on either path. On a rough wall (``roughness`` > 0, degrees) every draw is ``sample_global``'s, each facet hit
+    on its own path."""
     import surrogate
     from surrogate.kernels import PATH_DIRECT, PATH_TABLE, rebound_path
     from surrogate.validation import check_method
@@ -100,29 +102,45 @@ def _draw(table, args, shape, omega, keys=None):
     path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, check_method(args.method))
             if alpha1_is_physical(args.alpha1) and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
     keyed = args.grain_key is not None
+    if keys is None and keyed and (roughness > 0.0 or path == PATH_DIRECT):
+        keys = np.full(args.n, args.grain_key)
+    if roughness > 0.0:
+        hits = _global(table, args, V, half_size, shape, spin, keys, roughness_deg=roughness, method=args.method)
+        return _lab_draws(hits, speed, half_size), hits.V, hits.path, hits.wall_hits
+    ones = np.ones(args.n, dtype=np.int32)
     if path != PATH_DIRECT and keys is None:
         local_shape = surrogate.grain_of(table, [args.grain_key], shape).shape[0] if keyed else shape
         draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, local_shape,
                                        random_state=args.seed, clamp=args.clamp)
-        return draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio), PATH_TABLE
-    if keys is None and keyed:
-        keys = np.full(args.n, args.grain_key)
+        return (draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio),
+                np.full(args.n, PATH_TABLE, dtype=np.int8), ones)
+    hits = _global(table, args, V, half_size, shape, spin, keys, roughness_deg=0.0,
+                   method="direct" if path == PATH_DIRECT else "table")
+    return _lab_draws(hits, speed, half_size), hits.V, np.full(args.n, path, dtype=np.int8), ones
+
+
+def _global(table, args, V, half_size, shape, spin, keys, **kwargs):
+    """``sample_global`` of -n copies of the lab-frame hit V (m/s), its law-range warning left to the summary."""
+    import surrogate
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", surrogate.WallLawRangeWarning)      # the summary says it (_sample)
-        hits = surrogate.sample_global(
-            table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape, random_state=args.seed, omega=spin,
-            method="direct" if path == PATH_DIRECT else "table", clamp=args.clamp, grain_key=keys)
-    V_out, Omega_out, status = hits.V, hits.Omega, hits.status
-    alpha2, beta2, v = rebound_angles(V_out)
-    draws = surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
-                                 omega=Omega_out * (half_size / speed), status=status)
-    return draws, V_out, path
+        return surrogate.sample_global(table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape,
+                                       random_state=args.seed, omega=spin, clamp=args.clamp, grain_key=keys, **kwargs)
+
+
+def _lab_draws(hits, speed, half_size):
+    """The lab-frame rebounds of ``hits`` as local draws (the lab frame is the impact frame)."""
+    import surrogate
+    alpha2, beta2, v = rebound_angles(hits.V)
+    return surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
+                                omega=hits.Omega * (half_size / speed), status=hits.status)
 
 
 def _sample(args) -> int:
     import surrogate
-    from surrogate.kernels import PATH_DIRECT
-    from surrogate.validation import check_omega, check_shape
+    from surrogate.kernels import PATH_DIRECT, PATH_TABLE
+    from direct_model.wall import MAX_ROUGHNESS_DEG
+    from surrogate.validation import check_omega, check_roughness, check_shape
 
     if args.out is not None:
         check_output(args.out, SAMPLES_FILE_TYPE, args.overwrite, inputs=(args.table,))
@@ -132,12 +150,18 @@ def _sample(args) -> int:
     keys = None if args.grain_keys is None else _grain_keys(args.grain_keys, args.n)
     table = surrogate.load(args.table)
     check_shape(table, shape)
-    draws, velocity, path = _draw(table, args, shape, omega, keys)
+    if args.roughness_deg is not None and not 0.0 <= args.roughness_deg <= MAX_ROUGHNESS_DEG:
+        raise ValueError(f"--roughness-deg must be in [0, {MAX_ROUGHNESS_DEG:g}] degrees; got {args.roughness_deg:g}")
+    roughness = check_roughness(table, args.roughness_deg)
+    draws, velocity, paths, wall_hits = _draw(table, args, shape, omega, keys, roughness)
+    n_direct = int(np.count_nonzero(paths == PATH_DIRECT))
+    n_table = int(np.count_nonzero(paths == PATH_TABLE))
+    direct = n_direct == args.n
     speed = args.speed
     grain, fixed = {}, {}
     if args.grain_key is not None:
         kept = surrogate.grain_of(table, [args.grain_key], shape)
-        if path == PATH_DIRECT:        # what the direct path fixes (NaN: fixed proportions, one hand)
+        if direct:        # what the direct path fixes (NaN: fixed proportions, one hand)
             fixed = {k: float(v[0]) for k, v in zip(("ratio_ba", "ratio_cb", "hand"), kept[1:]) if not np.isnan(v[0])}
         grain = {"grain_key": args.grain_key, "grain_shape": kept.shape[0],
                  **{f"grain_{k}": v for k, v in fixed.items()}}
@@ -150,12 +174,20 @@ def _sample(args) -> int:
                         producer="surrogate sample",
                         provenance={"table": str(args.table), "table_config_sha256": table.config_sha256,
                                     "clamp": bool(args.clamp), "method": args.method, "omega_in": omega,
-                                    "path": "direct model" if path else "table", **grain})
+                                    "path": "direct model" if direct else "table" if n_table == args.n else
+                                    f"table {n_table}, direct model {n_direct}", "roughness_deg": roughness,
+                                    **grain})
     counts = ", ".join(f"{name} {int(np.sum(draws.status == code))}" for code, name in STATUS_NAMES.items())
     spin = "" if not np.any(omega) else f", Omega- a/|V-| = ({', '.join(f'{w:g}' for w in omega)})"
     print(f"{args.n} reflected states at alpha1 = {args.alpha1:g} deg, |V-| = {speed:g} m/s{spin}, {label}: {counts}")
-    print(f"  answered by the table {0 if path else args.n}, by the direct model {args.n if path else 0} "
-          f"(method {args.method}); failed {int(np.sum(draws.status == STATUS_FAILED))}")
+    print(f"  answered by the table {n_table}, by the direct model {n_direct} "
+          f"(method {args.method}{'; the last facet hit of each' if roughness > 0.0 else ''}); failed "
+          f"{int(np.sum(draws.status == STATUS_FAILED))}")
+    if roughness > 0.0:
+        again = int(np.count_nonzero(wall_hits > 1))
+        capped = int(np.count_nonzero(wall_hits == surrogate.MAX_WALL_HITS))
+        print(f"  rough wall, roughness {roughness:g} deg: {again} hit the wall again (mean facet hits "
+              f"{wall_hits[wall_hits > 0].mean():.3f}), {capped} reached the cap of {surrogate.MAX_WALL_HITS}")
     if table.wall.outside_speed_range(speed):
         print(f"  outside the speeds the wall law {table.wall.name!r} holds over ({table.wall.speed_range_text()}): "
               f"all {args.n}; the law is applied all the same")
@@ -164,7 +196,7 @@ def _sample(args) -> int:
     elif grain:
         labels = {"ratio_ba": "b/a", "ratio_cb": "c/b", "hand": "hand"}
         kept = (", ".join(f"{labels[k]} {v:.4g}" for k, v in fixed.items()) + ", kept on every hit") if fixed else \
-            "fixed proportions" if path == PATH_DIRECT else "proportions from the shape's law (table path)"
+            "fixed proportions" if direct else "proportions from the shape's law (table path)"
         print(f"  one grain, key {args.grain_key}: {grain['grain_shape']}, {kept}")
     ok = samples.rebounded
     for name, values in (("alpha2 (deg)", np.degrees(draws.alpha2[ok])), ("beta2 (deg)", np.degrees(draws.beta2[ok])),
@@ -265,6 +297,10 @@ def main(argv=None) -> int:
     keyed.add_argument("--grain-keys", default=None, metavar="FILE",
                        help="a text file of N grain keys in [0, 2**63), one per draw (white space between): draw "
                             "i is the grain of key i (sample_global's grain_key)")
+    sample.add_argument("--roughness-deg", type=float, default=None, metavar="DEG",
+                        help="the wall's roughness in degrees, in [0, 45] (default: the table's wall's; 0 a smooth "
+                             "wall): each draw lands on a facet tilted at random and may hit again (docs/model.md "
+                             "§12)")
     sample.add_argument("--clamp", action="store_true",
                         help="with --method table: outside the table's range (but physical), use the law at the "
                              "nearest grid edge")

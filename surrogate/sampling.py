@@ -54,8 +54,8 @@ from surrogate.kernels.wall_hit import METHOD_DIRECT, METHOD_TABLE, rebound_para
 from surrogate.table import SurrogateTable
 from surrogate.validation import (as_rows, check_grain_key,
                                   check_half_size, check_incident, check_interpolation, check_local_states,
-                                  check_method, check_omega, check_out, check_random_state, check_shape,
-                                  check_vectors)
+                                  check_method, check_omega, check_out, check_random_state, check_roughness,
+                                  check_shape, check_vectors)
 
 
 class WallLawRangeWarning(UserWarning):
@@ -121,7 +121,7 @@ def _incident(table: SurrogateTable, velocity, normal, half_size, omega) -> tupl
 
 def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None,
                   clamp: bool = False, interpolation: str = "scaled", out=None, *, omega=None, method: str = "auto",
-                  grain_key=None) -> Rebounds:
+                  grain_key=None, roughness_deg=None) -> Rebounds:
     """Reflected velocities and spins of particles hitting walls, in the global frame: every hit answered, by
     the table where it is valid and by the direct model elsewhere.
 
@@ -167,6 +167,11 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
         shape's law, which the table holds over random proportions (:func:`surrogate.grain_of` gives a key's
         grain). The orientation at impact and the table's draw stay random per hit; the stream advances as
         without keys. None gives the bits of a call without the keyword.
+    roughness_deg : None (default: the table's wall's, ``table.wall.roughness_deg``) or the wall's roughness Δγ in
+        degrees, in [0, 45]: 0 a smooth wall; above, each hit lands on a facet of the wall tilted at random and
+        may hit again (docs/model.md §12; :func:`surrogate.kernels.wall_hit.rough_rebound`), its facets drawn from
+        the hit's own uniforms, so the stream advances as on a smooth wall. A rough wall answers hit by hit
+        (about 3 times the table path's cost per hit; the direct model's for facet hits off the table).
 
     Returns
     -------
@@ -176,7 +181,10 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     ``status == surrogate.STATUS_FAILED``); ``path`` (N,) int8: which path answered the hit (0 the table, 1 the
     direct model; :data:`surrogate.kernels.PATH_TABLE`, :data:`surrogate.kernels.PATH_DIRECT`); ``shape`` (N,)
     int32: the particle's shape, its index in ``table.shapes``; ``n_collisions`` (N,) int32: the direct path's
-    collisions, −1 on the table path. Every check runs before anything is written: on a ValueError ``out`` is
+    collisions, −1 on the table path (on a rough wall: ``path`` and ``n_collisions`` of the last facet hit);
+    ``wall_hits`` (N,) int32: the hits on the wall each took, 1 on a smooth wall, up to
+    :data:`surrogate.MAX_WALL_HITS` on a rough one (a rebound still into the wall then counts as trapped), 0 for
+    a refused hit. Every check runs before anything is written: on a ValueError ``out`` is
     unchanged. Hits whose |V⁻| lies outside the speeds the table's wall law holds over
     (``table.wall.speed_range_m_s``) are answered all the same, with one :class:`WallLawRangeWarning` giving
     their number.
@@ -194,17 +202,17 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     if code == METHOD_DIRECT:
         _check_direct_shapes(table, cdf, shapes)
     scaled = check_interpolation(interpolation)
+    roughness = check_roughness(table, roughness_deg)
     out = check_out(out, n_particles, (V, nrm, a, W))
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     states = chunk_states(check_random_state(random_state), n_particles)
     rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
-                         as_rows(nrm, n_particles),
-                         as_rows(a, n_particles), states, code, out, scaled)
+                         as_rows(nrm, n_particles), as_rows(a, n_particles), states, code, out, scaled, roughness)
     return out
 
 
 def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ellipsoid", random_state=None, *,
-                  omega=None, out=None, grain_key=None) -> Rebounds:
+                  omega=None, out=None, grain_key=None, roughness_deg=None) -> Rebounds:
     """Reflected velocities and spins of particles hitting walls, from the direct model alone, in the caller's
     frame (docs/model.md §10): for any hit to be computed by the model itself, a spinning one or one off the
     table's grid (:func:`sample_global`'s ``method="auto"`` does this where the table does not apply).
@@ -229,6 +237,9 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     grain_key : None or (N,) integers in [0, 2**63), one per particle (as :func:`sample_global`'s): a keyed
         particle's shape (unless given per particle), proportions and hand are its key's
         (:func:`surrogate.grain_of`), its orientation random per hit. The stream advances as without keys.
+    roughness_deg : None (default: the table's wall's) or Δγ in degrees, in [0, 45], as :func:`sample_global`'s:
+        above 0, every facet hit by the direct model, each row's uniforms those :func:`sample_global` would give
+        it (U_PER_DRAW per row; its shape drawn first, as here without roughness).
 
     Returns
     -------
@@ -246,6 +257,7 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     cdf, shapes = check_shape(table, shape, n_particles)
     _check_direct_shapes(table, cdf, shapes)
     keys = check_grain_key(grain_key, n_particles)
+    roughness = check_roughness(table, roughness_deg)
     out = check_out(out, n_particles, (V, nrm, a, W))
     generator = check_random_state(random_state)
     if shapes.size == 0:
@@ -253,6 +265,11 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
         if keys.size:
             shapes = keyed_shapes(cdf, np.zeros(0, dtype=np.int64), keys)
     states = chunk_states(generator, n_particles)
+    if roughness != 0.0:
+        rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V,
+                             W, as_rows(nrm, n_particles), as_rows(a, n_particles), states, METHOD_DIRECT, out, True,
+                             roughness)
+        return out
     direct_rebound_parallel_rng(params, table.shape_arrays, table.model_shapes, shapes, keys, V,
                                 as_rows(W, n_particles), as_rows(nrm, n_particles), as_rows(a, n_particles), states,
                                 out)

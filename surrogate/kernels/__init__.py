@@ -57,10 +57,10 @@ from surrogate.kernels.pipeline import table_rebound_many, table_rebound_many_rn
 from surrogate.kernels.rng import CHUNK_ROWS, chunk_states, fill_uniforms, next_uniform, seed_state
 from surrogate.kernels.table_path import draw_local, table_rebound
 from surrogate.kernels.hit import PATH_DIRECT, PATH_NONE, PATH_TABLE
-from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, SPIN_TOLERANCE, rebound,
-                                        rebound_parallel_rng, rebound_path)
+from surrogate.kernels.wall_hit import (MAX_WALL_HITS, METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, SPIN_TOLERANCE,
+                                        rebound, rebound_parallel_rng, rebound_path)
 
-__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT",
+__all__ = ["BLOCK", "CHUNK_ROWS", "KernelData", "MAX_WALL_HITS", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT",
            "PATH_NONE", "PATH_TABLE", "SPIN_TOLERANCE", "STATUS_INVALID", "U_PER_DRAW", "U_PER_REBOUND",
            "arithmetic", "chunk_states", "direct_rebound", "direct_rebound_parallel_rng", "draw_local",
            "draw_local_parallel", "draw_local_parallel_rng", "draw_velocity", "fill_uniforms", "gather",

@@ -7,6 +7,8 @@ new field here and there (tests/native/test_native_api.py checks the three agree
 function. Read them by name: ``hit.V``, ``rebounds.status``.
 
 Units and frames: V⁺ in m/s and Ω⁺ in rad/s, in the caller's frame; NaN unless the status is STATUS_REBOUNDED.
+On a rough wall (:mod:`surrogate.kernels.facet`) one hit may take several facet hits: ``path`` and
+``n_collisions`` are then those of the last, ``wall_hits`` their number.
 """
 
 from typing import NamedTuple
@@ -30,6 +32,8 @@ class Hit(NamedTuple):
     n_collisions: int   # direct path: the rebound's collisions (up to the trap); table path and invalid: −1
     V: tuple            # V⁺, m/s (3 floats)
     Omega: tuple        # Ω⁺, rad/s (3 floats)
+    wall_hits: int      # the hits on the wall this hit took: 1 on a smooth wall; on a rough one ≥ 1 (re-hits of a
+                        # rebound into the mean wall, up to MAX_WALL_HITS); 0 for STATUS_INVALID
 
 
 class Rebounds(NamedTuple):
@@ -41,11 +45,13 @@ class Rebounds(NamedTuple):
     n_collisions: np.ndarray    # (N,) int32
     V: np.ndarray               # (N, 3) float64, m/s
     Omega: np.ndarray           # (N, 3) float64, rad/s
+    wall_hits: np.ndarray       # (N,) int32
 
 
 # the dtype and trailing shape of each field of Rebounds
 REBOUNDS_ARRAYS = {"status": (np.int8, ()), "path": (np.int8, ()), "shape": (np.int32, ()),
-                   "n_collisions": (np.int32, ()), "V": (np.float64, (3,)), "Omega": (np.float64, (3,))}
+                   "n_collisions": (np.int32, ()), "V": (np.float64, (3,)), "Omega": (np.float64, (3,)),
+                   "wall_hits": (np.int32, ())}
 
 
 def empty_rebounds(n: int) -> Rebounds:
@@ -54,14 +60,16 @@ def empty_rebounds(n: int) -> Rebounds:
 
 
 @numba.njit(inline="always", **JIT)
-def hit(status, path, shape, n_collisions, V, Omega):
+def hit(status, path, shape, n_collisions, V, Omega, wall_hits=1):
     """A :class:`Hit` with its integers as int64 and its vectors as float64 3-tuples: one type whatever the kernel
     that builds it, so every branch of a kernel returns the same type. A STATUS_INVALID hit gets PATH_NONE, shape
-    and n_collisions −1 and NaN vectors whatever is passed (as rbs_rebound writes it)."""
+    and n_collisions −1, NaN vectors and wall_hits 0 whatever is passed (as rbs_rebound writes it)."""
     if status == STATUS_INVALID:
-        return Hit(np.int64(STATUS_INVALID), np.int64(PATH_NONE), np.int64(-1), np.int64(-1), NAN3, NAN3)
+        return Hit(np.int64(STATUS_INVALID), np.int64(PATH_NONE), np.int64(-1), np.int64(-1), NAN3, NAN3,
+                   np.int64(0))
     return Hit(np.int64(status), np.int64(path), np.int64(shape), np.int64(n_collisions),
-               (float(V[0]), float(V[1]), float(V[2])), (float(Omega[0]), float(Omega[1]), float(Omega[2])))
+               (float(V[0]), float(V[1]), float(V[2])), (float(Omega[0]), float(Omega[1]), float(Omega[2])),
+               np.int64(wall_hits))
 
 
 @numba.njit(inline="always", **JIT)
@@ -77,6 +85,7 @@ def put_hit(out, i, h):
     out.path[i] = h.path
     out.shape[i] = h.shape
     out.n_collisions[i] = h.n_collisions
+    out.wall_hits[i] = h.wall_hits
     for k in range(3):
         out.V[i, k] = h.V[k]
         out.Omega[i, k] = h.Omega[k]

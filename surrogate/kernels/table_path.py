@@ -20,7 +20,7 @@ from surrogate.kernels.draw import draw_in_cell, draw_velocity
 from surrogate.kernels.frame import (float3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
                                      uniforms_ok)
 from surrogate.kernels.hit import PATH_TABLE, hit, invalid_hit
-from surrogate.kernels.locate import hint, locate
+from surrogate.kernels.locate import hint, locate_in_shape, mix_shape
 from surrogate.kernels.options import JIT, KERNEL
 
 
@@ -61,10 +61,16 @@ def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
 @numba.njit(**KERNEL)
 def table_rebound_typed(data, mix_cdf, V, n, a, u, scaled):
     """:func:`table_rebound` with V and n 3-tuples of float64, a a float64 and ``scaled`` a bool (module doc)."""
+    return table_shape_rebound(data, mix_shape(mix_cdf, u[0]), V, n, a, u, scaled)
+
+
+@numba.njit(inline="always", **JIT)
+def table_shape_rebound(data, shape, V, n, a, u, scaled):
+    """:func:`table_rebound_typed` of a particle of the table's shape ``shape`` (a valid index; u[0] unused)."""
     if not moves_into_wall(V, n):
         return invalid_hit()
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
-    cell = locate(data, mix_cdf, alpha1, speed, u)
+    cell = locate_in_shape(data, shape, alpha1, speed, u)
     hint(data, cell, u)
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
     ok = particle_ok(n, a) & uniforms_ok(u)

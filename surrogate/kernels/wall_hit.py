@@ -40,26 +40,29 @@ import math
 import numba
 import numpy as np
 
-from data_schema.samples import STATUS_INVALID
+from data_schema.samples import STATUS_FAILED, STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from direct_model.runtime import N_PARAMS, SCRATCH_SIZE, U_PER_REBOUND
+from direct_model.wall import MAX_ROUGHNESS_DEG
 from surrogate.kernels.direct_path import direct_rebound_typed
 from surrogate.kernels.draw import U_PER_DRAW
-from surrogate.kernels.frame import dot, float3, incidence, incidence_angle, particle_ok, uniforms_ok
+from surrogate.kernels.facet import facet_key, facet_normal
+from surrogate.kernels.frame import NAN3, dot, float3, incidence, incidence_angle, particle_ok, uniforms_ok
 from surrogate.kernels.hit import PATH_DIRECT, PATH_NONE, PATH_TABLE, hit, invalid_hit, put_hit
-from surrogate.kernels.grain import keyed_shapes, keyed_uniforms
+from surrogate.kernels.grain import NO_KEY, grain_shape, keyed_shapes, keyed_uniforms
 from surrogate.kernels.layout import AXIS_GRID
 from surrogate.kernels.locate import SHAPE_FROM_MIX, mix_shape
 from surrogate.kernels.memory import stack_scratch
 from surrogate.kernels.checks import check_keys, check_shapes
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.pipeline import no_uniforms, run_blocks, table_rebound_uniforms
-from surrogate.kernels.rng import CHUNK_ROWS
-from surrogate.kernels.table_path import table_rebound_typed
+from surrogate.kernels.rng import CHUNK_ROWS, grain_uniform
+from surrogate.kernels.table_path import table_rebound_typed, table_shape_rebound
 
 METHOD_AUTO, METHOD_TABLE, METHOD_DIRECT = 0, 1, 2
 # largest |Ω⁻| a/|V⁻| the table answers under METHOD_AUTO: where the table's law and the direct model's with
 # that spin stay within classifier accuracy 0.52, measured (docs/design/spin_tolerance.md; 0.0015 fails)
 SPIN_TOLERANCE = 0.001
+MAX_WALL_HITS = 10      # facet hits of one hit on a rough wall; a rebound still into the mean wall then is trapped
 
 
 @numba.njit(inline="always", **JIT)
@@ -108,7 +111,7 @@ def rebound_path(data, V, omega, n, a, method):
 
 @numba.njit(**KERNEL)
 def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method=METHOD_AUTO, scaled=True,
-            key=None):
+            key=None, roughness_deg=0.0):
     """One hit answered by its path (:func:`rebound_path`): a :class:`surrogate.kernels.hit.Hit` (status, path,
     the particle's shape in the table, the direct path's collisions, V⁺ in m/s and Ω⁺ in rad/s in the caller's
     frame; read it by name, ``hit.V``).
@@ -128,12 +131,18 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
         particle's grain key, an int ≥ 0 (:mod:`surrogate.kernels.grain`: its shape on either path, and on the
         direct path its proportions and hand, are the key's, whatever u[0], u[4], u[5], u[6] are; the 13
         uniforms are still all checked).
+    roughness_deg : the wall's roughness Δγ, degrees, in [0, MAX_ROUGHNESS_DEG]: 0 (the default) a smooth wall
+        (the hit above, bit for bit); above, :func:`rough_rebound`'s facet hits.
 
     Status STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED (direct path only) or STATUS_INVALID (bad input,
     a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0; then path PATH_NONE);
     NaN vectors unless rebounded.
     """
     V, omega, n, a, scaled = float3(V), float3(omega), float3(n), float(a), scaled != 0
+    if roughness_deg != 0.0:
+        return _rough_on_stack(data, params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX,
+                               NO_KEY if key is None else np.int64(key), V, omega, n, a, u, scaled, np.int64(method),
+                               float(roughness_deg))
     path = rebound_path(data, V, omega, n, a, np.int64(method))
     if key is not None:
         return _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path,
@@ -182,6 +191,69 @@ def _direct_path(params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n
     return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega)
 
 
+@numba.njit(**KERNEL)
+def _rough_on_stack(data, params, shape_arrays, model_shapes, mix_cdf, shape, key, V, omega, n, a, u, scaled, method,
+                    roughness_deg):
+    """:func:`rough_rebound`, its scratch space in this kernel's stack frame."""
+    return rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key, V, omega, n, a, u, scaled,
+                         method, roughness_deg, stack_scratch(SCRATCH_SIZE), stack_scratch(U_PER_DRAW))
+
+
+@numba.njit(inline="always", **JIT)
+def rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key, V, omega, n, a, u, scaled, method,
+                  roughness_deg, scratch, facet_u):
+    """One hit on a rough wall of roughness Δγ = ``roughness_deg`` (> 0, degrees; docs/model.md §12): a
+    :class:`surrogate.kernels.hit.Hit` whose ``wall_hits`` counts its facet hits.
+
+    The hit on the mean wall (unit normal n) is checked as :func:`rebound`'s; its shape is ``shape`` (the table's
+    index), or with SHAPE_FROM_MIX the grain key's (``key`` ≥ 0) or the mix's with u[0]. Then, up to
+    MAX_WALL_HITS times: a facet under the particle (:func:`surrogate.kernels.facet.facet_normal`), the hit on it
+    along its own path (:func:`rebound_path` with the facet's normal and ``method``: the table where it holds,
+    the direct model elsewhere, a grain key's slots as :func:`rebound`'s), and, if the rebound still moves into
+    the mean wall (V⁺·n ≤ 0), the next facet hit from that rebound's V⁺, Ω⁺, of the same shape. The first facet
+    hit takes u; the facets and every later hit take keyed uniforms of the hit's facet key
+    (:mod:`surrogate.kernels.facet`). A rebound still into the mean wall after MAX_WALL_HITS facet hits is
+    STATUS_TRAPPED; a facet not found (probability below 1e-13) STATUS_FAILED. ``path`` and ``n_collisions``
+    are the last facet hit's. ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,) float64: work space."""
+    path = rebound_path(data, V, omega, n, a, method)
+    if (path == PATH_NONE or key < NO_KEY or not uniforms_ok(u) or not 0.0 < roughness_deg <= MAX_ROUGHNESS_DEG
+            or shape < SHAPE_FROM_MIX or shape >= mix_cdf.shape[0]):
+        return invalid_hit()
+    if shape == SHAPE_FROM_MIX:
+        shape = grain_shape(mix_cdf, key) if key >= 0 else mix_shape(mix_cdf, u[0])
+    facets = facet_key(u)
+    slot = 0
+    for k in range(U_PER_DRAW):
+        facet_u[k] = u[k]
+    result = invalid_hit()
+    for wall_hits in range(1, MAX_WALL_HITS + 1):
+        found, facet, slot = facet_normal(V, n, roughness_deg, facets, slot)
+        if not found:
+            return hit(STATUS_FAILED, path, shape, -1, NAN3, NAN3, wall_hits)
+        path = rebound_path(data, V, omega, facet, a, method)
+        if key >= 0:
+            keyed_uniforms(key, facet_u, path == PATH_DIRECT, facet_u)
+        result = _shape_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, facet, a, facet_u,
+                                scaled, path, scratch)
+        if result.status != STATUS_REBOUNDED or dot(result.V, n) > 0.0:
+            return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega, wall_hits)
+        V, omega = result.V, result.Omega
+        for k in range(U_PER_DRAW):
+            facet_u[k] = grain_uniform(facets, slot + k)
+        slot += U_PER_DRAW
+    return hit(STATUS_TRAPPED, result.path, shape, result.n_collisions, NAN3, NAN3, MAX_WALL_HITS)
+
+
+@numba.njit(inline="always", **JIT)
+def _shape_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n, a, u, scaled, path, scratch):
+    """:func:`rebound_typed` of a particle of the table's shape ``shape`` (u[0] unused)."""
+    if path == PATH_TABLE:
+        return table_shape_rebound(data, shape, V, n, a, u, scaled)
+    if path == PATH_DIRECT:
+        return _direct_path(params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n, a, u, scratch)
+    return invalid_hit()
+
+
 @numba.njit(**JIT)
 def _auto_paths(data, V, omega, n, a, lo, hi, path):
     """path[lo:hi] under METHOD_AUTO (:func:`_auto_path`), omega with one row per row of V or one for all.
@@ -197,7 +269,7 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 @numba.njit(parallel=True, **JIT)
 def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
-                         method, out, scaled=True):
+                         method, out, scaled=True, roughness_deg=0.0):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
     a (N,), on all threads, into ``out`` (:class:`surrogate.kernels.hit.Rebounds` of N rows: row i is the
     :class:`surrogate.kernels.hit.Hit` of hit i).
@@ -217,24 +289,33 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     (:func:`surrogate.kernels.pipeline.table_rebound_uniforms`). Rows are not checked here
     (:func:`surrogate.sample_global` checks them first): a row with a bad input gets :func:`rebound`'s record of
     a refused hit (STATUS_INVALID, PATH_NONE). A method code outside the three is a ValueError.
+
+    ``roughness_deg`` (degrees): 0, the smooth wall above; > 0, every row is :func:`rough_rebound`'s with the
+    same row's uniforms (one by one, without the table's pipeline), outside [0, MAX_ROUGHNESS_DEG] a ValueError.
     """
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
+    if not 0.0 <= roughness_deg <= MAX_ROUGHNESS_DEG:
+        raise ValueError("The roughness must be in [0, MAX_ROUGHNESS_DEG] degrees.")
     check_shapes(shapes, V.shape[0], mix_cdf.shape[0])
     check_keys(keys, V.shape[0])
     row_shapes = keyed_shapes(mix_cdf, shapes, keys)     # a copy of shapes without keys
     rows = V.shape[0]
     for j in numba.prange(states.shape[0]):
         _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, states[j],
-                    method, out, scaled, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
+                    method, out, scaled, roughness_deg, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
 
 
 @numba.njit(**JIT)
 def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state, method,
-                out, scaled, lo, hi):
+                out, scaled, roughness_deg, lo, hi):
     """Rows [lo, hi) of :func:`rebound_parallel_rng` along their paths (one chunk, its uniforms from a copy of
     ``state``). Called, not inlined: numba's parallel passes then see one call in the loop, not the chunk's work
     (docs/design/test_time.md)."""
+    if roughness_deg != 0.0:
+        _rough_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state,
+                     method, out, scaled, roughness_deg, lo, hi)
+        return
     path = out.path
     if method == METHOD_AUTO:
         _auto_paths(data, V, omega, n, a, lo, hi, path)
@@ -248,9 +329,9 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
                    out.V[lo:hi], out.Omega[lo:hi], out.status[lo:hi], out.shape[lo:hi], scaled)
     for i in range(lo, hi):
         if path[i] == PATH_TABLE:       # the pipeline's rows completed as rebound's records (hit.hit)
-            out.n_collisions[i] = -1
+            out.n_collisions[i], out.wall_hits[i] = -1, 1
             if out.status[i] == STATUS_INVALID:
-                path[i], out.shape[i] = PATH_NONE, -1
+                path[i], out.shape[i], out.wall_hits[i] = PATH_NONE, -1, 0
     if n_table == hi - lo:
         return
     keyed = keys.shape[0] > 0
@@ -270,3 +351,21 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
                 params, shape_arrays, model_shapes, mix_cdf, shape, (V[i, 0], V[i, 1], V[i, 2]),
                 (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo], scratch)
         put_hit(out, i, result)
+
+
+@numba.njit(**JIT)
+def _rough_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state, method,
+                 out, scaled, roughness_deg, lo, hi):
+    """Rows [lo, hi) of :func:`rebound_parallel_rng` on a rough wall: :func:`rough_rebound` row by row, with the
+    uniforms the table's pipeline would give the rows."""
+    u = table_rebound_uniforms(state.copy(), hi - lo)
+    scratch, facet_u = np.empty(SCRATCH_SIZE), np.empty(U_PER_DRAW)
+    last_omega = omega.shape[0] - 1
+    for i in range(lo, hi):
+        w = min(i, last_omega)
+        shape = row_shapes[i] if row_shapes.shape[0] > 0 else SHAPE_FROM_MIX
+        key = keys[i] if keys.shape[0] > 0 else NO_KEY
+        put_hit(out, i, rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
+                                      (V[i, 0], V[i, 1], V[i, 2]), (omega[w, 0], omega[w, 1], omega[w, 2]),
+                                      (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo], scaled, method, roughness_deg,
+                                      scratch, facet_u))

@@ -25,6 +25,7 @@ the ``default`` preset, and the published corundum-on-steel wall law)::
     name = "corundum_on_St3_Lashkov1991"
     speed_range_m_s = [50.0, 300.0]   # the |V⁻| the law was measured over (not stated for your own k, p, q
                                       # unless given): the runtimes count the hits answered outside it
+    roughness_deg = 0.0               # the wall's roughness Δγ, degrees, in [0, 45]: 0 smooth (docs/model.md §12)
     # or law = "tabulated": q, contact_speed_m_s = [...], contact_sine = [0.0, ..., 1.0], and
     # restitution = [[a_nc per sine node], one row per speed node] (docs/model.md §4)
 
@@ -56,8 +57,8 @@ from data_schema.table import MAX_SPEED_RATIO, SPEED_GRID_RANGE, TableResolution
 from tablegen.tabulation.resolution import MIN_PARTICLES_PER_CELL, resolution_for
 from direct_model.registry import FAMILIES, ConvexPolyhedron, built_in_shape
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa
-from direct_model.wall import (CORUNDUM_ON_STEEL, EXPONENTIAL, WALL_FAMILIES, Wall, check_speed_range, wall_family,
-                               wall_record)
+from direct_model.wall import (CORUNDUM_ON_STEEL, EXPONENTIAL, MAX_ROUGHNESS_DEG, WALL_FAMILIES, Wall,
+                               check_roughness, check_speed_range, wall_family, wall_record)
 from tablegen.tabulation.config_error import ConfigError
 from tablegen.tabulation.shape_config import parse_shape_sections
 
@@ -149,6 +150,7 @@ class BuildConfig:
             f"name = {json.dumps(w.name)}",
             *([f"speed_range_m_s = [{w.speed_range_m_s[0]!r}, {w.speed_range_m_s[1]!r}]"]
               if w.speed_range_stated else []),
+            *([f"roughness_deg = {w.roughness_deg!r}"] if w.roughness_deg != 0.0 else []),
             "",
             *(_grain_toml(g) for g in self.grains),
         ])
@@ -201,7 +203,7 @@ CONFIG_KEYS = {
     "grid": {"alpha1_deg", "speed_m_s", "shapes"},
     "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
     "table": {"resolution"},
-    "wall": {"law", *WALL_VALUE_KEYS, "name", "speed_range_m_s"},
+    "wall": {"law", *WALL_VALUE_KEYS, "name", "speed_range_m_s", "roughness_deg"},
 }
 GRAINS_SECTION = "shapes"      # [shapes.NAME]: the user's grains; their keys are shape_config's
 
@@ -371,8 +373,14 @@ def _wall(raw: dict, source: str) -> Wall:
         except ValueError:
             raise ConfigError(f"{source}: 'wall.speed_range_m_s' must be finite with 0 <= low < high (m/s); "
                               f"got {speed_range!r}") from None
+    roughness = raw.get("roughness_deg", 0.0)
     try:
-        return wall_record(family.name, values, name, speed_range)
+        roughness = check_roughness(roughness)
+    except ValueError:
+        raise ConfigError(f"{source}: 'wall.roughness_deg' must be a number in [0, {MAX_ROUGHNESS_DEG:g}] degrees "
+                          f"(0: a smooth wall); got {roughness!r}") from None
+    try:
+        return wall_record(family.name, values, name, speed_range, roughness)
     except ValueError as exc:       # a tabulated law's nodes or values: the message names the parameter
         raise ConfigError(f"{source}: [wall]: {exc}") from None
 

@@ -95,6 +95,10 @@ BAD = [
     ("[wall]\nspeed_range_m_s = [-1.0, 50.0]", "wall.speed_range_m_s"),
     ("[wall]\nspeed_range_m_s = [1.0, inf]", "wall.speed_range_m_s"),
     ("[wall]\nspeed_range_m_s = \"fast\"", "wall.speed_range_m_s"),
+    ("[wall]\nroughness_deg = -1.0", "wall.roughness_deg"),
+    ("[wall]\nroughness_deg = 46", "wall.roughness_deg"),
+    ("[wall]\nroughness_deg = nan", "wall.roughness_deg"),
+    ("[wall]\nroughness_deg = true", "wall.roughness_deg"),
 ]
 
 
@@ -131,6 +135,16 @@ def test_speed_grids_the_runtime_cannot_serve_name_the_allowed_range(tmp_path, c
     for word in words:
         assert word in err[0], err[0]
     assert not (tmp_path / "t.h5").exists()
+
+
+def test_a_rough_wall_reads_and_round_trips_and_a_smooth_one_writes_no_roughness():
+    """roughness_deg (degrees) is read with any law; a smooth wall's configuration text has no roughness line, so a
+    smooth table's configuration, hash and fingerprint are those before rough walls."""
+    config = parse_config("[wall]\nroughness_deg = 7.5\n")
+    assert config.wall.roughness_deg == 7.5 and config.wall.speed_range_m_s == (50.0, 300.0)
+    assert "roughness_deg = 7.5" in config.to_toml() and parse_config(config.to_toml()) == config
+    assert "roughness" not in parse_config("").to_toml()
+    assert parse_config("[wall]\nroughness_deg = 0\n").to_toml() == parse_config("").to_toml()
 
 
 def test_a_tabulated_wall_law_reads_checks_and_round_trips():
