@@ -46,11 +46,12 @@ and prints the cost in ns per reflected state:
     and on a realistic mix where half the hits spin (as in OpenFOAM's ``hopperRebound``). Spinning
     states: the states of (a) with Ω⁻ of random direction and |Ω⁻|a/|V⁻| uniform over 0.3–1.2 (about
     hopperRebound's spinning hits: median 0.75, 90 % below 1.16); their count is N_SPIN = min(N, 20000),
-    since each costs microseconds.
+    since each costs microseconds. Last, ``"auto"`` on rough walls of Δγ = 5°, 10°, 20° (docs/model.md §12;
+    the states of (a), no spin): hit by hit, each facet hit on its own path, the re-hits by the direct model.
 
 Then it prints the ratios (c)/(b), (b)/(d), (c)/(b-block), (b-block)/(d), rebound over table_rebound,
 (e)'s auto over table,
-spinning and the 50 % mix over table,
+spinning and the 50 % mix over table, each rough wall over table,
 and the runtime's targets, each with 'met' or 'NOT met': (b) ≤ 150 ns per
 state per core, (b-block) ≤ 100 ns and ≤ 3 × (d), a deterministic
 restitution law. The exit code does not depend on the targets.
@@ -133,6 +134,7 @@ particles_per_cell = {particles}
 DIRECT_ALPHA1 = (20.0, 40.0, 60.0, 80.0)   # midpoints of four equal bins of 10–90°
 SPIN_RATIO = (0.3, 1.2)                    # |Ω⁻|a/|V⁻| of the spinning states of (e)
 N_SPIN = 20000                             # spinning states of (e) at most
+ROUGHNESS_DEG = (5.0, 10.0, 20.0)       # (e)'s rough walls, degrees
 # the runtime's targets (the same as the C library's, benchmarks/bench_native.py)
 TARGET_KERNEL_NS = 150.0                   # (b) per particle at most, ns per state per core
 TARGET_BLOCK_NS = 100.0                    # (b-block) at most
@@ -577,6 +579,14 @@ def main(argv=None) -> int:
                                                               random_state=SEED, omega=omega),
                note=f"{np.mean(paths == PATH_DIRECT):.3f} of the hits answered by the direct model", states=m_spin)
 
+    for roughness in ROUGHNESS_DEG:
+        hits = surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED, roughness_deg=roughness)
+        record(f"e_rough{roughness:g}", f"(e) auto on a rough wall, {roughness:g} deg, 1 thread", 1,
+               lambda: surrogate.sample_global(table, V, nrm, a, shape=mix, random_state=SEED,
+                                               roughness_deg=roughness),
+               note=f"{np.mean(hits.wall_hits > 1):.3f} of the hits hit again, "
+                    f"{np.mean(hits.path == PATH_DIRECT):.3f} ended on the direct model")
+
     direct_ns, direct_rows = direct_cost(st["speed_bins"], min_time, repeats)
     cpu_direct = float(np.mean([r["cpu_over_wall"] for r in direct_rows]))
     rows["c"] = {"key": "c", "label": "(c) direct model simulate('mix'), mean", "n": sum(r["n"] for r in direct_rows),
@@ -605,7 +615,9 @@ def main(argv=None) -> int:
               "spinning_us": rows["e_spin"]["ns_per_state"] / 1e3, "mix_us": rows["e_mix"]["ns_per_state"] / 1e3,
               "auto_over_table_cpu": rows["e_auto"]["cpu_ns_per_state"] / rows["e_table"]["cpu_ns_per_state"],
               "spinning_cpu_us": rows["e_spin"]["cpu_ns_per_state"] / 1e3,
-              "mix_cpu_us": rows["e_mix"]["cpu_ns_per_state"] / 1e3}
+              "mix_cpu_us": rows["e_mix"]["cpu_ns_per_state"] / 1e3,
+              **{f"rough{r:g}_over_table": rows[f"e_rough{r:g}"]["ns_per_state"] / rows["e_table"]["ns_per_state"]
+                 for r in ROUGHNESS_DEG}}
     targets = {"kernel_ns": bool(b <= TARGET_KERNEL_NS), "block_ns": bool(bb <= TARGET_BLOCK_NS),
                "block_over_bounce": bool(bb / d <= TARGET_BLOCK_OVER_BOUNCE)}
     print(f"\ntrapped fraction drawn: (a) {trapped_api:.4f}, (b) {trapped_b:.4f}")
@@ -631,6 +643,9 @@ def main(argv=None) -> int:
           f"{ratios['spinning_us']:.3g} us per spinning hit (CPU {ratios['spinning_cpu_us']:.3g} us)")
     print(f"  (e) auto half spinning / table, no spin       {ratios['mix_over_table']:12.4g}   "
           f"{ratios['mix_us']:.3g} us per hit (CPU {ratios['mix_cpu_us']:.3g} us)")
+    for r in ROUGHNESS_DEG:
+        print(f"  (e) auto, rough wall {r:2g} deg / table, smooth   {ratios[f'rough{r:g}_over_table']:12.4g}   "
+              f"{rows[f'e_rough{r:g}']['ns_per_state']:.4g} ns per hit")
     print("\nTargets are figures only: the exit code does not depend on them. Ratios and targets use the wall\n"
           "times (ns/state). cpu/wall = process CPU time / wall time of the best run: about the thread count\n"
           "on an idle machine; lower, other work took the CPU and the wall figures are pessimistic (cpu ns/st,\n"

@@ -50,7 +50,7 @@ from surrogate.kernels.layout import frozen
 from surrogate.kernels.locate import mix_shapes
 from surrogate.kernels.parallel import draw_local_parallel_rng
 from surrogate.kernels.rng import chunk_states
-from surrogate.kernels.wall_hit import METHOD_DIRECT, METHOD_TABLE, rebound_parallel_rng
+from surrogate.kernels.wall_hit import METHOD_DIRECT, METHOD_TABLE, rebound_parallel_rng, rough_rebound_parallel_rng
 from surrogate.table import SurrogateTable
 from surrogate.validation import (as_rows, check_grain_key,
                                   check_half_size, check_incident, check_interpolation, check_local_states,
@@ -206,8 +206,10 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     out = check_out(out, n_particles, (V, nrm, a, W))
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     states = chunk_states(check_random_state(random_state), n_particles)
-    rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
-                         as_rows(nrm, n_particles), as_rows(a, n_particles), states, code, out, scaled, roughness)
+    answer = rough_rebound_parallel_rng if roughness != 0.0 else rebound_parallel_rng
+    answer(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
+           as_rows(nrm, n_particles), as_rows(a, n_particles), states, code, out, scaled,
+           *((roughness,) if roughness != 0.0 else ()))
     return out
 
 
@@ -266,9 +268,9 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
             shapes = keyed_shapes(cdf, np.zeros(0, dtype=np.int64), keys)
     states = chunk_states(generator, n_particles)
     if roughness != 0.0:
-        rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V,
-                             W, as_rows(nrm, n_particles), as_rows(a, n_particles), states, METHOD_DIRECT, out, True,
-                             roughness)
+        rough_rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes,
+                                   keys, V, as_rows(W, n_particles), as_rows(nrm, n_particles),
+                                   as_rows(a, n_particles), states, METHOD_DIRECT, out, True, roughness)
         return out
     direct_rebound_parallel_rng(params, table.shape_arrays, table.model_shapes, shapes, keys, V,
                                 as_rows(W, n_particles), as_rows(nrm, n_particles), as_rows(a, n_particles), states,

@@ -24,11 +24,14 @@ def test_bench_sampler_reports_every_figure(small_table_path, tmp_path, capsys):
     figures = json.loads(out.read_text())
     results = figures["results"]
     for key in ("a_all", "a_1", "a_kernel_1", "b", "b_rebound", "b_views", "b_predrawn", "b_block", "b_rng", "c", "d",
-                "e_table", "e_auto", "e_spin", "e_mix"):
+                "e_table", "e_auto", "e_spin", "e_mix", "e_rough5", "e_rough10", "e_rough20"):
         assert results[key]["ns_per_state"] > 0, key
     assert figures["ratios"]["mix_over_table"] == pytest.approx(results["e_mix"]["ns_per_state"]
                                                                 / results["e_table"]["ns_per_state"])
     assert results["e_spin"]["note"].startswith("1.000 of the hits") and results["e_mix"]["note"].startswith("0.500")
+    assert figures["ratios"]["rough10_over_table"] == pytest.approx(results["e_rough10"]["ns_per_state"]
+                                                                    / results["e_table"]["ns_per_state"])
+    assert float(results["e_rough20"]["note"].split()[0]) > 0       # some hits on a rough wall hit again
     b, c, d = (results[k]["ns_per_state"] for k in ("b", "c", "d"))
     assert figures["ratios"]["direct_over_kernel"] == pytest.approx(c / b)
     assert figures["ratios"]["kernel_over_bounce"] == pytest.approx(b / d)

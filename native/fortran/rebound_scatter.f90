@@ -1,4 +1,4 @@
-! rebound_scatter.f90: Fortran bindings (iso_c_binding) to the native runtime of rebound-scatter, version 1.0.
+! rebound_scatter.f90: Fortran bindings (iso_c_binding) to the native runtime of rebound-scatter, version 1.2.
 !
 ! The C functions of rebound_scatter.h, called directly, and bind(c) derived types mirroring its records; units,
 ! frames and statuses as there (docs/native.md): V in m/s, Omega in rad/s, n a unit normal into the gas, a the
@@ -23,13 +23,17 @@ module rebound_scatter
 
   ! the version of this module (RBS_VERSION_NUMBER of C; Fortran names are case-blind, so rbs_version_number()
   ! is the library's function): compare with rbs_version_number()
-  integer(c_int), parameter :: RBS_VERSION_MAJOR = 1, RBS_VERSION_MINOR = 0, RBS_VERSION_PATCH = 0
+  integer(c_int), parameter :: RBS_VERSION_MAJOR = 1, RBS_VERSION_MINOR = 2, RBS_VERSION_PATCH = 0
   integer(c_int), parameter :: RBS_MODULE_VERSION_NUMBER = RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 &
                                                            + RBS_VERSION_PATCH
   integer(c_int), parameter :: RBS_TABLE_FORMAT_MAJOR = 4, RBS_U_PER_DRAW = 13, RBS_TABLE_MAX_SHAPES = 4096
   integer(c_int), parameter :: RBS_SHAPE_NAME_SIZE = 65, RBS_BLOCK = 32, RBS_LOCAL_SIZE = 6
   real(c_double), parameter :: RBS_NORMAL_TOLERANCE = 1e-6_c_double, RBS_SPIN_TOLERANCE = 0.001_c_double
   integer(c_int64_t), parameter :: RBS_NO_KEY = -1_c_int64_t
+  ! a rough wall (rbs_options%roughness_deg, rbs_result%wall_hits): the largest roughness (degrees), the default
+  ! roughness (the table's wall's), the most facet hits of one hit
+  real(c_double), parameter :: RBS_MAX_ROUGHNESS_DEG = 45.0_c_double, RBS_ROUGHNESS_OF_TABLE = -1.0_c_double
+  integer(c_int), parameter :: RBS_MAX_WALL_HITS = 10
 
   ! rbs_status: the one status space of every call and every hit
   integer(c_int), parameter :: RBS_OK = 0, RBS_TRAPPED = 1, RBS_FAILED = 2, RBS_INVALID = -1, RBS_ERR_IO = -2, &
@@ -67,6 +71,7 @@ module rebound_scatter
     integer(c_size_t) :: size = 0
     integer(c_int) :: method = RBS_METHOD_AUTO
     integer(c_int) :: interpolation = RBS_INTERPOLATION_SCALED
+    real(c_double) :: roughness_deg = RBS_ROUGHNESS_OF_TABLE  ! degrees: < 0 the table's, 0 smooth, (0, 45] rough
   end type rbs_options
 
   ! what a hit did (rbs_result; NaN vectors unless the status is RBS_OK)
@@ -76,6 +81,7 @@ module rebound_scatter
     integer(c_int) :: shape = -1                   ! the table's shape index (0-based)
     integer(c_int) :: n_collisions = -1            ! direct path: collisions of the rebound; table path: -1
     real(c_double) :: V(3) = 0.0_c_double, Omega(3) = 0.0_c_double
+    integer(c_int) :: wall_hits = 0                ! hits on the wall: 1 smooth, 1 to RBS_MAX_WALL_HITS rough
   end type rbs_result
 
   ! many hits from the table (rbs_hits): c_loc of V(3, count), n(3, count), a(count), u(RBS_U_PER_DRAW, count)
@@ -127,6 +133,7 @@ module rebound_scatter
     integer(c_int) :: n_contact_sines = 0
     type(c_ptr) :: contact_sine = c_null_ptr              ! |v_c-|/|V_c-| nodes, from 0 to 1
     type(c_ptr) :: restitution = c_null_ptr               ! a_nc at the nodes
+    real(c_double) :: roughness_deg = 0.0_c_double        ! the wall's roughness, degrees; 0: smooth
   end type rbs_wall_info
 
   ! one grain of a table's mix (rbs_grain): its table shape index (0-based), the b/a, c/b and hand the direct path

@@ -1,5 +1,5 @@
 /*
- * rebound_scatter.h: the native runtime of rebound-scatter, version 1.0.
+ * rebound_scatter.h: the native runtime of rebound-scatter, version 1.2.
  *
  * A C library that answers a particle's hit on a wall with its reflected state, for non-spherical particles
  * spinning or not, with the same law and the same bits as the numba kernels of the Python package `surrogate`
@@ -98,7 +98,7 @@ extern "C" {
 #endif
 
 #define RBS_VERSION_MAJOR 1
-#define RBS_VERSION_MINOR 1
+#define RBS_VERSION_MINOR 2
 #define RBS_VERSION_PATCH 0
 /* MAJOR · 1 000 000 + MINOR · 1 000 + PATCH, as rbs_version_number() returns it for the library linked */
 #define RBS_VERSION_NUMBER (RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 + RBS_VERSION_PATCH)
@@ -114,6 +114,9 @@ extern "C" {
  * and the direct model's with that spin stay within classifier accuracy 0.52 (docs/design/spin_tolerance.md). */
 #define RBS_SPIN_TOLERANCE 0.001
 #define RBS_NO_KEY (-1)             /* rbs_hit.grain_key of a particle without a grain key */
+#define RBS_MAX_ROUGHNESS_DEG 45.0  /* the largest wall roughness Δγ, degrees (direct_model.wall.MAX_ROUGHNESS_DEG) */
+#define RBS_ROUGHNESS_OF_TABLE (-1.0)   /* rbs_options.roughness_deg: the table's wall's roughness */
+#define RBS_MAX_WALL_HITS 10        /* the most facet hits of a hit (surrogate.kernels.wall_hit.MAX_WALL_HITS) */
 
 /* ---------------------------------------------------------------- status and enumerations */
 
@@ -196,8 +199,12 @@ typedef struct rbs_options {
     size_t size;            /* sizeof(rbs_options) */
     int method;             /* rbs_method; RBS_METHOD_AUTO */
     int interpolation;      /* rbs_interpolation of the table path; RBS_INTERPOLATION_SCALED */
+    /* since 1.2: the wall's roughness Δγ, degrees (rbs_rebound, "Rough walls"): < 0 (the default,
+       RBS_ROUGHNESS_OF_TABLE; also a record too small to hold it) the table's wall's (rbs_wall_info.roughness_deg),
+       0 a smooth wall, (0, RBS_MAX_ROUGHNESS_DEG] a rough one; NaN or above RBS_MAX_ROUGHNESS_DEG: RBS_INVALID */
+    double roughness_deg;
 } rbs_options;
-#define RBS_OPTIONS_INIT {sizeof(rbs_options), RBS_METHOD_AUTO, RBS_INTERPOLATION_SCALED}
+#define RBS_OPTIONS_INIT {sizeof(rbs_options), RBS_METHOD_AUTO, RBS_INTERPOLATION_SCALED, RBS_ROUGHNESS_OF_TABLE}
 
 /* What a hit did (written up to its size; NaN vectors unless the status is RBS_OK). */
 typedef struct rbs_result {
@@ -209,8 +216,10 @@ typedef struct rbs_result {
     int n_collisions;       /* direct path: collisions of the rebound (up to the trap); table path: −1 */
     double V[3];            /* reflected velocity V⁺, m/s, global frame */
     double Omega[3];        /* reflected angular velocity Ω⁺, rad/s, global frame */
+    int wall_hits;          /* since 1.2: the hits on the wall this hit took: 1 on a smooth wall, 1 to RBS_MAX_WALL_HITS
+                               on a rough one (its facet hits); 0 for RBS_INVALID */
 } rbs_result;
-#define RBS_RESULT_INIT {sizeof(rbs_result), RBS_INVALID, RBS_PATH_NONE, -1, -1, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}}
+#define RBS_RESULT_INIT {sizeof(rbs_result), RBS_INVALID, RBS_PATH_NONE, -1, -1, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0}
 
 /* ---------------------------------------------------------------- every wall hit: call this first */
 
@@ -224,15 +233,27 @@ typedef struct rbs_result {
  * on either path and, on the direct path, u[4], u[5] (b/a, c/b) and u[6] (the hand) by the key's; the hit still
  * takes RBS_U_PER_DRAW uniforms, all checked. Writes *result up to result->size and returns result->status:
  * RBS_OK, RBS_TRAPPED, RBS_FAILED or RBS_INVALID (a NULL table, mix, hit or result, a mix of another table, a
- * record too small, an unknown method or interpolation, a hit's input out of range). The direct path costs
- * microseconds, the table path a fraction of one. Thread-safe. */
+ * record too small, an unknown method or interpolation, a roughness out of range, a hit's input out of range). The
+ * direct path costs microseconds, the table path a fraction of one. Thread-safe.
+ *
+ * Rough walls (docs/model.md §12; surrogate.kernels.wall_hit.rough_rebound): with a roughness Δγ > 0 (the table's
+ * wall's, or options->roughness_deg) the particle lands on a facet, the mean wall (normal n) tilted by Gaussian
+ * angles of sd Δγ in the impact frame, drawn as seen along V⁻ (the shadow effect; surrogate.kernels.facet). The
+ * facet hit is answered along its own path (as above, with the facet's normal and options->method); if its rebound
+ * still moves into the mean wall (V⁺·n <= 0), that rebound hits another facet with its V⁺ and Ω⁺ and the same
+ * shape, up to RBS_MAX_WALL_HITS facet hits, after which the hit is RBS_TRAPPED. The first facet hit takes the
+ * hit's uniforms; the facets and every later facet hit take keyed uniforms of a hash of them, so a hit never takes
+ * more than RBS_U_PER_DRAW uniforms of a stream. result->wall_hits counts the facet hits; path and n_collisions are
+ * the last one's; a facet not found (probability below 1e-14) gives RBS_FAILED. Roughness 0 is the smooth wall,
+ * bit for bit. */
 RBS_API int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const rbs_hit *hit, const rbs_options *options,
                         rbs_result *result);
 
 /* The path that answers `hit` under options->method (surrogate.kernels.wall_hit.rebound_path), without drawing
  * (hit->u, hit->rng and hit->grain_key are not read). Under RBS_METHOD_AUTO, the table iff |Ω⁻| a/|V⁻| <=
  * RBS_SPIN_TOLERANCE (Ω⁻ = 0 included), and α1 and |V⁻| lie in the table's grid ranges, edges included; else the
- * direct model. RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_PATH_NONE for an argument rbs_rebound refuses. */
+ * direct model. RBS_PATH_TABLE or RBS_PATH_DIRECT; RBS_PATH_NONE for an argument rbs_rebound refuses. On a rough
+ * wall, the path of a hit on the mean wall (each facet hit of rbs_rebound takes its own). */
 RBS_API int rbs_rebound_path(const rbs_table *table, const rbs_hit *hit, const rbs_options *options);
 
 /* ---------------------------------------------------------------- many hits from the table */
@@ -265,7 +286,9 @@ typedef struct rbs_results {
  * b of every block of RBS_BLOCK rows takes its uniforms from lane b. options->method must be RBS_METHOD_AUTO or
  * RBS_METHOD_TABLE. Returns RBS_OK; or RBS_INVALID, every row RBS_INVALID and NaN (in the outputs that are not
  * NULL) and rng not advanced, for a NULL table, mix, hits or results, an array NULL with count > 0, a mix of
- * another table, a record too small, RBS_METHOD_DIRECT or an unknown interpolation, a NULL or all-zero rng. */
+ * another table, a record too small, RBS_METHOD_DIRECT or an unknown interpolation, a NULL or all-zero rng, a
+ * rough wall (a roughness other than 0, options->roughness_deg or the table's: the smooth wall only; rbs_rebound
+ * answers a rough wall's hits). */
 RBS_API int rbs_draw_many(const rbs_table *table, const rbs_mix *mix, const rbs_hits *hits, const rbs_options *options,
                           rbs_results *results);
 
@@ -277,7 +300,7 @@ RBS_API void rbs_draw_many_uniforms(rbs_rng *rng, size_t count, double *u);
  * out = (α2 rad, β2 rad, s = |V⁺|/|V⁻|, Ω_x, Ω_y, Ω_z in units of |V⁻|/a), NaN unless rebounded. Returns RBS_OK or
  * RBS_TRAPPED; RBS_INVALID for α1 outside (0, 90] or NaN, |V⁻| not finite and > 0, a uniform outside [0, 1), a NULL
  * pointer, a mix of another table, an unknown interpolation. Outside the grid (however far), the law at the nearest
- * grid edge. options->method is not read. */
+ * grid edge. options->method and options->roughness_deg are not read. */
 RBS_API int rbs_draw_local(const rbs_table *table, const rbs_mix *mix, double alpha1_deg, double speed_m_s,
                            const double u[RBS_U_PER_DRAW], const rbs_options *options, double out[RBS_LOCAL_SIZE]);
 
@@ -342,9 +365,9 @@ typedef struct rbs_shape_info {
  * of range. */
 RBS_API int rbs_table_shape_info(const rbs_table *table, int i, rbs_shape_info *info);
 
-/* The wall of a table (group /wall; docs/model.md §10): its law family, named parameters and arrays, as the build's
- * [wall] section gave them. The fields after speed_range_m_s came after 1.0: written only where the caller's
- * record reaches them (its size). Every pointer is valid until rbs_table_close. */
+/* The wall of a table (group /wall; docs/model.md §10, §12): its law family, named parameters and arrays, and its
+ * roughness, as the build's [wall] section gave them. The fields after speed_range_m_s came after 1.0: written only
+ * where the caller's record reaches them (its size). Every pointer is valid until rbs_table_close. */
 typedef struct rbs_wall_info {
     size_t size;                /* sizeof(rbs_wall_info) */
     const char *family;         /* the law family, "exponential" or "tabulated" */
@@ -362,8 +385,10 @@ typedef struct rbs_wall_info {
     const double *contact_sine;             /* the sines |v_c⁻|/|V_c⁻| of the impact angle, increasing from 0 to 1 */
     const double *restitution;              /* a_nc at the nodes, in (0, 1], row-major: n_contact_speeds rows of
                                                n_contact_sines values */
+    double roughness_deg;                   /* since 1.2: the wall's roughness Δγ, degrees, in
+                                               [0, RBS_MAX_ROUGHNESS_DEG]; 0: a smooth wall (a table without it) */
 } rbs_wall_info;
-#define RBS_WALL_INFO_INIT {sizeof(rbs_wall_info), NULL, NULL, 0, NULL, NULL, {0.0, 0.0}, 0, NULL, 0, NULL, NULL}
+#define RBS_WALL_INFO_INIT {sizeof(rbs_wall_info), NULL, NULL, 0, NULL, NULL, {0.0, 0.0}, 0, NULL, 0, NULL, NULL, 0.0}
 
 /* *info up to info->size. RBS_OK, or RBS_INVALID for a NULL pointer or a record too small. */
 RBS_API int rbs_table_wall(const rbs_table *table, rbs_wall_info *info);

@@ -104,6 +104,7 @@ struct rbs_table {
     char wall_name[RBS_WALL_NAME_SIZE];
     double wall_parameters[RBS_WALL_MAX_PARAMETERS];
     double wall_speed_range[2];                     /* m/s; {0, inf}: not stated (direct_model.wall) */
+    double wall_roughness;                          /* Δγ, degrees, in [0, RBS_MAX_ROUGHNESS_DEG]; 0: smooth */
     double wall[WALL_ARRAY_SIZE];
     char (*shape_names)[RBS_SHAPE_NAME_SIZE];       /* (n_shapes) names, grid/shapes */
     rbs_shape_records shapes;

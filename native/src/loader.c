@@ -756,6 +756,38 @@ static int read_wall_arrays(loader *ld, hid_t group, const wall_family *family, 
     return ld->code;
 }
 
+/* Whether the compound row wall/parameters (read already: one row of a compound type) has the field `name` */
+static int wall_row_has_field(hid_t group, const char *name)
+{
+    hid_t ds = -1, type = -1;
+    int index = -1;
+    H5E_BEGIN_TRY {
+        ds = H5Dopen2(group, "parameters", H5P_DEFAULT);
+        if (ds >= 0) type = H5Dget_type(ds);
+        if (type >= 0) index = H5Tget_member_index(type, name);
+    } H5E_END_TRY;
+    if (type >= 0) H5Tclose(type);
+    if (ds >= 0) H5Dclose(ds);
+    return index >= 0;
+}
+
+/* The wall's roughness (data_schema.table._wall): the optional field roughness_deg of wall/parameters, written for a
+ * rough wall only (absent: 0, smooth), one number in [0, RBS_MAX_ROUGHNESS_DEG] degrees; `names` the row's fields
+ * read, for the messages of read_row */
+static int read_wall_roughness(loader *ld, hid_t group, const char *names, rbs_table *t)
+{
+    t->wall_roughness = 0.0;
+    if (!wall_row_has_field(group, "roughness_deg")) return ld->code;
+    static const row_field field = {"roughness_deg", FIELD_REAL, 1, 0};
+    double roughness = 0.0;
+    if (read_row(ld, group, "wall", &field, 1, names, &roughness, sizeof roughness) != RBS_OK) return ld->code;
+    if (!(roughness >= 0.0 && roughness <= RBS_MAX_ROUGHNESS_DEG))
+        return rbs_fail(ld, RBS_ERR_FORMAT, "field 'roughness_deg' of dataset 'wall/parameters' must be in [0, %g] "
+                        "degrees; got %.17g", RBS_MAX_ROUGHNESS_DEG, roughness);
+    t->wall_roughness = roughness;
+    return RBS_OK;
+}
+
 /* The wall (group wall, data_schema.table._wall): its attributes family and name (strings), the family one of
  * WALL_FAMILIES, its parameters by field name within their ranges, then the family's arrays; into t (wall_*, and the
  * kernels' wall array t->wall, direct_model.wall.Wall.as_array: the family's code, q, then k, p or the arrays). */
@@ -784,15 +816,17 @@ static int read_wall(loader *ld, hid_t file, rbs_table *t)
     }
     double row[RBS_WALL_MAX_PARAMETERS + 2];        /* the family's parameters, then the speed range */
     int n = ld->code == RBS_OK ? family->n_parameters : 0;
+    char names_of_row[512] = "";
     if (ld->code == RBS_OK) {
         row_field fields[RBS_WALL_MAX_PARAMETERS + 1];
-        char names[512] = "";
+        char *names = names_of_row;
+        const size_t names_size = sizeof names_of_row;
         for (int i = 0; i < n; i++) {
             fields[i] = (row_field){family->parameters[i], FIELD_REAL, 1, (size_t)i * sizeof(double)};
-            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "", family->parameters[i]);
+            snprintf(names + strlen(names), names_size - strlen(names), "%s%s", i ? ", " : "", family->parameters[i]);
         }
         fields[n] = (row_field){"speed_range_m_s", FIELD_ARRAY, 2, (size_t)n * sizeof(double)};
-        snprintf(names + strlen(names), sizeof names - strlen(names), " (the %s wall law) and speed_range_m_s",
+        snprintf(names + strlen(names), names_size - strlen(names), " (the %s wall law) and speed_range_m_s",
                  family->name);
         read_row(ld, group, "wall", fields, n + 1, names, row, (size_t)(n + 2) * sizeof(double));
     }
@@ -811,6 +845,7 @@ static int read_wall(loader *ld, hid_t file, rbs_table *t)
         t->wall_speed_range[0] = low;
         t->wall_speed_range[1] = high;
     }
+    if (ld->code == RBS_OK) read_wall_roughness(ld, group, names_of_row, t);
     if (ld->code == RBS_OK && family->n_arrays > 0) read_wall_arrays(ld, group, family, t);
     H5Gclose(group);
     if (ld->code != RBS_OK) return ld->code;

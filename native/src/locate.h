@@ -52,7 +52,7 @@ RBS_INLINE void rbs_locate(const double *axis, int64_t axis_len, int64_t n, doub
 /* The cell a draw reads (surrogate.kernels.locate.locate): shape from u[0] and the mix, grid intervals and weights,
  * the neighbour (ia, iv) drawn with those weights from u[1], u[2] (stochastic interpolation). */
 typedef struct rbs_cell {
-    int64_t shape;      /* the table shape drawn from the mix */
+    int64_t shape;      /* the table shape: drawn from the mix, or given */
     int64_t drawn;      /* number of cell (shape, ia, iv) */
     int64_t below;      /* number of cell (shape, ja, iv): the lower α1 neighbour at the drawn speed */
     int64_t jv, iv;     /* speed interval, drawn speed index */
@@ -67,11 +67,11 @@ RBS_INLINE int64_t rbs_mix_shape(const double *cdf, int n_shapes, double u0)
     return shape;
 }
 
-RBS_INLINE rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_shapes, double alpha1, double speed,
-                                   const double *u)
+/* The cell of a draw of the table's shape `shape` (surrogate.kernels.locate.locate_in_shape; u[0] not read) */
+RBS_INLINE rbs_cell rbs_cell_in_shape(const rbs_table *t, int64_t shape, double alpha1, double speed, const double *u)
 {
     rbs_cell c;
-    int64_t shape = rbs_mix_shape(cdf, n_shapes, u[0]), ja;
+    int64_t ja;
     c.shape = shape;
     rbs_locate(t->alpha1_axis, (int64_t)t->alpha1_axis_len, t->n_alpha1, alpha1, &ja, &c.wa);
     rbs_locate(t->speed_axis, (int64_t)t->speed_axis_len, t->n_speed, speed, &c.jv, &c.wv);
@@ -80,6 +80,12 @@ RBS_INLINE rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_sha
     c.below = (shape * t->n_alpha1 + ja) * t->n_speed + c.iv;
     c.drawn = c.below + (ia - ja) * t->n_speed;
     return c;
+}
+
+RBS_INLINE rbs_cell rbs_cell_of(const rbs_table *t, const double *cdf, int n_shapes, double alpha1, double speed,
+                                const double *u)
+{
+    return rbs_cell_in_shape(t, rbs_mix_shape(cdf, n_shapes, u[0]), alpha1, speed, u);
 }
 
 /* offset of component c's row in cell number `cell` */

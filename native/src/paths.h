@@ -20,6 +20,11 @@ int rbs_table_rebound(const rbs_table *table, const rbs_mix *mix, const double V
                       const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
 int rbs_table_hit(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
                   const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3], int *shape);
+/* table_path.c: the table path of a particle of the table's shape `shape`, u[0] not read
+ * (surrogate.kernels.table_path.table_shape_rebound): as rbs_table_rebound, RBS_INVALID also for a shape outside the
+ * table's; the facet hits of a rough wall (wall_hit.c). */
+int rbs_table_shape_hit(const rbs_table *table, int shape, const double V[3], const double n[3], double a,
+                        const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
 
 /* direct_path.c: the direct model for one hit, caller's frame (surrogate.kernels.direct_path.direct_rebound): `shape`
  * the index of the particle's shape in the table's direct shapes (the four families in code order, then the

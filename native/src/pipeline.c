@@ -89,9 +89,13 @@ int rbs_draw_many(const rbs_table *t, const rbs_mix *mix, const rbs_hits *hits, 
     double *V_out = results->V, *Omega_out = results->Omega;
     signed char *status = results->status;
     int method, interpolation;
+    double roughness;
+    /* the smooth wall only: a rough wall's facet hits are rbs_rebound's */
     int ok = rbs_options_read(options, &method, &interpolation)
              && (method == RBS_METHOD_AUTO || method == RBS_METHOD_TABLE)
-             && rbs_table_arguments_ok(t, mix, interpolation) && (hits->u || rbs_rng_ok(hits->rng))
+             && rbs_table_arguments_ok(t, mix, interpolation)
+             && rbs_options_roughness(options, t->wall_roughness, &roughness) && roughness == 0.0
+             && (hits->u || rbs_rng_ok(hits->rng))
              && (count == 0 || (hits->V && hits->n && hits->a && V_out && Omega_out && status));
     if (!ok) {
         all_invalid(count, V_out, Omega_out, status);

@@ -48,4 +48,16 @@ static inline int rbs_options_read(const rbs_options *options, int *method, int 
     return *interpolation == RBS_INTERPOLATION_SCALED || *interpolation == RBS_INTERPOLATION_STOCHASTIC;
 }
 
+/* The roughness Δγ (degrees) options ask for, the table's wall's `table_roughness` for a negative one, a NULL
+ * options or a record too small to hold the field (1.0, 1.1), into *roughness: 1, or 0 for NaN or a roughness
+ * above RBS_MAX_ROUGHNESS_DEG (options checked by rbs_options_read). */
+static inline int rbs_options_roughness(const rbs_options *options, double table_roughness, double *roughness)
+{
+    double asked = RBS_ROUGHNESS_OF_TABLE;
+    if (options && RBS_HAS_FIELD(options, rbs_options, roughness_deg))
+        asked = options->roughness_deg;
+    *roughness = asked < 0.0 ? table_roughness : asked;
+    return *roughness <= RBS_MAX_ROUGHNESS_DEG;     /* false for NaN */
+}
+
 #endif /* RBS_RECORDS_H */

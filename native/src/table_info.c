@@ -85,6 +85,7 @@ int rbs_table_wall(const rbs_table *t, rbs_wall_info *info)
     if (RBS_HAS_FIELD(info, rbs_wall_info, contact_sine)) info->contact_sine = tabulated ? t->wall + W_NODES + ns : NULL;
     if (RBS_HAS_FIELD(info, rbs_wall_info, restitution))
         info->restitution = tabulated ? t->wall + W_NODES + ns + nz : NULL;
+    if (RBS_HAS_FIELD(info, rbs_wall_info, roughness_deg)) info->roughness_deg = t->wall_roughness;
     return RBS_OK;
 }
 

@@ -21,29 +21,60 @@ static void nan_out(double *x, int count)
         for (int k = 0; k < count; k++) x[k] = NAN;
 }
 
-RBS_HOT int rbs_table_hit(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
-                          const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
-                          int *shape)
+/* the inputs the table path checks first (surrogate.kernels.table_path.table_shape_rebound, moves_into_wall) */
+RBS_INLINE int inputs_ok(const rbs_table *t, const double *V, const double *n, const double *u, const double *V_out,
+                         const double *Omega_out, int interpolation)
 {
-    *shape = -1;
-    if (!V || !n || !u || !V_out || !Omega_out || !rbs_table_arguments_ok(t, mix, interpolation)
-        || !rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2])) {
-        nan_out(V_out, 3);
-        nan_out(Omega_out, 3);
-        return RBS_INVALID;
-    }
+    return V && n && u && V_out && Omega_out && t
+           && (interpolation == RBS_INTERPOLATION_SCALED || interpolation == RBS_INTERPOLATION_STOCHASTIC)
+           && rbs_moves_into_wall(V[0], V[1], V[2], n[0], n[1], n[2]);
+}
+
+/* The table path of a particle of the table's shape `shape` (a valid index), inputs checked by inputs_ok
+ * (surrogate.kernels.table_path.table_shape_rebound) */
+RBS_INLINE int hit_in_shape(const rbs_table *t, int64_t shape, const double V[3], const double n[3], double a,
+                            const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
+                            int *shape_out)
+{
     const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
     rbs_frame f;
     double x[6];
     rbs_impact_frame(Vi, ni, u[12], &f);
-    rbs_cell cell = rbs_cell_of(t, rbs_mix_cdf(mix), mix->n_shapes, f.alpha1, f.speed, u);
+    rbs_cell cell = rbs_cell_in_shape(t, shape, f.alpha1, f.speed, u);
     rbs_hint_draw(t, cell.drawn, u);
     int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, interpolation == RBS_INTERPOLATION_SCALED,
                                   x);
     int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);
     status = rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
-    *shape = status == RBS_INVALID ? -1 : (int)cell.shape;
+    *shape_out = status == RBS_INVALID ? -1 : (int)cell.shape;
     return status;
+}
+
+RBS_HOT int rbs_table_hit(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
+                          const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
+                          int *shape)
+{
+    *shape = -1;
+    if (!rbs_table_arguments_ok(t, mix, interpolation) || !inputs_ok(t, V, n, u, V_out, Omega_out, interpolation)) {
+        nan_out(V_out, 3);
+        nan_out(Omega_out, 3);
+        return RBS_INVALID;
+    }
+    return hit_in_shape(t, rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, u[0]), V, n, a, u, interpolation, V_out,
+                        Omega_out, shape);
+}
+
+RBS_HOT int rbs_table_shape_hit(const rbs_table *t, int shape, const double V[3], const double n[3], double a,
+                                const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
+                                double Omega_out[3])
+{
+    int drawn;
+    if (!inputs_ok(t, V, n, u, V_out, Omega_out, interpolation) || shape < 0 || shape >= t->n_shapes) {
+        nan_out(V_out, 3);
+        nan_out(Omega_out, 3);
+        return RBS_INVALID;
+    }
+    return hit_in_shape(t, shape, V, n, a, u, interpolation, V_out, Omega_out, &drawn);
 }
 
 int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,

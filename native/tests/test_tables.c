@@ -43,6 +43,14 @@ static int physical(const double *V_out, const double *W_out, const double *n)
     return V_out[0] * n[0] + V_out[1] * n[1] + V_out[2] * n[2] > 0.0;
 }
 
+/* two results field by field, vectors bit for bit (a memcmp of the records would read their padding) */
+static int same_result(const rbs_result *a, const rbs_result *b)
+{
+    return a->status == b->status && a->path == b->path && a->shape == b->shape && a->n_collisions == b->n_collisions
+           && a->wall_hits == b->wall_hits && memcmp(a->V, b->V, sizeof a->V) == 0
+           && memcmp(a->Omega, b->Omega, sizeof a->Omega) == 0;
+}
+
 /* a hit of V, Omega (NULL: none), n, a with the uniforms u (NULL: from rng) */
 static rbs_hit make_hit(const double V[3], const double Omega[3], const double n[3], double a, const double *u,
                         rbs_rng *rng)
@@ -417,9 +425,106 @@ static void spin_draws(const rbs_table *table, const rbs_mix *mix, double vlo, d
         rbs_result a_drawn = RBS_RESULT_INIT, a_given = RBS_RESULT_INIT;
         int st_drawn = rbs_rebound(table, mix, &h_drawn, &options[i % 3], &a_drawn);
         int st_given = rbs_rebound(table, mix, &h_given, &options[i % 3], &a_given);
-        CHECK(st_drawn == st_given && memcmp(&a_drawn, &a_given, sizeof a_drawn) == 0
+        CHECK(st_drawn == st_given && same_result(&a_drawn, &a_given)
               && memcmp(&r_drawn, &r_given, sizeof r_drawn) == 0, "uniforms drawn and given differ, hit %d", i);
     }
+}
+
+/* a rough wall (options' roughness on this table): grazing, spinning, keyed and hostile hits under the three methods;
+ * whatever rebounds is finite and leaves the mean wall, the rest is NaN, 1 to RBS_MAX_WALL_HITS facet hits (0 for
+ * RBS_INVALID); uniforms drawn are those given; roughness 0 is the smooth wall; bad roughnesses are refused */
+static void rough_draws(const rbs_table *table, const rbs_mix *mix, double vlo, double vhi)
+{
+    rbs_rng rng, r_drawn;
+    rbs_rng_seed_stream(&rng, 29, 1);
+    rbs_rng_seed_stream(&r_drawn, 29, 2);
+    const double a = 1e-4;
+    int rehits = 0;
+    for (int i = 0; i < 600; i++) {
+        double V[3], n[3], W[3], u[RBS_U_PER_DRAW], t[3];
+        unit(&rng, n);
+        unit(&rng, t);
+        unit(&rng, W);
+        double speed = 0.5 * vlo + 1.2 * vhi * rbs_rng_uniform(&rng);
+        double alpha1_deg = i % 2 ? 1.0 + 4.0 * rbs_rng_uniform(&rng) : 90.0 * rbs_rng_uniform(&rng);
+        double alpha1 = alpha1_deg * 0.017453292519943295;
+        double tn = t[0] * n[0] + t[1] * n[1] + t[2] * n[2], tt = 0.0;
+        for (int k = 0; k < 3; k++) {
+            t[k] -= tn * n[k];
+            tt += t[k] * t[k];
+        }
+        double ratio = i % 3 == 0 ? 0.0 : 0.5 * rbs_rng_uniform(&rng);
+        for (int k = 0; k < 3; k++) {
+            V[k] = speed * (cos(alpha1) * t[k] / sqrt(tt) - sin(alpha1) * n[k]);
+            W[k] *= ratio * speed / a;
+        }
+        if (i % 60 == 0) V[i % 3] = i % 120 == 0 ? NAN : 1e300;
+        rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
+        rbs_options o = make_options(i % 3, i % 2);
+        o.roughness_deg = i % 7 == 0 ? RBS_MAX_ROUGHNESS_DEG : 45.0 * rbs_rng_uniform(&rng);
+        rbs_rng r_given = r_drawn;
+        double ug[RBS_U_PER_DRAW];
+        rbs_rng_fill(&r_given, ug, RBS_U_PER_DRAW);
+        rbs_hit h = make_hit(V, W, n, a, i % 4 == 1 ? ug : u, NULL), h_drawn = make_hit(V, W, n, a, NULL, &r_drawn);
+        if (i % 5 == 0) h.grain_key = h_drawn.grain_key = rbs_grain_key(29, 0, (uint64_t)i);
+        rbs_result r = RBS_RESULT_INIT, r_from_rng = RBS_RESULT_INIT;
+        int st = rbs_rebound(table, mix, &h, &o, &r);
+        CHECK(st == r.status && (st == RBS_INVALID ? r.wall_hits == 0 : r.wall_hits >= 1
+                                 && r.wall_hits <= RBS_MAX_WALL_HITS), "rough hit %d: status %d, %d wall hits", i, st,
+              r.wall_hits);
+        CHECK(st == RBS_OK ? physical(r.V, r.Omega, n) : all_nan(r.V, 3) && all_nan(r.Omega, 3),
+              "rough hit %d: status %d", i, st);
+        rehits += r.wall_hits > 1;
+        if (i % 4 == 1) {
+            rbs_rebound(table, mix, &h_drawn, &o, &r_from_rng);
+            CHECK(same_result(&r, &r_from_rng) && memcmp(&r_drawn, &r_given, sizeof r_drawn) == 0,
+                  "rough hit %d: uniforms drawn and given differ", i);
+        } else {
+            r_drawn = r_given;
+        }
+        /* roughness 0: the smooth wall */
+        rbs_options smooth = make_options(i % 3, i % 2);
+        smooth.roughness_deg = 0.0;
+        rbs_result r_zero = RBS_RESULT_INIT, r_smooth = RBS_RESULT_INIT;
+        rbs_rebound(table, mix, &h, &smooth, &r_zero);
+        smooth.roughness_deg = RBS_ROUGHNESS_OF_TABLE;
+        rbs_rebound(table, mix, &h, &smooth, &r_smooth);
+        CHECK(same_result(&r_zero, &r_smooth) && (r_zero.status == RBS_INVALID) == (r_zero.wall_hits == 0)
+              && r_zero.wall_hits <= 1, "rough hit %d: roughness 0 is not the smooth wall", i);
+    }
+    CHECK(rehits > 0, "no facet re-hit in 600 rough hits");
+    const double V[3] = {100.0, -5.0, 0.0}, n[3] = {0.0, 1.0, 0.0}, still[3] = {0.0, 0.0, 0.0};
+    double u[RBS_U_PER_DRAW];
+    rbs_rng_fill(&rng, u, RBS_U_PER_DRAW);
+    rbs_hit h = make_hit(V, still, n, a, u, NULL);
+    static const double bad[] = {NAN, INFINITY, 45.000000000000007, 46.0, 1e300};
+    for (int j = 0; j < (int)(sizeof bad / sizeof bad[0]); j++) {
+        rbs_options o = make_options(RBS_METHOD_AUTO, RBS_INTERPOLATION_SCALED);
+        o.roughness_deg = bad[j];
+        rbs_result r = RBS_RESULT_INIT;
+        CHECK(rbs_rebound(table, mix, &h, &o, &r) == RBS_INVALID && r.wall_hits == 0 && r.path == RBS_PATH_NONE
+              && all_nan(r.V, 3), "roughness %g", bad[j]);
+        CHECK(rbs_rebound_path(table, &h, &o) == RBS_PATH_NONE, "path: roughness %g", bad[j]);
+    }
+    /* rbs_draw_many: the smooth wall only */
+    double Vm[3] = {100.0, -100.0, 0.0}, am = a, Vo[3], Wo[3];
+    signed char status = 7;
+    rbs_hits hits = RBS_HITS_INIT;
+    hits.count = 1;
+    hits.V = Vm;
+    hits.n = n;
+    hits.a = &am;
+    hits.u = u;
+    rbs_results results = RBS_RESULTS_INIT;
+    results.V = Vo;
+    results.Omega = Wo;
+    results.status = &status;
+    rbs_options o = make_options(RBS_METHOD_AUTO, RBS_INTERPOLATION_SCALED);
+    o.roughness_deg = 10.0;
+    CHECK(rbs_draw_many(table, mix, &hits, &o, &results) == RBS_INVALID && status == RBS_INVALID && all_nan(Vo, 3),
+          "draw_many on a rough wall");
+    o.roughness_deg = 0.0;
+    CHECK(rbs_draw_many(table, mix, &hits, &o, &results) == RBS_OK && status == RBS_OK, "draw_many, roughness 0");
 }
 
 /* what a table tells about itself */
@@ -654,6 +759,7 @@ static void draw_from(const char *path)
     CHECK(local_draw(table, mix, NAN, NAN, u, RBS_INTERPOLATION_SCALED, out) == RBS_INVALID, "NaN local draw");
     hostile_draws(table, mix, vlo, vhi);
     spin_draws(table, mix, vlo, vhi);
+    rough_draws(table, mix, vlo, vhi);
     CHECK(local_draw(table, NULL, 45.0, 100.0, u, RBS_INTERPOLATION_SCALED, out) == RBS_INVALID, "NULL mix");
     free(V);
     free(n);
@@ -674,8 +780,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s GOOD.h5 [PATH EXPECTED_STATUS]...\n", argv[0]);
         return 2;
     }
-    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.1.0") == 0
-          && RBS_VERSION_NUMBER == 1001000, "version %s, %d", rbs_version(), rbs_version_number());
+    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.2.0") == 0
+          && RBS_VERSION_NUMBER == 1002000, "version %s, %d", rbs_version(), rbs_version_number());
     rbs_table_close(NULL);
     CHECK(rbs_table_open(argv[1], NULL, NULL, 0) == RBS_INVALID, "NULL table pointer");
     for (int repeat = 0; repeat < 2; repeat++) draw_from(argv[1]);

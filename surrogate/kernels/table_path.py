@@ -64,9 +64,10 @@ def table_rebound_typed(data, mix_cdf, V, n, a, u, scaled):
     return table_shape_rebound(data, mix_shape(mix_cdf, u[0]), V, n, a, u, scaled)
 
 
-@numba.njit(inline="always", **JIT)
+@numba.njit(**KERNEL)
 def table_shape_rebound(data, shape, V, n, a, u, scaled):
-    """:func:`table_rebound_typed` of a particle of the table's shape ``shape`` (a valid index; u[0] unused)."""
+    """:func:`table_rebound_typed` of a particle of the table's shape ``shape`` (a valid index; u[0] unused).
+    Compiled on its own, not inlined: the rough wall's facet hits call it too (one compilation of the draw)."""
     if not moves_into_wall(V, n):
         return invalid_hit()
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])

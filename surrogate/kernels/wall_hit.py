@@ -269,7 +269,7 @@ def _auto_paths(data, V, omega, n, a, lo, hi, path):
 
 @numba.njit(parallel=True, **JIT)
 def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a, states,
-                         method, out, scaled=True, roughness_deg=0.0):
+                         method, out, scaled=True):
     """:func:`rebound` for every row of V (N, 3), omega (N, 3) or (1, 3) for all rows, n (N, 3) and
     a (N,), on all threads, into ``out`` (:class:`surrogate.kernels.hit.Rebounds` of N rows: row i is the
     :class:`surrogate.kernels.hit.Hit` of hit i).
@@ -288,34 +288,26 @@ def rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shap
     path are answered again), then the direct model answers the direct rows with the same row's uniforms
     (:func:`surrogate.kernels.pipeline.table_rebound_uniforms`). Rows are not checked here
     (:func:`surrogate.sample_global` checks them first): a row with a bad input gets :func:`rebound`'s record of
-    a refused hit (STATUS_INVALID, PATH_NONE). A method code outside the three is a ValueError.
-
-    ``roughness_deg`` (degrees): 0, the smooth wall above; > 0, every row is :func:`rough_rebound`'s with the
-    same row's uniforms (one by one, without the table's pipeline), outside [0, MAX_ROUGHNESS_DEG] a ValueError.
+    a refused hit (STATUS_INVALID, PATH_NONE). A method code outside the three is a ValueError. The smooth wall:
+    :func:`rough_rebound_parallel_rng` answers a rough one.
     """
     if not METHOD_AUTO <= method <= METHOD_DIRECT:
         raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
-    if not 0.0 <= roughness_deg <= MAX_ROUGHNESS_DEG:
-        raise ValueError("The roughness must be in [0, MAX_ROUGHNESS_DEG] degrees.")
     check_shapes(shapes, V.shape[0], mix_cdf.shape[0])
     check_keys(keys, V.shape[0])
     row_shapes = keyed_shapes(mix_cdf, shapes, keys)     # a copy of shapes without keys
     rows = V.shape[0]
     for j in numba.prange(states.shape[0]):
         _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, states[j],
-                    method, out, scaled, roughness_deg, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
+                    method, out, scaled, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
 
 
 @numba.njit(**JIT)
 def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state, method,
-                out, scaled, roughness_deg, lo, hi):
+                out, scaled, lo, hi):
     """Rows [lo, hi) of :func:`rebound_parallel_rng` along their paths (one chunk, its uniforms from a copy of
     ``state``). Called, not inlined: numba's parallel passes then see one call in the loop, not the chunk's work
     (docs/design/test_time.md)."""
-    if roughness_deg != 0.0:
-        _rough_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state,
-                     method, out, scaled, roughness_deg, lo, hi)
-        return
     path = out.path
     if method == METHOD_AUTO:
         _auto_paths(data, V, omega, n, a, lo, hi, path)
@@ -353,19 +345,38 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
         put_hit(out, i, result)
 
 
+@numba.njit(parallel=True, **JIT)
+def rough_rebound_parallel_rng(data, params, shape_arrays, model_shapes, mix_cdf, shapes, keys, V, omega, n, a,
+                               states, method, out, scaled, roughness_deg):
+    """:func:`rebound_parallel_rng` on a rough wall of roughness ``roughness_deg`` (degrees, in
+    (0, MAX_ROUGHNESS_DEG]; else a ValueError): row i is :func:`rough_rebound`'s with the uniforms that kernel
+    gives row i (one by one, without the table's pipeline). The same bits whatever the number of threads."""
+    if not METHOD_AUTO <= method <= METHOD_DIRECT:
+        raise ValueError("The 'method' code must be METHOD_AUTO (0), METHOD_TABLE (1) or METHOD_DIRECT (2).")
+    if not 0.0 < roughness_deg <= MAX_ROUGHNESS_DEG:
+        raise ValueError("The roughness must be in (0, MAX_ROUGHNESS_DEG] degrees.")
+    check_shapes(shapes, V.shape[0], mix_cdf.shape[0])
+    check_keys(keys, V.shape[0])
+    row_shapes = keyed_shapes(mix_cdf, shapes, keys)
+    rows = V.shape[0]
+    for j in numba.prange(states.shape[0]):
+        _rough_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, states[j],
+                     method, out, scaled, roughness_deg, j * CHUNK_ROWS, min((j + 1) * CHUNK_ROWS, rows))
+
+
 @numba.njit(**JIT)
 def _rough_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, keys, V, omega, n, a, state, method,
                  out, scaled, roughness_deg, lo, hi):
-    """Rows [lo, hi) of :func:`rebound_parallel_rng` on a rough wall: :func:`rough_rebound` row by row, with the
-    uniforms the table's pipeline would give the rows."""
+    """Rows [lo, hi) of :func:`rough_rebound_parallel_rng`: :func:`rough_rebound` row by row, with the uniforms the
+    table's pipeline would give the rows."""
     u = table_rebound_uniforms(state.copy(), hi - lo)
-    scratch, facet_u = np.empty(SCRATCH_SIZE), np.empty(U_PER_DRAW)
     last_omega = omega.shape[0] - 1
     for i in range(lo, hi):
         w = min(i, last_omega)
         shape = row_shapes[i] if row_shapes.shape[0] > 0 else SHAPE_FROM_MIX
         key = keys[i] if keys.shape[0] > 0 else NO_KEY
-        put_hit(out, i, rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
-                                      (V[i, 0], V[i, 1], V[i, 2]), (omega[w, 0], omega[w, 1], omega[w, 2]),
-                                      (n[i, 0], n[i, 1], n[i, 2]), a[i], u[i - lo], scaled, method, roughness_deg,
-                                      scratch, facet_u))
+        # the single-hit kernel itself: one compilation of the rough hit serves both
+        put_hit(out, i, _rough_on_stack(data, params, shape_arrays, model_shapes, mix_cdf, np.int64(shape),
+                                        np.int64(key), (V[i, 0], V[i, 1], V[i, 2]),
+                                        (omega[w, 0], omega[w, 1], omega[w, 2]), (n[i, 0], n[i, 1], n[i, 2]),
+                                        float(a[i]), u[i - lo], scaled, np.int64(method), float(roughness_deg)))

@@ -172,14 +172,16 @@ def bad_tables(good, folder) -> list:
 
 def _row_edit(group, drop=None, dtype=None, **values):
     """An edit of ``group/parameters`` (one compound row): field ``drop`` left out, fields of ``dtype`` (a
-    {name: dtype}) stored as that type, the fields of ``values`` set; rewritten chunked (1,) under Fletcher-32."""
+    {name: dtype}) stored as that type (a new field appended), the fields of ``values`` set; rewritten chunked (1,)
+    under Fletcher-32."""
     def edit(f):
         row = f[group]["parameters"][()]
         types = {name: row.dtype[name] for name in row.dtype.names if name != drop}
         types.update(dtype or {})
         new = np.zeros(1, dtype=[(name, t) for name, t in types.items()])
         for name in types:
-            new[name] = values.get(name, row[name]) if np.dtype(types[name]).kind not in "OSU" else b"0.61"
+            new[name] = (values[name] if name in values else row[name]) if np.dtype(types[name]).kind not in "OSU" \
+                else b"0.61"
         del f[group]["parameters"]
         f[group].create_dataset("parameters", data=new, chunks=(1,), fletcher32=True)
     return edit
@@ -229,6 +231,14 @@ def parameter_row_cases(good, folder) -> list:
         ("k_nan", _row_edit("wall", k=np.nan), f"field 'k' of {wall} must be finite and > 0; got nan"),
         ("q_inf", _row_edit("wall", q=np.inf), f"field 'q' of {wall} must be finite; got inf"),
         ("p_string", _row_edit("wall", dtype={"p": "S8"}), f"field 'p' of {wall} must be stored as one number"),
+        ("roughness_above_45", _row_edit("wall", dtype={"roughness_deg": "<f8"}, roughness_deg=46.0),
+         f"field 'roughness_deg' of {wall} must be in [0, 45] degrees; got 46"),
+        ("roughness_negative", _row_edit("wall", dtype={"roughness_deg": "<f8"}, roughness_deg=-0.5),
+         f"field 'roughness_deg' of {wall} must be in [0, 45] degrees; got -0.5"),
+        ("roughness_nan", _row_edit("wall", dtype={"roughness_deg": "<f8"}, roughness_deg=np.nan),
+         f"field 'roughness_deg' of {wall} must be in [0, 45] degrees; got nan"),
+        ("roughness_pair", _row_edit("wall", dtype={"roughness_deg": ("<f8", (2,))}, roughness_deg=[5.0, 5.0]),
+         f"field 'roughness_deg' of {wall} must be stored as one number"),
         ("wall_not_compound", _replace_row("wall", np.array([0.1, 0.61, 1.0])),
          f"{wall} must hold one row of a compound type, one field per parameter"),
         ("wall_two_rows", _replace_row("wall", np.zeros(2, dtype=[("k", "<f8"), ("p", "<f8"), ("q", "<f8")])),

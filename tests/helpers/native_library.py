@@ -31,7 +31,10 @@ U_PER_DRAW = 13                         # RBS_U_PER_DRAW
 BLOCK = 32                              # RBS_BLOCK
 LOCAL_SIZE = 6                          # RBS_LOCAL_SIZE
 NO_KEY = -1                             # RBS_NO_KEY
-VERSION_NUMBER = 1_001_000              # RBS_VERSION_NUMBER of 1.1.0
+VERSION_NUMBER = 1_002_000              # RBS_VERSION_NUMBER of 1.2.0
+ROUGHNESS_OF_TABLE = -1.0               # RBS_ROUGHNESS_OF_TABLE: rbs_options.roughness_deg's default
+MAX_ROUGHNESS_DEG = 45.0                # RBS_MAX_ROUGHNESS_DEG
+MAX_WALL_HITS = 10                      # RBS_MAX_WALL_HITS
 
 # rbs_status: one status space (the hits' codes are surrogate's STATUS_*)
 OK, TRAPPED, FAILED = 0, 1, 2
@@ -142,16 +145,22 @@ class Hit(Record):
 
 
 class Options(Record):
-    """rbs_options (RBS_OPTIONS_INIT: auto, scaled)."""
+    """rbs_options (RBS_OPTIONS_INIT: auto, scaled, the table's roughness)."""
 
-    _fields_ = [("method", ctypes.c_int), ("interpolation", ctypes.c_int)]
+    _fields_ = [("method", ctypes.c_int), ("interpolation", ctypes.c_int), ("roughness_deg", ctypes.c_double)]
+    LAST_1_0 = "interpolation"
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("roughness_deg", ROUGHNESS_OF_TABLE)
+        super().__init__(*args, **kwargs)
 
 
 class Result(Record):
     """rbs_result (RBS_RESULT_INIT)."""
 
     _fields_ = [("status", ctypes.c_int), ("path", ctypes.c_int), ("shape", ctypes.c_int),
-                ("n_collisions", ctypes.c_int), ("V", _d3), ("Omega", _d3)]
+                ("n_collisions", ctypes.c_int), ("V", _d3), ("Omega", _d3), ("wall_hits", ctypes.c_int)]
+    LAST_1_0 = "Omega"
 
     def __init__(self, *args, **kwargs):
         for name, value in (("status", INVALID), ("path", PATH_NONE), ("shape", -1), ("n_collisions", -1)):
@@ -190,14 +199,15 @@ class ShapeInfo(Record):
 
 
 class WallInfo(Record):
-    """rbs_wall_info (its fields of 1.0 up to speed_range_m_s, then a tabulated law's arrays)."""
+    """rbs_wall_info (its fields of 1.0 up to speed_range_m_s, then a tabulated law's arrays (1.1) and the wall's
+    roughness (1.2))."""
 
     _fields_ = [("family", ctypes.c_char_p), ("name", ctypes.c_char_p), ("n_parameters", ctypes.c_int),
                 ("parameter_names", ctypes.POINTER(ctypes.c_char_p)),
                 ("parameter_values", ctypes.POINTER(ctypes.c_double)), ("speed_range_m_s", ctypes.c_double * 2),
                 ("n_contact_speeds", ctypes.c_int), ("contact_speed_m_s", ctypes.POINTER(ctypes.c_double)),
                 ("n_contact_sines", ctypes.c_int), ("contact_sine", ctypes.POINTER(ctypes.c_double)),
-                ("restitution", ctypes.POINTER(ctypes.c_double))]
+                ("restitution", ctypes.POINTER(ctypes.c_double)), ("roughness_deg", ctypes.c_double)]
     LAST_1_0 = "speed_range_m_s"
 
 
@@ -270,8 +280,9 @@ def _f64(x) -> np.ndarray:
     return np.ascontiguousarray(x, dtype=np.float64)
 
 
-def options(method=METHOD_AUTO, interpolation=INTERPOLATION_SCALED, record=Options) -> Options:
-    return record(method=method, interpolation=interpolation)
+def options(method=METHOD_AUTO, interpolation=INTERPOLATION_SCALED, record=Options,
+            roughness_deg=ROUGHNESS_OF_TABLE) -> Options:
+    return record(method=method, interpolation=interpolation, roughness_deg=roughness_deg)
 
 
 def hit(V, Omega, n, a, u=None, rng: Rng | None = None, key: int = NO_KEY, record=Hit):
@@ -369,9 +380,10 @@ class NativeTable:
                 "both_hands": info.both_hands}
 
     def wall(self) -> dict:
-        """rbs_table_wall as a dict: family, name, parameters {name: value}, speed_range_m_s (low, high) and the
+        """rbs_table_wall as a dict: family, name, parameters {name: value}, speed_range_m_s (low, high), the
         arrays {name: copied values} of a tabulated law (contact_speed_m_s, contact_sine, restitution (speeds,
-        sines)), {} where the record's pointers are NULL (the exponential family; their counts then 0)."""
+        sines)), {} where the record's pointers are NULL (the exponential family; their counts then 0), and
+        roughness_deg."""
         info = WallInfo()
         assert self.lib.c.rbs_table_wall(self.handle, ref(info)) == OK
         names = [info.parameter_names[i].decode() for i in range(info.n_parameters)]
@@ -384,7 +396,8 @@ class NativeTable:
         arrays = {name: np.ctypeslib.as_array(pointer, shape=shape).copy()
                   for name, (pointer, shape) in pointers.items() if pointer}
         return {"family": info.family.decode(), "name": info.name.decode(), "parameters": dict(zip(names, values)),
-                "n_parameters": info.n_parameters, "speed_range_m_s": tuple(info.speed_range_m_s), "arrays": arrays}
+                "n_parameters": info.n_parameters, "speed_range_m_s": tuple(info.speed_range_m_s), "arrays": arrays,
+                "roughness_deg": info.roughness_deg}
 
     # -- mixes
     def mix_new(self, shape="mix", weights: dict | None = None):
@@ -425,12 +438,12 @@ class NativeTable:
 
     # -- one hit
     def hit(self, mix, V, Omega, n, a, u=None, state=None, key: int = NO_KEY, method=METHOD_AUTO,
-            interpolation=INTERPOLATION_SCALED):
+            interpolation=INTERPOLATION_SCALED, roughness_deg=ROUGHNESS_OF_TABLE):
         """rbs_rebound of one hit, uniforms ``u`` or drawn from the rng ``state``: (its rbs_result, the advanced
         state or None). The returned status is checked to be the result's."""
         rng = None if state is None else _rng(state)
         h, kept = hit(V, Omega, n, a, u, rng, key)
-        result, opts = Result(), options(method, interpolation)
+        result, opts = Result(), options(method, interpolation, roughness_deg=roughness_deg)
         code = self.lib.c.rbs_rebound(self.handle, _mix_ref(mix), ref(h), ref(opts), ref(result))
         assert code == result.status, (code, result.status)
         del kept
@@ -572,6 +585,8 @@ INTERNAL = {
     "rbs_carlson_rf": (_d, [_d, _d, _d]),
     "rbs_carlson_rj": (_d, [_d, _d, _d, _d]),
     "rbs_restitution_factor": (_d, [_d, _vp]),
+    "rbs_facet_key": (_i64, [_vp]),
+    "rbs_facet_normal": (_i, [_vp, _vp, _d, _i64, ctypes.POINTER(_i64), _vp]),
 }
 
 

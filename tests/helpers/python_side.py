@@ -10,8 +10,9 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 particle_body, bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix,
 rebound_model_frame), the wall records (``direct_model.wall``: WallMaterial, TabulatedWall and the node maxima) and
 the sampler's restitution factor (``surrogate.kernels.fastmath.restitution_factor``), user grains (tests/helpers/grains.py); those of every
-hit (``surrogate.kernels.wall_hit``: ``rebound``, ``rebound_path``, ``SPIN_TOLERANCE``, the METHOD_*
-and PATH_* codes); the law comparisons of tests/helpers/direct_law.py (its states, ``tablegen simulate`` and the
+hit (``surrogate.kernels.wall_hit``: ``rebound``, ``rebound_path``, ``SPIN_TOLERANCE``, ``MAX_WALL_HITS``, the
+METHOD_* and PATH_* codes), a rough wall's facets (``surrogate.kernels.facet``: ``facet_key``, ``facet_normal``;
+``direct_model.wall.MAX_ROUGHNESS_DEG``); the law comparisons of tests/helpers/direct_law.py (its states, ``tablegen simulate`` and the
 statistics); tables come from ``tablegen.build_table`` and ``tablegen.parse_config``;
 file checks and the samples' angle conversion from ``data_schema``.
 """
@@ -27,7 +28,7 @@ from surrogate.kernels.direct_path import direct_rebound
 from surrogate.kernels.locate import mix_shape
 from data_schema.table import TABLE_VERSION
 from direct_model.collision import collide
-from direct_model.wall import MAX_CONTACT_SINES, MAX_CONTACT_SPEEDS, TabulatedWall, WallMaterial
+from direct_model.wall import MAX_CONTACT_SINES, MAX_CONTACT_SPEEDS, MAX_ROUGHNESS_DEG, TabulatedWall, WallMaterial
 from surrogate.kernels.fastmath import restitution_factor
 from direct_model.body_rebound import quaternion_to_matrix
 from direct_model.runtime import (SCRATCH_SIZE, U_PER_REBOUND, aspect_ratio, normal_quantile, rebound_model_frame,
@@ -35,8 +36,9 @@ from direct_model.runtime import (SCRATCH_SIZE, U_PER_REBOUND, aspect_ratio, nor
 from direct_model.shape_arrays import bounding_radius, particle_body, shape_arrays
 from direct_model.shapes import MAX_VERTICES, SHAPES, AspectRatioLaw, body_vertices
 from tests.helpers.grains import cloud_grain, hull_grain
-from surrogate.kernels.wall_hit import (METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE,
-                                        SPIN_TOLERANCE, rebound, rebound_path)
+from surrogate.kernels.wall_hit import (MAX_WALL_HITS, METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT,
+                                        PATH_TABLE, SPIN_TOLERANCE, rebound, rebound_path)
+from surrogate.kernels.facet import facet_key, facet_normal
 from tests.helpers.direct_law import (A, N, STATES, assert_one_law, frame_of, incident, one_law, simulated, state_id,
                                       to_model_frame)
 
@@ -105,4 +107,5 @@ __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", 
            "collide", "normal_quantile", "quaternion_to_matrix", "direct_rebound", "uniform_quaternion",
            "A", "N", "SHAPES", "STATES", "assert_one_law", "frame_of", "incident", "one_law", "simulated", "state_id",
            "to_model_frame", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE",
-           "SPIN_TOLERANCE", "rebound_path", "rebound", "mix_shape", "TABLE_VERSION"]
+           "SPIN_TOLERANCE", "rebound_path", "rebound", "mix_shape", "TABLE_VERSION", "MAX_ROUGHNESS_DEG",
+           "MAX_WALL_HITS", "facet_key", "facet_normal"]

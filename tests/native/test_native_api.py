@@ -1,16 +1,16 @@
-"""The C library's public interface as native/include/rebound_scatter.h declares it (version 1.0).
+"""The C library's public interface as native/include/rebound_scatter.h declares it (version 1.2).
 
 - The public shared library exports exactly the header's RBS_API functions (the internal ones only from the
   test-only library), and tests.helpers.native_library types each of them.
 - The ctypes records of tests.helpers.native_library have the header's layout (sizeof, offsetof of every field, the
   RBS_*_INIT initialisers byte for byte), the enumerations and constants their values, as a C program compiled
-  against the header prints them; the header compiles without a warning in C11 and C++17 (-Wall -Wextra -pedantic),
-  its initialisers too.
+  against the header prints them, and so do the Fortran module's bind(c) types; the header compiles without a warning
+  in C11 and C++17 (-Wall -Wextra -pedantic), its initialisers too.
 - Records that grow: a record whose size is smaller than its 1.0 size gives RBS_INVALID, for every record of every
   call; an rbs_result whose size covers only up to its status gets only that written; records larger than the
   library's (a program built against a later header) work, their later bytes neither read nor written; a NULL
   rbs_options is RBS_OPTIONS_INIT.
-- The version (1.1.0, 1001000) and the one status space: each status a distinct value and a string.
+- The version (1.2.0, 1002000) and the one status space: each status a distinct value and a string.
 - The many-hit and local draws' refusals (rbs_draw_many, rbs_draw_local).
 """
 
@@ -25,8 +25,9 @@ import pytest
 
 from tests.helpers import python_side as py
 from tests.helpers.native_library import (ENUMS, HEADER, INSTALL_HINT, INTERNAL, INTERPOLATION_STOCHASTIC, INVALID,
-                                          LOCAL_SIZE, METHOD_AUTO, METHOD_DIRECT, METHOD_TABLE, NATIVE, NO_KEY, OK,
-                                          PATH_NONE, PUBLIC, RECORDS, STATUSES, U_PER_DRAW, VERSION_NUMBER, Grain, Hit,
+                                          LOCAL_SIZE, MAX_ROUGHNESS_DEG, MAX_WALL_HITS, METHOD_AUTO, METHOD_DIRECT,
+                                          METHOD_TABLE, NATIVE, NO_KEY, OK, PATH_NONE, PUBLIC, RECORDS,
+                                          ROUGHNESS_OF_TABLE, STATUSES, U_PER_DRAW, VERSION_NUMBER, Grain, Hit,
                                           Hits, Options, Result, Results, Rng, ShapeInfo, TableInfo, WallInfo, address,
                                           fields, hit, options, ref, run)
 from tests.helpers.states import max_ulp
@@ -86,7 +87,8 @@ def test_the_testing_library_exports_the_internal_functions(native):
 # ---------------------------------------------------------------- the header's records, enumerations and constants
 
 DEFINES = {"RBS_U_PER_DRAW": U_PER_DRAW, "RBS_VERSION_NUMBER": VERSION_NUMBER, "RBS_NO_KEY": NO_KEY,
-           "RBS_LOCAL_SIZE": LOCAL_SIZE, "RBS_BLOCK": 32}
+           "RBS_LOCAL_SIZE": LOCAL_SIZE, "RBS_BLOCK": 32, "RBS_MAX_ROUGHNESS_DEG": MAX_ROUGHNESS_DEG,
+           "RBS_ROUGHNESS_OF_TABLE": ROUGHNESS_OF_TABLE, "RBS_MAX_WALL_HITS": MAX_WALL_HITS}
 
 
 def _layout_program() -> str:
@@ -106,7 +108,8 @@ def _layout_program() -> str:
             lines.append(f'    printf("enum {constant} %d\\n", (int){constant});')
     for constant in ("RBS_U_PER_DRAW", "RBS_VERSION_NUMBER", "RBS_NO_KEY", "RBS_LOCAL_SIZE", "RBS_BLOCK",
                      "RBS_VERSION_MAJOR", "RBS_VERSION_MINOR", "RBS_VERSION_PATCH", "RBS_TABLE_FORMAT_MAJOR",
-                     "RBS_TABLE_MAX_SHAPES", "RBS_SHAPE_NAME_SIZE", "RBS_NORMAL_TOLERANCE", "RBS_SPIN_TOLERANCE"):
+                     "RBS_TABLE_MAX_SHAPES", "RBS_SHAPE_NAME_SIZE", "RBS_NORMAL_TOLERANCE", "RBS_SPIN_TOLERANCE",
+                     "RBS_MAX_ROUGHNESS_DEG", "RBS_ROUGHNESS_OF_TABLE", "RBS_MAX_WALL_HITS"):
         lines.append(f'    printf("define {constant} %.17g\\n", (double)({constant}));')
     lines += ["    return 0;", "}"]
     return "\n".join(lines) + "\n"
@@ -166,11 +169,13 @@ def test_the_enumerations_and_constants_are_the_helper_s_and_the_packages(header
     defines = {key[1]: float(value) for key, value in header_facts.items() if key[0] == "define"}
     for constant, value in DEFINES.items():
         assert defines[constant] == value, constant
-    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 1, 0)
+    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 2, 0)
     assert defines["RBS_U_PER_DRAW"] == py.U_PER_DRAW
     assert defines["RBS_SPIN_TOLERANCE"] == py.SPIN_TOLERANCE
     assert defines["RBS_NORMAL_TOLERANCE"] == NORMAL_TOLERANCE
     assert defines["RBS_TABLE_MAX_SHAPES"] == MAX_TABLE_SHAPES
+    assert defines["RBS_MAX_ROUGHNESS_DEG"] == py.MAX_ROUGHNESS_DEG
+    assert defines["RBS_MAX_WALL_HITS"] == py.MAX_WALL_HITS
     # the hits' statuses are surrogate's
     assert (OK, STATUSES["RBS_TRAPPED"], STATUSES["RBS_FAILED"], INVALID) == \
         (py.STATUS_REBOUNDED, py.STATUS_TRAPPED, py.STATUS_FAILED, py.STATUS_INVALID)
@@ -180,6 +185,48 @@ def test_the_enumerations_and_constants_are_the_helper_s_and_the_packages(header
 def test_the_header_s_table_format_is_the_one_read_and_written(header_facts, table_pair):
     defines = {key[1]: float(value) for key, value in header_facts.items() if key[0] == "define"}
     assert defines["RBS_TABLE_FORMAT_MAJOR"] == py.TABLE_VERSION[0] == table_pair[1].info().format_major
+
+
+def _fortran_layout_program() -> str:
+    """A Fortran program printing, for each record of the module (native/fortran/rebound_scatter.f90), its c_sizeof
+    and each field's offset (c_loc differences), as _layout_program prints them for C, and the defaults of the
+    fields of 1.2."""
+    lines = ["program layout", "  use rebound_scatter", "  implicit none"]
+    for k, name in enumerate(RECORDS):
+        lines.append(f"  type({name}), target :: x{k}")
+    lines.append("  print '(a, es24.17, 1x, i0, 1x, es24.17)', 'defaults ', x1%roughness_deg, x2%wall_hits, "
+                 "x7%roughness_deg")
+    for k, (name, record) in enumerate(RECORDS.items()):
+        lines.append(f"  print '(a, i0)', 'sizeof {name} ', c_sizeof(x{k})")
+        for field in fields(record):
+            lines.append(f"  print '(a, i0)', 'offsetof {name} {field} ', &\n"
+                         f"    transfer(c_loc(x{k}%{field}), 0_c_intptr_t) - transfer(c_loc(x{k}), 0_c_intptr_t)")
+    lines.append("end program layout")
+    return "\n".join(lines) + "\n"
+
+
+def test_the_fortran_records_have_the_header_s_layout(native_build, header_facts, tmp_path):
+    """The bind(c) types of the Fortran module: the header's sizeof and offsets, field for field (the fields of 1.2
+    too), and the defaults of RBS_OPTIONS_INIT, RBS_RESULT_INIT and RBS_WALL_INFO_INIT for the fields of 1.2."""
+    compiler = shutil.which("gfortran")
+    assert compiler, f"no Fortran compiler: {INSTALL_HINT}"
+    source = tmp_path / "layout.f90"
+    source.write_text(_fortran_layout_program())
+    done = run([compiler, f"-I{native_build / 'fortran_modules'}", str(source), "-o", str(tmp_path / "layout")])
+    assert done.returncode == 0, done.stderr[-3000:]
+    done = run([str(tmp_path / "layout")])
+    assert done.returncode == 0, done.stderr
+    facts = {}
+    for line in done.stdout.splitlines():
+        *key, value = line.split()
+        facts[tuple(key)] = value
+    for key, value in facts.items():
+        if key[0] in ("sizeof", "offsetof"):
+            assert int(value) == int(header_facts[key]), key
+    assert len(facts) == 1 + sum(1 + len(fields(record)) for record in RECORDS.values())
+    (roughness, wall_hits, wall_roughness), = [line.split()[1:] for line in done.stdout.splitlines()
+                                                if line.startswith("defaults")]
+    assert (float(roughness), int(wall_hits), float(wall_roughness)) == (ROUGHNESS_OF_TABLE, 0, 0.0)
 
 
 @pytest.mark.parametrize("language", ["c11", "c++17"])
@@ -202,7 +249,7 @@ def test_the_header_compiles_without_warnings(tmp_path, language):
 def test_version(native):
     version = native.version()
     major, minor, patch = map(int, version.split("."))
-    assert (major, minor, patch) == (1, 1, 0)
+    assert (major, minor, patch) == (1, 2, 0)
     assert native.version_number() == VERSION_NUMBER == major * 1_000_000 + minor * 1_000 + patch
 
 
