@@ -122,6 +122,9 @@ def _build_parser() -> argparse.ArgumentParser:
     report.add_argument("--alpha1", type=_alpha1_list, metavar="LIST",
                         help=f"comma-separated incidence angles in {ALPHA1_RANGE_TEXT} deg (default: 5,10,...,90 with "
                              "--direct; the table's grid with --table, of which LIST must be a subset)")
+    report.add_argument("--roughness-deg", type=_roughness_list, metavar="LIST",
+                        help="with --table: comma-separated wall roughness values in [0, 45] deg; the report adds the "
+                             "law of the mix (or of the first shape) on those rough walls (docs/model.md §12)")
     report.add_argument("--overwrite", action="store_true",
                         help="replace an existing output folder if it is a report this command wrote")
     report.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
@@ -269,6 +272,17 @@ def _alpha1_list(text: str) -> tuple:
         raise argparse.ArgumentTypeError(f"comma-separated angles in {ALPHA1_RANGE_TEXT} deg; {exc}") from None
 
 
+def _roughness_list(text: str) -> tuple:
+    """Comma-separated roughness values in [0, MAX_ROUGHNESS_DEG] degrees, as a tuple (argparse type)."""
+    from direct_model.wall import MAX_ROUGHNESS_DEG, check_roughness
+
+    try:
+        return tuple(check_roughness(float(v)) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"comma-separated roughness values in [0, {MAX_ROUGHNESS_DEG:g}] deg; got "
+                                         f"{text!r}") from None
+
+
 def _progress(args) -> bool:
     return not args.no_progress and sys.stderr.isatty()
 
@@ -398,6 +412,8 @@ def _report(args) -> int:
     require_matplotlib()
     if args.config is not None and not args.direct:
         raise ValueError(f"--config {args.config} goes with --direct: a table (--table) holds its own model")
+    if args.roughness_deg is not None and args.direct:
+        raise ValueError("--roughness-deg goes with --table: the rough wall's facet hits take the table's paths")
     if args.direct:
         config = _config(args)
         available = (tuple(FAMILIES) if config is None else config.shapes) + (MIX,)
@@ -409,7 +425,7 @@ def _report(args) -> int:
         data = direct_data(shapes, args.alpha1 or DEFAULT_ALPHA1, args.n, seed, progress=_progress(args),
                            config=config)
     else:
-        data = table_data(args.table, args.shapes, args.alpha1, args.n, seed)
+        data = table_data(args.table, args.shapes, args.alpha1, args.n, seed, args.roughness_deg or ())
     path = write_report(data, args.out, overwrite=args.overwrite)
     print(f"report written to {path / 'index.md'}")
     return 0

@@ -209,10 +209,30 @@ FIGURES = (
 )
 
 
+def rough_figure(data: ReportData) -> Figure:
+    """Mean α2 (left) and the standard deviation of β2 (right) against α1, one line per roughness Δγ."""
+    fig = _figure(11, 4.2)
+    left, right = fig.subplots(1, 2)
+    for roughness in sorted({g for g, _ in data.rough}):
+        points = [(a1, data.rough[roughness, a1]) for a1 in data.alpha1 if (roughness, a1) in data.rough]
+        a1 = [a for a, _ in points]
+        label = "smooth" if roughness == 0 else f"Δγ = {roughness:g}°"
+        left.plot(a1, [np.degrees(r.alpha2).mean() for _, r in points], marker="o", label=label)
+        right.plot(a1, [np.degrees(r.beta2).std() for _, r in points], marker="o", label=label)
+    left.set(xlabel=r"$\alpha_1$ (deg)", ylabel=r"mean $\alpha_2$ (deg)")
+    right.set(xlabel=r"$\alpha_1$ (deg)", ylabel=r"sd of $\beta_2$ (deg)")
+    left.legend()
+    fig.suptitle(f"{data.rough_shape} on rough walls, |V⁻| = {data.speed:g} m/s")
+    return fig
+
+
 def write_figures(data: ReportData, stats: dict, folder) -> list:
-    """Draw and save every figure of :data:`FIGURES` into ``folder``; return [(file, title, caption)]."""
+    """Draw and save every figure of :data:`FIGURES` into ``folder``, and :func:`rough_figure` as
+    ``rough_wall.png`` if the data have rough walls; return [(file, title, caption)] of :data:`FIGURES`'."""
     written = []
     for file, title, caption, draw in FIGURES:
         draw(data, stats).savefig(Path(folder) / file, dpi=DPI)
         written.append((file, title, caption))
+    if data.rough:
+        rough_figure(data).savefig(Path(folder) / "rough_wall.png", dpi=DPI)
     return written

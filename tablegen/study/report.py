@@ -37,8 +37,8 @@ from direct_model.shapes import MIX, SHAPES, AspectRatioLaw, second_moment_facto
 from tablegen.progress import progress_bar
 from tablegen.study.figures import require_matplotlib, write_figures
 from tablegen.study.statistics import (
-    COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, ReportData, from_sample_set, nearest_alpha1,
-    point_statistics,
+    COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, ReportData, RoughSamples, from_sample_set,
+    nearest_alpha1, point_statistics,
 )
 
 PAPER_SPEED = 200.0                                    # m/s, incident speed of the paper's study
@@ -138,8 +138,12 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
         points=_with_mix(parts, shapes, alpha1, available))
 
 
-def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0) -> ReportData:
+def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0, roughness=()) -> ReportData:
     """Draw ``n`` reflected states per shape and α1 from a table, at its grid speed nearest 200 m/s.
+
+    ``roughness``: roughness values Δγ (degrees, in [0, 45]) at which to draw, besides, the law of the mix (or of
+    the first reported shape without it) on rough walls: ``n`` hits per (Δγ, α1) by :func:`surrogate.sample_global`
+    (docs/model.md §12), in :attr:`ReportData.rough`.
 
     ``shapes``: names of the table's shapes (families or user grains) and ``"mix"``; None: all and the mix.
 
@@ -183,6 +187,9 @@ def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0
                 status_counts=np.asarray(table.cells["status_counts"][cell], dtype=np.int64),
                 collision_counts=np.r_[collisions[:5], collisions[5:].sum()].astype(np.int64))
     inertias = ", ".join(f"{s} {value:.4f}" for s, value in inertias.items())
+    rough_shape = MIX if MIX in shapes else shapes[0]
+    rough = {(float(g), a): _rough_samples(sampler, rough_shape, a, speed, g, n, seed) for g in roughness
+             for a in alpha1}
     return ReportData(
         source=f"table `{path}` (made {table.created}, config sha256 {table.config_sha256[:12]}…), "
                f"drawn with `surrogate.sample_local`",
@@ -194,7 +201,26 @@ def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0
                      f"aspect-ratio law of the table ({inertias}). Against the direct model at 200 m/s this "
                      "overestimates the mean E_Ω⁺/E_V⁻ by 4–11 %, and by up to 21 % for ellipsoids near "
                      "normal impact (docs/report.md).",
-        points=_with_mix(parts, shapes, alpha1, tuple(table.shapes)))
+        points=_with_mix(parts, shapes, alpha1, tuple(table.shapes)), rough=rough,
+        rough_shape=rough_shape if rough else "")
+
+
+def _rough_samples(sampler, shape: str, alpha1: float, speed: float, roughness: float, n: int,
+                   seed: int) -> RoughSamples:
+    """``n`` hits of ``shape`` (the table's mix for ``"mix"``) at (α1 deg, |V⁻| m/s) on the lab wall of
+    roughness ``roughness`` degrees, by :func:`surrogate.sample_global` (half-size 1 m: the angles do not
+    depend on it)."""
+    import surrogate
+
+    a1 = math.radians(alpha1)
+    V = np.tile([speed * math.cos(a1), -speed * math.sin(a1), 0.0], (n, 1))
+    hits = surrogate.sample_global(sampler, V, [0.0, 1.0, 0.0], 1.0, shape, random_state=seed,
+                                   roughness_deg=roughness)
+    ok = hits.status == STATUS_REBOUNDED
+    Vp = hits.V[ok]
+    return RoughSamples(alpha2=np.arctan2(Vp[:, 1], np.hypot(Vp[:, 0], Vp[:, 2])),
+                        beta2=np.arctan2(Vp[:, 2], Vp[:, 0]), again=float(np.mean(hits.wall_hits > 1)),
+                        trapped=float(np.mean(hits.status == surrogate.STATUS_TRAPPED)))
 
 
 def _ordered(shapes, available) -> tuple:
@@ -263,11 +289,30 @@ def render_index(data: ReportData, stats: dict, figures) -> str:
     for file, title, caption in figures:
         parts.append(f"## {title}\n\n{caption}\n\n![{title}]({file})")
     parts.append(_collision_section(data, stats))
+    if data.rough:
+        parts.append(_rough_section(data))
     parts.append("## Numbers\n\nMeans and most probable (m.p.) values over the rebounded particles; "
                  "\"rebounds\" is the number of rebounded samples, \"trapped %\" is of all particles.")
     for shape in data.shapes:
         parts.append(f"### {shape}\n\n" + _numbers_table(data, stats, shape))
     return "\n\n".join(parts) + "\n"
+
+
+def _rough_section(data: ReportData) -> str:
+    """The rough walls' numbers: per (Δγ, α1) the mean and sd of α2 and β2 (deg) and the shares that hit again
+    and were trapped."""
+    rows = []
+    for (roughness, a1), r in data.rough.items():
+        alpha2, beta2 = np.degrees(r.alpha2), np.degrees(r.beta2)
+        rows.append([f"{roughness:g}", f"{a1:g}", f"{alpha2.mean():.2f}", f"{alpha2.std():.2f}",
+                     f"{beta2.mean():.2f}", f"{beta2.std():.2f}", f"{100 * r.again:.2f}", f"{100 * r.trapped:.2f}"])
+    return ("## Rough walls\n\n"
+            f"{data.rough_shape} on walls of roughness Δγ (docs/model.md §12) at |V⁻| = {data.speed:g} m/s, "
+            f"{data.n} hits of `surrogate.sample_global` per row (the table where it holds, the direct model for "
+            "the other facet hits); \"hit again\": a rebound off a facet into the mean wall, hitting another facet."
+            "\n\n![Rough walls](rough_wall.png)\n\n"
+            + markdown_table(["Δγ (deg)", "α1 (deg)", "α2 mean", "α2 sd", "β2 mean", "β2 sd", "hit again %",
+                              "trapped %"], rows))
 
 
 def _conditions(data: ReportData) -> str:

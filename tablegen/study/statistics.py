@@ -83,6 +83,8 @@ class ReportData:
     seed : the seed of every run.
     counts_note, e_rot_method : markdown sentences on the collision counts and on E_Ω⁺/E_V⁻.
     points : {(shape, α1): PointSamples}.
+    rough : {(Δγ deg, α1): RoughSamples} of :attr:`rough_shape` on rough walls (docs/model.md §12); {}: none.
+    rough_shape : the shape (or ``"mix"``) of ``rough``.
     """
 
     source: str
@@ -95,6 +97,19 @@ class ReportData:
     counts_note: str
     e_rot_method: str
     points: dict
+    rough: dict = dataclasses.field(default_factory=dict)
+    rough_shape: str = ""
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class RoughSamples:
+    """The rebounds of one (Δγ, α1) on a rough wall: α2 and β2 (rad) of the rebounded particles, the share of
+    hits that hit the wall again (a rebound off a facet into the mean wall) and of trapped hits."""
+
+    alpha2: np.ndarray
+    beta2: np.ndarray
+    again: float
+    trapped: float
 
 
 def lab_velocity(alpha2, beta2, speed_ratio) -> np.ndarray:

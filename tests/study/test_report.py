@@ -221,3 +221,23 @@ def test_cli_from_a_table(small_table_path, tmp_path, capsys):
     # α1 off the table's grid: exit 2 naming alpha1 and the grid
     user_error(tablegen_main, ["report", "--table", str(small_table_path), "-o", str(tmp_path / "r2"),
                                "--alpha1", "45"], capsys, "alpha1")
+
+
+def test_cli_from_a_table_on_rough_walls(small_table_path, tmp_path, capsys):
+    """--roughness-deg adds the mix's law on those walls: a figure and one row per (Δγ, α1); the smooth wall's rows
+    never hit again, and the rough wall widens β2 at every α1 (400 hits a row: sd of an sd about 4 %)."""
+    out = tmp_path / "report"
+    assert tablegen_main(["report", "--table", str(small_table_path), "-o", str(out), "--shapes", "mix",
+                          "-n", "400", "--seed", "1", "--alpha1", "30,60", "--roughness-deg", "0,20"]) == 0
+    index = (out / "index.md").read_text(encoding="utf-8")
+    assert (out / "rough_wall.png").stat().st_size > 10_000 and "![Rough walls](rough_wall.png)" in index
+    section = index.split("## Rough walls")[1].split("\n## ")[0]
+    cells = [line.strip("| ").split(" | ") for line in section.splitlines() if line[2:3].isdigit()]
+    rows = {(float(c[0]), float(c[1])): [float(x) for x in c[2:]] for c in cells}
+    assert set(rows) == {(0.0, 30.0), (0.0, 60.0), (20.0, 30.0), (20.0, 60.0)}
+    for a1 in (30.0, 60.0):
+        assert rows[0.0, a1][4] == 0.0 and rows[20.0, a1][3] > 1.2 * rows[0.0, a1][3]
+    user_error(tablegen_main, ["report", "--direct", "-o", str(tmp_path / "r3"), "--roughness-deg", "5"], capsys,
+               "--roughness-deg goes with --table")
+    user_error(tablegen_main, ["report", "--table", str(small_table_path), "-o", str(tmp_path / "r4"),
+                               "--roughness-deg", "5,50"], capsys, "[0, 45]", "5,50")
