@@ -8,7 +8,8 @@ only turns those records into the solver-neutral record of the BSD module tableg
 (``SolverHits``, through saturne_api) and calls it; the statistics and their bounds are that module's (its
 docstring states them). It takes the hits a table or the direct model answered on the zones given (--zone,
 all by default), which must draw from one table with one mix, method and interpolation (each zone's, as the
-hits files list them; --table replaces the table):
+hits files list them; --table replaces the table), on a smooth wall (a rough zone, roughness_deg > 0, is
+refused):
 
 1. the path of every hit against the zones' method (``path_rule`` for auto: code_saturne 6.0's particles
    carry no spin (Ω⁻ = 0), so the direct model answers exactly the hits outside the table's grid; every hit
@@ -47,7 +48,8 @@ METHOD_PATH = {"table": PATH_TABLE, "direct": PATH_DIRECT}   # the one path of e
 def drawn_hits(run_dir: Path, zones=None) -> tuple[dict, dict]:
     """The hits a table or the direct model answered on ``zones`` (names; all if None), and their settings:
     the run's header with the zones' table, shape, method and interpolation. ValueError if no hit is left,
-    or if the zones differ in any of these: a comparison draws from one law."""
+    if the zones differ in any of these (a comparison draws from one law), or if one is rough (surrogate answers
+    the hits here on the smooth wall)."""
     hits, headers = read_hits(run_dir)
     keep = hits["interaction"] == HITS_TITLE
     if zones is not None:
@@ -56,6 +58,10 @@ def drawn_hits(run_dir: Path, zones=None) -> tuple[dict, dict]:
         raise ValueError(f"no hit a table or the direct model answered on {', '.join(zones or ['any zone'])}")
     described = zone_settings(run_dir)
     used = sorted(set(hits["patch"][keep].tolist()))
+    rough = [f"{z} (roughness_deg {described[z]['roughness']:g})" for z in used if described[z]["roughness"] > 0]
+    if rough:
+        raise ValueError(f"the zones {', '.join(rough)} are rough: the comparison with surrogate is of smooth walls; "
+                         "compare the smooth zones (--zone)")
     laws = {(described[z]["table"], str(described[z]["shape"]), described[z]["method"],
              described[z]["interpolation"]) for z in used}
     if len(laws) > 1:

@@ -28,11 +28,16 @@ STOCK_TYPES = ("rebound", "deposit", "outlet")   # the zone types that do what t
 ZONE_SUMMARY = {"hits": "hits", "rebounded": "rebounded", "stuck": "stuck", "removed": "removed",
                 "escaped": "escaped", "invalid": "invalid", "trapped": "trapped", "failed": "failed",
                 "table": "table", "direct": "direct", "speed_below": "|V|<grid", "speed_above": "|V|>grid",
-                "alpha1_outside": "alpha1-out", "outside_law": "out-of-law"}
+                "alpha1_outside": "alpha1-out", "outside_law": "out-of-law", "hit_again": "hit-again",
+                "at_cap": "at-cap"}
+# the counts of a log written before rough walls: neither hit-again nor at-cap, nor the roughness column
+_ZONE_SUMMARY_SMOOTH = dict(list(ZONE_SUMMARY.items())[:-2])
 _TYPES = "|".join(("rebound-scatter",) + STOCK_TYPES)
+# files written before rough walls have no roughness: their walls were smooth
 _ZONE = re.compile(rf"(?P<zone>.+?) = (?:(?P<stock>{'|'.join(STOCK_TYPES)})|rebound-scatter, table (?P<table>.+?), "
                    r"mix (?P<mix>.+?), method (?P<method>\w+), interpolation (?P<interpolation>\w+), "
-                   r"trapped (?P<trapped>\w+), wall (?P<wall>.*))$")
+                   r"trapped (?P<trapped>\w+)(?:, roughness (?P<roughness>[-0-9.eE+]+) deg(?: \(the table's\))?)?, "
+                   r"wall (?P<wall>.*))$")
 
 
 def read_hits(run_dir: Path) -> tuple[dict, list]:
@@ -45,7 +50,8 @@ def zone_settings(run_dir: Path) -> dict:
     """What each zone the adapter handles does, from the end of the hits files' second line: zone name ->
     ``{"type": ...}``, one of rebound-scatter and :data:`STOCK_TYPES`, and for rebound-scatter the zone's
     table (absolute path), shape (a name, or a dict of weights, as ``read_hits``'s headers give it), method,
-    interpolation, trapped (``deposit`` or ``remove``) and wall. ValueError if the line lists no zones."""
+    interpolation, trapped (``deposit`` or ``remove``), roughness (deg; 0 for files written before rough walls)
+    and wall. ValueError if the line lists no zones."""
     with rank_files(Path(run_dir) / "hits")[0].open() as fh:
         fh.readline()
         line = fh.readline().rstrip("\n")
@@ -64,22 +70,33 @@ def zone_settings(run_dir: Path) -> dict:
             pairs = (pair.split(":") for pair in shape[len("weights ("):-1].split(","))
             shape = {name.strip(): float(weight) for name, weight in pairs}
         out[m["zone"]] = {"type": "rebound-scatter", "table": m["table"], "shape": shape, "method": m["method"],
-                          "interpolation": m["interpolation"], "trapped": m["trapped"], "wall": m["wall"]}
+                          "interpolation": m["interpolation"], "trapped": m["trapped"],
+                          "roughness": float(m["roughness"] or 0), "wall": m["wall"]}
     return out
 
 
 def zone_summary(log_text: str) -> dict:
     """rbs_cs_finalize's per-zone counts (summed over the ranks) in a run_solver.log: zone name -> the counts
-    of :data:`ZONE_SUMMARY`'s columns by key, and ``interaction``, what the zone does."""
+    of :data:`ZONE_SUMMARY`'s columns by key, ``roughness``, the zone's wall roughness Δγ in degrees (None for a
+    zone of a stock type), and ``interaction``, what the zone does. A log written before rough walls has neither
+    ``hit_again``, ``at_cap`` nor ``roughness``."""
     block = log_text[log_text.rindex("    Per zone ("):].splitlines()
-    if block[1].split() != ["zone", *ZONE_SUMMARY.values(), "interaction"]:
+    header = block[1].split()
+    if header == ["zone", *_ZONE_SUMMARY_SMOOTH.values(), "interaction"]:
+        columns, roughness = _ZONE_SUMMARY_SMOOTH, ""
+    elif header == ["zone", *ZONE_SUMMARY.values(), "roughness", "interaction"]:
+        columns, roughness = ZONE_SUMMARY, r"\s+(\S+)"
+    else:
         raise ValueError(f"not the per-zone summary's columns: {block[1]!r}")
     out = {}
     for line in block[2:]:
-        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(ZONE_SUMMARY)}}})  (.*)$", line)
+        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(columns)}}}){roughness}  (.*)$", line)
         if m is None:
             break
-        out[m.group(1)] = dict(zip(ZONE_SUMMARY, map(int, m.group(2).split())), interaction=m.group(3))
+        counts = dict(zip(columns, map(int, m.group(2).split())))
+        if roughness:
+            counts["roughness"] = None if m.group(3) == "-" else float(m.group(3))
+        out[m.group(1)] = dict(counts, interaction=m.group(m.lastindex))
     return out
 
 

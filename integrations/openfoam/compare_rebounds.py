@@ -20,7 +20,8 @@ their bounds). The script:
    answered on the patches of one wall (``--patch``; a run with a ``patches`` list has a table per wall)
    (``solver_comparison.compare_hits``: the table's hits with ``surrogate.sample_global``, method
    "table", the direct model's with method "direct", Ω⁻ included; KS per variable, a classifier
-   two-sample test, the fractions not rebounded, each against the bound of one law);
+   two-sample test, the fractions not rebounded, each against the bound of one law); the hits of smooth
+   walls only (a patch's ``roughnessDeg`` 0): a rough patch is refused;
 3. compares the spinning hits with the table-only rebound (Ω⁻ ignored, as the adapter did before it
    passed Ω⁻) and the table's hits with the stock bounce (standardWallInteraction rebound, e = 1,
    mu = 0: specular, α2 = α1, β2 = 0, s = 1) on the same incident states;
@@ -57,7 +58,10 @@ HITS_TITLE = "stochasticRebound"   # the hits files' header: "# stochasticReboun
 PATCH_SUMMARY = {"hits": "hits", "rebounded": "rebounded", "stuck": "stuck", "removed": "removed",
                  "escaped": "escaped", "invalid": "invalid", "trapped": "trapped", "failed": "failed",
                  "table": "table", "direct": "direct", "speed_below": "|V|<grid", "speed_above": "|V|>grid",
-                 "alpha1_outside": "alpha1-out", "outside_law": "out-of-law"}
+                 "alpha1_outside": "alpha1-out", "outside_law": "out-of-law", "hit_again": "hit-again",
+                 "at_cap": "at-cap"}
+# the counts of a log written before rough walls: neither hit-again nor at-cap, nor the roughness column
+_PATCH_SUMMARY_SMOOTH = dict(list(PATCH_SUMMARY.items())[:-2])
 
 
 # ----------------------------------------------------------------------------- reading
@@ -99,6 +103,27 @@ def drawn_hits(hits: dict, patches=None) -> dict:
     return select_hits(hits, keep)
 
 
+def patch_roughness(case: Path) -> dict:
+    """Patch name -> the roughness (deg) its hits were drawn with, for each patch that draws, as the hits files'
+    second line states it (``NAME = stochasticRebound, ..., roughness R deg``; {} for files written before rough
+    walls, all of whose walls were smooth)."""
+    with rank_files(hits_dir(case))[0].open() as fh:
+        fh.readline()
+        line = fh.readline()
+    found = re.findall(r"(?:Patches: |; )(\S+) = stochasticRebound, .*?, roughness ([-0-9.eE+]+) deg", line)
+    return {patch: float(roughness) for patch, roughness in found}
+
+
+def _smooth_only(case: Path, hits: dict) -> None:
+    """ValueError if a patch of ``hits`` is rough: surrogate answers the comparison's hits on the smooth wall."""
+    drawn = set(hits["patch"].tolist())
+    rough = {patch: r for patch, r in patch_roughness(case).items() if r > 0 and patch in drawn}
+    if rough:
+        raise ValueError(f"the patches {', '.join(f'{p} (roughnessDeg {r:g})' for p, r in rough.items())} are "
+                         "rough: the comparison with surrogate is of smooth walls; compare the smooth patches "
+                         "(--patch)")
+
+
 def _table_of(settings: dict, table_path: Path | None) -> Path:
     """The table to compare with: the one given, else the run's global table."""
     if table_path is None and settings["table"] == "none":
@@ -109,18 +134,26 @@ def _table_of(settings: dict, table_path: Path | None) -> Path:
 
 def patch_summary(log: str) -> dict:
     """The adapter's per-patch counts at the last time step of a solver log: patch name -> the counts of
-    :data:`PATCH_SUMMARY`'s columns by key, and ``interaction``, what the patch does."""
+    :data:`PATCH_SUMMARY`'s columns by key, ``roughness``, the wall's roughness Δγ in degrees (None for a patch
+    that does not draw), and ``interaction``, what the patch does. A log written before rough walls has
+    neither ``hit_again``, ``at_cap`` nor ``roughness``."""
     block = log[log.rindex("    Per patch ("):].splitlines()
     header = block[1].split()
-    if header != ["patch", *PATCH_SUMMARY.values(), "interaction"]:
+    if header == ["patch", *_PATCH_SUMMARY_SMOOTH.values(), "interaction"]:
+        columns, roughness = _PATCH_SUMMARY_SMOOTH, ""
+    elif header == ["patch", *PATCH_SUMMARY.values(), "roughness", "interaction"]:
+        columns, roughness = PATCH_SUMMARY, r"\s+(\S+)"
+    else:
         raise ValueError(f"not the per-patch summary's columns: {block[1]!r}")
     out = {}
     for line in block[2:]:
-        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(PATCH_SUMMARY)}}})  (.*)$", line)
+        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(columns)}}}){roughness}  (.*)$", line)
         if m is None:
             break
-        counts = dict(zip(PATCH_SUMMARY, map(int, m.group(2).split())))
-        out[m.group(1)] = dict(counts, interaction=m.group(3))
+        counts = dict(zip(columns, map(int, m.group(2).split())))
+        if roughness:
+            counts["roughness"] = None if m.group(3) == "-" else float(m.group(3))
+        out[m.group(1)] = dict(counts, interaction=m.group(m.lastindex))
     return out
 
 
@@ -183,8 +216,9 @@ def compare_paths(case: Path, table_path: Path | None = None, patches=None) -> d
     from the path the run recorded)."""
     hits, headers = read_hits(case)
     settings = headers[0]
-    return path_rule(solver_hits(drawn_hits(hits, patches), settings), load(_table_of(settings, table_path)),
-                     settings["spin_tolerance"])
+    hits = drawn_hits(hits, patches)
+    _smooth_only(case, hits)
+    return path_rule(solver_hits(hits, settings), load(_table_of(settings, table_path)), settings["spin_tolerance"])
 
 
 def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifier: bool = True,
@@ -196,6 +230,7 @@ def compare(case: Path, table_path: Path | None = None, seed: int = 1, classifie
     the table's hits against the stock bounce (``Agreement`` records; their classifier is not run)."""
     hits, headers = read_hits(case)
     hits = drawn_hits(hits, patches)
+    _smooth_only(case, hits)
     settings = headers[0]
     table_path = _table_of(settings, table_path)
     table = load(table_path)

@@ -8,8 +8,8 @@ method auto; the solver's rebounds follow surrogate's law at the same incident s
 solver-neutral comparison tablegen.study.solver_comparison, called through compare_saturne_rebounds.py); each
 rank draws its own stream; each particle hits as one grain (grain kept) and the grains follow the mix's
 weights; trapped particles are deposited or removed; each boundary zone does what its [zone] section says
-(its own wall's table, or a stock behaviour) and is counted apart; a bad setup stops the solver with one
-clear message; and the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
+(its own wall's table, a rough wall, or a stock behaviour) and is counted apart; a bad setup stops the solver
+with one clear message; and the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
 
 These tests need code_saturne: they fail (they are not skipped) when it is missing, with a message naming
 integrations/code_saturne/install-deps.sh.
@@ -40,7 +40,7 @@ sys.path.insert(0, str(CS_DIR))
 
 import compare_saturne_rebounds  # noqa: E402
 import make_channel_table  # noqa: E402
-from read_hits import HITS_TITLE, read_cpu_seconds, read_hits, read_summary, zone_summary  # noqa: E402
+from read_hits import HITS_TITLE, read_cpu_seconds, read_hits, read_summary, zone_settings, zone_summary  # noqa: E402
 from saturne_api import (PATH_DIRECT, PATH_TABLE, STATUS_REBOUNDED, build_table_from_text,  # noqa: E402
                          grain_mismatches, load)
 
@@ -540,6 +540,9 @@ def test_each_zone_does_what_its_section_says(zones_case):
     assert target["removed"] == target["trapped"] > 200 and target["stuck"] == 0
     assert sides["rebounded"] == sides["hits"] and sum(sides[k] for k in (
         "table", "direct", "trapped", "speed_below", "speed_above", "alpha1_outside")) == 0
+    # the tables' walls are smooth: one wall hit per hit
+    assert walls["roughness"] == target["roughness"] == 0 and sides["roughness"] is None
+    assert walls["hit_again"] == walls["at_cap"] == target["hit_again"] == target["at_cap"] == 0
     # the first block: the hits a table or the direct model answered, both drawing zones'
     assert info["hits"] == walls["hits"] + target["hits"] and info["direct"] == walls["direct"]
     assert info["trapped"] == walls["trapped"] + target["trapped"]
@@ -593,19 +596,37 @@ def test_each_zone_draws_from_its_own_table(zones_case, wall_tables):
         compare_saturne_rebounds.compare(zones_case / "RESU", classifier=False)
 
 
+# the roughness (deg) of the walls zone in test_deposit_and_outlet_zones
+ROUGHNESS_DEG = 10
+
+
 def test_deposit_and_outlet_zones(cs_build, wall_tables, tmp_path_factory):
     """A deposit zone keeps every particle that hits it, at rest (the solver counts them as deposited), an
     outlet zone lets every one leave; neither is recorded, both are counted. The records are thinned
-    (hits_every = 3): the 1st, 4th, 7th, ... of the walls' hits, as the file's second line says."""
+    (hits_every = 3): the 1st, 4th, 7th, ... of the walls' hits, as the file's second line says. walls, a
+    section of its own with roughness_deg = 10 (a rough wall on the elastic wall's smooth table), says so in the
+    log and the hits files, and some of its hits hit the wall again; compare_saturne_rebounds.py refuses it."""
     # hits_every before the sections: a global key
     case = _zones_case(tmp_path_factory, "cs_stock_zones", wall_tables,
-                       "hits_every = 3\n\n[zone sides]\ntype = deposit\n[zone target]\ntype = outlet\n")
+                       f"hits_every = 3\n\n[zone walls]\nroughness_deg = {ROUGHNESS_DEG}\n"
+                       "[zone sides]\ntype = deposit\n[zone target]\ntype = outlet\n")
     _allrun(case, wall_tables["elastic"])
-    rows = zone_summary((case / "RESU" / "run_solver.log").read_text())
+    log = (case / "RESU" / "run_solver.log").read_text()
+    rows = zone_summary(log)
     assert {z: r["interaction"] for z, r in rows.items()} == {
         "target": "outlet", "walls": "rebound-scatter, wall elastic (hard steel)", "sides": "deposit"}
     assert rows["sides"]["stuck"] == rows["sides"]["hits"] > 100
     assert rows["target"]["escaped"] == rows["target"]["hits"] > 100
+    walls = rows["walls"]
+    assert f"rebound-scatter: zone walls = rebound-scatter, table {wall_tables['elastic']}" in log
+    assert f", roughness {ROUGHNESS_DEG} deg, wall elastic (hard steel)\n" in log
+    assert walls["roughness"] == ROUGHNESS_DEG and rows["sides"]["roughness"] is None
+    # some hits hit the wall again (docs/model.md §12: 2-5 % at Δγ = 10°); one path counted each
+    assert 0 < walls["hit_again"] < 0.2 * walls["hits"] and walls["at_cap"] <= walls["hit_again"], walls
+    assert walls["hits"] == walls["table"] + walls["direct"] + walls["invalid"], walls
+    assert zone_settings(case / "RESU")["walls"]["roughness"] == ROUGHNESS_DEG
+    with pytest.raises(ValueError, match=rf"the zones walls \(roughness_deg {ROUGHNESS_DEG}\) are rough"):
+        compare_saturne_rebounds.compare(case / "RESU", classifier=False)
     hits, _ = read_hits(case / "RESU")
     assert set(hits["patch"].tolist()) == {"walls"}
     # one rank: its walls hits are all the hits it would record, of which every 3rd is written
@@ -632,8 +653,11 @@ def test_deposit_and_outlet_zones(cs_build, wall_tables, tmp_path_factory):
      ['[zone target]: a zone of type rebound takes no key but type, not "table"']),
     ("[zone target]\nseed = 3\n",
      ['global key "seed" in [zone target]; the keys of a section are type, table, shape, weights, method, '
-      "interpolation, trapped"]),
-], ids=["unknown type", "unknown zone", "zone not CS_LAGR_BC_USER", "key of another type", "global key"])
+      "interpolation, trapped, roughness_deg"]),
+    ("[zone target]\nroughness_deg = 50\n",
+     ['[zone target]: roughness_deg must be in [0, 45] (degrees), not "50"']),
+], ids=["unknown type", "unknown zone", "zone not CS_LAGR_BC_USER", "key of another type", "global key",
+        "roughness out of range"])
 def test_bad_zone_section_is_one_clear_error(cs_build, wall_tables, tmp_path_factory, sections, words):
     case = _zones_case(tmp_path_factory, "cs_bad_zone", wall_tables, "\n" + sections, split=False)
     proc = _allrun(case, wall_tables["elastic"], check=False)

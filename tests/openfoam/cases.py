@@ -285,6 +285,20 @@ RESTART_HITS_EVERY = 3
 # remembered spin decays measurably
 SPIN_RELAXATION_S = 2e-4
 
+# the roughness (deg) of the walls patch in the run "rough"; frontAndBack stays smooth (its table's wall)
+ROUGHNESS_DEG = 10
+
+
+def _rough(case: Path) -> None:
+    """A patches list: walls on a rough wall (roughnessDeg ROUGHNESS_DEG), frontAndBack on the smooth wall of the
+    same table (no roughnessDeg: the table's, 0)."""
+    insert_coeff(case, f"""patches
+        (
+            walls           {{ type stochasticRebound; roughnessDeg {ROUGHNESS_DEG}; }}
+            frontAndBack    {{ type stochasticRebound; }}
+        );""")
+
+
 # name: (table, MPI ranks, patch interaction model, edit of the copied case or None)
 CASES = {
     "serial": ("case", 1, "stochasticRebound", None),
@@ -300,6 +314,7 @@ CASES = {
     "trapped_stick": ("trapping", 1, "stochasticRebound", _trapped("stick")),
     "trapped_remove": ("trapping", 1, "stochasticRebound", _trapped("remove")),
     "patches": ("elastic", 1, "stochasticRebound", _per_patch),
+    "rough": ("case", 1, "stochasticRebound", _rough),
     # parcels without spin: spinRelaxation auto (the default), off, a time (run to 2.5 ms, restarted by the test)
     # and auto on 2 ranks
     "kinematic": ("case", 1, "stochasticRebound", _kinematic),

@@ -9,8 +9,8 @@ rebounds the table answered and those the direct model answered against
 surrogate on the same incident states (the BSD statistics of
 tablegen.study.solver_comparison, called through compare_rebounds), the random streams per rank, the grain
 each parcel keeps from hit to hit (grain kept), a moving wall, OpenFOAM's erosion model beside ours, a wall per
-patch (two tables, OpenFOAM's rebound, an open patch; the per-patch summary) and the refused patch entries, and
-times the runs against standardWallInteraction.
+patch (two tables, OpenFOAM's rebound, an open patch; the per-patch summary), a rough patch beside a smooth one
+and the refused patch entries, and times the runs against standardWallInteraction.
 
 These tests need OpenFOAM: they fail (they are not skipped) when it is
 missing, with a message naming integrations/openfoam/install-deps.sh.
@@ -582,6 +582,9 @@ def test_each_patch_does_what_its_entry_says(patches_case, capsys):
     for name, r in drawn.items():
         assert r["hits"] == r["table"] + r["direct"] + r["invalid"] and r["escaped"] == 0, (name, r)
         assert r["trapped"] + r["failed"] == r["stuck"] + r["removed"], (name, r)
+        # the tables' walls are smooth: one wall hit per hit
+        assert r["roughness"] == 0 and r["hit_again"] == r["at_cap"] == 0, (name, r)
+    assert rows["back"]["roughness"] is None and rows["outlet"]["roughness"] is None
     walls, front, back, outlet = rows["walls"], rows["front"], rows["back"], rows["outlet"]
     # walls: method auto, the spinning hits to the direct model; front: method table, the trapped removed
     assert walls["direct"] > 500 and walls["table"] > 1000 and walls["stuck"] == walls["trapped"] == 0, walls
@@ -654,6 +657,86 @@ def test_each_wall_draws_from_its_own_table(patches_case, runs_folder):
         compare_rebounds.compare(patches_case, elastic, classifier=False)
 
 
+def test_a_rough_patch_hits_again_and_a_smooth_one_keeps_its_bits(runs_folder, openfoam_build):
+    """cases.CASES["rough"]: walls with roughnessDeg 10, frontAndBack on the same table's smooth wall. The log
+    states each patch's roughness; some of the walls' hits hit the wall again, none of frontAndBack's, whose
+    paths follow the rule of auto; compare_rebounds refuses the rough patch. Every
+    hit takes 13 uniforms of the rank's stream, rough or not, so the run's hits replay through the C library
+    (rbs_rebound on the recorded V⁻, n and grain key, with the stream's uniforms): the parcels' first hits
+    (Ω⁻ = 0, whose V⁺ does not depend on the recorded a's rounding) give the recorded V⁺ bit for bit,
+    frontAndBack's with roughness 0 (the smooth law), the walls' with roughness 10 where the replay
+    hit the wall once by the table (a hit that hits again goes on spinning, with a); with roughness 0 none of
+    the walls' does."""
+    from tests.helpers.native_library import PATH_TABLE as C_PATH_TABLE
+    from tests.helpers.native_library import U_PER_DRAW, Native
+
+    case = _case(runs_folder, "rough")
+    log = (case / f"log.{SOLVER}").read_text()
+    assert re.search(rf"\n        walls: stochasticRebound, .*, roughness {cases.ROUGHNESS_DEG} deg\n", log)
+    assert re.search(r"\n        frontAndBack: stochasticRebound, .*, roughness 0 deg \(the table's\)\n", log)
+    rows, info = compare_rebounds.patch_summary(log), _cloud_info(log)
+    rough, smooth = rows["walls"], rows["frontAndBack"]
+    assert rough["roughness"] == cases.ROUGHNESS_DEG and smooth["roughness"] == 0, rows
+    # α1 of 10-60° at Δγ 10° hits again 2-5 % of the time (docs/model.md §12)
+    assert 0.01 * rough["hits"] < rough["hit_again"] < 0.2 * rough["hits"] and rough["at_cap"] <= rough["hit_again"]
+    assert smooth["hit_again"] == smooth["at_cap"] == 0 and smooth["hits"] > 5000, smooth
+    # a rough hit is counted by the path of its last wall hit: one path each, as on a smooth wall
+    for r in (rough, smooth):
+        assert r["hits"] == r["table"] + r["direct"] + r["invalid"] and r["invalid"] == 0, r
+    assert info["hits"] == rough["hits"] + smooth["hits"] == info["table"] + info["direct"], info
+    # the smooth patch's paths follow the rule of method auto; a rough patch is not compared with surrogate
+    paths = compare_rebounds.compare_paths(case, patches=["frontAndBack"])
+    assert paths["spinning_not_direct"] == paths["outside_not_direct"] == paths["still_inside_not_table"] == 0
+    with pytest.raises(ValueError, match=rf"the patches walls \(roughnessDeg {cases.ROUGHNESS_DEG}\) are rough"):
+        compare_rebounds.compare(case, classifier=False)
+
+    hits, headers = compare_rebounds.read_hits(case)
+    native = Native(_cache() / "native-install" / "lib")
+    table = native.table(case / "constant" / "rebound_table.h5")
+    mix = table.mix("prism")
+    state = native.seed(headers[0]["seed"], 0)
+    replayed = {}
+    for i in range(len(hits["time"])):
+        u, state = native.fill(state, U_PER_DRAW)
+        assert u[0] == hits["u0"][i], i
+        if hits["Win"][i].any():
+            continue
+        patch = str(hits["patch"][i])
+        for roughness in (0.0, float(cases.ROUGHNESS_DEG)):
+            result, _ = table.hit(mix, hits["V"][i], hits["Win"][i], hits["n"][i], hits["a"][i], u,
+                                  key=int(hits["key"][i]), roughness_deg=roughness)
+            same = np.array_equal(np.array(result.V[:]), hits["Vout"][i])
+            once = result.wall_hits == 1 and result.path == C_PATH_TABLE
+            replayed.setdefault((patch, roughness), []).append((same, once))
+    smooth_bits, smooth_rough = (np.array(replayed["frontAndBack", r]) for r in (0.0, cases.ROUGHNESS_DEG))
+    rough_smooth, rough_bits = (np.array(replayed["walls", r]) for r in (0.0, cases.ROUGHNESS_DEG))
+    assert len(smooth_bits) > 3000 and smooth_bits[:, 0].all() and not smooth_rough[:, 0].any()
+    once = rough_bits[:, 1]
+    assert once.sum() > 0.9 * len(rough_bits) > 1000 and rough_bits[once, 0].all()
+    assert not rough_smooth[:, 0].any()
+
+
+def test_a_rough_wall_widens_the_rebound_angles(runs_folder, serial_case, capsys):
+    """rebound_spread.py on the serial run and on cases.CASES["rough"] (the same case, walls rough): the parcels'
+    first hits (Ω⁻ = 0) meet the walls in the same incident states in both runs, and on the rough walls their
+    rebound angle from the wall spreads wider (sd 15.1° → 16.8°; with seeds 1 and 2, 15.4° → 16.4° and 15.4° →
+    16.7°), out of the impact plane too; frontAndBack, smooth in both, keeps its spread."""
+    import rebound_spread
+
+    smooth, rough = (rebound_spread.spread(case) for case in (serial_case, _case(runs_folder, "rough")))
+    with capsys.disabled():
+        for name, run in (("smooth", smooth), ("rough walls", rough)):
+            print(f"\nhopperRebound, {name}: " + "; ".join(
+                f"{patch} roughness {p['roughness']:g}, {p['hit_again']} of {p['hits']} hits hit again, first hits' "
+                f"a2 sd {p['first']['alpha2_sd']:.2f}, b2 sd {p['first']['beta2_sd']:.2f}" for patch, p in run.items()))
+    walls = smooth["walls"]["first"], rough["walls"]["first"]
+    assert walls[0]["n"] == walls[1]["n"] > 1000
+    assert walls[1]["alpha2_sd"] > walls[0]["alpha2_sd"] + 0.8 and walls[1]["beta2_sd"] > walls[0]["beta2_sd"] + 1
+    sides = smooth["frontAndBack"]["first"], rough["frontAndBack"]["first"]
+    assert sides[0]["n"] == sides[1]["n"] and abs(sides[1]["alpha2_sd"] - sides[0]["alpha2_sd"]) < 0.5
+    assert smooth["walls"]["hit_again"] == 0 < rough["walls"]["hit_again"]
+
+
 def _refused(case_table, folder, edit, solver=SOLVER) -> str:
     """The solver's log of the case edited by ``edit``, which must stop with a FatalIOError before a time step."""
     case = cases.copy_case(folder)
@@ -686,13 +769,16 @@ def _patches(entries: str):
      ["patches entry walls in stochasticReboundCoeffs: bad shape cube for the table"]),
     (_patches("walls { type stochasticRebound; } frontAndBack { type escape; e 0.5; }"),
      ["unknown entry e in patches entry frontAndBack in stochasticReboundCoeffs; the entries are type"]),
+    (_patches("walls { type stochasticRebound; roughnessDeg 50; } frontAndBack { type stick; }"),
+     ["patches entry walls in stochasticReboundCoeffs: roughnessDeg must be in [0, 45] (degrees), not 50"]),
 ])
 def test_bad_patches_entries_stop_before_the_first_step(openfoam_build, case_table, tmp_path_factory, edit,
                                                         words):
     """A wall no entry names, an unknown type, e outside [0, 1], a table file missing, a name no patch has, a
-    shape the table lacks and an entry the type does not read: each a one-line FatalIOError naming the entry and
-    what is allowed, before any time step."""
+    shape the table lacks, an entry the type does not read and a roughness outside [0, 45] degrees: each a
+    one-line FatalIOError naming the entry and what is allowed, before any time step."""
     log = _refused(case_table, tmp_path_factory.mktemp("bad_patches"), edit)
+    assert log.count("FOAM FATAL IO ERROR") == 1, log[-3000:]
     for word in words:
         assert word in log, log[-3000:]
 

@@ -107,6 +107,8 @@ typedef struct {
   char        wall[RBS_CS_LINE];       /* its wall's name, else its law family */
   double      alpha1_lo, alpha1_hi, speed_lo, speed_hi;
   double      law_lo, law_hi;           /* the |V| its wall law holds over */
+  double      roughness;                /* its wall's (deg; 0: smooth), the
+                                           default of its zones */
 } rbs_cs_table_t;
 
 /* What a zone does; rule 0 holds the global settings, the rule of the
@@ -120,6 +122,11 @@ typedef struct {
   int         method;                  /* rbs_method */
   int         interpolation;           /* rbs_interpolation */
   int         remove_trapped;          /* 0: deposited, 1: removed */
+  double      roughness_given;         /* roughness_deg as given (deg), or
+                                          RBS_ROUGHNESS_OF_TABLE */
+  double      roughness;               /* the one its hits are drawn with:
+                                          the given one, else its table's
+                                          wall's */
 } rbs_cs_rule_t;
 
 typedef struct {
@@ -144,14 +151,16 @@ typedef struct {
 /* The counts per zone: the hits, each one of rebounded, stuck, removed,
    escaped or invalid; why a drawn hit did not rebound; its path; the drawn
    hits outside the grid of the zone's table, by cause; those outside the
-   speeds its wall law holds over */
+   speeds its wall law holds over; the drawn hits that hit the wall again
+   (rbs_result.wall_hits > 1) and those that reached RBS_MAX_WALL_HITS */
 enum {ZC_HITS, ZC_REBOUNDED, ZC_STUCK, ZC_REMOVED, ZC_ESCAPED, ZC_INVALID,
       ZC_TRAPPED, ZC_FAILED, ZC_TABLE, ZC_DIRECT, ZC_SPEED_BELOW,
-      ZC_SPEED_ABOVE, ZC_ALPHA1_OUT, ZC_OUTSIDE_LAW, ZC_N};
+      ZC_SPEED_ABOVE, ZC_ALPHA1_OUT, ZC_OUTSIDE_LAW, ZC_HIT_AGAIN, ZC_AT_CAP,
+      ZC_N};
 static const char *const _zc_names[ZC_N] = {
   "hits", "rebounded", "stuck", "removed", "escaped", "invalid", "trapped",
   "failed", "table", "direct", "|V|<grid", "|V|>grid", "alpha1-out",
-  "out-of-law"};
+  "out-of-law", "hit-again", "at-cap"};
 
 static int                 _initialized = 0;
 static rbs_cs_settings_t   _set;
@@ -186,11 +195,12 @@ _thread_cpu_seconds(void)
 
 /* A section's keys first: the others are global only */
 static const char *_keys[] = {"type", "table", "shape", "weights", "method",
-                              "interpolation", "trapped", "seed",
-                              "half_size_factor", "hits", "max_hit_records",
-                              "hits_every", "grain", "grain_seed"};
+                              "interpolation", "trapped", "roughness_deg",
+                              "seed", "half_size_factor", "hits",
+                              "max_hit_records", "hits_every", "grain",
+                              "grain_seed"};
 #define RBS_CS_N_KEYS (sizeof(_keys)/sizeof(_keys[0]))
-#define RBS_CS_N_SECTION_KEYS 7
+#define RBS_CS_N_SECTION_KEYS 8
 
 /* The global keys (before the first section) or one [zone NAME] section */
 typedef struct {
@@ -347,8 +357,8 @@ _read_settings_file(const char *path, int *n_blocks)
       bft_error(__FILE__, __LINE__, 0,
                 "rebound-scatter settings %s, line %d: unknown key \"%s\"; "
                 "the keys are table, shape, weights, seed, method, "
-                "interpolation, trapped, half_size_factor, hits, "
-                "max_hit_records, hits_every, grain, grain_seed, then "
+                "interpolation, trapped, roughness_deg, half_size_factor, "
+                "hits, max_hit_records, hits_every, grain, grain_seed, then "
                 "[zone NAME] sections", path, line_no, key);
     if (b->zone[0] == '\0' && i == 0)
       bft_error(__FILE__, __LINE__, 0,
@@ -358,7 +368,7 @@ _read_settings_file(const char *path, int *n_blocks)
       bft_error(__FILE__, __LINE__, 0,
                 "rebound-scatter settings %s, line %d: %s \"%s\" in [zone %s]"
                 "; the keys of a section are type, table, shape, weights, "
-                "method, interpolation, trapped", path, line_no,
+                "method, interpolation, trapped, roughness_deg", path, line_no,
                 i < 0 ? "unknown key" : "global key", key, b->zone);
     if (b->given[i])
       bft_error(__FILE__, __LINE__, 0,
@@ -397,6 +407,30 @@ _parse_choice(const char *where, const char *key, const char *text,
   bft_error(__FILE__, __LINE__, 0, "%s: %s must be %s, not \"%s\"",
             where, key, allowed, text);
   return -1;
+}
+
+/* roughness_deg: a number of degrees in [0, RBS_MAX_ROUGHNESS_DEG] (the
+   library refuses every hit of a roughness out of range: refused here,
+   before any hit) */
+static double
+_parse_roughness(const char *where, const char *text)
+{
+  char *end = NULL;
+  const double v = strtod(text, &end);
+  if (end == text || *end != '\0' || !(v >= 0 && v <= RBS_MAX_ROUGHNESS_DEG))
+    bft_error(__FILE__, __LINE__, 0,
+              "%s: roughness_deg must be in [0, %g] (degrees), not \"%s\"",
+              where, RBS_MAX_ROUGHNESS_DEG, text);
+  return v;
+}
+
+/* The roughness of a rule on its table: the given one, else the table's
+   wall's */
+static void
+_resolve_roughness(rbs_cs_rule_t *rule)
+{
+  rule->roughness = rule->roughness_given >= 0 ? rule->roughness_given
+                                               : _tables[rule->table].roughness;
 }
 
 static const char *
@@ -451,11 +485,12 @@ _open_table(const char *where, const char *text)
   t->speed_hi = info.speed_max_m_s;
   t->law_lo = wall.speed_range_m_s[0];
   t->law_hi = wall.speed_range_m_s[1];
+  t->roughness = wall.roughness_deg;
   bft_printf("\n  rebound-scatter: opened the table %s (wall %s, its law "
-             "holding for |V| %g-%g m/s; %d shapes, alpha1 %g-%g deg, "
-             "|V| %g-%g m/s)\n", t->path, t->wall, t->law_lo, t->law_hi,
-             rbs_table_n_shapes(table), t->alpha1_lo, t->alpha1_hi,
-             t->speed_lo, t->speed_hi);
+             "holding for |V| %g-%g m/s, roughness %g deg; %d shapes, alpha1 "
+             "%g-%g deg, |V| %g-%g m/s)\n", t->path, t->wall, t->law_lo,
+             t->law_hi, t->roughness, rbs_table_n_shapes(table),
+             t->alpha1_lo, t->alpha1_hi, t->speed_lo, t->speed_hi);
   return _n_tables++;
 }
 
@@ -601,6 +636,10 @@ _read_section(const rbs_cs_block_t *b, const rbs_cs_block_t *global,
       rule->remove_trapped = _parse_choice(where, "trapped", trapped,
                                            _trapped_names, _trapped_codes, 2,
                                            "deposit or remove");
+    const char *roughness = _value(b, "roughness_deg");
+    if (roughness != NULL)
+      rule->roughness_given = _parse_roughness(where, roughness);
+    _resolve_roughness(rule);
   }
   _zone_rule[z->id] = _n_rules;
   _zone_listed[z->id] = 1;
@@ -685,6 +724,9 @@ _read_settings(void)
                                        trapped ? trapped : "deposit",
                                        _trapped_names, _trapped_codes, 2,
                                        "deposit or remove");
+  const char *roughness = _value(g, "roughness_deg");
+  rule->roughness_given = (roughness == NULL) ? RBS_ROUGHNESS_OF_TABLE
+    : _parse_roughness(where, roughness);
   const char *shape = _value(g, "shape"), *weights = _value(g, "weights");
   if (shape != NULL && weights != NULL)
     bft_error(__FILE__, __LINE__, 0,
@@ -694,6 +736,7 @@ _read_settings(void)
   if (table != NULL && table[0] != '\0') {
     rule->table = _open_table(where, table);
     _make_mix(where, rule, shape, weights);
+    _resolve_roughness(rule);
   }
 
   /* The zones: a section's own rule, else the global one for a
@@ -745,10 +788,11 @@ _describe(const rbs_cs_rule_t *rule, int full, char *out, size_t size)
   _absolute(table, t->path);
   snprintf(out, size,
            "rebound-scatter, table %s, mix %s, method %s, interpolation %s, "
-           "trapped %s, wall %s", table, rule->mix_name,
+           "trapped %s, roughness %g deg%s, wall %s", table, rule->mix_name,
            _name(rule->method, _method_names, _method_codes, 3),
            _name(rule->interpolation, _interp_names, _interp_codes, 2),
-           _trapped_names[rule->remove_trapped], t->wall);
+           _trapped_names[rule->remove_trapped], rule->roughness,
+           rule->roughness_given < 0 ? " (the table's)" : "", t->wall);
 }
 
 /*----------------------------------------------------------------------------
@@ -835,7 +879,8 @@ _open_hits(int rank)
           "none), n: unit normal into the gas, Uw: wall velocity, patch: "
           "boundary zone, origProc/origId: -1 (6.0's particles carry no "
           "persistent id), path: 0 table, 1 direct model, -1 invalid or "
-          "stock, Vout/Wout: rebound velocity and angular velocity, "
+          "stock (on a rough wall, the last of its wall hits), Vout/Wout: "
+          "rebound velocity and angular velocity, "
           "spin_ratio: |Win| a/|V|, u0: first uniform of the draw, key: the "
           "particle's grain key (from its random value; -1: a new grain per "
           "hit), shape: its shape (empty: drawn per hit), "
@@ -1025,10 +1070,12 @@ rbs_cs_finalize(void)
   int used = snprintf(line, sizeof(line), "      %-*s", (int)width, "zone");
   for (int k = 0; k < ZC_N; k++)
     used += snprintf(line + used, sizeof(line) - used, " %10s", _zc_names[k]);
+  used += snprintf(line + used, sizeof(line) - used, " %10s", "roughness");
   bft_printf("    Per zone (hits; their fate; the path; hits outside the "
              "table's grid: |V| below, |V| above, alpha1 outside; outside "
-             "the wall law's speeds)\n"
-             "%s  interaction\n", line);
+             "the wall law's speeds; hits that hit the wall again, and those "
+             "that reached %d wall hits; the wall's roughness, deg)\n"
+             "%s  interaction\n", RBS_MAX_WALL_HITS, line);
   for (int i = 0; i < _n_zones; i++) {
     const cs_gnum_t *zc = _zone_count + (size_t)i*ZC_N;
     if (!_zone_listed[i] && zc[ZC_HITS] == 0)
@@ -1038,7 +1085,13 @@ rbs_cs_finalize(void)
     for (int k = 0; k < ZC_N; k++)
       used += snprintf(line + used, sizeof(line) - used, " %10llu",
                        (unsigned long long)zc[k]);
-    _describe(_rules + _zone_rule[i], 0, text, sizeof(text));
+    const rbs_cs_rule_t *rule = _rules + _zone_rule[i];
+    if (rule->type == RBS_CS_DRAWN)
+      used += snprintf(line + used, sizeof(line) - used, " %10g",
+                       rule->roughness);
+    else
+      used += snprintf(line + used, sizeof(line) - used, " %10s", "-");
+    _describe(rule, 0, text, sizeof(text));
     bft_printf("%s  %s\n", line, text);
   }
 
@@ -1263,19 +1316,26 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
   rbs_options options = RBS_OPTIONS_INIT;
   options.method = rule->method;
   options.interpolation = rule->interpolation;
+  options.roughness_deg = rule->roughness;
 
   /* the first of the hit's 13 uniforms, for the record */
   rbs_rng peek = _rng;
   const double u0 = rbs_rng_uniform(&peek);
 
   /* the path is a pure function of the state: learnt before the draw, so
-     the clock runs around the direct model's calls only */
-  const int path = rbs_rebound_path(table->table, &hit, &options);
+     the clock runs around the direct model's calls only. On a rough wall
+     each wall hit takes its own path: the last one's is counted (a hit that
+     hits again ends on the direct model under auto), and the clock runs
+     around every hit */
+  const int rough = rule->roughness > 0;
+  const int mean_path = rbs_rebound_path(table->table, &hit, &options);
   double t0 = 0;
-  if (path == RBS_PATH_DIRECT)
+  if (rough || mean_path == RBS_PATH_DIRECT)
     t0 = cs_timer_wtime();
   const int status = rbs_rebound(table->table, rule->mix, &hit, &options,
                                  &result);
+  const int path = (rough && result.path != RBS_PATH_NONE) ? result.path
+                                                           : mean_path;
   const double *V = hit.V, *n = hit.n, *Vout = result.V;
   if (path == RBS_PATH_DIRECT) {
     _count.direct_seconds += cs_timer_wtime() - t0;
@@ -1287,6 +1347,8 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
     zc[ZC_TABLE]++;
   }
   _count.hits++;
+  zc[ZC_HIT_AGAIN] += result.wall_hits > 1;
+  zc[ZC_AT_CAP] += result.wall_hits >= RBS_MAX_WALL_HITS;
 
   if (status != RBS_INVALID) {
     /* outside the grid, by cause: the direct model answers under auto and

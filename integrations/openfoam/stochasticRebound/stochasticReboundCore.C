@@ -116,6 +116,19 @@ std::string ordinal(uint64_t n)
     return std::to_string(n) + suffix;
 }
 
+// A rule's roughness in a few words, for the log and the hits file
+std::string roughnessName(const stochasticReboundCore::Rule& rule)
+{
+    char text[64];
+    std::snprintf
+    (
+        text, sizeof(text), "roughness %g deg%s", rule.roughnessDeg,
+        rule.roughnessGiven < 0 ? " (the table's)" : ""
+    );
+    return text;
+}
+
+
 // A halfSizeFactor: finite and > 0
 scalar positiveFactor
 (
@@ -204,6 +217,23 @@ void Foam::stochasticReboundCore::readSettings
                 << ": method must be auto, table or direct, not " << method
                 << exit(FatalIOError);
         }
+    }
+
+    if (dict.found("roughnessDeg"))
+    {
+        // One token, a number: the library would refuse every hit of a
+        // roughness out of range, so it is refused here, before any hit
+        ITstream& is = dict.lookup("roughnessDeg");
+        const scalar deg =
+            is.size() == 1 && is[0].isNumber() ? is[0].number() : -1;
+        if (!(deg >= 0 && deg <= RBS_MAX_ROUGHNESS_DEG))
+        {
+            FatalIOErrorInFunction(dict)
+                << where.c_str() << ": roughnessDeg must be in [0, "
+                << RBS_MAX_ROUGHNESS_DEG << "] (degrees), not "
+                << is.toString().c_str() << exit(FatalIOError);
+        }
+        rule.roughnessGiven = deg;
     }
 }
 
@@ -307,6 +337,7 @@ Foam::stochasticReboundCore::openTable
     table->speedHi = info.speed_max_m_s;
     table->lawLo = wall.speed_range_m_s[0];
     table->lawHi = wall.speed_range_m_s[1];
+    table->roughness = wall.roughness_deg;
     table->wall =
         wall.name && *wall.name ? wall.name
       : wall.family ? wall.family : "";
@@ -462,6 +493,8 @@ void Foam::stochasticReboundCore::readTableAndMix
         rule,
         where
     );
+    rule.roughnessDeg =
+        rule.roughnessGiven >= 0 ? rule.roughnessGiven : rule.table->roughness;
 }
 
 
@@ -496,7 +529,7 @@ Foam::stochasticReboundCore::Rule Foam::stochasticReboundCore::entryRule
             dict,
             {
                 "type", "table", "shape", "weights", "method",
-                "interpolation", "trapped"
+                "interpolation", "trapped", "roughnessDeg"
             },
             where
         );
@@ -719,13 +752,14 @@ std::string Foam::stochasticReboundCore::describe
                 text, sizeof(text),
                 "stochasticRebound, wall %s, table %s (%d shape%s, alpha1 "
                 "%g-%g deg, |V| %g-%g m/s), shape %s%s, method %s%s, "
-                "interpolation %s, trapped parcels %s",
+                "interpolation %s, trapped parcels %s, %s",
                 t.wall.c_str(), t.file.c_str(), nShapes,
                 nShapes == 1 ? "" : "s", t.alpha1Lo, t.alpha1Hi,
                 t.speedLo, t.speedHi, rule.mixName.c_str(), factors.c_str(),
                 methodName(rule.method), tolerance,
                 interpolationName(rule.interpolation),
-                rule.removeTrapped ? "removed" : "stick"
+                rule.removeTrapped ? "removed" : "stick",
+                roughnessName(rule).c_str()
             );
             return text;
         }
@@ -971,17 +1005,24 @@ void Foam::stochasticReboundCore::drawRebound
     rbs_options options = RBS_OPTIONS_INIT;
     options.method = rule.method;
     options.interpolation = rule.interpolation;
+    options.roughness_deg = rule.roughnessDeg;
 
     // The path is a pure function of the state: learnt before the draw,
-    // so the clock runs around the direct model's calls only
-    const int path = rbs_rebound_path(t, &hit, &options);
+    // so the clock runs around the direct model's calls only. On a rough
+    // wall each facet hit takes its own path: the last one's is counted
+    // (a hit that hits again ends on the direct model under auto), and the
+    // clock runs around every hit
+    const bool rough = rule.roughnessDeg > 0;
+    const int meanPath = rbs_rebound_path(t, &hit, &options);
     std::chrono::steady_clock::time_point t0;
-    if (path == RBS_PATH_DIRECT)
+    if (rough || meanPath == RBS_PATH_DIRECT)
     {
         t0 = std::chrono::steady_clock::now();
     }
     rbs_result result = RBS_RESULT_INIT;
     const int status = rbs_rebound(t, rule.mix.get(), &hit, &options, &result);
+    const int path =
+        rough && result.path != RBS_PATH_NONE ? result.path : meanPath;
     if (path == RBS_PATH_DIRECT)
     {
         c.directSeconds += std::chrono::duration<double>
@@ -998,6 +1039,8 @@ void Foam::stochasticReboundCore::drawRebound
     }
 
     ++c.hits;
+    counts[pcHitAgain] += result.wall_hits > 1;
+    counts[pcAtCap] += result.wall_hits >= RBS_MAX_WALL_HITS;
 
     const scalar speed = mag(Vin);
     const scalar spinRatio = speed > 0 ? mag(Win)*a/speed : 0;
@@ -1269,7 +1312,7 @@ Foam::stochasticReboundCore::stochasticReboundCore
         "table", "shape", "weights", "halfSizeFactor", "trapped", "seed",
         "interpolation", "method", "grain", "grainSeed", "writeHits",
         "maxHitRecords", "hitsEvery", "patches", "spinRelaxation",
-        "U", "writePrecision", "writeToFile", "useUserTime", "defaultCoeffs"
+        "roughnessDeg", "U", "writePrecision", "writeToFile", "useUserTime", "defaultCoeffs"
     });
     checkEntries(coeffs, known, std::string(coeffs.dictName()));
     if (maxHitRecords_ < 0)
@@ -1400,7 +1443,8 @@ Foam::stochasticReboundCore::stochasticReboundCore
                " angular velocity (colliding parcels' own; else the spin"
                " remembered from the parcel's last rebound, or 0), n: unit"
                " normal into the gas, Uw: wall velocity, path: 0 table, 1"
-               " direct model, -1 invalid or stock, Vout/Wout: rebound"
+               " direct model, -1 invalid or stock (on a rough wall, the"
+               " last of its wall hits), Vout/Wout: rebound"
                " velocity (relative to the wall) and angular velocity,"
                " spin_ratio: |Win| a/|V|, u0: first uniform of the draw, key:"
                " the parcel's grain key (-1: a new grain per hit), shape: its"
@@ -1728,7 +1772,7 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
     {
         "hits", "rebounded", "stuck", "removed", "escaped", "invalid",
         "trapped", "failed", "table", "direct", "|V|<grid", "|V|>grid",
-        "alpha1-out", "out-of-law"
+        "alpha1-out", "out-of-law", "hit-again", "at-cap"
     };
     char cell[256];
     std::string line("      ");
@@ -1739,9 +1783,13 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
         std::snprintf(cell, sizeof(cell), " %10s", name);
         line += cell;
     }
+    std::snprintf(cell, sizeof(cell), " %10s", "roughness");
+    line += cell;
     os  << "    Per patch (hits; their fate; the path; hits outside the"
         << " table's grid: |V| below, |V| above, alpha1 outside; outside"
-        << " the wall law's speeds)" << nl
+        << " the wall law's speeds; hits that hit the wall again, and those"
+        << " that reached " << RBS_MAX_WALL_HITS << " wall hits; the"
+        << " wall's roughness, deg)" << nl
         << line.c_str() << "  interaction" << nl;
     forAll(patchRule_, patchi)
     {
@@ -1760,8 +1808,17 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
             std::snprintf(cell, sizeof(cell), " %10ld", long(n));
             line += cell;
         }
-        os  << line.c_str() << "  "
-            << describe((*rules_)[patchRule_[patchi]], false).c_str() << nl;
+        const Rule& rule = (*rules_)[patchRule_[patchi]];
+        if (rule.type == ruleDrawn)
+        {
+            std::snprintf(cell, sizeof(cell), " %10g", rule.roughnessDeg);
+        }
+        else
+        {
+            std::snprintf(cell, sizeof(cell), " %10s", "-");
+        }
+        line += cell;
+        os  << line.c_str() << "  " << describe(rule, false).c_str() << nl;
     }
 
     if (s.hits.is_open())
