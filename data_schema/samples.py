@@ -11,7 +11,8 @@ sampler, so both can be compared with the same tools. Layout (docs/format.md):
                            float64 (n,)  reflected angular velocity Ω⁺ a/|V⁻|, lab frame
     /samples/n_collisions  int32 (n,)    collisions in the rebound; −1 where unknown
     /samples/status        int8 (n,)     0 rebounded, 1 trapped, 2 failed
-    /samples/<extra>       optional 1-D per-particle datasets (see OPTIONAL_DATASETS)
+    /samples/<extra>       optional 1-D per-particle datasets (see OPTIONAL_DATASETS; among them the
+                           rebound's work on the wall W_n, W_t in m²/s², wall_work_normal, wall_work_tangential)
 
 Lab frame: wall y = 0 with normal +Y into the gas, impact plane XY, incident
 velocity V⁻ = |V⁻|(cos α1, −sin α1, 0). For trapped and failed particles the
@@ -77,6 +78,8 @@ OPTIONAL_DATASETS = {
     "n_search_steps": ("int32", "contact-search steps in the rebound"),
     "n_multiple_roots": ("int32", "collisions whose normal equation had 3 positive roots"),
     "failure_reason": ("int8", "0 none, 1 collision solver, 2 search budget, 3 not approaching"),
+    "wall_work_normal": ("float64", "m²/s²: work on the wall per unit particle mass, normal impulses"),
+    "wall_work_tangential": ("float64", "m²/s²: work on the wall per unit particle mass, tangential impulses"),
 }
 REQUIRED_ATTRS = ("alpha1_deg", "speed_m_s", "shape", "seed", "producer")
 

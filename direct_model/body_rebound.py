@@ -31,7 +31,7 @@ from data_schema.samples import (
     STATUS_FAILED, STATUS_REBOUNDED, STATUS_TRAPPED,
 )
 from direct_model.options import JIT, KERNEL
-from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide
+from direct_model.collision import COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_OK, collide, wall_work
 from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound, find_contact, jerk_bound,
                                   lowest_points)
 from direct_model.rotation import ROT_PARAMS_SIZE
@@ -52,6 +52,10 @@ class BodyRebound(NamedTuple):
     rotational_energy: float    # ½ Ω·KΩ per unit mass after the last collision, (m/s)²
     V: tuple                    # V after the last collision, m/s (3 floats): V⁺ if rebounded
     Omega: tuple                # Ω after the last collision, (m/s)/a (3 floats): Ω⁺ if rebounded
+    # the work of the collisions on the wall per unit particle mass, m²/s², each ≥ 0 (collision.wall_work), summed
+    # over the collisions applied (up to the trap or the failure); exactly, their sum is E⁻ − E⁺, E = ½|V|² + ½Ω·KΩ
+    wall_work_normal: float     # W_n, the normal impulses' (plastic indentation)
+    wall_work_tangential: float  # W_t, the tangential impulses' (the slip's cutting)
 
 # layout of the scratch array of :func:`body_rebound`: the candidate points' heights and rates, then g̈ (curvatures)
 _HEIGHTS = 0
@@ -149,6 +153,8 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
     status = STATUS_FAILED
     failure = FAILURE_NONE
     e_rot = 0.0
+    work_n = 0.0
+    work_t = 0.0
     t_abs = 0.0
     n_flights = 0
     while True:
@@ -190,22 +196,27 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
             failure = FAILURE_COLLISION_SOLVER if outcome == COLLISION_FAILED else FAILURE_NOT_APPROACHING
             break
         n_multi += outcome == COLLISION_MULTIPLE_ROOTS
+        hit_n, hit_t = wall_work(V, W, rc, dV, dW)
+        work_n += hit_n
+        work_t += hit_t
         V += dV
         W += dW
         n_coll += 1
     return BodyRebound(np.int64(status), np.int64(failure), np.int64(n_coll), np.int64(n_steps), np.int64(n_multi),
-                       e_rot, (V[0], V[1], V[2]), (W[0], W[1], W[2]))
+                       e_rot, (V[0], V[1], V[2]), (W[0], W[1], W[2]), work_n, work_t)
 
 
 @numba.njit(parallel=True, **JIT)
 def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall, n_max, contact_tol, set_tol,
-                       max_steps, out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi):
+                       max_steps, out_V, out_W, out_erot, out_ncoll, out_status, out_failure, out_steps, out_multi,
+                       out_work_n, out_work_t):
     """Run :func:`body_rebound` for every particle i (parallel over blocks of particles).
 
     Inputs per particle: ``shapes[i]`` its shape's index in ``shape_arrays``
     (:class:`direct_model.shape_arrays.ShapeArrays`), ``ratios[i] = (b/a, c/b)``,
     ``hands[i]`` = ±1, ``quats[i]`` orientation quaternion (any norm > 0).
-    Common: V0, W0 (lab; m/s and (m/s)/a), wall and the tolerances. Outputs are
+    Common: V0, W0 (lab; m/s and (m/s)/a), wall and the tolerances. Outputs (out_work_n and out_work_t: the
+    wall work W_n and W_t, m²/s² per unit mass, :class:`BodyRebound`) are
     filled per particle; each particle's result depends on its inputs only, not
     on the blocking.
     """
@@ -236,3 +247,5 @@ def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall,
             out_steps[i] = rebound.n_search_steps
             out_multi[i] = rebound.n_multiple_roots
             out_erot[i] = rebound.rotational_energy
+            out_work_n[i] = rebound.wall_work_normal
+            out_work_t[i] = rebound.wall_work_tangential

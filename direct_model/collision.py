@@ -27,8 +27,10 @@ reported with :data:`COLLISION_MULTIPLE_ROOTS`; the smallest is taken.
 
 Energy: per unit mass the kinetic energy changes by ΔV_p·(V_c⁻ + V_c⁺)/2. Its
 normal part is ½λ(1 − a_nc)v_c⁻ ≤ 0 (λ > 0, v_c⁻ < 0) and its tangential part
-−μλ|V_c,t⁻ + ½ΔV_c,t|² ≤ 0, so kinetic energy never increases. Angular
-momentum about the contact point, KΩ − r_c × V_p, is unchanged.
+−μλ|V_c,t⁻ + ½ΔV_c,t|² ≤ 0, so kinetic energy never increases; minus the two
+parts are the work the collision does on the wall, W_n and W_t (:func:`wall_work`;
+docs/model.md §4.7). Angular momentum about the contact point, KΩ − r_c × V_p,
+is unchanged.
 """
 
 import numba
@@ -230,3 +232,28 @@ def collide(V, W, r, Kinv, wall, dV, dW):
     for i in range(3):
         dW[i] = Kinv[i, 0] * tx + Kinv[i, 1] * ty + Kinv[i, 2] * tz
     return COLLISION_MULTIPLE_ROOTS if multiple else COLLISION_OK
+
+
+@numba.njit(**KERNEL)
+def wall_work(V, W, r, dV, dW):
+    """The work one collision does on the wall, per unit particle mass, m²/s² (docs/model.md §4.7): (W_n, W_t).
+
+    V, W, r as :func:`collide`'s (before the collision; W × r in m/s, r in units of a), dV and dW its changes. The
+    kinetic energy per unit mass changes by ΔV·(V_c⁻ + V_c⁺)/2 (the impulse acts at the contact point), with
+    V_c⁻ = V + W × r and V_c⁺ = (V + ΔV) + (W + ΔW) × r; minus its normal part, −Δv (v_c⁻ + v_c⁺)/2 ≥ 0, is W_n
+    (plastic indentation), minus its tangential part, −(Δu (u_c⁻ + u_c⁺) + Δw (w_c⁻ + w_c⁺))/2 ≥ 0, is W_t
+    (the slip's cutting). Both ≥ 0 up to round-off; W_n + W_t is the kinetic energy the collision takes.
+    Reads its inputs only, so the rebound's state keeps its bits.
+    """
+    rx, ry, rz = r[0], r[1], r[2]
+    u0 = V[0] + W[1] * rz - W[2] * ry
+    v0 = V[1] + W[2] * rx - W[0] * rz
+    w0 = V[2] + W[0] * ry - W[1] * rx
+    Vx, Vy, Vz = V[0] + dV[0], V[1] + dV[1], V[2] + dV[2]
+    Wx, Wy, Wz = W[0] + dW[0], W[1] + dW[1], W[2] + dW[2]
+    u1 = Vx + Wy * rz - Wz * ry
+    v1 = Vy + Wz * rx - Wx * rz
+    w1 = Vz + Wx * ry - Wy * rx
+    normal = -(dV[1] * (v0 + v1)) * 0.5
+    tangential = -(dV[0] * (u0 + u1) + dV[2] * (w0 + w1)) * 0.5
+    return normal, tangential

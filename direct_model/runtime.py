@@ -167,7 +167,9 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
 
     Returns
     -------
-    :class:`direct_model.body_rebound.BodyRebound`, model frame: V⁺ in m/s, Ω⁺ in (m/s)/a.
+    :class:`direct_model.body_rebound.BodyRebound`, model frame: V⁺ in m/s, Ω⁺ in (m/s)/a; the work of the
+    rebound on the wall per unit particle mass, ``wall_work_normal`` and ``wall_work_tangential`` in m²/s²
+    (docs/model.md §4.7; a scalar of the rebound, the same in every frame).
     """
     verts = scratch[_VERTS:_VERTS + 3 * TREE_ABOVE].reshape((TREE_ABOVE, 3))
     semi, K, scale = scratch[_SEMI:_SEMI + 3], scratch[_K:_K + 3], scratch[_SCALE:_SCALE + 3]

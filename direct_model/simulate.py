@@ -133,7 +133,9 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
     Returns
     -------
     SampleSet with V⁺ (m/s), Ω⁺a/|V⁻| (lab frame), collision counts, status and
-    per-particle extras (shape code, hand, b/a, c/b, E_Ω⁺/E_V⁻, search steps).
+    per-particle extras (shape code, hand, b/a, c/b, E_Ω⁺/E_V⁻, search steps, the work of the rebound on the wall
+    per unit particle mass W_n and W_t in m²/s², docs/model.md §4.7: ``wall_work_normal``, ``wall_work_tangential``,
+    summed up to the trap or the failure).
     """
     record = shape if isinstance(shape, (Ellipsoid, ConvexPolyhedron)) else None
     if record is None and not (isinstance(shape, str) and (shape == MIX or shape in FAMILIES)):
@@ -175,6 +177,8 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
     out_failure = np.empty(n, dtype=np.int8)
     out_steps = np.empty(n, dtype=np.int32)
     out_multi = np.empty(n, dtype=np.int32)
+    out_work_n = np.empty(n)
+    out_work_t = np.empty(n)
     codes = np.empty(n, dtype=np.int8)
     hands = np.empty(n, dtype=np.int8)
     ratios = np.empty((n, 2))
@@ -188,7 +192,7 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
         sl = slice(start, stop)
         body_rebound_batch(arrays, codes[sl], ratios[sl], hands[sl], q[:m], V0, W0, wall_arr, n_max, contact_tol,
                            set_tol, max_steps, out_V[sl], out_W[sl], out_erot[sl], out_ncoll[sl], out_status[sl],
-                           out_failure[sl], out_steps[sl], out_multi[sl])
+                           out_failure[sl], out_steps[sl], out_multi[sl], out_work_n[sl], out_work_t[sl])
         if progress is not None:
             progress(m)
 
@@ -197,7 +201,8 @@ def simulate(shape, alpha1: float, speed: float, n: int, seed: int | None = None
         alpha1=alpha1, speed=speed, shape=name, seed=seed, producer="tablegen simulate",
         extra={"shape_code": codes, "hand": hands, "b_over_a": ratios[:, 0], "c_over_b": ratios[:, 1],
                "e_rot_ratio": out_erot / (0.5 * speed ** 2), "n_search_steps": out_steps,
-               "n_multiple_roots": out_multi, "failure_reason": out_failure},
+               "n_multiple_roots": out_multi, "failure_reason": out_failure,
+               "wall_work_normal": out_work_n, "wall_work_tangential": out_work_t},
         provenance={"omega_in": omega_arr, "kappa": kappa, "n_max": n_max,
                     "contact_tol": contact_tol, "set_tol": set_tol, "max_steps": max_steps,
                     **dict(zip(("aspect_mean", "aspect_sd", "aspect_low", "aspect_high"),

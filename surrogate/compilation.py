@@ -25,8 +25,9 @@ ROWS = 4        # particles per call: the calls only need to run
 TABLE_KERNELS = ("sample_global", "sample_local", "table_rebound", "draw_local", "table_rebound_many",
                  "table_rebound_many_rng", "table_rebound_parallel", "table_rebound_parallel_rng",
                  "draw_local_parallel")
-# ... and, with a table of a shape the direct model answers, the direct model's
-DIRECT_KERNELS = ("sample_direct", "rebound", "direct_rebound")
+# ... and, with a table of a shape the direct model answers, the direct model's and the rough wall's (its re-hits
+# take the direct model)
+DIRECT_KERNELS = ("sample_direct", "rebound", "direct_rebound", "sample_global_rough", "rebound_rough")
 
 
 def _calls(table: SurrogateTable) -> list:
@@ -66,6 +67,9 @@ def _calls(table: SurrogateTable) -> list:
                                                 a[0], u[0], kernels.METHOD_AUTO)),
             ("direct_rebound", lambda: kernels.direct_rebound(params, shapes, code, V[0], omega[-1], n[0], a[0],
                                                               u[0, :kernels.U_PER_REBOUND])),
+            ("sample_global_rough", lambda: sample_global(table, V, n, a, shape, 0, omega=omega, roughness_deg=5.0)),
+            ("rebound_rough", lambda: kernels.rebound(data, params, shapes, table.model_shapes, cdf, V[0], omega[-1],
+                                                      n[0], a[0], u[0], kernels.METHOD_AUTO, True, -1, 5.0)),
         ]
     return calls
 

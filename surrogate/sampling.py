@@ -184,8 +184,11 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     collisions, −1 on the table path (on a rough wall: ``path`` and ``n_collisions`` of the last facet hit);
     ``wall_hits`` (N,) int32: the hits on the wall each took, 1 on a smooth wall, up to
     :data:`surrogate.MAX_WALL_HITS` on a rough one (a rebound still into the wall then counts as trapped), 0 for
-    a refused hit. Every check runs before anything is written: on a ValueError ``out`` is
-    unchanged. Hits whose |V⁻| lies outside the speeds the table's wall law holds over
+    a refused hit; ``wall_work_normal``, ``wall_work_tangential`` (N,) float64: the work of the hit on the wall per
+    unit particle mass, m²/s² (W_n, plastic indentation, and W_t, cutting; docs/model.md §4.7), from the direct
+    path (summed over a rough hit's facet hits, up to the trap or the failure), NaN where the table answered (it
+    does not hold them yet) and for a refused hit. Every check runs before anything is written: on a ValueError
+    ``out`` is unchanged. Hits whose |V⁻| lies outside the speeds the table's wall law holds over
     (``table.wall.speed_range_m_s``) are answered all the same, with one :class:`WallLawRangeWarning` giving
     their number.
     The direct model takes the families and the table's user grains (convex polyhedra), with the parameters the
@@ -247,7 +250,8 @@ def sample_direct(table: SurrogateTable, velocity, normal, half_size, shape="ell
     -------
     :class:`Rebounds` (as :func:`sample_global`'s): status STATUS_REBOUNDED (0), STATUS_TRAPPED (1) or
     STATUS_FAILED (2, a collision solve or contact search failed), NaN rows unless rebounded; path PATH_DIRECT;
-    n_collisions the rebound's collisions (up to the trap). Hits outside the wall law's speed range: as
+    n_collisions the rebound's collisions (up to the trap); wall_work_normal and wall_work_tangential its work on
+    the wall (m²/s², up to the trap or the failure). Hits outside the wall law's speed range: as
     :func:`sample_global`.
     """
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels

@@ -1,5 +1,5 @@
 /*
- * rebound_scatter.h: the native runtime of rebound-scatter, version 1.2.
+ * rebound_scatter.h: the native runtime of rebound-scatter, version 1.3.
  *
  * A C library that answers a particle's hit on a wall with its reflected state, for non-spherical particles
  * spinning or not, with the same law and the same bits as the numba kernels of the Python package `surrogate`
@@ -98,7 +98,7 @@ extern "C" {
 #endif
 
 #define RBS_VERSION_MAJOR 1
-#define RBS_VERSION_MINOR 2
+#define RBS_VERSION_MINOR 3
 #define RBS_VERSION_PATCH 0
 /* MAJOR · 1 000 000 + MINOR · 1 000 + PATCH, as rbs_version_number() returns it for the library linked */
 #define RBS_VERSION_NUMBER (RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 + RBS_VERSION_PATCH)
@@ -218,8 +218,16 @@ typedef struct rbs_result {
     double Omega[3];        /* reflected angular velocity Ω⁺, rad/s, global frame */
     int wall_hits;          /* since 1.2: the hits on the wall this hit took: 1 on a smooth wall, 1 to RBS_MAX_WALL_HITS
                                on a rough one (its facet hits); 0 for RBS_INVALID */
+    /* since 1.3: what the hit did to the wall (docs/model.md §4.7), the work of its collisions on the wall per unit
+       particle mass, m²/s² (J/kg), each >= 0; their sum is the particle's loss of translational plus rotational
+       kinetic energy. The direct path's (up to the trap or the failure; on a rough wall summed over the facet hits);
+       NaN on the table path, which does not hold them yet (on a rough wall: if the table answered any facet hit),
+       and for RBS_INVALID */
+    double wall_work_normal;        /* W_n: the normal impulses' work (plastic indentation) */
+    double wall_work_tangential;    /* W_t: the tangential impulses' work (cutting, the erosion of ductile walls) */
 } rbs_result;
-#define RBS_RESULT_INIT {sizeof(rbs_result), RBS_INVALID, RBS_PATH_NONE, -1, -1, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0}
+#define RBS_RESULT_INIT {sizeof(rbs_result), RBS_INVALID, RBS_PATH_NONE, -1, -1, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0, \
+                         0.0, 0.0}
 
 /* ---------------------------------------------------------------- every wall hit: call this first */
 
@@ -244,8 +252,8 @@ typedef struct rbs_result {
  * shape, up to RBS_MAX_WALL_HITS facet hits, after which the hit is RBS_TRAPPED. The first facet hit takes the
  * hit's uniforms; the facets and every later facet hit take keyed uniforms of a hash of them, so a hit never takes
  * more than RBS_U_PER_DRAW uniforms of a stream. result->wall_hits counts the facet hits; path and n_collisions are
- * the last one's; a facet not found (probability below 1e-14) gives RBS_FAILED. Roughness 0 is the smooth wall,
- * bit for bit. */
+ * the last one's, the wall work the sum of theirs; a facet not found (probability below 1e-14) gives RBS_FAILED.
+ * Roughness 0 is the smooth wall, bit for bit. */
 RBS_API int rbs_rebound(const rbs_table *table, const rbs_mix *mix, const rbs_hit *hit, const rbs_options *options,
                         rbs_result *result);
 

@@ -46,18 +46,19 @@ static void lab_tensor(const double *R, const double *diag, double *out)
 int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
                      const double R0[9], const double V0[3], const double W0[3], const double *wall, long long n_max,
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
-                     long long *n_collisions, long long *n_steps)
+                     long long *n_collisions, long long *n_steps, double wall_work[2])
 {
     double stack[2 * MAX_STACK_VERTICES], *h = stack;
     /* a large hull's heights and rates on the heap: one block per call, so that threads share nothing */
     if (nv > MAX_STACK_VERTICES && !(h = malloc(2 * (size_t)nv * sizeof *h))) {
         *n_collisions = 0;
         *n_steps = 0;
+        if (wall_work) wall_work[0] = wall_work[1] = 0.0;
         return RBS_FAILED;
     }
     int room = nv > MAX_STACK_VERTICES ? nv : MAX_STACK_VERTICES;
     int status = rbs_body_rebound_in(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_tol, set_tol,
-                                     max_steps, V, W, n_collisions, n_steps, h, h + room);
+                                     max_steps, V, W, n_collisions, n_steps, wall_work, h, h + room);
     if (h != stack) free(h);
     return status;
 }
@@ -65,7 +66,8 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
 int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
                         const double R0[9], const double V0[3], const double W0[3], const double *wall,
                         long long n_max, double contact_tol, double set_tol, long long max_steps, double V[3],
-                        double W[3], long long *n_collisions, long long *n_steps, double *h, double *h1)
+                        double W[3], long long *n_collisions, long long *n_steps, double wall_work[2], double *h,
+                        double *h1)
 {
     double curv[3];
     double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
@@ -90,6 +92,7 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
         y = Rb;
     }
     long long n_coll = 0, steps_total = 0;
+    double work_n = 0.0, work_t = 0.0;
     int status = RBS_FAILED;
     for (;;) {
         lab_tensor(R, K, K_lab);
@@ -116,6 +119,10 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
         lab_tensor(R, Kinv, Kinv_lab);
         int outcome = rbs_collide(V, W, rc, Kinv_lab, wall, dV, dW);
         if (outcome != COLLISION_OK && outcome != COLLISION_MULTIPLE_ROOTS) break;
+        double hit_n, hit_t;
+        rbs_wall_work(V, W, rc, dV, dW, &hit_n, &hit_t);
+        work_n += hit_n;
+        work_t += hit_t;
         for (int k = 0; k < 3; k++) {
             V[k] += dV[k];
             W[k] += dW[k];
@@ -124,5 +131,9 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
     }
     *n_collisions = n_coll;
     *n_steps = steps_total;
+    if (wall_work) {
+        wall_work[0] = work_n;
+        wall_work[1] = work_t;
+    }
     return status;
 }

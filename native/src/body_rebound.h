@@ -18,17 +18,20 @@ void rbs_quaternion_to_matrix(const double q[4], double R[9]);
  * radius Rb; R0 body → lab at the start, V0 (m/s) and W0 ((m/s)/a) incident, wall the wall array (wall.h, layout
  * W_*), n_max collisions allowed, contact_tol and set_tol (units of a), max_steps per flight; V, W receive the state
  * after the last collision. Returns RBS_OK (rebounded), RBS_TRAPPED or RBS_FAILED; the collisions and search steps into
- * *n_collisions, *n_steps. The heights and rates of the vertices on the stack up to MAX_STACK_VERTICES, above in one
- * malloc (RBS_FAILED with no collision and no step if it fails). */
+ * *n_collisions, *n_steps, and, where wall_work is not NULL, the work of the collisions on the wall per unit particle
+ * mass (m²/s², rbs_wall_work summed in their order from 0: BodyRebound's wall_work_normal, wall_work_tangential) into
+ * wall_work[0] (normal) and wall_work[1] (tangential). The heights and rates of the vertices on the stack up to
+ * MAX_STACK_VERTICES, above in one malloc (RBS_FAILED with no collision, no step and no work if it fails). */
 int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
                      const double R0[9], const double V0[3], const double W0[3], const double *wall, long long n_max,
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
-                     long long *n_collisions, long long *n_steps);
+                     long long *n_collisions, long long *n_steps, double wall_work[2]);
 
 /* rbs_body_rebound with the caller's work space: h and h1 each with room for max(nv, 1) values. */
 int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
                         const double R0[9], const double V0[3], const double W0[3], const double *wall,
                         long long n_max, double contact_tol, double set_tol, long long max_steps, double V[3],
-                        double W[3], long long *n_collisions, long long *n_steps, double *h, double *h1);
+                        double W[3], long long *n_collisions, long long *n_steps, double wall_work[2], double *h,
+                        double *h1);
 
 #endif /* RBS_BODY_REBOUND_H */

@@ -1,7 +1,8 @@
 /*
- * collision.c: one impulsive collision of a rigid body with the wall y = 0 (direct_model.collision: collide,
- * smallest_positive_root, _first_guess, _bracketed_root, _cubic, _cubic_slope, _form). The same operations in the
- * same order as the numba kernels: plain products and sums (no fma), libm's sqrt, exp and pow.
+ * collision.c: one impulsive collision of a rigid body with the wall y = 0 and its work on the wall
+ * (direct_model.collision: collide, wall_work, smallest_positive_root, _first_guess, _bracketed_root, _cubic,
+ * _cubic_slope, _form). The same operations in the same order as the numba kernels: plain products and sums (no
+ * fma), libm's sqrt, exp and pow.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -175,4 +176,20 @@ int rbs_collide(const double V[3], const double W[3], const double r[3], const d
     double tz = rx * dV[1] - ry * dV[0];
     for (int i = 0; i < 3; i++) dW[i] = Kinv[3 * i] * tx + Kinv[3 * i + 1] * ty + Kinv[3 * i + 2] * tz;
     return multiple ? COLLISION_MULTIPLE_ROOTS : COLLISION_OK;
+}
+
+void rbs_wall_work(const double V[3], const double W[3], const double r[3], const double dV[3], const double dW[3],
+                   double *normal, double *tangential)
+{
+    double rx = r[0], ry = r[1], rz = r[2];
+    double u0 = V[0] + W[1] * rz - W[2] * ry;
+    double v0 = V[1] + W[2] * rx - W[0] * rz;
+    double w0 = V[2] + W[0] * ry - W[1] * rx;
+    double Vx = V[0] + dV[0], Vy = V[1] + dV[1], Vz = V[2] + dV[2];
+    double Wx = W[0] + dW[0], Wy = W[1] + dW[1], Wz = W[2] + dW[2];
+    double u1 = Vx + Wy * rz - Wz * ry;
+    double v1 = Vy + Wz * rx - Wx * rz;
+    double w1 = Vz + Wx * ry - Wy * rx;
+    *normal = -(dV[1] * (v0 + v1)) * 0.5;
+    *tangential = -(dV[0] * (u0 + u1) + dV[2] * (w0 + w1)) * 0.5;
 }

@@ -1,5 +1,6 @@
 /*
- * collision.h: one impulsive collision of a rigid body with the wall y = 0 (direct_model.collision). Frame:
+ * collision.h: one impulsive collision of a rigid body with the wall y = 0 and its work on the wall
+ * (direct_model.collision). Frame:
  * the model's lab frame (wall y = 0, normal +Y), velocities in m/s, lengths in units of a, angular velocities
  * in (m/s)/a.
  *
@@ -25,5 +26,12 @@ int rbs_smallest_positive_root(double c0, double c1, double c2, double c3, doubl
  * code (direct_model.collision.collide). */
 int rbs_collide(const double V[3], const double W[3], const double r[3], const double Kinv[9], const double *wall,
                 double dV[3], double dW[3]);
+
+/* The work of one collision on the wall per unit particle mass, m²/s² (direct_model.collision.wall_work): V, W and r
+ * as rbs_collide's (before the collision), dV, dW its changes; *normal = −Δv (v_c⁻ + v_c⁺)/2 and *tangential =
+ * −(Δu (u_c⁻ + u_c⁺) + Δw (w_c⁻ + w_c⁺))/2 with V_c⁻ = V + W × r, V_c⁺ = (V + dV) + (W + dW) × r: each >= 0 up to
+ * round-off, their sum the kinetic energy the collision takes. */
+void rbs_wall_work(const double V[3], const double W[3], const double r[3], const double dV[3], const double dW[3],
+                   double *normal, double *tangential);
 
 #endif /* RBS_COLLISION_H */

@@ -32,19 +32,23 @@ int rbs_table_shape_hit(const rbs_table *table, int shape, const double V[3], co
  * the wall), u RBS_U_PER_REBOUND uniforms in [0, 1) (direct_model.runtime: U_ORIENTATION, U_RATIOS, U_HAND,
  * U_AXIS). RBS_OK; RBS_TRAPPED or RBS_FAILED with NaN outputs; RBS_INVALID with NaN outputs for an input out of
  * range, a NULL pointer, a shape outside those. rbs_direct_hit also gives the
- * collisions of the rebound into *n_collisions (−1 for RBS_INVALID). */
+ * collisions of the rebound into *n_collisions (−1 for RBS_INVALID) and their work on the wall per unit particle mass
+ * (m²/s², up to the trap or the failure; rbs_rebound_model_frame_counted's) into wall_work[0] (normal) and
+ * wall_work[1] (tangential), NaN for RBS_INVALID. */
 int rbs_direct_rebound(const rbs_table *table, int shape, const double V[3], const double Omega[3], const double n[3],
                        double a, const double u[RBS_U_PER_REBOUND], double V_out[3], double Omega_out[3]);
 int rbs_direct_hit(const rbs_table *table, int shape, const double V[3], const double Omega[3], const double n[3],
                    double a, const double u[RBS_U_PER_REBOUND], double V_out[3], double Omega_out[3],
-                   int *n_collisions);
+                   int *n_collisions, double wall_work[2]);
 
 /* wall_hit.c: a hit along the path `path` (RBS_PATH_TABLE, RBS_PATH_DIRECT; surrogate.kernels.wall_hit.rebound_typed)
  * with its RBS_U_PER_DRAW uniforms u (a keyed hit's already keyed): RBS_INVALID and NaN for RBS_PATH_NONE or what
- * rbs_rebound refuses. The table shape into *shape, the direct path's collisions into *n_collisions (−1 if none). */
+ * rbs_rebound refuses. The table shape into *shape, the direct path's collisions into *n_collisions (−1 if none) and
+ * their work on the wall into wall_work[0], wall_work[1] (m²/s², rbs_direct_hit's; NaN on the table path, which does
+ * not hold it yet, and for RBS_INVALID). */
 int rbs_rebound_along(const rbs_table *table, const rbs_mix *mix, int path, const double V[3], const double Omega[3],
                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
-                      double Omega_out[3], int *shape, int *n_collisions);
+                      double Omega_out[3], int *shape, int *n_collisions, double wall_work[2]);
 
 /* grain.c: out = u with the slots a grain key fixes replaced by the key's uniforms: u[0] (the shape) always, and
  * with `direct` the direct model's proportions and hand, u[1 + U_RATIOS], u[2 + U_RATIOS], u[1 + U_HAND]

@@ -73,12 +73,14 @@ int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes
                             double wx, double wy, double wz, const double *u, double V[3], double W[3])
 {
     long long n_collisions;
-    return rbs_rebound_model_frame_counted(params, shapes, shape, vt, vn, wx, wy, wz, u, V, W, &n_collisions);
+    double wall_work[2];
+    return rbs_rebound_model_frame_counted(params, shapes, shape, vt, vn, wx, wy, wz, u, V, W, &n_collisions,
+                                           wall_work);
 }
 
 int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays *shapes, int shape, double vt,
                                     double vn, double wx, double wy, double wz, const double *u, double V[3],
-                                    double W[3], long long *n_collisions)
+                                    double W[3], long long *n_collisions, double wall_work[2])
 {
     double quat[4], R0[9], K[3], semi[3], stack[5 * MAX_STACK_VERTICES];
     /* the shape's vertex rows: room for the particle's vertices (an ellipsoid's one row: its support point) */
@@ -87,6 +89,7 @@ int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays
     double *verts = stack;
     if (room > MAX_STACK_VERTICES && !(verts = malloc(5 * (size_t)room * sizeof *verts))) {
         *n_collisions = 0;
+        wall_work[0] = wall_work[1] = 0.0;
         return RBS_FAILED;
     }
     rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], quat);
@@ -105,8 +108,8 @@ int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays
     /* n_max and max_steps as numba's int() of the float64 parameters; the heights and rates after the vertices */
     int status = rbs_body_rebound_in(kind, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL,
                                      rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
-                                     rbs_trunc(params[P_MAX_STEPS]), V, W, n_collisions, &n_steps, verts + 3 * room,
-                                     verts + 4 * room);
+                                     rbs_trunc(params[P_MAX_STEPS]), V, W, n_collisions, &n_steps, wall_work,
+                                     verts + 3 * room, verts + 4 * room);
     if (verts != stack) free(verts);
     return status;
 }

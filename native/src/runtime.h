@@ -54,9 +54,12 @@ void rbs_uniform_quaternion(double u0, double u1, double u2, double q[4]);
 int rbs_rebound_model_frame(const double *params, const rbs_shape_arrays *shapes, int shape, double vt, double vn,
                             double wx, double wy, double wz, const double *u, double V[3], double W[3]);
 
-/* rbs_rebound_model_frame, the collisions of the rebound into *n_collisions (up to the trap) */
+/* rbs_rebound_model_frame, the collisions of the rebound into *n_collisions (up to the trap) and their work on the
+ * wall per unit particle mass (m²/s², normal then tangential; rbs_body_rebound's, up to the trap or the failure, 0
+ * without a collision) into wall_work[0], wall_work[1] (direct_model.runtime.rebound_model_frame's
+ * wall_work_normal, wall_work_tangential) */
 int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays *shapes, int shape, double vt,
                                     double vn, double wx, double wy, double wz, const double *u, double V[3],
-                                    double W[3], long long *n_collisions);
+                                    double W[3], long long *n_collisions, double wall_work[2]);
 
 #endif /* RBS_RUNTIME_H */

@@ -74,29 +74,34 @@ RBS_HOT int rbs_rebound_path(const rbs_table *t, const rbs_hit *hit, const rbs_o
     return hit_path(t, hit, method);
 }
 
-/* What a rough hit gives (the fields of rbs_result but its size and status) */
+/* What a rough hit gives (the fields of rbs_result but its size, status and vectors) */
 typedef struct rough_out {
     int path, shape, n_collisions, wall_hits;
+    double wall_work[2];
 } rough_out;
 
-/* A facet hit of the table's shape `shape` along `path` (surrogate.kernels.wall_hit._shape_rebound; u[0] unused) */
+/* A facet hit of the table's shape `shape` along `path` (surrogate.kernels.wall_hit._shape_rebound; u[0] unused); the
+ * wall work NaN but on the direct path */
 static int shape_rebound(const rbs_table *t, int shape, int path, const double V[3], const double Omega[3],
                          const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation,
-                         double V_out[3], double Omega_out[3], int *n_collisions)
+                         double V_out[3], double Omega_out[3], int *n_collisions, double wall_work[2])
 {
     *n_collisions = -1;
+    wall_work[0] = wall_work[1] = NAN;
     if (path == RBS_PATH_TABLE)
         return rbs_table_shape_hit(t, shape, V, n, a, u, interpolation, V_out, Omega_out);
     if (path == RBS_PATH_DIRECT && rbs_uniforms_ok(u, 1))
-        return rbs_direct_hit(t, t->model_shape[shape], V, Omega, n, a, u + 1, V_out, Omega_out, n_collisions);
+        return rbs_direct_hit(t, t->model_shape[shape], V, Omega, n, a, u + 1, V_out, Omega_out, n_collisions,
+                              wall_work);
     nan_out(V_out);
     nan_out(Omega_out);
     return RBS_INVALID;
 }
 
 /* One hit on a rough wall of roughness Δγ = `roughness` degrees (surrogate.kernels.wall_hit.rough_rebound with the
- * shape from the mix): its status, V⁺ and Ω⁺ into V_out and Omega_out (NaN unless rebounded), the rest into *out.
- * `key` the grain key or RBS_NO_KEY, u the hit's uniforms (not keyed). */
+ * shape from the mix): its status, V⁺ and Ω⁺ into V_out and Omega_out (NaN unless rebounded), the rest into *out (the
+ * wall work summed over the facet hits in their order from 0, NaN once the table answered one). `key` the grain key
+ * or RBS_NO_KEY, u the hit's uniforms (not keyed). */
 static int rough_rebound(const rbs_table *t, const rbs_mix *mix, int64_t key, const double V_in[3],
                          const double Omega_in[3], const double n[3], double a, const double u[RBS_U_PER_DRAW],
                          int method, int interpolation, double roughness, double V_out[3], double Omega_out[3],
@@ -117,6 +122,7 @@ static int rough_rebound(const rbs_table *t, const rbs_mix *mix, int64_t key, co
     memcpy(facet_u, u, sizeof facet_u);
     out->shape = shape;
     out->n_collisions = -1;
+    out->wall_work[0] = out->wall_work[1] = 0.0;
     for (int wall_hits = 1; wall_hits <= RBS_MAX_WALL_HITS; wall_hits++) {
         double facet[3];
         out->wall_hits = wall_hits;
@@ -131,7 +137,11 @@ static int rough_rebound(const rbs_table *t, const rbs_mix *mix, int64_t key, co
             rbs_keyed_uniforms(key, facet_u, path == RBS_PATH_DIRECT, keyed);
             hit_u = keyed;
         }
-        int status = shape_rebound(t, shape, path, V, W, facet, a, hit_u, interpolation, Vn, Wn, &out->n_collisions);
+        double work[2];
+        int status = shape_rebound(t, shape, path, V, W, facet, a, hit_u, interpolation, Vn, Wn, &out->n_collisions,
+                                   work);
+        out->wall_work[0] += work[0];
+        out->wall_work[1] += work[1];
         out->path = path;
         if (status != RBS_OK || rbs_dot(Vn[0], Vn[1], Vn[2], n[0], n[1], n[2]) > 0.0) {
             if (status == RBS_OK) {
@@ -159,7 +169,7 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const rbs_hit *h
         return RBS_INVALID;
     }
     int status = RBS_INVALID, path = RBS_PATH_NONE, shape = -1, n_collisions = -1, wall_hits = 1;
-    double roughness = 0.0;
+    double roughness = 0.0, wall_work[2] = {NAN, NAN};
     if (!RBS_RECORD_OK(hit, rbs_hit)) {
         nan_out(result->V);
         nan_out(result->Omega);
@@ -174,13 +184,15 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const rbs_hit *h
         int ok = t && rbs_options_read(options, &method, &interpolation)
                  && rbs_options_roughness(options, t->wall_roughness, &roughness) && hit->grain_key >= RBS_NO_KEY;
         if (ok && roughness != 0.0) {
-            rough_out out = {RBS_PATH_NONE, -1, -1, 0};
+            rough_out out = {RBS_PATH_NONE, -1, -1, 0, {NAN, NAN}};
             status = rough_rebound(t, mix, hit->grain_key, hit->V, hit->Omega, hit->n, hit->a, u, method,
                                    interpolation, roughness, result->V, result->Omega, &out);
             path = out.path;
             shape = out.shape;
             n_collisions = out.n_collisions;
             wall_hits = out.wall_hits;
+            wall_work[0] = out.wall_work[0];
+            wall_work[1] = out.wall_work[1];
         } else {
             if (ok)
                 path = hit_path(t, hit, method);
@@ -194,7 +206,7 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const rbs_hit *h
                 }
             }
             status = rbs_rebound_along(t, mix, path, hit->V, hit->Omega, hit->n, hit->a, u, interpolation,
-                                       result->V, result->Omega, &shape, &n_collisions);
+                                       result->V, result->Omega, &shape, &n_collisions, wall_work);
         }
     }
     const int invalid = status == RBS_INVALID;
@@ -204,15 +216,20 @@ RBS_HOT int rbs_rebound(const rbs_table *t, const rbs_mix *mix, const rbs_hit *h
     result->n_collisions = invalid ? -1 : n_collisions;
     if (RBS_HAS_FIELD(result, rbs_result, wall_hits))
         result->wall_hits = invalid ? 0 : wall_hits;
+    if (RBS_HAS_FIELD(result, rbs_result, wall_work_tangential)) {
+        result->wall_work_normal = invalid ? NAN : wall_work[0];
+        result->wall_work_tangential = invalid ? NAN : wall_work[1];
+    }
     return status;
 }
 
 int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const double V[3], const double Omega[3],
                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
-                      double Omega_out[3], int *shape, int *n_collisions)
+                      double Omega_out[3], int *shape, int *n_collisions, double wall_work[2])
 {
     *shape = -1;
     *n_collisions = -1;
+    wall_work[0] = wall_work[1] = NAN;
     if (path == RBS_PATH_NONE || !u || !V_out || !Omega_out || !rbs_table_arguments_ok(t, mix, interpolation)
         || !rbs_uniforms_ok(u, 1)) {
         nan_out(V_out);
@@ -224,6 +241,6 @@ int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const do
     /* the table's shape drawn as the table path draws it, then its index in the direct model's shapes */
     int64_t drawn = rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, u[0]);
     *shape = (int)drawn;
-    return rbs_direct_hit(t, t->model_shape[drawn], V, Omega, n, a, u + 1, V_out, Omega_out,
-                          n_collisions);
+    return rbs_direct_hit(t, t->model_shape[drawn], V, Omega, n, a, u + 1, V_out, Omega_out, n_collisions,
+                          wall_work);
 }

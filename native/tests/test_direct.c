@@ -210,8 +210,9 @@ static void rebounds(rbs_rng *rng)
         int kind = shapes.kind[shape];
         double Rb = rbs_bounding_radius(kind, semi, verts, nv);
         long long n_coll, n_steps;
+        double work[2];
         int status = rbs_body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, WALLS[trial % 2], 1000, 1e-10, 1e-9,
-                                      100000, V, W, &n_coll, &n_steps);
+                                      100000, V, W, &n_coll, &n_steps, work);
         CHECK(status == RBS_OK || status == RBS_TRAPPED || status == RBS_FAILED, "status %d", status);
         if (status >= 0 && status < 3) counts[status]++;
         if (status != RBS_OK) continue;
@@ -223,6 +224,12 @@ static void rebounds(rbs_rng *rng)
         double gain = (0.5 * dot3(V, V) + 0.5 * kmin * dot3(W, W) - e0) / e0;
         if (gain > worst) worst = gain;
         CHECK(gain <= 1e-12, "a rebound added energy: at least %.3g relative (trial %d)", gain, trial);
+        /* the work on the wall, each part >= 0, is the energy lost: e0 − W_n − W_t between the bounds of E⁺ (to
+           round-off, 1e-13 e0 a collision) */
+        double kmax = fmax(K[0], fmax(K[1], K[2])), after = e0 - work[0] - work[1], tol = 1e-13 * (n_coll + 1) * e0;
+        CHECK(work[0] > 0.0 && work[1] >= 0.0 && after >= 0.5 * dot3(V, V) + 0.5 * kmin * dot3(W, W) - tol
+                  && after <= 0.5 * dot3(V, V) + 0.5 * kmax * dot3(W, W) + tol,
+              "the wall work %.17g, %.17g is not the energy lost (trial %d)", work[0], work[1], trial);
     }
     printf("rebounds: %d rebounded, %d trapped, %d failed; energy after (bounded below) / before − 1 at most %.3g\n", counts[0], counts[1], counts[2], worst);
 }
@@ -256,7 +263,7 @@ static void grain_model_frame(const rbs_table *table, rbs_rng *rng)
         long long n_coll, n_steps;
         int again = rbs_body_rebound(KIND_POLYHEDRON, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL,
                                      rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
-                                     rbs_trunc(params[P_MAX_STEPS]), Vr, Wr, &n_coll, &n_steps);
+                                     rbs_trunc(params[P_MAX_STEPS]), Vr, Wr, &n_coll, &n_steps, NULL);
         same += status == again && (status != RBS_OK || (memcmp(V, Vr, sizeof V) == 0 && memcmp(W, Wr, sizeof W) == 0));
         rebounded += status == RBS_OK;
     }
@@ -280,13 +287,13 @@ static void hostile(const rbs_table *table, const rbs_table *without)
     double Vo[3], Wo[3];
     CHECK(rbs_direct_rebound(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vo, Wo) == RBS_OK, "a good call");
     {   /* rbs_direct_hit: the same bits, and the collisions of the rebound */
-        double Vh[3], Wh[3];
+        double Vh[3], Wh[3], work[2];
         int n_collisions = -2;
-        CHECK(rbs_direct_hit(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vh, Wh, &n_collisions) == RBS_OK
-              && memcmp(Vh, Vo, sizeof Vh) == 0 && memcmp(Wh, Wo, sizeof Wh) == 0 && n_collisions >= 1,
-              "rbs_direct_hit: %d collisions", n_collisions);
-        CHECK(rbs_direct_hit(table, -1, V, Omega, n, 1e-3, u, Vh, Wh, &n_collisions) == RBS_INVALID
-              && n_collisions == -1, "rbs_direct_hit of no shape");
+        CHECK(rbs_direct_hit(table, RBS_PRISM, V, Omega, n, 1e-3, u, Vh, Wh, &n_collisions, work) == RBS_OK
+              && memcmp(Vh, Vo, sizeof Vh) == 0 && memcmp(Wh, Wo, sizeof Wh) == 0 && n_collisions >= 1
+              && work[0] > 0.0 && work[1] >= 0.0, "rbs_direct_hit: %d collisions", n_collisions);
+        CHECK(rbs_direct_hit(table, -1, V, Omega, n, 1e-3, u, Vh, Wh, &n_collisions, work) == RBS_INVALID
+              && n_collisions == -1 && isnan(work[0]) && isnan(work[1]), "rbs_direct_hit of no shape");
     }
 #define INVALID(...)                                                                                    \
     do {                                                                                                \

@@ -48,7 +48,9 @@ static int same_result(const rbs_result *a, const rbs_result *b)
 {
     return a->status == b->status && a->path == b->path && a->shape == b->shape && a->n_collisions == b->n_collisions
            && a->wall_hits == b->wall_hits && memcmp(a->V, b->V, sizeof a->V) == 0
-           && memcmp(a->Omega, b->Omega, sizeof a->Omega) == 0;
+           && memcmp(a->Omega, b->Omega, sizeof a->Omega) == 0
+           && memcmp(&a->wall_work_normal, &b->wall_work_normal, sizeof a->wall_work_normal) == 0
+           && memcmp(&a->wall_work_tangential, &b->wall_work_tangential, sizeof a->wall_work_tangential) == 0;
 }
 
 /* a hit of V, Omega (NULL: none), n, a with the uniforms u (NULL: from rng) */
@@ -780,8 +782,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s GOOD.h5 [PATH EXPECTED_STATUS]...\n", argv[0]);
         return 2;
     }
-    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.2.0") == 0
-          && RBS_VERSION_NUMBER == 1002000, "version %s, %d", rbs_version(), rbs_version_number());
+    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.3.0") == 0
+          && RBS_VERSION_NUMBER == 1003000, "version %s, %d", rbs_version(), rbs_version_number());
     rbs_table_close(NULL);
     CHECK(rbs_table_open(argv[1], NULL, NULL, 0) == RBS_INVALID, "NULL table pointer");
     for (int repeat = 0; repeat < 2; repeat++) draw_from(argv[1]);

@@ -51,7 +51,10 @@ def direct_rebound(params, shape_arrays, shape, V, omega, n, a, u):
 
     Status STATUS_REBOUNDED; STATUS_TRAPPED (still colliding after n_max collisions) or STATUS_FAILED
     (a collision solve or a contact search failed) with NaN vectors; STATUS_INVALID (the record of
-    :func:`surrogate.kernels.hit.invalid_hit`) for an input outside the ranges above.
+    :func:`surrogate.kernels.hit.invalid_hit`) for an input outside the ranges above. The hit's
+    ``wall_work_normal`` and ``wall_work_tangential``: the work of its collisions on the wall per unit particle
+    mass, m²/s² (W_n and W_t of :class:`direct_model.body_rebound.BodyRebound`; up to the trap or the failure),
+    NaN for STATUS_INVALID.
     """
     return direct_rebound_typed(params, shape_arrays, np.int64(shape), float3(V), float3(omega), float3(n), float(a), u,
                                 stack_scratch(SCRATCH_SIZE))
@@ -78,12 +81,14 @@ def direct_rebound_typed(params, shape_arrays, shape, V, omega, n, a, u, scratch
     # Ω⁻ in (m/s)/a, the model's unit (direct_model.body_rebound): rad/s times a
     rebound = rebound_model_frame(params, shape_arrays, shape, dot(V, ex), dot(V, n), a * dot(omega, ex),
                                   a * dot(omega, n), a * dot(omega, ez), u, scratch)
+    # the wall work in m²/s² as the model gives it (a scalar of the rebound: no frame, V in m/s and W × r too)
+    work_n, work_t = rebound.wall_work_normal, rebound.wall_work_tangential
     if rebound.status != STATUS_REBOUNDED:
         status = STATUS_TRAPPED if rebound.status == STATUS_TRAPPED else STATUS_FAILED
-        return hit(status, PATH_DIRECT, shape, rebound.n_collisions, NAN3, NAN3)
+        return hit(status, PATH_DIRECT, shape, rebound.n_collisions, NAN3, NAN3, 1, work_n, work_t)
     (vx, vy, vz), (wx, wy, wz) = rebound.V, rebound.Omega
     status, V_new, Omega_new = to_global(rebound.status, True, vx, vy, vz, wx, wy, wz, 1.0, a, ex, n, ez)
-    return hit(status, PATH_DIRECT, shape, rebound.n_collisions, V_new, Omega_new)
+    return hit(status, PATH_DIRECT, shape, rebound.n_collisions, V_new, Omega_new, 1, work_n, work_t)
 
 
 @numba.njit(**KERNEL)
@@ -122,4 +127,5 @@ def _direct_chunk(params, shape_arrays, model_shapes, shapes, keys, V, omega, n,
         result = direct_rebound_typed(params, shape_arrays, np.int64(model_shapes[shapes[i]]),
                                       (V[i, 0], V[i, 1], V[i, 2]), (omega[i, 0], omega[i, 1], omega[i, 2]),
                                       (n[i, 0], n[i, 1], n[i, 2]), float(a[i]), u, scratch)
-        put_hit(out, i, hit(result.status, result.path, shapes[i], result.n_collisions, result.V, result.Omega))
+        put_hit(out, i, hit(result.status, result.path, shapes[i], result.n_collisions, result.V, result.Omega,
+                            result.wall_hits, result.wall_work_normal, result.wall_work_tangential))

@@ -9,6 +9,12 @@ function. Read them by name: ``hit.V``, ``rebounds.status``.
 Units and frames: V⁺ in m/s and Ω⁺ in rad/s, in the caller's frame; NaN unless the status is STATUS_REBOUNDED.
 On a rough wall (:mod:`surrogate.kernels.facet`) one hit may take several facet hits: ``path`` and
 ``n_collisions`` are then those of the last, ``wall_hits`` their number.
+
+What a hit does to the wall (docs/model.md §4.7): ``wall_work_normal`` W_n and ``wall_work_tangential`` W_t, the
+work of its collisions on the wall per unit particle mass in m²/s² (J/kg), each ≥ 0, their sum the particle's drop of
+translational plus rotational kinetic energy (up to the trap or the failure for a hit trapped or failed). The direct
+path gives them (on a rough wall summed over the facet hits); the table path does not hold them yet: NaN there
+(and on a rough wall for a hit any of whose facet hits the table answered); NaN for STATUS_INVALID.
 """
 
 from typing import NamedTuple
@@ -34,6 +40,10 @@ class Hit(NamedTuple):
     Omega: tuple        # Ω⁺, rad/s (3 floats)
     wall_hits: int      # the hits on the wall this hit took: 1 on a smooth wall; on a rough one ≥ 1 (re-hits of a
                         # rebound into the mean wall, up to MAX_WALL_HITS); 0 for STATUS_INVALID
+    wall_work_normal: float      # W_n, m²/s²: the work of the hit's normal impulses on the wall per unit particle
+                                 # mass (module doc); NaN on the table path and for STATUS_INVALID
+    wall_work_tangential: float  # W_t, m²/s²: that of its tangential impulses (the cutting of ductile walls); NaN
+                                 # as W_n
 
 
 class Rebounds(NamedTuple):
@@ -46,12 +56,15 @@ class Rebounds(NamedTuple):
     V: np.ndarray               # (N, 3) float64, m/s
     Omega: np.ndarray           # (N, 3) float64, rad/s
     wall_hits: np.ndarray       # (N,) int32
+    wall_work_normal: np.ndarray        # (N,) float64, m²/s²
+    wall_work_tangential: np.ndarray    # (N,) float64, m²/s²
 
 
 # the dtype and trailing shape of each field of Rebounds
 REBOUNDS_ARRAYS = {"status": (np.int8, ()), "path": (np.int8, ()), "shape": (np.int32, ()),
                    "n_collisions": (np.int32, ()), "V": (np.float64, (3,)), "Omega": (np.float64, (3,)),
-                   "wall_hits": (np.int32, ())}
+                   "wall_hits": (np.int32, ()), "wall_work_normal": (np.float64, ()),
+                   "wall_work_tangential": (np.float64, ())}
 
 
 def empty_rebounds(n: int) -> Rebounds:
@@ -60,16 +73,18 @@ def empty_rebounds(n: int) -> Rebounds:
 
 
 @numba.njit(inline="always", **JIT)
-def hit(status, path, shape, n_collisions, V, Omega, wall_hits=1):
-    """A :class:`Hit` with its integers as int64 and its vectors as float64 3-tuples: one type whatever the kernel
-    that builds it, so every branch of a kernel returns the same type. A STATUS_INVALID hit gets PATH_NONE, shape
-    and n_collisions −1, NaN vectors and wall_hits 0 whatever is passed (as rbs_rebound writes it)."""
+def hit(status, path, shape, n_collisions, V, Omega, wall_hits=1, wall_work_normal=np.nan,
+        wall_work_tangential=np.nan):
+    """A :class:`Hit` with its integers as int64 and its floats as float64 (its vectors 3-tuples): one type whatever
+    the kernel that builds it, so every branch of a kernel returns the same type. A STATUS_INVALID hit gets
+    PATH_NONE, shape and n_collisions −1, NaN vectors, wall_hits 0 and NaN wall work whatever is passed (as
+    rbs_rebound writes it); the wall work's default, NaN, is the table path's."""
     if status == STATUS_INVALID:
         return Hit(np.int64(STATUS_INVALID), np.int64(PATH_NONE), np.int64(-1), np.int64(-1), NAN3, NAN3,
-                   np.int64(0))
+                   np.int64(0), np.nan, np.nan)
     return Hit(np.int64(status), np.int64(path), np.int64(shape), np.int64(n_collisions),
                (float(V[0]), float(V[1]), float(V[2])), (float(Omega[0]), float(Omega[1]), float(Omega[2])),
-               np.int64(wall_hits))
+               np.int64(wall_hits), float(wall_work_normal), float(wall_work_tangential))
 
 
 @numba.njit(inline="always", **JIT)
@@ -86,6 +101,8 @@ def put_hit(out, i, h):
     out.shape[i] = h.shape
     out.n_collisions[i] = h.n_collisions
     out.wall_hits[i] = h.wall_hits
+    out.wall_work_normal[i] = h.wall_work_normal
+    out.wall_work_tangential[i] = h.wall_work_tangential
     for k in range(3):
         out.V[i, k] = h.V[k]
         out.Omega[i, k] = h.Omega[k]

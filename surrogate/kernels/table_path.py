@@ -28,7 +28,8 @@ from surrogate.kernels.options import JIT, KERNEL
 def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
     """Reflected state of one particle in the global frame, drawn from the table: a
     :class:`surrogate.kernels.hit.Hit` (V⁺ in m/s, Ω⁺ in rad/s; ``path`` PATH_TABLE, ``shape`` the shape drawn
-    from the mix, ``n_collisions`` −1).
+    from the mix, ``n_collisions`` −1, ``wall_work_normal`` and ``wall_work_tangential`` NaN: the table does not
+    hold the work of a hit on the wall yet).
 
     Parameters
     ----------

@@ -188,7 +188,8 @@ def _direct_path(params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, n
         shape = mix_shape(mix_cdf, u[0])       # the table path's shape draw
     result = direct_rebound_typed(params, shape_arrays, model_shapes[shape], V, omega, n, a, u[1:1 + U_PER_REBOUND],
                                   scratch)
-    return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega)
+    return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega, 1,
+               result.wall_work_normal, result.wall_work_tangential)
 
 
 @numba.njit(**KERNEL)
@@ -214,7 +215,10 @@ def rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
     hit takes u; the facets and every later hit take keyed uniforms of the hit's facet key
     (:mod:`surrogate.kernels.facet`). A rebound still into the mean wall after MAX_WALL_HITS facet hits is
     STATUS_TRAPPED; a facet not found (probability below 1e-13) STATUS_FAILED. ``path`` and ``n_collisions``
-    are the last facet hit's. ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,) float64: work space."""
+    are the last facet hit's. The wall work (``wall_work_normal``, ``wall_work_tangential``, m²/s²) is the sum of
+    the facet hits' (summed in their order from 0; those before a facet not found), NaN if the table answered any
+    of them (it does not hold the work yet). ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,) float64:
+    work space."""
     path = rebound_path(data, V, omega, n, a, method)
     if (path == PATH_NONE or key < NO_KEY or not uniforms_ok(u) or not 0.0 < roughness_deg <= MAX_ROUGHNESS_DEG
             or shape < SHAPE_FROM_MIX or shape >= mix_cdf.shape[0]):
@@ -226,22 +230,26 @@ def rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
     for k in range(U_PER_DRAW):
         facet_u[k] = u[k]
     result = invalid_hit()
+    work_n, work_t = 0.0, 0.0           # the facet hits' wall work (NaN, the table path's, stays NaN)
     for wall_hits in range(1, MAX_WALL_HITS + 1):
         found, facet, slot = facet_normal(V, n, roughness_deg, facets, slot)
         if not found:
-            return hit(STATUS_FAILED, path, shape, -1, NAN3, NAN3, wall_hits)
+            return hit(STATUS_FAILED, path, shape, -1, NAN3, NAN3, wall_hits, work_n, work_t)
         path = rebound_path(data, V, omega, facet, a, method)
         if key >= 0:
             keyed_uniforms(key, facet_u, path == PATH_DIRECT, facet_u)
         result = _shape_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, V, omega, facet, a, facet_u,
                                 scaled, path, scratch)
+        work_n += result.wall_work_normal
+        work_t += result.wall_work_tangential
         if result.status != STATUS_REBOUNDED or dot(result.V, n) > 0.0:
-            return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega, wall_hits)
+            return hit(result.status, result.path, shape, result.n_collisions, result.V, result.Omega, wall_hits,
+                       work_n, work_t)
         V, omega = result.V, result.Omega
         for k in range(U_PER_DRAW):
             facet_u[k] = grain_uniform(facets, slot + k)
         slot += U_PER_DRAW
-    return hit(STATUS_TRAPPED, result.path, shape, result.n_collisions, NAN3, NAN3, MAX_WALL_HITS)
+    return hit(STATUS_TRAPPED, result.path, shape, result.n_collisions, NAN3, NAN3, MAX_WALL_HITS, work_n, work_t)
 
 
 @numba.njit(inline="always", **JIT)
@@ -322,6 +330,7 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
     for i in range(lo, hi):
         if path[i] == PATH_TABLE:       # the pipeline's rows completed as rebound's records (hit.hit)
             out.n_collisions[i], out.wall_hits[i] = -1, 1
+            out.wall_work_normal[i], out.wall_work_tangential[i] = np.nan, np.nan
             if out.status[i] == STATUS_INVALID:
                 path[i], out.shape[i], out.wall_hits[i] = PATH_NONE, -1, 0
     if n_table == hi - lo:

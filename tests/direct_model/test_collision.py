@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 
 from direct_model.collision import (
     COLLISION_FAILED, COLLISION_MULTIPLE_ROOTS, COLLISION_NOT_APPROACHING, COLLISION_OK,
-    collide, smallest_positive_root,
+    collide, smallest_positive_root, wall_work,
 )
 from direct_model.wall import CORUNDUM_ON_STEEL
 
@@ -79,6 +79,11 @@ def test_invariants(seed):
     assert change <= 1e-12 * scale ** 2
     # the contact point leaves the wall: v_c⁺ = −a_nc v_c⁻ > 0
     assert Vc2[1] > 0
+    # the work on the wall (docs/model.md §4.7): minus the normal and the tangential parts of the change, each ≥ 0
+    normal, tangential = wall_work(V, W, r, dV, dW)
+    assert normal >= 0.0 and tangential >= 0.0
+    assert normal == pytest.approx(-dV[1] * (Vc1[1] + Vc2[1]) / 2, rel=1e-12, abs=1e-13 * scale ** 2)
+    assert normal + tangential == pytest.approx(-change, rel=1e-10, abs=1e-12 * scale ** 2)
 
 
 def test_not_approaching_changes_nothing():
@@ -109,6 +114,11 @@ def test_sphere_closed_form(speed, alpha_deg):
     assert code == COLLISION_OK
     np.testing.assert_allclose(dV, [du, lam, 0.0], rtol=1e-13, atol=1e-13 * speed)
     np.testing.assert_allclose(dW, [0.0, 0.0, 2.5 * du], rtol=1e-13, atol=1e-13 * speed)
+    # the work on the wall: v_c = v_p from −v to a_nc v, u_c = u_p + Ω_z a from u to u + 3.5 Δu_p
+    normal, tangential = wall_work(V, W, r, dV, dW)
+    assert normal == pytest.approx(0.5 * (1.0 - a_nc ** 2) * v ** 2, rel=1e-13)
+    assert tangential == pytest.approx(-0.5 * du * (2.0 * u + 3.5 * du), rel=1e-12, abs=1e-13 * speed ** 2)
+    assert tangential >= 0.0 and (alpha_deg != 90.0 or tangential < 1e-20 * normal)    # u = |V| cos 90° ~ 1e-14 |V|
 
 
 def test_root_finder_takes_smallest_of_three_positive_roots():

@@ -35,7 +35,7 @@ def _batch(arrays, shape, hands, quats, alpha1, omega):
     n = len(quats)
     speed = 150.0
     out = [np.empty((n, 3)), np.empty((n, 3)), np.empty(n), np.empty(n, np.int32), np.empty(n, np.int8),
-           np.empty(n, np.int8), np.empty(n, np.int32), np.empty(n, np.int32)]
+           np.empty(n, np.int8), np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n), np.empty(n)]
     body_rebound_batch(arrays, np.full(n, shape, np.int8), np.tile(RATIOS, (n, 1)), hands, quats,
                        incident_velocity(alpha1, speed), np.asarray(omega, dtype=float) * speed,
                        CORUNDUM_ON_STEEL.as_array(), DEFAULT_N_MAX, DEFAULT_CONTACT_TOL, DEFAULT_SET_TOL,

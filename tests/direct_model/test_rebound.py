@@ -10,7 +10,7 @@ from direct_model.rotation import ROT_PARAMS_SIZE, rotation_at, rotation_init
 from direct_model.shape_arrays import KIND_ELLIPSOID
 
 from tests.helpers.grains import hull_grain
-from tests.helpers.one_particle import MIRROR, body, random_bodies, run_one
+from tests.helpers.one_particle import MIRROR, body, random_bodies, rebound_one, run_one
 
 GRAINS = [hull_grain(f"grain_{n}", n, seed=n, both_hands=True) for n in (8, 24, 64, 256)]
 BODIES = random_bodies(200, seed=7) + random_bodies(40, seed=8, shapes=GRAINS)
@@ -40,6 +40,14 @@ def test_sphere_single_collision_no_scatter(alpha1):
     du = -cf * lam * u / (speed + 1.75 * cf * lam)     # derivation in test_collision.py
     expected = [u + du, -v + lam, 0.0, 0.0, 0.0, 2.5 * du]
     np.testing.assert_allclose(results, np.tile(expected, (20, 1)), rtol=1e-12, atol=1e-12 * speed)
+    # its work on the wall (docs/model.md §4.7): v_c from −v to a_nc v, u_c = u_p + Ω_z a from u to u + 3.5 Δu_p;
+    # at normal impact (u = |V⁻| cos 90°, 1e-14 |V⁻|) no tangential work
+    done, _ = rebound_one("ellipsoid", (1.0, 1.0), R0, alpha1=alpha1, speed=speed)
+    assert done.wall_work_normal == pytest.approx(0.5 * (1 - a_nc ** 2) * v ** 2, rel=1e-12)
+    assert done.wall_work_tangential == pytest.approx(-0.5 * du * (2 * u + 3.5 * du), rel=1e-11,
+                                                      abs=1e-13 * speed ** 2)
+    assert done.wall_work_tangential >= 0.0
+    assert alpha1 != 90.0 or done.wall_work_tangential < 1e-20 * done.wall_work_normal
 
 
 def _vertex_heights(b, y, R):
@@ -129,6 +137,25 @@ def test_energy_does_not_increase(particle):
     V, W, status, ncoll, e_rot, _ = run_one(shape, ratios, R0, alpha1=60.0, speed=speed, hand=hand)
     assert ncoll >= 1
     assert 0.5 * V @ V + e_rot <= 0.5 * speed ** 2 * (1 + 1e-12)
+
+
+def test_the_wall_work_is_the_kinetic_energy_lost():
+    """The work of a rebound on the wall (docs/model.md §4.7), W_n and W_t summed over its collisions, each ≥ 0, is
+    the drop of the particle's translational plus rotational kinetic energy, E⁻ − E⁺ (to round-off, 1e-12 E⁻), for
+    every other body (the families and the grains), from rest and spinning, and up to the trap for a particle
+    trapped after one collision (n_max = 1)."""
+    seen = {STATUS_REBOUNDED: 0, STATUS_TRAPPED: 0}
+    for k, (shape, ratios, R0, hand) in enumerate(BODIES[::2]):
+        for omega_in, n_max in (((0.0, 0.0, 0.0), 1000), ((0.1, -0.2, 0.3), 1000), ((0.0, 0.0, 0.0), 1))[:2 + k % 2]:
+            done, e_in = rebound_one(shape, ratios, R0, alpha1=50.0, omega_in=omega_in, hand=hand, n_max=n_max)
+            if done.status not in seen:
+                continue
+            seen[done.status] += 1
+            V = np.array(done.V)
+            e_out = 0.5 * V @ V + done.rotational_energy
+            assert done.wall_work_normal > 0.0 and done.wall_work_tangential >= 0.0, (k, done)
+            assert abs(done.wall_work_normal + done.wall_work_tangential - (e_in - e_out)) <= 1e-12 * e_in, (k, done)
+    assert seen[STATUS_REBOUNDED] > 200 and seen[STATUS_TRAPPED] > 10, seen
 
 
 def _lab(R, diagonal):

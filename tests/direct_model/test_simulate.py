@@ -3,6 +3,7 @@
 import subprocess
 import sys
 
+import h5py
 import numba
 import numpy as np
 import pytest
@@ -85,6 +86,13 @@ def test_statuses_and_physical_ranges(shape):
     assert np.all(s.velocity[ok, 1] > 0)                    # leaves the wall
     assert np.all(s.e_trans_ratio[ok] + s.extra["e_rot_ratio"][ok] <= 1 + 1e-12)
     assert np.all(s.n_collisions[ok] >= 1)
+    # the work on the wall (m²/s²), each part ≥ 0, is the kinetic energy lost, trapped particles' up to the trap (to
+    # round-off: 1e-13 of E⁻ per collision; the rolling ellipsoids trapped after 1000 collisions reach 1.5e-11)
+    work_n, work_t = s.extra["wall_work_normal"], s.extra["wall_work_tangential"]
+    assert np.all(work_n > 0.0) and np.all(work_t >= 0.0)
+    e_in = 0.5 * 200.0 ** 2
+    lost = e_in * (1.0 - s.e_trans_ratio - s.extra["e_rot_ratio"])
+    assert np.all(np.abs(work_n + work_t - lost) <= 1e-13 * e_in * s.n_collisions)
     assert np.all((s.alpha2[ok] >= 0) & (s.alpha2[ok] <= np.pi))
 
 
@@ -140,6 +148,14 @@ def test_cli_writes_the_documented_layout(tmp_path):
     assert back.omega.tobytes() == direct.omega.tobytes()
     assert (back.alpha1, back.speed, back.shape, back.seed) == (30.0, 120.0, "cut_prism", 9)
     assert np.array_equal(back.status == STATUS_REBOUNDED, direct.rebounded)
+    for name in ("wall_work_normal", "wall_work_tangential"):
+        assert back.extra[name].tobytes() == direct.extra[name].tobytes()
+    # a file without the wall work (written before it was) still loads
+    with h5py.File(out, "a") as f:
+        assert f["samples/wall_work_normal"].attrs["units"].startswith("m²/s²")
+        del f["samples/wall_work_normal"], f["samples/wall_work_tangential"]
+    older = read_samples(out)
+    assert "wall_work_normal" not in older.extra and older.velocity.tobytes() == back.velocity.tobytes()
     # an existing file is not replaced without --overwrite, and is left intact
     before = out.read_bytes()
     again = subprocess.run([sys.executable, "-m", "tablegen.cli", "simulate", "--shape", "prism",

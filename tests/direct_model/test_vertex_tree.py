@@ -124,7 +124,7 @@ def _run(arrays, shape, count=300, seed=5):
     for spin in (0.0, 60.0):
         out = (np.empty((count, 3)), np.empty((count, 3)), np.empty(count), np.empty(count, dtype=np.int32),
                np.empty(count, dtype=np.int8), np.empty(count, dtype=np.int8), np.empty(count, dtype=np.int32),
-               np.empty(count, dtype=np.int32))
+               np.empty(count, dtype=np.int32), np.empty(count), np.empty(count))
         body_rebound_batch(arrays, codes, ratios, hands, quats, incident_velocity(35.0, 150.0),
                            np.array([0.0, 0.0, spin]), CORUNDUM_ON_STEEL.as_array(), 1000, 1e-10, 1e-9, 100_000, *out)
         rows.append(np.column_stack([x.reshape(count, -1).astype(np.float64) for x in out]))

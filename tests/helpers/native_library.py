@@ -31,7 +31,7 @@ U_PER_DRAW = 13                         # RBS_U_PER_DRAW
 BLOCK = 32                              # RBS_BLOCK
 LOCAL_SIZE = 6                          # RBS_LOCAL_SIZE
 NO_KEY = -1                             # RBS_NO_KEY
-VERSION_NUMBER = 1_002_000              # RBS_VERSION_NUMBER of 1.2.0
+VERSION_NUMBER = 1_003_000              # RBS_VERSION_NUMBER of 1.3.0
 ROUGHNESS_OF_TABLE = -1.0               # RBS_ROUGHNESS_OF_TABLE: rbs_options.roughness_deg's default
 MAX_ROUGHNESS_DEG = 45.0                # RBS_MAX_ROUGHNESS_DEG
 MAX_WALL_HITS = 10                      # RBS_MAX_WALL_HITS
@@ -159,7 +159,8 @@ class Result(Record):
     """rbs_result (RBS_RESULT_INIT)."""
 
     _fields_ = [("status", ctypes.c_int), ("path", ctypes.c_int), ("shape", ctypes.c_int),
-                ("n_collisions", ctypes.c_int), ("V", _d3), ("Omega", _d3), ("wall_hits", ctypes.c_int)]
+                ("n_collisions", ctypes.c_int), ("V", _d3), ("Omega", _d3), ("wall_hits", ctypes.c_int),
+                ("wall_work_normal", ctypes.c_double), ("wall_work_tangential", ctypes.c_double)]
     LAST_1_0 = "Omega"
 
     def __init__(self, *args, **kwargs):
@@ -570,12 +571,15 @@ INTERNAL = {
     "rbs_table_rebound": (_i, [_vp, _vp, _vp, _vp, _d, _vp, _i, _vp, _vp]),
     "rbs_direct_rebound": (_i, [_vp, _i, _vp, _vp, _vp, _d, _vp, _vp, _vp]),
     "rbs_collide": (_i, [_vp] * 7),
+    "rbs_wall_work": (None, [_vp] * 5 + [ctypes.POINTER(_d)] * 2),
     "rbs_body_vertices": (_i, [_i, _d, _d, _d, _d, _d, _vp]),
     "rbs_bounding_radius": (_d, [_i, _vp, _vp, _i]),
     "rbs_particle_body": (_i, [_vp, _i, _d, _d, _d, _vp, _vp, _vp]),
     "rbs_rebound_model_frame": (_i, [_vp, _vp, _i, _d, _d, _d, _d, _d, _vp, _vp, _vp]),
+    "rbs_rebound_model_frame_counted": (_i, [_vp, _vp, _i, _d, _d, _d, _d, _d, _vp, _vp, _vp, ctypes.POINTER(_ll),
+                                             _vp]),
     "rbs_body_rebound": (_i, [_i, _vp, _i, _vp, _vp, _d, _vp, _vp, _vp, _vp, _ll, _d, _d, _ll, _vp, _vp,
-                              ctypes.POINTER(_ll), ctypes.POINTER(_ll)]),
+                              ctypes.POINTER(_ll), ctypes.POINTER(_ll), _vp]),
     "rbs_normal_quantile": (_d, [_d]),
     "rbs_aspect_ratio": (_d, [_vp, _vp, _d]),
     "rbs_uniform_quaternion": (None, [_d, _d, _d, _vp]),

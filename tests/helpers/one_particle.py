@@ -44,6 +44,24 @@ def run_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0
             kappa=0.3, n_max=1000, contact_tol=1e-10, set_tol=1e-9, max_steps=100_000, history_rows=0):
     """Rebound of one particle (``shape`` and ``ratios`` as :func:`body`); returns (V⁺ m/s, Ω⁺ (m/s)/a, status,
     n_coll, e_rot, history)."""
+    done, V, W, history, _ = _rebound(shape, ratios, R0, alpha1, speed, omega_in, hand, kappa, n_max, contact_tol,
+                                      set_tol, max_steps, history_rows)
+    return V, W, done.status, done.n_collisions, done.rotational_energy, history
+
+
+def rebound_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0), hand=1, kappa=0.3,
+                n_max=1000):
+    """:func:`run_one`'s rebound as the kernel returns it (:class:`direct_model.body_rebound.BodyRebound`: V and
+    Omega after the last collision, the wall work, ...) and the incident kinetic energy per unit mass E⁻ =
+    ½|V⁻|² + ½Ω⁻·KΩ⁻ (m²/s², K the lab-frame J/m at the orientation R0)."""
+    done, _, _, _, b = _rebound(shape, ratios, R0, alpha1, speed, omega_in, hand, kappa, n_max, 1e-10, 1e-9, 100_000,
+                                0)
+    V0, W0 = incident_velocity(alpha1, speed), np.asarray(omega_in, dtype=float) * speed
+    return done, 0.5 * V0 @ V0 + 0.5 * W0 @ (R0 @ np.diag(b.K) @ R0.T) @ W0
+
+
+def _rebound(shape, ratios, R0, alpha1, speed, omega_in, hand, kappa, n_max, contact_tol, set_tol, max_steps,
+             history_rows):
     b = body(shape, ratios, hand, kappa)
     verts = np.zeros((max(len(b.vertices), 1), 3))         # an ellipsoid's support point goes to row 0
     verts[:len(b.vertices)] = b.vertices
@@ -53,7 +71,7 @@ def run_one(shape, ratios, R0, alpha1=45.0, speed=200.0, omega_in=(0.0, 0.0, 0.0
         b.kind, verts, len(b.vertices), b.semi, b.K, b.radius, np.ascontiguousarray(R0),
         incident_velocity(alpha1, speed), np.asarray(omega_in, dtype=float) * speed, CORUNDUM_ON_STEEL.as_array(),
         n_max, contact_tol, set_tol, max_steps, V, W, history, np.empty(WORK_SIZE), b.hull)
-    return V, W, done.status, done.n_collisions, done.rotational_energy, history
+    return done, V, W, history, b
 
 
 def random_bodies(n, seed, shapes=("ellipsoid", "prism", "cut_prism", "tetrahedron")):

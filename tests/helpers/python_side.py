@@ -6,7 +6,7 @@ only this module is re-pointed. The tests use the public API: ``surrogate.load``
 ``surrogate.U_PER_DRAW``, the ``STATUS_*`` codes, ``surrogate.sample_local`` and the kernels
 ``table_rebound``, ``table_rebound_many``, ``table_rebound_many_rng``, ``table_rebound_uniforms``,
 ``draw_local``; the direct model's free flight from ``direct_model.rotation``, its run-time kernel
-``direct_rebound`` and the kernels it calls (``direct_model``: collide, body_vertices, the shape arrays and
+``direct_rebound`` and the kernels it calls (``direct_model``: collide, wall_work, body_vertices, the shape arrays and
 particle_body, bounding_radius, normal_quantile, aspect_ratio, uniform_quaternion, quaternion_to_matrix,
 rebound_model_frame), the wall records (``direct_model.wall``: WallMaterial, TabulatedWall and the node maxima) and
 the sampler's restitution factor (``surrogate.kernels.fastmath.restitution_factor``), user grains (tests/helpers/grains.py); those of every
@@ -27,7 +27,7 @@ from surrogate.kernels import draw_local, table_rebound, table_rebound_many, tab
 from surrogate.kernels.direct_path import direct_rebound
 from surrogate.kernels.locate import mix_shape
 from data_schema.table import TABLE_VERSION
-from direct_model.collision import collide
+from direct_model.collision import collide, wall_work
 from direct_model.wall import MAX_CONTACT_SINES, MAX_CONTACT_SPEEDS, MAX_ROUGHNESS_DEG, TabulatedWall, WallMaterial
 from surrogate.kernels.fastmath import restitution_factor
 from direct_model.body_rebound import quaternion_to_matrix
@@ -104,7 +104,7 @@ __all__ = ["angles_to_velocity", "ROT_PARAMS_SIZE", "carlson_rf", "carlson_rj", 
            "MAX_VERTICES", "STATUS_FAILED", "U_PER_REBOUND", "aspect_ratio", "body_vertices", "bounding_radius",
            "SCRATCH_SIZE", "AspectRatioLaw", "cloud_grain", "hull_grain", "particle_body", "rebound_model_frame",
            "shape_arrays",
-           "collide", "normal_quantile", "quaternion_to_matrix", "direct_rebound", "uniform_quaternion",
+           "collide", "wall_work", "normal_quantile", "quaternion_to_matrix", "direct_rebound", "uniform_quaternion",
            "A", "N", "SHAPES", "STATES", "assert_one_law", "frame_of", "incident", "one_law", "simulated", "state_id",
            "to_model_frame", "METHOD_AUTO", "METHOD_DIRECT", "METHOD_TABLE", "PATH_DIRECT", "PATH_TABLE",
            "SPIN_TOLERANCE", "rebound_path", "rebound", "mix_shape", "TABLE_VERSION", "MAX_ROUGHNESS_DEG",

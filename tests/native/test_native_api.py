@@ -1,4 +1,4 @@
-"""The C library's public interface as native/include/rebound_scatter.h declares it (version 1.2).
+"""The C library's public interface as native/include/rebound_scatter.h declares it (version 1.3).
 
 - The public shared library exports exactly the header's RBS_API functions (the internal ones only from the
   test-only library), and tests.helpers.native_library types each of them.
@@ -10,7 +10,7 @@
   call; an rbs_result whose size covers only up to its status gets only that written; records larger than the
   library's (a program built against a later header) work, their later bytes neither read nor written; a NULL
   rbs_options is RBS_OPTIONS_INIT.
-- The version (1.2.0, 1002000) and the one status space: each status a distinct value and a string.
+- The version (1.3.0, 1003000) and the one status space: each status a distinct value and a string.
 - The many-hit and local draws' refusals (rbs_draw_many, rbs_draw_local).
 """
 
@@ -146,16 +146,22 @@ def test_the_ctypes_records_have_the_header_s_layout(header_facts):
 
 def test_a_hit_s_record_has_rbs_result_s_fields_in_every_language(header_facts):
     """surrogate.Hit (one hit, numba) and Rebounds (many, NumPy) have the fields of rbs_result, in its
-    order (``size`` aside), the paths the header's values, the vectors its length: a new output of a hit is a
-    field of all three."""
+    order (``size`` aside), the paths the header's values, the vectors its length, the kinds its (integers, floats):
+    a new output of a hit is a field of all three."""
     from surrogate.kernels import hit
     names = fields(Result)
     assert names[0] == "size" and hit.Hit._fields == hit.Rebounds._fields == tuple(names[1:])
     assert tuple(hit.REBOUNDS_ARRAYS) == tuple(names[1:])
+    c_types = dict(Result._fields_)
     for name, (dtype, tail) in hit.REBOUNDS_ARRAYS.items():
-        c_type = getattr(Result, name)
-        assert tail == (() if c_type.size == ctypes.sizeof(ctypes.c_int) else (c_type.size // 8,)), name
-        assert np.dtype(dtype).kind == ("f" if tail else "i"), name
+        c_type = c_types[name]
+        array = hasattr(c_type, "_length_")
+        element = c_type._type_ if array else c_type        # an array's element type
+        assert tail == ((c_type._length_,) if array else ()), name
+        assert np.dtype(dtype).kind == ("f" if element is ctypes.c_double else "i"), name
+    # the record a refused hit gets: NaN floats, as rbs_rebound writes them
+    refused = hit.invalid_hit()
+    assert np.isnan(refused.wall_work_normal) and np.isnan(refused.wall_work_tangential)
     assert (hit.PATH_NONE, hit.PATH_TABLE, hit.PATH_DIRECT) == tuple(
         int(header_facts[("enum", f"RBS_PATH_{p}")]) for p in ("NONE", "TABLE", "DIRECT"))
 
@@ -169,7 +175,7 @@ def test_the_enumerations_and_constants_are_the_helper_s_and_the_packages(header
     defines = {key[1]: float(value) for key, value in header_facts.items() if key[0] == "define"}
     for constant, value in DEFINES.items():
         assert defines[constant] == value, constant
-    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 2, 0)
+    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 3, 0)
     assert defines["RBS_U_PER_DRAW"] == py.U_PER_DRAW
     assert defines["RBS_SPIN_TOLERANCE"] == py.SPIN_TOLERANCE
     assert defines["RBS_NORMAL_TOLERANCE"] == NORMAL_TOLERANCE
@@ -190,12 +196,12 @@ def test_the_header_s_table_format_is_the_one_read_and_written(header_facts, tab
 def _fortran_layout_program() -> str:
     """A Fortran program printing, for each record of the module (native/fortran/rebound_scatter.f90), its c_sizeof
     and each field's offset (c_loc differences), as _layout_program prints them for C, and the defaults of the
-    fields of 1.2."""
+    fields of 1.2 and 1.3."""
     lines = ["program layout", "  use rebound_scatter", "  implicit none"]
     for k, name in enumerate(RECORDS):
         lines.append(f"  type({name}), target :: x{k}")
-    lines.append("  print '(a, es24.17, 1x, i0, 1x, es24.17)', 'defaults ', x1%roughness_deg, x2%wall_hits, "
-                 "x7%roughness_deg")
+    lines.append("  print '(a, es24.17, 1x, i0, 1x, es24.17, 2(1x, es24.17))', 'defaults ', x1%roughness_deg, &\n"
+                 "    x2%wall_hits, x7%roughness_deg, x2%wall_work_normal, x2%wall_work_tangential")
     for k, (name, record) in enumerate(RECORDS.items()):
         lines.append(f"  print '(a, i0)', 'sizeof {name} ', c_sizeof(x{k})")
         for field in fields(record):
@@ -207,7 +213,8 @@ def _fortran_layout_program() -> str:
 
 def test_the_fortran_records_have_the_header_s_layout(native_build, header_facts, tmp_path):
     """The bind(c) types of the Fortran module: the header's sizeof and offsets, field for field (the fields of 1.2
-    too), and the defaults of RBS_OPTIONS_INIT, RBS_RESULT_INIT and RBS_WALL_INFO_INIT for the fields of 1.2."""
+    and 1.3 too), and the defaults of RBS_OPTIONS_INIT, RBS_RESULT_INIT and RBS_WALL_INFO_INIT for the fields of 1.2
+    and 1.3."""
     compiler = shutil.which("gfortran")
     assert compiler, f"no Fortran compiler: {INSTALL_HINT}"
     source = tmp_path / "layout.f90"
@@ -224,9 +231,10 @@ def test_the_fortran_records_have_the_header_s_layout(native_build, header_facts
         if key[0] in ("sizeof", "offsetof"):
             assert int(value) == int(header_facts[key]), key
     assert len(facts) == 1 + sum(1 + len(fields(record)) for record in RECORDS.values())
-    (roughness, wall_hits, wall_roughness), = [line.split()[1:] for line in done.stdout.splitlines()
-                                                if line.startswith("defaults")]
+    (roughness, wall_hits, wall_roughness, work_n, work_t), = [line.split()[1:] for line in done.stdout.splitlines()
+                                                                if line.startswith("defaults")]
     assert (float(roughness), int(wall_hits), float(wall_roughness)) == (ROUGHNESS_OF_TABLE, 0, 0.0)
+    assert (float(work_n), float(work_t)) == (Result().wall_work_normal, Result().wall_work_tangential) == (0.0, 0.0)
 
 
 @pytest.mark.parametrize("language", ["c11", "c++17"])
@@ -249,7 +257,7 @@ def test_the_header_compiles_without_warnings(tmp_path, language):
 def test_version(native):
     version = native.version()
     major, minor, patch = map(int, version.split("."))
-    assert (major, minor, patch) == (1, 2, 0)
+    assert (major, minor, patch) == (1, 3, 0)
     assert native.version_number() == VERSION_NUMBER == major * 1_000_000 + minor * 1_000 + patch
 
 
@@ -365,6 +373,25 @@ def test_a_result_covering_its_status_gets_only_that(native, api_case):
     assert result.status == INVALID
     assert _tail(result, end) == b"\xab" * (ctypes.sizeof(Result) - end)
     del kept
+
+
+def test_a_result_of_1_2_gets_no_wall_work(native, api_case):
+    """The wall work of 1.3: written where the record reaches it (a direct hit's > 0, a table hit's NaN), left alone in
+    a record of 1.2 (its size ends before rbs_result.wall_work_normal), whose other fields are the same."""
+    table, mix, u = api_case
+    for spec, direct in ((SPIN_HIT, True), (GOOD_HIT, False)):
+        h, kept = hit(**spec, u=u)
+        full = Result()
+        assert _rebound(native.c, table, mix, h, None, full) == OK
+        work = (full.wall_work_normal, full.wall_work_tangential)
+        assert (work[0] > 0.0 and work[1] >= 0.0) if direct else np.isnan(work).all(), (spec, work)
+        old = Result()
+        _fill(old)
+        old.size = Result.wall_work_normal.offset
+        assert _rebound(native.c, table, mix, h, None, old) == OK
+        end = Result.wall_hits.offset + Result.wall_hits.size       # padding after it
+        assert bytes(old)[8:end] == bytes(full)[8:end] and _tail(old, old.size) == b"\xab" * 16
+        del kept
 
 
 def _draw_many(c, table, mix, count=40, opts=None, hits_size=None, results_size=None, rng=None, u=True,

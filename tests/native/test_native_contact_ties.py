@@ -35,7 +35,7 @@ def _rebound_c(c, s):
     status = c.rbs_body_rebound(s.body.kind, arrays[0].ctypes.data, len(s.body.vertices), arrays[1].ctypes.data,
                                 arrays[2].ctypes.data, s.body.radius, *(x.ctypes.data for x in arrays[3:]), N_MAX,
                                 CONTACT_TOL, SET_TOL, MAX_STEPS, V.ctypes.data, W.ctypes.data,
-                                ctypes.byref(n_collisions), ctypes.byref(n_steps))
+                                ctypes.byref(n_collisions), ctypes.byref(n_steps), None)
     return V, W, status, n_collisions.value
 
 

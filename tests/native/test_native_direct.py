@@ -233,7 +233,8 @@ def _random_tabulated_wall(rng, ns=None, nz=None):
 def test_one_collision_bit_for_bit(native):
     """rbs_collide against numba's collide on 10⁴ random states (any body, orientation, contact point, spin and
     wall law: every other state an exponential law, the others a tabulated one, its node counts from the fewest
-    to the most; a third not approaching): the same outcome and the same bits of ΔV and ΔΩ."""
+    to the most; a third not approaching): the same outcome and the same bits of ΔV and ΔΩ, and of the collision's
+    work on the wall (rbs_wall_work, numba's wall_work)."""
     c = _c(native)
     rng = np.random.default_rng(7)
     counts = [(1, 2), (1, 16), (16, 2), (py.MAX_CONTACT_SPEEDS, py.MAX_CONTACT_SINES)] + [(None, None)] * 60
@@ -256,6 +257,10 @@ def test_one_collision_bit_for_bit(native):
         code = c.rbs_collide(*(x.ctypes.data for x in (V, W, r, Kinv, wall, dV_c, dW_c)))
         assert code == py.collide(V, W, r, Kinv, wall, dV_py, dW_py)
         assert _same(dV_c, dV_py) and _same(dW_c, dW_py)
+        if code in (0, 1):
+            work = ctypes.c_double(), ctypes.c_double()
+            c.rbs_wall_work(*(x.ctypes.data for x in (V, W, r, dV_c, dW_c)), *map(ctypes.byref, work))
+            assert _same([w.value for w in work], py.wall_work(V, W, r, dV_py, dW_py))
         outcomes[code] = outcomes.get(code, 0) + 1
     assert outcomes.get(0, 0) > N_COLLISIONS // 3 and outcomes.get(2, 0) > N_COLLISIONS // 10
     print(f"\none collision: {N_COLLISIONS} states, outcomes {outcomes}, 0 ulp")
@@ -287,8 +292,8 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
     against direct_rebound, PER_SHAPE particles of each shape in random caller frames, the same uniforms: the same
     status, and for a rebound the same bits of V⁺ and Ω⁺ — multi-collision sequences included, so every operation
     of the port is numba's (a last-bit difference would grow through them); the result names the direct path
-    and the shape. Every tenth particle also through the direct path alone (the test-only library's
-    rbs_direct_rebound): the same bits."""
+    and the shape; the same bits of the wall work whatever the status (NaN for an invalid hit). Every tenth
+    particle also through the direct path alone (the test-only library's rbs_direct_rebound): the same bits."""
     python, c_table = table_pair
     c = _c(native)
     params = python.direct_parameters
@@ -303,6 +308,8 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
             mine = result.status, np.array(result.V[:]), np.array(result.Omega[:])
             assert mine[0] == status
             assert (result.path, result.shape) == ((PATH_DIRECT, shape) if status != INVALID else (PATH_NONE, -1))
+            assert _same([result.wall_work_normal, result.wall_work_tangential],
+                         [hit.wall_work_normal, hit.wall_work_tangential]), (shape, V, n, a, omega, u)
             if status == py.STATUS_REBOUNDED:
                 assert _same(mine[1], V_py) and _same(mine[2], W_py), (shape, V, n, a, omega, u)
                 assert result.n_collisions >= 1
@@ -318,9 +325,9 @@ def test_whole_rebounds_bit_for_bit(native, table_pair, spin):
 
 @pytest.mark.parametrize("spin", SPINS)
 def test_grain_rebounds_bit_for_bit(native, table_pair, spin):
-    """A user's grain rebounds in C as in numba: rbs_rebound_model_frame against rebound_model_frame over the
+    """A user's grain rebounds in C as in numba: rbs_rebound_model_frame_counted against rebound_model_frame over the
     grains' arrays (hulls of 8 to 1000 vertices), 400 particles each at random incidence, the same uniforms:
-    the same status and, for a rebound, the same bits of V⁺ and Ω⁺."""
+    the same status, collisions and bits of the wall work and, for a rebound, the same bits of V⁺ and Ω⁺."""
     c = _c(native)
     params = table_pair[0].direct_parameters
     arrays = py.shape_arrays(GRAINS)
@@ -336,10 +343,12 @@ def test_grain_rebounds_bit_for_bit(native, table_pair, spin):
         u = rng.random(py.U_PER_REBOUND)
         state = (speed * np.cos(alpha1), -speed * np.sin(alpha1), *omega)
         theirs = py.rebound_model_frame(params, arrays, shape, *state, u, scratch)
-        V, W = np.zeros(3), np.zeros(3)
-        status = c.rbs_rebound_model_frame(params.ctypes.data, ctypes.byref(struct), shape, *state, u.ctypes.data,
-                                           V.ctypes.data, W.ctypes.data)
-        assert status == theirs.status
+        V, W, work, collisions = np.zeros(3), np.zeros(3), np.zeros(2), ctypes.c_longlong(-1)
+        status = c.rbs_rebound_model_frame_counted(params.ctypes.data, ctypes.byref(struct), shape, *state,
+                                                   u.ctypes.data, V.ctypes.data, W.ctypes.data,
+                                                   ctypes.byref(collisions), work.ctypes.data)
+        assert (status, collisions.value) == (theirs.status, theirs.n_collisions)
+        assert _same(work, [theirs.wall_work_normal, theirs.wall_work_tangential]), (GRAINS[shape].name, state, u)
         if status == py.STATUS_REBOUNDED:
             assert _same(V, theirs.V) and _same(W, theirs.Omega), (GRAINS[shape].name, state, u)
         statuses[status] = statuses.get(status, 0) + 1

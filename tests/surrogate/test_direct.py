@@ -62,7 +62,8 @@ def test_rotating_the_frame_rotates_the_outputs(small_table, shape):
 def test_a_rebound_never_adds_energy(params, shapes, shape):
     """Through the kernel, in a random frame: ½|V⁺|² + ½ K_min |Ω⁺ a|² ≤ ½|V⁻|² + ½ K_max |Ω⁻ a|² per unit mass
     (lengths in m), K_min, K_max the extreme principal values of J/(m a²) of the particle drawn from the same
-    uniforms: the kinetic energy ½|V|² + ½ Ω·JΩ/m lies between these bounds, and collisions never add to it."""
+    uniforms: the kinetic energy ½|V|² + ½ Ω·JΩ/m lies between these bounds, and collisions never add to it. The
+    hit's wall work (m²/s², each part ≥ 0) is the energy lost: within the bounds of E⁻ − E⁺."""
     rng = np.random.default_rng(31)
     code = SHAPES.index(shape)
     kfac, law, cdf = second_moment_factors()[code], shapes.aspect[code], shapes.aspect_cdf[code]
@@ -83,6 +84,12 @@ def test_a_rebound_never_adds_energy(params, shapes, shape):
         before = 0.5 * V @ V + 0.5 * K.max() * (W @ W) * A * A
         after = 0.5 * np.dot(V_out, V_out) + 0.5 * K.min() * np.dot(W_out, W_out) * A * A
         assert after <= before * (1 + 1e-12), i
+        lost_most = before - after
+        lost_least = 0.5 * V @ V + 0.5 * K.min() * (W @ W) * A * A - (after + 0.5 * (K.max() - K.min()) * np.dot(
+            W_out, W_out) * A * A)
+        work = hit.wall_work_normal + hit.wall_work_tangential
+        assert hit.wall_work_normal > 0.0 and hit.wall_work_tangential >= 0.0, i
+        assert lost_least - 1e-12 * before <= work <= lost_most + 1e-12 * before, i
         checked += 1
     assert checked > 350
 
@@ -121,6 +128,7 @@ def test_same_seed_same_bits_whatever_the_threads(small_table):
     for one, many in zip(*runs):
         np.testing.assert_array_equal(one, many)
     assert set(np.unique(runs[0].status)) <= {STATUS_REBOUNDED, STATUS_TRAPPED, STATUS_FAILED}
+    assert np.all(runs[0].wall_work_normal > 0.0) and np.all(runs[0].wall_work_tangential >= 0.0)
 
 
 def test_the_parameters_are_the_table_s(small_table_path, small_table, tmp_path):

@@ -148,6 +148,8 @@ def test_rough_rows_are_the_single_hit_kernel_s_and_keep_the_stream(small_table,
             full.status[i], full.path[i], full.shape[i], full.n_collisions[i], full.wall_hits[i])
         np.testing.assert_array_equal(np.array(one.V), full.V[i])
         np.testing.assert_array_equal(np.array(one.Omega), full.Omega[i])
+        np.testing.assert_array_equal([one.wall_work_normal, one.wall_work_tangential],
+                                      [full.wall_work_normal[i], full.wall_work_tangential[i]])
 
 
 @pytest.fixture(scope="module")
@@ -227,7 +229,8 @@ def _sphere_sh(V, roughness_deg, law, rng):
 def test_a_sphere_on_a_rough_wall_is_sommerfeld_huber(small_table):
     """A near-sphere (b/a, c/b in [0.999999, 1]) through the product's rough wall against :func:`_sphere_sh`, at
     α1 = 4° and 30°, Δγ = 8°: two-sample KS of α2, β2, |V⁺|/|V⁻| (n = 1500 each; p > 1e-4) and the share of
-    re-hits within 5 standard errors."""
+    re-hits within 5 standard errors. The wall work, summed over a hit's facet hits, is the kinetic energy the
+    near-sphere lost, ½|V⁻|² − ½|V⁺|² − ½ (2/5) a²|Ω⁺|² (to its asphericity, 1e-6)."""
     law = AspectRatioLaw(1.0, 1e-3, 0.999999, 1.0)
     params = model_parameters(law, 0.3, 1000, CORUNDUM_ON_STEEL, 1e-10, 1e-9, 100_000, second_moment_factors())
     shapes = family_shape_arrays(0.3, law, second_moment_factors())
@@ -241,6 +244,9 @@ def test_a_sphere_on_a_rough_wall_is_sommerfeld_huber(small_table):
             one = rebound(small_table.kernel_data, params, shapes, frozen(np.array([0])), np.array([1.0]), V0,
                           np.zeros(3), (0.0, 1.0, 0.0), 1.0, rng.random(U_PER_DRAW), METHOD_DIRECT, True, -1, 8.0)
             assert one.status == STATUS_REBOUNDED
+            lost = 0.5 * V0 @ V0 - 0.5 * np.dot(one.V, one.V) - 0.2 * np.dot(one.Omega, one.Omega)
+            assert one.wall_work_normal > 0.0 and one.wall_work_tangential >= 0.0
+            assert one.wall_work_normal + one.wall_work_tangential == pytest.approx(lost, abs=1e-6 * V0 @ V0)
             model.append(one.V)
             model_hits.append(one.wall_hits)
             V, _, hits = _sphere_sh(V0.copy(), 8.0, wall, rng)

@@ -54,10 +54,11 @@ def _spinning(V, ratio, seed):
 
 def test_auto_without_spin_inside_the_grid_is_the_table_bit_for_bit(small_table):
     """Ω⁻ None or zero, every state in the grid: "auto" answers every hit by the table, with "table"'s bits
-    (three chunks of rows, so the chunked streams are compared too)."""
+    (three chunks of rows, so the chunked streams are compared too); the table holds no wall work (NaN)."""
     m = 2 * CHUNK_ROWS + 77
     V = _in_grid(m, 1)
     table = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=3, method="table")
+    assert np.isnan(table.wall_work_normal).all() and np.isnan(table.wall_work_tangential).all()
     for omega in (None, np.zeros(3), np.zeros((m, 3))):
         auto = surrogate.sample_global(small_table, V, NORMAL, A, "mix", random_state=3, omega=omega)
         assert np.all(auto.path == PATH_TABLE)
@@ -84,7 +85,7 @@ def _chunk_uniforms(seed, m):
 
 def test_direct_method_is_the_direct_model_with_the_hit_s_uniforms(small_table):
     """method "direct": each hit is direct_rebound on the model shape drawn from the mix with u[0] and
-    the uniforms u[1..7], bit for bit (spinning and not, in and out of the grid)."""
+    the uniforms u[1..7], bit for bit (spinning and not, in and out of the grid), its wall work too."""
     m = CHUNK_ROWS + 40
     V = _in_grid(m, 5, alpha1=(5.0, 90.0), speed=(20.0, 300.0))
     W = _spinning(V, 0.3, 6)
@@ -104,6 +105,9 @@ def test_direct_method_is_the_direct_model_with_the_hit_s_uniforms(small_table):
         assert st == status[i]
         np.testing.assert_array_equal(np.array(v), V_out[i])
         np.testing.assert_array_equal(np.array(w), W_out[i])
+        assert (hit.wall_work_normal, hit.wall_work_tangential) == (hits.wall_work_normal[i],
+                                                                    hits.wall_work_tangential[i])
+    assert np.all(hits.wall_work_normal > 0.0) and np.all(hits.wall_work_tangential >= 0.0)
 
 
 def test_rebound_is_the_table_or_the_direct_kernel_by_path(small_table):
@@ -125,6 +129,10 @@ def test_rebound_is_the_table_or_the_direct_kernel_by_path(small_table):
             want = direct_rebound(params, arrays, shape, V, W, NORMAL, A, u[1:8])
         assert got.status == want.status
         np.testing.assert_array_equal(np.array(got.V + got.Omega), np.array(want.V + want.Omega))
+        # the wall work: the direct path's, NaN on the table path
+        np.testing.assert_array_equal([got.wall_work_normal, got.wall_work_tangential],
+                                      [want.wall_work_normal, want.wall_work_tangential])
+        assert np.isnan(got.wall_work_normal) == (i % 2 == 0)
         for method in (METHOD_TABLE, METHOD_DIRECT):
             bad = u.copy()
             bad[12] = 1.0
