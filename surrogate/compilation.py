@@ -69,7 +69,7 @@ def _calls(table: SurrogateTable) -> list:
                                                               u[0, :kernels.U_PER_REBOUND])),
             ("sample_global_rough", lambda: sample_global(table, V, n, a, shape, 0, omega=omega, roughness_deg=5.0)),
             ("rebound_rough", lambda: kernels.rebound(data, params, shapes, table.model_shapes, cdf, V[0], omega[-1],
-                                                      n[0], a[0], u[0], kernels.METHOD_AUTO, True, -1, 5.0)),
+                                                      n[0], a[0], u[0], kernels.METHOD_AUTO, True, None, 5.0)),
         ]
     return calls
 

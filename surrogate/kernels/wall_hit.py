@@ -138,15 +138,27 @@ def rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u
     a uniform outside [0, 1) whatever the path, a method not in the three, a key < 0; then path PATH_NONE);
     NaN vectors unless rebounded.
     """
-    V, omega, n, a, scaled = float3(V), float3(omega), float3(n), float(a), scaled != 0
+    code = np.int64(NO_KEY) if key is None else np.int64(key) if key >= 0 else np.int64(_BAD_KEY)
+    return _rebound(data, params, shape_arrays, model_shapes, mix_cdf, float3(V), float3(omega), float3(n), float(a),
+                    u, np.int64(method), scaled != 0, code, float(roughness_deg))
+
+
+_BAD_KEY = NO_KEY - 1       # :func:`rebound`'s code of a key given < 0: refused (NO_KEY is no key at all)
+
+
+@numba.njit(**KERNEL)
+def _rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, method, scaled, key,
+             roughness_deg):
+    """:func:`rebound` with its arguments of one set of types (``key``: NO_KEY for none, _BAD_KEY for one < 0):
+    compiled once per type of ``u`` whatever types the callers pass (only their conversion is compiled for
+    them)."""
     if roughness_deg != 0.0:
-        return _rough_on_stack(data, params, shape_arrays, model_shapes, mix_cdf, SHAPE_FROM_MIX,
-                               NO_KEY if key is None else np.int64(key), V, omega, n, a, u, scaled, np.int64(method),
-                               float(roughness_deg))
-    path = rebound_path(data, V, omega, n, a, np.int64(method))
-    if key is not None:
+        return _rough_on_stack(data, params, shape_arrays, model_shapes, mix_cdf, np.int64(SHAPE_FROM_MIX), key, V,
+                               omega, n, a, u, scaled, method, roughness_deg)     # int64: _rough_chunk's types
+    path = rebound_path(data, V, omega, n, a, method)
+    if key != NO_KEY:
         return _keyed_rebound(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path,
-                              np.int64(key))
+                              key)
     return rebound_typed(data, params, shape_arrays, model_shapes, mix_cdf, V, omega, n, a, u, scaled, path)
 
 

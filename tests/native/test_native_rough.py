@@ -52,11 +52,11 @@ def smooth_pair(table_pair):
 
 
 def _numba(table, cdf, V, Omega, n, u, method, key, roughness):
-    """numba's Hit. The argument types of tests/surrogate/test_rough_wall.py's calls (V, Ω and u arrays, n a tuple,
-    the key an int, −1 for none: the rough kernel's NO_KEY), so that one compilation serves both."""
+    """numba's Hit (``key`` −1: none, as C's RBS_NO_KEY)."""
     return py.rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes, cdf,
                       np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(Omega, dtype=np.float64),
-                      tuple(float(x) for x in n), A, u, int(method), True, int(key), float(roughness))
+                      tuple(float(x) for x in n), A, u, int(method), True, None if key < 0 else int(key),
+                      float(roughness))
 
 
 def _fields(record) -> tuple:

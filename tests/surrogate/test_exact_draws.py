@@ -95,7 +95,8 @@ def test_a_keyed_hit_is_the_hit_with_the_key_s_uniforms(small_table, method):
             keyed[1 + U_RATIOS], keyed[2 + U_RATIOS], keyed[1 + U_HAND] = (keyed_uniform(key, s) for s in (1, 2, 3))
         got = rebound(*args, V, (0.0, 0.0, 0.0), NORMAL, A, u, method, True, key)
         want = rebound(*args, V, (0.0, 0.0, 0.0), NORMAL, A, keyed, method, True)
-        assert got == want and np.array(got.V + got.Omega).tobytes() == np.array(want.V + want.Omega).tobytes(), key
+        # field by field on the bits: NaN fields (the table path's wall work) are equal as bits, not as floats
+        assert all(np.array(x).tobytes() == np.array(y).tobytes() for x, y in zip(got, want)), key
         rebounded += got.status == STATUS_REBOUNDED
     assert rebounded > 100
 

@@ -142,8 +142,8 @@ def test_rough_rows_are_the_single_hit_kernel_s_and_keep_the_stream(small_table,
     cdf = surrogate.mix_cdf(small_table, "mix")
     for i in range(40):
         one = rebound(small_table.kernel_data, small_table.direct_parameters, small_table.shape_arrays,
-                      small_table.model_shapes, cdf, V[i], W[i], (0.0, 1.0, 0.0), 1e-3, u[i], 0, True, int(keys[i]),
-                      12.0)       # key −1: none (the rough kernel's NO_KEY), one compilation for both cases
+                      small_table.model_shapes, cdf, V[i], W[i], (0.0, 1.0, 0.0), 1e-3, u[i], 0, True,
+                      int(keys[i]) if keyed else None, 12.0)
         assert (one.status, one.path, one.shape, one.n_collisions, one.wall_hits) == (
             full.status[i], full.path[i], full.shape[i], full.n_collisions[i], full.wall_hits[i])
         np.testing.assert_array_equal(np.array(one.V), full.V[i])
@@ -242,7 +242,7 @@ def test_a_sphere_on_a_rough_wall_is_sommerfeld_huber(small_table):
         model, model_hits, sh, sh_hits = [], [], [], []
         for i in range(n):
             one = rebound(small_table.kernel_data, params, shapes, frozen(np.array([0])), np.array([1.0]), V0,
-                          np.zeros(3), (0.0, 1.0, 0.0), 1.0, rng.random(U_PER_DRAW), METHOD_DIRECT, True, -1, 8.0)
+                          np.zeros(3), (0.0, 1.0, 0.0), 1.0, rng.random(U_PER_DRAW), METHOD_DIRECT, True, None, 8.0)
             assert one.status == STATUS_REBOUNDED
             lost = 0.5 * V0 @ V0 - 0.5 * np.dot(one.V, one.V) - 0.2 * np.dot(one.Omega, one.Omega)
             assert one.wall_work_normal > 0.0 and one.wall_work_tangential >= 0.0
