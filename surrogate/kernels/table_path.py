@@ -62,7 +62,7 @@ def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
 @numba.njit(**KERNEL)
 def table_rebound_typed(data, mix_cdf, V, n, a, u, scaled):
     """:func:`table_rebound` with V and n 3-tuples of float64, a a float64 and ``scaled`` a bool (module doc)."""
-    return table_shape_rebound(data, mix_shape(mix_cdf, u[0]), V, n, a, u, scaled)
+    return table_shape_rebound(data, np.int64(mix_shape(mix_cdf, u[0])), V, n, a, u, scaled)   # int64: as rough hits
 
 
 @numba.njit(**KERNEL)
