@@ -17,16 +17,17 @@ from tests.helpers.tables import (NEAR_NORMAL_TABLE_CONFIG, OCTAHEDRON_TABLE_CON
                                   big_grain_config, write_grain_config)
 
 
-def _build(tmp_path_factory, name, config_text):
+def _build(tmp_path_factory, name, config_text, workers=None):
     path = tmp_path_factory.mktemp("tables") / f"{name}.h5"
-    build_table(parse_config(config_text), path)
+    build_table(parse_config(config_text), path, workers=workers)
     return path
 
 
 @pytest.fixture(scope="session")
 def small_table_path(tmp_path_factory):
-    """A table on a 3 × 3 grid."""
-    return _build(tmp_path_factory, "small", SMALL_TABLE_CONFIG)
+    """A table on a 3 × 3 grid. The session's first build: one worker compiles the model once, where two would each
+    compile it (on a fresh clone's empty cache) and take the core the session's background builds need."""
+    return _build(tmp_path_factory, "small", SMALL_TABLE_CONFIG, workers=1)
 
 
 @pytest.fixture(scope="session")

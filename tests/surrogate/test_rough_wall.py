@@ -59,12 +59,12 @@ def _facet_angles(alpha1_deg, roughness_deg, n):
 @pytest.mark.parametrize("alpha1_deg", [3.0, 60.0])
 def test_facets_follow_the_shadow_weighted_law(alpha1_deg):
     """The facets' γx and γz against their marginals of N(0, Δγ²)² · max(0, cos α1 sin γx + sin α1 cos γx cos γz)
-    (on a 2001² grid over ±8 Δγ, trapezoid rule); a χ² over 16 equiprobable bins of each (n = 40 000; p > 1e-4)."""
+    (on an 801² grid over ±8 Δγ, trapezoid rule); a χ² over 16 equiprobable bins of each (n = 40 000; p > 1e-4)."""
     spread, n = math.radians(10.0), 40_000
     drawn = _facet_angles(alpha1_deg, 10.0, n)
     assert not np.isnan(drawn).any()
     c, s = math.cos(math.radians(alpha1_deg)), math.sin(math.radians(alpha1_deg))
-    grid = np.linspace(-8 * spread, 8 * spread, 2001)
+    grid = np.linspace(-8 * spread, 8 * spread, 801)
     gx, gz = np.meshgrid(grid, grid, indexing="ij")
     density = (stats.norm.pdf(gx, 0, spread) * stats.norm.pdf(gz, 0, spread)
                * np.maximum(0.0, c * np.sin(gx) + s * np.cos(gx) * np.cos(gz)))
