@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import surrogate
+from example_table import load_or_build
 
 REPO = Path(__file__).resolve().parents[1]
 ALPHA1_DEG, SPEED = 45.0, 100.0          # the incident state, deg and m/s
@@ -43,14 +44,7 @@ seed = 35
 
 def get_table(path, out: Path):
     """Load ``path``, or build (once) the small table into ``out``."""
-    if path is None:
-        path = out / "grain_key_table.h5"
-        if not path.exists():
-            from tablegen import build_table, parse_config
-            out.mkdir(parents=True, exist_ok=True)
-            print(f"building a small table into {path} ...", flush=True)
-            build_table(parse_config(TABLE_TOML), path)
-    return surrogate.load(path)
+    return load_or_build(path, out, "grain_key_table.h5", TABLE_TOML)
 
 
 def keyed_hits(table, keys: np.ndarray, hits: int, method: str, seed: int):

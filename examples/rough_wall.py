@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import surrogate
+from example_table import load_or_build
 
 REPO = Path(__file__).resolve().parents[1]
 SPEED, HALF_SIZE = 150.0, 1e-4          # m/s, m
@@ -40,14 +41,7 @@ seed = 55
 
 def get_table(path, out: Path):
     """Load ``path``, or build (once) the small table into ``out``."""
-    if path is None:
-        path = out / "rough_wall_table.h5"
-        if not path.exists():
-            from tablegen import build_table, parse_config
-            out.mkdir(parents=True, exist_ok=True)
-            print(f"building a small table into {path} ...", flush=True)
-            build_table(parse_config(TABLE_TOML), path)
-    return surrogate.load(path)
+    return load_or_build(path, out, "rough_wall_table.h5", TABLE_TOML)
 
 
 def rebound_angles(V: np.ndarray) -> tuple:

@@ -5,7 +5,8 @@ import importlib.util
 from tests.helpers import REPO
 
 
-def test_the_rough_wall_example_reports_every_case(small_table_path, tmp_path, capsys):
+def test_the_rough_wall_example_reports_every_case(small_table_path, tmp_path, capsys, monkeypatch):
+    monkeypatch.syspath_prepend(str(REPO / "examples"))        # as when run as a script: its helper module beside it
     spec = importlib.util.spec_from_file_location("rough_wall", REPO / "examples" / "rough_wall.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
