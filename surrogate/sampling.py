@@ -170,8 +170,8 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     roughness_deg : None (default: the table's wall's, ``table.wall.roughness_deg``) or the wall's roughness Δγ in
         degrees, in [0, 45]: 0 a smooth wall; above, each hit lands on a facet of the wall tilted at random and
         may hit again (docs/model.md §12; :func:`surrogate.kernels.wall_hit.rough_rebound`), its facets drawn from
-        the hit's own uniforms, so the stream advances as on a smooth wall. A rough wall answers hit by hit
-        (about 3 times the table path's cost per hit; the direct model's for facet hits off the table).
+        the hit's own uniforms, so the stream advances as on a smooth wall. A rough wall answers hit by hit,
+        without the table's block pipeline (its cost per hit: docs/performance.md).
 
     Returns
     -------
@@ -209,10 +209,13 @@ def sample_global(table: SurrogateTable, velocity, normal, half_size, shape="ell
     out = check_out(out, n_particles, (V, nrm, a, W))
     params = frozen(table.direct_parameters)       # read-only, as the loaded table's: one compilation of the kernels
     states = chunk_states(check_random_state(random_state), n_particles)
-    answer = rough_rebound_parallel_rng if roughness != 0.0 else rebound_parallel_rng
-    answer(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys, V, W,
-           as_rows(nrm, n_particles), as_rows(a, n_particles), states, code, out, scaled,
-           *((roughness,) if roughness != 0.0 else ()))
+    rows = (V, W, as_rows(nrm, n_particles), as_rows(a, n_particles), states, code, out, scaled)
+    if roughness != 0.0:
+        rough_rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes,
+                                   keys, *rows, roughness)
+    else:
+        rebound_parallel_rng(table.kernel_data, params, table.shape_arrays, table.model_shapes, cdf, shapes, keys,
+                             *rows)
     return out
 
 
