@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from data_schema.samples import ALPHA1_RANGE_DEG, SHAPE_NAMES
-from direct_model.wall import MAX_ROUGHNESS_DEG
+from direct_model.wall import MAX_ROUGHNESS_DEG, check_roughness as check_roughness_value
 from surrogate.kernels.checks import (FAULT_ALPHA1_NOT_FINITE, FAULT_ALPHA1_OUTSIDE, FAULT_HALF_SIZE,
                                       FAULT_NORMAL_NOT_FINITE, FAULT_NORMAL_NOT_UNIT, FAULT_NOT_INTO_WALL,
                                       FAULT_SPEED_NOT_FINITE, FAULT_SPEED_OUTSIDE, FAULT_VELOCITY_NOT_FINITE,
@@ -249,11 +249,11 @@ def check_roughness(table, roughness_deg) -> float:
     ``roughness_deg``, a number in [0, MAX_ROUGHNESS_DEG] (0: a smooth wall)."""
     if roughness_deg is None:
         return table.wall.roughness_deg
-    if (isinstance(roughness_deg, bool) or not isinstance(roughness_deg, (int, float, np.integer, np.floating))
-            or not 0.0 <= roughness_deg <= MAX_ROUGHNESS_DEG):
+    try:
+        return check_roughness_value(roughness_deg)       # the wall record's own check: one set of allowed values
+    except ValueError:
         raise ValueError(f"The 'roughness_deg' parameter must be None (the table's wall's) or a number in "
-                         f"[0, {MAX_ROUGHNESS_DEG:g}] degrees; got {roughness_deg!r}.")
-    return float(roughness_deg)
+                         f"[0, {MAX_ROUGHNESS_DEG:g}] degrees; got {roughness_deg!r}.") from None
 
 
 def check_interpolation(interpolation) -> bool:
