@@ -17,7 +17,8 @@ Written by ``tablegen build``, read by the runtime sampler. Layout (docs/format.
     /shapes                the definition of every shape the table holds, one row per shape
                            (data_schema.shape_records: name, kind, vertices, triangles, inertia, aspect law, hands)
     /resolution            attrs: clusters, dictionary_size, levels
-    /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed)
+    /cells/<name>          one dataset per quantity, leading dimensions (n_shape, n_alpha, n_speed); the work
+                           datasets (WORK_DATASETS, format 4.1) all or none: a table of 4.0 draws no wall work
 
 Every numeric dataset carries HDF5's Fletcher-32 checksum, so a corrupted
 file fails to load with an error naming the dataset; the two parameter rows
@@ -50,6 +51,12 @@ Each cluster holds rebounds of one collision regime (``cluster_regime``):
 0 for rebounds of at most :data:`FEW_COLLISIONS` collisions, 1 for more. The
 sampler moves a draw between grid speeds by a law that depends on the regime
 (docs/format.md, "Between grid points").
+
+The work of a rebound on the wall (format 4.1, docs/design/table_representation.md, "The work on the wall"):
+each component continues its chain with two more variables, the rotational energy fraction
+r = E_Ω⁺/E⁻ and the root of the normal share ν = √(W_n/(W_n + W_t)), each linear in the six before it (and r) plus
+a residual quantile function of their own dictionary; a draw gives W = W_n + W_t = E⁻(1 − s² − r), W_n = ν² W.
+The trapped particles' mean work is kept per cell.
 """
 
 from __future__ import annotations
@@ -70,7 +77,7 @@ from data_schema.output import hdf5_bytes, write_output
 from direct_model.wall import MAX_ROUGHNESS_DEG, WALL_FAMILIES, Wall, check_speed_range, wall_family, wall_record
 
 TABLE_FILE_TYPE = "rebound_table"
-TABLE_VERSION = (4, 0)
+TABLE_VERSION = (4, 1)      # 4.1: the work datasets (a 4.0 table is read, without them)
 # the major versions whose stored configuration `tablegen info --config` reads: 3 (before rebound-scatter 1.0,
 # refused by the readers with how to rebuild it) and this one
 CONFIG_MAJORS = (3, TABLE_VERSION[0])
@@ -102,6 +109,13 @@ CHAIN_NAMES = ("alpha2", "abs_beta2", "speed_ratio", "omega_z", "omega_x_folded"
 CHAIN_TO_STATE = (0, 1, 2, 5, 3, 4)   # chain variable k is folded state column CHAIN_TO_STATE[k]
 N_CHAIN = len(CHAIN_NAMES)
 N_SLOPES = N_CHAIN * (N_CHAIN - 1) // 2
+# the work variables that continue each component's chain (module doc): r = E_Ω⁺/E⁻ and ν = √(W_n/(W_n + W_t))
+WORK_NAMES = ("rotation_fraction", "normal_share_root")
+N_WORK = len(WORK_NAMES)
+# slopes of work variable w on the chain variables and the work variables before it: N_CHAIN + w of them,
+# packed from WORK_SLOPE_START[w]
+WORK_SLOPE_START = tuple(sum(N_CHAIN + v for v in range(w)) for w in range(N_WORK))
+N_WORK_SLOPES = sum(N_CHAIN + w for w in range(N_WORK))
 
 
 def slope_index(k: int, j: int) -> int:
@@ -127,12 +141,12 @@ class TableResolution:
                              f"got {self.dictionary_size!r}.")
 
     def cell_nbytes(self) -> int:
-        """Bytes of one cell's datasets (:data:`CELL_DATASETS`)."""
-        return sum(int(np.prod(shape)) * np.dtype(CELL_DATASETS[name][0]).itemsize
+        """Bytes of one cell's datasets (:data:`CELL_DATASETS` and :data:`WORK_DATASETS`)."""
+        return sum(int(np.prod(shape)) * np.dtype(TABLE_CELL_DATASETS[name][0]).itemsize
                    for name, shape in self.cell_shapes().items())
 
     def cell_shapes(self) -> dict:
-        """Shape of each per-cell dataset (without the three leading grid dimensions)."""
+        """Shape of each per-cell dataset (without the three leading grid dimensions), the work's included."""
         c = self.clusters
         return {
             "cluster_weight": (c,),
@@ -148,6 +162,14 @@ class TableResolution:
             "std": (len(STATE_NAMES),),
             "indicatrix_2d": (len(INDICATRIX_ALPHA2_EDGES) - 1,),
             "indicatrix_3d": (len(INDICATRIX_ALPHA2_EDGES) - 1, len(INDICATRIX_BETA2_EDGES) - 1),
+            "work_loc": (c, N_WORK),
+            "work_scale": (c, N_WORK),
+            "work_shape": (c, N_WORK),
+            "work_slope": (c, N_WORK_SLOPES),
+            "work_dictionary": (N_WORK, self.dictionary_size, self.levels + 1),
+            "work_mean": (N_WORK,),
+            "work_std": (N_WORK,),
+            "trapped_work": (2,),
         }
 
 
@@ -210,6 +232,21 @@ CELL_DATASETS = {
     "indicatrix_2d": ("float32", "1/rad", "I(α2): density of α2 on INDICATRIX_ALPHA2_EDGES"),
     "indicatrix_3d": ("float32", "1/rad²", "I(α2, β2): density on the α2 × β2 edges, ∫∫ I dα2 dβ2 = 1"),
 }
+# the per-cell datasets of the work on the wall (format 4.1; all or none): the chain's two work variables
+# (WORK_NAMES), their moments, and the trapped particles' mean work
+WORK_DATASETS = {
+    "work_loc": ("float32", "1, 1", "location of each work variable's residual (r, ν), per cluster"),
+    "work_scale": ("float32", "1, 1", "scale of each work variable's residual, per cluster"),
+    "work_shape": ("uint8", "1", "index into work_dictionary of each work variable's residual, per cluster"),
+    "work_slope": ("float32", "1", "slopes of work variable w on the chain variables and the work variables before "
+                                   "it, packed from WORK_SLOPE_START[w], per cluster"),
+    "work_dictionary": ("float32", "1", "standardised residual quantile functions at probabilities i/L, per work "
+                                        "variable"),
+    "work_mean": ("float64", "1, 1", "means of r = E_Ω⁺/E⁻ and ν = √(W_n/(W_n + W_t)) over rebounds"),
+    "work_std": ("float64", "1, 1", "standard deviations of the same"),
+    "trapped_work": ("float64", "1, 1", "mean W_n/E⁻ and W_t/E⁻ of the trapped particles (0, 0 if none)"),
+}
+TABLE_CELL_DATASETS = {**CELL_DATASETS, **WORK_DATASETS}     # what this package writes per cell
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -229,9 +266,18 @@ class CellTable:
     std: np.ndarray
     indicatrix_2d: np.ndarray
     indicatrix_3d: np.ndarray
+    work_loc: np.ndarray | None = None      # the work datasets (WORK_DATASETS): None in a table of format 4.0
+    work_scale: np.ndarray | None = None
+    work_shape: np.ndarray | None = None
+    work_slope: np.ndarray | None = None
+    work_dictionary: np.ndarray | None = None
+    work_mean: np.ndarray | None = None
+    work_std: np.ndarray | None = None
+    trapped_work: np.ndarray | None = None
 
     def arrays(self) -> dict:
-        return {name: getattr(self, name) for name in CELL_DATASETS}
+        """The cell's datasets by name, the work's if it has them."""
+        return {name: getattr(self, name) for name in TABLE_CELL_DATASETS if getattr(self, name) is not None}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -276,12 +322,21 @@ class ReboundTable:
         missing = set(CELL_DATASETS) - set(self.cells)
         if missing:
             raise ValueError(f"ReboundTable is missing cell datasets {sorted(missing)}")
+        work = set(WORK_DATASETS) & set(self.cells)
+        if work and work != set(WORK_DATASETS):
+            raise ValueError(f"ReboundTable has the work datasets {sorted(work)} but not "
+                             f"{sorted(set(WORK_DATASETS) - work)}: all or none")
         for name, shape in expected.items():
-            if self.cells[name].shape != lead + shape:
+            if name in self.cells and self.cells[name].shape != lead + shape:
                 raise ValueError(f"dataset 'cells/{name}' has shape {self.cells[name].shape}, "
                                  f"expected {lead + shape}")
         if self.records and tuple(r.name for r in self.records) != tuple(self.shapes):
             raise ValueError(f"the records name {[r.name for r in self.records]}, the table {list(self.shapes)}")
+
+    @property
+    def has_work(self) -> bool:
+        """Whether the cells hold the work on the wall (:data:`WORK_DATASETS`; format 4.1)."""
+        return set(WORK_DATASETS) <= set(self.cells)
 
     def shape_records(self) -> tuple:
         """The registry record of each shape, table order: ``records``, or the families' at κ and the aspect law."""
@@ -341,7 +396,9 @@ class ReboundTable:
             res.attrs[field.name] = getattr(self.resolution, field.name)
         write_shape_records(f, self.shape_records())
         cells = f.create_group("cells")
-        for name, (dtype, units, meaning) in CELL_DATASETS.items():
+        for name, (dtype, units, meaning) in TABLE_CELL_DATASETS.items():
+            if name not in self.cells:      # a table read from format 4.0, written again
+                continue
             values = np.asarray(self.cells[name], dtype=dtype)
             # one chunk per cell: whole chunks only (automatic chunk shapes padded the table by a fifth)
             ds = cells.create_dataset(name, data=values, fletcher32=True, chunks=(1, 1, 1) + values.shape[3:])
@@ -363,7 +420,7 @@ class ReboundTable:
             raise DataFormatError(f"{where}: missing dataset(s) {', '.join('cells/' + n for n in missing)}")
         grid = f["grid"]
         alpha1_deg, speed_m_s, codes = (_read(grid, name) for name in ("alpha1_deg", "speed_m_s", "shape_codes"))
-        cells = {name: _read(f["cells"], name) for name in CELL_DATASETS}
+        cells = {name: _read(f["cells"], name) for name in TABLE_CELL_DATASETS if name in f["cells"]}
         shapes = _read_group(f[SHAPES_GROUP])
         model_row, wall_row = (_read_row(f[group]) for group in (MODEL_GROUP, WALL_GROUP))
         try:
@@ -586,14 +643,24 @@ def check_contract(table: ReboundTable, where: str, codes, shapes: dict) -> None
              ("mean", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
              ("std", lambda x: (x >= 0.0) & (x <= bound), f"in [0, {bound:g}]"),
              ("indicatrix_2d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
-             ("indicatrix_3d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"))
+             ("indicatrix_3d", lambda x: np.isfinite(x) & (x >= 0.0), "finite and >= 0"),
+             ("work_loc", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
+             ("work_scale", lambda x: (x >= 0.0) & (x <= bound), f"in [0, {bound:g}]"),
+             ("work_slope", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
+             ("work_shape", lambda x: x < m, f"below the dictionary size {m}"),
+             ("work_mean", lambda x: np.abs(x) <= bound, f"in [-{bound:g}, {bound:g}]"),
+             ("work_std", lambda x: (x >= 0.0) & (x <= bound), f"in [0, {bound:g}]"),
+             ("trapped_work", lambda x: (x >= 0.0) & (x <= 1.0), "in [0, 1] (fractions of E⁻)"))
     for name, ok, wanted in rules:
+        if name not in cells:       # the work datasets of a table of format 4.0
+            continue
         values = np.asarray(cells[name])
         bad = np.flatnonzero(~ok(values).ravel())
         if bad.size:
             refuse(f"dataset 'cells/{name}' holds {values.ravel()[bad[0]].item()!r} at element {bad[0]}; its values "
                    f"must be {wanted}")
-    check_dictionary(np.asarray(cells["shape_dictionary"]), table.resolution.levels, refuse)
+    for name in ("shape_dictionary", "work_dictionary")[:2 if table.has_work else 1]:
+        check_dictionary(np.asarray(cells[name]), table.resolution.levels, refuse, name)
     weight_sum = np.asarray(cells["cluster_weight"]).sum(axis=-1).ravel()
     bad = np.flatnonzero(np.abs(weight_sum - 1.0) > WEIGHT_SUM_TOLERANCE)
     if bad.size:
@@ -605,20 +672,20 @@ def check_contract(table: ReboundTable, where: str, codes, shapes: dict) -> None
                f"particle")
 
 
-def check_dictionary(dictionary: np.ndarray, levels: int, refuse) -> None:
-    """``refuse`` (called with the message) unless every row of ``cells/shape_dictionary`` is a standardised
+def check_dictionary(dictionary: np.ndarray, levels: int, refuse, name: str) -> None:
+    """``refuse`` (called with the message) unless every row of ``cells/<name>`` is a standardised
     quantile function: non-decreasing, its knots within ±√L (the largest |knot| of L + 1 knots of mean 0 and
     standard deviation 1; the build's non-decreasing pass only repeats knots) up to float32 round-off."""
     bound = np.float32(np.sqrt(levels) * (1.0 + DICTIONARY_BOUND_TOLERANCE))
     flat = dictionary.reshape(-1)
     bad = np.flatnonzero(~(np.abs(flat) <= bound))
     if bad.size:
-        refuse(f"dataset 'cells/shape_dictionary' holds {flat[bad[0]].item()!r} at element {bad[0]}; its values must "
+        refuse(f"dataset 'cells/{name}' holds {flat[bad[0]].item()!r} at element {bad[0]}; its values must "
                f"be in [-{bound:.9g}, {bound:.9g}] (sqrt of the levels {levels})")
     rows = dictionary.reshape(-1, dictionary.shape[-1])
     bad = np.flatnonzero(np.any(np.diff(rows, axis=1) < 0.0, axis=1))
     if bad.size:
-        refuse(f"dataset 'cells/shape_dictionary' row {bad[0]} decreases; each row (a quantile function) must be "
+        refuse(f"dataset 'cells/{name}' row {bad[0]} decreases; each row (a quantile function) must be "
                f"non-decreasing")
 
 

@@ -1,4 +1,4 @@
-! rebound_scatter.f90: Fortran bindings (iso_c_binding) to the native runtime of rebound-scatter, version 1.3.
+! rebound_scatter.f90: Fortran bindings (iso_c_binding) to the native runtime of rebound-scatter, version 1.4.
 !
 ! The C functions of rebound_scatter.h, called directly, and bind(c) derived types mirroring its records; units,
 ! frames and statuses as there (docs/native.md): V in m/s, Omega in rad/s, n a unit normal into the gas, a the
@@ -23,7 +23,7 @@ module rebound_scatter
 
   ! the version of this module (RBS_VERSION_NUMBER of C; Fortran names are case-blind, so rbs_version_number()
   ! is the library's function): compare with rbs_version_number()
-  integer(c_int), parameter :: RBS_VERSION_MAJOR = 1, RBS_VERSION_MINOR = 3, RBS_VERSION_PATCH = 0
+  integer(c_int), parameter :: RBS_VERSION_MAJOR = 1, RBS_VERSION_MINOR = 4, RBS_VERSION_PATCH = 0
   integer(c_int), parameter :: RBS_MODULE_VERSION_NUMBER = RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 &
                                                            + RBS_VERSION_PATCH
   integer(c_int), parameter :: RBS_TABLE_FORMAT_MAJOR = 4, RBS_U_PER_DRAW = 13, RBS_TABLE_MAX_SHAPES = 4096
@@ -82,8 +82,8 @@ module rebound_scatter
     integer(c_int) :: n_collisions = -1            ! direct path: collisions of the rebound; table path: -1
     real(c_double) :: V(3) = 0.0_c_double, Omega(3) = 0.0_c_double
     integer(c_int) :: wall_hits = 0                ! hits on the wall: 1 smooth, 1 to RBS_MAX_WALL_HITS rough
-    ! the work of the hit on the wall per unit particle mass, m**2/s**2, normal and tangential (direct path; NaN on
-    ! the table path and for RBS_INVALID)
+    ! the work of the hit on the wall per unit particle mass, m**2/s**2, normal and tangential (either path; NaN from
+    ! a table of format 4.0 on the table path, and for RBS_INVALID)
     real(c_double) :: wall_work_normal = 0.0_c_double, wall_work_tangential = 0.0_c_double
   end type rbs_result
 

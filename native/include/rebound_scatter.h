@@ -1,5 +1,5 @@
 /*
- * rebound_scatter.h: the native runtime of rebound-scatter, version 1.3.
+ * rebound_scatter.h: the native runtime of rebound-scatter, version 1.4.
  *
  * A C library that answers a particle's hit on a wall with its reflected state, for non-spherical particles
  * spinning or not, with the same law and the same bits as the numba kernels of the Python package `surrogate`
@@ -54,7 +54,7 @@
  * RBS_INVALID), so a stream stays aligned:
  *   table path:  u[0] shape from the mix   u[1] α1 neighbour   u[2] speed neighbour   u[3] trapped or not
  *                u[4] mixture component    u[5..10] the six chain variables   u[11] mirror sign
- *                u[12] in-wall axis at normal impact
+ *                u[12] in-wall axis at normal impact (the work on the wall: keyed uniforms of a hash of the 13)
  *   direct path: u[0] shape from the mix (as the table path)   u[1..3] the orientation (Shoemake's uniform
  *                quaternion)   u[4], u[5] b/a and c/b (inverse CDF of the shape's law)   u[6] the hand of a shape
  *                drawn in both hands (+1 below ½)   u[7] in-wall axis at normal impact   u[8..12] unused
@@ -98,7 +98,7 @@ extern "C" {
 #endif
 
 #define RBS_VERSION_MAJOR 1
-#define RBS_VERSION_MINOR 3
+#define RBS_VERSION_MINOR 4
 #define RBS_VERSION_PATCH 0
 /* MAJOR · 1 000 000 + MINOR · 1 000 + PATCH, as rbs_version_number() returns it for the library linked */
 #define RBS_VERSION_NUMBER (RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 + RBS_VERSION_PATCH)
@@ -220,9 +220,10 @@ typedef struct rbs_result {
                                on a rough one (its facet hits); 0 for RBS_INVALID */
     /* since 1.3: what the hit did to the wall (docs/model.md §4.7), the work of its collisions on the wall per unit
        particle mass, m²/s² (J/kg), each >= 0; their sum is the particle's loss of translational plus rotational
-       kinetic energy. The direct path's (up to the trap or the failure; on a rough wall summed over the facet hits);
-       NaN on the table path, which does not hold them yet (on a rough wall: if the table answered any facet hit),
-       and for RBS_INVALID */
+       kinetic energy. The direct path's from its collisions (up to the trap or the failure); since 1.4 the table
+       path's too, drawn jointly with the rebound (a trapped draw: its cell's trapped particles' mean); on a rough
+       wall summed over the facet hits. NaN from a table of format 4.0, which does not hold them (on a rough wall: if
+       such a table answered any facet hit), and for RBS_INVALID */
     double wall_work_normal;        /* W_n: the normal impulses' work (plastic indentation) */
     double wall_work_tangential;    /* W_t: the tangential impulses' work (cutting, the erosion of ductile walls) */
 } rbs_result;
@@ -403,7 +404,9 @@ RBS_API int rbs_table_wall(const rbs_table *table, rbs_wall_info *info);
 
 /* A derived kernel array, equal element for element to the field of surrogate's table.kernel_data of the same
  * name: "alpha1_axis", "speed_axis", "cells", "speed_restitution", "restitution_pieces" (float64), "clusters",
- * "dictionary" (float32); or "direct_parameters" (float64), equal to surrogate's table.direct_parameters.
+ * "dictionary" (float32); since 1.4 the work on the wall's "work_rows", "work_dictionary" (float32) and
+ * "work_cells" (float64), of count 0 for a table of format 4.0; or "direct_parameters" (float64), equal to
+ * surrogate's table.direct_parameters.
  * *data points into the table (read-only, valid until rbs_table_close), *count is its number of elements, *dtype
  * an rbs_dtype (any of the three output pointers may be NULL). RBS_OK or RBS_INVALID (unknown name). */
 RBS_API int rbs_table_kernel_array(const rbs_table *table, const char *name, const void **data, size_t *count,

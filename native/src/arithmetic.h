@@ -1,8 +1,8 @@
 /*
  * arithmetic.h: stage 3 of a draw, its arithmetic once its table values are read (surrogate.kernels.arithmetic:
- * _chain, _folded, _moved, _velocity, to_speed, _mirrored): the conditional chain of the six state
- * variables, the fold into the physical ranges, the move to the incident α1 and |V⁻|, the mirror sign; and
- * its block form (rbs_arithmetic_block). Local frame, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. Same
+ * _chain, _folded, _moved, _velocity, speed_factors, to_speed, speed_ratio_squared, _mirrored): the conditional
+ * chain of the six state variables, the fold into the physical ranges, the move to the incident α1 and |V⁻|, the
+ * mirror sign; and its block form (rbs_arithmetic_block). Local frame, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a. Same
  * operations, same order, fma() where numba fuses.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
@@ -66,16 +66,26 @@ RBS_INLINE void rbs_velocity(double alpha2, double beta2, double s, double v[3])
     v[2] = s * sb;
 }
 
+/* The factors of rbs_to_speed (surrogate.kernels.arithmetic.speed_factors): whether the regime is 0 (returned), the
+ * factor *f of V⁺ − V⁻ (regime 0) or of the normal rebound velocity (regime 1), the factor *g of the spin and of
+ * V⁺ − V⁻ off the normal. */
+RBS_INLINE int rbs_speed_factors(double regime, double f_target, double f_grid, double sin_alpha1, double *f, double *g)
+{
+    double a_target = 1.0 - (1.0 - f_target) * sin_alpha1;
+    double a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1;
+    int few = regime == 0.0;
+    *f = few ? (1.0 + a_target) / (1.0 + a_grid) : a_target / a_grid;
+    *g = few ? *f : 1.0;
+    return few;
+}
+
 /* A rebound drawn at grid speed V_iv moved to the incident speed V (surrogate.kernels.arithmetic.to_speed): x = (vx,
  * vy, vz, wx, wy, wz) in place; f_target, f_grid = exp(−k V^p) at V and V_iv. */
 RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, double cos_alpha1, double sin_alpha1,
                                 double x[6])
 {
-    double a_target = 1.0 - (1.0 - f_target) * sin_alpha1;
-    double a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1;
-    int few = regime == 0.0;
-    double f = few ? (1.0 + a_target) / (1.0 + a_grid) : a_target / a_grid;
-    double g = few ? f : 1.0;
+    double f, g;
+    int few = rbs_speed_factors(regime, f_target, f_grid, sin_alpha1, &f, &g);
     double vx_few = fma(f, x[0] - cos_alpha1, cos_alpha1);
     double vy_few = fabs(fma(f, x[1] + sin_alpha1, -sin_alpha1));
     x[0] = few ? vx_few : x[0];
@@ -95,11 +105,17 @@ RBS_INLINE void rbs_to_speed(double regime, double f_target, double f_grid, doub
 /* |V⁺|²/|V⁻|² a rebound may reach above 1 (surrogate.kernels.arithmetic.SPEED_TOLERANCE) */
 #define RBS_SPEED_TOLERANCE 1e-12
 
+/* s² = |V⁺|²/|V⁻|² of a local-frame V⁺ x[0..2] in units of |V⁻| (surrogate.kernels.arithmetic.speed_ratio_squared) */
+RBS_INLINE double rbs_speed_ratio_squared(const double x[3])
+{
+    return fma(x[0], x[0], fma(x[1], x[1], x[2] * x[2]));
+}
+
 /* A drawn x (local frame, units of |V⁻|) that may be reported as a rebound whatever table was loaded: leaving
  * the wall and no faster than it came (surrogate.kernels.arithmetic.drawn_ok). */
 RBS_INLINE int rbs_drawn_ok(const double x[6])
 {
-    return (x[1] > 0.0) & (fma(x[0], x[0], fma(x[1], x[1], x[2] * x[2])) <= 1.0 + RBS_SPEED_TOLERANCE);
+    return (x[1] > 0.0) & (rbs_speed_ratio_squared(x) <= 1.0 + RBS_SPEED_TOLERANCE);
 }
 
 /* the mirror symmetry Z → −Z when u < 1/2 */

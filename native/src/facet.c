@@ -17,14 +17,11 @@
 #include "rng_internal.h"
 
 #define FACET_DOMAIN 0x6A09E667F3BCC909ull     /* the facet keys' start (surrogate.kernels.facet._FACET_DOMAIN) */
-#define KEY_BITS 0x7FFFFFFFFFFFFFFFull         /* a key's 63 bits */
 #define SQRT_2_OVER_PI 0x1.9884533d43651p-1    /* math.sqrt(2.0 / math.pi): E|γx| / Δγ */
 
 int64_t rbs_facet_key(const double u[RBS_U_PER_DRAW])
 {
-    uint64_t h = rbs_splitmix64(FACET_DOMAIN);
-    for (int k = 0; k < RBS_U_PER_DRAW; k++) h = rbs_splitmix64(h + rbs_bits(u[k]) + RBS_GOLDEN);
-    return (int64_t)(h & KEY_BITS);
+    return rbs_hit_key(u, RBS_U_PER_DRAW, FACET_DOMAIN);
 }
 
 /* the radius of a Box–Muller pair, sqrt(−2 ln(1 − u)), u in [0, 1): a standard Rayleigh deviate */

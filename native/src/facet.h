@@ -14,8 +14,8 @@
 #define RBS_MAX_FACET_DRAWS 64      /* draws of one facet (surrogate.kernels.facet.MAX_FACET_DRAWS) */
 #define RBS_U_PER_FACET 6           /* keyed uniforms of one draw (surrogate.kernels.facet.U_PER_FACET) */
 
-/* The facet key of a hit of uniforms u: splitmix64 chained over their bits, top bit cleared (an int64 >= 0, as a
- * grain key; surrogate.kernels.facet.facet_key). */
+/* The facet key of a hit of uniforms u: rng_internal.h's rbs_hit_key from the facet keys' domain
+ * (surrogate.kernels.facet.facet_key). */
 int64_t rbs_facet_key(const double u[RBS_U_PER_DRAW]);
 
 /* A facet under the hit V (m/s) on the mean wall of unit normal n, roughness Δγ = roughness_deg > 0, from the keyed

@@ -1,6 +1,6 @@
 /*
  * gather.h: stage 2 of a draw, the table values it reads once located (surrogate.kernels.gather: _quantile,
- * _alpha1_terms, restitution_factors), and its block form (rbs_gather_block).
+ * _alpha1_terms, moved_term, restitution_factors), and its block form (rbs_gather_block).
  *
  * A draw reads its component row (located by locate.h), six pairs of residual-shape levels, the cell
  * records of the drawn cell and of its α1 neighbours, and the restitution pieces.
@@ -37,22 +37,28 @@ typedef struct rbs_term {
     double ratio, mean_cell, mean;
 } rbs_term;
 
+/* (ratio, m_cell, m) of a variable whose mean, sd and 1/sd sit at offsets at_* from a cell record's start in
+ * `cells`: the records of the α1 below (lo), above (hi) and the drawn cell (here) (surrogate.kernels.gather.moved_term;
+ * the state's cell records and the work's) */
+RBS_INLINE rbs_term rbs_moved_term(const double *cells, int64_t lo, int64_t hi, int64_t here, double wa, int at_mean,
+                                   int at_sd, int at_inv_sd)
+{
+    double sd = fma(wa, cells[hi + at_sd], (1.0 - wa) * cells[lo + at_sd]);
+    double inv_sd = cells[here + at_inv_sd];
+    double mean = fma(wa, cells[hi + at_mean], (1.0 - wa) * cells[lo + at_mean]);
+    rbs_term term = {inv_sd > 0.0 ? sd * inv_sd : 1.0, cells[here + at_mean], mean};
+    return term;
+}
+
 /* The terms that move a state drawn from cell `drawn` to the incident α1 (surrogate.kernels.gather._alpha1_terms):
  * m and σ linear in α1 (weight wa) between cell `below` and the next α1 up; with wa = 0 the cell above
  * is not read. */
 RBS_INLINE void rbs_alpha1_terms(const rbs_table *t, int64_t below, double wa, int64_t drawn, rbs_term terms[6])
 {
-    const double *cells = t->cells;
     int64_t lo = below * CELL_SIZE, here = drawn * CELL_SIZE;
     int64_t hi = wa > 0.0 ? (below + t->n_speed) * CELL_SIZE : lo;
-    for (int k = 0; k < 6; k++) {
-        double sd = fma(wa, cells[hi + CELL_SD + k], (1.0 - wa) * cells[lo + CELL_SD + k]);
-        double inv_sd = cells[here + CELL_INV_SD + k];
-        double mean = fma(wa, cells[hi + CELL_MEAN + k], (1.0 - wa) * cells[lo + CELL_MEAN + k]);
-        terms[k].ratio = inv_sd > 0.0 ? sd * inv_sd : 1.0;
-        terms[k].mean_cell = cells[here + CELL_MEAN + k];
-        terms[k].mean = mean;
-    }
+    for (int k = 0; k < 6; k++)
+        terms[k] = rbs_moved_term(t->cells, lo + k, hi + k, here + k, wa, CELL_MEAN, CELL_SD, CELL_INV_SD);
 }
 
 /* exp(−k V^p) at the incident speed (interval jv, weight wv) and at the drawn grid speed iv */

@@ -9,6 +9,10 @@
  *   speed_restitution   float64 (n_speed): the wall's restitution factor f(V) (exp(−k V^p) for the exponential
  *                       law) at the grid speeds
  *   restitution_pieces  float64: polynomial pieces of f(V) between them (layout.c)
+ *   work_rows    float32 (n_cells · C · WORK_ROW_SIZE): each component's two work variables (WORK_ROW_* layout)
+ *   work_dictionary     float32 (n_cells · N_WORK · n_levels · n_dictionary): their residual shapes, level-major
+ *   work_cells   float64 (n_cells · WORK_CELL_SIZE): their moments and the trapped particles' mean work
+ * The three work arrays are empty (has_work 0) for a table without the work on the wall (format 4.0).
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -47,6 +51,20 @@
 #define ROW_REGIME 35       /* collision regime: 0 = at most two collisions, 1 = more */
 #define ROW_SIZE 36
 
+/* A component's work row of `work_rows` (80 bytes): the chain's two work variables r and φ */
+#define WORK_ROW_LOC 0      /* 2 locations */
+#define WORK_ROW_SCALE 2    /* 2 scales */
+#define WORK_ROW_SHAPE 4    /* 2 residual shape indices into work_dictionary */
+#define WORK_ROW_SLOPE 6    /* 13 slopes: r on the six chain variables, φ on them and r */
+#define WORK_ROW_SIZE 20    /* 19 used; 20 keeps rows 16-byte aligned */
+
+/* A cell's work record of `work_cells` */
+#define WORK_CELL_MEAN 0    /* means of r and φ */
+#define WORK_CELL_SD 2      /* their standard deviations */
+#define WORK_CELL_INV_SD 4  /* 1/sd (0 where sd = 0) */
+#define WORK_CELL_TRAPPED 6 /* the trapped particles' mean W_n/E⁻ and W_t/E⁻ */
+#define WORK_CELL_SIZE 8
+
 /* A cell record of `cells` */
 #define CELL_P_TRAPPED 0
 #define CELL_MEAN 1         /* 6 means of (α2, β2, s, Ω_x, Ω_y, Ω_z) */
@@ -62,6 +80,8 @@
 
 #define N_CHAIN 6
 #define N_SLOPES 15
+#define N_WORK 2            /* work variables of a component (data_schema.table.WORK_NAMES) */
+#define N_WORK_SLOPES 13    /* data_schema.table.N_WORK_SLOPES */
 #define RESTITUTION_DEGREE 9   /* surrogate.kernels.fastmath.DEGREE */
 #define RESTITUTION_PIECE_RATIO 1.25   /* surrogate.kernels.fastmath.PIECE_RATIO */
 
@@ -71,7 +91,7 @@
 #define SPEED_GRID_MAX 1e4          /* m/s */
 #define MAX_SPEED_RATIO 16.0        /* between consecutive grid speeds */
 #define WEIGHT_SUM_TOLERANCE 1e-9   /* |Σ cluster_weight − 1| per cell */
-#define CELL_VALUE_BOUND 1e6        /* |value| of cluster_loc, cluster_scale, cluster_slope, mean, std */
+#define CELL_VALUE_BOUND 1e6        /* |value| of cluster_loc, cluster_scale, cluster_slope, mean, std and the work's */
 #define DICTIONARY_BOUND_TOLERANCE 1e-6     /* relative, on the bound √L of a shape_dictionary knot */
 #define USER_SHAPE_CODE 255         /* grid/shape_codes of a shape that is no family (data_schema.shape_records) */
 #define RBS_WALL_NAME_SIZE 256      /* bytes kept of the wall's name (attribute name of group wall), with its NUL */
@@ -120,6 +140,13 @@ struct rbs_table {
     double *speed_restitution;
     double *restitution_pieces;
     size_t restitution_pieces_len;
+    int has_work;                                   /* the cells hold the work on the wall (format 4.1) */
+    float *work_rows;                               /* 64-byte aligned; NULL without the work */
+    size_t work_rows_len;
+    float *work_dictionary;                         /* 64-byte aligned; NULL without the work */
+    size_t work_dictionary_len;
+    double *work_cells;                             /* NULL without the work */
+    size_t work_cells_len;
     double direct_parameters[N_PARAMS];             /* surrogate.table.SurrogateTable.direct_parameters (P_*) */
     /* the direct model's shapes (surrogate.table.SurrogateTable.shape_arrays): the four families in code order,
      * from the parameters, then the table's other polyhedra in table order; model_shape[i] is the index there of the
@@ -143,6 +170,15 @@ typedef struct rbs_raw_cells {
     int64_t *collision_counts;  /* (cells, 11): read to check them and their checksums, then freed */
     float *indicatrix_2d;       /* (cells, 72): likewise */
     float *indicatrix_3d;       /* (cells, 72, 72): likewise */
+    /* the work on the wall (format 4.1): all NULL for a table without it */
+    float *work_loc;            /* (cells, C, 2) */
+    float *work_scale;          /* (cells, C, 2) */
+    uint8_t *work_shape;        /* (cells, C, 2) */
+    float *work_slope;          /* (cells, C, 13) */
+    float *work_dictionary;     /* (cells, 2, M, L + 1) */
+    double *work_mean;          /* (cells, 2) */
+    double *work_std;           /* (cells, 2) */
+    double *trapped_work;       /* (cells, 2) */
 } rbs_raw_cells;
 
 /* A shape mix (rbs_mix_new_*, mix.c): the table it was made from (a mix of another table is refused), its shape

@@ -5,6 +5,7 @@
  *   axis records       surrogate.kernels.layout.axis_record / interval_lookup
  *   component rows     surrogate.kernels.layout.kernel_rows, with Walker's alias tables (alias_table)
  *   cell records       surrogate.kernels.layout.cell_records
+ *   the work's arrays  surrogate.kernels.layout.work_arrays (a table of format 4.1)
  *   restitution        surrogate.kernels.fastmath.restitution_factor at the grid speeds, and
  *                      surrogate.kernels.fastmath.restitution_pieces between them, of the table's wall array
  *                      (wall.h: the exponential family's exp(−k V^p), or the tabulated family's a_nc(V, 1))
@@ -200,6 +201,46 @@ static int all_finite_f(const float *x, size_t n)
     return 1;
 }
 
+/* surrogate.kernels.layout.work_arrays: the work rows (zero after their 19 values), the work's residual shapes
+ * level-major, and the work's cell records (means, sds, 1/sds, the trapped particles' mean work) */
+static int derive_work(rbs_table *t, const rbs_raw_cells *raw, size_t n_cells)
+{
+    const size_t C = (size_t)t->n_clusters, M = (size_t)t->n_dictionary, L1 = (size_t)t->n_levels;
+    t->work_rows_len = n_cells * C * WORK_ROW_SIZE;
+    t->work_rows = rbs_aligned_alloc(t->work_rows_len * sizeof *t->work_rows);
+    t->work_dictionary_len = n_cells * N_WORK * L1 * M;
+    t->work_dictionary = rbs_aligned_alloc(t->work_dictionary_len * sizeof *t->work_dictionary);
+    t->work_cells_len = n_cells * WORK_CELL_SIZE;
+    t->work_cells = malloc(t->work_cells_len * sizeof *t->work_cells);
+    if (!t->work_rows || !t->work_dictionary || !t->work_cells) return RBS_ERR_MEMORY;
+    memset(t->work_rows, 0, t->work_rows_len * sizeof *t->work_rows);
+    for (size_t at = 0; at < n_cells * C; at++) {
+        float *row = t->work_rows + at * WORK_ROW_SIZE;
+        for (int w = 0; w < N_WORK; w++) {
+            row[WORK_ROW_LOC + w] = raw->work_loc[at * N_WORK + w];
+            row[WORK_ROW_SCALE + w] = raw->work_scale[at * N_WORK + w];
+            row[WORK_ROW_SHAPE + w] = (float)raw->work_shape[at * N_WORK + w];
+        }
+        for (int k = 0; k < N_WORK_SLOPES; k++) row[WORK_ROW_SLOPE + k] = raw->work_slope[at * N_WORK_SLOPES + k];
+    }
+    for (size_t cw = 0; cw < n_cells * N_WORK; cw++)
+        for (size_t i = 0; i < L1; i++)
+            for (size_t m = 0; m < M; m++)
+                t->work_dictionary[(cw * L1 + i) * M + m] = raw->work_dictionary[(cw * M + m) * L1 + i];
+    for (size_t cell = 0; cell < n_cells; cell++) {
+        double *r = t->work_cells + cell * WORK_CELL_SIZE;
+        for (int w = 0; w < N_WORK; w++) {
+            double sd = raw->work_std[cell * N_WORK + w];
+            r[WORK_CELL_MEAN + w] = raw->work_mean[cell * N_WORK + w];
+            r[WORK_CELL_SD + w] = sd;
+            r[WORK_CELL_INV_SD + w] = sd > 0.0 ? 1.0 / sd : 0.0;
+            r[WORK_CELL_TRAPPED + w] = raw->trapped_work[cell * N_WORK + w];
+        }
+    }
+    t->has_work = 1;
+    return RBS_OK;
+}
+
 int rbs_derive(rbs_table *t, const rbs_raw_cells *raw, const char **what)
 {
     const size_t n_cells = (size_t)t->n_shapes * (size_t)t->n_alpha1 * (size_t)t->n_speed;
@@ -274,6 +315,7 @@ int rbs_derive(rbs_table *t, const rbs_raw_cells *raw, const char **what)
     t->restitution_pieces = rbs_restitution_pieces(t->speed_m_s, t->n_speed, wall, &t->n_pieces,
                                                    &t->restitution_pieces_len);
     if (!t->restitution_pieces) return RBS_ERR_MEMORY;
+    if (raw->work_loc && derive_work(t, raw, n_cells) != RBS_OK) return RBS_ERR_MEMORY;
 
     if (!all_finite(t->alpha1_axis, t->alpha1_axis_len)) *what = "alpha1_axis";
     else if (!all_finite(t->speed_axis, t->speed_axis_len)) *what = "speed_axis";
@@ -282,5 +324,8 @@ int rbs_derive(rbs_table *t, const rbs_raw_cells *raw, const char **what)
     else if (!all_finite_f(t->dictionary, t->dictionary_len)) *what = "dictionary (residual shapes)";
     else if (!all_finite(t->speed_restitution, (size_t)t->n_speed)) *what = "speed_restitution";
     else if (!all_finite(t->restitution_pieces, t->restitution_pieces_len)) *what = "restitution_pieces";
+    else if (!all_finite_f(t->work_rows, t->work_rows_len)) *what = "work_rows";
+    else if (!all_finite_f(t->work_dictionary, t->work_dictionary_len)) *what = "work_dictionary";
+    else if (!all_finite(t->work_cells, t->work_cells_len)) *what = "work_cells";
     return *what ? RBS_ERR_FORMAT : RBS_OK;
 }

@@ -281,10 +281,15 @@ static hid_t check_file(loader *ld, rbs_table *t)
     return file;
 }
 
+/* the cell datasets (data_schema.table.CELL_DATASETS), then those of the work on the wall (WORK_DATASETS, format
+ * 4.1: all or none) */
 static const char *const CELL_NAMES[] = {
     "cluster_weight", "cluster_loc", "cluster_scale", "cluster_shape", "cluster_slope", "cluster_regime",
-    "shape_dictionary", "status_counts", "collision_counts", "mean", "std", "indicatrix_2d", "indicatrix_3d"};
-#define N_CELL_NAMES (sizeof CELL_NAMES / sizeof CELL_NAMES[0])
+    "shape_dictionary", "status_counts", "collision_counts", "mean", "std", "indicatrix_2d", "indicatrix_3d",
+    "work_loc", "work_scale", "work_shape", "work_slope", "work_dictionary", "work_mean", "work_std", "trapped_work"};
+#define N_CELL_NAMES 13     /* the datasets every table holds */
+#define N_ALL_CELL_NAMES (sizeof CELL_NAMES / sizeof CELL_NAMES[0])
+#define N_WORK_NAMES (N_ALL_CELL_NAMES - N_CELL_NAMES)
 
 /* trailing shape of cell dataset i (data_schema.table.TableResolution.cell_shapes) */
 static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dims)
@@ -298,8 +303,47 @@ static int cell_trailing(size_t i, hsize_t C, hsize_t M, hsize_t L, hsize_t *dim
     case 8: dims[0] = 11; return 1;
     case 9: case 10: dims[0] = 6; return 1;
     case 11: dims[0] = 72; return 1;
-    default: dims[0] = 72; dims[1] = 72; return 2;
+    case 12: dims[0] = 72; dims[1] = 72; return 2;
+    case 13: case 14: case 15: dims[0] = C; dims[1] = N_WORK; return 2;
+    case 16: dims[0] = C; dims[1] = N_WORK_SLOPES; return 2;
+    case 17: dims[0] = N_WORK; dims[1] = M; dims[2] = L + 1; return 3;
+    default: dims[0] = N_WORK; return 1;
     }
+}
+
+/* two names in strcmp's order, for qsort (Python's sorted on ASCII names) */
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* `names` sorted, as Python's repr of a sorted list of strings: ['a', 'b'] */
+static void name_list(const char **names, size_t n, char *out, size_t size)
+{
+    qsort(names, n, sizeof *names, compare_names);
+    snprintf(out, size, "[");
+    for (size_t i = 0; i < n; i++)
+        snprintf(out + strlen(out), size - strlen(out), "%s'%s'", i ? ", " : "", names[i]);
+    snprintf(out + strlen(out), size - strlen(out), "]");
+}
+
+/* Whether the cells hold the work datasets: 1 for all, 0 for none; a subset is refused (RBS_ERR_FORMAT, -1) with
+ * data_schema.table.ReboundTable.__post_init__'s words, as the Python reader reports them */
+static int work_present(loader *ld, hid_t cells)
+{
+    const char *have[N_WORK_NAMES], *lack[N_WORK_NAMES];
+    size_t n_have = 0, n_lack = 0;
+    for (size_t i = N_CELL_NAMES; i < N_ALL_CELL_NAMES; i++) {
+        if (rbs_link_exists(cells, CELL_NAMES[i])) have[n_have++] = CELL_NAMES[i];
+        else lack[n_lack++] = CELL_NAMES[i];
+    }
+    if (n_have == 0 || n_lack == 0) return n_lack == 0;
+    char have_list[256], lack_list[256];
+    name_list(have, n_have, have_list, sizeof have_list);
+    name_list(lack, n_lack, lack_list, sizeof lack_list);
+    rbs_fail(ld, RBS_ERR_FORMAT, "inconsistent table: ReboundTable has the work datasets %s but not %s: all or none",
+             have_list, lack_list);
+    return -1;
 }
 
 /* The checksummed copy grid/shape_codes equals the names' codes (each family's code, USER_SHAPE_CODE for another
@@ -333,22 +377,22 @@ static int check_shape_codes(loader *ld, hid_t grid, const rbs_table *t)
         }                                                       \
     } while (0)
 
-/* Every row of shape_dictionary a standardised quantile function: non-decreasing, knots within ±√L up to
- * float32 round-off (data_schema.table.check_dictionary). */
-static int check_dictionary(loader *ld, const float *dictionary, size_t rows, long long L)
+/* Every row of cells/`name` (shape_dictionary, work_dictionary) a standardised quantile function: non-decreasing,
+ * knots within ±√L up to float32 round-off (data_schema.table.check_dictionary). */
+static int check_dictionary(loader *ld, const char *name, const float *dictionary, size_t rows, long long L)
 {
     const float bound = (float)(sqrt((double)L) * (1.0 + DICTIONARY_BOUND_TOLERANCE));
     const size_t knots = (size_t)L + 1;
     for (size_t i = 0; i < rows * knots; i++)
         if (!(fabsf(dictionary[i]) <= bound))
-            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' holds %g at element %zu; its values must "
-                        "be in [-%.9g, %.9g] (sqrt of the levels %lld)", (double)dictionary[i], i, (double)bound,
+            return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/%s' holds %g at element %zu; its values must be in "
+                        "[-%.9g, %.9g] (sqrt of the levels %lld)", name, (double)dictionary[i], i, (double)bound,
                         (double)bound, L);
     for (size_t row = 0; row < rows; row++)
         for (size_t i = 1; i < knots; i++)
             if (dictionary[row * knots + i] < dictionary[row * knots + i - 1])
-                return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/shape_dictionary' row %zu decreases; each row (a "
-                            "quantile function) must be non-decreasing", row);
+                return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'cells/%s' row %zu decreases; each row (a quantile "
+                            "function) must be non-decreasing", name, row);
     return RBS_OK;
 }
 
@@ -367,7 +411,9 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
     RULE(cluster_loc, n_cells * C * N_CHAIN, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
     RULE(cluster_scale, n_cells * C * N_CHAIN, v >= 0.0 && v <= CELL_VALUE_BOUND, "in [0, 1e+06]");
     RULE(cluster_slope, n_cells * C * N_SLOPES, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
-    RULE(cluster_shape, n_cells * C * N_CHAIN, v < (double)M, "below the dictionary size");
+    char below_m[64];
+    snprintf(below_m, sizeof below_m, "below the dictionary size %lld", M);
+    RULE(cluster_shape, n_cells * C * N_CHAIN, v < (double)M, below_m);
     RULE(cluster_regime, n_cells * C, v <= 1.0, "0 or 1");
     RULE(status_counts, n_cells * 3, v >= 0.0, ">= 0");
     RULE(collision_counts, n_cells * 11, v >= 0.0, ">= 0");
@@ -375,8 +421,21 @@ static int check_cell_values(loader *ld, const rbs_raw_cells *raw, size_t n_cell
     RULE(std, n_cells * 6, v >= 0.0 && v <= CELL_VALUE_BOUND, "in [0, 1e+06]");
     RULE(indicatrix_2d, n_cells * 72, isfinite(v) && v >= 0.0, "finite and >= 0");
     RULE(indicatrix_3d, n_cells * 72 * 72, isfinite(v) && v >= 0.0, "finite and >= 0");
+    if (raw->work_loc) {
+        RULE(work_loc, n_cells * C * N_WORK, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
+        RULE(work_scale, n_cells * C * N_WORK, v >= 0.0 && v <= CELL_VALUE_BOUND, "in [0, 1e+06]");
+        RULE(work_slope, n_cells * C * N_WORK_SLOPES, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
+        RULE(work_shape, n_cells * C * N_WORK, v < (double)M, below_m);
+        RULE(work_mean, n_cells * N_WORK, fabs(v) <= CELL_VALUE_BOUND, "in [-1e+06, 1e+06]");
+        RULE(work_std, n_cells * N_WORK, v >= 0.0 && v <= CELL_VALUE_BOUND, "in [0, 1e+06]");
+        RULE(trapped_work, n_cells * N_WORK, v >= 0.0 && v <= 1.0, "in [0, 1] (fractions of E⁻)");
+    }
 #undef RULE
-    if (check_dictionary(ld, raw->shape_dictionary, n_cells * N_CHAIN * (size_t)M, L) != RBS_OK) return ld->code;
+    if (check_dictionary(ld, "shape_dictionary", raw->shape_dictionary, n_cells * N_CHAIN * (size_t)M, L) != RBS_OK)
+        return ld->code;
+    if (raw->work_loc
+        && check_dictionary(ld, "work_dictionary", raw->work_dictionary, n_cells * N_WORK * (size_t)M, L) != RBS_OK)
+        return ld->code;
     for (size_t cell = 0; cell < n_cells; cell++) {
         double sum = 0.0;
         for (size_t c = 0; c < C; c++) sum += raw->cluster_weight[cell * C + c];
@@ -901,6 +960,14 @@ static void free_raw(rbs_raw_cells *raw)
     free(raw->collision_counts);
     free(raw->indicatrix_2d);
     free(raw->indicatrix_3d);
+    free(raw->work_loc);
+    free(raw->work_scale);
+    free(raw->work_shape);
+    free(raw->work_slope);
+    free(raw->work_dictionary);
+    free(raw->work_mean);
+    free(raw->work_std);
+    free(raw->trapped_work);
 }
 
 static int load(loader *ld, rbs_table *t)
@@ -978,8 +1045,11 @@ static int load(loader *ld, rbs_table *t)
         rbs_fail(ld, RBS_ERR_FORMAT, "inconsistent table: %zu cells of %lld components are too large", n_cells, C);
         goto done;
     }
-    /* every cell dataset's shape (only metadata: nothing read yet) */
-    for (size_t i = 0; i < N_CELL_NAMES; i++) {
+    /* the work datasets all or none, then every cell dataset's shape (only metadata: nothing read yet) */
+    const int has_work = work_present(ld, cells);
+    if (has_work < 0) goto done;
+    const size_t n_names = has_work ? N_ALL_CELL_NAMES : N_CELL_NAMES;
+    for (size_t i = 0; i < n_names; i++) {
         hsize_t want[8], found[8];
         int rank = 3 + cell_trailing(i, (hsize_t)C, (hsize_t)M, (hsize_t)L, want + 3), found_rank = 0;
         memcpy(want, lead, sizeof lead);
@@ -1012,6 +1082,16 @@ static int load(loader *ld, rbs_table *t)
     READ_CELLS(collision_counts, 8, H5T_NATIVE_INT64, int64_t);
     READ_CELLS(indicatrix_2d, 11, H5T_NATIVE_FLOAT, float);
     READ_CELLS(indicatrix_3d, 12, H5T_NATIVE_FLOAT, float);
+    if (has_work) {
+        READ_CELLS(work_loc, 13, H5T_NATIVE_FLOAT, float);
+        READ_CELLS(work_scale, 14, H5T_NATIVE_FLOAT, float);
+        READ_CELLS(work_shape, 15, H5T_NATIVE_UINT8, uint8_t);
+        READ_CELLS(work_slope, 16, H5T_NATIVE_FLOAT, float);
+        READ_CELLS(work_dictionary, 17, H5T_NATIVE_FLOAT, float);
+        READ_CELLS(work_mean, 18, H5T_NATIVE_DOUBLE, double);
+        READ_CELLS(work_std, 19, H5T_NATIVE_DOUBLE, double);
+        READ_CELLS(trapped_work, 20, H5T_NATIVE_DOUBLE, double);
+    }
 #undef READ_CELLS
     if (check_cell_values(ld, &raw, n_cells, (size_t)C, M, L) != RBS_OK) goto done;
     {
@@ -1071,6 +1151,9 @@ void rbs_table_close(rbs_table *t)
     free(t->dictionary);
     free(t->speed_restitution);
     free(t->restitution_pieces);
+    free(t->work_rows);
+    free(t->work_dictionary);
+    free(t->work_cells);
     free(t->shape_names);
     rbs_shape_records_free(&t->shapes);
     rbs_direct_shapes_free(t);

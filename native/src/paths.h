@@ -15,16 +15,20 @@
  * assumed): RBS_OK, RBS_TRAPPED or RBS_INVALID (V not moving into the wall, n not a unit vector, a not finite and
  * > 0, a uniform outside [0, 1), a result not finite or not leaving the wall, a NULL pointer, a mix of another
  * table, an unknown interpolation: RBS_INTERPOLATION_*), V⁺ (m/s) and Ω⁺ (rad/s) NaN unless rebounded.
- * rbs_table_hit also gives the table shape drawn from the mix into *shape (−1 for RBS_INVALID). */
+ * rbs_table_hit also gives the table shape drawn from the mix into *shape (−1 for RBS_INVALID) and the hit's work
+ * on the wall drawn with the rebound (work.h: m²/s², a trapped draw its cell's trapped particles' mean) into
+ * wall_work[0] (normal) and wall_work[1] (tangential), NaN from a table of format 4.0 and for RBS_INVALID. */
 int rbs_table_rebound(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
                       const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
 int rbs_table_hit(const rbs_table *table, const rbs_mix *mix, const double V[3], const double n[3], double a,
-                  const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3], int *shape);
+                  const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3], int *shape,
+                  double wall_work[2]);
 /* table_path.c: the table path of a particle of the table's shape `shape`, u[0] not read
- * (surrogate.kernels.table_path.table_shape_rebound): as rbs_table_rebound, RBS_INVALID also for a shape outside the
+ * (surrogate.kernels.table_path.table_shape_rebound): as rbs_table_hit, RBS_INVALID also for a shape outside the
  * table's; the facet hits of a rough wall (wall_hit.c). */
 int rbs_table_shape_hit(const rbs_table *table, int shape, const double V[3], const double n[3], double a,
-                        const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3]);
+                        const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
+                        double wall_work[2]);
 
 /* direct_path.c: the direct model for one hit, caller's frame (surrogate.kernels.direct_path.direct_rebound): `shape`
  * the index of the particle's shape in the table's direct shapes (the four families in code order, then the
@@ -43,9 +47,9 @@ int rbs_direct_hit(const rbs_table *table, int shape, const double V[3], const d
 
 /* wall_hit.c: a hit along the path `path` (RBS_PATH_TABLE, RBS_PATH_DIRECT; surrogate.kernels.wall_hit.rebound_typed)
  * with its RBS_U_PER_DRAW uniforms u (a keyed hit's already keyed): RBS_INVALID and NaN for RBS_PATH_NONE or what
- * rbs_rebound refuses. The table shape into *shape, the direct path's collisions into *n_collisions (−1 if none) and
- * their work on the wall into wall_work[0], wall_work[1] (m²/s², rbs_direct_hit's; NaN on the table path, which does
- * not hold it yet, and for RBS_INVALID). */
+ * rbs_rebound refuses. The table shape into *shape, the direct path's collisions into *n_collisions (−1 if none)
+ * and the hit's work on the wall into wall_work[0], wall_work[1] (m²/s², rbs_direct_hit's or rbs_table_hit's; NaN
+ * for RBS_INVALID). */
 int rbs_rebound_along(const rbs_table *table, const rbs_mix *mix, int path, const double V[3], const double Omega[3],
                       const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
                       double Omega_out[3], int *shape, int *n_collisions, double wall_work[2]);

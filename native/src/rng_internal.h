@@ -8,9 +8,11 @@
 
 #include <stdint.h>
 
+#include "fastmath.h"
 #include "rebound_scatter.h"
 
 #define RBS_GOLDEN 0x9E3779B97F4A7C15ull      /* splitmix64's increment */
+#define RBS_KEY_BITS 0x7FFFFFFFFFFFFFFFull    /* a key's 63 bits: the top bit cleared (surrogate.kernels.rng._KEY_BITS) */
 
 static inline uint64_t rbs_rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
@@ -45,6 +47,15 @@ static inline uint64_t rbs_splitmix64(uint64_t z)
 static inline double rbs_grain_uniform(uint64_t key, uint64_t slot)
 {
     return rbs_uniform_of(rbs_splitmix64(rbs_splitmix64(key + RBS_GOLDEN) + (slot + 1) * RBS_GOLDEN));
+}
+
+/* A key of a hit's first `count` uniforms u: splitmix64 chained over their bits from `domain`, top bit cleared (an
+ * int64 >= 0, as a grain key; surrogate.kernels.rng.hit_key). Each use of a hit's key has its own domain. */
+static inline int64_t rbs_hit_key(const double *u, int count, uint64_t domain)
+{
+    uint64_t h = rbs_splitmix64(domain);
+    for (int k = 0; k < count; k++) h = rbs_splitmix64(h + rbs_bits(u[k]) + RBS_GOLDEN);
+    return (int64_t)(h & RBS_KEY_BITS);
 }
 
 /* a state that is not NULL and not all zero (xoshiro256+'s fixed point: all-zero words give 0 forever) */

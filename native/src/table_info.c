@@ -30,8 +30,9 @@ int rbs_table_info_get(const rbs_table *t, rbs_table_info *info)
     info->speed_min_m_s = t->speed_m_s[0];
     info->speed_max_m_s = t->speed_m_s[t->n_speed - 1];
     info->kernel_bytes = (t->alpha1_axis_len + t->speed_axis_len + t->cells_len + (size_t)t->n_speed
-                          + t->restitution_pieces_len) * sizeof(double)
-                         + (t->clusters_len + t->dictionary_len) * sizeof(float);
+                          + t->restitution_pieces_len + t->work_cells_len) * sizeof(double)
+                         + (t->clusters_len + t->dictionary_len + t->work_rows_len + t->work_dictionary_len)
+                               * sizeof(float);
     return RBS_OK;
 }
 
@@ -102,6 +103,13 @@ int rbs_table_kernel_array(const rbs_table *t, const char *name, const void **da
     else if (strcmp(name, "dictionary") == 0) { p = t->dictionary; n = t->dictionary_len; type = RBS_DTYPE_FLOAT32; }
     else if (strcmp(name, "speed_restitution") == 0) { p = t->speed_restitution; n = (size_t)t->n_speed; }
     else if (strcmp(name, "restitution_pieces") == 0) { p = t->restitution_pieces; n = t->restitution_pieces_len; }
+    else if (strcmp(name, "work_rows") == 0) { p = t->work_rows; n = t->work_rows_len; type = RBS_DTYPE_FLOAT32; }
+    else if (strcmp(name, "work_dictionary") == 0) {
+        p = t->work_dictionary;
+        n = t->work_dictionary_len;
+        type = RBS_DTYPE_FLOAT32;
+    }
+    else if (strcmp(name, "work_cells") == 0) { p = t->work_cells; n = t->work_cells_len; }
     else if (strcmp(name, "direct_parameters") == 0) { p = t->direct_parameters; n = N_PARAMS; }
     else return RBS_INVALID;
     if (data) *data = p;

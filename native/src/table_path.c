@@ -1,7 +1,8 @@
 /*
  * table_path.c: one particle by the table's law (surrogate.kernels.table_path: table_rebound, draw_local; the
  * table path of rbs_rebound, and rbs_draw_local):
- * validity, impact frame, grid look-up, cache hints, the draw in its cell, back to the global frame.
+ * validity, impact frame, grid look-up, cache hints, the draw in its cell, its work on the wall (work.h), back to
+ * the global frame.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -13,6 +14,7 @@
 #include "paths.h"
 #include "records.h"
 #include "table_arguments.h"
+#include "work.h"
 
 /* NaN into the outputs a caller gave (any may be NULL) */
 static void nan_out(double *x, int count)
@@ -34,54 +36,60 @@ RBS_INLINE int inputs_ok(const rbs_table *t, const double *V, const double *n, c
  * (surrogate.kernels.table_path.table_shape_rebound) */
 RBS_INLINE int hit_in_shape(const rbs_table *t, int64_t shape, const double V[3], const double n[3], double a,
                             const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
-                            int *shape_out)
+                            int *shape_out, double wall_work[2])
 {
     const double Vi[3] = {V[0], V[1], V[2]}, ni[3] = {n[0], n[1], n[2]};
+    const int scaled = interpolation == RBS_INTERPOLATION_SCALED;
     rbs_frame f;
     double x[6];
     rbs_impact_frame(Vi, ni, u[12], &f);
     rbs_cell cell = rbs_cell_in_shape(t, shape, f.alpha1, f.speed, u);
     rbs_hint_draw(t, cell.drawn, u);
-    int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, interpolation == RBS_INTERPOLATION_SCALED,
-                                  x);
+    int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, scaled, x);
+    rbs_table_work(t, &cell, status, x, f.sin_alpha1, f.speed, u, scaled, wall_work);
     int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);
     status = rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
     *shape_out = status == RBS_INVALID ? -1 : (int)cell.shape;
+    if (status == RBS_INVALID)      /* a refused hit's work is NaN (surrogate.kernels.hit.hit) */
+        wall_work[0] = wall_work[1] = NAN;
     return status;
 }
 
 RBS_HOT int rbs_table_hit(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
                           const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3],
-                          int *shape)
+                          int *shape, double wall_work[2])
 {
     *shape = -1;
     if (!rbs_table_arguments_ok(t, mix, interpolation) || !inputs_ok(t, V, n, u, V_out, Omega_out, interpolation)) {
         nan_out(V_out, 3);
         nan_out(Omega_out, 3);
+        nan_out(wall_work, 2);
         return RBS_INVALID;
     }
     return hit_in_shape(t, rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, u[0]), V, n, a, u, interpolation, V_out,
-                        Omega_out, shape);
+                        Omega_out, shape, wall_work);
 }
 
 RBS_HOT int rbs_table_shape_hit(const rbs_table *t, int shape, const double V[3], const double n[3], double a,
                                 const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3],
-                                double Omega_out[3])
+                                double Omega_out[3], double wall_work[2])
 {
     int drawn;
     if (!inputs_ok(t, V, n, u, V_out, Omega_out, interpolation) || shape < 0 || shape >= t->n_shapes) {
         nan_out(V_out, 3);
         nan_out(Omega_out, 3);
+        nan_out(wall_work, 2);
         return RBS_INVALID;
     }
-    return hit_in_shape(t, shape, V, n, a, u, interpolation, V_out, Omega_out, &drawn);
+    return hit_in_shape(t, shape, V, n, a, u, interpolation, V_out, Omega_out, &drawn, wall_work);
 }
 
 int rbs_table_rebound(const rbs_table *t, const rbs_mix *mix, const double V[3], const double n[3], double a,
                       const double u[RBS_U_PER_DRAW], int interpolation, double V_out[3], double Omega_out[3])
 {
     int shape;
-    return rbs_table_hit(t, mix, V, n, a, u, interpolation, V_out, Omega_out, &shape);
+    double wall_work[2];
+    return rbs_table_hit(t, mix, V, n, a, u, interpolation, V_out, Omega_out, &shape, wall_work);
 }
 
 /* a local incident state a draw takes (surrogate.kernels.table_path.local_ok): α1 in (0, 90] deg, |V⁻| finite

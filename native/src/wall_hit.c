@@ -80,8 +80,7 @@ typedef struct rough_out {
     double wall_work[2];
 } rough_out;
 
-/* A facet hit of the table's shape `shape` along `path` (surrogate.kernels.wall_hit._shape_rebound; u[0] unused); the
- * wall work NaN but on the direct path */
+/* A facet hit of the table's shape `shape` along `path` (surrogate.kernels.wall_hit._shape_rebound; u[0] unused) */
 static int shape_rebound(const rbs_table *t, int shape, int path, const double V[3], const double Omega[3],
                          const double n[3], double a, const double u[RBS_U_PER_DRAW], int interpolation,
                          double V_out[3], double Omega_out[3], int *n_collisions, double wall_work[2])
@@ -89,7 +88,7 @@ static int shape_rebound(const rbs_table *t, int shape, int path, const double V
     *n_collisions = -1;
     wall_work[0] = wall_work[1] = NAN;
     if (path == RBS_PATH_TABLE)
-        return rbs_table_shape_hit(t, shape, V, n, a, u, interpolation, V_out, Omega_out);
+        return rbs_table_shape_hit(t, shape, V, n, a, u, interpolation, V_out, Omega_out, wall_work);
     if (path == RBS_PATH_DIRECT && rbs_uniforms_ok(u, 1))
         return rbs_direct_hit(t, t->model_shape[shape], V, Omega, n, a, u + 1, V_out, Omega_out, n_collisions,
                               wall_work);
@@ -100,8 +99,8 @@ static int shape_rebound(const rbs_table *t, int shape, int path, const double V
 
 /* One hit on a rough wall of roughness Δγ = `roughness` degrees (surrogate.kernels.wall_hit.rough_rebound with the
  * shape from the mix): its status, V⁺ and Ω⁺ into V_out and Omega_out (NaN unless rebounded), the rest into *out (the
- * wall work summed over the facet hits in their order from 0, NaN once the table answered one). `key` the grain key
- * or RBS_NO_KEY, u the hit's uniforms (not keyed). */
+ * wall work summed over the facet hits in their order from 0, NaN once a table of format 4.0 answered one). `key` the
+ * grain key or RBS_NO_KEY, u the hit's uniforms (not keyed). */
 static int rough_rebound(const rbs_table *t, const rbs_mix *mix, int64_t key, const double V_in[3],
                          const double Omega_in[3], const double n[3], double a, const double u[RBS_U_PER_DRAW],
                          int method, int interpolation, double roughness, double V_out[3], double Omega_out[3],
@@ -237,7 +236,7 @@ int rbs_rebound_along(const rbs_table *t, const rbs_mix *mix, int path, const do
         return RBS_INVALID;
     }
     if (path == RBS_PATH_TABLE)
-        return rbs_table_hit(t, mix, V, n, a, u, interpolation, V_out, Omega_out, shape);
+        return rbs_table_hit(t, mix, V, n, a, u, interpolation, V_out, Omega_out, shape, wall_work);
     /* the table's shape drawn as the table path draws it, then its index in the direct model's shapes */
     int64_t drawn = rbs_mix_shape(rbs_mix_cdf(mix), mix->n_shapes, u[0]);
     *shape = (int)drawn;

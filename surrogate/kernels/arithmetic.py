@@ -88,6 +88,19 @@ def _velocity(alpha2, beta2, s):
 
 
 @numba.njit(inline="always", **JIT)
+def speed_factors(regime, f_target, f_grid, sin_alpha1):
+    """(few, f, g) of :func:`to_speed`: whether the regime is 0; the factor f of V⁺ − V⁻ (regime 0) or of the
+    normal rebound velocity (regime 1); the factor g of the spin and of V⁺ − V⁻ off the normal."""
+    a_target = 1.0 - (1.0 - f_target) * sin_alpha1
+    a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1
+    # both laws computed, the regime's picked by selects: the regime varies from draw to draw, a branch
+    # on it would be mispredicted often
+    few = regime == 0.0
+    f = (1.0 + a_target) / (1.0 + a_grid) if few else a_target / a_grid
+    return few, f, f if few else 1.0
+
+
+@numba.njit(inline="always", **JIT)
 def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, wy, wz):
     """A rebound drawn at grid speed V_iv, moved to the incident speed V; returns (vx, vy, vz, wx, wy, wz).
 
@@ -111,13 +124,7 @@ def to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, wx, w
     becomes 2 − s, as the chain's s is folded: a rebound gains no kinetic
     energy).
     """
-    a_target = 1.0 - (1.0 - f_target) * sin_alpha1
-    a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1
-    # both laws computed, the regime's picked by selects: the regime varies from draw to draw, a branch
-    # on it would be mispredicted often
-    few = regime == 0.0
-    f = (1.0 + a_target) / (1.0 + a_grid) if few else a_target / a_grid
-    g = f if few else 1.0       # factor of the spin and of V⁺ − V⁻ off the normal
+    few, f, g = speed_factors(regime, f_target, f_grid, sin_alpha1)
     vx_few, vy_few = fma(f, vx - cos_alpha1, cos_alpha1), abs(fma(f, vy + sin_alpha1, -sin_alpha1))
     vx, vy, vz = vx_few if few else vx, vy_few if few else vy * f, g * vz
     s = math.sqrt(fma(vx, vx, fma(vy, vy, vz * vz)))
@@ -135,7 +142,13 @@ def drawn_ok(vx, vy, vz):
     leaving the wall (V⁺_y > 0) and no faster than it came (|V⁺| ≤ |V⁻| up to :data:`SPEED_TOLERANCE`; tables
     are built with Ω⁻ = 0, so a table draw never gains kinetic energy). A valid table's draws always pass (the
     folds of :func:`_folded` and :func:`to_speed`); values outside docs/format.md's bounds might not."""
-    return (vy > 0.0) & (fma(vx, vx, fma(vy, vy, vz * vz)) <= 1.0 + SPEED_TOLERANCE)
+    return (vy > 0.0) & (speed_ratio_squared(vx, vy, vz) <= 1.0 + SPEED_TOLERANCE)
+
+
+@numba.njit(inline="always", **JIT)
+def speed_ratio_squared(vx, vy, vz):
+    """s² = |V⁺|²/|V⁻|² of a local-frame V⁺ in units of |V⁻|."""
+    return fma(vx, vx, fma(vy, vy, vz * vz))
 
 
 @numba.njit(inline="always", **JIT)
@@ -184,7 +197,8 @@ def _mirrored(u, vx, vy, vz, wx, wy, wz):
 # -- the results of a block --------------------------------------------------------------------------
 
 OUT_STATUS, OUT_V, OUT_OMEGA = 0, 1, 4      # status, V⁺ (m/s), Ω⁺ (rad/s), global frame
-OUT_FIELDS = 7
+OUT_S2 = 7                                  # s² = |V⁺|²/|V⁻|² of the local draw, for its work on the wall
+OUT_FIELDS = 8
 
 
 @numba.njit(**KERNEL)
@@ -213,5 +227,6 @@ def _draw_global(g, fr, out, b, scaled):
     status, V_new, Omega_new = to_global(status, field(fr, FRAME_OK, b) != 0.0, vx, vy, vz, wx, wy, wz, speed, a,
                                          ex, n, ez)
     out[OUT_STATUS * BLOCK + b] = status
+    out[OUT_S2 * BLOCK + b] = speed_ratio_squared(vx, vy, vz)
     put3(out, OUT_V, b, V_new)
     put3(out, OUT_OMEGA, b, Omega_new)

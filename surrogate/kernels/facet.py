@@ -25,27 +25,22 @@ import numpy as np
 
 from direct_model.elementary import sincos
 from surrogate.kernels.draw import U_PER_DRAW
-from surrogate.kernels.fastmath import bits
 from surrogate.kernels.frame import impact_frame
 from surrogate.kernels.options import JIT
-from surrogate.kernels.rng import _GOLDEN, _splitmix64, grain_uniform
+from surrogate.kernels.rng import grain_uniform, hit_key
 
 MAX_FACET_DRAWS = 64        # draws of one facet: each is kept with probability ≥ 0.38, so 64 all fail < 1e-13
 U_PER_FACET = 6             # keyed uniforms of one draw: the mixture's branch, γx (2), γz (2), keep or not
 _FACET_DOMAIN = np.uint64(0x6A09E667F3BCC909)   # the facet keys' start: unrelated to the grain keys' hashes
-_KEY_BITS = np.uint64(0x7FFFFFFFFFFFFFFF)
 _SQRT_2_OVER_PI = math.sqrt(2.0 / math.pi)      # E|γx| / Δγ
 _DEG = math.pi / 180.0                         # as math.radians and RBS_DEG_TO_RAD
 
 
 @numba.njit(inline="always", **JIT)
 def facet_key(u):
-    """The facet key of a hit of uniforms ``u`` (its U_PER_DRAW = 13): splitmix64 chained over their bits from
-    _FACET_DOMAIN, top bit cleared (an int64 ≥ 0, as a grain key)."""
-    h = _splitmix64(_FACET_DOMAIN)
-    for k in range(U_PER_DRAW):
-        h = _splitmix64(h + bits(np.float64(u[k])) + _GOLDEN)
-    return np.int64(h & _KEY_BITS)
+    """The facet key of a hit of uniforms ``u`` (its U_PER_DRAW = 13): :func:`surrogate.kernels.rng.hit_key` from
+    _FACET_DOMAIN."""
+    return hit_key(u, U_PER_DRAW, _FACET_DOMAIN)
 
 
 @numba.njit(inline="always", **JIT)

@@ -71,10 +71,18 @@ def _three_terms(cells, lo, hi, here, wa, k):
 @numba.njit(inline="always", **JIT)
 def _term(cells, lo, hi, here, wa, k):
     """(ratio, m_cell, m) of state variable k (:func:`_alpha1_terms`)."""
-    sd = fma(wa, load(cells, hi + CELL_SD + k), (1.0 - wa) * load(cells, lo + CELL_SD + k))
-    inv_sd = load(cells, here + CELL_INV_SD + k)
-    mean = fma(wa, load(cells, hi + CELL_MEAN + k), (1.0 - wa) * load(cells, lo + CELL_MEAN + k))
-    return sd * inv_sd if inv_sd > 0.0 else 1.0, load(cells, here + CELL_MEAN + k), mean
+    return moved_term(cells, lo + k, hi + k, here + k, wa, CELL_MEAN, CELL_SD, CELL_INV_SD)
+
+
+@numba.njit(inline="always", **JIT)
+def moved_term(cells, lo, hi, here, wa, at_mean, at_sd, at_inv_sd):
+    """(ratio, m_cell, m) of a variable whose mean, sd and 1/sd sit at offsets ``at_*`` from a cell record's
+    start in ``cells``: the records of the α1 below (``lo``), above (``hi``) and the drawn cell (``here``)
+    (:func:`_alpha1_terms`)."""
+    sd = fma(wa, load(cells, hi + at_sd), (1.0 - wa) * load(cells, lo + at_sd))
+    inv_sd = load(cells, here + at_inv_sd)
+    mean = fma(wa, load(cells, hi + at_mean), (1.0 - wa) * load(cells, lo + at_mean))
+    return sd * inv_sd if inv_sd > 0.0 else 1.0, load(cells, here + at_mean), mean
 
 
 @numba.njit(inline="always", **JIT)

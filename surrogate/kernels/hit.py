@@ -12,9 +12,10 @@ On a rough wall (:mod:`surrogate.kernels.facet`) one hit may take several facet 
 
 What a hit does to the wall (docs/model.md §4.7): ``wall_work_normal`` W_n and ``wall_work_tangential`` W_t, the
 work of its collisions on the wall per unit particle mass in m²/s² (J/kg), each ≥ 0, their sum the particle's drop of
-translational plus rotational kinetic energy (up to the trap or the failure for a hit trapped or failed). The direct
-path gives them (on a rough wall summed over the facet hits); the table path does not hold them yet: NaN there
-(and on a rough wall for a hit any of whose facet hits the table answered); NaN for STATUS_INVALID.
+translational plus rotational kinetic energy (up to the trap or the failure for a hit trapped or failed). Both
+paths give them (on a rough wall summed over the facet hits): the direct model from its collisions, the table
+drawn jointly with the rebound (:mod:`surrogate.kernels.work`; a trapped draw its cell's trapped particles' mean).
+NaN from a table without the work (format 4.0), and for STATUS_INVALID.
 """
 
 from typing import NamedTuple
@@ -41,7 +42,7 @@ class Hit(NamedTuple):
     wall_hits: int      # the hits on the wall this hit took: 1 on a smooth wall; on a rough one ≥ 1 (re-hits of a
                         # rebound into the mean wall, up to MAX_WALL_HITS); 0 for STATUS_INVALID
     wall_work_normal: float      # W_n, m²/s²: the work of the hit's normal impulses on the wall per unit particle
-                                 # mass (module doc); NaN on the table path and for STATUS_INVALID
+                                 # mass (module doc); NaN for STATUS_INVALID and from a table without the work
     wall_work_tangential: float  # W_t, m²/s²: that of its tangential impulses (the cutting of ductile walls); NaN
                                  # as W_n
 
@@ -78,7 +79,7 @@ def hit(status, path, shape, n_collisions, V, Omega, wall_hits=1, wall_work_norm
     """A :class:`Hit` with its integers as int64 and its floats as float64 (its vectors 3-tuples): one type whatever
     the kernel that builds it, so every branch of a kernel returns the same type. A STATUS_INVALID hit gets
     PATH_NONE, shape and n_collisions −1, NaN vectors, wall_hits 0 and NaN wall work whatever is passed (as
-    rbs_rebound writes it); the wall work's default, NaN, is the table path's."""
+    rbs_rebound writes it); the wall work's default is NaN."""
     if status == STATUS_INVALID:
         return Hit(np.int64(STATUS_INVALID), np.int64(PATH_NONE), np.int64(-1), np.int64(-1), NAN3, NAN3,
                    np.int64(0), np.nan, np.nan)

@@ -18,7 +18,7 @@ import numpy as np
 
 from data_schema.common import DataFormatError
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
-from data_schema.table import N_CHAIN, N_SLOPES, ReboundTable
+from data_schema.table import N_CHAIN, N_SLOPES, N_WORK, N_WORK_SLOPES, ReboundTable
 from surrogate.kernels.fastmath import restitution_factor, restitution_pieces
 
 CACHE_LINE_BYTES = 64
@@ -43,6 +43,13 @@ class KernelData(NamedTuple):
     n_levels: int              # L + 1 quantile levels of a residual shape
     n_dictionary: int          # M residual shapes per chain variable and cell
     n_pieces: int              # restitution pieces per speed interval
+    # the work on the wall (format 4.1; empty arrays for a table without it, has_work False): each component's
+    # two work variables (WORK_ROW_* layout), their residual shapes (level-major, as ``dictionary``), and per
+    # cell their moments and the trapped particles' mean work (WORK_CELL_* layout)
+    work_rows: np.ndarray      # float32 (n_cells · n_clusters · WORK_ROW_SIZE,)
+    work_dictionary: np.ndarray  # float32 (n_cells · N_WORK · n_levels · n_dictionary,)
+    work_cells: np.ndarray     # float64 (n_cells · WORK_CELL_SIZE,)
+    has_work: bool
 
     @property
     def nbytes(self) -> int:
@@ -81,6 +88,20 @@ ROW_SHAPE = 14        # 6 residual shape indices m (KernelData.shape_dictionary(
 ROW_SLOPE = 20        # 15 slopes, x_k on x_j at k(k−1)/2 + j
 ROW_REGIME = 35       # collision regime: 0 = at most FEW_COLLISIONS collisions, 1 = more
 ROW_SIZE = 36
+
+# Layout of a component's work row in KernelData.work_rows: the chain's two work variables (r, ν), 80 bytes
+WORK_ROW_LOC = 0      # 2 locations
+WORK_ROW_SCALE = 2    # 2 scales
+WORK_ROW_SHAPE = 4    # 2 residual shape indices into KernelData.work_dictionary
+WORK_ROW_SLOPE = 6    # 13 slopes: r on the six chain variables, ν on them and r (WORK_SLOPE_START)
+WORK_ROW_SIZE = 20    # 19 used; 20 keeps rows 16-byte aligned
+
+# Layout of a cell's work record in KernelData.work_cells
+WORK_CELL_MEAN = 0    # means of r and ν
+WORK_CELL_SD = 2      # their standard deviations
+WORK_CELL_INV_SD = 4  # 1/sd (0 where sd = 0)
+WORK_CELL_TRAPPED = 6  # the trapped particles' mean W_n/E⁻ and W_t/E⁻
+WORK_CELL_SIZE = 8
 
 # Layout of a cell's record in KernelData.cells
 CELL_P_TRAPPED = 0    # probability of the trapped outcome
@@ -174,6 +195,25 @@ def kernel_rows(cells: dict) -> tuple:
     return aligned_copy(rows.ravel()), aligned_copy(np.swapaxes(dic, -1, -2).ravel())
 
 
+def work_arrays(table: ReboundTable) -> tuple:
+    """(work_rows, work_dictionary, work_cells), flat (see :class:`KernelData`); empty for a table without the
+    work on the wall."""
+    if not table.has_work:
+        return np.zeros(0, dtype=np.float32), np.zeros(0, dtype=np.float32), np.zeros(0)
+    cells = table.cells
+    lead = cells["work_loc"].shape[:4]
+    rows = np.zeros(lead + (WORK_ROW_SIZE,), dtype=np.float32)
+    rows[..., WORK_ROW_LOC:WORK_ROW_LOC + N_WORK] = cells["work_loc"]
+    rows[..., WORK_ROW_SCALE:WORK_ROW_SCALE + N_WORK] = cells["work_scale"]
+    rows[..., WORK_ROW_SHAPE:WORK_ROW_SHAPE + N_WORK] = cells["work_shape"]
+    rows[..., WORK_ROW_SLOPE:WORK_ROW_SLOPE + N_WORK_SLOPES] = cells["work_slope"]
+    std = np.asarray(cells["work_std"], dtype=np.float64)
+    inverse = np.divide(1.0, std, out=np.zeros_like(std), where=std > 0.0)
+    records = np.concatenate([cells["work_mean"], std, inverse, cells["trapped_work"]], axis=-1)
+    return (aligned_copy(rows.ravel()), aligned_copy(np.swapaxes(cells["work_dictionary"], -1, -2).ravel()),
+            records.ravel())
+
+
 def aligned_copy(a: np.ndarray, alignment: int = CACHE_LINE_BYTES) -> np.ndarray:
     """A C-contiguous copy of ``a`` that starts at a multiple of ``alignment`` bytes (a cache line)."""
     buffer = np.empty(a.nbytes + alignment, dtype=np.uint8)
@@ -216,7 +256,9 @@ def kernel_data(table: ReboundTable) -> KernelData:
         speed_restitution=frozen(np.array([restitution_factor(v, wall) for v in speed.tolist()])),
         restitution_pieces=frozen(pieces.ravel()),
         n_shapes=lead[0], n_alpha1=lead[1], n_speed=lead[2], n_clusters=table.cells["cluster_weight"].shape[3],
-        n_levels=dic_shape[-1], n_dictionary=dic_shape[-2], n_pieces=pieces.shape[1])
+        n_levels=dic_shape[-1], n_dictionary=dic_shape[-2], n_pieces=pieces.shape[1],
+        **dict(zip(("work_rows", "work_dictionary", "work_cells"), map(frozen, work_arrays(table)))),
+        has_work=table.has_work)
 
 
 # the stored datasets each kernel array is derived from, for error messages
@@ -226,6 +268,8 @@ DERIVED_FROM = {
     "clusters": "cells/cluster_weight, cluster_loc, cluster_scale, cluster_shape, cluster_slope, cluster_regime",
     "dictionary": "cells/shape_dictionary", "speed_restitution": "grid/speed_m_s and wall/parameters",
     "restitution_pieces": "grid/speed_m_s and wall/parameters",
+    "work_rows": "cells/work_loc, work_scale, work_shape, work_slope", "work_dictionary": "cells/work_dictionary",
+    "work_cells": "cells/work_mean, work_std, trapped_work",
 }
 
 

@@ -12,7 +12,7 @@ import numba
 
 from surrogate.kernels.checks import check_local_rows, check_rows, check_states, check_uniforms
 from surrogate.kernels.options import JIT
-from surrogate.kernels.pipeline import (no_shape_out, no_shapes, no_state, no_uniforms, run_blocks,
+from surrogate.kernels.pipeline import (no_shape_out, no_shapes, no_state, no_uniforms, no_work, run_blocks,
                                        table_rebound_uniforms)
 from surrogate.kernels.rng import CHUNK_ROWS, n_chunks
 from surrogate.kernels.table_path import draw_local
@@ -55,7 +55,7 @@ def _rebound_chunk(data, mix_cdf, V, n, a, u, state, V_out, Omega_out, status, s
     or :func:`surrogate.kernels.pipeline.table_rebound_many_rng` with ``state``. Called, not inlined: numba's
     parallel passes then see one call in the loop, not the chunk's work (docs/design/test_time.md)."""
     run_blocks(data, mix_cdf, no_shapes(), V[lo:hi], n[lo:hi], a[lo:hi], u, state, V_out[lo:hi], Omega_out[lo:hi],
-               status[lo:hi], no_shape_out(), scaled)
+               status[lo:hi], no_shape_out(), no_work(), no_work(), scaled)
 
 
 @numba.njit(parallel=True, **JIT)

@@ -26,6 +26,7 @@ from surrogate.kernels.gather import GATHERED_FIELDS, gather_block
 from surrogate.kernels.locate import I_DRAWN, INDEX_FIELDS, WEIGHT_FIELDS, locate_block, resolve_block
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import fill_lanes, seed_lanes
+from surrogate.kernels.work import work_block
 
 STAGES = 3      # blocks in the pipeline: located, resolved, drawn
 
@@ -49,7 +50,8 @@ def table_rebound_many(data, mix_cdf, V, n, a, u, V_out, Omega_out, status, scal
     """
     check_rows(V, n, a, V_out, Omega_out, status)
     check_uniforms(u, V.shape[0], "V")
-    run_blocks(data, mix_cdf, no_shapes(), V, n, a, u, no_state(), V_out, Omega_out, status, no_shape_out(), scaled)
+    run_blocks(data, mix_cdf, no_shapes(), V, n, a, u, no_state(), V_out, Omega_out, status, no_shape_out(),
+               no_work(), no_work(), scaled)
 
 
 @numba.njit(**JIT)
@@ -68,7 +70,7 @@ def table_rebound_many_rng(data, mix_cdf, V, n, a, state, V_out, Omega_out, stat
     check_state(state)
     check_rows(V, n, a, V_out, Omega_out, status)
     run_blocks(data, mix_cdf, no_shapes(), V, n, a, no_uniforms(), state, V_out, Omega_out, status, no_shape_out(),
-               scaled)
+               no_work(), no_work(), scaled)
 
 
 @numba.njit(**JIT)
@@ -93,15 +95,19 @@ def _lanes():
 
 
 @numba.njit(inline="always", **JIT)
-def run_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, shape_out, scaled):
+def run_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, shape_out, work_n, work_t,
+               scaled):
     """The pipeline (:func:`table_rebound_many` with ``u``, :func:`table_rebound_many_rng` with ``state``; the other
     argument empty: :func:`no_state`, :func:`no_uniforms`) with its scratch, V, n, a made C-contiguous
     (copied if they are not). ``shapes``: each row's shape index in the table, or SHAPE_FROM_MIX
     (:func:`surrogate.kernels.locate.row_shape`); empty (:func:`no_shapes`): every row's from the mix.
     ``shape_out``: (rows,) int32, each row's shape index (that of a row that does not move into its wall is
-    meaningless), or empty (:func:`no_shape_out`): not written."""
+    meaningless), or empty (:func:`no_shape_out`): not written. ``work_n``, ``work_t``: (rows,) float64, each
+    row's work on the wall W_n, W_t in m²/s² (:func:`surrogate.kernels.work.work_block`), or both empty
+    (:func:`no_work`): not computed."""
     _rebound_blocks(data, mix_cdf, shapes, np.ascontiguousarray(V), np.ascontiguousarray(n),
-                    np.ascontiguousarray(a), u, state, V_out, Omega_out, status, shape_out, scaled, *_block_scratch())
+                    np.ascontiguousarray(a), u, state, V_out, Omega_out, status, shape_out, work_n, work_t, scaled,
+                    *_block_scratch())
 
 
 @numba.njit(inline="always", **JIT)
@@ -114,6 +120,12 @@ def no_shapes():
 def no_shape_out():
     """The ``shape_out`` argument of :func:`run_blocks` when the rows' shapes are not wanted."""
     return np.zeros(0, dtype=np.int32)
+
+
+@numba.njit(inline="always", **JIT)
+def no_work():
+    """The ``work_n`` and ``work_t`` arguments of :func:`run_blocks` when the work on the wall is not wanted."""
+    return np.zeros(0)
 
 
 @numba.njit(inline="always", **JIT)
@@ -139,8 +151,8 @@ def _block_scratch():
 
 
 @numba.njit(**KERNEL)
-def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, shape_out, scaled, us, fr, index,
-                    weights, g, out, lanes):
+def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, status, shape_out, work_n, work_t,
+                    scaled, us, fr, index, weights, g, out, lanes):
     """:func:`table_rebound_many` (uniforms ``u``) or :func:`table_rebound_many_rng` (uniforms drawn from ``state``)
     with its scratch arrays (:func:`_block_scratch`): a pipeline of STAGES blocks, so that a block's table
     reads have a whole step to arrive before they are used."""
@@ -164,6 +176,9 @@ def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, 
             j, start = (k - 2) % STAGES, (k - 2) * BLOCK
             gather_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j], weights[j], g)
             arithmetic_block(g, fr[j], out, V_out, Omega_out, status, start, min(BLOCK, rows - start), scaled)
+            if work_n.shape[0] > 0:
+                work_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j], weights[j], g, out, work_n, work_t,
+                           start, scaled)
 
 
 @numba.njit(inline="always", **JIT)

@@ -33,6 +33,7 @@ import numba
 import numpy as np
 
 from data_schema import kernel_cache  # noqa: F401  (keys this module's kernels by their sources)
+from surrogate.kernels.fastmath import bits
 
 _53_BITS = 1.0 / 9007199254740992.0      # 2**-53
 CHUNK_ROWS = 1024      # rows of a chunk: the unit of work of the parallel kernels, drawn from one stream
@@ -137,6 +138,20 @@ def _splitmix64(x):
     z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
     z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
     return z ^ (z >> np.uint64(31))
+
+
+@numba.njit(inline="always", cache=True, nogil=True)
+def hit_key(u, count, domain):
+    """A key of a hit's first ``count`` uniforms ``u``: splitmix64 chained over their bits from ``domain``, top bit
+    cleared (an int64 ≥ 0, as a grain key). Each use of a hit's key has its own ``domain``, so its keyed uniforms
+    (:func:`grain_uniform`) are unrelated to another use's."""
+    h = _splitmix64(domain)
+    for k in range(count):
+        h = _splitmix64(h + bits(np.float64(u[k])) + _GOLDEN)
+    return np.int64(h & _KEY_BITS)
+
+
+_KEY_BITS = np.uint64(0x7FFFFFFFFFFFFFFF)
 
 
 @numba.njit(inline="always", cache=True, nogil=True)

@@ -22,14 +22,15 @@ from surrogate.kernels.frame import (float3, impact_frame, moves_into_wall, part
 from surrogate.kernels.hit import PATH_TABLE, hit, invalid_hit
 from surrogate.kernels.locate import hint, locate_in_shape, mix_shape
 from surrogate.kernels.options import JIT, KERNEL
+from surrogate.kernels.work import table_work
 
 
 @numba.njit(**KERNEL)
 def table_rebound(data, mix_cdf, V, n, a, u, scaled=True):
     """Reflected state of one particle in the global frame, drawn from the table: a
     :class:`surrogate.kernels.hit.Hit` (V⁺ in m/s, Ω⁺ in rad/s; ``path`` PATH_TABLE, ``shape`` the shape drawn
-    from the mix, ``n_collisions`` −1, ``wall_work_normal`` and ``wall_work_tangential`` NaN: the table does not
-    hold the work of a hit on the wall yet).
+    from the mix, ``n_collisions`` −1, ``wall_work_normal`` and ``wall_work_tangential`` W_n, W_t in m²/s² drawn
+    with the rebound (:mod:`surrogate.kernels.work`; NaN from a table without the work, format 4.0)).
 
     Parameters
     ----------
@@ -75,9 +76,11 @@ def table_shape_rebound(data, shape, V, n, a, u, scaled):
     cell = locate_in_shape(data, shape, alpha1, speed, u)
     hint(data, cell, u)
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
+    work_n, work_t = table_work(data, cell, status, (vx, vy, vz), sin_a1, speed, u, scaled)
     ok = particle_ok(n, a) & uniforms_ok(u)
     status, V_new, Omega_new = to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
-    return hit(status, PATH_TABLE, cell[0] // (data.n_alpha1 * data.n_speed), -1, V_new, Omega_new)
+    return hit(status, PATH_TABLE, cell[0] // (data.n_alpha1 * data.n_speed), -1, V_new, Omega_new, 1, work_n,
+               work_t)
 
 
 @numba.njit(inline="always", **JIT)

@@ -228,8 +228,8 @@ def rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
     (:mod:`surrogate.kernels.facet`). A rebound still into the mean wall after MAX_WALL_HITS facet hits is
     STATUS_TRAPPED; a facet not found (probability below 1e-13) STATUS_FAILED. ``path`` and ``n_collisions``
     are the last facet hit's. The wall work (``wall_work_normal``, ``wall_work_tangential``, m²/s²) is the sum of
-    the facet hits' (summed in their order from 0; those before a facet not found), NaN if the table answered any
-    of them (it does not hold the work yet). ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,) float64:
+    the facet hits' (summed in their order from 0; those before a facet not found), NaN if any of them was
+    answered by a table without the work (format 4.0). ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,) float64:
     work space."""
     path = rebound_path(data, V, omega, n, a, method)
     if (path == PATH_NONE or key < NO_KEY or not uniforms_ok(u) or not 0.0 < roughness_deg <= MAX_ROUGHNESS_DEG
@@ -242,7 +242,7 @@ def rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
     for k in range(U_PER_DRAW):
         facet_u[k] = u[k]
     result = invalid_hit()
-    work_n, work_t = 0.0, 0.0           # the facet hits' wall work (NaN, the table path's, stays NaN)
+    work_n, work_t = 0.0, 0.0           # the facet hits' wall work (a NaN, a table without it, stays NaN)
     for wall_hits in range(1, MAX_WALL_HITS + 1):
         found, facet, slot = facet_normal(V, n, roughness_deg, facets, slot)
         if not found:
@@ -338,11 +338,11 @@ def _path_chunk(data, params, shape_arrays, model_shapes, mix_cdf, row_shapes, k
         n_table += path[i] == PATH_TABLE
     if n_table > 0:
         run_blocks(data, mix_cdf, row_shapes[lo:hi], V[lo:hi], n[lo:hi], a[lo:hi], no_uniforms(), state.copy(),
-                   out.V[lo:hi], out.Omega[lo:hi], out.status[lo:hi], out.shape[lo:hi], scaled)
+                   out.V[lo:hi], out.Omega[lo:hi], out.status[lo:hi], out.shape[lo:hi], out.wall_work_normal[lo:hi],
+                   out.wall_work_tangential[lo:hi], scaled)
     for i in range(lo, hi):
         if path[i] == PATH_TABLE:       # the pipeline's rows completed as rebound's records (hit.hit)
             out.n_collisions[i], out.wall_hits[i] = -1, 1
-            out.wall_work_normal[i], out.wall_work_tangential[i] = np.nan, np.nan
             if out.status[i] == STATUS_INVALID:
                 path[i], out.shape[i], out.wall_hits[i] = PATH_NONE, -1, 0
     if n_table == hi - lo:

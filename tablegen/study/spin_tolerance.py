@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 import surrogate
-from data_schema.samples import SHAPE_NAMES, STATUS_REBOUNDED, rebound_angles
-from tablegen.study.validation import compare, direct_states, table_states
+from data_schema.samples import SHAPE_NAMES
+from tablegen.study.validation import compare, direct_states, table_hits, table_states
 
 # classifier accuracy at which the two laws count as apart, compared at the two decimals it is given in
 # (accuracy < 0.525 passes): at Ω⁻ = 0 the table's own accuracy against the model reaches 0.52 at n = 2e4
@@ -75,24 +75,6 @@ def accuracies(table, n: int, candidates=CANDIDATES, directions=tuple(DIRECTIONS
 # (shape, α1 deg, |V⁻| m/s, Ω⁻a/|V⁻| lab frame): spinning hits like hopperRebound's (|Ω⁻|a/|V⁻| 0.6–0.8)
 SPINNING_STATES = (("prism", 45.0, 250.0, (0.0, 0.0, -0.6)), ("ellipsoid", 20.0, 100.0, (0.3, 0.2, -0.5)),
                    ("tetrahedron", 70.0, 250.0, (0.0, 0.8, 0.0)))
-HALF_SIZE = 1e-4     # m: any value (the states are given in units of |V⁻| and |V⁻|/a)
-
-
-def global_states(table, shape, alpha1, speed, omega, n, seed, method) -> np.ndarray:
-    """(m, 6) rebounded states (α2, β2, s, Ω⁺a/|V⁻|) of ``surrogate.sample_global`` at one incident state given
-    in the lab frame (wall y = 0, normal +Y, V⁻ in the XY plane: also the impact frame of the hit)."""
-    a1 = np.radians(alpha1)
-    V = np.tile([speed * np.cos(a1), -speed * np.sin(a1), 0.0], (n, 1))
-    # clamp: α1 recomputed from V may fall a rounding error below the grid's first point
-    hits = surrogate.sample_global(table, V, (0.0, 1.0, 0.0), HALF_SIZE, shape, random_state=seed,
-                                   omega=np.asarray(omega) * speed / HALF_SIZE, method=method,
-                                   clamp=True)
-    V_out, W_out, status = hits.V, hits.Omega, hits.status
-    ok = status == STATUS_REBOUNDED
-    alpha2, beta2, v = rebound_angles(V_out[ok])
-    return np.column_stack([alpha2, beta2, v / speed, W_out[ok] * HALF_SIZE / speed])
-
-
 def spinning_accuracy(table, n: int, seed: int = 1) -> list:
     """At SPINNING_STATES: KS and classifier of ``auto``'s draws and of the table's against the batch direct
     model with that spin."""
@@ -100,7 +82,7 @@ def spinning_accuracy(table, n: int, seed: int = 1) -> list:
     for shape, alpha1, speed, omega in SPINNING_STATES:
         D = direct_states(shape, alpha1, speed, n, seed=seed + 1, omega_in=omega)
         for method in ("auto", "table"):
-            r = compare(global_states(table, shape, alpha1, speed, omega, n, seed, method), D, seed=seed)
+            r = compare(table_hits(table, shape, alpha1, speed, n, seed, omega, method)[:, :6], D, seed=seed)
             records.append({"shape": shape, "alpha1": alpha1, "speed": speed, "omega": omega, "method": method,
                             "classifier_accuracy": r["classifier_accuracy"], "ks_max": max(r["ks"].values())})
             print(f"{shape:<12} {alpha1:5.1f} deg {speed:5.0f} m/s  Omega- a/|V-| {omega}  {method:<6} "

@@ -34,7 +34,7 @@ import numpy as np
 
 from data_schema.common import package_version
 from data_schema.output import check_free_space, check_memory, check_output, remove_stale_temporaries, replace_file
-from data_schema.table import CELL_DATASETS, TABLE_FILE_TYPE, TABLE_VERSION, CellTable, ReboundTable, write_table
+from data_schema.table import TABLE_CELL_DATASETS, TABLE_FILE_TYPE, TABLE_VERSION, CellTable, ReboundTable, write_table
 from direct_model.shapes import second_moment_factors
 from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAULT_SET_TOL     # cells.py's simulate uses these
 from tablegen.tabulation.cells import cell_label, compile_cell_kernels, compute_cell
@@ -149,7 +149,7 @@ class Checkpoint:
 
     def load(self, shape: str, i_alpha: int, i_speed: int) -> CellTable:
         with np.load(self.cell_path(shape, i_alpha, i_speed)) as data:
-            return CellTable(**{name: data[name] for name in CELL_DATASETS})
+            return CellTable(**{name: data[name] for name in TABLE_CELL_DATASETS})
 
     def count(self) -> int:
         """Cells finished so far."""
@@ -315,7 +315,7 @@ def _store(checkpoint, task, cell, bar) -> None:
 def _assemble(config: BuildConfig, checkpoint: Checkpoint) -> ReboundTable:
     shapes = config.resolution.cell_shapes()
     lead = (len(config.shapes), len(config.alpha1_deg), len(config.speed_m_s))
-    cells = {name: np.empty(lead + shapes[name], dtype=CELL_DATASETS[name][0]) for name in CELL_DATASETS}
+    cells = {name: np.empty(lead + shapes[name], dtype=dtype) for name, (dtype, _, _) in TABLE_CELL_DATASETS.items()}
     for s, shape in enumerate(config.shapes):
         for ia in range(lead[1]):
             for iv in range(lead[2]):

@@ -1,8 +1,8 @@
 """From a cell's direct-model samples to its stored representation (docs/format.md).
 
 The representation (:mod:`data_schema.table`) is a mixture of small triangular
-chains. The folded states, each variable divided by its standard deviation,
-are partitioned by mini-batch k-means into C clusters of about
+chains. The folded states and their work on the wall (r, ν: :func:`work_variables`), each variable divided by
+its standard deviation, are partitioned by mini-batch k-means into C clusters of about
 :data:`SAMPLES_PER_CLUSTER` samples. Inside a cluster each chain variable is
 regressed (least squares) on the variables before it, and the residual's
 quantile function is stored at L + 1 probability levels, standardised to
@@ -35,10 +35,10 @@ import numba
 import numpy as np
 
 from data_schema import kernel_cache  # noqa: F401  (keys this module's kernels by their sources)
-from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, SampleSet, rebound_angles
+from data_schema.samples import STATUS_NAMES, STATUS_REBOUNDED, STATUS_TRAPPED, SampleSet, rebound_angles
 from data_schema.table import (
     CHAIN_TO_STATE, FEW_COLLISIONS, INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES, N_CHAIN, N_COLLISION_CLASSES,
-    N_SLOPES,
+    N_SLOPES, N_WORK, N_WORK_SLOPES, WORK_SLOPE_START,
     CellTable, TableResolution, slope_index,
 )
 from tablegen.tabulation.resolution import SAMPLES_PER_CLUSTER
@@ -51,6 +51,7 @@ KMEANS_EPOCHS = 5             # random centres and a few epochs suffice (docs/de
 DICTIONARY_ITERATIONS = 300   # Lloyd iterations of the dictionary's k-means at most (it stops when no label moves)
 PARTITION_KEY, DICTIONARY_KEY = 0, 1    # spawn keys of the partition's and the dictionary's random streams
 SPREAD_TOL = 1e-9             # relative to the variable's scale: below it a cluster has no shape
+WORK_FIELDS = ("wall_work_normal", "wall_work_tangential")    # the samples' W_n, W_t, m²/s²
 
 
 def rebound_states(samples: SampleSet) -> np.ndarray:
@@ -58,6 +59,17 @@ def rebound_states(samples: SampleSet) -> np.ndarray:
     ok = samples.rebounded
     alpha2, beta2, norm = rebound_angles(samples.velocity[ok])
     return np.column_stack([alpha2, beta2, norm / samples.speed, samples.omega[ok]])
+
+
+def work_variables(samples: SampleSet) -> np.ndarray:
+    """(r, ν) of the rebounded particles (data_schema.table.WORK_NAMES): r = E_Ω⁺/E⁻, the rotational energy
+    fraction, and ν = √(W_n/(W_n + W_t)), the root of the normal share of the work on the wall (0 where there is
+    none)."""
+    ok = samples.rebounded
+    work_n, work_t = (np.asarray(samples.extra[name], dtype=np.float64)[ok] for name in WORK_FIELDS)
+    total = work_n + work_t
+    share = np.sqrt(np.divide(work_n, total, out=np.zeros_like(total), where=total > 0.0))
+    return np.column_stack([np.asarray(samples.extra["e_rot_ratio"], dtype=np.float64)[ok], share])
 
 
 def folded_state(state: np.ndarray) -> np.ndarray:
@@ -93,12 +105,16 @@ class CellAccumulator:
     def __init__(self, max_states: int = MAX_STATES):
         self.max_states = max_states
         self.states = []
+        self.works = []
         self.regimes = []
         self.n_states = 0
         self.status_counts = np.zeros(len(STATUS_NAMES), dtype=np.int64)
         self.collision_counts = np.zeros(N_COLLISION_CLASSES, dtype=np.int64)
         self.sums = np.zeros(6)
         self.squares = np.zeros(6)
+        self.work_sums = np.zeros(N_WORK)
+        self.work_squares = np.zeros(N_WORK)
+        self.trapped_work = np.zeros(2)     # Σ W_n/E⁻, Σ W_t/E⁻ over the trapped particles
         self.hist2 = np.zeros(len(INDICATRIX_ALPHA2_EDGES) - 1)
         self.hist3 = np.zeros((len(INDICATRIX_ALPHA2_EDGES) - 1, len(INDICATRIX_BETA2_EDGES) - 1))
 
@@ -109,12 +125,19 @@ class CellAccumulator:
         self.collision_counts += np.bincount(ncoll - 1, minlength=N_COLLISION_CLASSES)
         state = rebound_states(samples)
         _add_moments(state, self.sums, self.squares)
+        work = work_variables(samples)
+        _add_moments(work, self.work_sums, self.work_squares)
+        trapped = samples.status == STATUS_TRAPPED
+        energy = 0.5 * samples.speed ** 2
+        _add_moments(np.column_stack([np.asarray(samples.extra[name], dtype=np.float64)[trapped] / energy
+                                      for name in WORK_FIELDS]), self.trapped_work, np.zeros(2))
         self.hist2 += np.histogram(state[:, 0], bins=INDICATRIX_ALPHA2_EDGES)[0]
         self.hist3 += np.histogram2d(state[:, 0], state[:, 1],
                                      bins=[INDICATRIX_ALPHA2_EDGES, INDICATRIX_BETA2_EDGES])[0]
         keep = min(self.max_states - self.n_states, int(ok.sum()))
         if keep > 0:
             self.states.append(folded_state(state[:keep]))
+            self.works.append(work[:keep])
             self.regimes.append(collision_regime(samples)[:keep])
             self.n_states += keep
 
@@ -128,16 +151,26 @@ class CellAccumulator:
         if self.n_states < SAMPLES_PER_CLUSTER:
             raise ValueError(f"{label}: only {self.n_states} rebounds; a table cell needs at least "
                              f"{SAMPLES_PER_CLUSTER}")
-        mean = self.sums / n
-        std = np.sqrt(np.maximum(self.squares / n - mean ** 2, 0.0))
+        mean, std = _moments(self.sums, self.squares, n)
+        work_mean, work_std = _moments(self.work_sums, self.work_squares, n)
+        n_trapped = int(self.status_counts[STATUS_TRAPPED])
         d_a2 = np.diff(INDICATRIX_ALPHA2_EDGES)
         d_b2 = np.diff(INDICATRIX_BETA2_EDGES)
         return CellTable(
-            **represent(np.concatenate(self.states), np.concatenate(self.regimes), resolution, seed),
+            **represent(np.concatenate(self.states), np.concatenate(self.regimes), resolution, seed,
+                        np.concatenate(self.works)),
+            work_mean=work_mean, work_std=work_std,
+            trapped_work=self.trapped_work / n_trapped if n_trapped else np.zeros(2),
             status_counts=self.status_counts.copy(), collision_counts=self.collision_counts.copy(),
             mean=mean, std=std,
             indicatrix_2d=(self.hist2 / (n * d_a2)).astype(np.float32),
             indicatrix_3d=(self.hist3 / (n * np.outer(d_a2, d_b2))).astype(np.float32))
+
+
+def _moments(sums: np.ndarray, squares: np.ndarray, n: int) -> tuple:
+    """(mean, standard deviation) from running sums of n values and of their squares."""
+    mean = sums / n
+    return mean, np.sqrt(np.maximum(squares / n - mean ** 2, 0.0))
 
 
 def _stream(seed: int, *key: int) -> np.random.Generator:
@@ -458,16 +491,20 @@ def _regime_partition(z: np.ndarray, regime: np.ndarray, clusters: int, seed: in
     return group, np.array(label_regime, dtype=np.uint8)
 
 
-def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolution, seed: int) -> dict:
-    """The stored law (``cluster_*`` and ``shape_dictionary`` arrays) of folded states (n, 6).
+def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolution, seed: int,
+              work: np.ndarray) -> dict:
+    """The stored law (``cluster_*``, ``shape_dictionary`` and ``work_*`` arrays but the work's moments) of folded
+    states (n, 6) and their work variables (n, N_WORK: r, ν, :func:`work_variables`).
 
     ``regime`` (n,) is each state's collision regime (:func:`collision_regime`).
-    Uses at most min(C, n // 25) clusters (at least one per regime present);
-    the remaining rows of the C-row arrays have weight 0 and are never drawn.
+    Uses at most min(C, n // 25) clusters (at least one per regime present), partitioned on the states and
+    their work variables together: the work has edges the state does not show (one collision against two),
+    which a partition on the state alone blurs (docs/design/table_representation.md, "The work on the wall").
+    The work variables continue each cluster's chain after the state's. The remaining rows of the C-row arrays have weight 0 and are never drawn.
     The arrays depend on the seed alone: not on the thread count or the CPU (module doc).
     """
     r = resolution
-    z = np.ascontiguousarray(folded[:, list(CHAIN_TO_STATE)], dtype=np.float64)
+    z = np.ascontiguousarray(np.column_stack([folded[:, list(CHAIN_TO_STATE)], work]), dtype=np.float64)
     n = len(z)
     mean, scale = _column_moments(z)
     group, label_regime = _regime_partition((z - mean) / np.where(scale > 0, scale, 1.0),
@@ -478,18 +515,20 @@ def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolutio
     weight[:G] = counts / n
     cluster_regime = np.zeros(r.clusters, dtype=np.uint8)
     cluster_regime[:G] = label_regime
-    loc = np.zeros((r.clusters, N_CHAIN))
-    scl = np.zeros((r.clusters, N_CHAIN))
-    shape_id = np.zeros((r.clusters, N_CHAIN), dtype=np.uint8)
-    slope = np.zeros((r.clusters, N_SLOPES))
-    dictionary = np.empty((N_CHAIN, r.dictionary_size, r.levels + 1))
+    n_all = N_CHAIN + N_WORK
+    loc = np.zeros((r.clusters, n_all))
+    scl = np.zeros((r.clusters, n_all))
+    shape_id = np.zeros((r.clusters, n_all), dtype=np.uint8)
+    slope = np.zeros((r.clusters, N_SLOPES + N_WORK_SLOPES))
+    dictionary = np.empty((n_all, r.dictionary_size, r.levels + 1))
+    starts = [slope_index(k, 0) for k in range(N_CHAIN)] + [N_SLOPES + w for w in WORK_SLOPE_START]
     by_group = np.argsort(group, kind="stable")
-    for k in range(N_CHAIN):
+    for k in range(n_all):
         residual = z[:, k]
         if k:
             A = np.ascontiguousarray(z[:, :k])
             b = _group_slopes(A, residual, group, counts.astype(np.float64))
-            slope[:G, slope_index(k, 0):slope_index(k, 0) + k] = b
+            slope[:G, starts[k]:starts[k] + k] = b
             residual = _residual(residual, A, b, group)
         q = _group_quantiles(residual, by_group, counts, r.levels)
         loc[:G, k], scl[:G, k] = _row_moments(q)
@@ -499,6 +538,11 @@ def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolutio
         standard = (q[spread] - loc[:G, k, None][spread]) / scl[:G, k, None][spread]
         dictionary[k], shape_id[:G, k][spread] = _dictionary(standard, r.dictionary_size,
                                                              _stream(seed, DICTIONARY_KEY, k))
-    return {"cluster_weight": weight, "cluster_loc": loc.astype(np.float32), "cluster_scale": scl.astype(np.float32),
-            "cluster_shape": shape_id, "cluster_slope": slope.astype(np.float32), "cluster_regime": cluster_regime,
-            "shape_dictionary": dictionary.astype(np.float32)}
+    chain, rest = slice(0, N_CHAIN), slice(N_CHAIN, n_all)
+    return {"cluster_weight": weight, "cluster_loc": loc[:, chain].astype(np.float32),
+            "cluster_scale": scl[:, chain].astype(np.float32), "cluster_shape": shape_id[:, chain],
+            "cluster_slope": slope[:, :N_SLOPES].astype(np.float32), "cluster_regime": cluster_regime,
+            "shape_dictionary": dictionary[chain].astype(np.float32),
+            "work_loc": loc[:, rest].astype(np.float32), "work_scale": scl[:, rest].astype(np.float32),
+            "work_shape": shape_id[:, rest], "work_slope": slope[:, N_SLOPES:].astype(np.float32),
+            "work_dictionary": dictionary[rest].astype(np.float32)}

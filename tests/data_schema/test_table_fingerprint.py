@@ -34,7 +34,8 @@ def test_every_dataset_and_law_attribute_enters(small_table_path, fingerprint, t
         fields = [(f"{group}/parameters", name) for group in ("model", "wall")
                   for name in f[group]["parameters"].dtype.names]
         attributes = [(group, name) for group in ("grid", "resolution", "wall") for name in f[group].attrs]
-    assert len(datasets) == 26 and "shapes/vertices" in datasets and "grid/shape_codes" in datasets
+    assert len(datasets) == 34 and "shapes/vertices" in datasets and "grid/shape_codes" in datasets
+    assert "cells/work_slope" in datasets and "cells/trapped_work" in datasets
     assert len(fields) == 14 and ("model/parameters", "aspect_ratio_sd") in fields and ("wall/parameters", "q") in fields
     assert ("wall/parameters", "speed_range_m_s") in fields
     assert ("wall", "family") in attributes and ("wall", "name") in attributes and ("grid", "particles_per_cell") in attributes

@@ -11,7 +11,7 @@ import pytest
 
 import surrogate
 from data_schema.common import DataFormatError
-from data_schema.table import (CELL_DATASETS, MODEL_FIELDS, TABLE_VERSION, read_table, stored_config,
+from data_schema.table import (CELL_DATASETS, MODEL_FIELDS, TABLE_VERSION, WORK_DATASETS, read_table, stored_config,
                                table_fingerprint)
 from direct_model.wall import WALL_FAMILIES
 from surrogate.cli import main as surrogate_main
@@ -58,9 +58,11 @@ def rebuild_table(tmp_path_factory):
 
 def test_the_layout_of_format_4(small_table_path):
     """/model and /wall hold one compound row each, chunked (1,) under Fletcher-32; grid keeps the grids, the names,
-    their checksummed codes and particles_per_cell, and no law attribute."""
+    their checksummed codes and particles_per_cell, and no law attribute; the cells hold the work datasets of
+    format 4.1."""
     with h5py.File(small_table_path, "r") as f:
-        assert tuple(f.attrs["format_version"]) == TABLE_VERSION == (4, 0)
+        assert tuple(f.attrs["format_version"]) == TABLE_VERSION == (4, 1)
+        assert set(WORK_DATASETS) <= set(f["cells"]) and set(f["cells"]) == set(CELL_DATASETS) | set(WORK_DATASETS)
         assert set(f) == {"grid", "model", "wall", "shapes", "resolution", "cells"}
         assert set(f["grid"]) == {"alpha1_deg", "speed_m_s", "shapes", "shape_codes"}
         assert set(f["grid"].attrs) == {"particles_per_cell"}

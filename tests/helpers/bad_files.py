@@ -39,6 +39,21 @@ def _set(name, index, value):
     return edit
 
 
+# the datasets of the work on the wall (data_schema.table.WORK_DATASETS)
+WORK_DATASETS = ("work_loc", "work_scale", "work_shape", "work_slope", "work_dictionary", "work_mean", "work_std",
+                 "trapped_work")
+
+
+def _drop_cells(*names, version=None):
+    """An edit removing the datasets cells/<name>, and with ``version`` setting the root's format_version."""
+    def edit(f):
+        for name in names:
+            del f["cells"][name]
+        if version is not None:
+            f.attrs["format_version"] = np.array(version, dtype=np.int64)
+    return edit
+
+
 def _attribute(group, name, value):
     def edit(f):
         f[group].attrs[name] = value
@@ -136,6 +151,23 @@ def bad_tables(good, folder) -> list:
                   "cluster_weight"))
     cases.append((edited_copy(good, folder, "negative_indicatrix.h5", _set("cells/indicatrix_3d", (0, 0, 0, 5, 5), -1.0)),
                   ERR_FORMAT, "indicatrix_3d"))
+    # the work on the wall (format 4.1): all of its datasets or none, each within its rules
+    cases.append((edited_copy(good, folder, "partial_work.h5", _drop_cells("trapped_work", "work_std")), ERR_FORMAT,
+                  "inconsistent table: ReboundTable has the work datasets ['work_dictionary', 'work_loc', 'work_mean', "
+                  "'work_scale', 'work_shape', 'work_slope'] but not ['trapped_work', 'work_std']: all or none"))
+    cases.append((edited_copy(good, folder, "no_work.h5", _drop_cells(*WORK_DATASETS, version=(4, 0))), OK, ""))
+    cases.append((edited_copy(good, folder, "work_shape_m.h5", _set("cells/work_shape", (0, 0, 0, 0, 1), 16)), ERR_FORMAT,
+                  "cells/work_shape"))
+    cases.append((edited_copy(good, folder, "negative_work_scale.h5", _set("cells/work_scale", (0, 0, 0, 0, 0), -0.5)),
+                  ERR_FORMAT, "cells/work_scale"))
+    cases.append((edited_copy(good, folder, "trapped_work_above_1.h5", _set("cells/trapped_work", (0, 0, 0, 1), 1.5)),
+                  ERR_FORMAT, "cells/trapped_work"))
+    cases.append((edited_copy(good, folder, "decreasing_work_dictionary.h5",
+                              _set("cells/work_dictionary", (0, 0, 0, 1, 3), np.linspace(1.0, -1.0, 25))),
+                  ERR_FORMAT, "dataset 'cells/work_dictionary' row 19 decreases"))
+    cases.append((edited_copy(good, folder, "work_slope_shape.h5",
+                              lambda f: _replace(f, "cells/work_slope", f["cells/work_slope"][()][..., :12])),
+                  ERR_FORMAT, "cells/work_slope"))
     cases.append((edited_copy(good, folder, "alpha1_grid.h5", lambda f: _replace(f, "grid/alpha1_deg",
                                                                            np.linspace(-30.0, 200.0, f["grid/alpha1_deg"].shape[0]))),
                   ERR_FORMAT, "grid/alpha1_deg"))

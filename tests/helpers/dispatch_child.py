@@ -17,7 +17,7 @@ import numpy as np
 from tests.helpers import python_side as py
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
-                 "restitution_pieces")
+                 "restitution_pieces", "work_rows", "work_dictionary", "work_cells")
 WEIGHTS = {"ellipsoid": 0.1, "prism": 0.2, "cut_prism": 0.3, "tetrahedron": 0.4}
 
 

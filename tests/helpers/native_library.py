@@ -31,7 +31,7 @@ U_PER_DRAW = 13                         # RBS_U_PER_DRAW
 BLOCK = 32                              # RBS_BLOCK
 LOCAL_SIZE = 6                          # RBS_LOCAL_SIZE
 NO_KEY = -1                             # RBS_NO_KEY
-VERSION_NUMBER = 1_003_000              # RBS_VERSION_NUMBER of 1.3.0
+VERSION_NUMBER = 1_004_000              # RBS_VERSION_NUMBER of 1.4.0
 ROUGHNESS_OF_TABLE = -1.0               # RBS_ROUGHNESS_OF_TABLE: rbs_options.roughness_deg's default
 MAX_ROUGHNESS_DEG = 45.0                # RBS_MAX_ROUGHNESS_DEG
 MAX_WALL_HITS = 10                      # RBS_MAX_WALL_HITS
@@ -363,6 +363,8 @@ class NativeTable:
             assert code == INVALID, code
             raise KeyError(name)
         ctype = {DTYPE_FLOAT64: ctypes.c_double, DTYPE_FLOAT32: ctypes.c_float}[dtype.value]
+        if count.value == 0:        # an empty array (a table without the work on the wall): no data to point at
+            return np.empty(0, dtype=np.dtype(ctype))
         array = np.ctypeslib.as_array(ctypes.cast(data, ctypes.POINTER(ctype)), shape=(count.value,))
         return array.copy()
 

@@ -20,7 +20,7 @@ from tests.helpers.native_library import (INTERPOLATION_SCALED, INTERPOLATION_ST
 from tests.helpers.states import incident_states, max_ulp, uniforms
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
-                 "restitution_pieces")
+                 "restitution_pieces", "work_rows", "work_dictionary", "work_cells")
 STATES_PER_CASE = 100_000
 SCALED, STOCHASTIC = INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC
 INTERPOLATIONS = {"scaled": SCALED, "stochastic": STOCHASTIC}
@@ -43,6 +43,7 @@ def test_derived_kernel_arrays_equal_surrogate(table_pair):
         expected, got = np.asarray(getattr(data, name)), native_table.kernel_array(name)
         assert got.dtype == expected.dtype and got.shape == expected.shape, name
         assert np.array_equal(got.view(np.uint8), expected.view(np.uint8)), f"{name} differs"
+    assert data.has_work and data.work_rows.size > 0, "the work arrays compared are empty"
     info = native_table.info()
     assert (info.n_shapes, info.n_alpha1, info.n_speed) == (data.n_shapes, data.n_alpha1, data.n_speed)
     assert (info.n_clusters, info.n_levels, info.n_dictionary, info.n_pieces) == \

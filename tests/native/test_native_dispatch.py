@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from tests.helpers.cpu_dispatch import CASES
+from tests.helpers.dispatch_child import KERNEL_ARRAYS
 from tests.helpers.native_library import INTERPOLATION_SCALED, INTERPOLATION_STOCHASTIC, mix_probes, mix_shapes
 from tests.helpers.states import max_ulp
 
@@ -44,8 +45,7 @@ def test_cases_take_other_code_paths(dispatch_runs):
 def test_derived_arrays_equal_the_c_library(dispatch_runs, table_pair, case):
     _, runs = dispatch_runs
     _, native_table = table_pair
-    for name in ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
-                 "restitution_pieces"):
+    for name in KERNEL_ARRAYS:
         got, expected = runs[case][f"array_{name}"], native_table.kernel_array(name)
         assert got.dtype == expected.dtype and got.shape == expected.shape, (case, name)
         assert np.array_equal(got.view(np.uint8), expected.view(np.uint8)), f"{case}: {name} differs from C"

@@ -60,8 +60,8 @@ def _numba(table, cdf, V, Omega, n, u, method, key, roughness):
 
 
 def _fields(record) -> tuple:
-    """Every field of an rbs_result or a Hit, the floats as bytes (the wall work summed over the facet hits, NaN once
-    the table answered one)."""
+    """Every field of an rbs_result or a Hit, the floats as bytes (the wall work summed over the facet hits, either
+    path's)."""
     return (int(record.status), int(record.path), int(record.shape), int(record.n_collisions), int(record.wall_hits),
             np.array(record.V[:], dtype=np.float64).tobytes(), np.array(record.Omega[:], dtype=np.float64).tobytes(),
             np.array([record.wall_work_normal, record.wall_work_tangential], dtype=np.float64).tobytes())

@@ -26,7 +26,7 @@ from tests.helpers.states import incident_states, max_ulp, uniforms
 from tests.helpers.tables import edited_copy
 
 KERNEL_ARRAYS = ("alpha1_axis", "speed_axis", "cells", "clusters", "dictionary", "speed_restitution",
-                 "restitution_pieces")
+                 "restitution_pieces", "work_rows", "work_dictionary", "work_cells")
 BULK = 5_000          # table-path states per interpolation
 ONE_BY_ONE = 200      # states per method, hit by hit (the direct path runs the model, in numba and in C)
 

@@ -1,11 +1,11 @@
 """Tables rewritten as a hostile user would, with valid checksums: both loaders refuse the same files.
 
-For every dataset a draw reads, one element set out of the range docs/format.md ("What makes a table valid")
-allows, the chunk's Fletcher-32 rewritten by HDF5: surrogate.load and rbs_table_open both refuse the file
-with a message naming the dataset (the known case: a cells/shape_dictionary entry of 1e6 loaded in both and
-gave rebounds faster than they came). An attribute stored with the wrong type is refused by both alike (the
-parameter rows of groups model and wall: tests/native/test_native_format.py). A table whose values are in range
-but absurd loads, and then both runtimes report status 0 only for rebounds that leave the wall no faster than
+For every dataset a draw reads (its work on the wall's too), one element set out of the range docs/format.md
+("What makes a table valid") allows, the chunk's Fletcher-32 rewritten by HDF5: surrogate.load and rbs_table_open
+both refuse the file with a message naming the dataset (the known case: a cells/shape_dictionary entry of 1e6
+loaded in both and gave rebounds faster than they came). An attribute stored with the wrong type is refused by both
+alike (the parameter rows of groups model and wall: tests/native/test_native_format.py). A table whose values are in
+range but absurd loads, and then both runtimes report status 0 only for rebounds that leave the wall no faster than
 they came.
 """
 
@@ -35,6 +35,15 @@ OUT_OF_RANGE = {      # dataset: (element, values outside its allowed range)
     "cells/status_counts": ((0, 0, 0, 0), (-1,)),
     "cells/mean": ((0, 0, 0, 2), (np.nan, np.inf, 2e6)),
     "cells/std": ((0, 0, 0, 2), (np.nan, -1.0, 2e6)),
+    # the work on the wall (format 4.1)
+    "cells/work_loc": ((0, 0, 0, 0, 1), (np.nan, np.inf, -2e6)),
+    "cells/work_scale": ((0, 0, 0, 0, 0), (np.nan, -1.0, 2e6)),
+    "cells/work_shape": ((0, 0, 0, 0, 1), (16, 255)),
+    "cells/work_slope": ((0, 0, 0, 0, 12), (np.nan, -np.inf, 2e6)),
+    "cells/work_dictionary": ((0, 0, 0, 1, 0, 12), (np.nan, 1e6, -5.0)),
+    "cells/work_mean": ((0, 0, 0, 1), (np.nan, 2e6)),
+    "cells/work_std": ((0, 0, 0, 0), (np.nan, -1.0, 2e6)),
+    "cells/trapped_work": ((0, 0, 0, 1), (np.nan, -0.1, 1.5)),
 }
 
 

@@ -226,10 +226,10 @@ def test_grain_key_refuses_what_is_no_64_bit_unsigned_integer(bad):
 
 
 def test_cli_draws_one_grain_over_orientations(small_table_path, small_table, tmp_path, capsys):
-    """surrogate sample --grain-key: on the table path the draws of the key's shape alone, on the direct path
-    those of sample_global with that key for every draw; the grain in the samples' provenance; --mix takes
+    """surrogate sample --grain-key: the draws of sample_global with that key for every draw (on the table path its
+    shape, on the direct path its proportions and hand too); the grain in the samples' provenance; --mix takes
     name=weight pairs as well as four numbers (the same draws)."""
-    from data_schema.samples import angles_to_velocity, read_samples
+    from data_schema.samples import read_samples
     from surrogate.cli import main
     from tests.helpers.cli import run_cli
     key = 7
@@ -249,17 +249,15 @@ def test_cli_draws_one_grain_over_orientations(small_table_path, small_table, tm
         assert outputs[0].velocity.tobytes() == outputs[1].velocity.tobytes()
         samples = outputs[0]
         assert samples.provenance["grain_key"] == key and samples.provenance["grain_shape"] == shape
+        a1 = math.radians(45.0)          # as the command line computes V⁻
+        V = np.tile([100.0 * math.cos(a1), -100.0 * math.sin(a1), 0.0], (500, 1))
+        keyed = surrogate.sample_global(small_table, V, NORMAL, 1.0, MIX, random_state=5, method=method,
+                                        grain_key=np.full(500, key))
+        assert samples.velocity.tobytes() == keyed.V.tobytes()
+        assert np.all(keyed.shape == small_table.shapes.index(shape))
         if method == "table":
-            alone = surrogate.sample_local(small_table, np.full(500, 45.0), 100.0, shape, random_state=5)
-            velocity = angles_to_velocity(alone.alpha2, alone.beta2, 100.0 * alone.speed_ratio)
-            assert samples.velocity.tobytes() == velocity.tobytes()
             assert "grain_ratio_ba" not in samples.provenance
         else:
-            a1 = math.radians(45.0)          # as the command line computes V⁻
-            V = np.tile([100.0 * math.cos(a1), -100.0 * math.sin(a1), 0.0], (500, 1))
-            keyed = surrogate.sample_global(small_table, V, NORMAL, 1.0, MIX, random_state=5, method="direct",
-                                            grain_key=np.full(500, key))
-            assert samples.velocity.tobytes() == keyed.V.tobytes()
             assert samples.provenance["grain_ratio_ba"] == surrogate.grain_of(small_table, [key], MIX).ratio_ba[0]
 
 

@@ -30,8 +30,9 @@ from tests.helpers.tables import written_out_config
 # 2 × 2 grid, two shapes; ~1.5 s to build
 TABLE_CONFIG = written_out_config([40.0, 70.0], [60.0, 120.0], ["prism", "tetrahedron"], seed=20250102)
 # table format 4.0 (the format alone: in the 3.4 layout the same table hashed as before, 1df2f289…bb54a), then the
-# wall's speed_range_m_s (8143ad6f…978d0 without it)
-TABLE_FINGERPRINT = "af2fd8aa671714b329867b164bf0fb05afdaa94b2a54a57ec75c0a5efa28c603"
+# wall's speed_range_m_s (8143ad6f…978d0 without it), then format 4.1 (af2fd8aa…8c603 before): the work on the
+# wall, whose variables the components are partitioned on too, so the rebound's datasets moved with it
+TABLE_FINGERPRINT = "9675742d1216433065cb2a4d36a7f4b47b7cfae59a7bc8e7a6d5c4b46901f714"
 MIX = {"prism": 0.5, "tetrahedron": 0.5}
 
 
@@ -121,16 +122,16 @@ KEY = 4764729254052721200           # GRAINS' last key
 # (40°, 60 m/s), local frame (status, V⁺ in units of |V⁻|, Ω⁺ in units of |V⁻|/a)
 DRAWS = {
     "table": [
-        (0, ("0x1.9f7aec1020319p+2", "0x1.3a85f59802808p+4", "-0x1.a33a254dd38dep+3", "0x1.d1b890c6ef6bap+8",
-             "0x1.21c3470c04f77p+13", "-0x1.c08fdb81adbadp+8")),
-        (0, ("0x1.430fe3e624acep+0", "0x1.8c5f5d7b11da2p+3", "0x1.c97da67250890p+4", "0x1.0dc9f346f5518p+15",
-             "0x1.a0ad12b9b4c19p+13", "-0x1.2b8d94e9039d9p+12")),
+        (0, ("0x1.6d4aff1abd552p+2", "0x1.5beaf5245542ep+4", "-0x1.8903554fe0139p+3", "0x1.18e49f89b41d0p+9",
+             "0x1.5d33825df68a6p+13", "0x1.41bf7eac8b893p+10")),
+        (0, ("-0x1.ffa5560a2b5cep+1", "0x1.3eb58cccdffcep+3", "0x1.934589d455f3bp+4", "0x1.f65f14f3279c3p+14",
+             "0x1.8da163feb5b52p+13", "-0x1.bd61b726c190ap+7")),
     ],
     "node": [
-        (0, ("0x1.969c2a5060df8p-2", "0x1.666125626205ap-2", "-0x1.0d972098fefc8p-2", "0x1.3b17c42e5c61cp-7",
-             "0x1.ed0be25d8bfeep-3", "-0x1.1aa223a5a945ep-4")),
-        (0, ("0x1.8e58d3966c980p-2", "0x1.cc553cf48f8c8p-3", "0x1.70d3a99f48d7bp-2", "0x1.bb72e129e3c19p-2",
-             "0x1.095db038aab48p-2", "-0x1.12c1f934972bep-1")),
+        (0, ("0x1.8f9b08018b510p-2", "0x1.6a145854b4c90p-2", "-0x1.0eeffe7a3b327p-2", "0x1.8218c451dd1dap-9",
+             "0x1.094166469036dp-2", "-0x1.09b43ff0a6dd6p-4")),
+        (0, ("0x1.271f2db4e7c84p-2", "0x1.b4396962bb71dp-3", "0x1.7f1187eb1835ap-2", "0x1.c4ddf008b4295p-2",
+             "0x1.fa7915705289bp-3", "-0x1.bd17ce49713b6p-2")),
     ],
     "direct": [
         (0, ("0x1.50bff2003dd58p+4", "0x1.92e8e97163a38p+3", "0x1.85d0d1f0f5977p+4", "0x1.0e0bba219f044p+15",
@@ -145,47 +146,57 @@ DRAWS = {
              "-0x1.872c758b6102cp+13", "0x1.1dcef846d6451p+9")),
     ],
     "keyed_table": [
-        (0, ("0x1.7e3186b3dc464p+4", "0x1.92fd203e5f089p+3", "0x1.d089b39df6994p+0", "-0x1.ad8e1ae021d9dp+9",
-             "-0x1.c305710bfbb7dp+12", "0x1.c7e74fefa9295p+11")),
-        (0, ("0x1.430fe3e624acep+0", "0x1.8c5f5d7b11da2p+3", "0x1.c97da67250890p+4", "0x1.0dc9f346f5518p+15",
-             "0x1.a0ad12b9b4c19p+13", "-0x1.2b8d94e9039d9p+12")),
+        (0, ("0x1.834cc2407c8a9p+4", "0x1.9078a20e74150p+3", "0x1.0498fcf20b221p+1", "-0x1.162c7b5729a45p+11",
+             "-0x1.c14e2106c6e8cp+12", "0x1.2bce2503f47e3p+11")),
+        (0, ("-0x1.ffa5560a2b5cep+1", "0x1.3eb58cccdffcep+3", "0x1.934589d455f3bp+4", "0x1.f65f14f3279c3p+14",
+             "0x1.8da163feb5b52p+13", "-0x1.bd61b726c190ap+7")),
     ],
 }
 
 
+# per path with a hit record: (W_n, W_t) in m²/s² for each row of U, the work on the wall of the draws above
+WORK = {
+    "table": [("0x1.8fbe70c77eaf8p+10", "0x1.1080e22b4d244p+10"), ("0x1.9f044008d8092p+10", "0x1.bec8427d4a404p+9")],
+    "direct": [("0x1.e963a9f10cb8ep+10", "0x1.4df3b9fc7d525p+5"), ("0x1.12096f2d7071cp+11", "0x1.ff2f769f15ff5p+5")],
+    "keyed_table": [("0x1.05e5c191d648fp+11", "0x1.34987278ab7d6p+9"),
+                    ("0x1.a5156e6e0f286p+10", "0x1.b1de6d9e6e681p+9")],
+}
+
+
 def _draw(table, path, u):
-    """(status, the six output numbers) of one draw along ``path`` (DRAWS' keys)."""
+    """(status, the six output numbers) of one draw along ``path`` (DRAWS' keys), and its work on the wall (W_n,
+    W_t) where it has a hit record (None at the node)."""
     cdf = surrogate.mix_cdf(table, MIX)
     zero = (0.0, 0.0, 0.0)
     if path == "node":
         status, *values = draw_velocity(table.kernel_data, cdf, 40.0, 60.0, u, True)
-        return status, tuple(values)
+        return status, tuple(values), None
     if path == "table":
         hit = table_rebound(table.kernel_data, cdf, V_IN, NORMAL, A, u, True)
-        status, v, w = hit.status, hit.V, hit.Omega
     elif path == "direct":          # the prism (the direct model's shape 1), u[1..7] as in rebound
         hit = direct_rebound(table.direct_parameters, table.shape_arrays, 1, V_IN, zero, NORMAL, A, u[1:8])
-        status, v, w = hit.status, hit.V, hit.Omega
     else:
         method = METHOD_DIRECT if path == "keyed_direct" else METHOD_TABLE
         hit = rebound(table.kernel_data, table.direct_parameters, table.shape_arrays, table.model_shapes, cdf,
                       V_IN, zero, NORMAL, A, u, method, True, KEY)
-        status, v, w = hit.status, hit.V, hit.Omega
-    return status, tuple(v) + tuple(w)
+    return hit.status, tuple(hit.V) + tuple(hit.Omega), (hit.wall_work_normal, hit.wall_work_tangential)
 
 
 @pytest.mark.parametrize("path", list(DRAWS))
 def test_draws_at_fixed_uniforms_known_values(table, path):
     """Draws of the table path (between grid points in α1 and |V⁻|, and at a grid point), of the direct path,
-    and of a grain key on either path, at the fixed uniforms U, every bit.
+    and of a grain key on either path, at the fixed uniforms U, every bit; their work on the wall too.
 
     Update the literals only for a deliberate change of the model (the direct model; the table's
     representation, its build or its draw: locate, gather, arithmetic), of the key derivation or of the
     format, and say so in the change; never to make the test pass after an unexplained change (find the first
     stage that moved). The failure message gives the new values as hex."""
-    for u, (status, values) in zip(U, DRAWS[path]):
-        got = _draw(table, path, u)
+    for k, (u, (status, values)) in enumerate(zip(U, DRAWS[path])):
+        *got, work = _draw(table, path, u)
+        got = tuple(got)
         assert got == (status, _hex(values)), (path, u, got[0], [x.hex() for x in got[1]])
+        if path in WORK:
+            assert work == _hex(WORK[path][k]), (path, u, [float(x).hex() for x in work])
 
 
 def test_a_grain_s_shape_and_proportions_are_independent(small_table):

@@ -9,7 +9,8 @@ import pytest
 import surrogate
 from data_schema.samples import STATUS_REBOUNDED, STATUS_TRAPPED
 from surrogate.kernels.layout import (CELL_MEAN, CELL_SD, CELL_SIZE, ROW_LOC, ROW_SCALE, ROW_SHAPE, ROW_SLOPE,
-                                      alias_table)
+                                      WORK_CELL_MEAN, WORK_CELL_SD, WORK_CELL_SIZE, WORK_CELL_TRAPPED, WORK_ROW_LOC,
+                                      WORK_ROW_SCALE, WORK_ROW_SHAPE, WORK_ROW_SIZE, WORK_ROW_SLOPE, alias_table)
 
 
 def test_runtime_does_not_import_tablegen():
@@ -27,7 +28,7 @@ def test_loaded_table_is_immutable(small_table):
     with pytest.raises(ValueError):
         small_table.kernel_data.rows()[0, 0, 0, 0, 0] = 1.0
     arrays = [a for a in small_table.kernel_data if isinstance(a, np.ndarray)]
-    assert len(arrays) == 7 and all(a.flags.c_contiguous and not a.flags.writeable for a in arrays)
+    assert len(arrays) == 10 and all(a.flags.c_contiguous and not a.flags.writeable for a in arrays)
 
 
 def test_kernel_arrays_hold_the_file_s_law(small_table_path, small_table):
@@ -50,6 +51,17 @@ def test_kernel_arrays_hold_the_file_s_law(small_table_path, small_table):
     np.testing.assert_allclose(data.p_trapped() * (counts[..., STATUS_REBOUNDED] + counts[..., STATUS_TRAPPED]),
                                counts[..., STATUS_TRAPPED], rtol=1e-12)
     assert data.dictionary.ctypes.data % 64 == 0 and data.clusters.ctypes.data % 64 == 0
+    # the work on the wall: each component's two work variables, their dictionary level-major, each cell's moments
+    # and the trapped particles' mean work
+    work = data.work_rows.reshape(data.cell_shape() + (data.n_clusters, WORK_ROW_SIZE))
+    for at, name in ((WORK_ROW_LOC, "work_loc"), (WORK_ROW_SCALE, "work_scale"), (WORK_ROW_SHAPE, "work_shape")):
+        np.testing.assert_array_equal(work[..., at:at + 2], cells[name])
+    np.testing.assert_array_equal(work[..., WORK_ROW_SLOPE:WORK_ROW_SLOPE + 13], cells["work_slope"])
+    np.testing.assert_array_equal(data.work_dictionary.reshape(data.cell_shape() + (2, data.n_levels, -1)),
+                                  np.swapaxes(cells["work_dictionary"], -1, -2))
+    records = data.work_cells.reshape(data.cell_shape() + (WORK_CELL_SIZE,))
+    for at, name in ((WORK_CELL_MEAN, "work_mean"), (WORK_CELL_SD, "work_std"), (WORK_CELL_TRAPPED, "trapped_work")):
+        np.testing.assert_array_equal(records[..., at:at + 2], cells[name])
 
 
 def test_a_tabulated_wall_law_is_stored_read_and_drawn_from(tabulated_table_path, tmp_path):

@@ -31,7 +31,7 @@ import numpy as np
 from data_schema.table import TableResolution
 from tablegen.tabulation.tabulate import represent
 saved = np.load(sys.argv[1])
-cell = represent(saved["folded"], saved["regime"], TableResolution(200, 16, 24), 20261121)
+cell = represent(saved["folded"], saved["regime"], TableResolution(200, 16, 24), 20261121, saved["work"])
 print(hashlib.sha256(b"".join(np.ascontiguousarray(cell[k]).tobytes() for k in sorted(cell))).hexdigest())
 """
 
@@ -72,9 +72,10 @@ def test_representation_bits_do_not_depend_on_numbas_target(tmp_path):
     rng = np.random.default_rng(5)
     folded = np.abs(rng.standard_normal((20_000, 6))) * np.array([1.0, 0.5, 0.3, 2.0, 2.0, 2.0])
     regime = (rng.random(20_000) < 0.2).astype(np.uint8)
+    work = np.column_stack([0.1 * folded[:, 2] ** 2 * rng.random(20_000), rng.random(20_000)])   # r, φ
     states = tmp_path / "states.npz"
-    np.savez(states, folded=folded, regime=regime)
-    cell = represent(folded, regime, TableResolution(200, 16, 24), 20261121)
+    np.savez(states, folded=folded, regime=regime, work=work)
+    cell = represent(folded, regime, TableResolution(200, 16, 24), 20261121, work)
     here = hashlib.sha256(b"".join(np.ascontiguousarray(cell[k]).tobytes() for k in sorted(cell))).hexdigest()
     env = environment("baseline", generic_numba=True)
     assert code_paths(env)["numba"] == "generic"

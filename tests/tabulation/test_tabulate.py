@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from data_schema.table import CHAIN_TO_STATE, N_CHAIN, TableResolution, slope_index
+from data_schema.table import CHAIN_TO_STATE, N_CHAIN, N_SLOPES, N_WORK, WORK_SLOPE_START, TableResolution, slope_index
 from tablegen.tabulation.resolution import resolution_for
 from tablegen.tabulation.tabulate import _regime_partition, regime_clusters, represent
 
@@ -12,10 +12,15 @@ N = 40_000
 
 
 def _folded(chain: np.ndarray) -> np.ndarray:
-    """Folded-state columns (α2, |β2|, s, Ω_x, Ω_y, Ω_z) from chain-order columns."""
-    folded = np.empty_like(chain)
-    folded[:, list(CHAIN_TO_STATE)] = chain
+    """Folded-state columns (α2, |β2|, s, Ω_x, Ω_y, Ω_z) from chain-order columns (the work's left out)."""
+    folded = np.empty((len(chain), N_CHAIN))
+    folded[:, list(CHAIN_TO_STATE)] = chain[:, :N_CHAIN]
     return folded
+
+
+def _work(chain: np.ndarray) -> np.ndarray:
+    """The work variables' columns of a chain (those after the state's)."""
+    return chain[:, N_CHAIN:]
 
 
 def _one_regime(x):
@@ -23,17 +28,19 @@ def _one_regime(x):
 
 
 def _linear_chain(n, seed):
-    """x0 uniform on [1, 2]; x_k = 0.5 x_{k−1} + 0.1 ε_k, ε_k standard normal (k ≥ 1)."""
+    """x0 uniform on [1, 2]; x_k = 0.5 x_{k−1} + 0.1 ε_k, ε_k standard normal (k ≥ 1): the six state
+    variables, then the two work variables."""
     rng = np.random.default_rng(seed)
-    x = np.empty((n, N_CHAIN))
+    x = np.empty((n, N_CHAIN + N_WORK))
     x[:, 0] = 1.0 + rng.random(n)
-    for k in range(1, N_CHAIN):
+    for k in range(1, N_CHAIN + N_WORK):
         x[:, k] = 0.5 * x[:, k - 1] + 0.1 * rng.standard_normal(n)
     return x
 
 
 def test_one_cluster_recovers_the_slopes_and_residual_shapes():
-    """With a single component the chain is ordinary least squares plus residual quantiles.
+    """With a single component the chain is ordinary least squares plus residual quantiles, the work variables'
+    (which continue it) as the state's.
 
     Slopes are fitted jointly on x_0..x_{k−1}, so the standard error of the
     slope on x_j is σ_ε/(sd(x_j | other regressors) √N). Given its neighbours
@@ -44,12 +51,13 @@ def test_one_cluster_recovers_the_slopes_and_residual_shapes():
     """
     x = _linear_chain(N, seed=1)
     cell = represent(_folded(x), _one_regime(x), TableResolution(clusters=1, dictionary_size=1, levels=24),
-                     seed=0)
-    slope = cell["cluster_slope"][0]
-    for k in range(1, N_CHAIN):
+                     seed=0, work=_work(x))
+    slope = np.concatenate([cell["cluster_slope"][0], cell["work_slope"][0]])
+    starts = [slope_index(k, 0) for k in range(N_CHAIN)] + [N_SLOPES + w for w in WORK_SLOPE_START]
+    for k in range(1, N_CHAIN + N_WORK):
         for j in range(k):
             expected = 0.5 if j == k - 1 else 0.0
-            assert abs(slope[slope_index(k, j)] - expected) < 5 * 0.0056, (k, j)
+            assert abs(slope[starts[k] + j] - expected) < 5 * 0.0056, (k, j)
     assert cell["cluster_weight"][0] == 1.0
     p = np.arange(1, 24) / 24
     # variable 0 is uniform: its standardised quantile function is linear in p
@@ -59,8 +67,10 @@ def test_one_cluster_recovers_the_slopes_and_residual_shapes():
     # the normal quantiles z_p with slope σ_ε = 0.1 (a sample quantile's SE is at most
     # √(p(1−p)/N)/φ(z_p) · σ = 0.001 here; allow 3 % on σ and 0.005 off the line)
     z = stats.norm.ppf(p)
-    for k in range(1, N_CHAIN):
-        knots = cell["cluster_loc"][0, k] + cell["cluster_scale"][0, k] * cell["shape_dictionary"][k, 0, 1:-1]
+    loc, scale = (np.concatenate([cell["cluster_" + name][0], cell["work_" + name][0]]) for name in ("loc", "scale"))
+    dictionary = np.concatenate([cell["shape_dictionary"], cell["work_dictionary"]])
+    for k in range(1, N_CHAIN + N_WORK):
+        knots = loc[k] + scale[k] * dictionary[k, 0, 1:-1]
         sigma, intercept = np.polyfit(z, knots, 1)
         assert abs(sigma - 0.1) < 0.003, k
         assert np.max(np.abs(knots - (intercept + sigma * z))) < 0.005, k
@@ -70,7 +80,7 @@ def test_clusters_follow_the_number_of_samples():
     """min(C, n // 25) components are used, weighted by their sample counts; the rest have weight 0."""
     x = _linear_chain(2_000, seed=2)
     cell = represent(_folded(x), _one_regime(x), TableResolution(clusters=500, dictionary_size=16, levels=24),
-                     seed=0)
+                     seed=0, work=_work(x))
     w = cell["cluster_weight"]
     used = np.count_nonzero(w)
     assert 0.8 * 80 <= used <= 80 and np.all(w[used:] == 0)
@@ -79,10 +89,11 @@ def test_clusters_follow_the_number_of_samples():
 
 
 def test_same_seed_same_arrays_and_the_seed_matters():
-    x = _folded(_linear_chain(5_000, seed=3))
+    chain = _linear_chain(5_000, seed=3)
+    x = _folded(chain)
     r = resolution_for(5_000)
     regime = (x[:, 0] > 1.5).astype(np.uint8)
-    a, b, c = (represent(x, regime, r, seed) for seed in (5, 5, 6))
+    a, b, c = (represent(x, regime, r, seed, _work(chain)) for seed in (5, 5, 6))
     for name in a:
         assert a[name].tobytes() == b[name].tobytes(), name
     assert any(a[name].tobytes() != c[name].tobytes() for name in a)
@@ -96,7 +107,8 @@ def test_each_collision_regime_gets_its_own_clusters():
     """
     x = _linear_chain(10_000, seed=4)
     regime = (x[:, 0] > 1.7).astype(np.uint8)
-    cell = represent(_folded(x), regime, TableResolution(clusters=200, dictionary_size=16, levels=24), seed=0)
+    cell = represent(_folded(x), regime, TableResolution(clusters=200, dictionary_size=16, levels=24), seed=0,
+                     work=_work(x))
     w, reg = cell["cluster_weight"], cell["cluster_regime"]
     for r in (0, 1):
         assert w[(reg == r) & (w > 0)].sum() == pytest.approx(np.mean(regime == r), rel=1e-12)
@@ -104,7 +116,7 @@ def test_each_collision_regime_gets_its_own_clusters():
     n1 = int(regime.sum())
     assert 0.8 * 140 <= share[0] <= 140 and 0.8 * 60 <= share[1] <= 60, (share, n1)
     # the partition itself: every state's cluster is of the state's regime
-    group, label_regime = _regime_partition(x, regime.astype(np.int64), 200, seed=0)
+    group, label_regime = _regime_partition(_folded(x), regime.astype(np.int64), 200, seed=0)
     assert np.array_equal(label_regime[group], regime)
     assert np.array_equal(np.unique(group), np.arange(len(label_regime)))
 
@@ -118,7 +130,8 @@ def test_clusters_of_one_value_get_scale_zero_and_leave_the_dictionary_standard(
     x[:3] = x[0]                                            # three identical states ...
     regime = np.zeros(len(x), dtype=np.uint8)
     regime[:3] = 1                                          # ... alone in regime 1
-    cell = represent(_folded(x), regime, TableResolution(clusters=80, dictionary_size=16, levels=24), seed=0)
+    cell = represent(_folded(x), regime, TableResolution(clusters=80, dictionary_size=16, levels=24), seed=0,
+                     work=_work(x))
     one = np.flatnonzero((cell["cluster_regime"] == 1) & (cell["cluster_weight"] > 0))
     assert len(one) == 1 and np.all(cell["cluster_scale"][one[0]] == 0.0)
     assert np.all(cell["cluster_scale"][:, 5] == 0.0)

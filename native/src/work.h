@@ -1,0 +1,117 @@
+/*
+ * work.h: the work of a table draw on the wall (surrogate.kernels.work: work_key, _work_quantile, _root_share,
+ * work_variables, trapped_work, table_work and drawn_work; docs/model.md §4.7): W_n and W_t, m²/s² per unit particle
+ * mass, drawn jointly with the rebound of the table path (table_path.c).
+ *
+ * A table of format 4.1 continues each component's chain with two work variables, the rotational energy fraction
+ * r = E_Ω⁺/E⁻ and the root of the normal share ν = √(W_n/(W_n + W_t)): each its residual quantile plus slopes on
+ * the draw's chain variables (and r). The work is what the drawn rebound's energy leaves, W = E⁻ (1 − s² − r),
+ * W_n = ν² W, W_t = (1 − ν)(1 + ν) W; between grid points r and ν move with the draw. Their two residual uniforms are keyed uniforms of the hit's
+ * work key, so the work takes nothing of the caller's stream. Same operations, same order, fma() where numba fuses.
+ *
+ * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
+ */
+#ifndef RBS_WORK_H
+#define RBS_WORK_H
+
+#include "arithmetic.h"
+#include "gather.h"
+#include "locate.h"
+#include "rng_internal.h"
+
+#define RBS_WORK_DOMAIN 0xBB67AE8584CAA73Bull     /* the work keys' start (surrogate.kernels.work._WORK_DOMAIN) */
+
+/* loc + scale · S(u) of work variable w of the component whose work row is at `row` of t->work_rows, in cell number
+ * `cell` (as rbs_quantile, from the work's own dictionary) */
+RBS_INLINE double rbs_work_quantile(const rbs_table *t, int64_t cell, int64_t row, int w, double u)
+{
+    const float *r = t->work_rows;
+    int64_t levels = t->n_levels - 1;
+    double x = u * (double)levels;
+    int64_t i = rbs_clamp_index(rbs_trunc(x), levels - 1);
+    int64_t at = ((cell * N_WORK + w) * t->n_levels + i) * t->n_dictionary + (int64_t)r[row + WORK_ROW_SHAPE + w];
+    double lo = (double)t->work_dictionary[at], hi = (double)t->work_dictionary[at + t->n_dictionary];
+    return fma((double)r[row + WORK_ROW_SCALE + w], fma(x - (double)i, hi - lo, lo),
+               (double)r[row + WORK_ROW_LOC + w]);
+}
+
+/* ν reflected into [0, 1] (the chain's linear shifts can step outside by a hair) */
+RBS_INLINE double rbs_root_share(double nu)
+{
+    nu = fabs(nu);
+    return nu > 1.0 ? 2.0 - nu : nu;
+}
+
+/* (r, ν) of the component at offset `row` of t->clusters in cell number `cell`, given the draw's chain variables x
+ * (chain order) and its work key: the residual quantiles plus the slopes on x (and r), folded (r >= 0, ν in [0, 1]) */
+RBS_INLINE void rbs_work_variables(const rbs_table *t, int64_t cell, int64_t row, const double x[N_CHAIN],
+                                   int64_t key, double *r_out, double *nu_out)
+{
+    const float *rows = t->work_rows;
+    int64_t at = row / ROW_SIZE * WORK_ROW_SIZE;       /* the component's work row */
+    double r = rbs_work_quantile(t, cell, at, 0, rbs_grain_uniform((uint64_t)key, 0));
+    double nu = rbs_work_quantile(t, cell, at, 1, rbs_grain_uniform((uint64_t)key, 1));
+    for (int j = 0; j < N_CHAIN; j++) {
+        r = fma((double)rows[at + WORK_ROW_SLOPE + j], x[j], r);
+        nu = fma((double)rows[at + WORK_ROW_SLOPE + N_CHAIN + j], x[j], nu);
+    }
+    nu = fma((double)rows[at + WORK_ROW_SLOPE + 2 * N_CHAIN], r, nu);
+    *r_out = fabs(r);
+    *nu_out = rbs_root_share(nu);
+}
+
+/* (W_n, W_t), m²/s², of a trapped draw in cell number `drawn` at |V⁻| = speed m/s: its cell's trapped particles'
+ * mean */
+RBS_INLINE void rbs_trapped_work(const rbs_table *t, int64_t drawn, double speed, double work[2])
+{
+    int64_t at = drawn * WORK_CELL_SIZE + WORK_CELL_TRAPPED;
+    double energy = 0.5 * speed * speed;
+    work[0] = energy * t->work_cells[at];
+    work[1] = energy * t->work_cells[at + 1];
+}
+
+/* (W_n, W_t), m²/s², into work, of the draw in `cell` with uniforms u that returned `status` (rbs_draw_in_cell) and
+ * the local V⁺ x[0..2] (units of |V⁻|), at sin α1 and |V⁻| = speed m/s; NaN for a table without the work or a draw
+ * neither rebounded nor trapped. A rebound's component and chain are read again (they are in cache). */
+RBS_INLINE void rbs_table_work(const rbs_table *t, const rbs_cell *cell, int status, const double x[3],
+                               double sin_alpha1, double speed, const double *u, int scaled, double work[2])
+{
+    work[0] = work[1] = NAN;
+    if (!t->has_work || (status != RBS_OK && status != RBS_TRAPPED))
+        return;
+    if (status == RBS_TRAPPED) {
+        rbs_trapped_work(t, cell->drawn, speed, work);
+        return;
+    }
+    const float *c = t->clusters;
+    int64_t row = rbs_component(t, cell->drawn, u[4]);
+    double q[6], b[15], state[6], r, nu;
+    rbs_quantiles(t, cell->drawn, row, u, q);
+    for (int k = 0; k < 15; k++) b[k] = (double)c[row + ROW_SLOPE + k];
+    rbs_chain(q, b, state);
+    const double chain[N_CHAIN] = {state[0], state[1], state[2], state[5], state[3], state[4]};
+    rbs_work_variables(t, cell->drawn, row, chain, rbs_hit_key(u, RBS_U_PER_DRAW, RBS_WORK_DOMAIN), &r, &nu);
+    if (scaled && cell->wa > 0.0) {
+        int64_t lo = cell->below * WORK_CELL_SIZE, hi = (cell->below + t->n_speed) * WORK_CELL_SIZE;
+        int64_t here = cell->drawn * WORK_CELL_SIZE;
+        rbs_term r_term = rbs_moved_term(t->work_cells, lo, hi, here, cell->wa, WORK_CELL_MEAN, WORK_CELL_SD,
+                                         WORK_CELL_INV_SD);
+        rbs_term nu_term = rbs_moved_term(t->work_cells, lo + 1, hi + 1, here + 1, cell->wa, WORK_CELL_MEAN,
+                                           WORK_CELL_SD, WORK_CELL_INV_SD);
+        r = fabs(rbs_shifted(r, r_term));
+        nu = rbs_root_share(rbs_shifted(nu, nu_term));
+    }
+    if (scaled && cell->wv > 0.0) {
+        /* the spin of a regime-0 draw scales by g, so r by g² */
+        double f_target, f_grid, f, g;
+        rbs_restitution_factors(t, cell->jv, cell->wv, cell->iv, &f_target, &f_grid);
+        rbs_speed_factors((double)c[row + ROW_REGIME], f_target, f_grid, sin_alpha1, &f, &g);
+        r *= g * g;
+    }
+    double left = 1.0 - rbs_speed_ratio_squared(x) - r;
+    double total = left > 0.0 ? 0.5 * speed * speed * left : 0.0;
+    work[0] = total * (nu * nu);
+    work[1] = total * ((1.0 - nu) * (1.0 + nu));
+}
+
+#endif /* RBS_WORK_H */

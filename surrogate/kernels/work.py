@@ -1,0 +1,151 @@
+"""The work of a table draw on the wall (docs/model.md §4.7; docs/design/table_representation.md, "The work on
+the wall"): W_n and W_t, m²/s² per unit particle mass, jointly with the rebound the table path drew.
+
+A table of format 4.1 continues each component's chain with two work variables (data_schema.table.WORK_NAMES):
+the rotational energy fraction r = E_Ω⁺/E⁻ and the root of the normal share ν = √(W_n/(W_n + W_t)), each its
+residual quantile plus slopes on the chain variables of the draw (and r). The work is then what the drawn
+rebound's energy leaves, W = W_n + W_t = E⁻ (1 − s² − r) with E⁻ = |V⁻|²/2 (tables are built with Ω⁻ = 0) and
+s = |V⁺|/|V⁻| of the rebound returned, so energy is conserved draw by draw whatever the move between grid
+points; W_n = ν² W, W_t = (1 − ν)(1 + ν) W. The root, because near grazing incidence W_n is a thousandth of W and
+follows the normal velocity: its root is nearly linear in the state, as the chain needs. Between grid points r
+and ν move with the draw: in α1 to their interpolated means and standard deviations, like the
+state; in |V⁻| the spin of a regime-0 draw scales by g (:func:`surrogate.kernels.arithmetic.speed_factors`),
+so r by g². A trapped draw does its cell's trapped particles' mean work.
+
+Random numbers: the two residual uniforms are keyed uniforms (:func:`surrogate.kernels.rng.grain_uniform`) of a
+hash of the hit's own uniforms (:func:`work_key`), so the work takes nothing of the caller's stream: a rebound
+is the same bits with or without it.
+"""
+
+import numba
+import numpy as np
+
+from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
+from data_schema.table import N_CHAIN, N_WORK
+from direct_model.elementary import fma
+from surrogate.kernels.arithmetic import OUT_S2, OUT_STATUS, _chain, speed_factors, speed_ratio_squared
+from surrogate.kernels.block import field, uniforms
+from surrogate.kernels.draw import U_PER_DRAW
+from surrogate.kernels.fastmath import clamp_index
+from surrogate.kernels.frame import FRAME_SIN, FRAME_SPEED, is_valid
+from surrogate.kernels.gather import gather, gathered_at, moved_term
+from surrogate.kernels.layout import (WORK_CELL_INV_SD, WORK_CELL_MEAN, WORK_CELL_SD, WORK_CELL_SIZE,
+                                      WORK_CELL_TRAPPED, WORK_ROW_LOC, WORK_ROW_SCALE, WORK_ROW_SHAPE, WORK_ROW_SIZE,
+                                      WORK_ROW_SLOPE, ROW_SIZE)
+from surrogate.kernels.locate import I_ROW, cell_at, component
+from surrogate.kernels.memory import load
+from surrogate.kernels.options import JIT, KERNEL
+from surrogate.kernels.rng import grain_uniform, hit_key
+
+_WORK_DOMAIN = np.uint64(0xBB67AE8584CAA73B)    # the work keys' start: unrelated to the facet keys'
+
+
+@numba.njit(inline="always", **JIT)
+def work_key(u):
+    """The work key of a hit of uniforms ``u`` (its U_PER_DRAW): :func:`surrogate.kernels.rng.hit_key` from
+    _WORK_DOMAIN."""
+    return hit_key(u, U_PER_DRAW, _WORK_DOMAIN)
+
+
+@numba.njit(inline="always", **JIT)
+def _work_quantile(data, cell, row, w, u):
+    """loc + scale · S(u) of work variable w in the component at offset ``row`` of ``data.work_rows`` in cell
+    number ``cell`` (as :func:`surrogate.kernels.gather._quantile`, from the work's own dictionary)."""
+    r = data.work_rows
+    levels = data.n_levels - 1
+    t = u * levels
+    i = clamp_index(int(t), levels - 1)
+    at = ((cell * N_WORK + w) * data.n_levels + i) * data.n_dictionary + int(load(r, row + WORK_ROW_SHAPE + w))
+    lo = np.float64(load(data.work_dictionary, at))
+    hi = np.float64(load(data.work_dictionary, at + data.n_dictionary))
+    return fma(np.float64(load(r, row + WORK_ROW_SCALE + w)), fma(t - i, hi - lo, lo),
+               np.float64(load(r, row + WORK_ROW_LOC + w)))
+
+
+@numba.njit(inline="always", **JIT)
+def _root_share(nu):
+    """ν reflected into [0, 1] (the chain's linear shifts can step outside by a hair, as the state's)."""
+    nu = abs(nu)
+    return 2.0 - nu if nu > 1.0 else nu
+
+
+@numba.njit(inline="always", **JIT)
+def work_variables(data, cell, row, x, key):
+    """(r, ν) of the component at offset ``row`` of ``data.clusters`` in cell number ``cell``, given the draw's
+    chain variables x (chain order) and its work key: each work variable's residual quantile plus its slopes on
+    x (and r), folded (r ≥ 0, ν in [0, 1])."""
+    rows, at = data.work_rows, row // ROW_SIZE * WORK_ROW_SIZE     # the component's work row
+    r = _work_quantile(data, cell, at, 0, grain_uniform(key, 0))
+    nu = _work_quantile(data, cell, at, 1, grain_uniform(key, 1))
+    for j in range(N_CHAIN):
+        r = fma(np.float64(load(rows, at + WORK_ROW_SLOPE + j)), x[j], r)
+        nu = fma(np.float64(load(rows, at + WORK_ROW_SLOPE + N_CHAIN + j)), x[j], nu)
+    nu = fma(np.float64(load(rows, at + WORK_ROW_SLOPE + 2 * N_CHAIN)), r, nu)
+    return abs(r), _root_share(nu)
+
+
+@numba.njit(inline="always", **JIT)
+def drawn_work(data, cell, row, gathered, status, s2, sin_alpha1, speed, key, scaled):
+    """(W_n, W_t), m²/s², of a table draw in ``cell`` (:func:`surrogate.kernels.locate.locate`) from the component
+    at offset ``row`` of ``data.clusters`` with the ``gathered`` values (:func:`surrogate.kernels.gather.gather`),
+    that returned ``status`` and s² = |V⁺|²/|V⁻|² ``s2``, at sin α1 and |V⁻| = ``speed`` m/s, with its work key
+    (module doc); NaN for a table without the work or a draw neither rebounded nor trapped. ``row`` and
+    ``gathered`` are read for a rebound only."""
+    if not data.has_work or (status != STATUS_REBOUNDED and status != STATUS_TRAPPED):
+        return np.nan, np.nan
+    drawn, below, wa, jv, wv, iv = cell
+    if status == STATUS_TRAPPED:
+        return trapped_work(data, drawn, speed)
+    q, slopes, regime, _, _, _, _, _, _, f_target, f_grid = gathered
+    state = _chain(q, slopes)
+    r, nu = work_variables(data, drawn, row, (state[0], state[1], state[2], state[5], state[3], state[4]), key)
+    if scaled and wa > 0.0:
+        lo, hi, here = below * WORK_CELL_SIZE, (below + data.n_speed) * WORK_CELL_SIZE, drawn * WORK_CELL_SIZE
+        r_term = moved_term(data.work_cells, lo, hi, here, wa, WORK_CELL_MEAN, WORK_CELL_SD, WORK_CELL_INV_SD)
+        nu_term = moved_term(data.work_cells, lo + 1, hi + 1, here + 1, wa, WORK_CELL_MEAN, WORK_CELL_SD,
+                              WORK_CELL_INV_SD)
+        r = abs(fma(r - r_term[1], r_term[0], r_term[2]))
+        nu = _root_share(fma(nu - nu_term[1], nu_term[0], nu_term[2]))
+    if scaled and wv > 0.0:
+        g = speed_factors(regime, f_target, f_grid, sin_alpha1)[2]
+        r *= g * g
+    left = 1.0 - s2 - r
+    work = 0.5 * speed * speed * left if left > 0.0 else 0.0
+    return work * (nu * nu), work * ((1.0 - nu) * (1.0 + nu))
+
+
+@numba.njit(inline="always", **JIT)
+def trapped_work(data, drawn, speed):
+    """(W_n, W_t), m²/s², of a trapped draw in cell number ``drawn`` at |V⁻| = ``speed`` m/s: its cell's trapped
+    particles' mean."""
+    at, energy = drawn * WORK_CELL_SIZE + WORK_CELL_TRAPPED, 0.5 * speed * speed
+    return energy * load(data.work_cells, at), energy * load(data.work_cells, at + 1)
+
+
+@numba.njit(inline="always", **JIT)
+def table_work(data, cell, status, v, sin_alpha1, speed, u, scaled):
+    """:func:`drawn_work` of one particle's draw with uniforms ``u`` that returned ``status`` and the local V⁺
+    ``v`` (units of |V⁻|, a 3-tuple): its component and gathered values read again (they are in cache)."""
+    if not data.has_work or (status != STATUS_REBOUNDED and status != STATUS_TRAPPED):
+        return np.nan, np.nan
+    if status == STATUS_TRAPPED:
+        return trapped_work(data, cell[0], speed)
+    row = component(data, cell[0], u[4])
+    return drawn_work(data, cell, row, gather(data, cell, row, u), status, speed_ratio_squared(v[0], v[1], v[2]),
+                      sin_alpha1, speed, work_key(u), scaled)
+
+
+@numba.njit(**KERNEL)
+def work_block(data, ub, m, fr, index, weights, g, out, work_n, work_t, start, scaled):
+    """The pipeline's stage after the arithmetic (:mod:`surrogate.kernels.pipeline`): the work on the wall
+    (:func:`drawn_work`) of the m particles of a drawn block (uniforms ``ub``, frame records ``fr``, cell
+    records ``index`` and ``weights``, gathered records ``g``, results ``out``), into rows start … start + m − 1
+    of ``work_n`` and ``work_t`` (m²/s²): the bits :func:`table_work` gives each particle."""
+    for b in range(m):
+        status = int(field(out, OUT_STATUS, b)) if is_valid(fr, b) else STATUS_INVALID
+        work = (np.nan, np.nan)
+        if data.has_work and (status == STATUS_REBOUNDED or status == STATUS_TRAPPED):
+            work = drawn_work(data, cell_at(index, weights, b), field(index, I_ROW, b), gathered_at(g, b), status,
+                              field(out, OUT_S2, b), field(fr, FRAME_SIN, b), field(fr, FRAME_SPEED, b),
+                              work_key(uniforms(ub, b)), scaled)
+        work_n[start + b], work_t[start + b] = work
