@@ -19,8 +19,8 @@ from data_schema.command_line import CommandParser, count_argument, run, seed_ar
 from data_schema.common import DataFormatError
 from data_schema.output import check_memory, check_output, kind_of
 from data_schema.samples import (
-    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_FAILED, STATUS_NAMES, SampleSet, alpha1_is_physical,
-    angles_to_velocity, read_samples, rebound_angles, write_samples,
+    ALPHA1_RANGE_TEXT, SAMPLES_FILE_TYPE, SHAPE_NAMES, STATUS_FAILED, STATUS_NAMES, SampleSet,
+    read_samples, rebound_angles, write_samples,
 )
 from data_schema.table import TABLE_FILE_TYPE
 
@@ -79,44 +79,31 @@ def _grain_keys(path: str, n: int) -> np.ndarray:
 
 
 def _draw(table, args, shape, omega, keys=None, roughness=0.0):
-    """(draws in the local frame, V⁺ in m/s lab frame, each draw's path, each draw's wall hits) at the incident
-    state of ``args``.
+    """The hits (:class:`surrogate.Rebounds`) of ``sample_global`` at the incident state of ``args``, in the lab frame
+    (wall y = 0, normal +Y, V⁻ in the XY plane), which is their impact frame.
 
-    The lab frame (wall y = 0, normal +Y, V⁻ in the XY plane) is the impact frame of that state, so the local
-    draws are lab-frame vectors. On a smooth wall the path is that of :func:`surrogate.kernels.rebound_path`, the
-    same for every draw of one incident state; the table's draws are those of ``sample_local``, the direct model's
-    those of ``sample_global``. With --grain-key every draw is the grain of that key (one grain over random
-    orientations): on the table path its shape, drawn by ``sample_local`` with the key's shape alone (the table
-    holds that shape's law over its random proportions), on the direct path its shape, proportions and hand.
-    With ``keys`` ((n,) int64, --grain-keys: one grain per draw), the draws of ``sample_global`` with those keys
-    on either path. On a rough wall (``roughness`` > 0, degrees) every draw is ``sample_global``'s, each facet hit
-    on its own path."""
-    import surrogate
-    from surrogate.kernels import PATH_DIRECT, PATH_TABLE, rebound_path
-    from surrogate.validation import check_method
+    On a smooth wall the path is that of :func:`surrogate.kernels.rebound_path`, the same for every draw of one
+    incident state. With --grain-key every draw is the grain of that key (one grain over random orientations): on
+    the table path its shape (the table holds that shape's law over its random proportions), on the direct path
+    its shape, proportions and hand. With ``keys`` ((n,) int64, --grain-keys: one grain per draw), those keys. On a
+    rough wall (``roughness`` > 0, degrees) each facet hit takes its own path."""
+    from surrogate.kernels import PATH_DIRECT, rebound_path
+    from surrogate.validation import check_local_states, check_method
 
+    check_local_states(table, args.alpha1, args.speed, clamp=True)      # the physical range, named as α1 and |V⁻|
     a1, speed = math.radians(args.alpha1), args.speed
     V = (speed * math.cos(a1), -speed * math.sin(a1), 0.0)
-    half_size = 1.0        # m: any value; the draws and Omega- are given in units of |V-| and |V-|/a
-    spin = tuple(float(w) * speed / half_size for w in omega)
-    path = (rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), half_size, check_method(args.method))
-            if alpha1_is_physical(args.alpha1) and math.isfinite(speed) and speed > 0.0 else PATH_TABLE)
-    keyed = args.grain_key is not None
-    if keys is None and keyed and (roughness > 0.0 or path == PATH_DIRECT):
+    spin = tuple(float(w) * speed / HALF_SIZE for w in omega)
+    path = rebound_path(table.kernel_data, V, spin, (0.0, 1.0, 0.0), HALF_SIZE, check_method(args.method))
+    if roughness == 0.0 and path != PATH_DIRECT:        # the table's range, unless --clamp
+        check_local_states(table, args.alpha1, args.speed, args.clamp)
+    if keys is None and args.grain_key is not None:
         keys = np.full(args.n, args.grain_key)
-    if roughness > 0.0:
-        hits = _global(table, args, V, half_size, shape, spin, keys, roughness_deg=roughness, method=args.method)
-        return _lab_draws(hits, speed, half_size), hits.V, hits.path, hits.wall_hits
-    ones = np.ones(args.n, dtype=np.int32)
-    if path != PATH_DIRECT and keys is None:
-        local_shape = surrogate.grain_of(table, [args.grain_key], shape).shape[0] if keyed else shape
-        draws = surrogate.sample_local(table, np.full(args.n, args.alpha1), speed, local_shape,
-                                       random_state=args.seed, clamp=args.clamp)
-        return (draws, angles_to_velocity(draws.alpha2, draws.beta2, speed * draws.speed_ratio),
-                np.full(args.n, PATH_TABLE, dtype=np.int8), ones)
-    hits = _global(table, args, V, half_size, shape, spin, keys, roughness_deg=0.0,
-                   method="direct" if path == PATH_DIRECT else "table")
-    return _lab_draws(hits, speed, half_size), hits.V, np.full(args.n, path, dtype=np.int8), ones
+    method = args.method if roughness > 0.0 else "direct" if path == PATH_DIRECT else "table"
+    return _global(table, args, V, HALF_SIZE, shape, spin, keys, roughness_deg=roughness, method=method)
+
+
+HALF_SIZE = 1.0        # m, of the drawn particles: any value; the draws and Omega- are given in units of |V-| and |V-|/a
 
 
 def _global(table, args, V, half_size, shape, spin, keys, **kwargs):
@@ -136,6 +123,19 @@ def _lab_draws(hits, speed, half_size):
                                 omega=hits.Omega * (half_size / speed), status=hits.status)
 
 
+def _print_work(hits, speed) -> None:
+    """The summary's lines of the work on the wall: the means of W_n and W_t over the hits that have one (every
+    answered hit but those of a table of format 4.0), in J/kg and in units of ½|V-|²."""
+    known = np.isfinite(hits.wall_work_normal) & np.isfinite(hits.wall_work_tangential)
+    if not known.any():
+        print("  work on the wall: not in this table (format 4.0; rebuild it for W_n, W_t)")
+        return
+    energy = 0.5 * speed * speed
+    normal, tangential = hits.wall_work_normal[known].mean(), hits.wall_work_tangential[known].mean()
+    print(f"  work on the wall per unit mass, mean over {int(known.sum())} hits: normal W_n {normal:.6g} J/kg "
+          f"({normal / energy:.4f} of 1/2|V-|^2), tangential W_t {tangential:.6g} J/kg ({tangential / energy:.4f})")
+
+
 def _sample(args) -> int:
     import surrogate
     from surrogate.kernels import PATH_DIRECT, PATH_TABLE
@@ -153,7 +153,8 @@ def _sample(args) -> int:
     if args.roughness_deg is not None and not 0.0 <= args.roughness_deg <= MAX_ROUGHNESS_DEG:
         raise ValueError(f"--roughness-deg must be in [0, {MAX_ROUGHNESS_DEG:g}] degrees; got {args.roughness_deg:g}")
     roughness = check_roughness(table, args.roughness_deg)
-    draws, velocity, paths, wall_hits = _draw(table, args, shape, omega, keys, roughness)
+    hits = _draw(table, args, shape, omega, keys, roughness)
+    draws, paths, wall_hits = _lab_draws(hits, args.speed, HALF_SIZE), hits.path, hits.wall_hits
     n_direct = int(np.count_nonzero(paths == PATH_DIRECT))
     n_table = int(np.count_nonzero(paths == PATH_TABLE))
     direct = n_direct == args.n
@@ -169,9 +170,10 @@ def _sample(args) -> int:
         names, counts = np.unique(surrogate.grain_of(table, keys, shape).shape, return_counts=True)
         grain = {"grain_keys": str(args.grain_keys),
                  "grain_shapes": ", ".join(f"{name} {count}" for name, count in zip(names, counts))}
-    samples = SampleSet(velocity=velocity, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
+    samples = SampleSet(velocity=hits.V, omega=draws.omega, n_collisions=np.full(args.n, -1, dtype=np.int32),
                         status=draws.status, alpha1=args.alpha1, speed=speed, shape=label, seed=args.seed,
                         producer="surrogate sample",
+                        extra={name: getattr(hits, name) for name in ("wall_work_normal", "wall_work_tangential")},
                         provenance={"table": str(args.table), "table_config_sha256": table.config_sha256,
                                     "clamp": bool(args.clamp), "method": args.method, "omega_in": omega,
                                     "path": "direct model" if direct else "table" if n_table == args.n else
@@ -204,6 +206,7 @@ def _sample(args) -> int:
         if values.size:
             q05, q50, q95 = np.percentile(values, [5, 50, 95])
             print(f"  {name:<15} mean {values.mean():8.3f}   5% {q05:8.3f}   median {q50:8.3f}   95% {q95:8.3f}")
+    _print_work(hits, speed)
     if args.out is not None:
         written = write_samples(args.out, samples, overwrite=args.overwrite, inputs=(args.table,))
         print(f"samples written to {written}")

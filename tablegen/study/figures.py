@@ -17,6 +17,7 @@ from direct_model.shapes import MIX
 from tablegen.study.statistics import (
     NORMAL_IMPACT, QUANTITIES, ReportData, derived, indicatrix_2d, indicatrix_3d, nearest_alpha1,
 )
+from tablegen.study.wall_work import bitter_deformation, finnie, means, scaled_to_meet
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -226,13 +227,53 @@ def rough_figure(data: ReportData) -> Figure:
     return fig
 
 
+def work_figure(data):
+    """Mean W_n/E⁻ (left) and W_t/E⁻ (middle) against α1 per shape at each speed (the second speed dashed), with
+    Bitter's and Finnie's angle dependence scaled to meet the mix's at the first speed; right, the mix's median
+    and 10–90 % band of each at each speed."""
+    fig = _figure(15.0, 4.4)
+    left, middle, right = fig.subplots(1, 3)
+    alpha1 = np.asarray(data.alpha1)
+    speeds = data.work_speeds
+    for i, shape in enumerate(data.shapes):
+        style = _shape_style(shape, i)
+        for k, speed in enumerate(speeds):
+            normal, tangential = means(data.work, shape, alpha1, speed)
+            kw = dict(style, ls="-" if k == len(speeds) - 1 else "--", label=f"{shape}, {speed:g} m/s")
+            left.plot(alpha1, normal, **kw)
+            middle.plot(alpha1, tangential, **kw)
+    reference = "mix" if "mix" in data.shapes else data.shapes[0]
+    normal, tangential = means(data.work, reference, alpha1, speeds[-1])
+    fine = np.linspace(max(alpha1.min(), 0.5), 90.0, 200)
+    for ax, law, curve, name in ((left, bitter_deformation, normal, "Bitter deformation, sin²α1"),
+                                 (middle, finnie, tangential, "Finnie cutting")):
+        at, c = scaled_to_meet(law, alpha1, curve)
+        ax.plot(fine, c * law(fine), color="grey", lw=1.5, ls=":", label=f"{name} (meets {reference} at {at:g}°)")
+    for k, speed in enumerate(speeds):
+        points = [data.work[reference, a, speed] for a in alpha1]
+        for values, colour in (([p.normal for p in points], "C0"), ([p.tangential for p in points], "C3")):
+            q = np.array([np.quantile(v, [0.1, 0.5, 0.9]) if v.size else [np.nan] * 3 for v in values])
+            right.plot(alpha1, q[:, 1], color=colour, ls="-" if k == len(speeds) - 1 else "--")
+            right.fill_between(alpha1, q[:, 0], q[:, 2], color=colour, alpha=0.15 if k == len(speeds) - 1 else 0.08)
+    right.plot([], [], color="C0", label="$W_n/E^-$")
+    right.plot([], [], color="C3", label="$W_t/E^-$")
+    for ax, label in ((left, r"mean $W_n/E^-$"), (middle, r"mean $W_t/E^-$"),
+                      (right, f"{reference}: median, 10–90 %")):
+        ax.set(xlabel=r"$\alpha_1$ (deg)", ylabel=label)
+        ax.legend(fontsize=6.5)
+    return fig
+
+
 def write_figures(data: ReportData, stats: dict, folder) -> list:
-    """Draw and save every figure of :data:`FIGURES` into ``folder``, and :func:`rough_figure` as
-    ``rough_wall.png`` if the data have rough walls; return [(file, title, caption)] of :data:`FIGURES`'."""
+    """Draw and save every figure of :data:`FIGURES` into ``folder``, :func:`rough_figure` as ``rough_wall.png`` if
+    the data have rough walls and :func:`work_figure` as ``wall_work.png`` if they have the work on the wall;
+    return [(file, title, caption)] of :data:`FIGURES`'."""
     written = []
     for file, title, caption, draw in FIGURES:
         draw(data, stats).savefig(Path(folder) / file, dpi=DPI)
         written.append((file, title, caption))
     if data.rough:
         rough_figure(data).savefig(Path(folder) / "rough_wall.png", dpi=DPI)
+    if data.work:
+        work_figure(data).savefig(Path(folder) / "wall_work.png", dpi=DPI)
     return written

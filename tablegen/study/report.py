@@ -40,8 +40,10 @@ from tablegen.study.statistics import (
     COLLISION_CLASSES, NORMAL_IMPACT, QUANTITIES, PointSamples, ReportData, RoughSamples, from_sample_set,
     nearest_alpha1, point_statistics,
 )
+from tablegen.study.wall_work import means, pooled, work_samples
 
 PAPER_SPEED = 200.0                                    # m/s, incident speed of the paper's study
+WORK_SPEEDS = (100.0, PAPER_SPEED)                     # m/s, of the work on the wall: also at half the speed
 DEFAULT_ALPHA1 = tuple(float(a) for a in range(5, 91, 5))   # deg
 DEFAULT_N = 20_000
 INERTIA_QUADRATURE_POINTS = 4096                       # midpoint rule of ⟨r²⟩ over the aspect-ratio law
@@ -101,7 +103,8 @@ def _with_mix(parts: dict, shapes, alpha1, mix_of) -> dict:
 
 def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0,
                 progress: bool = False, config=None) -> ReportData:
-    """Run the direct model at 200 m/s, Ω⁻ = 0, for each shape and α1 (deg); ``n`` particles each.
+    """Run the direct model at 200 m/s, Ω⁻ = 0, for each shape and α1 (deg); ``n`` particles each; and at each
+    speed of :data:`WORK_SPEEDS` for the work on the wall.
 
     Every run uses the same ``seed`` (common random numbers: the same
     orientations and aspect ratios at every point). The mix pools the
@@ -116,14 +119,19 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
     model = {} if config is None else config.model()
     alpha1 = tuple(sorted(set(float(a) for a in alpha1)))
     mix_of = _constituents(shapes, available)
-    bar = progress_bar(progress, len(mix_of) * len(alpha1) * n, "particle", "report runs")
-    parts = {}
+    bar = progress_bar(progress, len(mix_of) * len(alpha1) * len(WORK_SPEEDS) * n, "particle", "report runs")
+    parts, work = {}, {}
     for shape in mix_of:
         body = shape if config is None else config.body(shape)
         for a in alpha1:
-            parts[shape, a] = from_sample_set(simulate(body, a, PAPER_SPEED, n, seed=seed, **model))
-            if bar is not None:
-                bar.update(n)
+            for speed in WORK_SPEEDS:
+                run = simulate(body, a, speed, n, seed=seed, **model)
+                work[shape, a, speed] = work_samples(run.status, run.extra["wall_work_normal"],
+                                                     run.extra["wall_work_tangential"], speed)
+                if speed == PAPER_SPEED:
+                    parts[shape, a] = from_sample_set(run)
+                if bar is not None:
+                    bar.update(n)
     if bar is not None:
         bar.close()
     source = "direct model (`direct_model.simulate.simulate`)"
@@ -135,11 +143,22 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
         counts_note=f"Counted over the {n} simulated particles per shape.",
         e_rot_method="exact: E_Ω⁺ = ½ Ω⁺·JΩ⁺ with each particle's own inertia tensor and orientation "
                      "(docs/model.md §5.4).",
-        points=_with_mix(parts, shapes, alpha1, available))
+        points=_with_mix(parts, shapes, alpha1, available), work=_work_with_mix(work, shapes, alpha1, available),
+        work_speeds=WORK_SPEEDS, work_source="the direct model, the same seed at every point")
+
+
+def _work_with_mix(work: dict, shapes, alpha1, mix_of) -> dict:
+    """The reported work samples: the pure shapes asked for, and the mix pooled from ``mix_of``, at every speed."""
+    speeds = sorted({v for _, _, v in work})
+    return {(shape, a, v): pooled([work[s, a, v] for s in mix_of]) if shape == MIX else work[shape, a, v]
+            for shape in shapes for a in alpha1 for v in speeds}
 
 
 def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0, roughness=()) -> ReportData:
     """Draw ``n`` reflected states per shape and α1 from a table, at its grid speed nearest 200 m/s.
+
+    The work on the wall (a table of format 4.1): ``n`` hits per (shape, α1) at the grid speeds nearest
+    :data:`WORK_SPEEDS` by :func:`surrogate.sample_global`.
 
     ``roughness``: roughness values Δγ (degrees, in [0, 45]) at which to draw, besides, the law of the mix (or of
     the first reported shape without it) on rough walls: ``n`` hits per (Δγ, α1) by :func:`surrogate.sample_global`
@@ -186,6 +205,12 @@ def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0
                 e_rot_ratio=inertia * np.sum(d.omega[ok] ** 2, axis=1),
                 status_counts=np.asarray(table.cells["status_counts"][cell], dtype=np.int64),
                 collision_counts=np.r_[collisions[:5], collisions[5:].sum()].astype(np.int64))
+    work = {}
+    if sampler.kernel_data.has_work:
+        grid_speeds = [float(table.speed_m_s[int(np.argmin(np.abs(np.asarray(table.speed_m_s) - v)))])
+                       for v in WORK_SPEEDS]
+        work = {(shape, a, v): _table_work(sampler, shape, a, v, n, seed) for shape in mix_of for a in alpha1
+                for v in dict.fromkeys(grid_speeds)}
     inertias = ", ".join(f"{s} {value:.4f}" for s, value in inertias.items())
     rough_shape = MIX if MIX in shapes else shapes[0]
     rough = {(float(g), a): _rough_samples(sampler, rough_shape, a, speed, g, n, seed) for g in roughness
@@ -202,7 +227,23 @@ def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0
                      "overestimates the mean E_Ω⁺/E_V⁻ by 4–11 %, and by up to 21 % for ellipsoids near "
                      "normal impact (docs/report.md).",
         points=_with_mix(parts, shapes, alpha1, tuple(table.shapes)), rough=rough,
-        rough_shape=rough_shape if rough else "")
+        rough_shape=rough_shape if rough else "", work=_work_with_mix(work, shapes, alpha1, tuple(table.shapes)),
+        work_speeds=tuple(sorted({v for _, _, v in work})),
+        work_source="drawn from the table with `surrogate.sample_global`, at its grid speeds nearest "
+                    + " and ".join(f"{v:g}" for v in WORK_SPEEDS) + " m/s")
+
+
+def _table_work(sampler, shape: str, alpha1: float, speed: float, n: int, seed: int):
+    """The work on the wall of ``n`` table hits of ``shape`` at (α1 deg, |V⁻| m/s) on the lab wall
+    (:func:`surrogate.sample_global`, the table path; half-size 1 m: the work does not depend on it)."""
+    import surrogate
+
+    a1 = math.radians(alpha1)
+    V = np.tile([speed * math.cos(a1), -speed * math.sin(a1), 0.0], (n, 1))
+    # clamp: α1 recomputed from V may fall a rounding error outside the grid
+    hits = surrogate.sample_global(sampler, V, [0.0, 1.0, 0.0], 1.0, shape, random_state=seed, method="table",
+                                   clamp=True)
+    return work_samples(hits.status, hits.wall_work_normal, hits.wall_work_tangential, speed)
 
 
 def _rough_samples(sampler, shape: str, alpha1: float, speed: float, roughness: float, n: int,
@@ -289,6 +330,8 @@ def render_index(data: ReportData, stats: dict, figures) -> str:
     for file, title, caption in figures:
         parts.append(f"## {title}\n\n{caption}\n\n![{title}]({file})")
     parts.append(_collision_section(data, stats))
+    if data.work:
+        parts.append(_work_section(data))
     if data.rough:
         parts.append(_rough_section(data))
     parts.append("## Numbers\n\nMeans and most probable (m.p.) values over the rebounded particles; "
@@ -313,6 +356,27 @@ def _rough_section(data: ReportData) -> str:
             "\n\n![Rough walls](rough_wall.png)\n\n"
             + markdown_table(["Δγ (deg)", "α1 (deg)", "α2 mean", "α2 sd", "β2 mean", "β2 sd", "hit again %",
                               "trapped %"], rows))
+
+
+def _work_section(data: ReportData) -> str:
+    """The report's section: the figure and, per shape, the mean W_n/E⁻ and W_t/E⁻ against α1 at each speed."""
+    header = ["α1 (deg)"] + [f"{name} {speed:g} m/s" for speed in data.work_speeds
+                             for name in ("W_n/E⁻", "W_t/E⁻")]
+    tables = []
+    for shape in data.shapes:
+        columns = [means(data.work, shape, data.alpha1, speed) for speed in data.work_speeds]
+        rows = [[f"{a:g}"] + [f"{values[k]:.4f}" for pair in columns for values in pair]
+                for k, a in enumerate(data.alpha1)]
+        tables.append(f"### {shape}\n\n" + markdown_table(header, rows))
+    return ("## Work on the wall\n\n"
+            f"The work of each hit on the wall per unit mass (docs/model.md §4.7) in units of E⁻ = ½|V⁻|²: W_n of "
+            f"the normal impulses (indentation), W_t of the tangential ones (cutting), over the hits that "
+            f"rebounded or were trapped, at |V⁻| = {', '.join(f'{v:g}' for v in data.work_speeds)} m/s "
+            f"({data.work_source}). Grey: Bitter's (1963) deformation wear, sin²α1, beside W_n, and Finnie's "
+            f"(1960) ductile cutting beside W_t, each scaled to meet the mix's mean curve at the speed "
+            f"{data.work_speeds[-1]:g} m/s where that curve peaks: shapes of curves, not magnitudes (those models "
+            f"give the volume a sphere's hit removes).\n\n![Work on the wall](wall_work.png)\n\n"
+            + "\n\n".join(tables))
 
 
 def _conditions(data: ReportData) -> str:

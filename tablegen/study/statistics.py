@@ -85,6 +85,9 @@ class ReportData:
     points : {(shape, α1): PointSamples}.
     rough : {(Δγ deg, α1): RoughSamples} of :attr:`rough_shape` on rough walls (docs/model.md §12); {}: none.
     rough_shape : the shape (or ``"mix"``) of ``rough``.
+    work : {(shape, α1, |V⁻| m/s): :class:`tablegen.study.wall_work.WorkSamples`}, the work on the wall at each
+        speed of ``work_speeds``, for every reported shape and the mix; {}: none (a table without it).
+    work_source : markdown words on where the work's hits come from.
     """
 
     source: str
@@ -99,6 +102,9 @@ class ReportData:
     points: dict
     rough: dict = dataclasses.field(default_factory=dict)
     rough_shape: str = ""
+    work: dict = dataclasses.field(default_factory=dict)
+    work_speeds: tuple = ()
+    work_source: str = ""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

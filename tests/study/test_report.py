@@ -13,13 +13,14 @@ from tablegen.cli import main as tablegen_main
 from direct_model.shapes import AspectRatioLaw, second_moment_factor
 from direct_model.simulate import simulate
 from tablegen.study.figures import FIGURES
-from tablegen.study.report import direct_data, isotropic_inertia, pool
+from tablegen.study.report import WORK_SPEEDS, direct_data, isotropic_inertia, pool
+from tablegen.study.wall_work import bitter_deformation, finnie, scaled_to_meet
 from tablegen.study.statistics import (
     PointSamples, collision_classes, derived, histogram_mode, indicatrix_2d, indicatrix_3d, lab_velocity,
     nearest_alpha1, point_statistics,
 )
 
-EXPECTED_FILES = {f[0] for f in FIGURES} | {"index.md", FOLDER_MARKER}
+EXPECTED_FILES = {f[0] for f in FIGURES} | {"wall_work.png", "index.md", FOLDER_MARKER}
 
 
 def _synthetic(m=1000, seed=0, status=(0, 0, 0), collisions=(0,) * 6) -> PointSamples:
@@ -123,6 +124,34 @@ def test_direct_data_holds_the_rebounds_of_the_direct_model():
     assert mix.collision_counts.sum() == mix.status_counts[STATUS_REBOUNDED]
 
 
+def test_the_work_on_the_wall_is_the_direct_model_s_at_both_speeds():
+    """The report's work: every hit that rebounded or was trapped, W/(½|V⁻|²), at each speed of WORK_SPEEDS; the mix
+    pools the shapes'."""
+    data = direct_data(["prism", "mix"], (45.0,), n=200, seed=5)
+    assert data.work_speeds == WORK_SPEEDS == (100.0, 200.0)
+    for speed in WORK_SPEEDS:
+        s = simulate("prism", 45.0, speed, 200, seed=5)
+        kept = (s.status == STATUS_REBOUNDED) | (s.status == STATUS_TRAPPED)
+        w = data.work["prism", 45.0, speed]
+        np.testing.assert_array_equal(w.normal, s.extra["wall_work_normal"][kept] / (0.5 * speed ** 2))
+        np.testing.assert_array_equal(w.tangential, s.extra["wall_work_tangential"][kept] / (0.5 * speed ** 2))
+        assert data.work["mix", 45.0, speed].normal.size == sum(
+            np.count_nonzero(simulate(shape, 45.0, speed, 200, seed=5).status != STATUS_FAILED)
+            for shape in ("ellipsoid", "prism", "cut_prism", "tetrahedron"))
+
+
+def test_the_erosion_laws_drawn_beside_the_work():
+    """Finnie's cutting function is continuous where its regimes meet (tan α = 1/3: both 0.3) and peaks where
+    tan 2α = 2/3 (16.85°); Bitter's deformation wear is sin²α; a law scaled to meet a curve equals it at its peak."""
+    meet = np.degrees(np.arctan(1.0 / 3.0))
+    assert finnie(meet) == pytest.approx(0.3, abs=1e-12) and finnie(meet + 1e-9) == pytest.approx(0.3, abs=1e-8)
+    fine = np.linspace(0.1, 90.0, 89_901)
+    assert fine[np.argmax(finnie(fine))] == pytest.approx(np.degrees(np.arctan(2.0 / 3.0)) / 2.0, abs=1e-3)
+    assert finnie(90.0) == pytest.approx(0.0, abs=1e-15) and bitter_deformation([30.0, 90.0]) == pytest.approx([0.25, 1])
+    at, c = scaled_to_meet(bitter_deformation, [30.0, 60.0, 90.0], np.array([0.1, 0.5, 0.4]))
+    assert at == 60.0 and c * bitter_deformation(60.0) == pytest.approx(0.5, rel=1e-14)
+
+
 def _figure_links(index: str) -> set:
     return set(re.findall(r"!\[[^\]]*\]\(([^)]+)\)", index))
 
@@ -138,6 +167,7 @@ def test_cli_direct_writes_every_figure_and_refuses_an_existing_folder(tmp_path,
     assert _figure_links(index) == EXPECTED_FILES - {"index.md", FOLDER_MARKER}
     assert "## Collisions per rebound at α1 = 90°" in index and "| cut_prism |" in index
     assert "**E_Ω⁺/E_V⁻** is exact" in index
+    assert "## Work on the wall" in index and "| α1 (deg) | W_n/E⁻ 100 m/s | W_t/E⁻ 100 m/s |" in index
     # the numbers table: one row per α1, with the statistics of the same run
     data = direct_data(["cut_prism"], (30.0, 90.0), n=300, seed=3)
     st = point_statistics(data.points["cut_prism", 30.0])
@@ -213,6 +243,8 @@ def test_cli_from_a_table(small_table_path, tmp_path, capsys):
     # grid α1, the grid speed nearest 200 m/s (150 and 250 tie: the lower), the approximate rotational energy
     assert "| α1 (deg) | 30, 60, 90 |" in index and "150 m/s (the table's grid speed nearest 200 m/s)" in index
     assert "**E_Ω⁺/E_V⁻** is approximate" in index
+    # the work on the wall at the grid speeds nearest 100 and 200 m/s (50 and 150)
+    assert "| α1 (deg) | W_n/E⁻ 50 m/s | W_t/E⁻ 50 m/s | W_n/E⁻ 150 m/s | W_t/E⁻ 150 m/s |" in index
     # collision percentages at 90° are the table's own cell counts
     table = read_table(small_table_path)
     cell = table.cells["collision_counts"][table.shapes.index("prism"), 2, 1]
