@@ -9,7 +9,9 @@ solver-neutral comparison tablegen.study.solver_comparison, called through compa
 rank draws its own stream; each particle hits as one grain (grain kept) and the grains follow the mix's
 weights; trapped particles are deposited or removed; each boundary zone does what its [zone] section says
 (its own wall's table, a rough wall, or a stock behaviour) and is counted apart; a bad setup stops the solver
-with one clear message; and the CPU time against the solver's own rebound (CS_LAGR_REBOUND).
+with one clear message; the work of the hits on the walls, the adapter's boundary statistics in the run's
+postprocessing against the hit records and the summary, a table of format 4.0 (no work) counted apart; and the
+CPU time against the solver's own rebound (CS_LAGR_REBOUND).
 
 These tests need code_saturne: they fail (they are not skipped) when it is missing, with a message naming
 integrations/code_saturne/install-deps.sh.
@@ -40,9 +42,10 @@ sys.path.insert(0, str(CS_DIR))
 
 import compare_saturne_rebounds  # noqa: E402
 import make_channel_table  # noqa: E402
-from read_hits import HITS_TITLE, read_cpu_seconds, read_hits, read_summary, zone_settings, zone_summary  # noqa: E402
-from saturne_api import (PATH_DIRECT, PATH_TABLE, STATUS_REBOUNDED, build_table_from_text,  # noqa: E402
-                         grain_mismatches, load)
+from read_hits import (BOUNDARY_STATISTICS, HITS_TITLE, boundary_statistics, read_cpu_seconds,  # noqa: E402
+                       read_hits, read_summary, zone_settings, zone_summary)
+from saturne_api import (PATH_DIRECT, PATH_TABLE, STATUS_INVALID, STATUS_REBOUNDED,  # noqa: E402
+                         build_table_from_text, grain_mismatches, load, table_without_work)
 
 INSTALL_HINT = ("run `bash integrations/code_saturne/install-deps.sh` (as root on Debian bookworm: it installs "
                 "Debian's code_saturne 6.0 with its headers and Open MPI) and then "
@@ -259,6 +262,90 @@ def test_each_rank_draws_its_own_stream(parallel_case, serial_case):
     # rank 0 draws stream 0 of the seed, as a serial run does: the first draw is the same
     serial, _ = read_hits(serial_case / "RESU")
     assert serial["u0"][0] == u0[0][0] != u0[1][0]
+
+
+# ----------------------------------------------------------------------------- the work on the walls
+
+DENSITY = 2650.0   # the case's sand (cs_user_lagr_boundary_conditions.c): a grain's mass is ρπd³/6 (cs_user_lagr_in)
+# the summary writes the mean work with 6 significant digits (a relative rounding of at most 5e-6) and the
+# postprocessing the statistics in float32 (6e-8 each): the bound on their products' and sums' relative difference
+PRINTED_RTOL = 6e-6
+
+
+def _check_work(case: Path, with_work=None) -> dict:
+    """The adapter's boundary statistics of a run (its EnSight output), checked per zone against the hit records
+    and the summary. In a zone that draws, over the hits ``with_work(hits)`` (default: every record of the zone
+    but the invalid ones; the case's statistical weight is 1): the statistic of the hits counts them, that of
+    the mass sums their ρπd³/6, the zone's counts add up (hits = with work + without + invalid), the two works
+    are the summary's means times that mass and at most the translational kinetic energy the grains lost (V⁺ = 0
+    where none rebounded: the rest went into their spin); every value is finite and >= 0, and every other
+    zone's faces (the inlet, a stock zone) hold none. The first block's total work is the statistics' sum.
+    Returns per drawing zone its means (J/kg), total works (J) and the work's share of the translational
+    energy lost."""
+    run = case / "RESU"
+    stats, log = boundary_statistics(run), (run / "run_solver.log").read_text()
+    rows, info = zone_summary(log), read_summary(log)
+    hits, _ = read_hits(run)
+    for name in BOUNDARY_STATISTICS:
+        assert np.all(np.isfinite(stats[name]) & (stats[name] >= 0)), name
+    out = {}
+    drawn = [zone for zone, row in rows.items() if row["interaction"].startswith("rebound-scatter")]
+    for zone in drawn:
+        row, on = rows[zone], stats["zone"] == zone
+        rec = (hits["patch"] == zone) & (with_work(hits) if with_work else hits["status"] != STATUS_INVALID)
+        mass = DENSITY * np.pi * hits["d"][rec] ** 3 / 6
+        assert stats["rbs_wall_hits"][on].sum() == np.sum(rec) == row["hits"] - row["no_work"] - row["invalid"] > 0
+        np.testing.assert_allclose(stats["rbs_wall_hit_mass"][on].sum(), mass.sum(), rtol=1e-6)
+        work = {}
+        for key in ("normal", "tangential"):
+            work[key] = stats[f"rbs_wall_work_{key}"][on].sum()
+            np.testing.assert_allclose(work[key], row[f"work_{key}"] * mass.sum(), rtol=PRINTED_RTOL)
+        v_in, v_out = hits["V"][rec], np.nan_to_num(hits["Vout"][rec])
+        lost = np.sum(mass * 0.5 * (np.einsum("ij,ij->i", v_in, v_in) - np.einsum("ij,ij->i", v_out, v_out)))
+        share = (work["normal"] + work["tangential"]) / lost
+        assert 0 < share <= 1 + 1e-6, (zone, share)
+        out[zone] = {"Wn": row["work_normal"], "Wt": row["work_tangential"], "Wn_J": work["normal"],
+                     "Wt_J": work["tangential"], "share": share}
+    others = ~np.isin(stats["zone"], drawn)
+    assert others.any() and all(np.all(stats[name][others] == 0) for name in BOUNDARY_STATISTICS)
+    for key in ("normal", "tangential"):
+        np.testing.assert_allclose(info[f"work_{key}_J"], stats[f"rbs_wall_work_{key}"].sum(), rtol=PRINTED_RTOL)
+    assert info["no_work"] == sum(rows[zone]["no_work"] for zone in drawn)
+    return out
+
+
+def test_work_on_the_walls(serial_case, parallel_case, capsys):
+    """The work of the hits on the walls (rbs_result.wall_work_normal, wall_work_tangential; docs/model.md §4.7):
+    the boundary statistics of the serial and the 2-rank run (summed over the ranks by the postprocessing) against
+    their hit records and summaries (_check_work); the table of format 4.1 gives every hit its work."""
+    lines = []
+    for name, case in (("serial", serial_case), ("2 ranks", parallel_case)):
+        work = _check_work(case)
+        assert set(work) == {"target", "walls"} and read_summary(
+            (case / "RESU" / "run_solver.log").read_text())["no_work"] == 0
+        lines += [f"  {name:8s}{zone:7s} W_n {w['Wn']:.6g} J/kg, W_t {w['Wt']:.6g} J/kg; {w['Wn_J']:.4g} J, "
+                  f"{w['Wt_J']:.4g} J; {w['share']:.3f} of the translational energy lost" for zone, w in work.items()]
+    with capsys.disabled():
+        print("\nchannelRebound, the work on the walls (mean per unit mass; sum; share of the energy lost):\n"
+              + "\n".join(lines))
+
+
+def test_work_with_a_table_of_format_4_0(cs_build, case_table, serial_case, tmp_path_factory):
+    """A table of format 4.0 holds no work: its hits (the table path's) are counted without work (no-work) and
+    left out of the statistics and the means, which hold the direct model's hits alone; the rebounds are the
+    serial run's (the same table without its work datasets), bit for bit."""
+    table = table_without_work(case_table, tmp_path_factory.mktemp("cs_table_4_0") / "rebound_table_4_0.h5")
+    case = _run_case(tmp_path_factory, "cs_format_4_0", table)
+    log = (case / "RESU" / "run_solver.log").read_text()
+    rows, info = zone_summary(log), read_summary(log)
+    assert info["no_work"] == info["table"] > 0
+    for zone in ("target", "walls"):
+        assert rows[zone]["no_work"] == rows[zone]["table"] > 0 and rows[zone]["direct"] > 0, rows[zone]
+    _check_work(case, with_work=lambda hits: hits["path"] == PATH_DIRECT)
+    hits, _ = read_hits(case / "RESU")
+    serial, _ = read_hits(serial_case / "RESU")
+    for key in ("V", "n", "d", "status", "path", "Vout", "Wout", "u0", "key"):
+        np.testing.assert_array_equal(hits[key], serial[key], err_msg=key)
 
 
 @pytest.fixture(scope="session")
@@ -542,6 +629,9 @@ def test_each_zone_does_what_its_section_says(zones_case):
         "table", "direct", "trapped", "speed_below", "speed_above", "alpha1_outside")) == 0
     # the tables' walls are smooth: one wall hit per hit
     assert walls["roughness"] == target["roughness"] == 0 and sides["roughness"] is None
+    # the drawn hits' work on the wall, the trapped ones' too (up to the trap); none on the solver's rebound
+    assert sides["work_normal"] is None and sides["no_work"] == walls["no_work"] == target["no_work"] == 0
+    _check_work(zones_case)
     assert walls["hit_again"] == walls["at_cap"] == target["hit_again"] == target["at_cap"] == 0
     # the first block: the hits a table or the direct model answered, both drawing zones'
     assert info["hits"] == walls["hits"] + target["hits"] and info["direct"] == walls["direct"]

@@ -41,6 +41,7 @@
 #include "cs_ale.h"
 #include "cs_boundary_zone.h"
 #include "cs_math.h"
+#include "cs_mesh.h"
 #include "cs_mesh_quantities.h"
 #include "cs_parall.h"
 #include "cs_time_step.h"
@@ -51,10 +52,17 @@
 #include "cs_lagr_event.h"
 #include "cs_lagr_particle.h"
 #include "cs_lagr_prototypes.h"
+#include "cs_lagr_stat.h"
 #include "cs_lagr_tracking.h"
 
 #include "rebound_scatter.h"
 #include "rbs_cs_rebound.h"
+
+/* rbs_result's work on the wall of the table path (1.3 gives it on the
+   direct path only) */
+#if RBS_VERSION_NUMBER < 1004000
+#error "rbs_cs_rebound.c needs rebound_scatter.h 1.4 or later"
+#endif
 
 /*----------------------------------------------------------------------------
  * Settings, state and counters of this rank
@@ -152,15 +160,37 @@ typedef struct {
    escaped or invalid; why a drawn hit did not rebound; its path; the drawn
    hits outside the grid of the zone's table, by cause; those outside the
    speeds its wall law holds over; the drawn hits that hit the wall again
-   (rbs_result.wall_hits > 1) and those that reached RBS_MAX_WALL_HITS */
+   (rbs_result.wall_hits > 1) and those that reached RBS_MAX_WALL_HITS; the
+   drawn hits without work on the wall (NaN: a table of format 4.0) */
 enum {ZC_HITS, ZC_REBOUNDED, ZC_STUCK, ZC_REMOVED, ZC_ESCAPED, ZC_INVALID,
       ZC_TRAPPED, ZC_FAILED, ZC_TABLE, ZC_DIRECT, ZC_SPEED_BELOW,
       ZC_SPEED_ABOVE, ZC_ALPHA1_OUT, ZC_OUTSIDE_LAW, ZC_HIT_AGAIN, ZC_AT_CAP,
-      ZC_N};
+      ZC_NO_WORK, ZC_N};
 static const char *const _zc_names[ZC_N] = {
   "hits", "rebounded", "stuck", "removed", "escaped", "invalid", "trapped",
   "failed", "table", "direct", "|V|<grid", "|V|>grid", "alpha1-out",
-  "out-of-law", "hit-again", "at-cap"};
+  "out-of-law", "hit-again", "at-cap", "no-work"};
+
+/* The work on the wall per zone, summed over the drawn hits with work:
+   statistical weight x mass x W_n, x W_t (J), and weight x mass (kg) */
+enum {ZW_NORMAL, ZW_TANGENTIAL, ZW_MASS, ZW_N};
+
+/* The boundary statistics (rbs_cs_define_statistics), per boundary face of
+   the rank, over the drawn hits with work: weight x mass x W_n, x W_t (J),
+   weight x mass (kg) and weight (the hits) */
+enum {ST_WORK_NORMAL, ST_WORK_TANGENTIAL, ST_MASS, ST_HITS, ST_N};
+static const char *const _stat_names[ST_N] = {
+  "rbs_wall_work_normal", "rbs_wall_work_tangential", "rbs_wall_hit_mass",
+  "rbs_wall_hits"};
+static int _stat_ids[ST_N] = {ST_WORK_NORMAL, ST_WORK_TANGENTIAL, ST_MASS,
+                              ST_HITS};   /* the data function's inputs */
+static int        _stats_defined = 0;
+static cs_lnum_t  _stat_n_faces = 0;
+static cs_real_t *_stat_new[ST_N];  /* the hits since the solver's last
+                                       update of its statistics */
+static cs_real_t *_stat_sum[ST_N];  /* over the statistics' period */
+static int        _stat_nt[ST_N] = {-1, -1, -1, -1};  /* the step of each
+                                                         one's last update */
 
 static int                 _initialized = 0;
 static rbs_cs_settings_t   _set;
@@ -173,6 +203,7 @@ static int                *_zone_rule = NULL;     /* per boundary zone; -1 none 
 static int                *_zone_listed = NULL;   /* CS_LAGR_BC_USER or named
                                                      when initialized */
 static cs_gnum_t          *_zone_count = NULL;    /* ZC_N per zone */
+static double             *_zone_work = NULL;     /* ZW_N per zone */
 static rbs_rng             _rng;
 static FILE               *_hits = NULL;
 static long long           _n_recorded = 0;
@@ -747,6 +778,8 @@ _read_settings(void)
   BFT_MALLOC(_zone_listed, _n_zones, int);
   BFT_MALLOC(_zone_count, (size_t)_n_zones*ZC_N, cs_gnum_t);
   memset(_zone_count, 0, (size_t)_n_zones*ZC_N*sizeof(cs_gnum_t));
+  BFT_MALLOC(_zone_work, (size_t)_n_zones*ZW_N, double);
+  memset(_zone_work, 0, (size_t)_n_zones*ZW_N*sizeof(double));
   for (int i = 0; i < _n_zones; i++) {
     _zone_rule[i] = -1;
     _zone_listed[i] = 0;
@@ -965,8 +998,93 @@ _record_hit(int b_zone_id, const rbs_cs_rule_t *rule, double d,
 }
 
 /*----------------------------------------------------------------------------
+ * The boundary statistics: 6.0's Lagrangian mesh-based statistics of the
+ * tracking events (cs_lagr_stat_mesh_define, as its boundary mass flux)
+ *----------------------------------------------------------------------------*/
+
+/* The arrays of this rank's boundary faces, zero on first use (the mesh is
+   read after cs_user_lagr_model, where the statistics are defined) */
+static void
+_stat_allocate(void)
+{
+  if (_stat_n_faces > 0 || cs_glob_mesh->n_b_faces == 0)
+    return;
+  _stat_n_faces = cs_glob_mesh->n_b_faces;
+  for (int s = 0; s < ST_N; s++) {
+    BFT_MALLOC(_stat_new[s], _stat_n_faces, cs_real_t);
+    BFT_MALLOC(_stat_sum[s], _stat_n_faces, cs_real_t);
+    memset(_stat_new[s], 0, _stat_n_faces*sizeof(cs_real_t));
+    memset(_stat_sum[s], 0, _stat_n_faces*sizeof(cs_real_t));
+  }
+}
+
+/* The solver's update of the statistic *input (cs_lagr_moment_m_data_t),
+   at each flush of its boundary events, at least once per time step after
+   the particles moved: the hits since the last update are added to the
+   statistic, which restarts with each step while the statistics are
+   unsteady (isttio = 0, or up to the step nstist), as the solver's own */
+static void
+_stat_update(const void                 *input,
+             const cs_lagr_event_set_t  *events,
+             int                         location_id,
+             int                         class_id,
+             cs_real_t                   vals[])
+{
+  CS_UNUSED(events);
+  CS_UNUSED(location_id);
+  CS_UNUSED(class_id);
+  const int s = *(const int *)input;
+  const int nt = cs_glob_time_step->nt_cur;
+  _stat_allocate();
+  if (_stat_nt[s] != nt
+      && (cs_glob_lagr_time_scheme->isttio == 0
+          || nt <= cs_glob_lagr_stat_options->nstist))
+    memset(_stat_sum[s], 0, _stat_n_faces*sizeof(cs_real_t));
+  _stat_nt[s] = nt;
+  for (cs_lnum_t f = 0; f < _stat_n_faces; f++) {
+    _stat_sum[s][f] += _stat_new[s][f];
+    _stat_new[s][f] = 0;
+    vals[f] = _stat_sum[s][f];
+  }
+}
+
+/* A drawn hit's work on the face, once the statistics have started (the
+   step idstnt, when the solver starts updating them) */
+static void
+_stat_add(cs_lnum_t face_id, double weight, double mass, double wn,
+          double wt)
+{
+  if (!_stats_defined
+      || cs_glob_time_step->nt_cur < cs_glob_lagr_stat_options->idstnt)
+    return;
+  _stat_allocate();
+  _stat_new[ST_WORK_NORMAL][face_id] += weight*mass*wn;
+  _stat_new[ST_WORK_TANGENTIAL][face_id] += weight*mass*wt;
+  _stat_new[ST_MASS][face_id] += weight*mass;
+  _stat_new[ST_HITS][face_id] += weight;
+}
+
+/*----------------------------------------------------------------------------
  * Public functions
  *----------------------------------------------------------------------------*/
+
+void
+rbs_cs_define_statistics(void)
+{
+  if (_stats_defined)
+    return;
+  /* defined later, a statistic would miss the preparation of its values
+     for the first step */
+  if (cs_glob_time_step->nt_cur > cs_glob_time_step->nt_prev)
+    bft_error(__FILE__, __LINE__, 0,
+              "rebound-scatter: call rbs_cs_define_statistics() from "
+              "cs_user_lagr_model, before the time steps");
+  for (int s = 0; s < ST_N; s++)
+    cs_lagr_stat_mesh_define(_stat_names[s], CS_MESH_LOCATION_BOUNDARY_FACES,
+                             CS_LAGR_STAT_GROUP_TRACKING_EVENT, 0, 1,
+                             _stat_update, _stat_ids + s, 0, -1);
+  _stats_defined = 1;
+}
 
 void
 rbs_cs_initialize(void)
@@ -984,6 +1102,15 @@ rbs_cs_initialize(void)
     bft_error(__FILE__, __LINE__, 0,
               "rebound-scatter: a turbomachinery model is on; the rebound is "
               "drawn relative to walls at rest, so it needs fixed walls");
+
+  /* the library the solver loads may be older than the header it was
+     compiled with */
+  if (rbs_version_number() < 1004000)
+    bft_error(__FILE__, __LINE__, 0,
+              "rebound-scatter: the C runtime loaded is %s; rbs_cs_rebound.c "
+              "needs 1.4 or later (the table path's work on the wall): "
+              "rebuild it (integrations/code_saturne/build.sh)",
+              rbs_version());
 
   memset(&_count, 0, sizeof(_count));
   _read_settings();
@@ -1015,6 +1142,13 @@ rbs_cs_initialize(void)
 void
 rbs_cs_finalize(void)
 {
+  /* the statistics' arrays: the solver's updates allocate them whether or
+     not a zone draws */
+  for (int k = 0; k < ST_N; k++) {
+    BFT_FREE(_stat_new[k]);
+    BFT_FREE(_stat_sum[k]);
+  }
+  _stat_n_faces = 0;
   if (!_initialized)
     return;
   cs_gnum_t c[8] = {_count.hits, _count.table_path, _count.direct_path,
@@ -1025,14 +1159,20 @@ rbs_cs_finalize(void)
   cs_parall_counter(c, 8);
   cs_parall_sum(4, CS_DOUBLE, w);
   cs_parall_counter(_zone_count, _n_zones*ZC_N);
+  cs_parall_sum(_n_zones*ZW_N, CS_DOUBLE, _zone_work);
 
-  /* the trapped policy of the zones that draw, if they share one */
-  cs_gnum_t all_hits = 0;
+  /* the trapped policy of the zones that draw, if they share one; the work
+     on their walls */
+  cs_gnum_t all_hits = 0, no_work = 0;
+  double work[ZW_N] = {0, 0, 0};
   int policy = -1;
   size_t width = 4;
   for (int i = 0; i < _n_zones; i++) {
     const cs_gnum_t *zc = _zone_count + (size_t)i*ZC_N;
     all_hits += zc[ZC_HITS];
+    no_work += zc[ZC_NO_WORK];
+    for (int k = 0; k < ZW_N; k++)
+      work[k] += _zone_work[(size_t)i*ZW_N + k];
     if (!_zone_listed[i] && zc[ZC_HITS] == 0)
       continue;
     width = CS_MAX(width, strlen(cs_boundary_zone_by_id(i)->name));
@@ -1056,25 +1196,32 @@ rbs_cs_finalize(void)
              "    - invalid (solver's rebound)   = %llu\n"
              "    - outside the table's grid     = %llu\n"
              "    - CPU time in the hits         = %g s (%g us per hit, "
-             "every zone's)\n",
+             "every zone's)\n"
+             "    - work on the walls, normal and tangential = %g J, %g J "
+             "(%llu hits without work: a table of format 4.0)\n",
              _rules[0].table >= 0 ? _rules[0].mix_name : "tables per zone",
              (unsigned long long)c[0], (unsigned long long)c[1],
              (unsigned long long)c[2], c[2] > 0 ? 1e6*w[2]/c[2] : 0.,
              (unsigned long long)c[3], trapped, (unsigned long long)c[4], w[0],
              trapped, (unsigned long long)c[5], w[1], (unsigned long long)c[6],
              (unsigned long long)c[7], w[3],
-             all_hits > 0 ? 1e6*w[3]/all_hits : 0.);
+             all_hits > 0 ? 1e6*w[3]/all_hits : 0., work[ZW_NORMAL],
+             work[ZW_TANGENTIAL], (unsigned long long)no_work);
 
   /* Per zone: the zones the adapter handles, a line each */
   char line[RBS_CS_TEXT], text[RBS_CS_TEXT];
   int used = snprintf(line, sizeof(line), "      %-*s", (int)width, "zone");
   for (int k = 0; k < ZC_N; k++)
     used += snprintf(line + used, sizeof(line) - used, " %10s", _zc_names[k]);
-  used += snprintf(line + used, sizeof(line) - used, " %10s", "roughness");
+  used += snprintf(line + used, sizeof(line) - used, " %10s %12s %12s",
+                   "roughness", "Wn(J/kg)", "Wt(J/kg)");
   bft_printf("    Per zone (hits; their fate; the path; hits outside the "
              "table's grid: |V| below, |V| above, alpha1 outside; outside "
              "the wall law's speeds; hits that hit the wall again, and those "
-             "that reached %d wall hits; the wall's roughness, deg)\n"
+             "that reached %d wall hits; hits without work on the wall; the "
+             "wall's roughness, deg; the mean work on the wall per unit "
+             "particle mass, normal and tangential, weighted by the mass "
+             "that hit, J/kg)\n"
              "%s  interaction\n", RBS_MAX_WALL_HITS, line);
   for (int i = 0; i < _n_zones; i++) {
     const cs_gnum_t *zc = _zone_count + (size_t)i*ZC_N;
@@ -1086,11 +1233,19 @@ rbs_cs_finalize(void)
       used += snprintf(line + used, sizeof(line) - used, " %10llu",
                        (unsigned long long)zc[k]);
     const rbs_cs_rule_t *rule = _rules + _zone_rule[i];
+    const double *zw = _zone_work + (size_t)i*ZW_N;
     if (rule->type == RBS_CS_DRAWN)
       used += snprintf(line + used, sizeof(line) - used, " %10g",
                        rule->roughness);
     else
       used += snprintf(line + used, sizeof(line) - used, " %10s", "-");
+    if (zw[ZW_MASS] > 0)
+      used += snprintf(line + used, sizeof(line) - used, " %12.6g %12.6g",
+                       zw[ZW_NORMAL]/zw[ZW_MASS],
+                       zw[ZW_TANGENTIAL]/zw[ZW_MASS]);
+    else
+      used += snprintf(line + used, sizeof(line) - used, " %12s %12s", "-",
+                       "-");
     _describe(rule, 0, text, sizeof(text));
     bft_printf("%s  %s\n", line, text);
   }
@@ -1107,6 +1262,7 @@ rbs_cs_finalize(void)
   BFT_FREE(_zone_rule);
   BFT_FREE(_zone_listed);
   BFT_FREE(_zone_count);
+  BFT_FREE(_zone_work);
   _n_rules = _n_tables = _n_zones = 0;
   _initialized = 0;
 }
@@ -1191,7 +1347,6 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
                                   int                       *event_flag,
                                   cs_lagr_tracking_state_t  *tracking_state)
 {
-  CS_UNUSED(face_id);
   rbs_cs_initialize();
   const double cpu0 = _thread_cpu_seconds();
 
@@ -1218,6 +1373,7 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
   const double d = cs_lagr_particle_get_real(particle, p_am, CS_LAGR_DIAMETER);
   const double weight = cs_lagr_particle_get_real(particle, p_am,
                                                   CS_LAGR_STAT_WEIGHT);
+  const double mass = cs_lagr_particle_get_real(particle, p_am, CS_LAGR_MASS);
   const cs_lnum_t cell_id = cs_lagr_particle_get_lnum(particle, p_am,
                                                       CS_LAGR_CELL_ID);
   const cs_real_t *cell_cen = cs_glob_mesh_quantities->cell_cen + 3*cell_id;
@@ -1366,6 +1522,20 @@ cs_lagr_user_boundary_interaction(cs_lagr_particle_set_t    *particles,
     zc[ZC_OUTSIDE_LAW] += speed < table->law_lo || speed > table->law_hi;
     if (below || above || alpha1_out)
       _count.outside_grid++;
+
+    /* The work on the wall (docs/model.md §4.7), J/kg; a table of format 4.0
+       holds none (NaN): such a hit is counted, and left out of the sums */
+    const double wn = result.wall_work_normal;
+    const double wt = result.wall_work_tangential;
+    if (isfinite(wn) && isfinite(wt)) {
+      double *zw = _zone_work + (size_t)b_zone_id*ZW_N;
+      zw[ZW_NORMAL] += weight*mass*wn;
+      zw[ZW_TANGENTIAL] += weight*mass*wt;
+      zw[ZW_MASS] += weight*mass;
+      _stat_add(face_id, weight, mass, wn, wt);
+    }
+    else
+      zc[ZC_NO_WORK]++;
   }
 
   if (status == RBS_OK) {

@@ -28,7 +28,9 @@
  * Use: put rbs_cs_rebound.c and this header in the case's SRC folder, give
  * the walls the zone type CS_LAGR_BC_USER in cs_user_lagr_boundary_conditions
  * and call rbs_cs_initialize() there after the zone types, call
- * rbs_cs_finalize() from cs_user_extra_operations_finalize, and link the C
+ * rbs_cs_finalize() from cs_user_extra_operations_finalize (and, for the
+ * boundary statistics of the work on the walls, rbs_cs_define_statistics()
+ * from cs_user_lagr_model), and link the C
  * runtime (code_saturne compile --cflags=-I<prefix>/include
  *  --libs="-L<prefix>/lib -lrebound_scatter -Wl,-rpath,<prefix>/lib").
  * The settings, global and per boundary zone, are read from a key = value
@@ -48,9 +50,21 @@ extern "C" {
  * value and what is allowed. */
 void rbs_cs_initialize(void);
 
-/* The counts summed over the ranks, in total and per zone, written to the
- * solver's log; the hits files closed and the tables released. Collective:
- * call it on every rank. */
+/* Define the adapter's boundary statistics, per boundary face over the
+ * hits a table or the direct model answered with work on the wall (a table
+ * of format 4.0 gives none): the work on the wall,
+ * rbs_wall_work_normal and rbs_wall_work_tangential (statistical weight x
+ * particle mass x W_n, W_t, J), the mass that hit, rbs_wall_hit_mass
+ * (weight x mass, kg), and the hits, rbs_wall_hits (weight). Lagrangian
+ * statistics of 6.0 (cs_lagr_stat_mesh_define): postprocessed on the
+ * boundary and logged; per time step, or summed from the step nstist with
+ * steady statistics (isttio = 1). Call it from cs_user_lagr_model; optional
+ * (the summary's work does not need it). */
+void rbs_cs_define_statistics(void);
+
+/* The counts and the work on the walls summed over the ranks, in total and
+ * per zone, written to the solver's log; the hits files closed and the
+ * tables released. Collective: call it on every rank. */
 void rbs_cs_finalize(void);
 
 #ifdef __cplusplus

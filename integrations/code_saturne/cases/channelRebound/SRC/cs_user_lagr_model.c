@@ -1,5 +1,6 @@
 /*============================================================================
- * channelRebound: one-way coupled particle tracking, first-order in time
+ * channelRebound: one-way coupled particle tracking, first-order in time;
+ * the boundary statistics
  *
  * Copyright (C) 2026 the rebound-scatter authors
  *
@@ -23,6 +24,9 @@
 
 #include "cs_lagr.h"
 #include "cs_lagr_prototypes.h"
+#include "cs_lagr_stat.h"
+
+#include "rbs_cs_rebound.h"
 
 BEGIN_C_DECLS
 
@@ -31,8 +35,14 @@ cs_user_lagr_model(void)
 {
   cs_glob_lagr_time_scheme->iilagr = CS_LAGR_ONEWAY_COUPLING;
   cs_glob_lagr_time_scheme->isuila = 0;
-  cs_glob_lagr_time_scheme->isttio = 0;
   cs_glob_lagr_model->physical_model = 0;
+
+  /* the air is at rest: steady statistics, summed from the first step to
+     the last, among them rebound-scatter's work on the walls */
+  cs_glob_lagr_time_scheme->isttio = 1;
+  cs_glob_lagr_stat_options->idstnt = 1;
+  cs_glob_lagr_stat_options->nstist = 1;
+  rbs_cs_define_statistics();
 
   /* laminar air: no turbulent dispersion; one step per time step, so that
      each wall hit is met once */
