@@ -1,4 +1,4 @@
-"""The small table an example builds for itself when it is given none (examples/rough_wall.py,
+"""The small table an example builds for itself when it is given none (examples/rough_wall.py, wall_work.py,
 examples/grain_key_paths.py)."""
 
 from pathlib import Path

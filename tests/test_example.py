@@ -7,7 +7,6 @@ incident states, straight-line motion before and after the hit, and the
 whole script on a small table.
 """
 
-import importlib.util
 import math
 from pathlib import Path
 
@@ -15,6 +14,7 @@ import numpy as np
 import pytest
 
 import surrogate
+from tests.helpers.examples import example_module
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "particle_beam.py"
 N = 2000
@@ -23,10 +23,7 @@ ANGLE = 30.0                                    # wall beam, degrees from the wa
 
 @pytest.fixture(scope="module")
 def beam():
-    spec = importlib.util.spec_from_file_location("particle_beam", EXAMPLE)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_module(EXAMPLE)
 
 
 def _wall_run(beam, table, model, e=0.5, seed=3):

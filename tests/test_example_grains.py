@@ -1,6 +1,5 @@
 """examples/grains: the script writes the shipped grains again, and every one is a valid grain of its config."""
 
-import importlib.util
 import tomllib
 from pathlib import Path
 
@@ -8,16 +7,14 @@ import numpy as np
 import pytest
 
 from tablegen.tabulation.shape_config import parse_shape_sections
+from tests.helpers.examples import example_module
 
 FOLDER = Path(__file__).resolve().parents[1] / "examples" / "grains"
 
 
 @pytest.fixture(scope="module")
 def make_grains():
-    spec = importlib.util.spec_from_file_location("make_grains", FOLDER / "make_grains.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_module(FOLDER / "make_grains.py")
 
 
 def _vertex_lines(path):
@@ -51,9 +48,7 @@ def test_every_grain_of_the_config_is_irregular_and_convex(make_grains):
 def test_the_law_figure_draws_every_shape(tmp_path, capsys):
     """plot_law.py with 300 particles a shape: a PNG, and a line for each family and each grain of the config."""
     pytest.importorskip("matplotlib")
-    spec = importlib.util.spec_from_file_location("plot_law", FOLDER / "plot_law.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = example_module(FOLDER / "plot_law.py")
     out = tmp_path / "law.png"
     assert module.main(["--n", "300", "--out", str(out)]) == 0
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -1,15 +1,10 @@
 """examples/rough_wall.py runs on any table of the four families and reports every case (docs/model.md §12)."""
 
-import importlib.util
-
-from tests.helpers import REPO
+from tests.helpers.examples import EXAMPLES, example_module
 
 
-def test_the_rough_wall_example_reports_every_case(small_table_path, tmp_path, capsys, monkeypatch):
-    monkeypatch.syspath_prepend(str(REPO / "examples"))        # as when run as a script: its helper module beside it
-    spec = importlib.util.spec_from_file_location("rough_wall", REPO / "examples" / "rough_wall.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+def test_the_rough_wall_example_reports_every_case(small_table_path, tmp_path, capsys):
+    module = example_module(EXAMPLES / "rough_wall.py")
     figure = tmp_path / "rough.png"
     assert module.main(["--table", str(small_table_path), "--n", "200", "--figure", str(figure)]) == 0
     rows = [line.split() for line in capsys.readouterr().out.splitlines() if line[:6].strip().isdigit()]
