@@ -69,10 +69,18 @@ RBS_INLINE void rbs_velocity(double alpha2, double beta2, double s, double v[3])
 /* The factors of rbs_to_speed (surrogate.kernels.arithmetic.speed_factors): whether the regime is 0 (returned), the
  * factor *f of V⁺ − V⁻ (regime 0) or of the normal rebound velocity (regime 1), the factor *g of the spin and of
  * V⁺ − V⁻ off the normal. */
+/* The wall law's normal restitution a = 1 − (1 − f) sin α1 at the incident and the drawn grid speed, from its factors f
+ * there (surrogate.kernels.arithmetic.restitutions) */
+RBS_INLINE void rbs_restitutions(double f_target, double f_grid, double sin_alpha1, double *a_target, double *a_grid)
+{
+    *a_target = 1.0 - (1.0 - f_target) * sin_alpha1;
+    *a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1;
+}
+
 RBS_INLINE int rbs_speed_factors(double regime, double f_target, double f_grid, double sin_alpha1, double *f, double *g)
 {
-    double a_target = 1.0 - (1.0 - f_target) * sin_alpha1;
-    double a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1;
+    double a_target, a_grid;
+    rbs_restitutions(f_target, f_grid, sin_alpha1, &a_target, &a_grid);
     int few = regime == 0.0;
     *f = few ? (1.0 + a_target) / (1.0 + a_grid) : a_target / a_grid;
     *g = few ? *f : 1.0;

@@ -14,6 +14,19 @@
 
 /* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
  * returns the status (NaN state when trapped; RBS_INVALID for a draw rbs_drawn_ok refuses). */
+/* The chain's folded state of a draw in `cell`, moved in place to the incident α1 when `scaled` and wa > 0
+ * (surrogate.kernels.arithmetic.at_alpha1) */
+RBS_INLINE void rbs_at_alpha1(const rbs_table *t, const rbs_cell *cell, int scaled, double state[6])
+{
+    if (scaled && cell->wa > 0.0) {
+        rbs_term terms[6];
+        double moved[6];
+        rbs_alpha1_terms(t, cell->below, cell->wa, cell->drawn, terms);
+        rbs_moved(state, terms, moved);
+        for (int k = 0; k < 6; k++) state[k] = moved[k];
+    }
+}
+
 RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
                                    const double *u, int scaled, double x[6])
 {
@@ -28,13 +41,7 @@ RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double
     for (int k = 0; k < 15; k++) b[k] = (double)r[row + ROW_SLOPE + k];
     rbs_chain(q, b, state);
     double regime = (double)r[row + ROW_REGIME];
-    if (scaled && cell->wa > 0.0) {
-        rbs_term terms[6];
-        double moved[6];
-        rbs_alpha1_terms(t, cell->below, cell->wa, cell->drawn, terms);
-        rbs_moved(state, terms, moved);
-        for (int k = 0; k < 6; k++) state[k] = moved[k];
-    }
+    rbs_at_alpha1(t, cell, scaled, state);
     rbs_velocity(state[0], state[1], state[2], x);
     x[3] = state[3];
     x[4] = state[4];

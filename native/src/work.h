@@ -5,18 +5,17 @@
  *
  * A table of format 4.1 continues each component's chain with two work variables, the rotational energy fraction
  * r = E_Ω⁺/E⁻ and the root of the normal share ν = √(W_n/(W_n + W_t)): each its residual quantile plus slopes on
- * the draw's chain variables (and r). The work is what the drawn rebound's energy leaves, W = E⁻ (1 − s² − r),
- * W_n = ν² W, W_t = (1 − ν)(1 + ν) W; between grid points r and ν move with the draw. Their two residual uniforms are keyed uniforms of the hit's
- * work key, so the work takes nothing of the caller's stream. Same operations, same order, fma() where numba fuses.
+ * the draw's chain variables (and r). The work is what the drawn rebound's energy leaves, W = E⁻ (1 − s² − r), with
+ * W_n = ν² W at the drawn grid speed; between grid points r and ν move with the draw, and between grid speeds W is
+ * split in the proportion of W_n times (1 − a(V)²)/(1 − a(V_j)²) to W_t times W(V)/W(V_j). Their two residual uniforms are keyed uniforms of the hit's work key, so the work
+ * takes nothing of the caller's stream. Same operations, same order, fma() where numba fuses.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
 #ifndef RBS_WORK_H
 #define RBS_WORK_H
 
-#include "arithmetic.h"
-#include "gather.h"
-#include "locate.h"
+#include "draw.h"
 #include "rng_internal.h"
 
 #define RBS_WORK_DOMAIN 0xBB67AE8584CAA73Bull     /* the work keys' start (surrogate.kernels.work._WORK_DOMAIN) */
@@ -60,6 +59,12 @@ RBS_INLINE void rbs_work_variables(const rbs_table *t, int64_t cell, int64_t row
     *nu_out = rbs_root_share(nu);
 }
 
+/* x if x > 0, else 0 */
+RBS_INLINE double rbs_positive(double x)
+{
+    return x > 0.0 ? x : 0.0;
+}
+
 /* (W_n, W_t), m²/s², of a trapped draw in cell number `drawn` at |V⁻| = speed m/s: its cell's trapped particles'
  * mean */
 RBS_INLINE void rbs_trapped_work(const rbs_table *t, int64_t drawn, double speed, double work[2])
@@ -101,17 +106,31 @@ RBS_INLINE void rbs_table_work(const rbs_table *t, const rbs_cell *cell, int sta
         r = fabs(rbs_shifted(r, r_term));
         nu = rbs_root_share(rbs_shifted(nu, nu_term));
     }
+    double s2 = rbs_speed_ratio_squared(x);
+    double normal = nu * nu, tangential = (1.0 - nu) * (1.0 + nu);     /* the weights of the split of W */
     if (scaled && cell->wv > 0.0) {
-        /* the spin of a regime-0 draw scales by g, so r by g² */
-        double f_target, f_grid, f, g;
+        /* between grid speeds W_n moves as one collision's normal work, ½ m_eff v_c²(1 − a²); W_t with W */
+        rbs_at_alpha1(t, cell, scaled, state);
+        double s0 = state[2];                                           /* s at the drawn grid speed */
+        double grid_total = 1.0 - s0 * s0 - r;
+        double f_target, f_grid, f, g, a_target, a_grid;
         rbs_restitution_factors(t, cell->jv, cell->wv, cell->iv, &f_target, &f_grid);
         rbs_speed_factors((double)c[row + ROW_REGIME], f_target, f_grid, sin_alpha1, &f, &g);
+        rbs_restitutions(f_target, f_grid, sin_alpha1, &a_target, &a_grid);
         r *= g * g;
+        double left = 1.0 - s2 - r;
+        normal *= (1.0 - a_target) * (1.0 + a_target) / ((1.0 - a_grid) * (1.0 + a_grid)) * rbs_positive(grid_total);
+        tangential *= rbs_positive(left);
     }
-    double left = 1.0 - rbs_speed_ratio_squared(x) - r;
-    double total = left > 0.0 ? 0.5 * speed * speed * left : 0.0;
-    work[0] = total * (nu * nu);
-    work[1] = total * ((1.0 - nu) * (1.0 + nu));
+    double total = rbs_positive(1.0 - s2 - r);
+    double weights = normal + tangential;
+    if (!(weights > 0.0)) {
+        work[0] = work[1] = 0.0;
+        return;
+    }
+    double energy = 0.5 * speed * speed;
+    work[0] = energy * (total * normal / weights);
+    work[1] = energy * (total * tangential / weights);
 }
 
 #endif /* RBS_WORK_H */

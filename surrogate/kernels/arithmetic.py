@@ -88,11 +88,29 @@ def _velocity(alpha2, beta2, s):
 
 
 @numba.njit(inline="always", **JIT)
+def at_alpha1(gathered, scaled):
+    """The folded state (state order) of the draw of the ``gathered`` values (:func:`surrogate.kernels.gather.gather`)
+    at its grid speed: the chain (:func:`_chain`), then with ``scaled`` the move to the incident α1 when wa > 0
+    (:func:`_moved`)."""
+    q, slopes, _, _, _, wa, _, ratio, shift, _, _ = gathered
+    state = _chain(q, slopes)
+    terms = ((ratio[0], shift[0], shift[1]), (ratio[1], 0.0, 0.0), (ratio[2], shift[2], shift[3]),
+             (ratio[3], 0.0, 0.0), (ratio[4], 0.0, 0.0), (ratio[5], shift[4], shift[5]))
+    return _pick6(scaled and wa > 0.0, _moved(state, terms), state)
+
+
+@numba.njit(inline="always", **JIT)
+def restitutions(f_target, f_grid, sin_alpha1):
+    """(a(V), a(V_iv)): the wall law's normal restitution a = 1 − (1 − f) sin α1 at the incident and the drawn grid
+    speed, from its factors f there (:func:`to_speed`)."""
+    return 1.0 - (1.0 - f_target) * sin_alpha1, 1.0 - (1.0 - f_grid) * sin_alpha1
+
+
+@numba.njit(inline="always", **JIT)
 def speed_factors(regime, f_target, f_grid, sin_alpha1):
     """(few, f, g) of :func:`to_speed`: whether the regime is 0; the factor f of V⁺ − V⁻ (regime 0) or of the
     normal rebound velocity (regime 1); the factor g of the spin and of V⁺ − V⁻ off the normal."""
-    a_target = 1.0 - (1.0 - f_target) * sin_alpha1
-    a_grid = 1.0 - (1.0 - f_grid) * sin_alpha1
+    a_target, a_grid = restitutions(f_target, f_grid, sin_alpha1)
     # both laws computed, the regime's picked by selects: the regime varies from draw to draw, a branch
     # on it would be mispredicted often
     few = regime == 0.0
@@ -163,10 +181,7 @@ def arithmetic(gathered, cos_alpha1, sin_alpha1, scaled):
     as SIMD instructions.
     """
     q, slopes, regime, trapped, mirror, wa, wv, ratio, shift, f_target, f_grid = gathered
-    state = _chain(q, slopes)
-    terms = ((ratio[0], shift[0], shift[1]), (ratio[1], 0.0, 0.0), (ratio[2], shift[2], shift[3]),
-             (ratio[3], 0.0, 0.0), (ratio[4], 0.0, 0.0), (ratio[5], shift[4], shift[5]))
-    state = _pick6(scaled and wa > 0.0, _moved(state, terms), state)
+    state = at_alpha1(gathered, scaled)
     vx, vy, vz = _velocity(state[0], state[1], state[2])
     local = (vx, vy, vz, state[3], state[4], state[5])
     moved = to_speed(regime, f_target, f_grid, cos_alpha1, sin_alpha1, vx, vy, vz, state[3], state[4], state[5])

@@ -6,11 +6,14 @@ the rotational energy fraction r = E_Ω⁺/E⁻ and the root of the normal share
 residual quantile plus slopes on the chain variables of the draw (and r). The work is then what the drawn
 rebound's energy leaves, W = W_n + W_t = E⁻ (1 − s² − r) with E⁻ = |V⁻|²/2 (tables are built with Ω⁻ = 0) and
 s = |V⁺|/|V⁻| of the rebound returned, so energy is conserved draw by draw whatever the move between grid
-points; W_n = ν² W, W_t = (1 − ν)(1 + ν) W. The root, because near grazing incidence W_n is a thousandth of W and
+points; at the drawn grid speed W_n = ν² W. The root, because near grazing incidence W_n is a thousandth of W and
 follows the normal velocity: its root is nearly linear in the state, as the chain needs. Between grid points r
-and ν move with the draw: in α1 to their interpolated means and standard deviations, like the
-state; in |V⁻| the spin of a regime-0 draw scales by g (:func:`surrogate.kernels.arithmetic.speed_factors`),
-so r by g². A trapped draw does its cell's trapped particles' mean work.
+and ν move with the draw: in α1 to their interpolated means and standard deviations, like the state. In |V⁻|
+the spin of a regime-0 draw scales by g (:func:`surrogate.kernels.arithmetic.speed_factors`), so r by g², and W
+is split in the proportion of W_n at the grid speed times (1 − a(V)²)/(1 − a(V_j)²), one collision's normal work
+½ m_eff v_c²(1 − a²) at the wall law's normal restitution a (:func:`surrogate.kernels.arithmetic.restitutions`), to
+W_t at the grid speed times W(V)/W(V_j): near grazing W_n then moves as one collision's, near normal impact W_t
+as W does. A trapped draw does its cell's trapped particles' mean work.
 
 Random numbers: the two residual uniforms are keyed uniforms (:func:`surrogate.kernels.rng.grain_uniform`) of a
 hash of the hit's own uniforms (:func:`work_key`), so the work takes nothing of the caller's stream: a rebound
@@ -23,7 +26,8 @@ import numpy as np
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import N_CHAIN, N_WORK
 from direct_model.elementary import fma
-from surrogate.kernels.arithmetic import OUT_S2, OUT_STATUS, _chain, speed_factors, speed_ratio_squared
+from surrogate.kernels.arithmetic import (OUT_S2, OUT_STATUS, _chain, at_alpha1, restitutions, speed_factors,
+                                         speed_ratio_squared)
 from surrogate.kernels.block import field, uniforms
 from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.fastmath import clamp_index
@@ -106,12 +110,29 @@ def drawn_work(data, cell, row, gathered, status, s2, sin_alpha1, speed, key, sc
                               WORK_CELL_INV_SD)
         r = abs(fma(r - r_term[1], r_term[0], r_term[2]))
         nu = _root_share(fma(nu - nu_term[1], nu_term[0], nu_term[2]))
+    normal, tangential = nu * nu, (1.0 - nu) * (1.0 + nu)     # the weights of the split of W: ν², 1 − ν²
     if scaled and wv > 0.0:
+        # between grid speeds W_n moves as one collision's normal work, ½ m_eff v_c²(1 − a²); W_t with W
+        s0 = at_alpha1(gathered, scaled)[2]         # s at the drawn grid speed
+        grid_total = 1.0 - s0 * s0 - r
         g = speed_factors(regime, f_target, f_grid, sin_alpha1)[2]
+        a_target, a_grid = restitutions(f_target, f_grid, sin_alpha1)
         r *= g * g
-    left = 1.0 - s2 - r
-    work = 0.5 * speed * speed * left if left > 0.0 else 0.0
-    return work * (nu * nu), work * ((1.0 - nu) * (1.0 + nu))
+        left = 1.0 - s2 - r
+        normal *= (1.0 - a_target) * (1.0 + a_target) / ((1.0 - a_grid) * (1.0 + a_grid)) * _positive(grid_total)
+        tangential *= _positive(left)
+    total = _positive(1.0 - s2 - r)
+    weights = normal + tangential
+    if not weights > 0.0:
+        return 0.0, 0.0
+    energy = 0.5 * speed * speed
+    return energy * (total * normal / weights), energy * (total * tangential / weights)
+
+
+@numba.njit(inline="always", **JIT)
+def _positive(x):
+    """x if x > 0, else 0."""
+    return x if x > 0.0 else 0.0
 
 
 @numba.njit(inline="always", **JIT)

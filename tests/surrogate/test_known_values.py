@@ -156,10 +156,10 @@ DRAWS = {
 
 # per path with a hit record: (W_n, W_t) in m²/s² for each row of U, the work on the wall of the draws above
 WORK = {
-    "table": [("0x1.8fbe70c77eaf8p+10", "0x1.1080e22b4d244p+10"), ("0x1.9f044008d8092p+10", "0x1.bec8427d4a404p+9")],
+    "table": [("0x1.8df98a500db48p+10", "0x1.1245c8a2be1f4p+10"), ("0x1.a179a5c0bd44ep+10", "0x1.b9dd770d7fc8bp+9")],
     "direct": [("0x1.e963a9f10cb8ep+10", "0x1.4df3b9fc7d525p+5"), ("0x1.12096f2d7071cp+11", "0x1.ff2f769f15ff5p+5")],
-    "keyed_table": [("0x1.05e5c191d648fp+11", "0x1.34987278ab7d6p+9"),
-                    ("0x1.a5156e6e0f286p+10", "0x1.b1de6d9e6e681p+9")],
+    "keyed_table": [("0x1.03dab71bdbd80p+11", "0x1.3cc49c509540fp+9"),
+                    ("0x1.a77f79ad85f3fp+10", "0x1.ad0a571f80d0dp+9")],
 }
 
 
