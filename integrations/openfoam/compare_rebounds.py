@@ -1,8 +1,9 @@
 """Compare the rebounds an OpenFOAM run applied with the Python implementations, the stock bounce and,
-for erosion, a run with the stock bounce.
+for erosion, a run with the stock bounce; map the work of its hits on the walls beside the stock erosion.
 
     python compare_rebounds.py CASE [--table T.h5] [--png FILE.png] [--json FILE.json] [--check]
                                [--no-classifier] [--erosion-against SPECULAR_CASE [--erosion-png FILE.png]]
+                               [--work-png FILE.png]
 
 This file holds what is OpenFOAM's: the readers of the per-hit records the stochasticRebound adapter wrote
 (CASE/postProcessing/lagrangian/<cloud>/stochasticRebound/hits_<rank>.csv: incident velocity relative to
@@ -28,7 +29,13 @@ their bounds). The script:
 4. plots the table's hits against the sampler and the specular line, and the spinning hits against the
    direct model and the table alone (--png);
 5. with --erosion-against, reads OpenFOAM's particleErosion field of both runs and maps the volume each
-   wall face lost side by side (--erosion-png).
+   wall face lost side by side (--erosion-png);
+6. with --work-png, reads the adapter's work fields of the run (<cloud>:stochasticReboundWorkNormal,
+   ...WorkTangential, J per wall face, and ...Hits) and its particleErosion field, prints where each one's
+   maximum sits, the totals and Spearman's rank correlation of W_t and W_n with Q over the faces hit, and
+   maps W_t, W_n and Q side by side (a serial run: the fields of the case's last time folder). The wall
+   work records (wallWork_<rank>.csv, a row per row of the hits files: the face, the mass and W_n, W_t of
+   each hit) are read by ``read_wall_work``.
 
 --check exits with status 1 if a bound of 1 or 2 is not met.
 
@@ -59,9 +66,16 @@ PATCH_SUMMARY = {"hits": "hits", "rebounded": "rebounded", "stuck": "stuck", "re
                  "escaped": "escaped", "invalid": "invalid", "trapped": "trapped", "failed": "failed",
                  "table": "table", "direct": "direct", "speed_below": "|V|<grid", "speed_above": "|V|>grid",
                  "alpha1_outside": "alpha1-out", "outside_law": "out-of-law", "hit_again": "hit-again",
-                 "at_cap": "at-cap"}
-# the counts of a log written before rough walls: neither hit-again nor at-cap, nor the roughness column
-_PATCH_SUMMARY_SMOOTH = dict(list(PATCH_SUMMARY.items())[:-2])
+                 "at_cap": "at-cap", "no_work": "no-work"}
+# the counts of a log written before the work on the wall (no no-work column, nor the mean work per hit), and
+# before rough walls (neither hit-again nor at-cap, nor the roughness column)
+_PATCH_SUMMARY_ROUGH = dict(list(PATCH_SUMMARY.items())[:-1])
+_PATCH_SUMMARY_SMOOTH = dict(list(PATCH_SUMMARY.items())[:-3])
+# the mean work on the wall per hit (J/kg) of the summary's last columns: key -> column name
+PATCH_SUMMARY_WORK = {"work_normal_mean": "Wn/hit", "work_tangential_mean": "Wt/hit"}
+# the work fields' names after the cloud's name and a colon (volScalarFields, J and a count of hits per face)
+WORK_FIELDS = {"normal": "stochasticReboundWorkNormal", "tangential": "stochasticReboundWorkTangential",
+               "hits": "stochasticReboundHits"}
 
 
 # ----------------------------------------------------------------------------- reading
@@ -134,26 +148,30 @@ def _table_of(settings: dict, table_path: Path | None) -> Path:
 
 def patch_summary(log: str) -> dict:
     """The adapter's per-patch counts at the last time step of a solver log: patch name -> the counts of
-    :data:`PATCH_SUMMARY`'s columns by key, ``roughness``, the wall's roughness Δγ in degrees (None for a patch
-    that does not draw), and ``interaction``, what the patch does. A log written before rough walls has
-    neither ``hit_again``, ``at_cap`` nor ``roughness``."""
+    :data:`PATCH_SUMMARY`'s columns by key, ``roughness``, the wall's roughness Δγ in degrees, the mean work on
+    the wall per hit with work of :data:`PATCH_SUMMARY_WORK` (J/kg; each None for a patch that does not draw,
+    the means also where no hit gave work), and ``interaction``, what the patch does. A log written before the
+    work on the wall has neither ``no_work`` nor the means, one written before rough walls neither
+    ``hit_again``, ``at_cap`` nor ``roughness``."""
     block = log[log.rindex("    Per patch ("):].splitlines()
     header = block[1].split()
-    if header == ["patch", *_PATCH_SUMMARY_SMOOTH.values(), "interaction"]:
-        columns, roughness = _PATCH_SUMMARY_SMOOTH, ""
-    elif header == ["patch", *PATCH_SUMMARY.values(), "roughness", "interaction"]:
-        columns, roughness = PATCH_SUMMARY, r"\s+(\S+)"
+    layouts = ((_PATCH_SUMMARY_SMOOTH, ()), (_PATCH_SUMMARY_ROUGH, ("roughness",)),
+               (PATCH_SUMMARY, ("roughness", *PATCH_SUMMARY_WORK)))
+    for columns, extra in layouts:
+        names = [PATCH_SUMMARY_WORK.get(key, key) for key in extra]
+        if header == ["patch", *columns.values(), *names, "interaction"]:
+            break
     else:
         raise ValueError(f"not the per-patch summary's columns: {block[1]!r}")
     out = {}
     for line in block[2:]:
-        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(columns)}}}){roughness}  (.*)$", line)
+        m = re.match(rf"\s+(\S+)((?:\s+\d+){{{len(columns)}}})((?:\s+\S+){{{len(extra)}}})  (.*)$", line)
         if m is None:
             break
         counts = dict(zip(columns, map(int, m.group(2).split())))
-        if roughness:
-            counts["roughness"] = None if m.group(3) == "-" else float(m.group(3))
-        out[m.group(1)] = dict(counts, interaction=m.group(m.lastindex))
+        for key, value in zip(extra, m.group(3).split()):
+            counts[key] = None if value == "-" else float(value)
+        out[m.group(1)] = dict(counts, interaction=m.group(4))
     return out
 
 
@@ -408,30 +426,48 @@ def _foam_list(text: str, what: str) -> list:
     return [e.split() for e in entries]
 
 
-def wall_face_centres(case: Path, patch: str) -> np.ndarray:
-    """(n_faces, 3) centres (vertex means, m) of the faces of ``patch``, from the case's ASCII polyMesh."""
+def wall_faces(case: Path, patch: str) -> list:
+    """The faces of ``patch``, each an (n_vertices, 3) array of its vertices (m), from the case's ASCII polyMesh."""
     mesh = case / "constant" / "polyMesh"
     points = np.array(_foam_list((mesh / "points").read_text(), "points"), dtype=float)
     faces = _foam_list((mesh / "faces").read_text(), "faces")
     block = re.search(rf"\n\s*{re.escape(patch)}\s*\{{([^}}]*)\}}", (mesh / "boundary").read_text()).group(1)
     start = int(re.search(r"startFace\s+(\d+);", block).group(1))
     count = int(re.search(r"nFaces\s+(\d+);", block).group(1))
-    return np.array([points[np.array(faces[f], dtype=int)].mean(axis=0) for f in range(start, start + count)])
+    return [points[np.array(faces[f], dtype=int)] for f in range(start, start + count)]
+
+
+def wall_face_centres(case: Path, patch: str) -> np.ndarray:
+    """(n_faces, 3) centres (vertex means, m) of the faces of ``patch``, from the case's ASCII polyMesh."""
+    return np.array([vertices.mean(axis=0) for vertices in wall_faces(case, patch)])
+
+
+def read_patch_field(case: Path, field: str, patch: str, time: str | None = None) -> np.ndarray:
+    """The values on the faces of ``patch`` of the ASCII volScalarField ``field`` at ``time`` (a time folder's
+    name; default the last one that holds the field) of ``case``: a case folder, or a processor folder of a
+    decomposed run (its own mesh and time folders)."""
+    if time is None:
+        times = [p for p in case.iterdir() if re.fullmatch(r"[0-9.e+-]+", p.name) and (p / field).is_file()]
+        if not times:
+            raise FileNotFoundError(f"{case}: no field {field} in a time folder")
+        time = max(times, key=lambda p: float(p.name)).name
+    text = (case / time / field).read_text()
+    block = text[re.search(rf"\n\s*{re.escape(patch)}\s*\n\s*\{{", text).end():]
+    m = re.search(r"value\s+(uniform\s+([-0-9.eE+]+)|nonuniform\s+List<scalar>\s*(\d+)\s*\(([^)]*)\))", block)
+    if m.group(2) is not None:
+        boundary = (case / "constant" / "polyMesh" / "boundary").read_text()
+        entry = re.search(rf"\n\s*{re.escape(patch)}\s*\{{([^}}]*)\}}", boundary).group(1)
+        return np.full(int(re.search(r"nFaces\s+(\d+);", entry).group(1)), float(m.group(2)))
+    values = np.array(m.group(4).split(), dtype=float)
+    if len(values) != int(m.group(3)):
+        raise ValueError(f"{case / time / field}: {patch} holds {len(values)} values, not {m.group(3)}")
+    return values
 
 
 def read_erosion(case: Path, patch: str = "walls", cloud: str = "kinematicCloud") -> np.ndarray:
     """The volume each face of ``patch`` lost (m³), from OpenFOAM's particleErosion field <cloud>Q at the
     last write time of a serial run."""
-    times = [p for p in case.iterdir() if re.fullmatch(r"[0-9.e+-]+", p.name) and (p / f"{cloud}Q").is_file()]
-    if not times:
-        raise FileNotFoundError(f"{case}: no {cloud}Q field (particleErosion) in a time folder")
-    text = (max(times, key=lambda p: float(p.name)) / f"{cloud}Q").read_text()
-    block = text[re.search(rf"\n\s*{re.escape(patch)}\s*\n\s*\{{", text).end():]
-    m = re.search(r"value\s+(uniform\s+([-0-9.eE+]+)|nonuniform\s+List<scalar>\s*(\d+)\s*\(([^)]*)\))", block)
-    if m.group(2) is not None:
-        n_faces = len(wall_face_centres(case, patch))
-        return np.full(n_faces, float(m.group(2)))
-    return np.array(m.group(4).split(), dtype=float)
+    return read_patch_field(case, f"{cloud}Q", patch)
 
 
 def erosion_summary(case: Path, patch: str = "walls") -> dict:
@@ -474,6 +510,164 @@ def plot_erosion(cases: dict, png: Path, patch: str = "walls") -> None:
     plt.close(fig)
 
 
+# ----------------------------------------------------------------------------- the work on the wall
+
+def read_wall_work(case: Path, hits: dict | None = None) -> dict:
+    """The adapter's wall work records (``wallWork_<rank>.csv`` beside the hits files, row i of a rank's file for
+    row i of its hits file), all ranks in rank order as :func:`read_hits` reads theirs: columns origProc, origId,
+    patch, face (the face hit, its index in the patch), mass (the parcel's particles', kg) and Wn, Wt (the work
+    on the wall per unit particle mass, J/kg; NaN for an invalid hit, a stock rebound, a table of format 4.0).
+    With ``hits`` (:func:`read_hits` of the case), ValueError unless the rows are the same hits."""
+    folder = hits_dir(case)
+    files = [folder / f.name.replace("hits_", "wallWork_") for f in rank_files(folder)]
+    rows = []
+    for f in files:
+        with open(f) as fh:
+            if not fh.readline().startswith(f"# {HITS_TITLE} wall work:"):
+                raise ValueError(f"{f}: line 1 is not a wall work header")
+            if fh.readline().strip() != "origProc,origId,patch,face,mass,Wn,Wt":
+                raise ValueError(f"{f}: line 2 is not the wall work columns")
+            rows += [line.rstrip("\n").split(",") for line in fh if line.strip()]
+    columns = list(zip(*rows)) if rows else [()] * 7
+    work = {"origProc": np.array(columns[0], dtype=np.int64), "origId": np.array(columns[1], dtype=np.int64),
+            "patch": np.array(columns[2], dtype=object), "face": np.array(columns[3], dtype=np.int64),
+            "mass": np.array(columns[4], dtype=float), "Wn": np.array(columns[5], dtype=float),
+            "Wt": np.array(columns[6], dtype=float)}
+    if hits is not None:
+        same = len(work["face"]) == len(hits["patch"]) and all(
+            np.array_equal(work[name], hits[name]) for name in ("origProc", "origId", "patch"))
+        if not same:
+            raise ValueError(f"{folder}: the wall work records are not the rows of the hits files")
+    return work
+
+
+def face_sums(patch_names, faces, values, patch: str, n_faces: int) -> np.ndarray:
+    """Per face of ``patch`` (``n_faces``), the sum of ``values`` over the records on it (``patch_names`` and
+    ``faces`` of each record, as :func:`read_wall_work` gives them)."""
+    on = patch_names == patch
+    return np.bincount(faces[on], weights=values[on], minlength=n_faces)
+
+
+def wall_work_maps(case: Path, patches=("walls", "frontAndBack"), cloud: str = "kinematicCloud") -> dict:
+    """Per patch, at the last write time of a serial run: its faces' vertices and centres (m) and, per face, the
+    work fields (``normal``, ``tangential``: J; ``hits``) and particleErosion's ``Q`` (m³)."""
+    out = {}
+    for patch in patches:
+        maps = {key: read_patch_field(case, f"{cloud}:{name}", patch) for key, name in WORK_FIELDS.items()}
+        maps["Q"] = read_patch_field(case, f"{cloud}Q", patch)
+        faces = wall_faces(case, patch)
+        out[patch] = dict(maps, faces=faces, centres=np.array([f.mean(axis=0) for f in faces]))
+    return out
+
+
+def wall_work_summary(case: Path, patches=("walls", "frontAndBack"), cloud: str = "kinematicCloud") -> dict:
+    """The work on the walls of a serial run against particleErosion's Q, from the fields at its last write time:
+    per patch (and ``all``, over them) the faces and the faces hit, the totals of W_n and W_t (J) and of Q (m³),
+    the face of each one's maximum (its index, centre in m and value), and Spearman's rank correlation of W_t and
+    of W_n with Q over the faces hit."""
+    from scipy.stats import spearmanr
+    maps = wall_work_maps(case, patches, cloud)
+    maps["all"] = {key: np.concatenate([maps[p][key] for p in patches]) for key in maps[patches[0]] if key != "faces"}
+    out = {}
+    for patch, m in maps.items():
+        hit = m["hits"] > 0
+        s = {"faces": int(hit.size), "faces_hit": int(hit.sum()), "hits": int(m["hits"].sum())}
+        for key in ("normal", "tangential", "Q"):
+            i = int(np.argmax(m[key]))
+            s[key] = {"total": float(m[key].sum()), "max": float(m[key][i]), "max_face": i,
+                      "max_centre": m["centres"][i].tolist()}
+        for key in ("normal", "tangential"):
+            s[f"spearman_{key}_Q"] = float(spearmanr(m[key][hit], m["Q"][hit])[0])
+        out[patch] = s
+    return out
+
+
+def _xy_outlines(faces: list, centres: np.ndarray):
+    """The faces seen along z, one outline per point of the x-y plane (the faces across the depth share it):
+    (index of each face's outline, the outlines: a face edge-on, as the hopper's side walls are, a segment
+    between its extreme vertices, else its polygon)."""
+    keys, first, index = np.unique(np.round(centres[:, :2], 7), axis=0, return_index=True, return_inverse=True)
+    outlines = []
+    for i in first:
+        xy = faces[i][:, :2]
+        edge = xy - xy.mean(axis=0)
+        area = 0.5 * abs(np.dot(edge[:, 0], np.roll(edge[:, 1], 1)) - np.dot(edge[:, 1], np.roll(edge[:, 0], 1)))
+        if area < 1e-9 * np.ptp(xy, axis=0).max() ** 2:
+            far = np.argmax(np.linalg.norm(edge, axis=1))
+            xy = np.array([xy[far], xy[np.argmax(np.linalg.norm(xy - xy[far], axis=1))]])
+        outlines.append(xy)
+    return index.ravel(), outlines
+
+
+def plot_wall_work(case: Path, png: Path, patches=("walls", "frontAndBack"), cloud: str = "kinematicCloud") -> None:
+    """The work on the walls beside particleErosion's Q, from one serial run: a row per patch, the columns W_t,
+    W_n (J) and Q (m³), the patch seen along z (the hopper's side walls edge-on, its front and back planes face
+    on), each face's value summed with the faces behind it, on one log scale per column; grey, nothing. The
+    titles give each patch's total, the face of the maximum (circled) and Spearman's rank correlation with Q
+    over the faces hit (:func:`wall_work_summary`)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.colors import LogNorm
+    maps, summary = wall_work_maps(case, patches, cloud), wall_work_summary(case, patches, cloud)
+    columns = (("tangential", "$W_t$", "J", "tangential work on the wall, $W_t$ (J)"),
+               ("normal", "$W_n$", "J", "normal work on the wall, $W_n$ (J)"),
+               ("Q", "$Q$", "m³", "particleErosion's volume lost, $Q$ (m³)"))
+    views = {}
+    for patch in patches:
+        index, outlines = _xy_outlines(maps[patch]["faces"], maps[patch]["centres"])
+        views[patch] = (outlines, {key: np.bincount(index, weights=maps[patch][key]) for key, *_ in columns})
+    norms = {}
+    for key, *_ in columns:
+        positive = np.concatenate([v[key][v[key] > 0] for _, v in views.values()])
+        norms[key] = LogNorm(vmin=positive.min(), vmax=positive.max())
+    fig, axes = plt.subplots(len(patches), len(columns), figsize=(4.4 * len(columns), 5.0 * len(patches) + 1),
+                             squeeze=False, layout="constrained")
+    for row, patch in enumerate(patches):
+        outlines, values = views[patch]
+        s = summary[patch]
+        for col, (key, name, unit, label) in enumerate(columns):
+            ax, v = axes[row, col], values[key]
+            colours = plt.get_cmap("inferno_r")(norms[key](np.where(v > 0, v, norms[key].vmin)))
+            colours[v <= 0] = (0.85, 0.85, 0.85, 1.0)
+            if all(len(o) == 2 for o in outlines):
+                ax.add_collection(LineCollection(outlines, colors=colours, linewidths=5, capstyle="butt"))
+            else:
+                ax.add_collection(PolyCollection(outlines, facecolors=colours, edgecolors="none"))
+            ax.autoscale_view()
+            x, y, _ = s[key]["max_centre"]
+            ax.plot(x, y, "o", mfc="none", mec="tab:cyan", ms=12, mew=1.5)
+            ax.set_aspect("equal")
+            ax.set_xlabel("x (m)")
+            ax.set_ylabel("y (m)")
+            title = f"{patch}: {name} total {s[key]['total']:.3g} {unit}\nmax face (circled) at x {x:.3f}, y {y:.3f} m"
+            if key != "Q":
+                title += f"\nSpearman with $Q$ over the faces hit: {s[f'spearman_{key}_Q']:.2f}"
+            ax.set_title(title, fontsize=9)
+            if row == len(patches) - 1:
+                mappable = plt.cm.ScalarMappable(norm=norms[key], cmap="inferno_r")
+                fig.colorbar(mappable, ax=axes[:, col].tolist(), label=label, location="bottom", shrink=0.9)
+    fig.suptitle(f"{case.name}, stochasticRebound: the work of {summary['all']['hits']} hits on the walls beside "
+                 "particleErosion's $Q$ (Finnie), per face, summed across the depth", fontsize=10)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+
+
+def wall_work_report(summary: dict) -> str:
+    """:func:`wall_work_summary` in a few lines."""
+    lines = []
+    for patch, s in summary.items():
+        maxima = "; ".join(f"{key} max {s[key]['max']:.3g} at x {s[key]['max_centre'][0]:.3f}, y "
+                           f"{s[key]['max_centre'][1]:.3f}, z {s[key]['max_centre'][2]:.3f} m"
+                           for key in ("tangential", "normal", "Q"))
+        lines.append(f"wall work ({patch}): {s['hits']} hits on {s['faces_hit']} of {s['faces']} faces; W_n "
+                     f"{s['normal']['total']:.4g} J, W_t {s['tangential']['total']:.4g} J, Q {s['Q']['total']:.4g} "
+                     f"m3; Spearman W_t-Q {s['spearman_tangential_Q']:.3f}, W_n-Q {s['spearman_normal_Q']:.3f}; "
+                     f"{maxima}")
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("case", type=Path)
@@ -488,6 +682,8 @@ def main(argv=None) -> int:
     parser.add_argument("--erosion-against", type=Path, metavar="CASE",
                         help="a run of the same case with standardWallInteraction: compare the erosion of both")
     parser.add_argument("--erosion-png", type=Path, help="write the two erosion maps side by side here")
+    parser.add_argument("--work-png", type=Path,
+                        help="write the maps of the work on the walls (W_t, W_n) beside particleErosion's Q here")
     args = parser.parse_args(argv)
     try:
         res = compare(args.case, args.table, args.seed, classifier=not args.no_classifier, patches=args.patch)
@@ -516,6 +712,11 @@ def main(argv=None) -> int:
             plot_erosion({"standardWallInteraction (specular)": args.erosion_against,
                           f"stochasticRebound, method {res['settings']['method']}": args.case}, args.erosion_png)
             print(f"wrote {args.erosion_png}")
+    if args.work_png:
+        res["wall_work"] = wall_work_summary(args.case)
+        print(wall_work_report(res["wall_work"]))
+        plot_wall_work(args.case, args.work_png)
+        print(f"wrote {args.work_png}")
     if args.json:
         plain = {k: v.as_dict() if hasattr(v, "as_dict") else v for k, v in res.items() if not k.startswith("_")}
         args.json.write_text(json.dumps(plain, indent=2))

@@ -8,9 +8,11 @@ from the session's start), and checks the hit counts per path, the
 rebounds the table answered and those the direct model answered against
 surrogate on the same incident states (the BSD statistics of
 tablegen.study.solver_comparison, called through compare_rebounds), the random streams per rank, the grain
-each parcel keeps from hit to hit (grain kept), a moving wall, OpenFOAM's erosion model beside ours, a wall per
-patch (two tables, OpenFOAM's rebound, an open patch; the per-patch summary), a rough patch beside a smooth one
-and the refused patch entries, and times the runs against standardWallInteraction.
+each parcel keeps from hit to hit (grain kept), a moving wall, OpenFOAM's erosion model beside ours, the work of
+the hits on the walls (the fields per face against the hit records, on one and two ranks, over a restart, from a
+table without it), a wall per patch (two tables, OpenFOAM's rebound, an open patch; the per-patch summary), a
+rough patch beside a smooth one and the refused patch entries, and times the runs against
+standardWallInteraction.
 
 These tests need OpenFOAM: they fail (they are not skipped) when it is
 missing, with a message naming integrations/openfoam/install-deps.sh.
@@ -68,14 +70,18 @@ def _timings(case: Path) -> dict:
 
 def _cloud_info(log: str, cloud: str | None = None) -> dict:
     """The stochasticRebound counts of the last time step in a solver log (of ``cloud``'s block, where a solver has
-    several clouds), the incoming spin's mean and max, and the spin memory's: the hits with a remembered spin, the
-    parcels holding one and the hits that missed it (None where the summary has no such line)."""
+    several clouds), the work on the walls (J, normal and tangential) and the hits without it, the incoming spin's
+    mean and max, and the spin memory's: the hits with a remembered spin, the parcels holding one and the hits that
+    missed it (None where the summary has no such line)."""
     start = log.rindex(f"Cloud: {cloud}\n") if cloud else log.rindex("Stochastic rebound")
     block = log[log.index("Stochastic rebound", start):]
     block = block[:block.index("Per patch (")]
     spin = re.search(r"incoming spin \|Omega\|a/\|V\|\s*= mean\s*([-0-9.eE+]+), max\s*([-0-9.eE+]+)", block)
     memory = re.search(r"hits with a remembered spin = (\d+) \(held for (\d+) parcels; (\d+) missed it", block)
+    work = re.search(r"work on the walls \(normal, tangential\) = ([-0-9.eE+]+), ([-0-9.eE+]+) J \((\d+) hits "
+                     r"without it", block)
     return dict(summary_counts(block), spin_mean=float(spin.group(1)) if spin else None,
+                work_normal=float(work.group(1)), work_tangential=float(work.group(2)), no_work=int(work.group(3)),
                 spin_max=float(spin.group(2)) if spin else None,
                 remembered=int(memory.group(1)) if memory else None, held=int(memory.group(2)) if memory else None,
                 missed=int(memory.group(3)) if memory else None)
@@ -245,11 +251,13 @@ def test_serial_run_hit_counts_and_rebounds_against_the_sampler(serial_case, tmp
 
 def test_comparison_script_command_line(serial_case, tmp_path):
     out = subprocess.run([sys.executable, str(OPENFOAM_DIR / "compare_rebounds.py"), str(serial_case),
-                          "--check", "--no-classifier", "--json", str(tmp_path / "c.json")],
+                          "--check", "--no-classifier", "--json", str(tmp_path / "c.json"),
+                          "--work-png", str(tmp_path / "work.png")],
                          capture_output=True, text=True, cwd=REPO,
                          env=dict(os.environ, PYTHONPATH=str(REPO)))
     assert out.returncode == 0, out.stdout + out.stderr
     assert "bound" in out.stdout and (tmp_path / "c.json").stat().st_size > 0
+    assert "wall work (walls):" in out.stdout and (tmp_path / "work.png").stat().st_size > 10_000
 
 
 def test_two_rank_run_hit_counts_and_rebounds(parallel_case, serial_case):
@@ -342,13 +350,17 @@ def test_a_parcel_keeps_its_grain_over_a_restart(runs_folder, serial_case, case_
     seed (new streams) and grainSeed the first run's: the parcels (their ids are written with the cloud and read
     back) hit after the restart as the grains they were before it. The first run draws as the serial run does
     and wrote every 3rd hit (hitsEvery 3): its rows are every 3rd of the serial run's to 2.5 ms, whose hits stand
-    for its own."""
+    for its own. The work fields it wrote at 2.5 ms are the sums of those hits; the restart reads them back and
+    adds its own hits' (its draws are not the serial run's: another seed)."""
     case = _case(runs_folder, "restart")
     _check_every_kth_hit(case, serial_case, cases.RESTART_HITS_EVERY, "Every 3rd hit (hitsEvery 3): the 1st, 4th, "
                          "7th, ... of the hits this rank would record.", 0.0025)
     _, before_headers = compare_rebounds.read_hits(case)
     serial, _ = compare_rebounds.read_hits(serial_case)
     before = {name: column[serial["time"] <= 0.0025] for name, column in serial.items()}
+    half = _work_fields(case, "0.0025")
+    _check_fields(half, _record_sums(compare_rebounds.read_wall_work(serial_case, serial), serial["time"] <= 0.0025,
+                                     half))
     control = case / "system" / "controlDict"
     text = re.sub(r"\nendTime\s+[^;]+;", "\nendTime         0.005;", control.read_text())
     control.write_text(re.sub(r"\nstartFrom\s+[^;]+;", "\nstartFrom       latestTime;", text))
@@ -359,8 +371,17 @@ def test_a_parcel_keeps_its_grain_over_a_restart(runs_folder, serial_case, case_
     cases.set_coeff(case, "hitsEvery", "1")
     script = f". {OPENFOAM_DIR / 'openfoam-env.sh'} && {SOLVER} > log.restart 2>&1"
     _run(["bash", "-c", script], cwd=case)
-    assert "Starting time loop" in (case / "log.restart").read_text()
+    log = (case / "log.restart").read_text()
+    assert "Starting time loop" in log
+    assert (f"stochasticRebound: read the work on the walls ({CLOUD}:stochasticReboundWorkNormal, {CLOUD}:"
+            f"stochasticReboundWorkTangential, {CLOUD}:stochasticReboundHits) at time 0.0025") in log
     after, after_headers = compare_rebounds.read_hits(case)
+    end = _work_fields(case, END)
+    added = _record_sums(compare_rebounds.read_wall_work(case, after), np.ones(len(after["time"]), bool), end)
+    _check_fields(end, {patch: {key: half[patch][key] + added[patch][key] for key in added[patch]}
+                        for patch in end})
+    info = _cloud_info(log)
+    assert (info["work_normal"], info["work_tangential"]) == pytest.approx(_field_totals(end), rel=1e-6)
     assert (after_headers[0]["seed"], after_headers[0]["grain_seed"]) == (seed + 1, seed)
     assert after["time"].min() > 0.0025 and before["time"].max() <= 0.0025
     _check_grains(case, case_table)
@@ -395,8 +416,9 @@ def test_moving_wall_velocity_is_taken_out_of_the_incident_velocity(runs_folder)
 
 @pytest.fixture(scope="session")
 def many_shapes(runs_folder):
-    """The case's table with 63 user grains beside its prism (format 3.4; the grains share the prism's cells:
-    tests.helpers.python_side.many_shape_table), and the case run on it with shape mix (equal weights)."""
+    """The case's table with 63 user grains beside its prism (the grains share the prism's cells:
+    tests.helpers.python_side.many_shape_table) as format 4.0 wrote it (no work on the wall), and the case run on
+    it with shape mix (equal weights)."""
     return runs_folder / cases.TABLES["many_shapes"], _case(runs_folder, "many_shapes")
 
 
@@ -427,6 +449,28 @@ def test_the_parcels_grains_follow_the_mix_weights(many_shapes):
     expected = len(shapes) / len(names)
     chi2 = float(np.sum((counts - expected) ** 2 / expected))
     assert chi2 < stats.chi2.ppf(0.999, len(names) - 1), (chi2, counts)
+
+
+def test_a_table_without_work_leaves_its_hits_out_of_the_work_fields(many_shapes):
+    """On the table of format 4.0 (cases.as_format_4_0) the hits its law answered give no work (NaN): each is
+    counted (the summary's no-work, per patch and in all) and left out of the fields, which hold the work of the
+    hits the direct model answered, and no NaN."""
+    _, case = many_shapes
+    log = (case / f"log.{SOLVER}").read_text()
+    info, rows = _cloud_info(log), compare_rebounds.patch_summary(log)
+    hits, _ = compare_rebounds.read_hits(case)
+    work = compare_rebounds.read_wall_work(case, hits)
+    on_table = hits["path"] == compare_rebounds.PATH_TABLE
+    assert np.array_equal(np.isnan(work["Wn"]), on_table) and np.array_equal(np.isnan(work["Wt"]), on_table)
+    assert info["no_work"] == info["table"] == on_table.sum() > 1000, info
+    for patch in ("walls", "frontAndBack"):
+        direct = (work["patch"] == patch) & ~on_table
+        assert rows[patch]["no_work"] == rows[patch]["table"], rows[patch]
+        assert rows[patch]["work_normal_mean"] == pytest.approx(work["Wn"][direct].mean(), rel=1e-5)
+    fields = _work_fields(case, END)
+    _check_fields(fields, _record_sums(work, np.ones(len(work["face"]), bool), fields))
+    assert sum(int(v["hits"].sum()) for v in fields.values()) == info["direct"]
+    assert (info["work_normal"], info["work_tangential"]) == pytest.approx(_field_totals(fields), rel=1e-6)
 
 
 @pytest.fixture(scope="session")
@@ -474,6 +518,130 @@ def test_erosion_beside_the_rebound_models(serial_case, standard_cases, tmp_path
     assert specular["total_m3"] > 1.5 * ours["total_m3"], (ours, specular)
     png = tmp_path / "erosion.png"
     compare_rebounds.plot_erosion({"specular": standard_cases[1], "ours": serial_case}, png)
+    assert png.stat().st_size > 10_000
+
+
+# ----------------------------------------------------------------------------- the work on the walls
+
+CLOUD = "kinematicCloud"
+END = "0.005"   # the runs' last (written) time
+
+
+def _patches_of(root: Path) -> list:
+    """The patches of the mesh of ``root`` (a case or a processor folder) that are not processor patches."""
+    boundary = (root / "constant" / "polyMesh" / "boundary").read_text()
+    return [name for name, kind in re.findall(r"\n\s*(\w+)\s*\{\s*type\s+(\w+);", boundary) if kind != "processor"]
+
+
+def _work_fields(root: Path, time: str) -> dict:
+    """The work fields of ``root``'s mesh at ``time``: patch -> {normal, tangential, hits: values per face}; each
+    field zero inside (checked)."""
+    for name in compare_rebounds.WORK_FIELDS.values():
+        text = (root / time / f"{CLOUD}:{name}").read_text()
+        assert "\ninternalField   uniform 0;\n" in text, name
+    return {patch: {key: compare_rebounds.read_patch_field(root, f"{CLOUD}:{name}", patch, time)
+                    for key, name in compare_rebounds.WORK_FIELDS.items()} for patch in _patches_of(root)}
+
+
+def _record_sums(work: dict, rows, fields: dict) -> dict:
+    """The sums per face of the wall work records at ``rows`` (a boolean mask) with work, in the layout of
+    :func:`_work_fields`'s ``fields``: mass × W_n, mass × W_t (J) and the number of hits."""
+    rows = rows & np.isfinite(work["Wn"]) & np.isfinite(work["Wt"])
+    sums = {}
+    for patch, values in fields.items():
+        n = len(values["hits"])
+        sums[patch] = {key: compare_rebounds.face_sums(work["patch"][rows], work["face"][rows], weights, patch, n)
+                       for key, weights in (("normal", (work["mass"] * work["Wn"])[rows]),
+                                            ("tangential", (work["mass"] * work["Wt"])[rows]),
+                                            ("hits", np.ones(rows.sum())))}
+    return sums
+
+
+def _check_fields(fields: dict, expected: dict) -> None:
+    """Each field's values on each patch are ≥ 0, the hits those of ``expected`` exactly, the work its sums to
+    the 8 digits the fields are written with, and zero on every face no hit with work reached."""
+    for patch, values in fields.items():
+        assert np.array_equal(values["hits"], expected[patch]["hits"]), patch
+        for key in ("normal", "tangential"):
+            assert np.all(values[key] >= 0) and np.all(values[key][expected[patch]["hits"] == 0] == 0), (patch, key)
+            np.testing.assert_allclose(values[key], expected[patch][key], rtol=6e-8, atol=0, err_msg=f"{patch} {key}")
+
+
+def _field_totals(fields: dict) -> tuple:
+    return tuple(sum(float(v[key].sum()) for v in fields.values()) for key in ("normal", "tangential"))
+
+
+def test_the_work_on_the_walls_sums_the_hits_face_by_face(serial_case):
+    """The work fields of the serial run at its end, <cloud>:stochasticReboundWorkNormal, ...WorkTangential (J)
+    and ...Hits, against its wall work records (wallWork_0.csv, a row per row of the hits file): per face of every
+    patch, the sums of mass × W_n and mass × W_t and the number of hits, zero where no hit was; the log's totals
+    are the fields' and the per-patch summary's means per hit the records'; every hit of a table of format 4.1
+    gives work, ≥ 0, and on the parcels' first hits (Ω⁻ = 0) no more than the translational kinetic energy they
+    lose."""
+    hits, _ = compare_rebounds.read_hits(serial_case)
+    work = compare_rebounds.read_wall_work(serial_case, hits)
+    assert np.all(np.isfinite(work["Wn"])) and np.all(np.isfinite(work["Wt"]))
+    assert np.all(work["Wn"] >= 0) and np.all(work["Wt"] >= 0) and np.all(work["mass"] > 0)
+    fields = _work_fields(serial_case, END)
+    assert set(fields) == {"walls", "frontAndBack", "inlet", "outlet"}
+    _check_fields(fields, _record_sums(work, np.ones(len(work["face"]), bool), fields))
+    assert min(int(np.sum(fields[p]["hits"] > 0)) for p in ("walls", "frontAndBack")) > 200
+    log = (serial_case / f"log.{SOLVER}").read_text()
+    info = _cloud_info(log)
+    assert info["no_work"] == 0
+    assert (info["work_normal"], info["work_tangential"]) == pytest.approx(_field_totals(fields), rel=1e-6)
+    for patch, row in compare_rebounds.patch_summary(log).items():
+        on = work["patch"] == patch
+        if row["roughness"] is None:
+            assert row["work_normal_mean"] is row["work_tangential_mean"] is None and not on.any(), patch
+            continue
+        assert row["no_work"] == 0 and row["hits"] == on.sum()
+        assert (row["work_normal_mean"], row["work_tangential_mean"]) == pytest.approx(
+            (work["Wn"][on].mean(), work["Wt"][on].mean()), rel=1e-5), patch
+    # W_n + W_t = E⁻ − E⁺: from rest (Ω⁻ = 0), E⁻ = |V⁻|²/2 and E⁺ ≥ |V⁺|²/2
+    still = ~hits["Win"].any(axis=1)
+    drop = 0.5 * (np.sum(hits["V"] ** 2, axis=1) - np.sum(hits["Vout"] ** 2, axis=1))
+    energy = 0.5 * np.sum(hits["V"] ** 2, axis=1)
+    assert still.sum() > 5000
+    assert np.all((work["Wn"] + work["Wt"])[still] <= drop[still] + 1e-9 * energy[still])
+
+
+def test_each_rank_adds_the_work_of_its_own_faces(parallel_case):
+    """On 2 ranks each rank's fields (processor<r>/0.005, its own faces) hold the work of its own hits; the log's
+    totals are both ranks'."""
+    hits, _ = compare_rebounds.read_hits(parallel_case)
+    work = compare_rebounds.read_wall_work(parallel_case, hits)
+    totals = np.zeros(2)
+    for rank in (0, 1):
+        root = parallel_case / f"processor{rank}"
+        fields = _work_fields(root, END)
+        expected = _record_sums(work, hits["rank"] == rank, fields)
+        _check_fields(fields, expected)
+        assert sum(int(v["hits"].sum()) for v in fields.values()) > 1000, rank
+        totals += _field_totals(fields)
+    info = _cloud_info((parallel_case / f"log.{SOLVER}").read_text())
+    assert (info["work_normal"], info["work_tangential"]) == pytest.approx(tuple(totals), rel=1e-6)
+
+
+def test_the_work_on_the_walls_beside_the_erosion_model(serial_case, tmp_path, capsys):
+    """compare_rebounds' summary and figure of the work on the walls beside particleErosion's Q of the same run:
+    the totals are the log's; the cutting work W_t ranks the faces as Finnie's cutting erosion does (Spearman's
+    rank correlation over the faces hit 0.91 on the side and funnel walls, 0.97 on the front and back planes,
+    where the grains graze)."""
+    summary = compare_rebounds.wall_work_summary(serial_case)
+    with capsys.disabled():
+        print("\n" + compare_rebounds.wall_work_report(summary))
+    info = _cloud_info((serial_case / f"log.{SOLVER}").read_text())
+    every = summary["all"]
+    assert (every["normal"]["total"], every["tangential"]["total"]) == pytest.approx(
+        (info["work_normal"], info["work_tangential"]), rel=1e-6)
+    assert every["hits"] == info["hits"]
+    for patch in ("walls", "frontAndBack"):
+        s = summary[patch]
+        assert s["spearman_tangential_Q"] > 0.8 and s["spearman_normal_Q"] > 0.5, (patch, s)
+        assert 0 < s["faces_hit"] < s["faces"]
+    png = tmp_path / "wall_work.png"
+    compare_rebounds.plot_wall_work(serial_case, png)
     assert png.stat().st_size > 10_000
 
 
@@ -629,8 +797,9 @@ def test_each_patch_does_what_its_entry_says(patches_case, capsys):
         for key, count in (("speed_below", np.sum(speed < 80)), ("speed_above", np.sum(speed > 140)),
                            ("alpha1_outside", np.sum(alpha1 < 5))):
             assert rows[name][key] == pytest.approx(count, abs=2), (name, key)
-        assert min(rows[name]["speed_below"], rows[name]["alpha1_outside"]) > 0, name
-    assert front["speed_above"] > 0
+        assert rows[name]["speed_below"] > 0, name
+    # α1 below the grid: the grazing hits of front; the walls see 0-2 of their 4000 hits there
+    assert front["speed_above"] > 0 and front["alpha1_outside"] > 0
     # the hits outside the speeds the wall law holds over: the elastic wall's (walls) 60-200 m/s, the lossy
     # wall (front) states none
     on = hits["patch"] == "walls"
@@ -655,6 +824,28 @@ def test_each_wall_draws_from_its_own_table(patches_case, runs_folder):
     assert not other.ks_ok and other.mean_speed_ratio[0] > other.mean_speed_ratio[1] + 0.05, other
     with pytest.raises(ValueError, match="of 2 walls"):
         compare_rebounds.compare(patches_case, elastic, classifier=False)
+
+
+def test_the_work_of_a_wall_per_patch(patches_case):
+    """With a wall per patch the fields hold the work of the hits the tables and the direct model answered on
+    their patches, the trapped hits' on the lossy wall (trapped remove) included, and nothing of the stock
+    rebound's (back: no work recorded, zero fields, no mean in the summary) or of the open patch's."""
+    hits, _ = compare_rebounds.read_hits(patches_case)
+    work = compare_rebounds.read_wall_work(patches_case, hits)
+    drawn = hits["interaction"] == compare_rebounds.HITS_TITLE
+    assert np.all(np.isfinite(work["Wn"][drawn]) & np.isfinite(work["Wt"][drawn]))
+    assert np.all(np.isnan(work["Wn"][~drawn]) & np.isnan(work["Wt"][~drawn])) and (~drawn).sum() > 1000
+    trapped = hits["status"] == compare_rebounds.STATUS_TRAPPED
+    assert trapped.sum() > 100 and np.all(work["Wn"][trapped] + work["Wt"][trapped] > 0)
+    fields = _work_fields(patches_case, END)
+    _check_fields(fields, _record_sums(work, drawn, fields))
+    for patch in ("back", "outlet"):
+        assert not any(fields[patch][key].any() for key in fields[patch]), patch
+    rows = compare_rebounds.patch_summary((patches_case / f"log.{SOLVER}").read_text())
+    assert rows["back"]["work_normal_mean"] is rows["outlet"]["work_tangential_mean"] is None
+    for patch in ("walls", "front"):
+        on = work["patch"] == patch
+        assert rows[patch]["work_tangential_mean"] == pytest.approx(work["Wt"][on].mean(), rel=1e-5), patch
 
 
 def test_a_rough_patch_hits_again_and_a_smooth_one_keeps_its_bits(runs_folder, openfoam_build):

@@ -141,6 +141,7 @@ bool Foam::StochasticRebound<CloudType>::correct
     parcel.rho = p.rho();
     parcel.mu = core_.autoRelaxation() ? cloud.mu()[p.cell()] : 0;
     parcel.mass = p.nParticle()*p.mass();
+    parcel.face = pp.whichFace(p.face());
     parcel.origProc = p.origProc();
     parcel.origId = p.origId();
     // The hit's time: the parcel has tracked stepFraction of this step

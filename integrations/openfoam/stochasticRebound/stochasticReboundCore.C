@@ -157,6 +157,15 @@ const char* const Foam::stochasticReboundCore::omegaFieldName =
 const char* const Foam::stochasticReboundCore::timeFieldName =
     "stochasticReboundTime";
 
+const char* const Foam::stochasticReboundCore::workNormalFieldName =
+    "stochasticReboundWorkNormal";
+
+const char* const Foam::stochasticReboundCore::workTangentialFieldName =
+    "stochasticReboundWorkTangential";
+
+const char* const Foam::stochasticReboundCore::workHitsFieldName =
+    "stochasticReboundHits";
+
 
 // * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
 
@@ -850,7 +859,9 @@ void Foam::stochasticReboundCore::recordHit
     scalar spinRatio,
     double u0,
     int64_t key,
-    int shape
+    int shape,
+    double workNormal,
+    double workTangential
 )
 {
     State& s = *state_;
@@ -930,6 +941,81 @@ void Foam::stochasticReboundCore::recordHit
         interaction, wall.c_str()
     );
     s.hits << line;
+
+    std::snprintf
+    (
+        line, sizeof(line), "%d,%d,%s,%d,%.17g,%.17g,%.17g\n",
+        int(parcel.origProc), int(parcel.origId), pp.name().c_str(),
+        int(parcel.face), parcel.mass, workNormal, workTangential
+    );
+    s.work << line;
+}
+
+
+void Foam::stochasticReboundCore::makeWorkFields
+(
+    const fvMesh& mesh,
+    const word& cloudName
+)
+{
+    // As particleErosion's Q: named after the cloud, zero inside, values
+    // on the patches' faces, read back at a restart's start time
+    const Time& time = mesh.time();
+    label nRead = 0;
+    auto field = [&](const char* name, const dimensionSet& dims)
+    {
+        IOobject io
+        (
+            cloudName + ":" + name, time.timeName(), mesh,
+            IOobject::READ_IF_PRESENT, IOobject::AUTO_WRITE
+        );
+        nRead += io.typeHeaderOk<volScalarField>(true);
+        return std::unique_ptr<volScalarField>
+        (
+            new volScalarField(io, mesh, dimensionedScalar(dims, Zero))
+        );
+    };
+    State& s = *state_;
+    s.workNormal = field(workNormalFieldName, dimEnergy);
+    s.workTangential = field(workTangentialFieldName, dimEnergy);
+    s.workHits = field(workHitsFieldName, dimless);
+    if (returnReduce(nRead, maxOp<label>()))
+    {
+        Info<< "    stochasticRebound: read the work on the walls ("
+            << s.workNormal->name() << ", " << s.workTangential->name()
+            << ", " << s.workHits->name() << ") at time "
+            << time.timeName() << nl;
+    }
+}
+
+
+void Foam::stochasticReboundCore::addWork
+(
+    const polyPatch& pp,
+    const Parcel& parcel,
+    double Wn,
+    double Wt,
+    label* counts
+)
+{
+    State& s = *state_;
+    if (!std::isfinite(Wn) || !std::isfinite(Wt))
+    {
+        // A table of format 4.0 holds no work: one NaN would make the face's
+        // sum NaN for the rest of the run
+        ++counts[pcNoWork];
+        ++s.counters.noWork;
+        return;
+    }
+    const label patchi = pp.index();
+    const label facei = parcel.face;
+    s.workNormal->boundaryFieldRef()[patchi][facei] += parcel.mass*Wn;
+    s.workTangential->boundaryFieldRef()[patchi][facei] += parcel.mass*Wt;
+    s.workHits->boundaryFieldRef()[patchi][facei] += 1;
+    s.counters.workNormal += parcel.mass*Wn;
+    s.counters.workTangential += parcel.mass*Wt;
+    s.patchWork[2*patchi] += Wn;
+    s.patchWork[2*patchi + 1] += Wt;
 }
 
 
@@ -1072,6 +1158,15 @@ void Foam::stochasticReboundCore::drawRebound
         c.outsideGrid += below || above || alpha1Out;
     }
 
+    if (status != RBS_INVALID)
+    {
+        addWork
+        (
+            pp, parcel, result.wall_work_normal, result.wall_work_tangential,
+            counts
+        );
+    }
+
     const uint64_t parcelId = parcelKey(parcel.origProc, parcel.origId);
     switch (status)
     {
@@ -1130,7 +1225,8 @@ void Foam::stochasticReboundCore::drawRebound
         (
             parcel, pp, rule, hit.V, hit.Omega, hit.n, a, result.status,
             path, result.V, result.Omega, spinRatio, u[0], hit.grain_key,
-            result.shape
+            result.shape, result.wall_work_normal,
+            result.wall_work_tangential
         );
     }
 }
@@ -1168,7 +1264,7 @@ void Foam::stochasticReboundCore::stockRebound
     if (state_->hits.is_open())
     {
         // Recorded in the model's terms: n into the gas, Ω unchanged, no
-        // draw (path -1, u0 nan), no grain
+        // draw (path -1, u0 nan), no grain, no work (not the model's)
         const scalar nMag = mag(nw);
         const vector n(nMag > 0 ? vector(-nw/nMag) : vector(Zero));
         const scalar a = halfSizeFactor_*0.5*parcel.d;
@@ -1186,7 +1282,7 @@ void Foam::stochasticReboundCore::stockRebound
         recordHit
         (
             parcel, pp, rule, V, Om, N, a, RBS_OK, RBS_PATH_NONE, Vo, Om,
-            speed > 0 ? mag(W)*a/speed : 0, NAN, RBS_NO_KEY, -1
+            speed > 0 ? mag(W)*a/speed : 0, NAN, RBS_NO_KEY, -1, NAN, NAN
         );
     }
 }
@@ -1283,7 +1379,7 @@ void Foam::stochasticReboundCore::readSpins(const objectRegistry& cloud)
 Foam::stochasticReboundCore::stochasticReboundCore
 (
     const dictionary& coeffs,
-    const polyMesh& mesh,
+    const fvMesh& mesh,
     const objectRegistry& cloud,
     bool ownSpin,
     bool steady
@@ -1389,6 +1485,8 @@ Foam::stochasticReboundCore::stochasticReboundCore
         }
     }
     state_->patchCounts.setSize(nPatchCounts*patchRule_.size(), Zero);
+    state_->patchWork.setSize(2*patchRule_.size(), Zero);
+    makeWorkFields(mesh, cloud.name());
 
     // Rank r draws stream r of the seed: no two ranks share draws
     const label stream = Pstream::myProcNo();
@@ -1470,6 +1568,28 @@ Foam::stochasticReboundCore::stochasticReboundCore
                "nx,ny,nz,Uwx,Uwy,Uwz,status,path,Voutx,Vouty,Voutz,Wx,Wy,Wz,"
                "spin_ratio,u0,key,shape,ratio_ba,ratio_cb,hand,interaction,"
                "wall\n";
+
+        // The work in a file of its own: the hits file keeps the columns
+        // tablegen/study/hit_records.py reads for both adapters
+        const fileName workFile
+        (
+            dir/("wallWork_" + Foam::name(stream) + ".csv")
+        );
+        state_->work.open(workFile.c_str(), std::ios::out | std::ios::trunc);
+        if (!state_->work)
+        {
+            FatalErrorInFunction
+                << "Cannot write " << workFile << exit(FatalError);
+        }
+        state_->work
+            << "# stochasticRebound wall work: row i is row i of hits_"
+            << stream << ".csv. face: the face hit (its index in the patch),"
+               " mass: the parcel's particles' (nParticle*mass, kg), Wn/Wt:"
+               " the work of the hit on the wall per unit particle mass,"
+               " normal and tangential (J/kg, rbs_result.wall_work_normal and"
+               " wall_work_tangential; nan: none, for an invalid hit, a stock"
+               " rebound or a table of format 4.0)\n"
+            << "origProc,origId,patch,face,mass,Wn,Wt\n";
     }
 
     Info<< "    stochasticRebound: a = " << halfSizeFactor_ << "*d/2, seed "
@@ -1682,6 +1802,10 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
     const scalar mFailed = totalScalar("massFailed", c.failedMass);
     const scalar directSeconds =
         totalScalar("directModelSeconds", c.directSeconds);
+    const scalar workNormal = totalScalar("workNormal", c.workNormal);
+    const scalar workTangential =
+        totalScalar("workTangential", c.workTangential);
+    const label nNoWork = total("nNoWork", c.noWork);
     label nSpin = model.getModelProperty<label>("nSpinSamples");
     scalar spinSum = model.getModelProperty<scalar>("spinRatioSum");
     scalar spinMax = model.getModelProperty<scalar>("spinRatioMax");
@@ -1710,7 +1834,10 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
         << "      - failed (direct model), " << policy << " (number, mass) = "
         << nFailed << ", " << mFailed << nl
         << "      - invalid (left as stock)     = " << nInvalid << nl
-        << "      - outside the table's grid    = " << nOutside << nl;
+        << "      - outside the table's grid    = " << nOutside << nl
+        << "      - work on the walls (normal, tangential) = " << workNormal
+        << ", " << workTangential << " J (" << nNoWork << " hits without"
+        << " it: a table of format 4.0)" << nl;
 
     if (ownSpin_ || remembers())
     {
@@ -1741,7 +1868,11 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
     labelList counts(s.patchCounts);
     Pstream::listCombineGather(counts, plusEqOp<label>());
     Pstream::listCombineScatter(counts);
+    scalarList work(s.patchWork);
+    Pstream::listCombineGather(work, plusEqOp<scalar>());
+    Pstream::listCombineScatter(work);
     List<labelList> patchTotals(patchRule_.size());
+    List<scalarList> patchWorkTotals(patchRule_.size());
     size_t width = 5;
     forAll(patchRule_, patchi)
     {
@@ -1764,6 +1895,19 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
         {
             total[k] += counts[nPatchCounts*patchi + k];
         }
+        scalarList& sums = patchWorkTotals[patchi];
+        sums.setSize(2, Zero);
+        model.getModelProperty
+        (
+            word("patchWork_" + patchNames_[patchi]),
+            sums
+        );
+        if (sums.size() != 2)
+        {
+            sums.setSize(2, Zero);
+        }
+        sums[0] += work[2*patchi];
+        sums[1] += work[2*patchi + 1];
         width = std::max(width, patchNames_[patchi].size());
     }
 
@@ -1772,7 +1916,7 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
     {
         "hits", "rebounded", "stuck", "removed", "escaped", "invalid",
         "trapped", "failed", "table", "direct", "|V|<grid", "|V|>grid",
-        "alpha1-out", "out-of-law", "hit-again", "at-cap"
+        "alpha1-out", "out-of-law", "hit-again", "at-cap", "no-work"
     };
     char cell[256];
     std::string line("      ");
@@ -1783,13 +1927,17 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
         std::snprintf(cell, sizeof(cell), " %10s", name);
         line += cell;
     }
-    std::snprintf(cell, sizeof(cell), " %10s", "roughness");
-    line += cell;
+    for (const char* name : {"roughness", "Wn/hit", "Wt/hit"})
+    {
+        std::snprintf(cell, sizeof(cell), " %10s", name);
+        line += cell;
+    }
     os  << "    Per patch (hits; their fate; the path; hits outside the"
         << " table's grid: |V| below, |V| above, alpha1 outside; outside"
         << " the wall law's speeds; hits that hit the wall again, and those"
-        << " that reached " << RBS_MAX_WALL_HITS << " wall hits; the"
-        << " wall's roughness, deg)" << nl
+        << " that reached " << RBS_MAX_WALL_HITS << " wall hits; hits"
+        << " without wall work; the wall's roughness, deg; the mean work on"
+        << " the wall per hit with work, normal and tangential, J/kg)" << nl
         << line.c_str() << "  interaction" << nl;
     forAll(patchRule_, patchi)
     {
@@ -1818,12 +1966,28 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
             std::snprintf(cell, sizeof(cell), " %10s", "-");
         }
         line += cell;
+        // Over the drawn hits whose work addWork added
+        const labelList& n = patchTotals[patchi];
+        const label nWork = n[pcHits] - n[pcInvalid] - n[pcNoWork];
+        for (const scalar sum : patchWorkTotals[patchi])
+        {
+            if (rule.type == ruleDrawn && nWork > 0)
+            {
+                std::snprintf(cell, sizeof(cell), " %10.6g", sum/nWork);
+            }
+            else
+            {
+                std::snprintf(cell, sizeof(cell), " %10s", "-");
+            }
+            line += cell;
+        }
         os  << line.c_str() << "  " << describe(rule, false).c_str() << nl;
     }
 
     if (s.hits.is_open())
     {
         s.hits.flush();
+        s.work.flush();
     }
 
     if (model.writeTime())
@@ -1844,6 +2008,9 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
         model.setModelProperty("nSpinSamples", nSpin);
         model.setModelProperty("spinRatioSum", spinSum);
         model.setModelProperty("spinRatioMax", spinMax);
+        model.setModelProperty("workNormal", workNormal);
+        model.setModelProperty("workTangential", workTangential);
+        model.setModelProperty("nNoWork", nNoWork);
         forAll(patchRule_, patchi)
         {
             if (patchRule_[patchi] >= 0)
@@ -1853,10 +2020,16 @@ void Foam::stochasticReboundCore::info(Ostream& os, subModelBase& model)
                     word("patchCounts_" + patchNames_[patchi]),
                     patchTotals[patchi]
                 );
+                model.setModelProperty
+                (
+                    word("patchWork_" + patchNames_[patchi]),
+                    patchWorkTotals[patchi]
+                );
             }
         }
         s.counters = Counters();
         s.patchCounts = Zero;
+        s.patchWork = Zero;
     }
 }
 
