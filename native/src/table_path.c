@@ -45,6 +45,9 @@ RBS_INLINE int hit_in_shape(const rbs_table *t, int64_t shape, const double V[3]
     rbs_impact_frame(Vi, ni, u[12], &f);
     rbs_cell cell = rbs_cell_in_shape(t, shape, f.alpha1, f.speed, u);
     rbs_hint_draw(t, cell.drawn, u);
+    double first;
+    int64_t c;
+    rbs_hint_work(t, cell.drawn, rbs_first_row(t, cell.drawn, u[4], &first, &c), u);
     int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, scaled, x);
     rbs_table_work(t, &cell, status, x, f.sin_alpha1, f.speed, u, scaled, wall_work);
     int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);

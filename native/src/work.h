@@ -22,16 +22,42 @@
 
 /* loc + scale · S(u) of work variable w of the component whose work row is at `row` of t->work_rows, in cell number
  * `cell` (as rbs_quantile, from the work's own dictionary) */
-RBS_INLINE double rbs_work_quantile(const rbs_table *t, int64_t cell, int64_t row, int w, double u)
+/* offset in t->work_dictionary of the level of work variable w that u picks in cell number `cell`, and in *dt the
+ * interpolation parameter there (surrogate.kernels.work._level_at) */
+RBS_INLINE int64_t rbs_work_level(const rbs_table *t, int64_t cell, int w, double u, double *dt)
 {
-    const float *r = t->work_rows;
     int64_t levels = t->n_levels - 1;
     double x = u * (double)levels;
     int64_t i = rbs_clamp_index(rbs_trunc(x), levels - 1);
-    int64_t at = ((cell * N_WORK + w) * t->n_levels + i) * t->n_dictionary + (int64_t)r[row + WORK_ROW_SHAPE + w];
+    *dt = x - (double)i;
+    return ((cell * N_WORK + w) * t->n_levels + i) * t->n_dictionary;
+}
+
+/* cache hints for the work's reads of a draw with uniforms u from the component at offset `row` of t->clusters in
+ * cell number `drawn`: its work row and the levels its keyed uniforms pick (surrogate.kernels.work.hint_work) */
+RBS_INLINE void rbs_hint_work(const rbs_table *t, int64_t drawn, int64_t row, const double *u)
+{
+    if (!t->has_work)
+        return;
+    int64_t at = row / ROW_SIZE * WORK_ROW_SIZE;
+    RBS_PREFETCH(t->work_rows + at);
+    RBS_PREFETCH(t->work_rows + at + WORK_ROW_SIZE - 1);
+    int64_t key = rbs_hit_key(u, RBS_U_PER_DRAW, RBS_WORK_DOMAIN);
+    for (int w = 0; w < N_WORK; w++) {
+        double dt;
+        int64_t level = rbs_work_level(t, drawn, w, rbs_grain_uniform((uint64_t)key, (uint64_t)w), &dt);
+        RBS_PREFETCH(t->work_dictionary + level);
+        RBS_PREFETCH(t->work_dictionary + level + t->n_dictionary);
+    }
+}
+
+RBS_INLINE double rbs_work_quantile(const rbs_table *t, int64_t cell, int64_t row, int w, double u)
+{
+    const float *r = t->work_rows;
+    double dt;
+    int64_t at = rbs_work_level(t, cell, w, u, &dt) + (int64_t)r[row + WORK_ROW_SHAPE + w];
     double lo = (double)t->work_dictionary[at], hi = (double)t->work_dictionary[at + t->n_dictionary];
-    return fma((double)r[row + WORK_ROW_SCALE + w], fma(x - (double)i, hi - lo, lo),
-               (double)r[row + WORK_ROW_LOC + w]);
+    return fma((double)r[row + WORK_ROW_SCALE + w], fma(dt, hi - lo, lo), (double)r[row + WORK_ROW_LOC + w]);
 }
 
 /* ν reflected into [0, 1] (the chain's linear shifts can step outside by a hair) */

@@ -26,7 +26,7 @@ from surrogate.kernels.gather import GATHERED_FIELDS, gather_block
 from surrogate.kernels.locate import I_DRAWN, INDEX_FIELDS, WEIGHT_FIELDS, locate_block, resolve_block
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import fill_lanes, seed_lanes
-from surrogate.kernels.work import work_block
+from surrogate.kernels.work import hint_work_block, work_block
 
 STAGES = 3      # blocks in the pipeline: located, resolved, drawn
 
@@ -172,6 +172,8 @@ def _rebound_blocks(data, mix_cdf, shapes, V, n, a, u, state, V_out, Omega_out, 
         if 1 <= k <= n_blocks:
             j, start = (k - 1) % STAGES, (k - 1) * BLOCK
             resolve_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j])
+            if work_n.shape[0] > 0:
+                hint_work_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j])
         if k >= 2:
             j, start = (k - 2) % STAGES, (k - 2) * BLOCK
             gather_block(data, us[j], min(BLOCK, rows - start), fr[j], index[j], weights[j], g)

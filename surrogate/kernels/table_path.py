@@ -20,9 +20,9 @@ from surrogate.kernels.draw import draw_in_cell, draw_velocity
 from surrogate.kernels.frame import (float3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
                                      uniforms_ok)
 from surrogate.kernels.hit import PATH_TABLE, hit, invalid_hit
-from surrogate.kernels.locate import hint, locate_in_shape, mix_shape
+from surrogate.kernels.locate import first_row, hint, locate_in_shape, mix_shape
 from surrogate.kernels.options import JIT, KERNEL
-from surrogate.kernels.work import table_work
+from surrogate.kernels.work import hint_work, table_work
 
 
 @numba.njit(**KERNEL)
@@ -75,6 +75,7 @@ def table_shape_rebound(data, shape, V, n, a, u, scaled):
     alpha1, speed, cos_a1, sin_a1, ex, ez = impact_frame(V, n, u[12])
     cell = locate_in_shape(data, shape, alpha1, speed, u)
     hint(data, cell, u)
+    hint_work(data, cell[0], first_row(data, cell[0], u[4])[2], u)
     status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
     work_n, work_t = table_work(data, cell, status, (vx, vy, vz), sin_a1, speed, u, scaled)
     ok = particle_ok(n, a) & uniforms_ok(u)

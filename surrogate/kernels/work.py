@@ -36,8 +36,8 @@ from surrogate.kernels.gather import gather, gathered_at, moved_term
 from surrogate.kernels.layout import (WORK_CELL_INV_SD, WORK_CELL_MEAN, WORK_CELL_SD, WORK_CELL_SIZE,
                                       WORK_CELL_TRAPPED, WORK_ROW_LOC, WORK_ROW_SCALE, WORK_ROW_SHAPE, WORK_ROW_SIZE,
                                       WORK_ROW_SLOPE, ROW_SIZE)
-from surrogate.kernels.locate import I_ROW, cell_at, component
-from surrogate.kernels.memory import load
+from surrogate.kernels.locate import I_DRAWN, I_ROW, cell_at, component
+from surrogate.kernels.memory import load, prefetch
 from surrogate.kernels.options import JIT, KERNEL
 from surrogate.kernels.rng import grain_uniform, hit_key
 
@@ -52,17 +52,42 @@ def work_key(u):
 
 
 @numba.njit(inline="always", **JIT)
+def _level_at(data, cell, w, u):
+    """Offset in ``data.work_dictionary`` of the level of work variable w that u picks in cell number ``cell``, and
+    the interpolation parameter there (t − i of :func:`_work_quantile`)."""
+    levels = data.n_levels - 1
+    t = u * levels
+    i = clamp_index(int(t), levels - 1)
+    return ((cell * N_WORK + w) * data.n_levels + i) * data.n_dictionary, t - i
+
+
+@numba.njit(inline="always", **JIT)
+def hint_work(data, drawn, row, u):
+    """Cache hints (:func:`surrogate.kernels.memory.prefetch`) for the work's table reads of a draw with uniforms
+    ``u`` from the component at offset ``row`` of ``data.clusters`` (before its alias, or after) in cell number
+    ``drawn``: its work row and the levels its two keyed uniforms pick, so that they are in flight with the
+    rebound's reads."""
+    if data.has_work:
+        at = row // ROW_SIZE * WORK_ROW_SIZE
+        prefetch(data.work_rows, (at,))
+        prefetch(data.work_rows, (at + WORK_ROW_SIZE - 1,))
+        key = work_key(u)
+        for w in range(N_WORK):
+            level = _level_at(data, drawn, w, grain_uniform(key, w))[0]
+            prefetch(data.work_dictionary, (level,))
+            prefetch(data.work_dictionary, (level + data.n_dictionary,))
+
+
+@numba.njit(inline="always", **JIT)
 def _work_quantile(data, cell, row, w, u):
     """loc + scale · S(u) of work variable w in the component at offset ``row`` of ``data.work_rows`` in cell
     number ``cell`` (as :func:`surrogate.kernels.gather._quantile`, from the work's own dictionary)."""
     r = data.work_rows
-    levels = data.n_levels - 1
-    t = u * levels
-    i = clamp_index(int(t), levels - 1)
-    at = ((cell * N_WORK + w) * data.n_levels + i) * data.n_dictionary + int(load(r, row + WORK_ROW_SHAPE + w))
+    level, dt = _level_at(data, cell, w, u)
+    at = level + int(load(r, row + WORK_ROW_SHAPE + w))
     lo = np.float64(load(data.work_dictionary, at))
     hi = np.float64(load(data.work_dictionary, at + data.n_dictionary))
-    return fma(np.float64(load(r, row + WORK_ROW_SCALE + w)), fma(t - i, hi - lo, lo),
+    return fma(np.float64(load(r, row + WORK_ROW_SCALE + w)), fma(dt, hi - lo, lo),
                np.float64(load(r, row + WORK_ROW_LOC + w)))
 
 
@@ -154,6 +179,15 @@ def table_work(data, cell, status, v, sin_alpha1, speed, u, scaled):
     row = component(data, cell[0], u[4])
     return drawn_work(data, cell, row, gather(data, cell, row, u), status, speed_ratio_squared(v[0], v[1], v[2]),
                       sin_alpha1, speed, work_key(u), scaled)
+
+
+@numba.njit(**KERNEL)
+def hint_work_block(data, ub, m, fr, index):
+    """Cache hints for the work's reads (:func:`hint_work`) of the m particles of a resolved block (uniforms ``ub``,
+    frame records ``fr``, cell records ``index``)."""
+    for b in range(m):
+        if is_valid(fr, b):
+            hint_work(data, field(index, I_DRAWN, b), field(index, I_ROW, b), uniforms(ub, b))
 
 
 @numba.njit(**KERNEL)
