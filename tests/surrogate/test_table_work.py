@@ -56,15 +56,17 @@ def test_each_row_s_work_is_the_single_hit_s_and_closes_the_rebound_s_energy(sma
         assert np.all(work[~ok] <= energy[~ok])
 
 
+def _drop_work(f):
+    """A table file edited back to format 4.0: no work datasets."""
+    for name in WORK_DATASETS:
+        del f[f"cells/{name}"]
+    f.attrs["format_version"] = np.array([4, 0], dtype=f.attrs["format_version"].dtype)
+
+
 def test_the_work_takes_nothing_of_the_stream_and_a_4_0_table_gives_nan(small_table_path, tmp_path):
     """The small table without its work datasets (as format 4.0 wrote it) draws the same rebounds, bit for bit,
     and NaN work (the path "auto" takes too)."""
-    def drop_work(f):
-        for name in WORK_DATASETS:
-            del f[f"cells/{name}"]
-        f.attrs["format_version"] = np.array([4, 0], dtype=f.attrs["format_version"].dtype)
-
-    older = surrogate.load(edited_copy(small_table_path, tmp_path, "format_4_0.h5", drop_work))
+    older = surrogate.load(edited_copy(small_table_path, tmp_path, "format_4_0.h5", _drop_work))
     table = surrogate.load(small_table_path)
     assert table.kernel_data.has_work and not older.kernel_data.has_work
     V = _incident(CHUNK_ROWS + 5, 2, alpha1=(30.0, 90.0), speed=(50.0, 250.0))
@@ -77,3 +79,23 @@ def test_the_work_takes_nothing_of_the_stream_and_a_4_0_table_gives_nan(small_ta
         assert np.isfinite(new.wall_work_normal).all()
     with h5py.File(small_table_path, "r") as f:
         assert tuple(f.attrs["format_version"]) == (4, 1)
+
+
+def test_the_command_lines_say_a_4_0_table_holds_no_work(small_table_path, tmp_path, capsys):
+    """surrogate sample prints the mean W_n and W_t per hit (the draws' own, in J/kg and in units of ½|V⁻|²), and
+    says so when the table holds none; tablegen report leaves its work section out for such a table."""
+    from data_schema.samples import read_samples
+    from surrogate.cli import main as surrogate_main
+    from tablegen.study.report import table_data
+    from tests.helpers.cli import run_cli
+
+    older = edited_copy(small_table_path, tmp_path, "format_4_0.h5", _drop_work)
+    argv = ["sample", "--alpha1", "60", "--speed", "150", "-n", "500", "--seed", "2", "--out"]
+    code, _, text = run_cli(surrogate_main, argv + [str(tmp_path / "s.h5"), "--table", str(small_table_path)], capsys)
+    samples = read_samples(tmp_path / "s.h5")
+    means = [samples.extra[f"wall_work_{name}"].mean() for name in ("normal", "tangential")]
+    assert code == 0 and (f"work on the wall per unit mass, mean over 500 hits: normal W_n {means[0]:.6g} J/kg "
+                          f"({means[0] / (0.5 * 150.0 ** 2):.4f} of 1/2|V-|^2), tangential W_t {means[1]:.6g} J/kg") in text
+    code, _, text = run_cli(surrogate_main, argv + [str(tmp_path / "o.h5"), "--table", str(older)], capsys)
+    assert code == 0 and "work on the wall: not in this table (format 4.0; rebuild it for W_n, W_t)" in text
+    assert table_data(older, shapes=("prism",), alpha1=(60.0,), n=50, seed=1).work == {}
