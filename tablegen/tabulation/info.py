@@ -47,6 +47,8 @@ def describe_table(table: ReboundTable, path: Path | None = None) -> str:
     lines += [
         f"format version {table.format_version[0]}.{table.format_version[1]}, made {table.created} by package "
         f"version {table.package_version}",
+        "the work on the wall: " + ("W_n, W_t drawn with each rebound" if table.has_work else
+                                    "not held (format 4.0: rebuild the table for W_n, W_t)"),
         f"config sha256 {table.config_sha256}, master seed {table.master_seed}",
         f"alpha1 (deg): {_grid(table.alpha1_deg)}",
         f"speed (m/s):  {_grid(table.speed_m_s)}",

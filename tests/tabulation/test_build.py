@@ -185,7 +185,7 @@ def test_info_describes_the_table(tiny_table, capsys):
     out = capsys.readouterr().out
     for text in (f"format version {TABLE_VERSION[0]}.{TABLE_VERSION[1]}",
                  f"fingerprint sha256 {table_fingerprint(tiny_table)}", "alpha1 (deg): 2 values", "prism",
-                 "tetrahedron", "config sha256", "3000 particles"):
+                 "tetrahedron", "config sha256", "3000 particles", "the work on the wall: W_n, W_t drawn with each rebound"):
         assert text in out
 
 
