@@ -103,7 +103,7 @@ def _draw(table, args, shape, omega, keys=None, roughness=0.0):
     return _global(table, args, V, HALF_SIZE, shape, spin, keys, roughness_deg=roughness, method=method)
 
 
-HALF_SIZE = 1.0        # m, of the drawn particles: any value; the draws and Omega- are given in units of |V-| and |V-|/a
+HALF_SIZE = 1.0        # m, of the drawn particles: any value (the draws and Omega- are in units of |V-|, |V-|/a)
 
 
 def _global(table, args, V, half_size, shape, spin, keys, **kwargs):

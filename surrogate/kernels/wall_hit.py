@@ -229,8 +229,8 @@ def rough_rebound(data, params, shape_arrays, model_shapes, mix_cdf, shape, key,
     STATUS_TRAPPED; a facet not found (probability below 1e-13) STATUS_FAILED. ``path`` and ``n_collisions``
     are the last facet hit's. The wall work (``wall_work_normal``, ``wall_work_tangential``, m²/s²) is the sum of
     the facet hits' (summed in their order from 0; those before a facet not found), NaN if any of them was
-    answered by a table without the work (format 4.0). ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,) float64:
-    work space."""
+    answered by a table without the work (format 4.0). ``scratch`` (SCRATCH_SIZE,) and ``facet_u`` (U_PER_DRAW,)
+    float64: work space."""
     path = rebound_path(data, V, omega, n, a, method)
     if (path == PATH_NONE or key < NO_KEY or not uniforms_ok(u) or not 0.0 < roughness_deg <= MAX_ROUGHNESS_DEG
             or shape < SHAPE_FROM_MIX or shape >= mix_cdf.shape[0]):

@@ -1,6 +1,7 @@
 """The work of the rebounds on the wall in ``tablegen report`` (docs/report.md, "Work on the wall"; docs/model.md
-§4.7), its data and the laws drawn beside it (the figure: :func:`tablegen.study.figures.work_figure`): per (shape, α1, |V⁻|) the normal and tangential work W_n, W_t of every hit that rebounded or was trapped
-(up to the trap), in units of the incident energy E⁻ = ½|V⁻|², their means and spread against α1, and beside them
+§4.7), its data and the laws drawn beside it (the figure: :func:`tablegen.study.figures.work_figure`): per
+(shape, α1, |V⁻|) the normal and tangential work W_n, W_t of every hit that rebounded or was trapped (up to the
+trap), in units of the incident energy E⁻ = ½|V⁻|², their means and spread against α1, and beside them
 the angle dependence of two classical erosion models of a ductile wall, each scaled to meet the mix's mean curve
 at the angle where that curve peaks:
 

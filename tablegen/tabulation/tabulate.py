@@ -500,7 +500,8 @@ def represent(folded: np.ndarray, regime: np.ndarray, resolution: TableResolutio
     Uses at most min(C, n // 25) clusters (at least one per regime present), partitioned on the states and
     their work variables together: the work has edges the state does not show (one collision against two),
     which a partition on the state alone blurs (docs/design/table_representation.md, "The work on the wall").
-    The work variables continue each cluster's chain after the state's. The remaining rows of the C-row arrays have weight 0 and are never drawn.
+    The work variables continue each cluster's chain after the state's. The remaining rows of the C-row arrays
+    have weight 0 and are never drawn.
     The arrays depend on the seed alone: not on the thread count or the CPU (module doc).
     """
     r = resolution
