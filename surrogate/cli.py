@@ -100,27 +100,27 @@ def _draw(table, args, shape, omega, keys=None, roughness=0.0):
     if keys is None and args.grain_key is not None:
         keys = np.full(args.n, args.grain_key)
     method = args.method if roughness > 0.0 else "direct" if path == PATH_DIRECT else "table"
-    return _global(table, args, V, HALF_SIZE, shape, spin, keys, roughness_deg=roughness, method=method)
+    return _global(table, args, V, shape, spin, keys, roughness_deg=roughness, method=method)
 
 
 HALF_SIZE = 1.0        # m, of the drawn particles: any value (the draws and Omega- are in units of |V-|, |V-|/a)
 
 
-def _global(table, args, V, half_size, shape, spin, keys, **kwargs):
+def _global(table, args, V, shape, spin, keys, **kwargs):
     """``sample_global`` of -n copies of the lab-frame hit V (m/s), its law-range warning left to the summary."""
     import surrogate
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", surrogate.WallLawRangeWarning)      # the summary says it (_sample)
-        return surrogate.sample_global(table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), half_size, shape,
+        return surrogate.sample_global(table, np.tile(V, (args.n, 1)), (0.0, 1.0, 0.0), HALF_SIZE, shape,
                                        random_state=args.seed, omega=spin, clamp=args.clamp, grain_key=keys, **kwargs)
 
 
-def _lab_draws(hits, speed, half_size):
+def _lab_draws(hits, speed):
     """The lab-frame rebounds of ``hits`` as local draws (the lab frame is the impact frame)."""
     import surrogate
     alpha2, beta2, v = rebound_angles(hits.V)
     return surrogate.LocalDraws(alpha2=alpha2, beta2=beta2, speed_ratio=v / speed,
-                                omega=hits.Omega * (half_size / speed), status=hits.status)
+                                omega=hits.Omega * (HALF_SIZE / speed), status=hits.status)
 
 
 def _print_work(hits, speed) -> None:
@@ -154,7 +154,7 @@ def _sample(args) -> int:
         raise ValueError(f"--roughness-deg must be in [0, {MAX_ROUGHNESS_DEG:g}] degrees; got {args.roughness_deg:g}")
     roughness = check_roughness(table, args.roughness_deg)
     hits = _draw(table, args, shape, omega, keys, roughness)
-    draws, paths, wall_hits = _lab_draws(hits, args.speed, HALF_SIZE), hits.path, hits.wall_hits
+    draws, paths, wall_hits = _lab_draws(hits, args.speed), hits.path, hits.wall_hits
     n_direct = int(np.count_nonzero(paths == PATH_DIRECT))
     n_table = int(np.count_nonzero(paths == PATH_TABLE))
     direct = n_direct == args.n

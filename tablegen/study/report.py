@@ -92,13 +92,12 @@ def pool(parts) -> PointSamples:
     return PointSamples(**merged)
 
 
-def _with_mix(parts: dict, shapes, alpha1, mix_of) -> dict:
-    """The reported points: the pure shapes asked for, and the mix pooled from ``mix_of``."""
-    points = {}
-    for shape in shapes:
-        for a in alpha1:
-            points[shape, a] = pool([parts[s, a] for s in mix_of]) if shape == MIX else parts[shape, a]
-    return points
+def _with_mix(parts: dict, shapes, mix_of, merge=pool) -> dict:
+    """The reported samples of ``parts`` (keyed (shape, α1, ...)): the pure shapes asked for, and the mix, ``merge``
+    of ``mix_of``'s at the same α1 (and speed)."""
+    rests = dict.fromkeys(key[1:] for key in parts)
+    return {(shape, *rest): merge([parts[(s, *rest)] for s in mix_of]) if shape == MIX else parts[(shape, *rest)]
+            for shape in shapes for rest in rests}
 
 
 def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0,
@@ -143,15 +142,8 @@ def direct_data(shapes, alpha1=DEFAULT_ALPHA1, n: int = DEFAULT_N, seed: int = 0
         counts_note=f"Counted over the {n} simulated particles per shape.",
         e_rot_method="exact: E_Ω⁺ = ½ Ω⁺·JΩ⁺ with each particle's own inertia tensor and orientation "
                      "(docs/model.md §5.4).",
-        points=_with_mix(parts, shapes, alpha1, available), work=_work_with_mix(work, shapes, alpha1, available),
+        points=_with_mix(parts, shapes, available), work=_with_mix(work, shapes, available, pooled),
         work_speeds=WORK_SPEEDS, work_source="the direct model, the same seed at every point")
-
-
-def _work_with_mix(work: dict, shapes, alpha1, mix_of) -> dict:
-    """The reported work samples: the pure shapes asked for, and the mix pooled from ``mix_of``, at every speed."""
-    speeds = sorted({v for _, _, v in work})
-    return {(shape, a, v): pooled([work[s, a, v] for s in mix_of]) if shape == MIX else work[shape, a, v]
-            for shape in shapes for a in alpha1 for v in speeds}
 
 
 def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0, roughness=()) -> ReportData:
@@ -226,8 +218,8 @@ def table_data(path, shapes=None, alpha1=None, n: int = DEFAULT_N, seed: int = 0
                      f"aspect-ratio law of the table ({inertias}). Against the direct model at 200 m/s this "
                      "overestimates the mean E_Ω⁺/E_V⁻ by 4–11 %, and by up to 21 % for ellipsoids near "
                      "normal impact (docs/report.md).",
-        points=_with_mix(parts, shapes, alpha1, tuple(table.shapes)), rough=rough,
-        rough_shape=rough_shape if rough else "", work=_work_with_mix(work, shapes, alpha1, tuple(table.shapes)),
+        points=_with_mix(parts, shapes, tuple(table.shapes)), rough=rough,
+        rough_shape=rough_shape if rough else "", work=_with_mix(work, shapes, tuple(table.shapes), pooled),
         work_speeds=tuple(sorted({v for _, _, v in work})),
         work_source="drawn from the table with `surrogate.sample_global`, at its grid speeds nearest "
                     + " and ".join(f"{v:g}" for v in WORK_SPEEDS) + " m/s")

@@ -68,8 +68,8 @@ def work_variables(samples: SampleSet) -> np.ndarray:
     ok = samples.rebounded
     work_n, work_t = (np.asarray(samples.extra[name], dtype=np.float64)[ok] for name in WORK_FIELDS)
     total = work_n + work_t
-    share = np.sqrt(np.divide(work_n, total, out=np.zeros_like(total), where=total > 0.0))
-    return np.column_stack([np.asarray(samples.extra["e_rot_ratio"], dtype=np.float64)[ok], share])
+    root = np.sqrt(np.divide(work_n, total, out=np.zeros_like(total), where=total > 0.0))
+    return np.column_stack([np.asarray(samples.extra["e_rot_ratio"], dtype=np.float64)[ok], root])
 
 
 def folded_state(state: np.ndarray) -> np.ndarray:
