@@ -269,7 +269,7 @@ PIECE_LOOP = dict(_nrt=False)
 def _flight_setups(shapes, shape, semi, K, R, verts, nv, W, rot, K_lab, ell, hull):
     """What rebound does at the start of a flight: K in the lab frame, ℓ = KΩ, curvature_bound, jerk_bound and
     (at the flight's second search step, if it has one) rotation_init; rot[i] receives the rotation parameters;
-    K_lab (3, 3) and ell (3,) are work arrays; ``hull`` a family's (scanned: no tree)."""
+    K_lab (3, 3) and ell (3,) are work arrays; ``hull`` a family's (scanned: no vertex graph)."""
     kind = shapes.kind[shape]
     for i in range(semi.shape[0]):
         lab_tensor(R[i], K[i], K_lab)

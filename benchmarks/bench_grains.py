@@ -1,7 +1,7 @@
 """Cost per rebound of the direct model against the hull size of a convex grain (docs/model.md §9).
 
 Random convex grains of 8, 24, 64, 256, 1000 and 10 000 hull vertices (random points on a sphere, every one a
-vertex; a hull of more than 64 searched through its tree, direct_model.vertex_tree; in their
+vertex; a hull of more than 64 walked over its vertex graph, direct_model.hull_walk; in their
 canonical frame, stretched per particle by the families' b/a, c/b law, both hands) and the prism for reference,
 through the run-time kernel (``direct_model.runtime.rebound_model_frame``: the whole rebound from its 7
 uniforms, what a direct hit costs, the caller's frame aside) on one thread. Printed per shape and set of states:

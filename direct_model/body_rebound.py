@@ -36,7 +36,7 @@ from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound
                                   lowest_points)
 from direct_model.rotation import ROT_PARAMS_SIZE
 from direct_model.shape_arrays import bounding_radius, particle_body, particle_hull
-from direct_model.vertex_tree import TREE_ABOVE, lowest_two
+from direct_model.hull_walk import START, WALK_ABOVE, WALK_WORK, clear, map_start, walk_lowest_two
 
 HISTORY_COLUMNS = 17
 
@@ -59,14 +59,15 @@ class BodyRebound(NamedTuple):
 
 # layout of the scratch array of :func:`body_rebound`: the candidate points' heights and rates, then g̈ (curvatures)
 _HEIGHTS = 0
-_RATES = _HEIGHTS + TREE_ABOVE     # a scanned body's candidates: at most TREE_ABOVE (more: its tree)
-_CURVATURE = _RATES + TREE_ABOVE
+_RATES = _HEIGHTS + WALK_ABOVE     # a scanned body's candidates: at most WALK_ABOVE (more: walked)
+_CURVATURE = _RATES + WALK_ABOVE
 _PARAMS = _CURVATURE + 3
 _R = _PARAMS + ROT_PARAMS_SIZE
 _K_LAB = _R + 9
 _KINV_LAB = _K_LAB + 9
 _K = _KINV_LAB + 9                 # then six 3-vectors: 1/K, ℓ, r_c, ΔV, ΔΩ, Ω(t)
-WORK_SIZE = _K + 18
+_WALK = _K + 18
+WORK_SIZE = _WALK + WALK_WORK
 _BLOCKS = 1024                     # parallel work units of body_rebound_batch (scratch allocated per block)
 
 
@@ -110,15 +111,16 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         of flight k (k < H): time (a/(m/s)), centre height y (a), V (3), Ω (3),
         R (9, row-major). Pass an array with H = 0 to record nothing.
     work : (WORK_SIZE,) float64 scratch space (no allocation per particle).
-    hull : (unit, scale, nodes, links), the hull's tree (:func:`direct_model.flight.find_contact`): its vertices
-        are unit[i] · scale and ``verts`` is not read; nodes of no rows: ``verts[:nv]`` are scanned.
+    hull : (unit, scale, graph_start, graph, starts, far), a hull walked over its vertex graph
+        (:func:`direct_model.flight.find_contact`): its vertices are unit[i] · scale and ``verts`` is not read;
+        graph_start of no rows: ``verts[:nv]`` are scanned.
 
     Returns
     -------
     :class:`BodyRebound`.
     """
-    h = work[_HEIGHTS:_HEIGHTS + TREE_ABOVE]
-    h1 = work[_RATES:_RATES + TREE_ABOVE]
+    h = work[_HEIGHTS:_HEIGHTS + WALK_ABOVE]
+    h1 = work[_RATES:_RATES + WALK_ABOVE]
     curv = work[_CURVATURE:_CURVATURE + 3]
     params = work[_PARAMS:_PARAMS + ROT_PARAMS_SIZE]
     R = work[_R:_R + 9].reshape((3, 3))
@@ -130,6 +132,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
     dV = work[_K + 9:_K + 12]
     dW = work[_K + 12:_K + 15]
     Wt = work[_K + 15:_K + 18]          # angular velocity during the search
+    walk_work = work[_WALK:_WALK + WALK_WORK]
 
     # element by element: an array assigned to a slice would compile numba's shape-mismatch message
     for i in range(3):
@@ -138,8 +141,12 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         for j in range(3):
             R[i, j] = R0[i, j]
 
+    if hull[2].shape[0] > 0:
+        clear(walk_work)
+        walk_work[START] = map_start(hull[4], (R[1, 0], R[1, 1], R[1, 2]), hull[1])
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0 and hull[2].shape[0] > 0:
-        y = -lowest_two(hull[0], hull[1], hull[2], hull[3], (R[1, 0], R[1, 1], R[1, 2]), 0.0)[0]
+        y = -walk_lowest_two(hull[0], hull[1], hull[2], hull[3], (R[1, 0], R[1, 1], R[1, 2]), 0.0,
+                             int(walk_work[START]), walk_work)[0]
     elif W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
         n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv)
         y = -np.inf
@@ -175,7 +182,7 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         for i in range(3):
             Wt[i] = W[i]
         code, t, steps = find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1],
-                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, curv, rc, hull)
+                                      contact_tol, set_tol, max_steps, R, Wt, h, h1, curv, rc, hull, walk_work)
         n_steps += steps
         if code == SEARCH_ESCAPED:
             status = STATUS_REBOUNDED
@@ -225,7 +232,7 @@ def body_rebound_batch(shape_arrays, shapes, ratios, hands, quats, V0, W0, wall,
     for block in numba.prange(n_blocks):
         no_history = np.empty((0, HISTORY_COLUMNS))
         work = np.empty(WORK_SIZE)
-        verts = np.empty((TREE_ABOVE, 3))
+        verts = np.empty((WALK_ABOVE, 3))
         K = np.empty(3)
         semi = np.empty(3)
         scale = np.empty(3)

@@ -51,9 +51,12 @@ h + h'T' − ½MT'² exceeds its round-off (T' = T(1 + 10⁻¹²)) provably has 
 step above T, so it is passed over without its square root and division
 (:func:`may_reach`): the same steps, the same bits, as a scan of every point.
 T is the second smallest safe step of the points before it in the scan, and on
-a hull of many vertices (more than :data:`PASS_OVER_ABOVE`) at most the larger
+a scanned hull of more than :data:`PASS_OVER_ABOVE` vertices at most the larger
 of the two lowest points' safe steps (:func:`pass_over_bound`), which costs a
-scan and two safe steps first.
+scan and two safe steps first. A hull of more than
+:data:`direct_model.hull_walk.WALK_ABOVE` vertices is not scanned but walked over
+its vertex graph (:mod:`direct_model.hull_walk`, :func:`walk_safe_steps`), with
+the same answers.
 
 The flight's rotation set-up (:func:`direct_model.rotation.rotation_init`) is
 done at the first step that needs the orientation at a later time: a flight
@@ -68,8 +71,8 @@ import numpy as np
 from direct_model.options import KERNEL
 from direct_model.rotation import rotation_at, rotation_init
 from direct_model.shape_arrays import KIND_ELLIPSOID
-from direct_model.vertex_tree import (FLOOR, ROUNDING, contact_sums, height, leaf_vertices, lower_bound, lowest_two,
-                                      spread, vertex)
+from direct_model.hull_walk import (BAND, START, band, descend, height, map_start, member, nearer, reach, vertex,
+                                   walk_contact_sums, walk_lowest_two)
 
 SEARCH_CONTACT = 0      # a point touches the wall (within contact_tol) and approaches it
 SEARCH_ESCAPED = 1      # the body can never reach the wall again
@@ -281,38 +284,73 @@ def take_step(h, hdot, M, T, i, tau, tau_other, b):
     return tau, min(tau_other, tau_i), b
 
 
+REFINE = 3              # descents that tighten a walk's step bound before the walk (walk_safe_steps)
+
+
+@numba.njit(inline="always", **KERNEL)
+def _vertex_step(unit, scale, g, d, y, v, M, i):
+    """Vertex i's safe step, its height and rate computed as the scan computes them."""
+    h, p0, p1, p2 = height(unit, scale, g, y, i)
+    return safe_step(h, v + (d[0] * p0 + d[1] * p1 + d[2] * p2), M)
+
+
 @numba.njit(**KERNEL)
-def tree_safe_steps(unit, scale, nodes, links, g, d, y, v, M, T):
-    """(tau, tau_other, b) of the hull's vertices through its tree (:mod:`direct_model.vertex_tree`), what
-    :func:`find_contact`'s loop over every vertex finds (b = −1 if no step is finite) when ``T`` is at least the
-    second smallest safe step (:func:`pass_over_bound`); h = y + g·p, h' = v + d·p, M the curvature bound. A
-    node is passed over when a lower bound of max(h, 0) + h'T' − ½MT'² over its box (T' = T(1 + 10⁻¹²) +
-    10⁻³⁰⁰, as :func:`may_reach`) is positive beyond 10⁻¹² of its terms: every vertex in it then has a safe step
-    above T, which may_reach would say too."""
-    Tp = T * (1.0 + 1e-12) + 1e-300
+def walk_safe_steps(unit, scale, graph_start, graph, starts, g, d, y, v, M, low, second, work):
+    """(tau, tau_other, b) of a hull's vertices walked over its graph (:mod:`direct_model.hull_walk`), what
+    :func:`find_contact`'s loop over every vertex finds (b = −1 if no step is finite); h = y + g·p,
+    h' = v + d·p, M the curvature bound, ``low`` and ``second`` the two lowest vertices.
+
+    The bound T, at least the second smallest step: the second smallest of distinct vertices' steps, the two
+    lowest's first, then with those of the vertex where the level h + T'h' is lowest and of its neighbours (a
+    descent from the start map's vertex, ``starts``), each such round tightening T. The walk of the level's bound
+    at T' (T(1 + 10⁻¹²) + 10⁻³⁰⁰, as :func:`may_reach`) meets every vertex that may_reach lets through at T, taken in index order as the scan
+    takes them; T infinite: every vertex."""
+    t1, i1 = _vertex_step(unit, scale, g, d, y, v, M, low), low
+    t2, i2 = _vertex_step(unit, scale, g, d, y, v, M, second), second
+    if t2 < t1:
+        t1, i1, t2, i2 = t2, i2, t1, i1
+    m = -1
+    for _ in range(REFINE):
+        if not t2 < np.inf:
+            break
+        before, last = t2, m
+        Tp = t2 * (1.0 + 1e-12) + 1e-300
+        m = descend(unit, scale, graph_start, graph, g, d, y, v, Tp,
+                    map_start(starts, (g[0] + Tp * d[0], g[1] + Tp * d[1], g[2] + Tp * d[2]), scale))[0]
+        if m == last:
+            break
+        for k in range(graph_start[m] - 1, graph_start[m + 1]):
+            j = m if k < graph_start[m] else graph[k]        # m, then its neighbours
+            if j != i1 and j != i2:
+                h, p0, p1, p2 = height(unit, scale, g, y, j)
+                h1 = v + (d[0] * p0 + d[1] * p1 + d[2] * p2)
+                if may_reach(h, h1, M, t2):
+                    tj = safe_step(h, h1, M)
+                    if tj < t1:
+                        t1, i1, t2, i2 = tj, j, t1, i1
+                    elif tj < t2:
+                        t2, i2 = tj, j
+        if not t2 < before:
+            break
+    T = t2
+    count = -1
+    if T < np.inf:
+        Tp = T * (1.0 + 1e-12) + 1e-300
+        size = abs(y) + reach(g, scale) + (abs(v) + reach(d, scale)) * Tp + 0.5 * abs(M) * Tp * Tp
+        count = band(unit, scale, graph_start, graph, g, d, y, v, Tp, 0.5 * M * Tp * Tp + BAND * size, i1, work)
     tau, tau_other, b = np.inf, np.inf, -1
-    k = 0
-    while k < nodes.shape[0]:
-        if T < np.inf:
-            low_h, low_rate = lower_bound(y, g, scale, nodes, k), lower_bound(v, d, scale, nodes, k)
-            q = max(low_h, 0.0) + (low_rate - 0.5 * M * Tp) * Tp
-            size = (abs(low_h) + 2.0 * spread(g, scale, nodes, k)
-                    + (abs(low_rate) + 2.0 * spread(d, scale, nodes, k)) * Tp + 0.5 * abs(M) * Tp * Tp + FLOOR)
-            if q > ROUNDING * size:
-                k = links[k, 2]
-                continue
-        for i in leaf_vertices(links, k):
-            h, p0, p1, p2 = height(unit, scale, g, y, i)
-            tau, tau_other, b = take_step(h, v + (d[0] * p0 + d[1] * p1 + d[2] * p2), M, T, i, tau, tau_other, b)
-        k += 1                  # into the first child, or past a leaf
+    for k in range(count if count >= 0 else unit.shape[0]):
+        i = member(work, count, k)
+        h, p0, p1, p2 = height(unit, scale, g, y, i)
+        tau, tau_other, b = take_step(h, v + (d[0] * p0 + d[1] * p1 + d[2] * p2), M, T, i, tau, tau_other, b)
     return tau, tau_other, b
 
 
 @numba.njit(inline="always", **KERNEL)
-def point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b):
-    """(h, h', h'') of candidate ``b``: from the scan's arrays, or computed for vertex b of a hull with a tree
-    (the same operations as :func:`lowest_points` and :func:`curvature`)."""
-    if tree:
+def point_state(walk, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b):
+    """(h, h', h'') of candidate ``b``: from the scan's arrays, or computed for vertex b of a walked hull (the
+    same operations as :func:`lowest_points` and :func:`curvature`)."""
+    if walk:
         p0, p1, p2 = vertex(unit, scale, b)
         return (y + (g[0] * p0 + g[1] * p1 + g[2] * p2), v + (d[0] * p0 + d[1] * p1 + d[2] * p2),
                 curv[0] * p0 + curv[1] * p1 + curv[2] * p2)
@@ -321,7 +359,7 @@ def point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b):
 
 @numba.njit(**KERNEL)
 def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contact_tol, set_tol,
-                 max_steps, R, W, h, h1, curv, rc, hull):
+                 max_steps, R, W, h, h1, curv, rc, hull, walk_work):
     """Advance a flight from its start (t = 0) to the next collision or to escape.
 
     Parameters
@@ -340,17 +378,20 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         return, at the returned time.
     h, h1, curv, rc : work arrays (nv, nv, 3, 3 entries; :func:`lowest_points`); for a
         contact, rc receives the contact point relative to the centroid (lab frame).
-    hull : (unit, scale, nodes, links): a hull's tree (:mod:`direct_model.vertex_tree`; its vertices are
-        unit[i] · scale, and ``verts``, ``h``, ``h1`` are not read), or nodes of no rows: the candidates are
-        scanned. The same steps and bits either way.
+    hull : (unit, scale, graph_start, graph, starts, far) of a hull walked over its vertex graph
+        (:func:`direct_model.shape_arrays.particle_hull`, :mod:`direct_model.hull_walk`: its vertices are
+        unit[i] · scale, and ``verts``, ``h``, ``h1`` are not read), or graph_start of no rows: the candidates
+        are scanned. The same steps and bits either way.
+    walk_work : (WALK_WORK,) a walk's work space (:func:`direct_model.hull_walk.clear` before a rebound's first
+        search), its entry START the vertex a walk starts from, on return the last lowest vertex.
 
     Returns
     -------
     (code, t, n_steps) with code one of the ``SEARCH_*`` values.
     """
-    unit, scale, nodes, links = hull
-    tree = nodes.shape[0] > 0
-    g, d = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)       # the tree's view of the normal and its turn (module doc)
+    unit, scale, graph_start, graph = hull[0], hull[1], hull[2], hull[3]
+    walk = graph_start.shape[0] > 0
+    g, d = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)       # a walk's view of the normal and its turn (module doc)
     n, h_second, second = nv, np.inf, -1
     b = -1                # the binding point of the last step
     t = 0.0
@@ -362,11 +403,13 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
                 rotation_init(K, R, ell, params)
             rotation_at(params, t, R, W)
         y = y0 + v * t
-        if tree:
+        if walk:
             g0, g1, g2, d0, d1, d2, a0, a1, a2 = turning(R, W, K)
             g, d = (g0, g1, g2), (d0, d1, d2)
             curv[0], curv[1], curv[2] = a0, a1, a2
-            hmin, low, h_second, second = lowest_two(unit, scale, nodes, links, g, y)
+            hmin, low, h_second, second = walk_lowest_two(unit, scale, graph_start, graph, g, y,
+                                                          nearer(unit, scale, hull[4], g, y, walk_work), walk_work)
+            walk_work[START] = low
         else:
             n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv)
             hmin, low = np.inf, 0
@@ -374,8 +417,9 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
                 if h[i] < hmin:
                     hmin, low = h[i], i
         if -contact_tol <= hmin <= contact_tol:
-            if tree:
-                count, p0, p1, p2, rate, best = contact_sums(unit, scale, nodes, links, g, d, y, v, hmin + set_tol)
+            if walk:
+                count, p0, p1, p2, rate, best = walk_contact_sums(unit, scale, graph_start, graph, g, d, y, v,
+                                                                  hmin + set_tol, low, walk_work)
                 q0, q1, q2 = vertex(unit, scale, max(best, 0))
                 touching = contact_point(count, p0, p1, p2, rate, best, q0, q1, q2, R, rc)
             else:
@@ -387,7 +431,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
             # safeguarded second-order Newton on its height.
             if b < 0:             # below the wall at the start: no bracket, the budget ends it
                 b = low
-            hb, h1b, h2b = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b)
+            hb, h1b, h2b = point_state(walk, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b)
             if hb < 0.0:
                 t_hi = t
             else:
@@ -398,13 +442,9 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         if v > 0.0 and y > Rb:
             return SEARCH_ESCAPED, t, step + 1
         # the smallest and second smallest safe steps are at most T: points that surely take longer are passed
-        if tree:
-            T = np.inf
-            if second >= 0:
-                h1_low = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, low)[1]
-                h1_second = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, second)[1]
-                T = max(safe_step(hmin, h1_low, M), safe_step(h_second, h1_second, M))
-            tau, tau_other, found = tree_safe_steps(unit, scale, nodes, links, g, d, y, v, M, T)
+        if walk:
+            tau, tau_other, found = walk_safe_steps(unit, scale, graph_start, graph, hull[4], g, d, y, v, M, low,
+                                                    second, walk_work)
         else:
             T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
             tau, tau_other, found = np.inf, np.inf, -1
@@ -414,7 +454,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
             b = found
         if 0.0 < tau < np.inf:
             # b's longer step from its exact curvature, valid up to the horizon (module doc)
-            hb, h1b, h2b = point_state(tree, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b)
+            hb, h1b, h2b = point_state(walk, kind, verts, h, h1, curv, unit, scale, g, d, y, v, b)
             horizon = min(tau_other, HORIZON * tau)
             tau = max(tau, min(horizon, safe_step(hb, h1b, min(M, M3 * horizon / 3.0 - h2b))))
         if v > 0.0 and tau >= (Rb - y) / v:

@@ -29,7 +29,7 @@ import numpy as np
 from direct_model.polyhedron import canonical_frame, mass_properties, vertex_graph
 from direct_model.shapes import DEFAULT_KAPPA, MIX, SHAPES, AspectRatioLaw, check_kappa, shape_vertices
 
-# A hull of more than direct_model.vertex_tree.TREE_ABOVE vertices is searched through its tree, with no work space
+# A hull of more than direct_model.hull_walk.WALK_ABOVE vertices is walked over its vertex graph, with no work space
 # per vertex; 2^16 vertices hold a micro-CT scan's hull several times over (docs/design/grains.md).
 MAX_HULL_VERTICES = 65536
 MIN_THICKNESS = 1e-3        # thinnest half-extent, in units of a: the flight bound grows as (a / thickness)²

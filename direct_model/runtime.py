@@ -26,7 +26,7 @@ from direct_model.options import KERNEL
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, quaternion_to_matrix, body_rebound
 from direct_model.shape_arrays import ShapeArrays, bounding_radius, family_shape_arrays, particle_body, particle_hull
 from direct_model.shapes import SHAPES, AspectRatioLaw, check_kappa, normal_cdf
-from direct_model.vertex_tree import TREE_ABOVE
+from direct_model.hull_walk import WALK_ABOVE
 from direct_model.wall import WALL_ARRAY_SIZE, Wall, wall_from_array
 
 U_PER_REBOUND = 7
@@ -41,10 +41,10 @@ P_KFAC = 11                                          # second-moment factor s pe
 P_WALL = P_KFAC + len(SHAPES)                        # the wall's array (direct_model.wall, layout W_*), zero-padded
 N_PARAMS = P_WALL + WALL_ARRAY_SIZE
 
-# the scratch of one call: rebound's work, then the body's vertices (those of a hull scanned without its tree), its
-# half-extents, J/m and scale, R0, V0, W0, V, W
+# the scratch of one call: rebound's work, then the body's vertices (a scanned hull's; a walked one needs none),
+# its half-extents, J/m and scale, R0, V0, W0, V, W
 _VERTS = WORK_SIZE
-_SEMI = _VERTS + 3 * TREE_ABOVE
+_SEMI = _VERTS + 3 * WALK_ABOVE
 _K = _SEMI + 3
 _SCALE = _K + 3
 _R0 = _SCALE + 3
@@ -171,7 +171,7 @@ def rebound_model_frame(params, shape_arrays, shape, vt, vn, wx, wy, wz, u, scra
     rebound on the wall per unit particle mass, ``wall_work_normal`` and ``wall_work_tangential`` in m²/s²
     (docs/model.md §4.7; a scalar of the rebound, the same in every frame).
     """
-    verts = scratch[_VERTS:_VERTS + 3 * TREE_ABOVE].reshape((TREE_ABOVE, 3))
+    verts = scratch[_VERTS:_VERTS + 3 * WALK_ABOVE].reshape((WALK_ABOVE, 3))
     semi, K, scale = scratch[_SEMI:_SEMI + 3], scratch[_K:_K + 3], scratch[_SCALE:_SCALE + 3]
     R0 = scratch[_R0:_R0 + 9].reshape((3, 3))
     V0, W0 = scratch[_V0:_V0 + 3], scratch[_V0 + 3:_V0 + 6]

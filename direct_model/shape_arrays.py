@@ -27,12 +27,15 @@ array              dtype, shape        content
                                        (libm's erfc), NaN for fixed proportions
 ``half_extents``   float64 (n, 3)      derived: (max − min)/2 of the unit body's vertices along ξ, η, ζ (an
                                        ellipsoid's semi-axes)
-``tree_start``     int64 (n + 1,)      derived: shape i's rows of ``tree_nodes`` and ``tree_links`` (none for a hull
-                                       of at most :data:`direct_model.vertex_tree.TREE_ABOVE` vertices)
-``tree_nodes``     float64 (total_k,   derived: the boxes of the tree of each hull of more vertices
-                   NODE_SIZE)          (:mod:`direct_model.vertex_tree`: centre, axes, half-extents)
-``tree_links``     int64 (total_k, 4)  derived: first vertex, count, next node after the subtree, leaf flag;
-                                       vertex indices the shape's own
+``graph_start``    int64 (total + 1,)  derived: vertex row r's neighbours are graph[graph_start[r]:graph_start[r +
+                                       1]] (:func:`direct_model.polyhedron.vertex_graph`; none for an ellipsoid)
+``graph``          int32 (2 × edges,)  derived: the hulls' vertex graphs, as the shape's own vertex indices
+``starts``         int32 (n, MAP_SIZE) derived: a hull's start map, the vertex where a descent along a direction
+                                       starts (:func:`direct_model.hull_walk.start_map`; 0 for a scanned shape)
+``far_start``      int64 (n + 1,)      derived: shape i's rows of ``far``
+``far``            int32 (total_f,)    derived: the vertices that may be a particle's farthest
+                                       (:func:`direct_model.hull_walk.farthest_candidates`), the shape's own
+                                       indices
 =================  ==================  ===========================================================================
 
 The unit body of a family (docs/model.md §3) is its body at b/a = c/b = 1, its vertices in the order of
@@ -64,7 +67,8 @@ from direct_model.options import KERNEL
 from direct_model.registry import (FRAME_CHECK, MAX_HULL_VERTICES, ConvexPolyhedron, Ellipsoid, built_in_shape,
                                    built_in_shapes, polyhedron)
 from direct_model.shapes import DEFAULT_KAPPA, SHAPES, AspectRatioLaw, normal_cdf, second_moment_factor, shape_vertices
-from direct_model.vertex_tree import NODE_SIZE, build_tree, farthest
+from direct_model.hull_walk import MAP_SIZE, WALK_ABOVE, farthest_candidates, start_map, walk_farthest
+from direct_model.polyhedron import vertex_graph
 
 KIND_ELLIPSOID, KIND_POLYHEDRON = 0, 1
 MIN_HULL_VERTICES = 4
@@ -84,9 +88,11 @@ class ShapeArrays(NamedTuple):
     both_hands: np.ndarray       # uint8 (n,)
     aspect_cdf: np.ndarray       # float64 (n, 2): derived from aspect
     half_extents: np.ndarray     # float64 (n, 3): derived from vertices
-    tree_start: np.ndarray       # int64 (n + 1,): derived, the hulls' trees
-    tree_nodes: np.ndarray       # float64 (total_k, NODE_SIZE)
-    tree_links: np.ndarray       # int64 (total_k, 4)
+    graph_start: np.ndarray      # int64 (total + 1,): derived, the hulls' vertex graphs
+    graph: np.ndarray            # int32 (2 × edges,)
+    starts: np.ndarray           # int32 (n, MAP_SIZE): derived, where a descent starts
+    far_start: np.ndarray        # int64 (n + 1,): derived, the farthest vertex's candidates
+    far: np.ndarray              # int32 (total_f,)
 
     @property
     def n_shapes(self) -> int:
@@ -115,23 +121,33 @@ def from_stored(kind, vertex_start, vertices, triangle_start, triangles, second_
                   aspect=_frozen(np.reshape(aspect, (-1, 4)), np.float64), both_hands=_frozen(both_hands, np.uint8))
     _check(**arrays)
     n = len(arrays["kind"])
-    cdf, half, trees = np.full((n, 2), np.nan), np.zeros((n, 3)), []
+    cdf, half = np.full((n, 2), np.nan), np.zeros((n, 3))
+    starts, degrees, graphs, fars = np.zeros((n, MAP_SIZE), np.int32), [np.zeros(1, np.int64)], [], []
     for i, (mean, sd, low, high) in enumerate(arrays["aspect"]):
         if not np.isnan(mean):
             cdf[i] = normal_cdf((low - mean) / sd), normal_cdf((high - mean) / sd)
         lo, hi = arrays["vertex_start"][i], arrays["vertex_start"][i + 1]
         if arrays["kind"][i] == KIND_ELLIPSOID:
             half[i] = arrays["vertices"][lo]
-            trees.append(build_tree(arrays["vertices"][lo:lo]))
+            degrees.append(np.zeros(1, np.int64))
+            fars.append(np.zeros(0, np.int32))
         else:
+            unit = arrays["vertices"][lo:hi]
             half[i] = _half_extents(arrays["vertices"], lo, hi - lo)
-            trees.append(build_tree(arrays["vertices"][lo:hi]))
-    counts = [len(nodes) for nodes, _ in trees]
-    nodes = np.concatenate([nodes for nodes, _ in trees]).reshape(-1, NODE_SIZE)
-    links = np.concatenate([links for _, links in trees]).reshape(-1, 4)
+            start, neighbours = vertex_graph(arrays["triangles"][arrays["triangle_start"][i]:
+                                                                 arrays["triangle_start"][i + 1]], hi - lo)
+            degrees.append(np.diff(start).astype(np.int64))
+            graphs.append(neighbours)
+            if hi - lo > WALK_ABOVE:
+                starts[i] = start_map(unit)
+            fars.append(farthest_candidates(unit))
+    graph_start = np.cumsum(np.concatenate(degrees))
     return ShapeArrays(**arrays, aspect_cdf=_frozen(cdf, np.float64), half_extents=_frozen(half, np.float64),
-                       tree_start=_frozen(np.concatenate([[0], np.cumsum(counts)]), np.int64),
-                       tree_nodes=_frozen(nodes, np.float64), tree_links=_frozen(links, np.int64))
+                       graph_start=_frozen(graph_start, np.int64),
+                       graph=_frozen(np.concatenate([np.zeros(0, np.int32), *graphs]), np.int32),
+                       starts=_frozen(starts, np.int32),
+                       far_start=_frozen(np.concatenate([[0], np.cumsum([len(f) for f in fars])]), np.int64),
+                       far=_frozen(np.concatenate([np.zeros(0, np.int32), *fars]), np.int32))
 
 
 def _check(kind, vertex_start, vertices, triangle_start, triangles, second_moments, aspect, both_hands):
@@ -273,9 +289,9 @@ def particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi, scale
     ``ratio_ba``, ``ratio_cb``: the particle's b/a and c/b (ignored for a shape of fixed proportions);
     ``hand`` ±1 (−1: the mirror image ζ → −ζ; an ellipsoid is its own). Writes the factors that take the unit
     body to the particle's into ``scale`` (its vertex i is unit[i] · scale), the body frame's vertices into
-    ``verts[:nv]`` if it has room for them (nv = 0 for an ellipsoid; a hull searched through its tree needs
-    none), the principal J/m into ``K`` (a²) and the half-extents along ξ, η, ζ into ``semi`` (an ellipsoid's
-    semi-axes), all in units of the particle's a (the largest is 1).
+    ``verts[:nv]`` if it has room for them (nv = 0 for an ellipsoid; a walked hull needs none), the principal J/m
+    into ``K`` (a²) and the half-extents along ξ, η, ζ into ``semi`` (an ellipsoid's semi-axes), all in units of
+    the particle's a (the largest is 1).
     """
     lo, nv = shapes.vertex_start[shape], shapes.vertex_start[shape + 1] - shapes.vertex_start[shape]
     unit = shapes.vertices
@@ -320,12 +336,12 @@ def _half_extents(unit, lo, nv):
 @numba.njit(**KERNEL)
 def bounding_radius(kind, semi, verts, nv, hull):
     """Radius of the smallest centroid-centred sphere holding the body (units of a): the largest semi-axis of
-    an ellipsoid, the farthest vertex of a polyhedron (of ``verts[:nv]``, or through the tree of ``hull``,
+    an ellipsoid, the farthest vertex of a polyhedron (of ``verts[:nv]``, or of a walked ``hull``'s candidates,
     :func:`particle_hull`)."""
     if kind == KIND_ELLIPSOID:
         return max(semi[0], max(semi[1], semi[2]))
     if hull[2].shape[0] > 0:
-        return np.sqrt(farthest(hull[0], hull[1], hull[2], hull[3]))
+        return np.sqrt(walk_farthest(hull[0], hull[1], hull[5]))
     r2 = 0.0
     for i in range(nv):
         r2 = max(r2, verts[i, 0] ** 2 + verts[i, 1] ** 2 + verts[i, 2] ** 2)
@@ -333,16 +349,19 @@ def bounding_radius(kind, semi, verts, nv, hull):
 
 
 def scanned_hull(verts) -> tuple:
-    """The ``hull`` argument of the kernels for a body given by its vertices alone (``verts``, scanned: no tree)."""
-    return (np.asarray(verts, dtype=np.float64), np.ones(3), np.zeros((0, NODE_SIZE)), np.zeros((0, 4), dtype=np.int64))
+    """The ``hull`` argument of the kernels for a body given by its vertices alone (``verts``, scanned)."""
+    return (np.asarray(verts, dtype=np.float64), np.ones(3), np.zeros(0, dtype=np.int64), np.zeros(0, np.int32),
+            np.zeros(MAP_SIZE, np.int32), np.zeros(0, np.int32))
 
 
 @numba.njit(inline="always", **KERNEL)
 def particle_hull(shapes, shape, scale):
-    """(unit, scale, nodes, links): shape ``shape``'s unit vertices and tree (no rows for a hull scanned from
-    ``verts``) with the particle's ``scale`` (:func:`particle_body`), what the contact search takes
+    """(unit, scale, graph_start, graph, starts, far): shape ``shape``'s unit vertices, its vertex graph (no rows
+    for a hull scanned from ``verts``, of at most :data:`direct_model.hull_walk.WALK_ABOVE` vertices), start map
+    and farthest candidates with the particle's ``scale`` (:func:`particle_body`), what the contact search takes
     (:func:`direct_model.flight.find_contact`). From Python call ``particle_hull.py_func``: compiled without
     numba's reference counts, the kernel hands Python each slice's whole parent array."""
     lo, hi = shapes.vertex_start[shape], shapes.vertex_start[shape + 1]
-    first, last = shapes.tree_start[shape], shapes.tree_start[shape + 1]
-    return shapes.vertices[lo:hi], scale, shapes.tree_nodes[first:last], shapes.tree_links[first:last]
+    last = hi + 1 if hi - lo > WALK_ABOVE else lo
+    return (shapes.vertices[lo:hi], scale, shapes.graph_start[lo:last], shapes.graph, shapes.starts[shape],
+            shapes.far[shapes.far_start[shape]:shapes.far_start[shape + 1]])

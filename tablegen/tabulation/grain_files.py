@@ -31,8 +31,8 @@ COPLANAR = 1e-9             # points whose spread off their best plane is below 
 # precision. Two copies differ only if a coordinate lies within that round-off of a rounding boundary (a chance
 # of about 1e-4 per coordinate); a settled record settles to itself exactly.
 SETTLE = 2.0 ** -36
-# a larger hull's vertices go in Morton order: neighbours in space near in index, so that a leaf of its contact
-# search's tree (direct_model.vertex_tree) is a small patch; a smaller hull keeps the order its tables were built in
+# a larger hull's vertices go in Morton order: neighbours in space near in index, so that a walk over its vertex
+# graph (direct_model.hull_walk) reads nearby memory; a smaller hull keeps the order its tables were built in
 SPATIAL_ORDER_ABOVE = 256
 MORTON_BITS = 21            # per axis: 63 bits in all
 

@@ -110,7 +110,7 @@ def write_grain_config(folder, text=GRAIN_TABLE_CONFIG, mesh=GRAIN_MESH):
 
 # a table of one user grain of BIG_GRAIN_VERTICES hull vertices on one grid point, the fewest particles a cell allows
 # (it builds in a few seconds): points on the surface of the ellipsoid of semi-axes (1, 0.7, 0.5), each one a hull
-# vertex, given as the configuration's points; numba searches its contact through the hull's tree, C scans every
+# vertex, given as the configuration's points; numba walks its vertex graph in the contact search, C scans every
 # vertex with its work space on the heap
 BIG_GRAIN_VERTICES = 10_000
 

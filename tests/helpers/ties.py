@@ -18,7 +18,7 @@ import numpy as np
 from direct_model.body_rebound import HISTORY_COLUMNS, WORK_SIZE, body_rebound
 from direct_model.registry import grain
 from direct_model.shape_arrays import scanned_hull
-from direct_model.vertex_tree import TREE_ABOVE
+from direct_model.hull_walk import WALK_ABOVE
 from direct_model.wall import CORUNDUM_ON_STEEL
 from tablegen.tabulation.grain_files import convex_hull
 from tests.helpers.one_particle import Body, body
@@ -218,8 +218,8 @@ def tie_states():
 # -- the rebound ---------------------------------------------------------------------------------------------------
 
 def kernel_body(s: TieState):
-    """The state's vertices as the kernels take them: TREE_ABOVE rows (a scanned body's most), the body's first."""
-    verts = np.zeros((TREE_ABOVE, 3))
+    """The state's vertices as the kernels take them: WALK_ABOVE rows (a scanned body's most), the body's first."""
+    verts = np.zeros((WALK_ABOVE, 3))
     verts[:len(s.body.vertices)] = s.body.vertices
     return verts
 

@@ -1,5 +1,5 @@
-"""A grain of 10 000 hull vertices (tests/conftest.py, big_grain_table_path): numba searches its contact through
-the hull's tree of boxes (direct_model.vertex_tree), C scans every vertex with its work space on the heap
+"""A grain of 10 000 hull vertices (tests/conftest.py, big_grain_table_path): numba searches its contact by walks
+over the hull's vertex graph (direct_model.hull_walk), C scans every vertex with its work space on the heap
 (native/src/runtime.c, above MAX_STACK_VERTICES); both give the same bits. C loads the table with the grain's
 10 000 vertices, and its hits on the direct path, spinning or not, and on the table path equal numba's, field by
 field (status, path, shape, collisions, V⁺, Ω⁺)."""
@@ -10,6 +10,7 @@ import numpy as np
 
 from tests.helpers import python_side as py
 from tests.helpers.native_library import FAMILY_NONE, METHOD_DIRECT, METHOD_TABLE, PATH_DIRECT, PATH_TABLE
+from direct_model.shape_arrays import particle_hull
 from tests.helpers.tables import BIG_GRAIN_VERTICES
 
 HITS = 150      # half of them spinning; C scans the 10 000 vertices at every search step (about a millisecond a hit)
@@ -24,9 +25,9 @@ def test_the_big_grain_loads_in_c_with_its_vertices(native, big_grain_table_path
         assert info["n_vertices"] == BIG_GRAIN_VERTICES == len(arrays["vertices"]) and info["family"] == FAMILY_NONE
         assert info["vertices"].tobytes() == arrays["vertices"].tobytes()
         assert info["inertia"].tobytes() == arrays["inertia"][0].tobytes()
-        # numba searches this hull through its tree: the hits below set the tree against C's scan
+        # numba walks this hull: the hits below set the walk against C's scan
         shape = table.model_shapes[0]
-        assert shape == 4 and table.shape_arrays.tree_start[shape + 1] > table.shape_arrays.tree_start[shape]
+        assert shape == 4 and len(particle_hull.py_func(table.shape_arrays, shape, np.ones(3))[2]) > 0
     finally:
         c_table.close()
 
@@ -49,7 +50,7 @@ def _hits(rng):
     return V, omega, n, a
 
 
-def test_the_big_grain_rebounds_with_the_bits_of_numba_s_tree(native, big_grain_table_path):
+def test_the_big_grain_rebounds_with_the_bits_of_numba_s_walk(native, big_grain_table_path):
     """rbs_rebound under RBS_METHOD_DIRECT and RBS_METHOD_TABLE, the same hits and uniforms: numba's rebound's
     record, bit for bit; at least 9 in 10 direct hits rebound, spinning and not."""
     table, c_table = py.load(big_grain_table_path), native.table(big_grain_table_path)

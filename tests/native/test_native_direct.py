@@ -24,7 +24,7 @@ PER_SHAPE = 2000                  # particles per shape and spin
 N_COLLISIONS = 10_000
 LAW = py.AspectRatioLaw()
 # user grains: hulls of 8 to 1000 vertices in both hands, of fixed proportions or stretched by the families' law (above
-# 64 vertices numba searches through the hull's tree, C scans; above 256 C's work space is on the heap)
+# 64 vertices numba walks the hull's vertex graph, C scans; above 256 C's work space is on the heap)
 GRAINS = [py.hull_grain(f"grain_{n}", n, seed=n, aspect=LAW if n in (24, 256, 1000) else None, both_hands=True)
           for n in (8, 24, 64, 256, 1000)] + [py.cloud_grain("cloud", 300, seed=3, aspect=LAW)]
 
@@ -168,7 +168,8 @@ def test_shapes_bit_for_bit(native):
 def test_particle_bodies_bit_for_bit(native, table_pair):
     """One particle's body from the shape arrays (rbs_particle_body, rbs_bounding_radius): vertices, J/m,
     half-extents and radius as numba's, for the table's families and the user grains (hulls of more than
-    direct_model.vertex_tree.TREE_ABOVE vertices: numba's radius through the hull's tree, C's from every vertex),
+    direct_model.hull_walk.WALK_ABOVE vertices: numba's radius from the hull's farthest candidates, C's from every
+    vertex),
     random ratios and hands. C computes the half-extents from the vertices, numba reads them precomputed; numba's
     vertices (room for 256 here) are unit[i] · scale."""
     c = _c(native)
