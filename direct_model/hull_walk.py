@@ -20,7 +20,7 @@ neighbours of vertex i are graph[graph_start[i]:graph_start[i + 1]], indices int
 (:data:`MAP_SIZE`,) its start map (:func:`start_map`: a vertex near the lowest along any direction, where a
 descent starts; it decides speed, never an answer) and ``far`` the vertices that may be the farthest from the
 centre for some stretch (:func:`farthest_candidates`). A hull of :data:`WALK_ABOVE` vertices or fewer is scanned.
-Work space: ``work`` (:data:`WALK_WORK`,) float64, a hash set of the vertices met, three lists and the last
+Work space: ``work`` (:data:`WALK_WORK`,) float64, a hash set of the vertices met, two lists and the last
 answer; a walk that would meet more than :data:`ROOM` vertices gives up, and its query scans every vertex (the
 same answer, slower).
 """
@@ -35,7 +35,7 @@ from direct_model.options import JIT, KERNEL
 WALK_ABOVE = 64         # vertices; a hull with more is walked (the same bits as a scan; docs/design/grains.md)
 ROOM = 128              # vertices one walk may meet (its band and the ring around it); more: the query scans
 SLOTS = 256             # hash slots of the vertices met: twice ROOM, so probes stay short
-START = SLOTS + 3 * ROOM                # after the hash set, the vertices met with their slots, the band's members:
+START = SLOTS + 2 * ROOM                # after the hash set, the slots of the vertices met, the band's members:
 WALK_WORK = START + 1                   # the vertex the next walk starts from
 BAND = 1e-9             # relative widening of a walk's bound (module doc)
 MAP_CELLS = 16          # cells along a face's edge of a hull's start map (a cube map of directions)
@@ -44,20 +44,33 @@ FAR_MARGIN = 1e-12      # a vertex is dropped from ``far`` when another beats it
 _HASH = 2654435761      # Knuth's multiplicative hash
 
 
-def start_map(unit) -> np.ndarray:
-    """(MAP_SIZE,) int32: for each cell of a cube map of directions w (:func:`map_cell`), the first vertex of
-    ``unit`` (n, 3) lowest along its centre's direction: where a descent along w starts (a speed device only)."""
-    edge = (np.arange(MAP_CELLS) + 0.5) / MAP_CELLS * 2.0 - 1.0
-    x, y = np.meshgrid(edge, edge, indexing="ij")
-    directions = np.empty((MAP_SIZE, 3))
+@numba.njit(**JIT)
+def start_map(unit, graph_start, graph):
+    """(MAP_SIZE,) int32: for each cell of a cube map of directions w (:func:`map_cell`), a vertex of ``unit``
+    (n, 3) lowest along its centre's direction (its vertex graph ``graph_start``, ``graph`` local): where a descent
+    along w starts. Each cell's by a steepest descent from the cell's before it (a speed device only)."""
+    starts = np.empty(MAP_SIZE, dtype=np.int32)
+    i = 0
     for face in range(6):
         axis, sign = face // 2, -1.0 if face % 2 else 1.0
-        rows = directions[face * MAP_CELLS ** 2:(face + 1) * MAP_CELLS ** 2]
-        rows[:, axis] = sign
-        rows[:, (axis + 1) % 3], rows[:, (axis + 2) % 3] = x.ravel(), y.ravel()
-    unit = np.asarray(unit, dtype=np.float64)
-    return np.array([np.argmin(unit[:, 0] * w[0] + unit[:, 1] * w[1] + unit[:, 2] * w[2]) for w in directions],
-                    dtype=np.int32)
+        for a in range(MAP_CELLS):
+            for b in range(MAP_CELLS):
+                w = np.empty(3)
+                w[axis] = sign
+                w[(axis + 1) % 3] = (a + 0.5) / MAP_CELLS * 2.0 - 1.0
+                w[(axis + 2) % 3] = (b + 0.5) / MAP_CELLS * 2.0 - 1.0
+                best = w[0] * unit[i, 0] + w[1] * unit[i, 1] + w[2] * unit[i, 2]
+                while True:
+                    here = i
+                    for k in range(graph_start[here], graph_start[here + 1]):
+                        j = graph[k]
+                        x = w[0] * unit[j, 0] + w[1] * unit[j, 1] + w[2] * unit[j, 2]
+                        if x < best:
+                            i, best = j, x
+                    if i == here:
+                        break
+                starts[(face * MAP_CELLS + a) * MAP_CELLS + b] = i
+    return starts
 
 
 @numba.njit(inline="always", **KERNEL)
@@ -176,15 +189,14 @@ def descend(unit, scale, graph_start, graph, g, d, y, v, T, i):
 @numba.njit(**KERNEL)
 def band(unit, scale, graph_start, graph, g, d, y, v, T, limit, start, work):
     """The vertices connected to ``start`` through vertices of level at most ``limit``, ascending, into
-    ``work[SLOTS + 2·ROOM:]``; returns their number, or −1 if ``start`` is above the limit or the walk would meet
+    ``work[SLOTS + ROOM:START]``; returns their number, or −1 if ``start`` is above the limit or the walk would meet
     more than ROOM vertices (module doc). ``work[:SLOTS]`` is zero on entry and on return (:func:`clear`)."""
-    slots, met, where = work[:SLOTS], work[SLOTS:SLOTS + ROOM], work[SLOTS + ROOM:SLOTS + 2 * ROOM]
-    members = work[SLOTS + 2 * ROOM:]
+    slots, where, members = work[:SLOTS], work[SLOTS:SLOTS + ROOM], work[SLOTS + ROOM:START]
     if not level(unit, scale, g, d, y, v, T, start) <= limit:
         return -1
     slot = (int(start) * _HASH) & (SLOTS - 1)
     slots[slot] = start + 1.0
-    met[0], where[0], members[0] = start, slot, start
+    where[0], members[0] = slot, start
     n_met, count, head = 1, 1, 0
     while head < count and n_met >= 0:
         i = int(members[head])
@@ -200,7 +212,7 @@ def band(unit, scale, graph_start, graph, g, d, y, v, T, limit, start, work):
                 n_met = -n_met              # full: give up
                 break
             slots[slot] = j + 1.0
-            met[n_met], where[n_met] = j, slot
+            where[n_met] = slot
             n_met += 1
             if level(unit, scale, g, d, y, v, T, j) <= limit:
                 members[count] = j
@@ -229,7 +241,7 @@ def clear(work):
 @numba.njit(inline="always", **KERNEL)
 def member(work, count, k):
     """The k-th vertex a query takes: of the band (``count`` ≥ 0 of them), or of the whole hull (count −1)."""
-    return int(work[SLOTS + 2 * ROOM + k]) if count >= 0 else k
+    return int(work[SLOTS + ROOM + k]) if count >= 0 else k
 
 
 @numba.njit(**KERNEL)

@@ -139,7 +139,7 @@ def from_stored(kind, vertex_start, vertices, triangle_start, triangles, second_
             degrees.append(np.diff(start).astype(np.int64))
             graphs.append(neighbours)
             if hi - lo > WALK_ABOVE:
-                starts[i] = start_map(unit)
+                starts[i] = start_map(unit, start, neighbours)
             fars.append(farthest_candidates(unit))
     graph_start = np.cumsum(np.concatenate(degrees))
     return ShapeArrays(**arrays, aspect_cdf=_frozen(cdf, np.float64), half_extents=_frozen(half, np.float64),

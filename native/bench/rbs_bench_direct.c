@@ -147,7 +147,9 @@ static int time_pieces(const rbs_table *table, int shape, const char *path, int 
     uint8_t hands[RBS_N_FAMILIES];
     rbs_family_shapes_fill(kind, vertex_start, vertices, moments, law, law_cdf, hands, params[P_KAPPA],
                            params + P_ASPECT_MEAN, params + P_CDF_LOW, params + P_KFAC);
-    rbs_shape_arrays families = {RBS_N_FAMILIES, kind, vertex_start, vertices, moments, law, law_cdf, hands};
+    rbs_shape_arrays families = {.n_shapes = RBS_N_FAMILIES, .kind = kind, .vertex_start = vertex_start,
+                                 .vertices = vertices, .second_moments = moments, .aspect = law,
+                                 .aspect_cdf = law_cdf, .both_hands = hands};
     static const char *names[5] = {"us_model_frame", "us_flight_setup", "us_orientation", "us_lowest_points",
                                    "us_collision"};
     double keep = 0.0;

@@ -58,7 +58,7 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
     }
     int room = nv > MAX_STACK_VERTICES ? nv : MAX_STACK_VERTICES;
     int status = rbs_body_rebound_in(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_tol, set_tol,
-                                     max_steps, V, W, n_collisions, n_steps, wall_work, h, h + room);
+                                     max_steps, V, W, n_collisions, n_steps, wall_work, h, h + room, NULL);
     if (h != stack) free(h);
     return status;
 }
@@ -67,9 +67,10 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
                         const double R0[9], const double V0[3], const double W0[3], const double *wall,
                         long long n_max, double contact_tol, double set_tol, long long max_steps, double V[3],
                         double W[3], long long *n_collisions, long long *n_steps, double wall_work[2], double *h,
-                        double *h1)
+                        double *h1, const rbs_hull *hull)
 {
     double curv[3];
+    rbs_walk walk;
     double params[RBS_ROT_PARAMS_SIZE], R[9], K_lab[9], Kinv_lab[9];
     double Kinv[3], ell[3], rc[3], dV[3], dW[3], Wt[3];
 
@@ -81,7 +82,18 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
     }
 
     double y;
-    if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
+    if (hull) {
+        rbs_walk_clear(&walk);
+        const double g[3] = {R[3], R[4], R[5]};
+        walk.start = rbs_walk_map_start(hull, g);
+    }
+    if (hull && W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
+        const double g[3] = {R[3], R[4], R[5]};
+        double h_second;
+        int low, second;
+        rbs_walk_lowest_two(hull, g, 0.0, walk.start, &walk, &y, &low, &h_second, &second);
+        y = -y;
+    } else if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
         int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv);
         /* numpy's min: the first NaN, else the smallest */
         double lowest = h[0];
@@ -103,7 +115,7 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
         double t = 0.0;
         long long steps = 0;
         int code = rbs_find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y, V[1], contact_tol, set_tol,
-                                    max_steps, &t, R, Wt, h, h1, curv, rc, &steps);
+                                    max_steps, &t, R, Wt, h, h1, curv, rc, &steps, hull, &walk);
         steps_total += steps;
         if (code == SEARCH_ESCAPED) {
             status = RBS_OK;

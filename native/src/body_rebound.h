@@ -8,6 +8,8 @@
 #ifndef RBS_BODY_REBOUND_H
 #define RBS_BODY_REBOUND_H
 
+#include "hull_walk.h"
+
 /* R = the rotation matrix of the quaternion q = (w, x, y, z), normalised here
  * (direct_model.body_rebound.quaternion_to_matrix) */
 void rbs_quaternion_to_matrix(const double q[4], double R[9]);
@@ -27,11 +29,12 @@ int rbs_body_rebound(int kind, double *verts, int nv, const double semi[3], cons
                      double contact_tol, double set_tol, long long max_steps, double V[3], double W[3],
                      long long *n_collisions, long long *n_steps, double wall_work[2]);
 
-/* rbs_body_rebound with the caller's work space: h and h1 each with room for max(nv, 1) values. */
+/* rbs_body_rebound with the caller's work space, h and h1 each with room for max(nv, 1) values; or, with hull not
+ * NULL, the body a hull walked over its vertex graph (hull_walk.h: verts, h and h1 are not read). */
 int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], const double K[3], double Rb,
                         const double R0[9], const double V0[3], const double W0[3], const double *wall,
                         long long n_max, double contact_tol, double set_tol, long long max_steps, double V[3],
                         double W[3], long long *n_collisions, long long *n_steps, double wall_work[2], double *h,
-                        double *h1);
+                        double *h1, const rbs_hull *hull);
 
 #endif /* RBS_BODY_REBOUND_H */

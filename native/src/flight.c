@@ -9,12 +9,14 @@
 #include <math.h>
 
 #include "flight.h"
+#include "hull_walk.h"
 #include "pymath.h"
 #include "rebound_scatter.h"
 #include "rotation.h"
 #include "shapes.h"
 
 #define HORIZON 4.0 /* direct_model.flight.HORIZON */
+#define REFINE 3    /* direct_model.flight.REFINE */
 /* above this many vertices pass_over_bound starts the pass: from 12 here, 24 in numba
  * (direct_model.flight.PASS_OVER_ABOVE), where each compiler's scan pays for it (the same bits either way) */
 #define PASS_OVER_ABOVE 12
@@ -66,8 +68,7 @@ static double taylor_root(double h, double hdot, double hddot)
     return -2.0 * h / (hdot + copysign(sqrt(disc), hdot));
 }
 
-int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
-                      const double W[3], double y, double v, double *h, double *h1, double curv[3])
+void rbs_turning(const double R[9], const double W[3], const double K[3], double g[3], double d[3], double a[3])
 {
     double g0 = R[3], g1 = R[4], g2 = R[5];
     double w0 = R[0] * W[0] + R[3] * W[1] + R[6] * W[2]; /* ω = Rᵀ Ω */
@@ -78,9 +79,23 @@ int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], con
     double e1 = (m2 * w0 - m0 * w2) / K[1];
     double e2 = (m0 * w1 - m1 * w0) / K[2];
     double d0 = g1 * w2 - g2 * w1, d1 = g2 * w0 - g0 * w2, d2 = g0 * w1 - g1 * w0; /* ġ = g × ω */
-    double a0 = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1);                           /* g̈ = ġ × ω + g × ω̇ */
-    double a1 = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2);
-    double a2 = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0);
+    g[0] = g0;
+    g[1] = g1;
+    g[2] = g2;
+    d[0] = d0;
+    d[1] = d1;
+    d[2] = d2;
+    a[0] = d1 * w2 - d2 * w1 + (g1 * e2 - g2 * e1); /* g̈ = ġ × ω + g × ω̇ */
+    a[1] = d2 * w0 - d0 * w2 + (g2 * e0 - g0 * e2);
+    a[2] = d0 * w1 - d1 * w0 + (g0 * e1 - g1 * e0);
+}
+
+int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], const double K[3], const double R[9],
+                      const double W[3], double y, double v, double *h, double *h1, double curv[3])
+{
+    double g[3], d[3], a[3];
+    rbs_turning(R, W, K, g, d, a);
+    double g0 = g[0], g1 = g[1], g2 = g[2], d0 = d[0], d1 = d[1], d2 = d[2], a0 = a[0], a1 = a[1], a2 = a[2];
     if (kind == KIND_ELLIPSOID) {
         double u0 = semi[0] * g0, u1 = semi[1] * g1, u2 = semi[2] * g2;
         double sigma = sqrt(u0 * u0 + u1 * u1 + u2 * u2);
@@ -114,33 +129,18 @@ static double curvature(int kind, const double *verts, int i, const double curv[
     return curv[0] * verts[3 * i] + curv[1] * verts[3 * i + 1] + curv[2] * verts[3 * i + 2];
 }
 
-/* the contact point among touching candidates into rc (lab); 0 if none approaches (the points within set_tol of
- * the lowest form the contact set: their centroid if it approaches, else the lowest approaching point of the set) */
-static int choose_contact(int n, const double *verts, const double *h, const double *h1, const double *R,
-                          double set_tol, double *rc)
+/* choose_contact's choice from the contact set's sums (count points, Σp, Σh') and its lowest approaching point best
+ * at q (−1: none): the centroid if it approaches, else q, into rc (lab); 0 if neither (direct_model.flight.
+ * contact_point) */
+static int contact_point(int count, const double sums[3], double rate, int best, const double q[3], const double *R,
+                         double *rc)
 {
-    double hmin = INFINITY;
-    for (int i = 0; i < n; i++) hmin = py_min(hmin, h[i]);
-    int count = 0, best = -1;
-    double p0 = 0.0, p1 = 0.0, p2 = 0.0, rate = 0.0, best_h = INFINITY;
-    for (int i = 0; i < n; i++) {
-        if (h[i] <= hmin + set_tol) {
-            count += 1;
-            p0 = p0 + verts[3 * i];
-            p1 = p1 + verts[3 * i + 1];
-            p2 = p2 + verts[3 * i + 2];
-            rate = rate + h1[i];
-            if (h1[i] < 0.0 && h[i] < best_h) {
-                best = i;
-                best_h = h[i];
-            }
-        }
-    }
+    double p0 = sums[0], p1 = sums[1], p2 = sums[2];
     if (!(count > 1 && rate < 0.0)) {
         if (best < 0) return 0;
-        p0 = verts[3 * best];
-        p1 = verts[3 * best + 1];
-        p2 = verts[3 * best + 2];
+        p0 = q[0];
+        p1 = q[1];
+        p2 = q[2];
         count = 1;
     }
     p0 = p0 / (double)count;
@@ -150,75 +150,211 @@ static int choose_contact(int n, const double *verts, const double *h, const dou
     return 1;
 }
 
+/* the contact point among touching candidates into rc (lab); 0 if none approaches (the points within set_tol of
+ * the lowest form the contact set: their centroid if it approaches, else the lowest approaching point of the set) */
+static int choose_contact(int n, const double *verts, const double *h, const double *h1, const double *R,
+                          double set_tol, double *rc)
+{
+    double hmin = INFINITY;
+    for (int i = 0; i < n; i++) hmin = py_min(hmin, h[i]);
+    int count = 0, best = -1;
+    double sums[3] = {0.0, 0.0, 0.0}, rate = 0.0, best_h = INFINITY;
+    for (int i = 0; i < n; i++) {
+        if (h[i] <= hmin + set_tol) {
+            count += 1;
+            for (int k = 0; k < 3; k++) sums[k] = sums[k] + verts[3 * i + k];
+            rate = rate + h1[i];
+            if (h1[i] < 0.0 && h[i] < best_h) {
+                best = i;
+                best_h = h[i];
+            }
+        }
+    }
+    return contact_point(count, sums, rate, best, verts + 3 * (best > 0 ? best : 0), R, rc);
+}
+
+/* the (h, h', safe step) of vertex i of a walked hull, as the scan computes them */
+static double vertex_step(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double M, int i)
+{
+    double p[3];
+    double h = rbs_hull_height(hl, g, y, i, p);
+    return safe_step(h, v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]), M);
+}
+
+/* the scan's loop over the safe steps (flight.c, rbs_find_contact) for one point: a point whose safe step surely
+ * exceeds the second smallest so far (or T, at least the final second smallest) changes neither */
+static void take_step(double h, double h1, double M, double T, int i, double *tau, double *tau_other, int *b)
+{
+    double bound = py_min(T, *tau_other);
+    if (bound < INFINITY && !may_reach(h, h1, M, bound)) return;
+    double tau_i = safe_step(h, h1, M);
+    if (tau_i < *tau) {
+        *tau_other = *tau;
+        *tau = tau_i;
+        *b = i;
+    } else {
+        *tau_other = py_min(*tau_other, tau_i);
+    }
+}
+
+/* (tau, tau_other, b) of a walked hull's vertices (direct_model.flight.walk_safe_steps): the bound T from the two
+ * lowest and the vertices around the lowest of the level h + T'h', then the walk of T's band in index order */
+static void walk_safe_steps(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double M,
+                            int low, int second, rbs_walk *w, double *tau, double *tau_other, int *b)
+{
+    double t1 = vertex_step(hl, g, d, y, v, M, low), t2 = vertex_step(hl, g, d, y, v, M, second), p[3];
+    int i1 = low, i2 = second;
+    if (t2 < t1) {
+        double t = t1;
+        t1 = t2;
+        t2 = t;
+        i1 = second;
+        i2 = low;
+    }
+    int m = -1;
+    for (int round = 0; round < REFINE && t2 < INFINITY; round++) {
+        double before = t2, Tp = t2 * (1.0 + 1e-12) + 1e-300;
+        int last = m;
+        const double e[3] = {g[0] + Tp * d[0], g[1] + Tp * d[1], g[2] + Tp * d[2]};
+        m = rbs_walk_descend(hl, g, d, y, v, Tp, rbs_walk_map_start(hl, e), NULL);
+        if (m == last) break;
+        for (int64_t k = hl->graph_start[m] - 1; k < hl->graph_start[m + 1]; k++) {
+            int j = k < hl->graph_start[m] ? m : hl->graph[k]; /* m, then its neighbours */
+            if (j == i1 || j == i2) continue;
+            double h = rbs_hull_height(hl, g, y, j, p), h1 = v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]);
+            if (!may_reach(h, h1, M, t2)) continue;
+            double tj = safe_step(h, h1, M);
+            if (tj < t1) {
+                t2 = t1;
+                i2 = i1;
+                t1 = tj;
+                i1 = j;
+            } else if (tj < t2) {
+                t2 = tj;
+                i2 = j;
+            }
+        }
+        if (!(t2 < before)) break;
+    }
+    double T = t2;
+    int count = -1;
+    if (T < INFINITY) {
+        double Tp = T * (1.0 + 1e-12) + 1e-300;
+        double size = fabs(y) + rbs_hull_reach(g, hl->scale) + (fabs(v) + rbs_hull_reach(d, hl->scale)) * Tp
+                      + 0.5 * fabs(M) * Tp * Tp;
+        count = rbs_walk_band(hl, g, d, y, v, Tp, 0.5 * M * Tp * Tp + WALK_BAND * size, i1, w);
+    }
+    *tau = *tau_other = INFINITY;
+    *b = -1;
+    for (int k = 0; k < (count >= 0 ? count : hl->n); k++) {
+        int i = rbs_walk_member(w, count, k);
+        double h = rbs_hull_height(hl, g, y, i, p);
+        take_step(h, v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]), M, T, i, tau, tau_other, b);
+    }
+}
+
+/* (h, h', h'') of candidate b: from the scan's arrays, or computed for vertex b of a walked hull
+ * (direct_model.flight.point_state) */
+static void point_state(const rbs_hull *hl, int kind, const double *verts, const double *h, const double *h1,
+                        const double curv[3], const double g[3], const double d[3], double y, double v, int b,
+                        double state[3])
+{
+    if (hl) {
+        double p[3];
+        rbs_hull_vertex(hl, b, p);
+        state[0] = y + (g[0] * p[0] + g[1] * p[1] + g[2] * p[2]);
+        state[1] = v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]);
+        state[2] = curv[0] * p[0] + curv[1] * p[1] + curv[2] * p[2];
+        return;
+    }
+    state[0] = h[b];
+    state[1] = h1[b];
+    state[2] = curvature(kind, verts, b, curv);
+}
+
 int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], double Rb, const double K[3],
                      const double ell[3], double M, double M3, double *params, double y0, double v, double contact_tol,
                      double set_tol, long long max_steps, double *t_out, double R[9], double W[3], double *h,
-                     double *h1, double curv[3], double rc[3], long long *n_steps)
+                     double *h1, double curv[3], double rc[3], long long *n_steps, const rbs_hull *hull,
+                     rbs_walk *walk)
 {
     int b = -1;                 /* the binding point of the last step */
     double t = 0.0;
     double t_lo = 0.0;          /* latest time known to precede any contact */
     double t_hi = INFINITY;     /* a time past the contact of point b, once a step overshoots */
+    double g[3] = {0.0, 0.0, 0.0}, d[3] = {0.0, 0.0, 0.0}; /* a walk's view of the normal and its turn */
     for (long long step = 0; step < max_steps; step++) {
         if (step > 0) {
             if (step == 1) rbs_rotation_init(K, R, ell, params);
             rbs_rotation_at(params, t, R, W);
         }
         double y = y0 + v * t;
-        int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv);
-        double hmin = INFINITY;
-        int low = 0;
-        for (int i = 0; i < n; i++)
-            if (h[i] < hmin) {
-                hmin = h[i];
-                low = i;
-            }
+        double hmin = INFINITY, h_second = INFINITY;
+        int n = nv, low = 0, second = -1;
+        if (hull) {
+            rbs_turning(R, W, K, g, d, curv);
+            rbs_walk_lowest_two(hull, g, y, rbs_walk_nearer(hull, g, y, walk), walk, &hmin, &low, &h_second, &second);
+            walk->start = low;
+        } else {
+            n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv);
+            for (int i = 0; i < n; i++)
+                if (h[i] < hmin) {
+                    hmin = h[i];
+                    low = i;
+                }
+        }
         *n_steps = step + 1;
         *t_out = t;
-        if (-contact_tol <= hmin && hmin <= contact_tol && choose_contact(n, verts, h, h1, R, set_tol, rc))
-            return SEARCH_CONTACT;
+        if (-contact_tol <= hmin && hmin <= contact_tol) {
+            int touching;
+            if (hull) {
+                int count, best;
+                double sums[3], rate, q[3];
+                rbs_walk_contact_sums(hull, g, d, y, v, hmin + set_tol, low, walk, &count, sums, &rate, &best);
+                rbs_hull_vertex(hull, best > 0 ? best : 0, q);
+                touching = contact_point(count, sums, rate, best, q, R, rc);
+            } else {
+                touching = choose_contact(n, verts, h, h1, R, set_tol, rc);
+            }
+            if (touching) return SEARCH_CONTACT;
+        }
+        double state[3] = {0.0, 0.0, 0.0}; /* b's height, rate and curvature: set before their reads */
         if (hmin < -contact_tol || t_hi < INFINITY) {
             /* bracket [t_lo, t_hi] in which only point b reaches the wall, monotonically: safeguarded
              * second-order Newton on its height */
             if (b < 0) b = low; /* below the wall at the start: no bracket, the budget ends it */
-            if (h[b] < 0.0) t_hi = t;
+            point_state(hull, kind, verts, h, h1, curv, g, d, y, v, b, state);
+            if (state[0] < 0.0) t_hi = t;
             else t_lo = t;
-            double t_new = t + taylor_root(h[b], h1[b], curvature(kind, verts, b, curv));
+            double t_new = t + taylor_root(state[0], state[1], state[2]);
             t = t_lo < t_new && t_new < t_hi ? t_new : 0.5 * (t_lo + t_hi);
             continue;
         }
         if (v > 0.0 && y > Rb) return SEARCH_ESCAPED;
         /* the smallest and second smallest safe steps are at most T: points that surely take longer are passed */
-        double T = n > PASS_OVER_ABOVE ? pass_over_bound(h, h1, n, low, M) : INFINITY;
         double tau = INFINITY, tau_other = INFINITY;
-        for (int i = 0; i < n; i++) {
-            /* a point whose safe step surely exceeds the second smallest so far changes neither */
-            double bound = py_min(T, tau_other);
-            if (bound < INFINITY && !may_reach(h[i], h1[i], M, bound)) continue;
-            double tau_i = safe_step(h[i], h1[i], M);
-            if (tau_i < tau) {
-                tau_other = tau;
-                tau = tau_i;
-                b = i;
-            } else {
-                tau_other = py_min(tau_other, tau_i);
-            }
+        int found = -1;
+        if (hull) {
+            walk_safe_steps(hull, g, d, y, v, M, low, second, walk, &tau, &tau_other, &found);
+        } else {
+            double T = n > PASS_OVER_ABOVE ? pass_over_bound(h, h1, n, low, M) : INFINITY;
+            for (int i = 0; i < n; i++) take_step(h[i], h1[i], M, T, i, &tau, &tau_other, &found);
         }
-        double h2b = 0.0; /* b's curvature: set with a finite step, before its only reads */
+        if (found >= 0) b = found;
         if (0.0 < tau && tau < INFINITY) {
             /* b's longer step from its exact curvature, valid up to the horizon */
-            h2b = curvature(kind, verts, b, curv);
+            point_state(hull, kind, verts, h, h1, curv, g, d, y, v, b, state);
             double horizon = py_min(tau_other, HORIZON * tau);
-            tau = py_max(tau, py_min(horizon, safe_step(h[b], h1[b], py_min(M, M3 * horizon / 3.0 - h2b))));
+            tau = py_max(tau, py_min(horizon, safe_step(state[0], state[1], py_min(M, M3 * horizon / 3.0 - state[2]))));
         }
         if (v > 0.0 && tau >= (Rb - y) / v) return SEARCH_ESCAPED;
         if (!(0.0 < tau && tau < INFINITY)) return SEARCH_STALLED;
         /* second-order Newton step of b where it is safe: no other point can reach the wall first, and b
          * approaches monotonically */
-        if (h1[b] < 0.0) {
-            double t_newton = taylor_root(h[b], h1[b], h2b);
+        if (state[1] < 0.0) {
+            double t_newton = taylor_root(state[0], state[1], state[2]);
             if (tau < t_newton && t_newton < tau_other
-                && (h1[b] + M * t_newton < 0.0 || h1[b] + (h2b + 0.5 * M3 * t_newton) * t_newton < 0.0))
+                && (state[1] + M * t_newton < 0.0 || state[1] + (state[2] + 0.5 * M3 * t_newton) * t_newton < 0.0))
                 tau = t_newton;
         }
         t_lo = t;

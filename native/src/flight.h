@@ -10,6 +10,7 @@
 
 #include <math.h>
 
+#include "hull_walk.h"
 #include "internal.h"
 #include "pymath.h"
 #include "shapes.h"
@@ -66,6 +67,10 @@ RBS_INLINE double rbs_jerk_bound(int kind, const double semi[3], double Rb, cons
     return g3 * Rb;
 }
 
+/* The lab's normal seen from the body and how it turns (direct_model.flight.turning): g = Rᵀ e_y, ġ and g̈ (a vertex
+ * p has h'' = g̈·p), from the orientation R, the lab Ω W and the principal J/m K. */
+void rbs_turning(const double R[9], const double W[3], const double K[3], double g[3], double d[3], double a[3]);
+
 /* Heights h[i] (units of a) and rates h1[i] of the candidate lowest points at orientation R, lab angular velocity W,
  * centre height y and vertical velocity v: every vertex (body frame, verts), or the ellipsoid's support point,
  * written into verts[0..2]; curv receives what gives a point's curvature h'': g̈ (a vertex p has h'' = g̈·p), or the
@@ -77,11 +82,14 @@ int rbs_lowest_points(int kind, double *verts, int nv, const double semi[3], con
  * K, ell its principal J/m and ℓ = L/m (lab), M, M3 its bounds, params its rotation (filled here by
  * rbs_rotation_init when first needed), y0 and v its centre height (a) at t = 0 and vertical velocity (m/s); R, W
  * on entry at t = 0, on return at the returned time *t; rc the contact point from the centroid (lab) for a
- * contact; h, h1 work space of nv points (at least one), curv of 3. Returns a SEARCH_* code, the search steps taken
- * into *n_steps. */
+ * contact; h, h1 work space of nv points (at least one), curv of 3. hull: a hull walked over its vertex graph
+ * (hull_walk.h; verts, h and h1 are not read; walk its work space, rbs_walk_clear'ed before a rebound's first search,
+ * its start the vertex a descent to the lowest may start from, on return the last lowest), or NULL: the candidates
+ * are scanned; the same steps and bits either way. Returns a SEARCH_* code, the search steps taken into *n_steps. */
 int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], double Rb, const double K[3],
                      const double ell[3], double M, double M3, double *params, double y0, double v, double contact_tol,
                      double set_tol, long long max_steps, double *t, double R[9], double W[3], double *h,
-                     double *h1, double curv[3], double rc[3], long long *n_steps);
+                     double *h1, double curv[3], double rc[3], long long *n_steps, const rbs_hull *hull,
+                     rbs_walk *walk);
 
 #endif /* RBS_FLIGHT_H */

@@ -3,9 +3,10 @@
  * uniform_quaternion, rebound_model_frame): the random inputs of one rebound from RBS_U_PER_REBOUND uniforms,
  * the particle's body from the shape arrays (shapes.c), every other model parameter from the P_* array, then the
  * rebound (body_rebound.c). The same operations in the same order as the numba kernels; libm's sqrt, log, sin
- * and cos. The work space of one call: the body's vertices and their heights and rates (40 bytes a vertex), on the
- * stack up to MAX_STACK_VERTICES vertices (10 KiB), above in one malloc freed before the return (no buffer is shared:
- * threads may call it on one table).
+ * and cos. The work space of one call: a scanned body's vertices and their heights and rates (40 bytes a vertex), on
+ * the stack up to MAX_STACK_VERTICES vertices (10 KiB), above in one malloc freed before the return (no buffer is
+ * shared: threads may call it on one table); a walked hull's (hull_walk.h) none per vertex: its walk's 2 KiB on the
+ * stack.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -82,9 +83,11 @@ int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays
                                     double vn, double wx, double wy, double wz, const double *u, double V[3],
                                     double W[3], long long *n_collisions, double wall_work[2])
 {
-    double quat[4], R0[9], K[3], semi[3], stack[5 * MAX_STACK_VERTICES];
-    /* the shape's vertex rows: room for the particle's vertices (an ellipsoid's one row: its support point) */
-    int64_t rows = shapes->vertex_start[shape + 1] - shapes->vertex_start[shape];
+    double quat[4], R0[9], K[3], semi[3], scale[3], stack[5 * MAX_STACK_VERTICES];
+    /* a scanned shape's vertex rows: room for the particle's vertices (an ellipsoid's one row: its support point);
+     * a walked one needs none */
+    int walked = rbs_walked(shapes, shape);
+    int64_t rows = walked ? 1 : shapes->vertex_start[shape + 1] - shapes->vertex_start[shape];
     int room = rows > MAX_STACK_VERTICES ? (int)rows : MAX_STACK_VERTICES;
     double *verts = stack;
     if (room > MAX_STACK_VERTICES && !(verts = malloc(5 * (size_t)room * sizeof *verts))) {
@@ -100,16 +103,18 @@ int rbs_rebound_model_frame_counted(const double *params, const rbs_shape_arrays
     double ratio_ba = fixed ? 1.0 : rbs_aspect_ratio(law, cdf, u[U_RATIOS]);
     double ratio_cb = fixed ? 1.0 : rbs_aspect_ratio(law, cdf, u[U_RATIOS + 1]);
     double hand = !shapes->both_hands[shape] || u[U_HAND] < 0.5 ? 1.0 : -1.0;
-    int nv = rbs_particle_body(shapes, shape, ratio_ba, ratio_cb, hand, verts, K, semi);
+    int nv = rbs_particle_body(shapes, shape, ratio_ba, ratio_cb, hand, walked ? NULL : verts, K, semi, scale);
     int kind = shapes->kind[shape];
-    double Rb = rbs_bounding_radius(kind, semi, verts, nv);
+    rbs_hull hull;
+    if (walked) rbs_particle_hull(shapes, shape, scale, &hull);
+    double Rb = walked ? sqrt(rbs_walk_farthest(&hull)) : rbs_bounding_radius(kind, semi, verts, nv);
     const double V0[3] = {vt, vn, 0.0}, W0[3] = {wx, wy, wz};
     long long n_steps;
     /* n_max and max_steps as numba's int() of the float64 parameters; the heights and rates after the vertices */
     int status = rbs_body_rebound_in(kind, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL,
                                      rbs_trunc(params[P_N_MAX]), params[P_CONTACT_TOL], params[P_SET_TOL],
                                      rbs_trunc(params[P_MAX_STEPS]), V, W, n_collisions, &n_steps, wall_work,
-                                     verts + 3 * room, verts + 4 * room);
+                                     verts + 3 * room, verts + 4 * room, walked ? &hull : NULL);
     if (verts != stack) free(verts);
     return status;
 }

@@ -40,6 +40,8 @@ void rbs_shape_records_free(rbs_shape_records *r)
     free(r->family);
     free(r->vertex_start);
     free(r->vertices);
+    free(r->triangle_start);
+    free(r->triangles);
     free(r->inertia);
     free(r->aspect);
     free(r->both_hands);
@@ -348,8 +350,7 @@ int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, c
     rbs_shape_records *r = &t->shapes;
     const long long n = t->n_shapes;
     char *names = NULL;
-    int64_t *triangle_start = NULL, n_vertex = 0, n_triangle = 0;
-    int32_t *triangles = NULL;
+    int64_t n_vertex = 0, n_triangle = 0;
     name_type = H5Tcopy(H5T_C_S1);
     H5Tset_size(name_type, RBS_SHAPE_NAME_SIZE);
     H5Tset_strpad(name_type, H5T_STR_NULLTERM);
@@ -364,18 +365,17 @@ int rbs_shape_records_load(loader *ld, hid_t file, rbs_table *t, double kappa, c
         || !(r->vertex_start = read_member(ld, group, "vertex_start", H5T_INTEGER, H5T_NATIVE_INT64, 8, 1, n + 1, 0,
                                            NULL))
         || !(r->vertices = read_member(ld, group, "vertices", H5T_FLOAT, H5T_NATIVE_DOUBLE, 8, 2, -1, 3, &n_vertex))
-        || !(triangle_start = read_member(ld, group, "triangle_start", H5T_INTEGER, H5T_NATIVE_INT64, 8, 1, n + 1, 0,
-                                          NULL))
-        || !(triangles = read_member(ld, group, "triangles", H5T_INTEGER, H5T_NATIVE_INT32, 4, 2, -1, 3, &n_triangle))
+        || !(r->triangle_start = read_member(ld, group, "triangle_start", H5T_INTEGER, H5T_NATIVE_INT64, 8, 1, n + 1,
+                                             0, NULL))
+        || !(r->triangles = read_member(ld, group, "triangles", H5T_INTEGER, H5T_NATIVE_INT32, 4, 2, -1, 3,
+                                        &n_triangle))
         || !(r->inertia = read_member(ld, group, "inertia", H5T_FLOAT, H5T_NATIVE_DOUBLE, 8, 2, n, 3, NULL))
         || !(r->aspect = read_member(ld, group, "aspect", H5T_FLOAT, H5T_NATIVE_DOUBLE, 8, 2, n, 4, NULL))
         || !(r->both_hands = read_member(ld, group, "both_hands", H5T_INTEGER, H5T_NATIVE_UINT8, 1, 1, n, 0, NULL)))
         goto done;
-    check_records(ld, t, names, triangles, triangle_start, n_vertex, n_triangle, kappa, aspect);
+    check_records(ld, t, names, r->triangles, r->triangle_start, n_vertex, n_triangle, kappa, aspect);
 done:
     free(names);
-    free(triangle_start);
-    free(triangles);
     if (name_type >= 0) H5Tclose(name_type);
     H5Gclose(group);
     return ld->code;
@@ -391,9 +391,75 @@ void rbs_direct_shapes_free(rbs_table *t)
     free((void *)d->aspect);
     free((void *)d->aspect_cdf);
     free((void *)d->both_hands);
+    free((void *)d->half_extents);
+    free((void *)d->graph_start);
+    free((void *)d->graph);
+    free((void *)d->starts);
+    free((void *)d->far_start);
+    free((void *)d->far);
     free(t->model_shape);
     memset(d, 0, sizeof *d);
     t->model_shape = NULL;
+}
+
+/* the derived arrays of t->direct_shapes (direct_model.shape_arrays.from_stored): every shape's half-extents, and a
+ * walked hull's vertex graph, start map and farthest candidates (hull_walk.h) from the table's triangles; 0, or −1
+ * out of memory (the caller frees what is set) */
+static int walks_build(rbs_table *t)
+{
+    const rbs_shape_records *r = &t->shapes;
+    rbs_shape_arrays *d = &t->direct_shapes;
+    int n = d->n_shapes;
+    int64_t rows = d->vertex_start[n];
+    double *half = malloc((size_t)n * 3 * sizeof *half);
+    int64_t *graph_start = calloc((size_t)rows + 1, sizeof *graph_start), *far_start = calloc((size_t)n + 1, 8);
+    int32_t *starts = calloc((size_t)n * MAP_SIZE, sizeof *starts), *far = malloc((size_t)rows * sizeof *far);
+    d->half_extents = half;
+    d->graph_start = graph_start;
+    d->starts = starts;
+    d->far_start = far_start;
+    d->far = far;
+    if (!half || !graph_start || !far_start || !starts || !far) return -1;
+    /* the record of direct shape j: table shape i with t->model_shape[i] == j */
+    int *record = malloc((size_t)n * sizeof *record);
+    if (!record) return -1;
+    for (int i = 0; i < t->n_shapes; i++)
+        if (t->model_shape[i] >= RBS_N_FAMILIES) record[t->model_shape[i]] = i;
+    int64_t edges = 0;
+    int32_t *graph = NULL;
+    int failed = 0;
+    for (int j = 0; j < n && !failed; j++) {
+        int64_t lo = d->vertex_start[j], count = d->vertex_start[j + 1] - lo;
+        if (d->kind[j] == KIND_ELLIPSOID) memcpy(half + 3 * j, d->vertices + 3 * lo, 3 * sizeof *half);
+        else rbs_half_extents(d->vertices, lo, (int)count, half + 3 * j);
+        for (int64_t k = lo; k < lo + count; k++) graph_start[k + 1] = edges;
+        far_start[j + 1] = far_start[j];
+        if (j < RBS_N_FAMILIES || count <= WALK_ABOVE) continue;
+        int i = record[j];
+        int64_t *start = NULL;
+        int32_t *local = NULL, *grown = NULL;
+        if (rbs_vertex_graph(r->triangles + 3 * r->triangle_start[i], r->triangle_start[i + 1] - r->triangle_start[i],
+                             (int)count, &start, &local) != 0
+            || !(grown = realloc(graph, (size_t)(edges + start[count]) * sizeof *graph))) {
+            free(start);
+            free(local);
+            failed = 1;
+            break;
+        }
+        graph = grown;
+        memcpy(graph + edges, local, (size_t)start[count] * sizeof *graph);
+        for (int64_t k = 0; k <= count; k++) graph_start[lo + k] = edges + start[k];
+        rbs_start_map(d->vertices + 3 * lo, start, local, starts + (int64_t)MAP_SIZE * j);
+        edges += start[count];
+        free(start);
+        free(local);
+        int kept = rbs_farthest_candidates(d->vertices + 3 * lo, (int)count, far + far_start[j]);
+        if (kept < 0) failed = 1;
+        else far_start[j + 1] = far_start[j] + kept;
+    }
+    free(record);
+    d->graph = graph;
+    return failed ? -1 : 0;
 }
 
 int rbs_direct_shapes_build(rbs_table *t)
@@ -415,8 +481,9 @@ int rbs_direct_shapes_build(rbs_table *t)
     double *aspect_cdf = malloc((size_t)n * 2 * sizeof *aspect_cdf);
     uint8_t *both_hands = malloc((size_t)n);
     t->model_shape = malloc((size_t)t->n_shapes * sizeof *t->model_shape);
-    t->direct_shapes = (rbs_shape_arrays){n, kind, vertex_start, vertices, second_moments, aspect, aspect_cdf,
-                                          both_hands};
+    t->direct_shapes = (rbs_shape_arrays){.n_shapes = n, .kind = kind, .vertex_start = vertex_start,
+                                          .vertices = vertices, .second_moments = second_moments, .aspect = aspect,
+                                          .aspect_cdf = aspect_cdf, .both_hands = both_hands};
     if (!kind || !vertex_start || !vertices || !second_moments || !aspect || !aspect_cdf || !both_hands
         || !t->model_shape) {
         rbs_direct_shapes_free(t);
@@ -446,6 +513,10 @@ int rbs_direct_shapes_build(rbs_table *t)
         aspect_cdf[2 * j + 1] = isnan(law[0]) ? NAN : rbs_normal_cdf((law[3] - law[0]) / law[1]);
         both_hands[j] = r->both_hands[i];
         j++;
+    }
+    if (walks_build(t) != 0) {
+        rbs_direct_shapes_free(t);
+        return RBS_ERR_MEMORY;
     }
     return RBS_OK;
 }

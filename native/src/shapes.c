@@ -80,8 +80,7 @@ void rbs_family_shapes_fill(int8_t *kind, int64_t *vertex_start, double *vertice
     }
 }
 
-/* (max − min)/2 of rows lo .. lo + nv of `unit` along each axis (direct_model.shape_arrays._half_extents) */
-static void half_extents(const double *unit, int64_t lo, int nv, double e[3])
+void rbs_half_extents(const double *unit, int64_t lo, int nv, double e[3])
 {
     for (int k = 0; k < 3; k++) {
         double low = unit[3 * lo + k], high = low;
@@ -94,7 +93,7 @@ static void half_extents(const double *unit, int64_t lo, int nv, double e[3])
 }
 
 int rbs_particle_body(const rbs_shape_arrays *s, int shape, double ratio_ba, double ratio_cb, double hand,
-                      double *verts, double K[3], double semi[3])
+                      double *verts, double K[3], double semi[3], double scale[3])
 {
     int64_t lo = s->vertex_start[shape];
     int nv = (int)(s->vertex_start[shape + 1] - lo);
@@ -104,8 +103,10 @@ int rbs_particle_body(const rbs_shape_arrays *s, int shape, double ratio_ba, dou
     if (s->kind[shape] == KIND_ELLIPSOID) {
         nv = 0;
         for (int k = 0; k < 3; k++) e[k] = unit[3 * lo + k];
+    } else if (s->half_extents) {
+        for (int k = 0; k < 3; k++) e[k] = s->half_extents[3 * shape + k];
     } else {
-        half_extents(unit, lo, nv, e);
+        rbs_half_extents(unit, lo, nv, e);
     }
     for (int k = 0; k < 3; k++) e[k] = d[k] * e[k];
     double a = py_max(e[0], py_max(e[1], e[2])), f[3];
@@ -114,7 +115,8 @@ int rbs_particle_body(const rbs_shape_arrays *s, int shape, double ratio_ba, dou
         f[k] = d[k] / a;
     }
     if (hand < 0.0) f[2] = -f[2];
-    for (int i = 0; i < nv; i++)
+    for (int k = 0; k < 3; k++) scale[k] = f[k];
+    for (int i = 0; verts && i < nv; i++)
         for (int k = 0; k < 3; k++) verts[3 * i + k] = unit[3 * (lo + i) + k] * f[k];
     const double *m = s->second_moments + 3 * shape;
     double a2 = f[0] * f[0], b2 = f[1] * f[1], c2 = f[2] * f[2];
@@ -140,4 +142,18 @@ double rbs_bounding_radius(int kind, const double semi[3], const double *verts, 
         r2 = py_max(r2, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     }
     return sqrt(r2);
+}
+
+int rbs_walked(const rbs_shape_arrays *s, int shape)
+{
+    return s->graph_start && s->kind[shape] == KIND_POLYHEDRON
+           && s->vertex_start[shape + 1] - s->vertex_start[shape] > WALK_ABOVE;
+}
+
+void rbs_particle_hull(const rbs_shape_arrays *s, int shape, const double scale[3], rbs_hull *hull)
+{
+    int64_t lo = s->vertex_start[shape], n = s->vertex_start[shape + 1] - lo;
+    *hull = (rbs_hull){s->vertices + 3 * lo, (int)n, {scale[0], scale[1], scale[2]}, s->graph_start + lo, s->graph,
+                       s->starts + (int64_t)MAP_SIZE * shape, s->far + s->far_start[shape],
+                       (int)(s->far_start[shape + 1] - s->far_start[shape])};
 }

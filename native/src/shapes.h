@@ -10,6 +10,7 @@
 
 #include <stdint.h>
 
+#include "hull_walk.h"
 #include "rebound_scatter.h"
 
 #define RBS_N_FAMILIES 4    /* the built-in families, codes RBS_ELLIPSOID .. RBS_TETRAHEDRON (direct_model.shapes.SHAPES) */
@@ -42,6 +43,14 @@ typedef struct rbs_shape_arrays {
     const double *aspect;           /* n_shapes × 4: the b/a, c/b law (mean, sd, low, high); NaN: fixed */
     const double *aspect_cdf;       /* n_shapes × 2: Φ((low − mean)/sd), Φ((high − mean)/sd) */
     const uint8_t *both_hands;      /* 1: half of the particles are the mirror image */
+    /* derived (NULL: none); half_extents NULL: computed from the vertices per call (the same values) */
+    const double *half_extents;     /* n_shapes × 3: (max − min)/2 of the unit body along ξ, η, ζ */
+    /* a hull of more than WALK_ABOVE vertices is walked (hull_walk.h) where graph_start is not NULL: */
+    const int64_t *graph_start;     /* vertex_start[n_shapes] + 1: row r's neighbours graph[graph_start[r] ..] */
+    const int32_t *graph;           /* the vertex graphs, the shape's own vertex indices */
+    const int32_t *starts;          /* n_shapes × MAP_SIZE: the start maps (a walked hull's) */
+    const int64_t *far_start;       /* n_shapes + 1: shape i's farthest candidates far[far_start[i] ..] */
+    const int32_t *far;
 } rbs_shape_arrays;
 
 /* The built-in families' names by code (direct_model.shapes.SHAPES): the registry the loader consults for a
@@ -64,12 +73,23 @@ void rbs_family_shapes_fill(int8_t *kind, int64_t *vertex_start, double *vertice
                             const double law[4], const double law_cdf[2], const double kfac[RBS_N_FAMILIES]);
 
 /* One particle's body from shape `shape` of `s` (direct_model.shape_arrays.particle_body): b/a and c/b
- * (ignored for fixed proportions), hand ±1; the vertices into verts (row-major, room for the shape's
- * vertex_start[shape + 1] − vertex_start[shape] rows: numba copies them only into a scan's room, the bits are the
- * same), the principal J/m into K (a²), the half-extents into semi (from all the vertices, the values of numba's
- * precomputed half_extents); returns their number, 0 for an ellipsoid. */
+ * (ignored for fixed proportions), hand ±1; the vertices into verts unless it is NULL (row-major, room for the
+ * shape's vertex_start[shape + 1] − vertex_start[shape] rows: numba copies them only into a scan's room, the bits
+ * are the same), the principal J/m into K (a²), the half-extents into semi and the factors that take the unit body
+ * to the particle's into scale (vertex i is unit[i] · scale); returns their number, 0 for an ellipsoid. */
 int rbs_particle_body(const rbs_shape_arrays *s, int shape, double ratio_ba, double ratio_cb, double hand,
-                      double *verts, double K[3], double semi[3]);
+                      double *verts, double K[3], double semi[3], double scale[3]);
+
+/* Whether shape `shape` of `s` is walked over its vertex graph: a hull of more than WALK_ABOVE vertices, with the
+ * graphs in `s` */
+int rbs_walked(const rbs_shape_arrays *s, int shape);
+
+/* A walked shape's hull for the particle of the scale rbs_particle_body gave (direct_model.shape_arrays.
+ * particle_hull) */
+void rbs_particle_hull(const rbs_shape_arrays *s, int shape, const double scale[3], rbs_hull *hull);
+
+/* (max − min)/2 of rows lo .. lo + nv of `unit` along each axis into e (direct_model.shape_arrays._half_extents) */
+void rbs_half_extents(const double *unit, int64_t lo, int nv, double e[3]);
 
 /* Radius of the smallest centroid-centred sphere holding the body, units of a
  * (direct_model.shape_arrays.bounding_radius). */

@@ -184,8 +184,10 @@ static void make_shapes(test_shapes *s, rbs_rng *rng)
     for (int k = 0; k < 4; k++) s->aspect[16 + k] = NAN;
     s->aspect_cdf[8] = s->aspect_cdf[9] = NAN;
     s->both_hands[4] = 1;
-    s->arrays = (rbs_shape_arrays){5, s->kind, s->vertex_start, s->vertices, s->second_moments, s->aspect,
-                                   s->aspect_cdf, s->both_hands};
+    /* no vertex graph: the grain of GRAIN_VERTICES is scanned (its work space on the heap) */
+    s->arrays = (rbs_shape_arrays){.n_shapes = 5, .kind = s->kind, .vertex_start = s->vertex_start,
+                                   .vertices = s->vertices, .second_moments = s->second_moments, .aspect = s->aspect,
+                                   .aspect_cdf = s->aspect_cdf, .both_hands = s->both_hands};
 }
 
 static void rebounds(rbs_rng *rng)
@@ -197,7 +199,7 @@ static void rebounds(rbs_rng *rng)
     for (int trial = 0; trial < TRIALS / 10; trial++) {
         int shape = trial % 5;
         double ratio_ba = 0.5 + 0.5 * rbs_rng_uniform(rng), ratio_cb = 0.5 + 0.5 * rbs_rng_uniform(rng);
-        double hand = rbs_rng_uniform(rng) < 0.5 ? 1.0 : -1.0, semi[3];
+        double hand = rbs_rng_uniform(rng) < 0.5 ? 1.0 : -1.0, semi[3], scale[3];
         double q[4], R0[9], V0[3], W0[3], V[3], W[3], K[3], K0[9], KW0[3];
         rbs_uniform_quaternion(rbs_rng_uniform(rng), rbs_rng_uniform(rng), rbs_rng_uniform(rng), q);
         rbs_quaternion_to_matrix(q, R0);
@@ -206,7 +208,7 @@ static void rebounds(rbs_rng *rng)
         V0[1] = -speed * sin(angle);
         V0[2] = 0.0;
         for (int k = 0; k < 3; k++) W0[k] = trial % 8 < 4 ? 0.0 : 0.3 * speed * (2.0 * rbs_rng_uniform(rng) - 1.0);
-        int nv = rbs_particle_body(&shapes.arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi);
+        int nv = rbs_particle_body(&shapes.arrays, shape, ratio_ba, ratio_cb, hand, verts, K, semi, scale);
         int kind = shapes.kind[shape];
         double Rb = rbs_bounding_radius(kind, semi, verts, nv);
         long long n_coll, n_steps;
@@ -249,7 +251,8 @@ static void grain_model_frame(const rbs_table *table, rbs_rng *rng)
     make_shapes(&shapes, rng);
     int same = 0, rebounded = 0;
     for (int trial = 0; trial < 100; trial++) {
-        double u[RBS_U_PER_REBOUND], q[4], R0[9], K[3], semi[3], verts[3 * GRAIN_VERTICES], V[3], W[3], Vr[3], Wr[3];
+        double u[RBS_U_PER_REBOUND], q[4], R0[9], K[3], semi[3], scale[3], verts[3 * GRAIN_VERTICES];
+        double V[3], W[3], Vr[3], Wr[3];
         rbs_rng_fill(rng, u, RBS_U_PER_REBOUND);
         double speed = 10.0 + 290.0 * rbs_rng_uniform(rng), angle = 0.05 + 1.5 * rbs_rng_uniform(rng);
         double W0[3] = {0.0, 0.0, 0.0}, V0[3] = {speed * cos(angle), -speed * sin(angle), 0.0};
@@ -258,7 +261,7 @@ static void grain_model_frame(const rbs_table *table, rbs_rng *rng)
         /* runtime.c's steps for a shape of fixed proportions in both hands */
         rbs_uniform_quaternion(u[U_ORIENTATION], u[U_ORIENTATION + 1], u[U_ORIENTATION + 2], q);
         rbs_quaternion_to_matrix(q, R0);
-        int nv = rbs_particle_body(&shapes.arrays, 4, 1.0, 1.0, u[U_HAND] < 0.5 ? 1.0 : -1.0, verts, K, semi);
+        int nv = rbs_particle_body(&shapes.arrays, 4, 1.0, 1.0, u[U_HAND] < 0.5 ? 1.0 : -1.0, verts, K, semi, scale);
         double Rb = rbs_bounding_radius(KIND_POLYHEDRON, semi, verts, nv);
         long long n_coll, n_steps;
         int again = rbs_body_rebound(KIND_POLYHEDRON, verts, nv, semi, K, Rb, R0, V0, W0, params + P_WALL,

@@ -239,7 +239,8 @@ class ShapeArrays(ctypes.Structure):
     """rbs_shape_arrays (native/src/shapes.h, internal): pointers into a direct_model.shape_arrays.ShapeArrays'
     arrays."""
 
-    FIELDS = ("kind", "vertex_start", "vertices", "second_moments", "aspect", "aspect_cdf", "both_hands")
+    FIELDS = ("kind", "vertex_start", "vertices", "second_moments", "aspect", "aspect_cdf", "both_hands", "half_extents",
+              "graph_start", "graph", "starts", "far_start", "far")
     _fields_ = [("n_shapes", ctypes.c_int)] + [(name, ctypes.c_void_p) for name in FIELDS]
 
     @classmethod
@@ -576,7 +577,7 @@ INTERNAL = {
     "rbs_wall_work": (None, [_vp] * 5 + [ctypes.POINTER(_d)] * 2),
     "rbs_body_vertices": (_i, [_i, _d, _d, _d, _d, _d, _vp]),
     "rbs_bounding_radius": (_d, [_i, _vp, _vp, _i]),
-    "rbs_particle_body": (_i, [_vp, _i, _d, _d, _d, _vp, _vp, _vp]),
+    "rbs_particle_body": (_i, [_vp, _i, _d, _d, _d, _vp, _vp, _vp, _vp]),
     "rbs_rebound_model_frame": (_i, [_vp, _vp, _i, _d, _d, _d, _d, _d, _vp, _vp, _vp]),
     "rbs_rebound_model_frame_counted": (_i, [_vp, _vp, _i, _d, _d, _d, _d, _d, _vp, _vp, _vp, ctypes.POINTER(_ll),
                                              _vp]),

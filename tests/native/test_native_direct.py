@@ -183,8 +183,11 @@ def test_particle_bodies_bit_for_bit(native, table_pair):
             # C's vertices: room for the shape's rows; numba's: room for 256 (it copies them only where they fit)
             mine = (np.zeros((int(np.diff(arrays.vertex_start).max()), 3)), np.zeros(3), np.zeros(3))
             theirs, scale = (np.zeros((256, 3)), np.zeros(3), np.zeros(3)), np.zeros(3)
-            n = c.rbs_particle_body(ctypes.byref(struct), shape, ba, cb, hand, *(x.ctypes.data for x in mine))
+            c_scale = np.zeros(3)
+            n = c.rbs_particle_body(ctypes.byref(struct), shape, ba, cb, hand, *(x.ctypes.data for x in mine),
+                                    c_scale.ctypes.data)
             assert n == py.particle_body(arrays, shape, ba, cb, hand, *theirs, scale)
+            assert _same(c_scale, scale)
             assert _same(mine[1], theirs[1]) and _same(mine[2], theirs[2])
             unit = arrays.vertices[arrays.vertex_start[shape]:arrays.vertex_start[shape] + n]
             assert _same(mine[0][:n], unit * scale) and (n > 256 or _same(mine[0][:n], theirs[0][:n]))
