@@ -36,7 +36,7 @@ from direct_model.flight import (SEARCH_ESCAPED, SEARCH_STALLED, curvature_bound
                                   lowest_points)
 from direct_model.rotation import ROT_PARAMS_SIZE
 from direct_model.shape_arrays import bounding_radius, particle_body, particle_hull
-from direct_model.hull_walk import START, WALK_ABOVE, WALK_WORK, clear, map_start, walk_lowest_two
+from direct_model.hull_walk import START, WALK_ABOVE, WALK_WORK, clear, map_start, walk_lowest
 
 HISTORY_COLUMNS = 17
 
@@ -145,8 +145,8 @@ def body_rebound(kind, verts, nv, semi, K, Rb, R0, V0, W0, wall, n_max, contact_
         clear(walk_work)
         walk_work[START] = map_start(hull[4], (R[1, 0], R[1, 1], R[1, 2]), hull[1])
     if W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0 and hull[2].shape[0] > 0:
-        y = -walk_lowest_two(hull[0], hull[1], hull[2], hull[3], (R[1, 0], R[1, 1], R[1, 2]), 0.0,
-                             int(walk_work[START]), walk_work)[0]
+        y = -walk_lowest(hull[0], hull[1], hull[2], hull[3], (R[1, 0], R[1, 1], R[1, 2]), 0.0,
+                         int(walk_work[START]), walk_work)[0]
     elif W0[0] == 0.0 and W0[1] == 0.0 and W0[2] == 0.0:
         n = lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv)
         y = -np.inf

@@ -71,8 +71,8 @@ import numpy as np
 from direct_model.options import KERNEL
 from direct_model.rotation import rotation_at, rotation_init
 from direct_model.shape_arrays import KIND_ELLIPSOID
-from direct_model.hull_walk import (BAND, START, band, descend, height, map_start, member, nearer, reach, vertex,
-                                   walk_contact_sums, walk_lowest_two)
+from direct_model.hull_walk import (BAND, START, band, descend, height, level, map_start, member, nearer, reach, vertex,
+                                   walk_contact_sums, walk_lowest)
 
 SEARCH_CONTACT = 0      # a point touches the wall (within contact_tol) and approaches it
 SEARCH_ESCAPED = 1      # the body can never reach the wall again
@@ -294,42 +294,50 @@ def _vertex_step(unit, scale, g, d, y, v, M, i):
     return safe_step(h, v + (d[0] * p0 + d[1] * p1 + d[2] * p2), M)
 
 
+@numba.njit(inline="always", **KERNEL)
+def _tighten(unit, scale, g, d, y, v, M, j, t1, i1, t2, i2):
+    """(t1, i1, t2, i2), the two smallest safe steps met and their vertices, after vertex j (not i1 nor i2)."""
+    h, p0, p1, p2 = height(unit, scale, g, y, j)
+    h1 = v + (d[0] * p0 + d[1] * p1 + d[2] * p2)
+    if t2 < np.inf and not may_reach(h, h1, M, t2):
+        return t1, i1, t2, i2
+    tj = safe_step(h, h1, M)
+    if tj < t1:
+        return tj, j, t1, i1
+    if tj < t2:
+        return t1, i1, tj, j
+    return t1, i1, t2, i2
+
+
 @numba.njit(**KERNEL)
-def walk_safe_steps(unit, scale, graph_start, graph, starts, g, d, y, v, M, low, second, work):
+def walk_safe_steps(unit, scale, graph_start, graph, starts, g, d, y, v, M, low, work):
     """(tau, tau_other, b) of a hull's vertices walked over its graph (:mod:`direct_model.hull_walk`), what
     :func:`find_contact`'s loop over every vertex finds (b = −1 if no step is finite); h = y + g·p,
-    h' = v + d·p, M the curvature bound, ``low`` and ``second`` the two lowest vertices.
+    h' = v + d·p, M the curvature bound, ``low`` the lowest vertex.
 
-    The bound T, at least the second smallest step: the second smallest of distinct vertices' steps, the two
-    lowest's first, then with those of the vertex where the level h + T'h' is lowest and of its neighbours (a
-    descent from the start map's vertex, ``starts``), each such round tightening T. The walk of the level's bound
-    at T' (T(1 + 10⁻¹²) + 10⁻³⁰⁰, as :func:`may_reach`) meets every vertex that may_reach lets through at T, taken in index order as the scan
-    takes them; T infinite: every vertex."""
-    t1, i1 = _vertex_step(unit, scale, g, d, y, v, M, low), low
-    t2, i2 = _vertex_step(unit, scale, g, d, y, v, M, second), second
-    if t2 < t1:
-        t1, i1, t2, i2 = t2, i2, t1, i1
-    m = -1
+    The bound T, at least the second smallest step: the second smallest of the steps of distinct vertices, the
+    lowest's and its neighbours' first, then those of the vertex where the level h + T'h' is lowest and of its
+    neighbours (a descent from there or from the start map's vertex, ``starts``), each such round tightening T.
+    The walk of the level's bound at T' (T(1 + 10⁻¹²) + 10⁻³⁰⁰, as :func:`may_reach`) meets every vertex that
+    may_reach lets through at T, taken in index order as the scan takes them; T infinite: every vertex."""
+    t1, i1, t2, i2 = _vertex_step(unit, scale, g, d, y, v, M, low), low, np.inf, -1
+    for k in range(graph_start[low], graph_start[low + 1]):
+        t1, i1, t2, i2 = _tighten(unit, scale, g, d, y, v, M, graph[k], t1, i1, t2, i2)
+    m = low
     for _ in range(REFINE):
         if not t2 < np.inf:
             break
-        before, last = t2, m
+        before = t2
         Tp = t2 * (1.0 + 1e-12) + 1e-300
-        m = descend(unit, scale, graph_start, graph, g, d, y, v, Tp,
-                    map_start(starts, (g[0] + Tp * d[0], g[1] + Tp * d[1], g[2] + Tp * d[2]), scale))[0]
+        mapped = map_start(starts, (g[0] + Tp * d[0], g[1] + Tp * d[1], g[2] + Tp * d[2]), scale)
+        start = mapped if level(unit, scale, g, d, y, v, Tp, mapped) < level(unit, scale, g, d, y, v, Tp, m) else m
+        last, m = m, descend(unit, scale, graph_start, graph, g, d, y, v, Tp, start)[0]
         if m == last:
             break
         for k in range(graph_start[m] - 1, graph_start[m + 1]):
             j = m if k < graph_start[m] else graph[k]        # m, then its neighbours
             if j != i1 and j != i2:
-                h, p0, p1, p2 = height(unit, scale, g, y, j)
-                h1 = v + (d[0] * p0 + d[1] * p1 + d[2] * p2)
-                if may_reach(h, h1, M, t2):
-                    tj = safe_step(h, h1, M)
-                    if tj < t1:
-                        t1, i1, t2, i2 = tj, j, t1, i1
-                    elif tj < t2:
-                        t2, i2 = tj, j
+                t1, i1, t2, i2 = _tighten(unit, scale, g, d, y, v, M, j, t1, i1, t2, i2)
         if not t2 < before:
             break
     T = t2
@@ -392,7 +400,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
     unit, scale, graph_start, graph = hull[0], hull[1], hull[2], hull[3]
     walk = graph_start.shape[0] > 0
     g, d = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)       # a walk's view of the normal and its turn (module doc)
-    n, h_second, second = nv, np.inf, -1
+    n = nv
     b = -1                # the binding point of the last step
     t = 0.0
     t_lo = 0.0            # latest time known to precede any contact
@@ -407,8 +415,8 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
             g0, g1, g2, d0, d1, d2, a0, a1, a2 = turning(R, W, K)
             g, d = (g0, g1, g2), (d0, d1, d2)
             curv[0], curv[1], curv[2] = a0, a1, a2
-            hmin, low, h_second, second = walk_lowest_two(unit, scale, graph_start, graph, g, y,
-                                                          nearer(unit, scale, hull[4], g, y, walk_work), walk_work)
+            hmin, low = walk_lowest(unit, scale, graph_start, graph, g, y, nearer(unit, scale, hull[4], g, y, walk_work),
+                                    walk_work)
             walk_work[START] = low
         else:
             n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv)
@@ -444,7 +452,7 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
         # the smallest and second smallest safe steps are at most T: points that surely take longer are passed
         if walk:
             tau, tau_other, found = walk_safe_steps(unit, scale, graph_start, graph, hull[4], g, d, y, v, M, low,
-                                                    second, walk_work)
+                                                    walk_work)
         else:
             T = pass_over_bound(h, h1, n, low, M) if n > PASS_OVER_ABOVE else np.inf
             tau, tau_other, found = np.inf, np.inf, -1

@@ -4,7 +4,7 @@ their number, with the bits of a scan of every vertex (docs/design/grains.md, "H
 Why a walk finds what a scan finds. One particle's vertex i is p = unit[i] · scale (the unit body stretched and
 mirrored, the products :func:`direct_model.shape_arrays.particle_body` writes), its height over the wall
 h = y + g·p and its rate h' = v + d·p (:mod:`direct_model.flight`). Every query of the contact search asks about
-the vertices where a *level* h + T·h', linear in p, is at most a bound L: the lowest two (T = 0), the contact set
+the vertices where a *level* h + T·h', linear in p, is at most a bound L: the lowest (T = 0), the contact set
 (T = 0, L the lowest height plus the set's tolerance), the vertices that may reach the wall within a step T
 (h + T'h' ≤ ½MT'² plus round-off, as :func:`direct_model.flight.may_reach` decides). On a convex polyhedron the
 vertices below a plane are connected in its vertex graph, so a breadth-first walk from one of them over the
@@ -245,24 +245,23 @@ def member(work, count, k):
 
 
 @numba.njit(**KERNEL)
-def walk_lowest_two(unit, scale, graph_start, graph, g, y, start, work):
-    """(h_low, low, h_second, second): the lowest vertex (the first of equal ones) and the lowest other vertex
-    (the first of equal ones: :func:`direct_model.flight.pass_over_bound`'s), heights h = y + g·p (units of a);
-    descending from vertex ``start``. Both are at most the lowest neighbour's height of the descent's end, so
-    the walk of that bound meets them."""
+def walk_lowest(unit, scale, graph_start, graph, g, y, start, work):
+    """(h_low, low): the lowest vertex (the first of equal ones), h = y + g·p (units of a), descending from vertex
+    ``start``. Every vertex as low as the descent's end is walked to from it (module doc); with no neighbour that
+    low, the end is the answer without a walk."""
     zero = (0.0, 0.0, 0.0)
-    m, _, bound = descend(unit, scale, graph_start, graph, g, zero, y, 0.0, 0.0, start)
-    count = band(unit, scale, graph_start, graph, g, zero, y, 0.0, 0.0,
-                 bound + BAND * (abs(y) + reach(g, scale)), m, work)
-    h_low, low, h_second, second = np.inf, -1, np.inf, -1
+    m, h_m, around = descend(unit, scale, graph_start, graph, g, zero, y, 0.0, 0.0, start)
+    limit = h_m + BAND * (abs(y) + reach(g, scale))
+    if around > limit:
+        return h_m, m
+    count = band(unit, scale, graph_start, graph, g, zero, y, 0.0, 0.0, limit, m, work)
+    h_low, low = np.inf, -1
     for k in range(count if count >= 0 else unit.shape[0]):
         i = member(work, count, k)
         h = height(unit, scale, g, y, i)[0]
         if h < h_low:
-            h_second, second, h_low, low = h_low, low, h, i
-        elif h < h_second:
-            h_second, second = h, i
-    return h_low, low, h_second, second
+            h_low, low = h, i
+    return h_low, low
 
 
 @numba.njit(**KERNEL)

@@ -89,9 +89,8 @@ int rbs_body_rebound_in(int kind, double *verts, int nv, const double semi[3], c
     }
     if (hull && W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
         const double g[3] = {R[3], R[4], R[5]};
-        double h_second;
-        int low, second;
-        rbs_walk_lowest_two(hull, g, 0.0, walk.start, &walk, &y, &low, &h_second, &second);
+        int low;
+        rbs_walk_lowest(hull, g, 0.0, walk.start, &walk, &y, &low);
         y = -y;
     } else if (W0[0] == 0.0 && W0[1] == 0.0 && W0[2] == 0.0) {
         int n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, 0.0, 0.0, h, h1, curv);

@@ -173,14 +173,6 @@ static int choose_contact(int n, const double *verts, const double *h, const dou
     return contact_point(count, sums, rate, best, verts + 3 * (best > 0 ? best : 0), R, rc);
 }
 
-/* the (h, h', safe step) of vertex i of a walked hull, as the scan computes them */
-static double vertex_step(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double M, int i)
-{
-    double p[3];
-    double h = rbs_hull_height(hl, g, y, i, p);
-    return safe_step(h, v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]), M);
-}
-
 /* the scan's loop over the safe steps (flight.c, rbs_find_contact) for one point: a point whose safe step surely
  * exceeds the second smallest so far (or T, at least the final second smallest) changes neither */
 static void take_step(double h, double h1, double M, double T, int i, double *tau, double *tau_other, int *b)
@@ -197,59 +189,69 @@ static void take_step(double h, double h1, double M, double T, int i, double *ta
     }
 }
 
-/* (tau, tau_other, b) of a walked hull's vertices (direct_model.flight.walk_safe_steps): the bound T from the two
- * lowest and the vertices around the lowest of the level h + T'h', then the walk of T's band in index order */
-static void walk_safe_steps(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double M,
-                            int low, int second, rbs_walk *w, double *tau, double *tau_other, int *b)
+/* the two smallest safe steps met, t[0] <= t[1], and their vertices i[], after vertex j (not i[0] nor i[1])
+ * (direct_model.flight._tighten) */
+static void tighten(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double M, int j,
+                    double t[2], int i[2])
 {
-    double t1 = vertex_step(hl, g, d, y, v, M, low), t2 = vertex_step(hl, g, d, y, v, M, second), p[3];
-    int i1 = low, i2 = second;
-    if (t2 < t1) {
-        double t = t1;
-        t1 = t2;
-        t2 = t;
-        i1 = second;
-        i2 = low;
+    double p[3];
+    double h = rbs_hull_height(hl, g, y, j, p), h1 = v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]);
+    if (t[1] < INFINITY && !may_reach(h, h1, M, t[1])) return;
+    double tj = safe_step(h, h1, M);
+    if (tj < t[0]) {
+        t[1] = t[0];
+        i[1] = i[0];
+        t[0] = tj;
+        i[0] = j;
+    } else if (tj < t[1]) {
+        t[1] = tj;
+        i[1] = j;
     }
-    int m = -1;
-    for (int round = 0; round < REFINE && t2 < INFINITY; round++) {
-        double before = t2, Tp = t2 * (1.0 + 1e-12) + 1e-300;
-        int last = m;
+}
+
+/* (tau, tau_other, b) of a walked hull's vertices (direct_model.flight.walk_safe_steps): the bound T from the
+ * lowest, its neighbours and the vertices around the lowest of the level h + T'h', then the walk of T's band in
+ * index order */
+static void walk_safe_steps(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double M,
+                            int low, rbs_walk *w, double *tau, double *tau_other, int *b)
+{
+    double p[3], t[2] = {INFINITY, INFINITY};
+    int i[2] = {low, -1};
+    {
+        double h = rbs_hull_height(hl, g, y, low, p);
+        t[0] = safe_step(h, v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]), M);
+    }
+    for (int64_t k = hl->graph_start[low]; k < hl->graph_start[low + 1]; k++) tighten(hl, g, d, y, v, M, hl->graph[k],
+                                                                                       t, i);
+    int m = low;
+    for (int round = 0; round < REFINE && t[1] < INFINITY; round++) {
+        double before = t[1], Tp = t[1] * (1.0 + 1e-12) + 1e-300;
         const double e[3] = {g[0] + Tp * d[0], g[1] + Tp * d[1], g[2] + Tp * d[2]};
-        m = rbs_walk_descend(hl, g, d, y, v, Tp, rbs_walk_map_start(hl, e), NULL);
+        int mapped = rbs_walk_map_start(hl, e);
+        int start = rbs_walk_level(hl, g, d, y, v, Tp, mapped) < rbs_walk_level(hl, g, d, y, v, Tp, m) ? mapped : m;
+        int last = m;
+        m = rbs_walk_descend(hl, g, d, y, v, Tp, start, NULL);
         if (m == last) break;
         for (int64_t k = hl->graph_start[m] - 1; k < hl->graph_start[m + 1]; k++) {
             int j = k < hl->graph_start[m] ? m : hl->graph[k]; /* m, then its neighbours */
-            if (j == i1 || j == i2) continue;
-            double h = rbs_hull_height(hl, g, y, j, p), h1 = v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]);
-            if (!may_reach(h, h1, M, t2)) continue;
-            double tj = safe_step(h, h1, M);
-            if (tj < t1) {
-                t2 = t1;
-                i2 = i1;
-                t1 = tj;
-                i1 = j;
-            } else if (tj < t2) {
-                t2 = tj;
-                i2 = j;
-            }
+            if (j != i[0] && j != i[1]) tighten(hl, g, d, y, v, M, j, t, i);
         }
-        if (!(t2 < before)) break;
+        if (!(t[1] < before)) break;
     }
-    double T = t2;
+    double T = t[1];
     int count = -1;
     if (T < INFINITY) {
         double Tp = T * (1.0 + 1e-12) + 1e-300;
         double size = fabs(y) + rbs_hull_reach(g, hl->scale) + (fabs(v) + rbs_hull_reach(d, hl->scale)) * Tp
                       + 0.5 * fabs(M) * Tp * Tp;
-        count = rbs_walk_band(hl, g, d, y, v, Tp, 0.5 * M * Tp * Tp + WALK_BAND * size, i1, w);
+        count = rbs_walk_band(hl, g, d, y, v, Tp, 0.5 * M * Tp * Tp + WALK_BAND * size, i[0], w);
     }
     *tau = *tau_other = INFINITY;
     *b = -1;
     for (int k = 0; k < (count >= 0 ? count : hl->n); k++) {
-        int i = rbs_walk_member(w, count, k);
-        double h = rbs_hull_height(hl, g, y, i, p);
-        take_step(h, v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]), M, T, i, tau, tau_other, b);
+        int j = rbs_walk_member(w, count, k);
+        double h = rbs_hull_height(hl, g, y, j, p);
+        take_step(h, v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]), M, T, j, tau, tau_other, b);
     }
 }
 
@@ -289,11 +291,11 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
             rbs_rotation_at(params, t, R, W);
         }
         double y = y0 + v * t;
-        double hmin = INFINITY, h_second = INFINITY;
-        int n = nv, low = 0, second = -1;
+        double hmin = INFINITY;
+        int n = nv, low = 0;
         if (hull) {
             rbs_turning(R, W, K, g, d, curv);
-            rbs_walk_lowest_two(hull, g, y, rbs_walk_nearer(hull, g, y, walk), walk, &hmin, &low, &h_second, &second);
+            rbs_walk_lowest(hull, g, y, rbs_walk_nearer(hull, g, y, walk), walk, &hmin, &low);
             walk->start = low;
         } else {
             n = rbs_lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv);
@@ -335,7 +337,7 @@ int rbs_find_contact(int kind, double *verts, int nv, const double semi[3], doub
         double tau = INFINITY, tau_other = INFINITY;
         int found = -1;
         if (hull) {
-            walk_safe_steps(hull, g, d, y, v, M, low, second, walk, &tau, &tau_other, &found);
+            walk_safe_steps(hull, g, d, y, v, M, low, walk, &tau, &tau_other, &found);
         } else {
             double T = n > PASS_OVER_ABOVE ? pass_over_bound(h, h1, n, low, M) : INFINITY;
             for (int i = 0; i < n; i++) take_step(h[i], h1[i], M, T, i, &tau, &tau_other, &found);

@@ -1,5 +1,5 @@
 /*
- * hull_walk.c: walks over a hull's vertex graph (direct_model.hull_walk: level, descend, band, walk_lowest_two,
+ * hull_walk.c: walks over a hull's vertex graph (direct_model.hull_walk: level, descend, band, walk_lowest,
  * walk_contact_sums, walk_farthest, nearer, map_cell, start_map, farthest_candidates; direct_model.polyhedron:
  * vertex_graph). The same operations in the same order as the numba kernels where they decide an answer; where
  * they decide only the speed (the start map, the descents' paths) too, so that both runtimes walk alike.
@@ -130,26 +130,16 @@ int rbs_farthest_candidates(const double *unit, int n, int32_t *far)
     return count;
 }
 
-/* vertex i's level h + T·h' (T = 0: its height, bit for bit) */
-static inline double level(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double T,
-                           int i)
-{
-    double p[3];
-    double h = rbs_hull_height(hl, g, y, i, p);
-    if (T == 0.0) return h;
-    return h + T * (v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]));
-}
-
 int rbs_walk_descend(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double T, int i,
                      double *around)
 {
-    double best = level(hl, g, d, y, v, T, i);
+    double best = rbs_walk_level(hl, g, d, y, v, T, i);
     for (;;) {
         int here = i;
         double low = INFINITY;
         for (int64_t k = hl->graph_start[here]; k < hl->graph_start[here + 1]; k++) {
             int j = hl->graph[k];
-            double x = level(hl, g, d, y, v, T, j);
+            double x = rbs_walk_level(hl, g, d, y, v, T, j);
             low = py_min(low, x);
             if (x < best) {
                 i = j;
@@ -213,7 +203,7 @@ void rbs_walk_clear(rbs_walk *w)
 int rbs_walk_band(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double T, double limit,
                   int start, rbs_walk *w)
 {
-    if (!(level(hl, g, d, y, v, T, start) <= limit)) return -1;
+    if (!(rbs_walk_level(hl, g, d, y, v, T, start) <= limit)) return -1;
     uint32_t slot = ((uint32_t)start * HASH) & (WALK_SLOTS - 1);
     w->slots[slot] = start + 1;
     w->where[0] = (int32_t)slot;
@@ -232,7 +222,7 @@ int rbs_walk_band(const rbs_hull *hl, const double g[3], const double d[3], doub
             }
             w->slots[slot] = j + 1;
             w->where[n_met++] = (int32_t)slot;
-            if (level(hl, g, d, y, v, T, j) <= limit) w->members[count++] = j;
+            if (rbs_walk_level(hl, g, d, y, v, T, j) <= limit) w->members[count++] = j;
         }
     }
     for (int k = 0; k < n_met; k++) w->slots[w->where[k]] = 0;
@@ -249,33 +239,26 @@ int rbs_walk_band(const rbs_hull *hl, const double g[3], const double d[3], doub
     return count;
 }
 
-void rbs_walk_lowest_two(const rbs_hull *hl, const double g[3], double y, int start, rbs_walk *w, double *h_low,
-                         int *low, double *h_second, int *second)
+void rbs_walk_lowest(const rbs_hull *hl, const double g[3], double y, int start, rbs_walk *w, double *h_low, int *low)
 {
     static const double zero[3] = {0.0, 0.0, 0.0};
-    double bound, p[3];
-    int m = rbs_walk_descend(hl, g, zero, y, 0.0, 0.0, start, &bound);
-    int count = rbs_walk_band(hl, g, zero, y, 0.0, 0.0, bound + WALK_BAND * (fabs(y) + rbs_hull_reach(g, hl->scale)),
-                              m, w);
-    double hl_ = INFINITY, hs = INFINITY;
-    int l = -1, s = -1;
+    double around, p[3];
+    int m = rbs_walk_descend(hl, g, zero, y, 0.0, 0.0, start, &around);
+    double h_m = rbs_hull_height(hl, g, y, m, p), limit = h_m + WALK_BAND * (fabs(y) + rbs_hull_reach(g, hl->scale));
+    *h_low = h_m;
+    *low = m;
+    if (around > limit) return; /* no neighbour as low: m is the answer */
+    int count = rbs_walk_band(hl, g, zero, y, 0.0, 0.0, limit, m, w);
+    *h_low = INFINITY;
+    *low = -1;
     for (int k = 0; k < (count >= 0 ? count : hl->n); k++) {
         int i = rbs_walk_member(w, count, k);
         double h = rbs_hull_height(hl, g, y, i, p);
-        if (h < hl_) {
-            hs = hl_;
-            s = l;
-            hl_ = h;
-            l = i;
-        } else if (h < hs) {
-            hs = h;
-            s = i;
+        if (h < *h_low) {
+            *h_low = h;
+            *low = i;
         }
     }
-    *h_low = hl_;
-    *low = l;
-    *h_second = hs;
-    *second = s;
 }
 
 void rbs_walk_contact_sums(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double limit,

@@ -58,6 +58,16 @@ static inline double rbs_hull_height(const rbs_hull *hl, const double g[3], doub
     return y + (g[0] * p[0] + g[1] * p[1] + g[2] * p[2]);
 }
 
+/* vertex i's level h + T·h' (T = 0: its height, bit for bit) */
+static inline double rbs_walk_level(const rbs_hull *hl, const double g[3], const double d[3], double y, double v,
+                                    double T, int i)
+{
+    double p[3];
+    double h = rbs_hull_height(hl, g, y, i, p);
+    if (T == 0.0) return h;
+    return h + T * (v + (d[0] * p[0] + d[1] * p[1] + d[2] * p[2]));
+}
+
 /* Σ |direction_k · scale_k| · 2: a bound on |direction·p| over the unit body (direct_model.hull_walk.reach) */
 static inline double rbs_hull_reach(const double direction[3], const double scale[3])
 {
@@ -86,14 +96,14 @@ int rbs_farthest_candidates(const double *unit, int n, int32_t *far);
 /* The queries (direct_model.hull_walk); w's hash set empty on entry and on return (rbs_walk_clear before a rebound's
  * first). */
 void rbs_walk_clear(rbs_walk *w);
+
 int rbs_walk_map_start(const rbs_hull *hl, const double direction[3]);
 int rbs_walk_nearer(const rbs_hull *hl, const double g[3], double y, const rbs_walk *w);
 int rbs_walk_descend(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double T, int i,
                      double *around);
 int rbs_walk_band(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double T, double limit,
                   int start, rbs_walk *w);
-void rbs_walk_lowest_two(const rbs_hull *hl, const double g[3], double y, int start, rbs_walk *w, double *h_low,
-                         int *low, double *h_second, int *second);
+void rbs_walk_lowest(const rbs_hull *hl, const double g[3], double y, int start, rbs_walk *w, double *h_low, int *low);
 void rbs_walk_contact_sums(const rbs_hull *hl, const double g[3], const double d[3], double y, double v, double limit,
                            int low, rbs_walk *w, int *count, double sums[3], double *rate, int *best);
 double rbs_walk_farthest(const rbs_hull *hl);

@@ -1,5 +1,5 @@
 """The contact search of a hull of many vertices by walks over its vertex graph (direct_model.hull_walk): each
-query finds what a scan of every vertex finds, to the bit (the lowest vertex and the first of equal ones, the contact
+query finds what a scan of every vertex finds, to the bit (the lowest vertex, the first of equal ones; the contact
 set's sums in index order, the two smallest safe steps and the first vertex of the smallest, the farthest vertex),
 from any start, through exact ties and through a walk that gives up; and a whole rebound of a 3000-vertex grain
 walked is its rebound with every vertex scanned at every query."""
@@ -14,7 +14,7 @@ import pytest
 from direct_model.body_rebound import body_rebound_batch, quaternion_to_matrix
 from direct_model.flight import take_step, walk_safe_steps
 from direct_model.hull_walk import (MAP_CELLS, ROOM, SLOTS, WALK_ABOVE, WALK_WORK, farthest_candidates, map_cell,
-                                    map_start, start_map, walk_contact_sums, walk_farthest, walk_lowest_two)
+                                    map_start, start_map, walk_contact_sums, walk_farthest, walk_lowest)
 from direct_model.registry import grain
 from direct_model.shape_arrays import particle_hull, shape_arrays
 from direct_model.shapes import AspectRatioLaw
@@ -75,9 +75,8 @@ def _queries_against_scan(record, rng, states, starts_at_random):
         y, v, M = rng.uniform(0.0, 1.5), rng.uniform(-300.0, 50.0), rng.choice([0.0, rng.uniform(0.0, 500.0)])
         h, h1 = _scan(unit, scale, g, d, y, v)
         low = int(np.argmin(h))
-        second = int(np.argmin(np.where(np.arange(len(h)) == low, np.inf, h)))
         start = int(rng.integers(len(unit))) if starts_at_random else int(map_start(starts, g, scale))
-        assert walk_lowest_two(unit, scale, graph_start, graph, g, y, start, work) == (h[low], low, h[second], second)
+        assert walk_lowest(unit, scale, graph_start, graph, g, y, start, work) == (h[low], low)
         limit = h[low] + rng.choice([1e-9, 0.01, 0.1])
         members = np.flatnonzero(h <= limit)
         p = unit * scale
@@ -92,15 +91,14 @@ def _queries_against_scan(record, rng, states, starts_at_random):
         tau, tau_other, b = np.inf, np.inf, -1
         for i in range(len(h)):                 # the scan, nothing passed over
             tau, tau_other, b = take_step(h[i], h1[i], M, np.inf, i, tau, tau_other, b)
-        assert walk_safe_steps(unit, scale, graph_start, graph, starts, g, d, y, v, M, low, second, work) == (
-            tau, tau_other, b)
+        assert walk_safe_steps(unit, scale, graph_start, graph, starts, g, d, y, v, M, low, work) == (tau, tau_other, b)
         assert not work[:SLOTS].any()           # the hash set left empty for the next walk
 
 
 @pytest.mark.parametrize("starts_at_random", [False, True])
 def test_each_query_finds_what_a_scan_finds(big, starts_at_random):
     """On 200 random orientations and stretches (mirrored too) of a 1000-vertex grain, the walks started from the
-    start map or from a random vertex: the lowest and second lowest vertex (first of equal ones), the contact
+    start map or from a random vertex: the lowest vertex (the first of equal ones), the contact
     set's count, sums and lowest approaching vertex for three widths of the set, the farthest vertex's |p|², and
     the two smallest safe steps and the first vertex of the smallest: equal to the scan's, bit for bit."""
     _queries_against_scan(big, np.random.default_rng(8 + starts_at_random), 200, starts_at_random)
@@ -117,8 +115,8 @@ def test_a_near_sphere_s_queries_find_what_a_scan_finds():
 
 @pytest.mark.parametrize("sides", [40, ROOM + 20])
 def test_exact_ties_are_resolved_as_a_scan_resolves_them(sides):
-    """A face of ``sides`` vertices of equal height facing the wall: the lowest is the first of them, the second
-    the next, the contact set all of them summed in index order; with more than ROOM of them the walk gives up
+    """A face of ``sides`` vertices of equal height facing the wall: the lowest is the first of them, the contact
+    set all of them summed in index order; with more than ROOM of them the walk gives up
     and the query scans every vertex, with the same answers."""
     rings = _ring_prism(sides)
     assert len(rings.vertices) == 2 * sides > WALK_ABOVE
@@ -133,8 +131,7 @@ def test_exact_ties_are_resolved_as_a_scan_resolves_them(sides):
         tied = np.flatnonzero(h == h.min())
         assert len(tied) == sides
         for start in (int(map_start(starts, g, scale)), int(tied[-1]), int(np.argmax(h))):
-            assert walk_lowest_two(unit, scale, graph_start, graph, g, 0.5, start, work) == (h.min(), tied[0], h.min(),
-                                                                                              tied[1])
+            assert walk_lowest(unit, scale, graph_start, graph, g, 0.5, start, work) == (h.min(), tied[0])
             count, *_ = walk_contact_sums(unit, scale, graph_start, graph, g, (0.0, 0.0, 0.0), 0.5, -1.0,
                                           h.min() + 1e-9, tied[0], work)
             assert count == sides
