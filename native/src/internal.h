@@ -98,14 +98,15 @@
 #define RBS_WALL_MAX_PARAMETERS 8   /* the most parameters of a wall law family (loader.c: WALL_FAMILIES) */
 
 /* The shapes of a table as data (data_schema.shape_records: group /shapes), table order; shape_records.c reads,
- * checks and frees them. The triangles give a walked hull its vertex graph (rbs_direct_shapes_build). */
+ * checks and frees them. The triangles give a walked hull its vertex graph, then are freed (rbs_direct_shapes_build):
+ * the runtime needs no surface. */
 typedef struct rbs_shape_records {
     int8_t *kind;               /* (n) RBS_SMOOTH or RBS_POLYHEDRON */
     int *family;                /* (n) RBS_ELLIPSOID .. RBS_TETRAHEDRON, or −1 for any other shape */
     int64_t *vertex_start;      /* (n + 1) shape i's vertices are rows vertex_start[i] .. vertex_start[i+1] − 1 */
     double *vertices;           /* (vertex_start[n], 3) body frame, units of a, at b/a = c/b = 1 */
     int64_t *triangle_start;    /* (n + 1) shape i's triangles are rows triangle_start[i] .. triangle_start[i+1] − 1 */
-    int32_t *triangles;         /* (triangle_start[n], 3) indices into the shape's own vertices */
+    int32_t *triangles;         /* (triangle_start[n], 3) indices into the shape's own vertices; NULL after the load */
     double *inertia;            /* (n, 3) principal J/m, units of a² */
     double *aspect;             /* (n, 4) mean, sd, low, high of b/a and c/b; NaN row: fixed proportions */
     uint8_t *both_hands;        /* (n) 0 or 1 */

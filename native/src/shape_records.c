@@ -464,7 +464,7 @@ static int walks_build(rbs_table *t)
 
 int rbs_direct_shapes_build(rbs_table *t)
 {
-    const rbs_shape_records *r = &t->shapes;
+    rbs_shape_records *r = &t->shapes;
     const double *p = t->direct_parameters;
     int n = RBS_N_FAMILIES;
     int64_t rows = FAMILY_VERTEX_ROWS;
@@ -514,7 +514,13 @@ int rbs_direct_shapes_build(rbs_table *t)
         both_hands[j] = r->both_hands[i];
         j++;
     }
-    if (walks_build(t) != 0) {
+    int built = walks_build(t);
+    /* the triangles have given the walks their graphs: the runtime needs no surface */
+    free(t->shapes.triangle_start);
+    free(t->shapes.triangles);
+    t->shapes.triangle_start = NULL;
+    t->shapes.triangles = NULL;
+    if (built != 0) {
         rbs_direct_shapes_free(t);
         return RBS_ERR_MEMORY;
     }

@@ -72,10 +72,16 @@ def model_sha256() -> str:
     return digest.hexdigest()
 
 
-def _worker_init(threads: int) -> None:
-    """Worker set-up: numba threads; Ctrl-C is the main process's to handle; die with the main process."""
+_WORKER_CONFIG = None       # a local worker's build configuration, sent once (_worker_init)
+
+
+def _worker_init(threads: int, config) -> None:
+    """Worker set-up: numba threads and the build's configuration (once, not once per cell: a population's hulls
+    make it megabytes); Ctrl-C is the main process's to handle; die with the main process."""
+    global _WORKER_CONFIG
     import numba
     numba.set_num_threads(threads)
+    _WORKER_CONFIG = config
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if sys.platform == "linux":
         import ctypes
@@ -235,10 +241,9 @@ def _run_local(config, tasks, checkpoint, workers, bar) -> None:
     threads = max(1, (os.cpu_count() or 1) // workers)
     # spawn, not fork: forking a process whose numba kernels already ran on OpenMP threads is unsafe
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_worker_init, initargs=(threads,))
+                               initializer=_worker_init, initargs=(threads, config))
     try:
-        futures = {pool.submit(_compute_and_save, config, checkpoint.cell_path(*task), *task): task
-                   for task in tasks}
+        futures = {pool.submit(_compute_and_save, checkpoint.cell_path(*task), *task): task for task in tasks}
         for future in as_completed(futures):
             task = futures[future]
             try:
@@ -255,15 +260,15 @@ def _run_local(config, tasks, checkpoint, workers, bar) -> None:
         _stop(pool)
 
 
-def _compute_and_save(config: BuildConfig, path: Path, shape: str, i_alpha: int, i_speed: int) -> None:
-    """A local worker's task: compute a cell and checkpoint it to ``path`` itself.
+def _compute_and_save(path: Path, shape: str, i_alpha: int, i_speed: int) -> None:
+    """A local worker's task: compute a cell of its configuration and checkpoint it to ``path`` itself.
 
     Its reply through the pool's pipe is then a few bytes, which a pipe writes whole or not at all
     (PIPE_BUF). A 100 kB cell sent back instead could be cut off by :func:`_stop` terminating its worker,
     and the pool's reader thread would wait forever for the rest (the main process holds the pipe's other
     end), hanging the interpreter's exit.
     """
-    save_cell(path, compute_cell(config, shape, i_alpha, i_speed))
+    save_cell(path, compute_cell(_WORKER_CONFIG, shape, i_alpha, i_speed))
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
@@ -293,7 +298,9 @@ def _connect(scheduler: str):
 def _run_dask(config, tasks, checkpoint, client, bar) -> None:
     from dask.distributed import as_completed
 
-    futures = {client.submit(compute_cell, config, *task, pure=False): task for task in tasks}
+    # the configuration once to every worker, not once per cell (a population's hulls make it megabytes)
+    shared = client.scatter(config, broadcast=True)
+    futures = {client.submit(compute_cell, shared, *task, pure=False): task for task in tasks}
     try:
         for future in as_completed(futures):
             task = futures[future]

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import h5py
+import numba
 import numpy as np
 import pytest
 
@@ -248,11 +249,12 @@ def test_a_signal_stops_the_workers_and_keeps_the_checkpoints(tmp_path, signal_n
     assert len(list(partial.glob("*.npz"))) >= 1 and not out.exists()
 
 
-def test_a_local_worker_saves_its_cell_and_sends_back_nothing(tmp_path):
+def test_a_local_worker_saves_its_cell_and_sends_back_nothing(tmp_path, monkeypatch):
     # a cell sent back could be cut off by terminating its worker, and the pool's reader would wait forever
     config = parse_config(TINY)
     path = tmp_path / "cell.npz"
-    assert driver._compute_and_save(config, path, "prism", 1, 0) is None
+    monkeypatch.setattr(driver, "_WORKER_CONFIG", config)       # what _worker_init gives each worker
+    assert driver._compute_and_save(path, "prism", 1, 0) is None
     with np.load(path) as saved:
         expected = compute_cell(config, "prism", 1, 0).arrays()
         assert sorted(saved.files) == sorted(expected)
