@@ -88,9 +88,9 @@ def map_cell(w0, w1, w2):
     big = abs(top)
     if not big > 0.0:
         return 0
-    i = min(MAP_CELLS - 1, max(0, int((x / big + 1.0) * (0.5 * MAP_CELLS))))
-    j = min(MAP_CELLS - 1, max(0, int((y / big + 1.0) * (0.5 * MAP_CELLS))))
-    return (face * MAP_CELLS + i) * MAP_CELLS + j
+    scale = 0.5 * MAP_CELLS / big
+    i, j = int((x + big) * scale), int((y + big) * scale)       # |x|, |y| ≤ big: 0 to MAP_CELLS
+    return (face * MAP_CELLS + min(i, MAP_CELLS - 1)) * MAP_CELLS + min(j, MAP_CELLS - 1)
 
 
 @numba.njit(inline="always", **KERNEL)

@@ -177,8 +177,10 @@ static int map_cell(double w0, double w1, double w2)
     int face = 2 * axis + (top < 0.0 ? 1 : 0);
     double big = fabs(top);
     if (!(big > 0.0)) return 0;
-    int i = (int)py_min(MAP_CELLS - 1.0, py_max(0.0, trunc((x / big + 1.0) * (0.5 * MAP_CELLS))));
-    int j = (int)py_min(MAP_CELLS - 1.0, py_max(0.0, trunc((y / big + 1.0) * (0.5 * MAP_CELLS))));
+    double scale = 0.5 * MAP_CELLS / big;
+    int i = (int)((x + big) * scale), j = (int)((y + big) * scale); /* |x|, |y| <= big: 0 .. MAP_CELLS */
+    i = i < MAP_CELLS ? i : MAP_CELLS - 1;
+    j = j < MAP_CELLS ? j : MAP_CELLS - 1;
     return (face * MAP_CELLS + i) * MAP_CELLS + j;
 }
 
