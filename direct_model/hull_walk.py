@@ -50,25 +50,16 @@ def start_map(unit, graph_start, graph):
     (n, 3) lowest along its centre's direction (its vertex graph ``graph_start``, ``graph`` local): where a descent
     along w starts. Each cell's by a steepest descent from the cell's before it (a speed device only)."""
     starts = np.empty(MAP_SIZE, dtype=np.int32)
+    ones, zero, w = np.ones(3), (0.0, 0.0, 0.0), np.empty(3)
     i = 0
     for face in range(6):
         axis, sign = face // 2, -1.0 if face % 2 else 1.0
         for a in range(MAP_CELLS):
             for b in range(MAP_CELLS):
-                w = np.empty(3)
                 w[axis] = sign
                 w[(axis + 1) % 3] = (a + 0.5) / MAP_CELLS * 2.0 - 1.0
                 w[(axis + 2) % 3] = (b + 0.5) / MAP_CELLS * 2.0 - 1.0
-                best = w[0] * unit[i, 0] + w[1] * unit[i, 1] + w[2] * unit[i, 2]
-                while True:
-                    here = i
-                    for k in range(graph_start[here], graph_start[here + 1]):
-                        j = graph[k]
-                        x = w[0] * unit[j, 0] + w[1] * unit[j, 1] + w[2] * unit[j, 2]
-                        if x < best:
-                            i, best = j, x
-                    if i == here:
-                        break
+                i = descend(unit, ones, graph_start, graph, (w[0], w[1], w[2]), zero, 0.0, 0.0, 0.0, i)[0]
                 starts[(face * MAP_CELLS + a) * MAP_CELLS + b] = i
     return starts
 

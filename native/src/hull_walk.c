@@ -61,8 +61,10 @@ int rbs_vertex_graph(const int32_t *triangles, int64_t nt, int n, int64_t **star
     return 0;
 }
 
-void rbs_start_map(const double *unit, const int64_t *start, const int32_t *graph, int32_t *starts)
+void rbs_start_map(const double *unit, int n, const int64_t *start, const int32_t *graph, int32_t *starts)
 {
+    static const double zero[3] = {0.0, 0.0, 0.0};
+    const rbs_hull whole = {unit, n, {1.0, 1.0, 1.0}, start, graph, NULL, NULL, 0};
     int i = 0;
     for (int face = 0; face < 6; face++) {
         int axis = face / 2;
@@ -73,19 +75,7 @@ void rbs_start_map(const double *unit, const int64_t *start, const int32_t *grap
                 w[axis] = sign;
                 w[(axis + 1) % 3] = (a + 0.5) / MAP_CELLS * 2.0 - 1.0;
                 w[(axis + 2) % 3] = (b + 0.5) / MAP_CELLS * 2.0 - 1.0;
-                double best = w[0] * unit[3 * i] + w[1] * unit[3 * i + 1] + w[2] * unit[3 * i + 2];
-                for (;;) {
-                    int here = i;
-                    for (int64_t k = start[here]; k < start[here + 1]; k++) {
-                        int j = graph[k];
-                        double x = w[0] * unit[3 * j] + w[1] * unit[3 * j + 1] + w[2] * unit[3 * j + 2];
-                        if (x < best) {
-                            i = j;
-                            best = x;
-                        }
-                    }
-                    if (i == here) break;
-                }
+                i = rbs_walk_descend(&whole, w, zero, 0.0, 0.0, 0.0, i, NULL);
                 starts[(face * MAP_CELLS + a) * MAP_CELLS + b] = i;
             }
     }

@@ -87,8 +87,8 @@ static inline int rbs_walk_member(const rbs_walk *w, int count, int k)
  * each list ascending, malloc'ed here. */
 int rbs_vertex_graph(const int32_t *triangles, int64_t nt, int n, int64_t **start, int32_t **graph);
 
-/* starts (MAP_SIZE) of the unit vertices (n × 3) and their graph (start local to them) */
-void rbs_start_map(const double *unit, const int64_t *start, const int32_t *graph, int32_t *starts);
+/* starts (MAP_SIZE) of the n unit vertices (n × 3) and their graph (start local to them) */
+void rbs_start_map(const double *unit, int n, const int64_t *start, const int32_t *graph, int32_t *starts);
 
 /* the farthest candidates of the n unit vertices, ascending, into far (room for n); returns their number or −1 */
 int rbs_farthest_candidates(const double *unit, int n, int32_t *far);

@@ -449,7 +449,7 @@ static int walks_build(rbs_table *t)
         graph = grown;
         memcpy(graph + edges, local, (size_t)start[count] * sizeof *graph);
         for (int64_t k = 0; k <= count; k++) graph_start[lo + k] = edges + start[k];
-        rbs_start_map(d->vertices + 3 * lo, start, local, starts + (int64_t)MAP_SIZE * j);
+        rbs_start_map(d->vertices + 3 * lo, (int)count, start, local, starts + (int64_t)MAP_SIZE * j);
         edges += start[count];
         free(start);
         free(local);
