@@ -1,5 +1,5 @@
-"""benchmarks/bench_sampler.py, bench_direct.py and bench_grains.py run end to end and report every figure the
-issues ask for.
+"""benchmarks/bench_sampler.py and bench_direct.py run end to end and report every figure the issues ask for
+(bench_grains.py, which times C too: tests/native/test_native_bench.py).
 
 A smoke test, so the benchmark cannot silently break when the kernels' data or signatures change; the
 figures themselves are machine-dependent and are not asserted (speed is reported, never tested). And the
@@ -82,19 +82,3 @@ def test_a_hits_sample_without_omega_in_is_refused(tmp_path):
     sample = bench_direct.read_hits_sample(path)
     assert sample["omega"].tolist() == [[0.0, 0.0, 1e4]] and sample["n"].tolist() == [[0.0, 1.0, 0.0]]
 
-
-bench_grains = pytest.importorskip("bench_grains")
-
-
-def test_bench_grains_reports_the_cost_against_hull_size(tmp_path, capsys):
-    out = tmp_path / "grains.json"
-    assert bench_grains.main(["--states", "40", "--repeats", "1", "--json", str(out)]) == 0
-    rows = json.loads(out.read_text())["rows"]
-    one_set = [("prism", 8)] + [(f"grain_{n}", n) for n in bench_grains.SIZES]
-    assert [(r["shape"], r["vertices"]) for r in rows] == one_set * 2
-    for row in rows:
-        assert row["us_per_rebound"] > 0 and row["collisions_per_rebound"] >= 1
-        assert row["over_prism"] == pytest.approx(row["us_per_rebound"] / next(
-            r["us_per_rebound"] for r in rows if r["shape"] == "prism" and r["states"] == row["states"]))
-    printed = capsys.readouterr().out
-    assert all(f"Target: a {size}-vertex grain within {ratio:g}x" in printed for size, ratio in bench_grains.TARGETS.items())

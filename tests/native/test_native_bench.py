@@ -1,5 +1,5 @@
-"""benchmarks/bench_native.py and bench_direct.py --runtime run end to end (--quick) on the session's table
-and report every figure.
+"""benchmarks/bench_native.py and bench_direct.py --runtime run end to end (--quick) on the session's table,
+and bench_grains.py on a few states, and report every figure.
 
 Smoke tests: the figures are machine-dependent and are not asserted; the bits of the C calls against
 numba's on the bench states are.
@@ -7,6 +7,8 @@ numba's on the bench states are.
 
 import json
 import sys
+
+import pytest
 
 from tests.helpers import REPO
 
@@ -46,3 +48,23 @@ def test_bench_direct_runtime_quick(native_build, small_table_path, tmp_path, ca
     printed = capsys.readouterr().out
     assert "C outputs equal numba's bits on every row: yes" in printed and "Where C's time goes" in printed
     assert "at the 'spinning' states:" in printed and "averaged over hopperRebound's hits, per shape: ellipsoid" in printed
+
+
+def test_bench_grains_reports_the_cost_against_hull_size(native_build, tmp_path, capsys):
+    """bench_grains.py times numba and C on every hull size, C's outputs numba's bits, and reports the targets."""
+    import bench_grains
+    out = tmp_path / "grains.json"
+    assert bench_grains.main(["--states", "40", "--repeats", "1", "--build-dir", str(native_build), "--json",
+                              str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    one_set = [("prism", 8)] + [(f"grain_{n}", n) for n in bench_grains.SIZES]
+    assert [(r["shape"], r["vertices"]) for r in rows] == one_set * 2
+    for row in rows:
+        assert row["us_per_rebound"] > 0 and row["c_us_per_rebound"] > 0 and row["collisions_per_rebound"] >= 1
+        assert row["c_equals_numba"] is True
+        assert row["over_prism"] == pytest.approx(row["us_per_rebound"] / next(
+            r["us_per_rebound"] for r in rows if r["shape"] == "prism" and r["states"] == row["states"]))
+    printed = capsys.readouterr().out
+    for size, ratio in bench_grains.TARGETS.items():
+        for runtime in ("numba", "C"):
+            assert f"Target: a {size}-vertex grain within {ratio:g}x the prism's cost per rebound, {runtime}:" in printed
