@@ -158,6 +158,11 @@ def check_shape_datasets(arrays: dict, names, refuse) -> None:
         own = arrays["triangles"][arrays["triangle_start"][i]:arrays["triangle_start"][i + 1]]
         if np.any((own < 0) | (own >= n_vertices[i])):
             refuse(f"dataset 'shapes/triangles' of shape {names[i]!r} holds a vertex index outside 0..{n_vertices[i] - 1}")
+        if polyhedral and np.bincount(own.ravel(), minlength=n_vertices[i]).min() == 0:
+            # a vertex on no triangle is off the surface the contact search walks over
+            first = int(np.argmin(np.bincount(own.ravel(), minlength=n_vertices[i])))
+            refuse(f"dataset 'shapes/triangles' of shape {names[i]!r} leaves vertex {first} on no triangle; every "
+                   f"vertex of a hull is on its surface")
     vertices = arrays["vertices"]
     bad = np.flatnonzero(~(np.abs(vertices) <= VERTEX_BOUND).ravel())
     if bad.size:

@@ -233,6 +233,19 @@ static int check_records(loader *ld, rbs_table *t, const char *names, const int3
             if (triangles[k] < 0 || triangles[k] >= nv)
                 return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/triangles' of shape '%s' holds a vertex index "
                                 "outside 0..%lld", t->shape_names[i], (long long)(nv - 1));
+        if (polyhedral) { /* a vertex on no triangle is off the surface the contact search walks over */
+            unsigned char *on = calloc((size_t)nv, 1);
+            if (!on) return rbs_fail(ld, RBS_ERR_MEMORY, "out of memory checking the triangles of shape '%s'",
+                                     t->shape_names[i]);
+            for (int64_t k = 3 * triangle_start[i]; k < 3 * triangle_start[i + 1]; k++) on[triangles[k]] = 1;
+            int64_t first = 0;
+            while (first < nv && on[first]) first++;
+            free(on);
+            if (first < nv)
+                return rbs_fail(ld, RBS_ERR_FORMAT, "dataset 'shapes/triangles' of shape '%s' leaves vertex %lld on no "
+                                "triangle; every vertex of a hull is on its surface", t->shape_names[i],
+                                (long long)first);
+        }
     }
     for (int64_t k = 0; k < 3 * n_vertex; k++)
         if (!(fabs(r->vertices[k]) <= VERTEX_BOUND))

@@ -138,6 +138,17 @@ def test_a_flipped_bit_in_any_shapes_dataset_fails_to_load_in_both(native, small
         _refused_alike(native, path, f"shapes/{name}")
 
 
+def _off_surface(vertex, instead):
+    """An edit giving the prism's (rows 0-11 of shapes/triangles) every corner ``vertex`` as ``instead``: the same
+    number of triangles, every index in range, ``vertex`` on no triangle."""
+    def edit(f):
+        values = f["shapes/triangles"][()]
+        prism = values[:12]
+        prism[prism == vertex] = instead
+        f["shapes/triangles"][...] = values
+    return edit
+
+
 # dataset: edits (HDF5 rewrites the chunk with a fresh Fletcher-32) that break what /shapes may hold, one per rule (the small table: rows
 # ellipsoid, prism (vertices 0-7), cut_prism (8-31), tetrahedron (32-35))
 BAD_VALUES = {
@@ -147,7 +158,7 @@ BAD_VALUES = {
     "vertices": [_set("shapes/vertices", (3, 1), np.nan), _set("shapes/vertices", (3, 1), 1.6),
                  _set("shapes/vertices", (3, 1), 0.5)],
     "triangle_start": [_set("shapes/triangle_start", 2, 11)],
-    "triangles": [_set("shapes/triangles", (0, 0), 8), _set("shapes/triangles", (0, 0), -1)],
+    "triangles": [_set("shapes/triangles", (0, 0), 8), _set("shapes/triangles", (0, 0), -1), _off_surface(7, 6)],
     "inertia": [_set("shapes/inertia", (1, 0), -0.5), _set("shapes/inertia", (1, 0), np.inf),
                 _set("shapes/inertia", (1, 0), 1.5)],
     "aspect": [_set("shapes/aspect", (1, 2), 1.0), _set("shapes/aspect", (1, 1), 0.0),
