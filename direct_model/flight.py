@@ -415,8 +415,8 @@ def find_contact(kind, verts, nv, semi, Rb, K, ell, M, M3, params, y0, v, contac
             g0, g1, g2, d0, d1, d2, a0, a1, a2 = turning(R, W, K)
             g, d = (g0, g1, g2), (d0, d1, d2)
             curv[0], curv[1], curv[2] = a0, a1, a2
-            hmin, low = walk_lowest(unit, scale, graph_start, graph, g, y, nearer(unit, scale, hull[4], g, y, walk_work),
-                                    walk_work)
+            start = nearer(unit, scale, hull[4], g, y, walk_work)
+            hmin, low = walk_lowest(unit, scale, graph_start, graph, g, y, start, walk_work)
             walk_work[START] = low
         else:
             n = lowest_points(kind, verts, nv, semi, K, R, W, y, v, h, h1, curv)

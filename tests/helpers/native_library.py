@@ -239,8 +239,8 @@ class ShapeArrays(ctypes.Structure):
     """rbs_shape_arrays (native/src/shapes.h, internal): pointers into a direct_model.shape_arrays.ShapeArrays'
     arrays."""
 
-    FIELDS = ("kind", "vertex_start", "vertices", "second_moments", "aspect", "aspect_cdf", "both_hands", "half_extents",
-              "graph_start", "graph", "starts", "far_start", "far")
+    FIELDS = ("kind", "vertex_start", "vertices", "second_moments", "aspect", "aspect_cdf", "both_hands",
+              "half_extents", "graph_start", "graph", "starts", "far_start", "far")
     _fields_ = [("n_shapes", ctypes.c_int)] + [(name, ctypes.c_void_p) for name in FIELDS]
 
     @classmethod

@@ -67,4 +67,5 @@ def test_bench_grains_reports_the_cost_against_hull_size(native_build, tmp_path,
     printed = capsys.readouterr().out
     for size, ratio in bench_grains.TARGETS.items():
         for runtime in ("numba", "C"):
-            assert f"Target: a {size}-vertex grain within {ratio:g}x the prism's cost per rebound, {runtime}:" in printed
+            assert f"Target: a {size}-vertex grain within {ratio:g}x the prism's cost per rebound, {runtime}:" in \
+                printed
