@@ -1,8 +1,10 @@
 """Cost per rebound of the direct model against the hull size of a convex grain (docs/model.md §9).
 
 Random convex grains of 8, 24, 64, 256, 1000 and 10 000 hull vertices (random points on a sphere, every one a
-vertex; a hull of more than 64 walked over its vertex graph, direct_model.hull_walk; in their
-canonical frame, stretched per particle by the families' b/a, c/b law, both hands) and the prism for reference,
+vertex; a hull of more than 64 walked over its vertex graph, direct_model.hull_walk), two scanned-like grains (the
+hulls of 2500 and 26 000 points of examples/grains/simplification.py's bumpy, noisy ellipsoid: about 1200 and
+2500 vertices), all in their canonical frame, stretched per particle by the families' b/a, c/b law, both hands,
+and the prism for reference,
 through the run-time kernel (``direct_model.runtime.rebound_model_frame``: the whole rebound from its 7
 uniforms, what a direct hit costs, the caller's frame aside) on one thread, in numba and in C (the same kernel,
 ``rbs_rebound_model_frame``, in a C loop: native/bench/rbs_bench_grains.c, built by CMake into a temporary folder
@@ -41,15 +43,20 @@ from direct_model.simulate import DEFAULT_CONTACT_TOL, DEFAULT_MAX_STEPS, DEFAUL
 from direct_model.wall import CORUNDUM_ON_STEEL
 from bench_native import build_native  # benchmarks/, next to this script
 from machine import machine_info
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples" / "grains"))
+from simplification import scanned_points  # noqa: E402  (the scanned-like grain of the simplification figure)
 from tablegen.tabulation.grain_files import convex_hull
 
 SIZES = (8, 24, 64, 256, 1000, 10000)
+SCANNED = (2500, 26000)     # points of a scanned-like grain (examples/grains/simplification.py)
 SEED = 20261125
 TARGETS = {64: 2.0, 1000: 1.5, 10000: 2.5}     # hull vertices: the most a rebound may cost, in prism rebounds
 
 
 def shapes():
-    """(names, vertex counts, shape arrays): the prism (the family, its factor s) and one random grain per size."""
+    """(names, vertex counts, shape arrays): the prism (the family, its factor s), one random grain per size, then
+    the scanned-like grains (named by their vertex counts)."""
     law = AspectRatioLaw()
     records = [built_in_shape("prism", aspect=law)]
     for n in SIZES:
@@ -57,6 +64,9 @@ def shapes():
         vertices, triangles, _ = convex_hull(points / np.linalg.norm(points, axis=1)[:, None], f"grain_{n}")
         assert len(vertices) == n
         records.append(grain(f"grain_{n}", vertices, triangles, aspect=law, both_hands=True))
+    for n in SCANNED:
+        vertices, triangles, _ = convex_hull(scanned_points(points=n), "scanned")
+        records.append(grain(f"scanned_{len(vertices)}", vertices, triangles, aspect=law, both_hands=True))
     factor = {"prism": second_moment_factors(DEFAULT_KAPPA)[SHAPES.index("prism")]}
     return [r.name for r in records], [len(r.vertices) for r in records], shape_arrays(records, factor)
 

@@ -45,15 +45,15 @@ BASELINE = "baseline"       # the full grain against itself, another seed
 ALPHA = 0.05                # level of the printed noise bounds (one law's statistics exceed them this often)
 
 
-def scanned_points(seed: int = GRAIN_SEED) -> np.ndarray:
-    """(POINTS, 3) points on a bumpy, noisy ellipsoid surface, as a scanner gives a grain's surface."""
+def scanned_points(seed: int = GRAIN_SEED, points: int = POINTS) -> np.ndarray:
+    """(points, 3) points on a bumpy, noisy ellipsoid surface, as a scanner gives a grain's surface."""
     rng = np.random.default_rng(seed)
-    u = rng.normal(size=(POINTS, 3))
+    u = rng.normal(size=(points, 3))
     u /= np.linalg.norm(u, axis=1, keepdims=True)
     k = rng.normal(size=(WAVES, 3)) * WAVE_NUMBER
     phase = rng.uniform(0.0, 2.0 * np.pi, WAVES)
     bumps = np.sin(u @ k.T + phase).sum(axis=1) / np.sqrt(WAVES)        # unit variance
-    radius = 1.0 + BUMPS * bumps + SCAN_NOISE * rng.normal(size=POINTS)
+    radius = 1.0 + BUMPS * bumps + SCAN_NOISE * rng.normal(size=points)
     return u * SEMI_AXES * radius[:, None]
 
 

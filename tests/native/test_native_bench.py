@@ -58,7 +58,9 @@ def test_bench_grains_reports_the_cost_against_hull_size(native_build, tmp_path,
                               str(out)]) == 0
     rows = json.loads(out.read_text())["rows"]
     one_set = [("prism", 8)] + [(f"grain_{n}", n) for n in bench_grains.SIZES]
-    assert [(r["shape"], r["vertices"]) for r in rows] == one_set * 2
+    scanned = [(r["shape"], r["vertices"]) for r in rows[len(one_set):len(one_set) + len(bench_grains.SCANNED)]]
+    assert all(name == f"scanned_{n}" and n > 1000 for name, n in scanned)
+    assert [(r["shape"], r["vertices"]) for r in rows] == (one_set + scanned) * 2
     for row in rows:
         assert row["us_per_rebound"] > 0 and row["c_us_per_rebound"] > 0 and row["collisions_per_rebound"] >= 1
         assert row["c_equals_numba"] is True
