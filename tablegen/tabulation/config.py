@@ -28,6 +28,8 @@ the ``default`` preset, and the published corundum-on-steel wall law)::
     roughness_deg = 0.0               # the wall's roughness Δγ, degrees, in [0, 45]: 0 smooth (docs/model.md §12)
     # or law = "tabulated": q, contact_speed_m_s = [...], contact_sine = [0.0, ..., 1.0], and
     # restitution = [[a_nc per sine node], one row per speed node] (docs/model.md §4)
+    # or preset = "NAME": a wall preset (tablegen/tabulation/walls; docs/model.md §4.8) for every key above but
+    # roughness_deg
 
     [shapes.sand_a]                   # a user's grain, named in grid.shapes (tablegen.tabulation.shape_config)
     mesh = "grains/sand_a.stl"        # relative to the configuration file; or vertices = [[x, y, z], ...]
@@ -203,8 +205,10 @@ CONFIG_KEYS = {
     "grid": {"alpha1_deg", "speed_m_s", "shapes"},
     "simulation": {"particles_per_cell", "seed", "kappa", "n_max", "aspect_ratio"},
     "table": {"resolution"},
-    "wall": {"law", *WALL_VALUE_KEYS, "name", "speed_range_m_s", "roughness_deg"},
+    "wall": {"preset", "law", *WALL_VALUE_KEYS, "name", "speed_range_m_s", "roughness_deg"},
 }
+WALL_PRESETS = "tablegen.tabulation.walls"      # the package of the wall presets' files
+PRESET_ADDS = ("roughness_deg",)    # what a [wall] section may add to a preset: its surface, not the pair's law
 GRAINS_SECTION = "shapes"      # [shapes.NAME]: the user's grains; their keys are shape_config's
 
 
@@ -213,6 +217,19 @@ def preset_text(name: str) -> str:
     if name not in PRESETS:
         raise ConfigError(f"unknown preset {name!r}; presets: {', '.join(PRESETS)}")
     return resources.files("tablegen.tabulation.presets").joinpath(f"{name}.toml").read_text()
+
+
+def wall_presets() -> tuple:
+    """The names of the wall presets (``tablegen/tabulation/walls/NAME.toml``), sorted."""
+    files = resources.files(WALL_PRESETS).iterdir()
+    return tuple(sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml")))
+
+
+def wall_preset_text(name: str) -> str:
+    """The TOML text of the wall preset ``name``: its source in comment lines, then its ``[wall]`` section."""
+    if name not in wall_presets():
+        raise ConfigError(f"unknown wall preset {name!r}; wall presets: {', '.join(wall_presets())}")
+    return resources.files(WALL_PRESETS).joinpath(f"{name}.toml").read_text()
 
 
 def load_config(path=None, preset: str = "default", log=None) -> BuildConfig:
@@ -331,7 +348,11 @@ def _wall(raw: dict, source: str) -> Wall:
     default exponential) and that family's parameters and arrays by name, each checked against its range;
     missing scalar parameters take the corundum-on-steel law's values (its q for the tabulated family), a
     tabulated law's arrays must be given. Its speed range ``speed_range_m_s`` = [low, high] m/s: the default
-    law's when no law value is given, else not stated unless given."""
+    law's when no law value is given, else not stated unless given. ``preset`` names a wall preset
+    (:func:`wall_presets`), whose section stands for the law, its name and its speed range; ``roughness_deg`` may
+    be added to it."""
+    if "preset" in raw:
+        raw = _preset_section(raw, source)
     law = raw.get("law", EXPONENTIAL)
     if law not in WALL_FAMILIES:
         raise ConfigError(f"{source}: 'wall.law' must be one of {', '.join(WALL_FAMILIES)}; got {law!r}")
@@ -383,6 +404,20 @@ def _wall(raw: dict, source: str) -> Wall:
         return wall_record(family.name, values, name, speed_range, roughness)
     except ValueError as exc:       # a tabulated law's nodes or values: the message names the parameter
         raise ConfigError(f"{source}: [wall]: {exc}") from None
+
+
+def _preset_section(raw: dict, source: str) -> dict:
+    """The ``[wall]`` section of the preset ``raw["preset"]``, with the keys of :data:`PRESET_ADDS` that ``raw``
+    gives; ConfigError for an unknown preset or a key the preset sets."""
+    preset, presets = raw["preset"], wall_presets()
+    if not isinstance(preset, str) or preset not in presets:
+        raise ConfigError(f"{source}: 'wall.preset' must be one of {', '.join(presets)}; got {preset!r}")
+    extra = sorted(k for k in raw if k not in ("preset", *PRESET_ADDS))
+    if extra:
+        raise ConfigError(f"{source}: 'wall.{extra[0]}' cannot be given with 'wall.preset' (the preset {preset!r} "
+                          f"sets the law, its name and speed range; only {', '.join(PRESET_ADDS)} may be added)")
+    section = tomllib.loads(wall_preset_text(preset))["wall"]
+    return {**section, **{key: raw[key] for key in PRESET_ADDS if key in raw}}
 
 
 def _check_keys(data: dict, source: str) -> None:

@@ -5,7 +5,7 @@ import pytest
 from tests.helpers.cli import user_error
 
 from tablegen.cli import main as tablegen_main
-from tablegen.tabulation.config import PRESETS, ConfigError, load_config, parse_config
+from tablegen.tabulation.config import PRESETS, ConfigError, load_config, parse_config, wall_preset_text, wall_presets
 from direct_model.wall import CORUNDUM_ON_STEEL, WallMaterial
 
 
@@ -34,6 +34,21 @@ def test_wall_law_defaults_to_corundum_on_steel_and_round_trips():
     assert config.sha256() != load_config().sha256()      # the wall law is part of the configuration's hash
     assert parse_config("[wall]\nk = 0.2\n").wall == WallMaterial(k=0.2, p=CORUNDUM_ON_STEEL.p,
                                                                    q=CORUNDUM_ON_STEEL.q, name=CORUNDUM_ON_STEEL.name)
+
+
+def test_a_wall_preset_stands_for_its_section_and_takes_a_roughness():
+    """``preset`` gives the preset file's [wall] section: the default wall's preset builds the default table (equal
+    configuration text, so an equal hash); roughness_deg may be added; each preset file is a configuration alone,
+    names itself and states where its law holds."""
+    assert "corundum_on_St3_Lashkov1991" in wall_presets()
+    default = parse_config('[wall]\npreset = "corundum_on_St3_Lashkov1991"\n')
+    assert default == load_config() and default.sha256() == load_config().sha256()
+    rough = parse_config('[wall]\npreset = "corundum_on_St3_Lashkov1991"\nroughness_deg = 5\n').wall
+    assert rough == WallMaterial(roughness_deg=5.0, speed_range_m_s=(50.0, 300.0))
+    for name in wall_presets():
+        alone = parse_config(wall_preset_text(name), name)
+        assert alone.wall.name == name and alone.wall.speed_range_stated
+        assert parse_config(f'[wall]\npreset = "{name}"\n').wall == alone.wall
 
 
 def test_the_wall_law_s_speed_range_and_the_grid_beyond_it():
@@ -99,6 +114,11 @@ BAD = [
     ("[wall]\nroughness_deg = 46", "wall.roughness_deg"),
     ("[wall]\nroughness_deg = nan", "wall.roughness_deg"),
     ("[wall]\nroughness_deg = true", "wall.roughness_deg"),
+    ("[wall]\npreset = \"sand_on_Al\"", "wall.preset"),
+    ("[wall]\npreset = 1", "wall.preset"),
+    ("[wall]\npreset = \"corundum_on_St3_Lashkov1991\"\nq = 0.5", "wall.q"),
+    ("[wall]\npreset = \"corundum_on_St3_Lashkov1991\"\nname = \"mine\"", "wall.name"),
+    ("[wall]\npreset = \"corundum_on_St3_Lashkov1991\"\nroughness_deg = 50", "wall.roughness_deg"),
 ]
 
 
