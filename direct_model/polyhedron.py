@@ -31,6 +31,7 @@ canonical vertices of two copies of it agree to that, not to 1e-16 (to 1e-12 for
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from typing import NamedTuple
@@ -86,19 +87,26 @@ def monomial_integrals(vertices, triangles, exponents):
                       p1[:, 2] * p2[:, 0] - p1[:, 0] * p2[:, 2],
                       p1[:, 0] * p2[:, 1] - p1[:, 1] * p2[:, 0]], axis=1)
     six_volume = _dot3(p0, cross.T)
+    column = [[np.ascontiguousarray(tri[:, corner, axis]) for axis in range(3)] for corner in range(3)]
     out = []
     for p, q, r in exponents:
         axes = (0,) * p + (1,) * q + (2,) * r
         k = len(axes)
         total = np.zeros(len(tri))
-        for corners in itertools.product(range(3), repeat=k):
-            weight = math.prod(math.factorial(corners.count(i)) for i in range(3)) / math.factorial(k + 3)
+        for corners, weight in _corner_weights(k):
             term = np.full(len(tri), weight)
             for corner, axis in zip(corners, axes):
-                term = term * tri[:, corner, axis]
-            total = total + term
+                term *= column[corner][axis]
+            total += term
         out.append(math.fsum(six_volume * total))
     return out
+
+
+@functools.cache
+def _corner_weights(k: int) -> tuple:
+    """Each map of k coordinates to the three corners with its weight (Π counts!)/(k + 3)! (monomial_integrals)."""
+    return tuple((corners, math.prod(math.factorial(corners.count(i)) for i in range(3)) / math.factorial(k + 3))
+                 for corners in itertools.product(range(3), repeat=k))
 
 
 SECOND = ((2, 0, 0), (0, 2, 0), (0, 0, 2), (1, 1, 0), (1, 0, 1), (0, 1, 1))

@@ -204,7 +204,7 @@ def settled(record):
     rank[order] = np.arange(len(order), dtype=np.int32)
     triangles = rank[record.triangles]
     first = np.argmin(triangles, axis=1)
-    triangles = np.stack([np.roll(t, -k) for t, k in zip(triangles, first)])
+    triangles = np.take_along_axis(triangles, (first[:, None] + np.arange(3)) % 3, axis=1)
     triangles = triangles[np.lexsort(triangles.T[::-1])]
     return polyhedron(record.name, vertices[order], triangles, record.aspect, record.both_hands)
 
