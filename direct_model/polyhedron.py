@@ -177,9 +177,13 @@ def _narrowest(points, directions):
 
 
 def _edges(triangles):
+    """The hull's edges (e, 2), each (smaller, larger vertex index), in ascending order of both."""
     t = np.asarray(triangles)
-    pairs = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-    return np.unique(np.sort(pairs, axis=1), axis=0)
+    pairs = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]).astype(np.int64)
+    low, high = pairs.min(axis=1), pairs.max(axis=1)
+    width = int(high.max()) + 1 if len(high) else 1
+    keys = np.unique(low * width + high)              # one integer per edge: a sort of numbers, not of rows
+    return np.stack([keys // width, keys % width], axis=1).astype(t.dtype)
 
 
 def _plane_axes(points, triangles, normal):
