@@ -12,8 +12,6 @@
 #include "gather.h"
 #include "locate.h"
 
-/* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
- * returns the status (NaN state when trapped; RBS_INVALID for a draw rbs_drawn_ok refuses). */
 /* The chain's folded state of a draw in `cell`, moved in place to the incident α1 when `scaled` and wa > 0
  * (surrogate.kernels.arithmetic.at_alpha1) */
 RBS_INLINE void rbs_at_alpha1(const rbs_table *t, const rbs_cell *cell, int scaled, double state[6])
@@ -27,20 +25,26 @@ RBS_INLINE void rbs_at_alpha1(const rbs_table *t, const rbs_cell *cell, int scal
     }
 }
 
-RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
-                                   const double *u, int scaled, double x[6])
+/* Offset in t->clusters of the component u[4] picks in the drawn cell, and its chain variables in `chain`
+ * (surrogate.kernels.gather.gather: the draw's table reads) */
+RBS_INLINE int64_t rbs_drawn_chain(const rbs_table *t, const rbs_cell *cell, const double *u, double chain[6])
 {
-    if (u[3] < t->cells[cell->drawn * CELL_SIZE + CELL_P_TRAPPED]) {
-        for (int k = 0; k < 6; k++) x[k] = NAN;
-        return RBS_TRAPPED;
-    }
     const float *r = t->clusters;
     int64_t row = rbs_component(t, cell->drawn, u[4]);
-    double q[6], b[15], state[6];
+    double q[6], b[15];
     rbs_quantiles(t, cell->drawn, row, u, q);
     for (int k = 0; k < 15; k++) b[k] = (double)r[row + ROW_SLOPE + k];
-    rbs_chain(q, b, state);
-    double regime = (double)r[row + ROW_REGIME];
+    rbs_chain(q, b, chain);
+    return row;
+}
+
+/* The rebound of the component at `row` with its chain variables `chain` (rbs_drawn_chain; unchanged), in x
+ * (surrogate.kernels.arithmetic.arithmetic); the status, RBS_INVALID for a draw rbs_drawn_ok refuses */
+RBS_INLINE int rbs_draw_chain(const rbs_table *t, const rbs_cell *cell, int64_t row, const double chain[6],
+                              double cos_alpha1, double sin_alpha1, const double *u, int scaled, double x[6])
+{
+    double state[6] = {chain[0], chain[1], chain[2], chain[3], chain[4], chain[5]};
+    double regime = (double)t->clusters[row + ROW_REGIME];
     rbs_at_alpha1(t, cell, scaled, state);
     rbs_velocity(state[0], state[1], state[2], x);
     x[3] = state[3];
@@ -53,6 +57,26 @@ RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double
     }
     rbs_mirrored(u[11], x);
     return rbs_drawn_ok(x) ? RBS_OK : RBS_INVALID;
+}
+
+/* Whether the draw of uniforms u in the drawn cell is a trapped particle (surrogate.kernels.gather.is_trapped) */
+RBS_INLINE int rbs_drawn_trapped(const rbs_table *t, const rbs_cell *cell, const double *u)
+{
+    return u[3] < t->cells[cell->drawn * CELL_SIZE + CELL_P_TRAPPED];
+}
+
+/* The whole draw in a located cell (surrogate.kernels.draw.draw_in_cell): x = (vx, vy, vz, wx, wy, wz) local;
+ * returns the status (NaN state when trapped; RBS_INVALID for a draw rbs_drawn_ok refuses). */
+RBS_INLINE int rbs_draw_in_cell(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
+                                   const double *u, int scaled, double x[6])
+{
+    if (rbs_drawn_trapped(t, cell, u)) {
+        for (int k = 0; k < 6; k++) x[k] = NAN;
+        return RBS_TRAPPED;
+    }
+    double chain[6];
+    int64_t row = rbs_drawn_chain(t, cell, u, chain);
+    return rbs_draw_chain(t, cell, row, chain, cos_alpha1, sin_alpha1, u, scaled, x);
 }
 
 #endif /* RBS_DRAW_H */

@@ -48,8 +48,7 @@ RBS_INLINE int hit_in_shape(const rbs_table *t, int64_t shape, const double V[3]
     double first;
     int64_t c;
     rbs_hint_work(t, cell.drawn, rbs_first_row(t, cell.drawn, u[4], &first, &c), u);
-    int status = rbs_draw_in_cell(t, &cell, f.cos_alpha1, f.sin_alpha1, u, scaled, x);
-    rbs_table_work(t, &cell, status, x, f.sin_alpha1, f.speed, u, scaled, wall_work);
+    int status = rbs_draw_with_work(t, &cell, f.cos_alpha1, f.sin_alpha1, f.speed, u, scaled, x, wall_work);
     int ok = rbs_particle_ok(ni[0], ni[1], ni[2], a) & rbs_uniforms_ok(u, 1);
     status = rbs_to_global(status, ok, x, f.speed, a, f.ex, ni, f.ez, V_out, Omega_out);
     *shape_out = status == RBS_INVALID ? -1 : (int)cell.shape;

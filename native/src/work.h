@@ -1,14 +1,15 @@
 /*
  * work.h: the work of a table draw on the wall (surrogate.kernels.work: work_key, _work_quantile, _root_share,
- * work_variables, trapped_work, table_work and drawn_work; docs/model.md §4.7): W_n and W_t, m²/s² per unit particle
- * mass, drawn jointly with the rebound of the table path (table_path.c).
+ * work_variables, trapped_work, drawn_work and draw_with_work; docs/model.md §4.7): W_n and W_t, m²/s² per unit
+ * particle mass, drawn jointly with the rebound of the table path (table_path.c).
  *
  * A table of format 4.1 continues each component's chain with two work variables, the rotational energy fraction
  * r = E_Ω⁺/E⁻ and the root of the normal share ν = √(W_n/(W_n + W_t)): each its residual quantile plus slopes on
  * the draw's chain variables (and r). The work is what the drawn rebound's energy leaves, W = E⁻ (1 − s² − r), with
  * W_n = ν² W at the drawn grid speed; between grid points r and ν move with the draw, and between grid speeds W is
- * split in the proportion of W_n times (1 − a(V)²)/(1 − a(V_j)²) to W_t times W(V)/W(V_j). Their two residual uniforms are keyed uniforms of the hit's work key, so the work
- * takes nothing of the caller's stream. Same operations, same order, fma() where numba fuses.
+ * split in the proportion of W_n times (1 − a(V)²)/(1 − a(V_j)²) to W_t times W(V)/W(V_j). Their two residual
+ * uniforms are keyed uniforms of the hit's work key, so the work takes nothing of the caller's stream. Same
+ * operations, same order, fma() where numba fuses.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -101,11 +102,13 @@ RBS_INLINE void rbs_trapped_work(const rbs_table *t, int64_t drawn, double speed
     work[1] = energy * t->work_cells[at + 1];
 }
 
-/* (W_n, W_t), m²/s², into work, of the draw in `cell` with uniforms u that returned `status` (rbs_draw_in_cell) and
- * the local V⁺ x[0..2] (units of |V⁻|), at sin α1 and |V⁻| = speed m/s; NaN for a table without the work or a draw
- * neither rebounded nor trapped. A rebound's component and chain are read again (they are in cache). */
-RBS_INLINE void rbs_table_work(const rbs_table *t, const rbs_cell *cell, int status, const double x[3],
-                               double sin_alpha1, double speed, const double *u, int scaled, double work[2])
+/* (W_n, W_t), m²/s², into work, of the draw in `cell` with uniforms u from the component at `row` with the chain
+ * variables `chain` (rbs_drawn_chain), that returned `status` and the local V⁺ x[0..2] (units of |V⁻|), at sin α1
+ * and |V⁻| = speed m/s (surrogate.kernels.work.drawn_work); NaN for a table without the work or a draw neither
+ * rebounded nor trapped. `row` and `chain` are read for a rebound only. */
+RBS_INLINE void rbs_drawn_work(const rbs_table *t, const rbs_cell *cell, int64_t row, const double chain[6], int status,
+                               const double x[3], double sin_alpha1, double speed, const double *u, int scaled,
+                               double work[2])
 {
     work[0] = work[1] = NAN;
     if (!t->has_work || (status != RBS_OK && status != RBS_TRAPPED))
@@ -115,13 +118,9 @@ RBS_INLINE void rbs_table_work(const rbs_table *t, const rbs_cell *cell, int sta
         return;
     }
     const float *c = t->clusters;
-    int64_t row = rbs_component(t, cell->drawn, u[4]);
-    double q[6], b[15], state[6], r, nu;
-    rbs_quantiles(t, cell->drawn, row, u, q);
-    for (int k = 0; k < 15; k++) b[k] = (double)c[row + ROW_SLOPE + k];
-    rbs_chain(q, b, state);
-    const double chain[N_CHAIN] = {state[0], state[1], state[2], state[5], state[3], state[4]};
-    rbs_work_variables(t, cell->drawn, row, chain, rbs_hit_key(u, RBS_U_PER_DRAW, RBS_WORK_DOMAIN), &r, &nu);
+    double state[6] = {chain[0], chain[1], chain[2], chain[3], chain[4], chain[5]}, r, nu;
+    const double ordered[N_CHAIN] = {state[0], state[1], state[2], state[5], state[3], state[4]};
+    rbs_work_variables(t, cell->drawn, row, ordered, rbs_hit_key(u, RBS_U_PER_DRAW, RBS_WORK_DOMAIN), &r, &nu);
     if (scaled && cell->wa > 0.0) {
         int64_t lo = cell->below * WORK_CELL_SIZE, hi = (cell->below + t->n_speed) * WORK_CELL_SIZE;
         int64_t here = cell->drawn * WORK_CELL_SIZE;
@@ -157,6 +156,26 @@ RBS_INLINE void rbs_table_work(const rbs_table *t, const rbs_cell *cell, int sta
     double energy = 0.5 * speed * speed;
     work[0] = energy * (total * normal / weights);
     work[1] = energy * (total * tangential / weights);
+}
+
+/* The draw in a located cell (rbs_draw_in_cell: the status, x) and its work on the wall (rbs_drawn_work, into
+ * work) from one read of its component and chain (surrogate.kernels.work.draw_with_work), at sin α1, cos α1 and
+ * |V⁻| = speed m/s */
+RBS_INLINE int rbs_draw_with_work(const rbs_table *t, const rbs_cell *cell, double cos_alpha1, double sin_alpha1,
+                                  double speed, const double *u, int scaled, double x[6], double work[2])
+{
+    if (rbs_drawn_trapped(t, cell, u)) {
+        for (int k = 0; k < 6; k++) x[k] = NAN;
+        work[0] = work[1] = NAN;
+        if (t->has_work)
+            rbs_trapped_work(t, cell->drawn, speed, work);
+        return RBS_TRAPPED;
+    }
+    double chain[6];
+    int64_t row = rbs_drawn_chain(t, cell, u, chain);
+    int status = rbs_draw_chain(t, cell, row, chain, cos_alpha1, sin_alpha1, u, scaled, x);
+    rbs_drawn_work(t, cell, row, chain, status, x, sin_alpha1, speed, u, scaled, work);
+    return status;
 }
 
 #endif /* RBS_WORK_H */

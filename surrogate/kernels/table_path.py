@@ -16,13 +16,13 @@ import numba
 import numpy as np
 
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED
-from surrogate.kernels.draw import draw_in_cell, draw_velocity
+from surrogate.kernels.draw import draw_velocity
 from surrogate.kernels.frame import (float3, impact_frame, moves_into_wall, particle_ok, rebound_ok, to_global,
                                      uniforms_ok)
 from surrogate.kernels.hit import PATH_TABLE, hit, invalid_hit
 from surrogate.kernels.locate import first_row, hint, locate_in_shape, mix_shape
 from surrogate.kernels.options import JIT, KERNEL
-from surrogate.kernels.work import hint_work, table_work
+from surrogate.kernels.work import draw_with_work, hint_work
 
 
 @numba.njit(**KERNEL)
@@ -76,8 +76,7 @@ def table_shape_rebound(data, shape, V, n, a, u, scaled):
     cell = locate_in_shape(data, shape, alpha1, speed, u)
     hint(data, cell, u)
     hint_work(data, cell[0], first_row(data, cell[0], u[4])[2], u)
-    status, vx, vy, vz, wx, wy, wz = draw_in_cell(data, cell, cos_a1, sin_a1, u, scaled)
-    work_n, work_t = table_work(data, cell, status, (vx, vy, vz), sin_a1, speed, u, scaled)
+    status, vx, vy, vz, wx, wy, wz, work_n, work_t = draw_with_work(data, cell, cos_a1, sin_a1, speed, u, scaled)
     ok = particle_ok(n, a) & uniforms_ok(u)
     status, V_new, Omega_new = to_global(status, ok, vx, vy, vz, wx, wy, wz, speed, a, ex, n, ez)
     return hit(status, PATH_TABLE, cell[0] // (data.n_alpha1 * data.n_speed), -1, V_new, Omega_new, 1, work_n,

@@ -26,13 +26,13 @@ import numpy as np
 from data_schema.samples import STATUS_INVALID, STATUS_REBOUNDED, STATUS_TRAPPED
 from data_schema.table import N_CHAIN, N_WORK
 from direct_model.elementary import fma
-from surrogate.kernels.arithmetic import (OUT_S2, OUT_STATUS, _chain, at_alpha1, restitutions, speed_factors,
-                                         speed_ratio_squared)
+from surrogate.kernels.arithmetic import (NAN6, OUT_S2, OUT_STATUS, _chain, arithmetic, at_alpha1, restitutions,
+                                         speed_factors, speed_ratio_squared)
 from surrogate.kernels.block import field, uniforms
 from surrogate.kernels.draw import U_PER_DRAW
 from surrogate.kernels.fastmath import clamp_index
 from surrogate.kernels.frame import FRAME_SIN, FRAME_SPEED, is_valid
-from surrogate.kernels.gather import gather, gathered_at, moved_term
+from surrogate.kernels.gather import gather, gathered_at, is_trapped, moved_term
 from surrogate.kernels.layout import (WORK_CELL_INV_SD, WORK_CELL_MEAN, WORK_CELL_SD, WORK_CELL_SIZE,
                                       WORK_CELL_TRAPPED, WORK_ROW_LOC, WORK_ROW_SCALE, WORK_ROW_SHAPE, WORK_ROW_SIZE,
                                       WORK_ROW_SLOPE, ROW_SIZE)
@@ -168,17 +168,21 @@ def trapped_work(data, drawn, speed):
     return energy * load(data.work_cells, at), energy * load(data.work_cells, at + 1)
 
 
-@numba.njit(inline="always", **JIT)
-def table_work(data, cell, status, v, sin_alpha1, speed, u, scaled):
-    """:func:`drawn_work` of one particle's draw with uniforms ``u`` that returned ``status`` and the local V⁺
-    ``v`` (units of |V⁻|, a 3-tuple): its component and gathered values read again (they are in cache)."""
-    if not data.has_work or (status != STATUS_REBOUNDED and status != STATUS_TRAPPED):
-        return np.nan, np.nan
-    if status == STATUS_TRAPPED:
-        return trapped_work(data, cell[0], speed)
-    row = component(data, cell[0], u[4])
-    return drawn_work(data, cell, row, gather(data, cell, row, u), status, speed_ratio_squared(v[0], v[1], v[2]),
-                      sin_alpha1, speed, work_key(u), scaled)
+@numba.njit(**KERNEL)
+def draw_with_work(data, cell, cos_alpha1, sin_alpha1, speed, u, scaled):
+    """:func:`surrogate.kernels.draw.draw_in_cell` of one particle with uniforms ``u`` at |V⁻| = ``speed`` m/s, and
+    its work on the wall (:func:`drawn_work`) from the same component and gathered values: (status, V⁺ (3, units
+    of |V⁻|), Ω⁺ (3, units of |V⁻|/a), W_n, W_t (m²/s²))."""
+    drawn = cell[0]
+    if is_trapped(data, drawn, u[3]):
+        work = trapped_work(data, drawn, speed) if data.has_work else (np.nan, np.nan)
+        return (STATUS_TRAPPED,) + NAN6 + work
+    row = component(data, drawn, u[4])
+    gathered = gather(data, cell, row, u)
+    status, vx, vy, vz, wx, wy, wz = arithmetic(gathered, cos_alpha1, sin_alpha1, scaled)
+    work_n, work_t = drawn_work(data, cell, row, gathered, status, speed_ratio_squared(vx, vy, vz), sin_alpha1,
+                                speed, work_key(u), scaled)
+    return status, vx, vy, vz, wx, wy, wz, work_n, work_t
 
 
 @numba.njit(**KERNEL)
@@ -195,7 +199,7 @@ def work_block(data, ub, m, fr, index, weights, g, out, work_n, work_t, start, s
     """The pipeline's stage after the arithmetic (:mod:`surrogate.kernels.pipeline`): the work on the wall
     (:func:`drawn_work`) of the m particles of a drawn block (uniforms ``ub``, frame records ``fr``, cell
     records ``index`` and ``weights``, gathered records ``g``, results ``out``), into rows start … start + m − 1
-    of ``work_n`` and ``work_t`` (m²/s²): the bits :func:`table_work` gives each particle."""
+    of ``work_n`` and ``work_t`` (m²/s²): the bits :func:`draw_with_work` gives each particle."""
     for b in range(m):
         status = int(field(out, OUT_STATUS, b)) if is_valid(fr, b) else STATUS_INVALID
         work = (np.nan, np.nan)

@@ -1,6 +1,6 @@
 """The work of a table draw on the wall in C (since 1.4; docs/model.md §4.7, docs/native.md "What a hit does to the
 wall"): rbs_rebound on the table path gives W_n and W_t (rbs_result.wall_work_normal, wall_work_tangential) drawn
-jointly with the rebound, the bits of numba's surrogate.kernels.work.table_work (native/src/work.h).
+jointly with the rebound, the bits of numba's surrogate.kernels.work.draw_with_work (native/src/work.h).
 
 - Hits on the session's small table (format 4.1), on its grid points, between them and beyond its edges, both
   interpolations, trapped draws among them (u[3] below the trapping cells' P(trapped)): every field of rbs_result is
