@@ -538,7 +538,7 @@ def main(argv=None) -> int:
            lambda: table_rebound_parallel_rng(data, cdf, V, nrm, a, streams, V_out, Omega_out, status))
     record("a_kernel_1", "    breakdown: table_rebound_parallel_rng, 1 thread", 1,
            lambda: table_rebound_parallel_rng(data, cdf, V, nrm, a, streams, V_out, Omega_out, status))
-    trapped_api = float(np.mean(api()[2] != 0))
+    trapped_api = float(np.mean(api().status != 0))
     record("b", "(b) table_rebound in @njit loop, xoshiro256+", 1,
            lambda: loop_kernel_rng(data, cdf, V, nrm, a, seed_state(SEED), V_out, Omega_out, status))
     record("b_rebound", "    variant: rebound (its path decided; no spin)", 1,
