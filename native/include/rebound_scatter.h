@@ -99,7 +99,7 @@ extern "C" {
 
 #define RBS_VERSION_MAJOR 1
 #define RBS_VERSION_MINOR 4
-#define RBS_VERSION_PATCH 0
+#define RBS_VERSION_PATCH 1
 /* MAJOR · 1 000 000 + MINOR · 1 000 + PATCH, as rbs_version_number() returns it for the library linked */
 #define RBS_VERSION_NUMBER (RBS_VERSION_MAJOR * 1000000 + RBS_VERSION_MINOR * 1000 + RBS_VERSION_PATCH)
 

@@ -6,10 +6,10 @@
  * A table of format 4.1 continues each component's chain with two work variables, the rotational energy fraction
  * r = E_Ω⁺/E⁻ and the root of the normal share ν = √(W_n/(W_n + W_t)): each its residual quantile plus slopes on
  * the draw's chain variables (and r). The work is what the drawn rebound's energy leaves, W = E⁻ (1 − s² − r), with
- * W_n = ν² W at the drawn grid speed; between grid points r and ν move with the draw, and between grid speeds W is
- * split in the proportion of W_n times (1 − a(V)²)/(1 − a(V_j)²) to W_t times W(V)/W(V_j). Their two residual
- * uniforms are keyed uniforms of the hit's work key, so the work takes nothing of the caller's stream. Same
- * operations, same order, fma() where numba fuses.
+ * W_n = ν² W at the drawn grid speed; between grid points r and ν move with the draw, and between grid speeds W_n
+ * and W_t move as one collision's, by (1 − a(V)²)/(1 − a(V_j)²) and (1 + a(V))/(1 + a(V_j)), then each by the
+ * least relative change that closes W. Their two residual uniforms are keyed uniforms of the hit's work key, so
+ * the work takes nothing of the caller's stream. Same operations, same order, fma() where numba fuses.
  *
  * Copyright (c) the rebound-scatter authors. BSD-3-Clause license.
  */
@@ -102,6 +102,17 @@ RBS_INLINE void rbs_trapped_work(const rbs_table *t, int64_t drawn, double speed
     work[1] = energy * t->work_cells[at + 1];
 }
 
+/* W_n of the pair (W_n, W_t) = (normal, tangential) (≥ 0, not both 0) changed to sum to `total` (≥ 0) by the least
+ * relative change of each: the difference split in proportion to their squares; kept in [0, total]
+ * (surrogate.kernels.work.closed_normal) */
+RBS_INLINE double rbs_closed_normal(double normal, double tangential, double total)
+{
+    double squares = normal * normal + tangential * tangential;
+    double work_n = normal + (total - normal - tangential) * (normal * normal / squares);
+    work_n = work_n > 0.0 ? work_n : 0.0;
+    return work_n < total ? work_n : total;
+}
+
 /* (W_n, W_t), m²/s², into work, of the draw in `cell` with uniforms u from the component at `row` with the chain
  * variables `chain` (rbs_drawn_chain), that returned `status` and the local V⁺ x[0..2] (units of |V⁻|), at sin α1
  * and |V⁻| = speed m/s (surrogate.kernels.work.drawn_work); NaN for a table without the work or a draw neither
@@ -132,20 +143,29 @@ RBS_INLINE void rbs_drawn_work(const rbs_table *t, const rbs_cell *cell, int64_t
         nu = rbs_root_share(rbs_shifted(nu, nu_term));
     }
     double s2 = rbs_speed_ratio_squared(x);
-    double normal = nu * nu, tangential = (1.0 - nu) * (1.0 + nu);     /* the weights of the split of W */
+    double normal = nu * nu, tangential = (1.0 - nu) * (1.0 + nu);     /* the shares of W at the grid speed */
+    double energy = 0.5 * speed * speed;
     if (scaled && cell->wv > 0.0) {
-        /* between grid speeds W_n moves as one collision's normal work, ½ m_eff v_c²(1 − a²); W_t with W */
+        /* between grid speeds each part moves as one collision's, W_n ∝ 1 − a² and W_t ∝ λ ∝ 1 + a (units of E⁻),
+         * then both change by the least relative amount that closes the moved rebound's energy */
         rbs_at_alpha1(t, cell, scaled, state);
         double s0 = state[2];                                           /* s at the drawn grid speed */
-        double grid_total = 1.0 - s0 * s0 - r;
+        double grid_total = rbs_positive(1.0 - s0 * s0 - r);
         double f_target, f_grid, f, g, a_target, a_grid;
         rbs_restitution_factors(t, cell->jv, cell->wv, cell->iv, &f_target, &f_grid);
         rbs_speed_factors((double)c[row + ROW_REGIME], f_target, f_grid, sin_alpha1, &f, &g);
         rbs_restitutions(f_target, f_grid, sin_alpha1, &a_target, &a_grid);
         r *= g * g;
-        double left = 1.0 - s2 - r;
-        normal *= (1.0 - a_target) * (1.0 + a_target) / ((1.0 - a_grid) * (1.0 + a_grid)) * rbs_positive(grid_total);
-        tangential *= rbs_positive(left);
+        double total = rbs_positive(1.0 - s2 - r);
+        double moved_n = normal * grid_total
+                         * ((1.0 - a_target) * (1.0 + a_target) / ((1.0 - a_grid) * (1.0 + a_grid)));
+        double moved_t = tangential * grid_total * ((1.0 + a_target) / (1.0 + a_grid));
+        if (moved_n * moved_n + moved_t * moved_t > 0.0) {
+            double work_n = rbs_closed_normal(moved_n, moved_t, total);
+            work[0] = energy * work_n;
+            work[1] = energy * (total - work_n);
+            return;
+        }
     }
     double total = rbs_positive(1.0 - s2 - r);
     double weights = normal + tangential;
@@ -153,7 +173,6 @@ RBS_INLINE void rbs_drawn_work(const rbs_table *t, const rbs_cell *cell, int64_t
         work[0] = work[1] = 0.0;
         return;
     }
-    double energy = 0.5 * speed * speed;
     work[0] = energy * (total * normal / weights);
     work[1] = energy * (total * tangential / weights);
 }

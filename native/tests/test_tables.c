@@ -794,8 +794,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s GOOD.h5 [PATH EXPECTED_STATUS]...\n", argv[0]);
         return 2;
     }
-    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.4.0") == 0
-          && RBS_VERSION_NUMBER == 1004000, "version %s, %d", rbs_version(), rbs_version_number());
+    CHECK(rbs_version_number() == RBS_VERSION_NUMBER && strcmp(rbs_version(), "1.4.1") == 0
+          && RBS_VERSION_NUMBER == 1004001, "version %s, %d", rbs_version(), rbs_version_number());
     rbs_table_close(NULL);
     CHECK(rbs_table_open(argv[1], NULL, NULL, 0) == RBS_INVALID, "NULL table pointer");
     for (int repeat = 0; repeat < 2; repeat++) draw_from(argv[1]);

@@ -9,11 +9,13 @@ s = |V⁺|/|V⁻| of the rebound returned, so energy is conserved draw by draw w
 points; at the drawn grid speed W_n = ν² W. The root, because near grazing incidence W_n is a thousandth of W and
 follows the normal velocity: its root is nearly linear in the state, as the chain needs. Between grid points r
 and ν move with the draw: in α1 to their interpolated means and standard deviations, like the state. In |V⁻|
-the spin of a regime-0 draw scales by g (:func:`surrogate.kernels.arithmetic.speed_factors`), so r by g², and W
-is split in the proportion of W_n at the grid speed times (1 − a(V)²)/(1 − a(V_j)²), one collision's normal work
-½ m_eff v_c²(1 − a²) at the wall law's normal restitution a (:func:`surrogate.kernels.arithmetic.restitutions`), to
-W_t at the grid speed times W(V)/W(V_j): near grazing W_n then moves as one collision's, near normal impact W_t
-as W does. A trapped draw does its cell's trapped particles' mean work.
+the spin of a regime-0 draw scales by g (:func:`surrogate.kernels.arithmetic.speed_factors`), so r by g²; W_n/E⁻
+and W_t/E⁻ at the grid speed move as one collision's at the wall law's normal restitution a
+(:func:`surrogate.kernels.arithmetic.restitutions`), W_n by (1 − a(V)²)/(1 − a(V_j)²) (its normal work
+½ m_eff v_c²(1 − a²)) and W_t by (1 + a(V))/(1 + a(V_j)) (friction's work follows the normal impulse), and then
+each changes by the least relative amount that closes W (:func:`closed_normal`): the larger part, W_t near
+grazing and W_n near normal impact, takes most of the difference. A trapped draw does its cell's trapped
+particles' mean work.
 
 Random numbers: the two residual uniforms are keyed uniforms (:func:`surrogate.kernels.rng.grain_uniform`) of a
 hash of the hit's own uniforms (:func:`work_key`), so the work takes nothing of the caller's stream: a rebound
@@ -135,23 +137,38 @@ def drawn_work(data, cell, row, gathered, status, s2, sin_alpha1, speed, key, sc
                               WORK_CELL_INV_SD)
         r = abs(fma(r - r_term[1], r_term[0], r_term[2]))
         nu = _root_share(fma(nu - nu_term[1], nu_term[0], nu_term[2]))
-    normal, tangential = nu * nu, (1.0 - nu) * (1.0 + nu)     # the weights of the split of W: ν², 1 − ν²
+    normal, tangential = nu * nu, (1.0 - nu) * (1.0 + nu)     # the shares of W at the drawn grid speed: ν², 1 − ν²
+    energy = 0.5 * speed * speed
     if scaled and wv > 0.0:
-        # between grid speeds W_n moves as one collision's normal work, ½ m_eff v_c²(1 − a²); W_t with W
+        # between grid speeds each part moves as one collision's, W_n ∝ 1 − a² and W_t ∝ λ ∝ 1 + a (units of E⁻),
+        # then both change by the least relative amount that closes the moved rebound's energy
         s0 = at_alpha1(gathered, scaled)[2]         # s at the drawn grid speed
-        grid_total = 1.0 - s0 * s0 - r
+        grid_total = _positive(1.0 - s0 * s0 - r)
         g = speed_factors(regime, f_target, f_grid, sin_alpha1)[2]
         a_target, a_grid = restitutions(f_target, f_grid, sin_alpha1)
         r *= g * g
-        left = 1.0 - s2 - r
-        normal *= (1.0 - a_target) * (1.0 + a_target) / ((1.0 - a_grid) * (1.0 + a_grid)) * _positive(grid_total)
-        tangential *= _positive(left)
+        total = _positive(1.0 - s2 - r)
+        moved_n = normal * grid_total * ((1.0 - a_target) * (1.0 + a_target) / ((1.0 - a_grid) * (1.0 + a_grid)))
+        moved_t = tangential * grid_total * ((1.0 + a_target) / (1.0 + a_grid))
+        if moved_n * moved_n + moved_t * moved_t > 0.0:
+            work_n = closed_normal(moved_n, moved_t, total)
+            return energy * work_n, energy * (total - work_n)
     total = _positive(1.0 - s2 - r)
     weights = normal + tangential
     if not weights > 0.0:
         return 0.0, 0.0
-    energy = 0.5 * speed * speed
     return energy * (total * normal / weights), energy * (total * tangential / weights)
+
+
+@numba.njit(inline="always", **JIT)
+def closed_normal(normal, tangential, total):
+    """W_n of the pair (W_n, W_t) = (``normal``, ``tangential``) (≥ 0, not both 0) changed to sum to ``total``
+    (≥ 0) by the least relative change of each: the difference split in proportion to their squares, so the
+    larger part takes most of it; W_n kept in [0, total]."""
+    squares = normal * normal + tangential * tangential
+    work_n = normal + (total - normal - tangential) * (normal * normal / squares)
+    work_n = work_n if work_n > 0.0 else 0.0
+    return work_n if work_n < total else total
 
 
 @numba.njit(inline="always", **JIT)

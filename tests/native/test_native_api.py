@@ -10,7 +10,7 @@
   call; an rbs_result whose size covers only up to its status gets only that written; records larger than the
   library's (a program built against a later header) work, their later bytes neither read nor written; a NULL
   rbs_options is RBS_OPTIONS_INIT.
-- The version (1.4.0, 1004000) and the one status space: each status a distinct value and a string.
+- The version (1.4.1, 1004001) and the one status space: each status a distinct value and a string.
 - The many-hit and local draws' refusals (rbs_draw_many, rbs_draw_local).
 """
 
@@ -175,7 +175,7 @@ def test_the_enumerations_and_constants_are_the_helper_s_and_the_packages(header
     defines = {key[1]: float(value) for key, value in header_facts.items() if key[0] == "define"}
     for constant, value in DEFINES.items():
         assert defines[constant] == value, constant
-    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 4, 0)
+    assert (defines["RBS_VERSION_MAJOR"], defines["RBS_VERSION_MINOR"], defines["RBS_VERSION_PATCH"]) == (1, 4, 1)
     assert defines["RBS_U_PER_DRAW"] == py.U_PER_DRAW
     assert defines["RBS_SPIN_TOLERANCE"] == py.SPIN_TOLERANCE
     assert defines["RBS_NORMAL_TOLERANCE"] == NORMAL_TOLERANCE
@@ -257,7 +257,7 @@ def test_the_header_compiles_without_warnings(tmp_path, language):
 def test_version(native):
     version = native.version()
     major, minor, patch = map(int, version.split("."))
-    assert (major, minor, patch) == (1, 4, 0)
+    assert (major, minor, patch) == (1, 4, 1)
     assert native.version_number() == VERSION_NUMBER == major * 1_000_000 + minor * 1_000 + patch
 
 

@@ -123,7 +123,7 @@ def test_installed_package_config(native_build, tmp_path):
     done = run(["cmake", "--build", str(build)])
     assert done.returncode == 0, done.stdout + done.stderr
     outputs = {run([str(build / name)]).stdout for name in ("consumer", "consumer_static")}
-    assert len(outputs) == 1 and outputs.pop().startswith("1.4.0 1004000 1004000 ")
+    assert len(outputs) == 1 and outputs.pop().startswith("1.4.1 1004001 1004001 ")
 
 
 @pytest.mark.parametrize("script", ["install-deps.sh"])

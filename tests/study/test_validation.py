@@ -29,7 +29,6 @@ from tests.helpers.tables import NEAR_NORMAL_POINT
 
 N_DRAWS = 20_000
 KS_TARGET = 0.03
-WORK_SPEED_KS = 0.04        # the work's marginals between grid speeds (test_between_grid_speeds_near_normal_impact)
 
 
 @pytest.mark.parametrize("shape, alpha1, speed", [
@@ -131,17 +130,16 @@ def test_grazing_alpha1_step_of_one_degree_is_too_wide(wide_grazing_table):
 # laws as they are (interpolation="stochastic") are detected by the classifier.
 @pytest.mark.parametrize("shape", ["ellipsoid", "prism", "cut_prism", "tetrahedron", "mix"])
 def test_between_grid_speeds_near_normal_impact(near_normal_table, shape):
-    """The rebound and its work on the wall, jointly (the work's rotational share moves with the spin). The work's
-    marginals are held to WORK_SPEED_KS: the noise (95 % point 0.014 for two samples of 2·10⁴, a little more with
-    the build's) plus the error of moving the work between grid speeds measured on direct samples near normal
-    impact, KS 0.018–0.025 on W_n/E⁻ (docs/design/table_representation.md, "The work on the wall")."""
+    """The rebound and its work on the wall, jointly (the work's rotational share moves with the spin), every
+    marginal within KS_TARGET. W_n and W_t move between grid speeds each as one collision's and are then closed on
+    the moved rebound's energy (docs/design/table_representation.md, "The work on the wall": W_n's KS 0.010–0.015
+    here, 0.016–0.032 when W_t moved with the total)."""
     T = table_hits(near_normal_table, shape, *NEAR_NORMAL_POINT, N_DRAWS, seed=9)
     D = direct_states(shape, *NEAR_NORMAL_POINT, N_DRAWS, seed=103, work=True)
     result = compare(T, D)
     ks = result["ks"]
-    worst = max(STATE_NAMES, key=ks.get)
+    worst = max(ks, key=ks.get)
     assert ks[worst] <= KS_TARGET, f"{worst}: KS = {ks[worst]:.4f}"
-    assert max(ks["work_normal"], ks["work_tangential"]) <= WORK_SPEED_KS, ks
     assert result["classifier_accuracy"] <= OFF_GRID_ACCURACY
 
 
