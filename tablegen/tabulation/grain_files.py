@@ -166,8 +166,8 @@ def simplification_report(vertices, triangles, simple_vertices, simple_triangles
     distance = max(farthest_from(simple_vertices, vertices), farthest_from(vertices, simple_vertices))
     change = ", ".join(f"{100.0 * (x / y - 1.0):+.2f}%" for x, y in zip(moments_s, moments))
     return (f"simplified from {len(vertices)} to {len(simple_vertices)} hull vertices: volume "
-            f"{100.0 * (volume_s / volume - 1.0):+.2f}%, principal moments {change}, a {100.0 * (a_s / a - 1.0):+.2f}%, "
-            f"largest distance from the original hull {distance / a:.3g} a")
+            f"{100.0 * (volume_s / volume - 1.0):+.2f}%, principal moments {change}, "
+            f"a {100.0 * (a_s / a - 1.0):+.2f}%, largest distance from the original hull {distance / a:.3g} a")
 
 
 def canonical_grain(name, vertices, triangles, source, aspect=None, both_hands=False):

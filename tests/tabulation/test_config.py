@@ -182,9 +182,11 @@ def test_a_tabulated_wall_law_reads_checks_and_round_trips():
     for edit, word in [
         (TABULATED_WALL + "k = 0.2\n", "'wall.k' is not a parameter of the tabulated wall law"),
         (TABULATED_WALL.replace("contact_sine = [0.0, 0.5, 1.0]\n", ""), "needs 'wall.contact_sine'"),
-        (TABULATED_WALL.replace("0.42", "1.2"), r"'restitution' must be in \(0, 1\] at every node; got 1.2 at \[2\]\[2\]"),
+        (TABULATED_WALL.replace("0.42", "1.2"),
+         r"'restitution' must be in \(0, 1\] at every node; got 1.2 at \[2\]\[2\]"),
         (TABULATED_WALL.replace("[0.0, 0.5, 1.0]", "[0.0, 0.5, 0.9]"), "'contact_sine' must be 2 to 16"),
-        (TABULATED_WALL.replace("[40.0, 120.0, 300.0]", "[40.0, true, 300.0]"), "'wall.contact_speed_m_s' must be a list"),
+        (TABULATED_WALL.replace("[40.0, 120.0, 300.0]", "[40.0, true, 300.0]"),
+         "'wall.contact_speed_m_s' must be a list"),
         (TABULATED_WALL.replace('"tabulated"', '"linear"'), "'wall.law' must be one of exponential, tabulated"),
     ]:
         with pytest.raises(ConfigError, match=word):
