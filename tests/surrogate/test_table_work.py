@@ -99,3 +99,22 @@ def test_the_command_lines_say_a_4_0_table_holds_no_work(small_table_path, tmp_p
     code, _, text = run_cli(surrogate_main, argv + [str(tmp_path / "o.h5"), "--table", str(older)], capsys)
     assert code == 0 and "work on the wall: not in this table (format 4.0; rebuild it for W_n, W_t)" in text
     assert table_data(older, shapes=("prism",), alpha1=(60.0,), n=50, seed=1).work == {}
+
+
+def test_the_closure_between_grid_speeds_is_the_least_relative_change():
+    """closed_normal (the split of W between grid speeds): W_n and W_t = total − W_n sum to the total, stay in
+    [0, total], keep estimates that already sum to it (to a rounding), and minimise (δ_n/n)² + (δ_t/t)² over the changes that close
+    the sum: checked against a fine search over W_n, within the search's step."""
+    from surrogate.kernels.work import closed_normal
+    rng = np.random.default_rng(64)
+    for _ in range(200):
+        n, t = rng.uniform(0.0, 1.0, 2) * rng.choice([1e-4, 1.0], 2)
+        total = (n + t) * rng.uniform(0.8, 1.2)
+        work_n = closed_normal(n, t, total)
+        assert 0.0 <= work_n <= total
+        grid = np.linspace(max(0.0, total - 10 * t - 1.0), min(total, n * 10 + 1.0), 200_001)
+        grid = grid[(grid >= 0.0) & (grid <= total)]
+        cost = ((grid - n) / n) ** 2 + ((total - grid - t) / t) ** 2
+        best = grid[np.argmin(cost)]
+        assert abs(work_n - best) <= 2 * (grid[1] - grid[0]) + 1e-12 * total, (n, t, total, work_n, best)
+        assert abs(closed_normal(n, t, n + t) - n) <= 4e-16 * (n + t)       # (n + t) − n − t: a rounding at most
