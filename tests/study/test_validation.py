@@ -131,9 +131,8 @@ def test_grazing_alpha1_step_of_one_degree_is_too_wide(wide_grazing_table):
 @pytest.mark.parametrize("shape", ["ellipsoid", "prism", "cut_prism", "tetrahedron", "mix"])
 def test_between_grid_speeds_near_normal_impact(near_normal_table, shape):
     """The rebound and its work on the wall, jointly (the work's rotational share moves with the spin), every
-    marginal within KS_TARGET. W_n and W_t move between grid speeds each as one collision's and are then closed on
-    the moved rebound's energy (docs/design/table_representation.md, "The work on the wall": W_n's KS 0.010–0.015
-    here, 0.016–0.032 when W_t moved with the total)."""
+    marginal within KS_TARGET: W_n and W_t move between grid speeds each as one collision's and are then closed on
+    the moved rebound's energy (docs/design/table_representation.md, "The work on the wall")."""
     T = table_hits(near_normal_table, shape, *NEAR_NORMAL_POINT, N_DRAWS, seed=9)
     D = direct_states(shape, *NEAR_NORMAL_POINT, N_DRAWS, seed=103, work=True)
     result = compare(T, D)

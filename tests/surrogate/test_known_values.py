@@ -154,8 +154,7 @@ DRAWS = {
 }
 
 
-# per path with a hit record: (W_n, W_t) in m²/s² for each row of U, the work on the wall of the draws above (the
-# table's between grid speeds since W_n and W_t move each as one collision's, closed on W: library 1.4.1)
+# per path with a hit record: (W_n, W_t) in m²/s² for each row of U, the work on the wall of the draws above
 WORK = {
     "table": [("0x1.7d9f15be9e24cp+10", "0x1.22a03d342daf0p+10"), ("0x1.ab52435351a77p+10", "0x1.a62c3be857039p+9")],
     "direct": [("0x1.e963a9f10cb8ep+10", "0x1.4df3b9fc7d525p+5"), ("0x1.12096f2d7071cp+11", "0x1.ff2f769f15ff5p+5")],
